@@ -1,0 +1,43 @@
+"""grazing: simulation and analysis of impacting (vibro-impact) systems.
+
+>>> import math, grazing
+>>> model = grazing.models.pendulum("B", eta=0.446, theta_hat=math.radians(40))
+>>> sol = grazing.simulate(model, [0.0, 0.0], transient=400, periods=10)
+>>> sol.samples.shape
+(10, 2)
+"""
+
+from importlib.metadata import PackageNotFoundError, version
+
+from grazing import models
+from grazing.core import HybridModel, Impacts, Parameter, Solution
+from grazing.engine.simulate import simulate
+from grazing.errors import (
+    ConvergenceError,
+    GrazingError,
+    InvalidParameterError,
+    InvalidStateError,
+    SimulationError,
+)
+from grazing.sweeps import detect_period
+
+try:
+    __version__ = version("grazing")
+except PackageNotFoundError:  # pragma: no cover - running from a source tree
+    __version__ = "0.0.0"
+
+__all__ = [
+    "ConvergenceError",
+    "GrazingError",
+    "HybridModel",
+    "Impacts",
+    "InvalidParameterError",
+    "InvalidStateError",
+    "Parameter",
+    "SimulationError",
+    "Solution",
+    "__version__",
+    "detect_period",
+    "models",
+    "simulate",
+]

@@ -1,0 +1,6 @@
+"""The hybrid model type and the solution type."""
+
+from grazing.core.model import HybridModel, Parameter
+from grazing.core.solution import Impacts, Solution
+
+__all__ = ["HybridModel", "Impacts", "Parameter", "Solution"]

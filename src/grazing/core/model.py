@@ -1,0 +1,402 @@
+"""The hybrid model type: vector field, guard, reset, Jacobians and parameters.
+
+A hybrid (impacting) system in the sense of the paper's eqs. (9)-(10) is
+
+    x' = f(x, t)        while h(x, t) > 0,
+    x <- g(x, t)        when h(x, t) reaches 0.
+
+Models are written symbolically with sympy; the Jacobians ``f_x``, ``h_x``,
+``g_x`` (what the saltation matrix, paper eq. 14, needs) are derived
+automatically, and the engine generates and caches compiled kernels for them.
+A :class:`HybridModel` also carries parameter values; :meth:`with_params`
+returns a copy with other values that shares the compiled kernels.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from functools import cached_property
+from types import MappingProxyType, ModuleType
+from typing import Any
+
+import numpy as np
+import sympy as sp
+
+from grazing.engine.compile import SymbolicSystem, generate_source, load_source
+from grazing.errors import InvalidParameterError, InvalidStateError
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """A named model parameter with a default value and an allowed interval.
+
+    Examples
+    --------
+    >>> r = Parameter("r", 0.8, lower=0.0, upper=1.0, description="restitution")
+    >>> r.check(0.5)
+    0.5
+    >>> r.check(1.5)
+    Traceback (most recent call last):
+    ...
+    grazing.errors.InvalidParameterError: r = 1.5 is outside [0, 1] (restitution)
+    """
+
+    name: str
+    default: float
+    lower: float = -math.inf
+    upper: float = math.inf
+    lower_open: bool = False
+    upper_open: bool = False
+    description: str = ""
+
+    def interval(self) -> str:
+        def fmt(v: float) -> str:
+            return f"{v:g}"
+
+        lo = "(" if self.lower_open or math.isinf(self.lower) else "["
+        hi = ")" if self.upper_open or math.isinf(self.upper) else "]"
+        return f"{lo}{fmt(self.lower)}, {fmt(self.upper)}{hi}"
+
+    def check(self, value: Any) -> float:
+        """Return ``value`` as a float, or raise :class:`InvalidParameterError`."""
+        try:
+            v = float(value)
+        except (TypeError, ValueError):
+            raise InvalidParameterError(f"{self.name} must be a number, got {value!r}") from None
+        if not math.isfinite(v):
+            raise InvalidParameterError(f"{self.name} must be finite, got {v}")
+        below = v < self.lower or (self.lower_open and v == self.lower)
+        above = v > self.upper or (self.upper_open and v == self.upper)
+        if below or above:
+            what = f" ({self.description})" if self.description else ""
+            raise InvalidParameterError(f"{self.name} = {v:g} is outside {self.interval()}{what}")
+        return v
+
+
+class _Definition:
+    """The parameter-independent part of a model, shared by all its copies."""
+
+    def __init__(
+        self,
+        name: str,
+        states: Sequence[sp.Symbol],
+        time: sp.Symbol,
+        parameters: Sequence[Parameter],
+        vector_field: Sequence[Any],
+        guard: Any,
+        reset: Sequence[Any],
+        period: Any,
+        contact_direction: Sequence[Any] | None,
+        periodic: bool,
+        state_labels: Sequence[str] | None,
+        description: str,
+        reference: str,
+    ):
+        self.name = name
+        self.parameters = tuple(parameters)
+        pnames = [p.name for p in self.parameters]
+        if len(set(pnames)) != len(pnames):
+            raise ValueError("parameter names must be unique")
+        psyms = tuple(sp.Symbol(p) for p in pnames)
+        states = tuple(states)
+        self.system = SymbolicSystem(
+            states=states,
+            time=time,
+            params=psyms,
+            vector_field=tuple(sp.sympify(e) for e in vector_field),
+            guard=sp.sympify(guard),
+            reset=tuple(sp.sympify(e) for e in reset),
+            contact_direction=None
+            if contact_direction is None
+            else tuple(sp.sympify(e) for e in contact_direction),
+        )
+        n = len(states)
+        if len(self.system.vector_field) != n or len(self.system.reset) != n:
+            raise ValueError("vector_field and reset need one expression per state")
+        if self.system.contact_direction is not None and len(self.system.contact_direction) != n:
+            raise ValueError("contact_direction needs one expression per state")
+        allowed = set(states) | {time} | set(psyms)
+        exprs = [*self.system.vector_field, self.system.guard, *self.system.reset]
+        for e in exprs:
+            extra = e.free_symbols - allowed
+            if extra:
+                raise ValueError(f"unknown symbols {sorted(map(str, extra))} in {e}")
+        self.period_expr = sp.sympify(period)
+        if self.period_expr.free_symbols - set(psyms):
+            raise ValueError("the period may depend on parameters only")
+        self.periodic = periodic
+        self.state_names = tuple(str(s) for s in states)
+        self.state_labels = tuple(state_labels) if state_labels else self.state_names
+        self.description = description
+        self.reference = reference
+        self._kernels: dict[tuple[str, ...], ModuleType] = {}
+
+    def kernels(self, sensitivities: tuple[str, ...] = ()) -> ModuleType:
+        if sensitivities not in self._kernels:
+            syms = [sp.Symbol(s) for s in sensitivities]
+            self._kernels[sensitivities] = load_source(generate_source(self.system, syms))
+        return self._kernels[sensitivities]
+
+    @cached_property
+    def numeric(self) -> dict[str, Callable[..., Any]]:
+        """numpy functions of ``(x, t, p)`` for f, h, g and their Jacobians."""
+        s = self.system
+        x = sp.Matrix(s.states)
+        f = sp.Matrix(s.vector_field)
+        g = sp.Matrix(s.reset)
+        h = sp.Matrix([s.guard])
+        args = (list(s.states), s.time, list(s.params))
+        mk = lambda e: sp.lambdify(args, e, modules="numpy")  # noqa: E731
+        return {
+            "f": mk(f),
+            "h": mk(s.guard),
+            "g": mk(g),
+            "f_x": mk(f.jacobian(x)),
+            "h_x": mk(h.jacobian(x)),
+            "g_x": mk(g.jacobian(x)),
+            "h_t": mk(sp.diff(s.guard, s.time)),
+            "g_t": mk(sp.diff(g, s.time)),
+            "normal_rate": mk(s.normal_rate),
+            "normal_accel": mk(s.normal_accel),
+            "period": sp.lambdify([list(s.params)], self.period_expr, modules="math"),
+        }
+
+
+class HybridModel:
+    """A hybrid dynamical system ``x' = f(x, t)``, ``h(x, t) > 0``, ``x <- g(x, t)``.
+
+    Parameters
+    ----------
+    name
+        Short name of the model.
+    states
+        sympy symbols of the state vector.
+    time
+        sympy symbol of time.
+    parameters
+        The model's :class:`Parameter` list; expressions refer to them by
+        ``sympy.Symbol(parameter.name)``.
+    vector_field
+        ``f(x, t)``, one expression per state.
+    guard
+        ``h(x, t)``: positive in the allowed region, zero on the stop.
+    reset
+        ``g(x, t)``: the state just after an impact.
+    period
+        Forcing period (expression in the parameters): stroboscopic samples are
+        taken once per period.
+    contact_direction
+        Direction in which the reset acts (for a mechanical impact, the
+        velocity direction). Needed to continue complete chattering as
+        sticking; without it a chattering accumulation stops the run.
+    periodic
+        True when f, h and g are periodic in time with the given period (lets
+        the engine keep the forcing phase exact over long runs).
+    state_labels
+        Display names of the states (defaults to the symbol names).
+    values
+        Parameter values (defaults from ``parameters``).
+
+    Examples
+    --------
+    A linear oscillator hitting a stop at ``x = sigma``:
+
+    >>> import sympy as sp
+    >>> from grazing import HybridModel, Parameter
+    >>> x, v, t = sp.symbols("x v t")
+    >>> zeta, w, sigma, r = sp.symbols("zeta omega sigma r")
+    >>> model = HybridModel(
+    ...     "oscillator", [x, v], t,
+    ...     [Parameter("zeta", 0.05, lower=0), Parameter("omega", 1.5, lower=0, lower_open=True),
+    ...      Parameter("sigma", 0.5), Parameter("r", 0.8, lower=0, upper=1)],
+    ...     vector_field=[v, -2 * zeta * v - x + sp.cos(w * t)],
+    ...     guard=sigma - x, reset=[x, -r * v], period=2 * sp.pi / w,
+    ...     contact_direction=[0, 1])
+    >>> model.with_params(r=0.5).params["r"]
+    0.5
+    """
+
+    def __init__(
+        self,
+        name: str,
+        states: Sequence[sp.Symbol],
+        time: sp.Symbol,
+        parameters: Sequence[Parameter],
+        vector_field: Sequence[Any],
+        guard: Any,
+        reset: Sequence[Any],
+        period: Any,
+        *,
+        contact_direction: Sequence[Any] | None = None,
+        periodic: bool = True,
+        state_labels: Sequence[str] | None = None,
+        description: str = "",
+        reference: str = "",
+        values: Mapping[str, float] | None = None,
+    ):
+        self._def = _Definition(
+            name,
+            states,
+            time,
+            parameters,
+            vector_field,
+            guard,
+            reset,
+            period,
+            contact_direction,
+            periodic,
+            state_labels,
+            description,
+            reference,
+        )
+        self._values = self._checked({p.name: p.default for p in self._def.parameters}, values or {})
+
+    # -- construction -------------------------------------------------------
+    @classmethod
+    def _from(cls, definition: _Definition, values: dict[str, float]) -> HybridModel:
+        obj = cls.__new__(cls)
+        obj._def = definition
+        obj._values = values
+        return obj
+
+    def _checked(self, base: dict[str, float], changes: Mapping[str, Any]) -> dict[str, float]:
+        by_name = {p.name: p for p in self._def.parameters}
+        out = dict(base)
+        for k, v in changes.items():
+            if k not in by_name:
+                raise InvalidParameterError(
+                    f"unknown parameter {k!r} for model {self._def.name!r} (known: {', '.join(by_name)})"
+                )
+            out[k] = by_name[k].check(v)
+        period = self._def.numeric["period"]([out[p.name] for p in self._def.parameters])
+        if not (math.isfinite(period) and period > 0):
+            raise InvalidParameterError(f"the forcing period must be positive, got {period}")
+        return out
+
+    def with_params(self, **changes: float) -> HybridModel:
+        """A copy of this model with some parameter values changed (validated)."""
+        return HybridModel._from(self._def, self._checked(self._values, changes))
+
+    # -- description ----------------------------------------------------------
+    @property
+    def name(self) -> str:
+        return self._def.name
+
+    @property
+    def parameters(self) -> tuple[Parameter, ...]:
+        return self._def.parameters
+
+    @property
+    def params(self) -> Mapping[str, float]:
+        """Current parameter values (read-only)."""
+        return MappingProxyType(self._values)
+
+    @property
+    def param_vector(self) -> np.ndarray:
+        return np.array([self._values[p.name] for p in self._def.parameters], dtype=float)
+
+    @property
+    def state_names(self) -> tuple[str, ...]:
+        return self._def.state_names
+
+    @property
+    def state_labels(self) -> tuple[str, ...]:
+        return self._def.state_labels
+
+    @property
+    def n_states(self) -> int:
+        return len(self._def.state_names)
+
+    @property
+    def period(self) -> float:
+        """Forcing period (the stroboscopic sampling interval)."""
+        return float(self._def.numeric["period"](list(self.param_vector)))
+
+    @property
+    def periodic(self) -> bool:
+        return self._def.periodic
+
+    @property
+    def has_sticking(self) -> bool:
+        return self._def.system.contact_direction is not None
+
+    @property
+    def symbolic(self) -> SymbolicSystem:
+        """The symbolic vector field, guard and reset."""
+        return self._def.system
+
+    @property
+    def description(self) -> str:
+        return self._def.description
+
+    @property
+    def reference(self) -> str:
+        return self._def.reference
+
+    def __repr__(self) -> str:
+        vals = ", ".join(f"{k}={v:g}" for k, v in self._values.items())
+        return f"<HybridModel {self.name}: {vals}>"
+
+    # -- numerics -------------------------------------------------------------
+    def kernels(self, sensitivities: Sequence[str] = ()) -> ModuleType:
+        """The compiled kernel module (generated and cached on first use)."""
+        names = {p.name for p in self._def.parameters}
+        for s in sensitivities:
+            if s not in names:
+                raise InvalidParameterError(f"unknown parameter {s!r}")
+        return self._def.kernels(tuple(sensitivities))
+
+    def _call(self, what: str, x: Any, t: float) -> Any:
+        fn = self._def.numeric[what]
+        return fn(list(np.asarray(x, dtype=float)), float(t), list(self.param_vector))
+
+    def vector_field(self, x: Any, t: float = 0.0) -> np.ndarray:
+        """``f(x, t)``."""
+        return np.asarray(self._call("f", x, t), dtype=float).reshape(-1)
+
+    def guard(self, x: Any, t: float = 0.0) -> float:
+        """``h(x, t)``: positive in the allowed region."""
+        return float(self._call("h", x, t))
+
+    def reset(self, x: Any, t: float = 0.0) -> np.ndarray:
+        """``g(x, t)``: the state just after an impact at ``x``."""
+        return np.asarray(self._call("g", x, t), dtype=float).reshape(-1)
+
+    def jacobians(self, x: Any, t: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(f_x, h_x, g_x)`` at ``(x, t)``."""
+        n = self.n_states
+        fx = np.asarray(self._call("f_x", x, t), dtype=float).reshape(n, n)
+        hx = np.asarray(self._call("h_x", x, t), dtype=float).reshape(n)
+        gx = np.asarray(self._call("g_x", x, t), dtype=float).reshape(n, n)
+        return fx, hx, gx
+
+    def saltation(self, x: Any, t: float = 0.0) -> np.ndarray:
+        """Saltation matrix (paper eq. 14) of an impact at ``x`` on the stop.
+
+        ``S = g_x + (f(g(x)) - g_x f(x) - g_t) h_x / (h_x f(x) + h_t)``; the
+        time terms vanish for autonomous guards and resets, giving eq. 14.
+        """
+        _, hx, gx = self.jacobians(x, t)
+        fm = self.vector_field(x, t)
+        fp = self.vector_field(self.reset(x, t), t)
+        gt = np.asarray(self._call("g_t", x, t), dtype=float).reshape(-1)
+        ht = float(self._call("h_t", x, t))
+        return gx + np.outer(fp - gx @ fm - gt, hx) / (hx @ fm + ht)
+
+    def check_state(self, x: Any, t: float = 0.0) -> np.ndarray:
+        """Return ``x`` as a float array, or raise if it is not an allowed state."""
+        arr = np.asarray(x, dtype=float).reshape(-1)
+        if arr.shape != (self.n_states,):
+            raise InvalidStateError(
+                f"state must have {self.n_states} components ({', '.join(self.state_names)}), got {arr.size}"
+            )
+        if not np.all(np.isfinite(arr)):
+            raise InvalidStateError(f"state must be finite, got {arr.tolist()}")
+        hv = self.guard(arr, t)
+        if hv < 0:
+            raise InvalidStateError(
+                f"initial state {arr.tolist()} is beyond the stop (guard h = {hv:.3g} < 0)"
+            )
+        return arr

@@ -1,0 +1,98 @@
+"""Results of a simulation."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from grazing.sweeps.period import DEFAULT_MAX_PERIOD, DEFAULT_PERIOD_TOL, detect_period
+
+if TYPE_CHECKING:  # pragma: no cover
+    from grazing.core.model import HybridModel
+
+
+@dataclass(frozen=True)
+class Impacts:
+    """Impact-map samples: one row per impact.
+
+    Attributes
+    ----------
+    t
+        Impact times.
+    phase
+        Forcing phase ``2 pi (t mod T) / T`` in [0, 2 pi).
+    speed
+        Approach speed ``-dh/dt`` just before the impact (for the pendulum,
+        the angular velocity ``theta'`` hitting the stop).
+    state
+        State just before the impact, shape ``(n_impacts, n_states)``.
+    """
+
+    t: np.ndarray
+    phase: np.ndarray
+    speed: np.ndarray
+    state: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.t.size)
+
+
+@dataclass(frozen=True)
+class Solution:
+    """The outcome of :func:`grazing.simulate`.
+
+    Attributes
+    ----------
+    model
+        The model (with its parameter values) that was simulated.
+    t, samples
+        Stroboscopic sample times and states, one per sampled forcing period
+        (transient periods discarded).
+    impacts
+        Impacts during the sampled span (see :class:`Impacts`).
+    n_impacts
+        Number of impacts over the whole run, transient included.
+    sticking
+        Sticking intervals ``[t_start, t_end]`` during the sampled span.
+    trajectory_t, trajectory
+        Dense trajectory over the sampled span (with both states at every
+        impact), if requested.
+    t_final, x_final
+        Time and state at the end of the run (the last sample).
+    jacobian
+        Derivative of ``x_final`` with respect to ``x0`` (and to the requested
+        parameters, as extra columns), if requested.
+    jacobian_valid
+        False when the run stuck to the stop (the Jacobian across sticking is
+        not computed).
+    lyapunov
+        Lyapunov exponents per unit time over the sampled span, if requested.
+    guard_min
+        ``(h_min, t, x)``: the smallest value of the guard over the sampled
+        span, if requested (``theta_hat - max theta`` for the pendulum).
+    n_steps
+        Number of Taylor steps taken.
+    """
+
+    model: HybridModel
+    t: np.ndarray
+    samples: np.ndarray
+    impacts: Impacts
+    n_impacts: int
+    sticking: np.ndarray
+    t_final: float
+    x_final: np.ndarray
+    n_steps: int
+    trajectory_t: np.ndarray | None = None
+    trajectory: np.ndarray | None = None
+    jacobian: np.ndarray | None = None
+    jacobian_valid: bool = True
+    lyapunov: np.ndarray | None = None
+    guard_min: tuple[float, float, np.ndarray] | None = None
+    info: dict[str, Any] = field(default_factory=dict)
+
+    def period(self, tol: float = DEFAULT_PERIOD_TOL, max_period: int = DEFAULT_MAX_PERIOD) -> int:
+        """Smallest period of the sampled sequence (0 if none); see :func:`detect_period`."""
+        return detect_period(self.samples, tol=tol, max_period=max_period)

@@ -1,0 +1,512 @@
+"""Hybrid integration driver, appended to every generated model module.
+
+This file is not imported on its own: :mod:`grazing.engine.compile` appends its
+text to the module generated for a model, where the model functions it calls
+(``tc_free``, ``tc_var``, ``tc_stick``, ``rhs``, ``guard``, ``reset`` ...) and
+the constants ``NX``, ``NSENS``, ``HAS_STICK``, ``NW_FREE``, ``NW_VAR``,
+``NW_STICK`` are defined.  Keeping the driver in the same module as the model
+functions lets numba resolve them as globals and cache the compiled result on
+disk.
+
+Time is kept as ``k * T + s`` with ``s`` in [0, T) for models whose vector
+field is T-periodic in time (``wrap``), so that the forcing phase does not lose
+precision over long runs.
+
+Status codes: 0 ok, 1 step limit, 2 non-finite state, 3 impacts accumulate but
+the model has no sticking rule (or a zero-time event loop).
+"""
+
+STATUS_OK = 0
+STATUS_STEP_LIMIT = 1
+STATUS_NONFINITE = 2
+STATUS_ZENO = 3
+
+
+@njit(cache=True)
+def _step_size(X, n, O, order, max_step):
+    """Jorba-Zou step size from the last two Taylor coefficients.
+
+    The norms run over the first ``n`` rows of ``X`` (the state, and the
+    variational equations when they are integrated) and the event function
+    (``O[0]``), so that the event polynomial and the Jacobian are as accurate
+    as the state even where the state itself is constant (sticking, an
+    equilibrium).
+    """
+    nx = abs(O[0, 0])
+    n1 = abs(O[0, order - 1])
+    n2 = abs(O[0, order])
+    for i in range(n):
+        nx = max(nx, abs(X[i, 0]))
+        n1 = max(n1, abs(X[i, order - 1]))
+        n2 = max(n2, abs(X[i, order]))
+    sc = max(1.0, nx)
+    rho = math.inf
+    if n1 > 0.0:
+        rho = min(rho, (sc / n1) ** (1.0 / (order - 1)))
+    if n2 > 0.0:
+        rho = min(rho, (sc / n2) ** (1.0 / order))
+    h = rho * math.exp(-2.0 - 0.7 / (order - 1))
+    return min(h, max_step)
+
+
+@njit(cache=True)
+def _eval_rows(X, nrows, order, dt, out):
+    for i in range(nrows):
+        acc = X[i, order]
+        for j in range(order - 1, -1, -1):
+            acc = acc * dt + X[i, j]
+        out[i] = acc
+
+
+@njit(cache=True)
+def _poly_derivative(c, order, u):
+    acc = 0.0
+    for j in range(order, 0, -1):
+        acc = acc * u + j * c[j]
+    return acc
+
+
+@njit(cache=True)
+def _grow(buf, count):
+    if count < buf.shape[0]:
+        return buf
+    new = np.empty((2 * buf.shape[0] + 8, buf.shape[1]))
+    new[: buf.shape[0]] = buf
+    return new
+
+
+@njit(cache=True)
+def _saltation(xm, xp, s, pv, V, ncol):
+    """Apply the saltation matrix (paper eq. 14, with time and parameter terms) to V."""
+    n = NX
+    fm = np.empty(n)
+    fp = np.empty(n)
+    rhs(xm, s, pv, fm)
+    rhs(xp, s, pv, fp)
+    Gx = np.zeros((n, n))
+    Gt = np.zeros(n)
+    Gp = np.zeros((n, max(NSENS, 1)))
+    reset_jac(xm, s, pv, Gx, Gt, Gp)
+    hx = np.zeros(n)
+    hp = np.zeros(max(NSENS, 1))
+    ht = guard_grad(xm, s, pv, hx)
+    guard_pgrad(xm, s, pv, hp)
+    den = ht
+    for i in range(n):
+        den += hx[i] * fm[i]
+    w = np.empty(n)
+    for i in range(n):
+        acc = fp[i] - Gt[i]
+        for j in range(n):
+            acc -= Gx[i, j] * fm[j]
+        w[i] = acc / den
+    # row vector hx V (+ hp on the parameter columns)
+    hv = np.zeros(ncol)
+    for c in range(ncol):
+        acc = 0.0
+        for j in range(n):
+            acc += hx[j] * V[j, c]
+        if c >= n:
+            acc += hp[c - n]
+        hv[c] = acc
+    Vn = np.empty((n, ncol))
+    for i in range(n):
+        for c in range(ncol):
+            acc = 0.0
+            for j in range(n):
+                acc += Gx[i, j] * V[j, c]
+            if c >= n:
+                acc += Gp[i, c - n]
+            Vn[i, c] = acc + w[i] * hv[c]
+    V[:, :] = Vn
+
+
+@njit(cache=True)
+def _orthonormalize(V, n, logs):
+    """Modified Gram-Schmidt on the first n columns of V; adds log norms to logs."""
+    for c in range(n):
+        for q in range(c):
+            d = 0.0
+            for i in range(n):
+                d += V[i, c] * V[i, q]
+            for i in range(n):
+                V[i, c] -= d * V[i, q]
+        nrm = 0.0
+        for i in range(n):
+            nrm += V[i, c] * V[i, c]
+        nrm = math.sqrt(nrm)
+        logs[c] += math.log(nrm) if nrm > 0.0 else -math.inf
+        if nrm > 0.0:
+            for i in range(n):
+                V[i, c] /= nrm
+
+
+@njit(cache=True)
+def _enter_contact(x, s, pv):
+    """Project x onto the contact manifold {h = 0, L_f h = 0}."""
+    n = NX
+    gx = np.zeros(n)
+    for _ in range(3):
+        hval = guard(x, s, pv)
+        guard_grad(x, s, pv, gx)
+        nn = 0.0
+        for i in range(n):
+            nn += gx[i] * gx[i]
+        if nn == 0.0 or hval == 0.0:
+            break
+        for i in range(n):
+            x[i] -= hval * gx[i] / nn
+    e = np.zeros(n)
+    contact_dir(x, s, pv, e)
+    gr = np.zeros(n)
+    for _ in range(3):
+        vn = normal_rate(x, s, pv)
+        normal_rate_grad(x, s, pv, gr)
+        d = 0.0
+        for i in range(n):
+            d += gr[i] * e[i]
+        if d == 0.0 or vn == 0.0:
+            break
+        for i in range(n):
+            x[i] -= vn / d * e[i]
+
+
+@njit(cache=True)
+def integrate(
+    x_init,
+    V_init,
+    k0,
+    s0,
+    mode0,
+    pv,
+    T,
+    wrap,
+    order,
+    max_step,
+    max_steps,
+    n_samples,
+    ks,
+    ss,
+    n_keep,
+    use_var,
+    lyap,
+    traj_dt,
+    track_min,
+    record_impacts,
+    chatter_time,
+):
+    """Integrate until the ``n_samples``-th stroboscopic sample.
+
+    Samples are taken at local times ``(ks, ss)``, ``(ks + 1, ss)``, ... (or
+    ``ss``, ``ss + T``, ... without wrapping); the last ``n_keep`` are stored
+    and define the recorded span (impacts, trajectory, minimum of the guard,
+    Lyapunov sums).  ``mode0`` is 0 in free flight, 1 when sticking to the
+    stop; the final mode is returned so that a run can be continued.
+    """
+    n = NX
+    ncol = n + NSENS
+    nv = n * ncol if use_var else 0
+    ntot = n + nv
+    x = np.empty(ntot)
+    x[:n] = x_init
+    if use_var:
+        for i in range(n):
+            for c in range(ncol):
+                x[n + i * ncol + c] = V_init[i, c]
+    X = np.zeros((ntot, order + 1))
+    O = np.zeros((1, order + 1))
+    W = np.zeros((NW_VAR if use_var else NW_FREE, order + 1))
+    WS = np.zeros((NW_STICK, order + 1))
+    XS = np.zeros((n, order + 1))
+    work = np.zeros((ROOT_WORK_ROWS, max(order + 1, ROOT_WORK_MIN_COLS)))
+    a = np.zeros(order + 1)
+    gm = np.zeros(order + 1)
+    xe = np.empty(ntot)
+    xp = np.empty(ntot)
+    V = np.empty((n, ncol))
+
+    samples = np.empty((n_keep, n))
+    imp = np.empty((16, 2 + n))
+    sticks = np.empty((4, 2))
+    traj = np.empty((64 if traj_dt > 0.0 else 1, 1 + n))
+    logs = np.zeros(n)
+    scratch = np.zeros(n)
+    min_info = np.full(2 + n, math.inf)
+
+    k = k0
+    s = s0
+    mode = mode0
+    defl = 0
+    isamp = 0
+    keep_from = n_samples - n_keep
+    recording = keep_from == 0
+    lyap_t0 = k * T + s
+    lyap_started = recording
+    n_imp = 0
+    n_imp_rec = 0
+    n_stick = 0
+    n_traj = 0
+    kt = k
+    st = s
+    status = STATUS_OK
+    nsteps = 0
+    zero_events = 0
+    jac_valid = True
+    if recording and traj_dt > 0.0:
+        traj[0, 0] = k * T + s
+        traj[0, 1:] = x[:n]
+        n_traj = 1
+        st += traj_dt
+        while wrap and st >= T:
+            st -= T
+            kt += 1
+
+    while True:
+        if nsteps >= max_steps:
+            status = STATUS_STEP_LIMIT
+            break
+        for i in range(n):
+            if not math.isfinite(x[i]):
+                status = STATUS_NONFINITE
+                break
+        if status != STATUS_OK:
+            break
+        if mode == 0:
+            if use_var:
+                tc_var(x, s, pv, order, X, O, W)
+            else:
+                tc_free(x, s, pv, order, X, O, W)
+            h = _step_size(X, ntot, O, order, max_step)
+        else:
+            tc_stick(x, s, pv, order, XS, O, WS)
+            h = _step_size(XS, n, O, order, max_step)
+        rem = (ks - k) * T + (ss - s)
+        is_last = False
+        if isamp == n_samples - 1 and h >= rem:
+            h = rem
+            is_last = True
+
+        # Event polynomial in the normalised step time u in [0, 1].
+        sign = 1.0 if mode == 0 else -1.0
+        hk = 1.0
+        for j in range(order + 1):
+            a[j] = sign * O[0, j] * hk
+            hk *= h
+        d = defl
+        if mode == 0 and d == 0 and a[0] <= 0.0 and order >= 1 and a[1] > 0.0:
+            d = 1  # on the surface (to rounding) and leaving it: not an impact
+        for j in range(d):
+            a[j] = 0.0
+        while 0 < d < 3 and a[d] == 0.0:
+            d += 1
+        u = first_root(a[d:], order - d, work)
+        event = u >= 0.0 and h > 0.0
+        if event and u == 0.0:
+            zero_events += 1
+            if zero_events > 3:
+                status = STATUS_ZENO
+                break
+        else:
+            zero_events = 0
+        h_acc = u * h if event else h
+        if event and is_last and u >= 1.0:
+            event = False
+        Xr = X if mode == 0 else XS
+        nrows = ntot if mode == 0 else n
+
+        # Samples and trajectory points within (0, h_acc].
+        while isamp < n_samples:
+            dt = (ks - k) * T + (ss - s)
+            if dt > h_acc or (event and dt == h_acc and not is_last):
+                break
+            if is_last and isamp == n_samples - 1:
+                dt = h_acc
+            if isamp >= keep_from:
+                _eval_rows(Xr, n, order, dt, xe)
+                samples[isamp - keep_from, :] = xe[:n]
+            isamp += 1
+            if wrap:
+                ks += 1
+            else:
+                ss += T
+            if isamp == keep_from and not recording and n_keep > 0:
+                recording = True
+                if traj_dt > 0.0:
+                    _eval_rows(Xr, n, order, dt, xe)
+                    traj = _grow(traj, n_traj)
+                    traj[n_traj, 0] = k * T + s + dt
+                    traj[n_traj, 1:] = xe[:n]
+                    n_traj += 1
+                    kt = k
+                    st = s + dt + traj_dt
+                    while wrap and st >= T:
+                        st -= T
+                        kt += 1
+        if recording and traj_dt > 0.0:
+            while True:
+                dt = (kt - k) * T + (st - s)
+                if dt > h_acc:
+                    break
+                _eval_rows(Xr, n, order, dt, xe)
+                traj = _grow(traj, n_traj)
+                traj[n_traj, 0] = k * T + s + dt
+                traj[n_traj, 1:] = xe[:n]
+                n_traj += 1
+                st += traj_dt
+                while wrap and st >= T:
+                    st -= T
+                    kt += 1
+        if recording and track_min and mode == 0 and h_acc > 0.0:
+            # Minimum of the guard on [0, h_acc): the start point and an
+            # interior critical point where its derivative turns positive.
+            hk = 1.0
+            for j in range(order + 1):
+                gm[j] = O[0, j] * hk
+                hk *= h
+            if gm[0] < min_info[0]:
+                min_info[0] = gm[0]
+                min_info[1] = k * T + s
+                min_info[2:] = x[:n]
+            uend = h_acc / h
+            if gm[1] < 0.0 and _poly_derivative(gm, order, uend) > 0.0:
+                lo = 0.0
+                hi = uend
+                for _ in range(80):
+                    mid = 0.5 * (lo + hi)
+                    if _poly_derivative(gm, order, mid) < 0.0:
+                        lo = mid
+                    else:
+                        hi = mid
+                um = 0.5 * (lo + hi)
+                gv = horner(gm, order, um)
+                if gv < min_info[0]:
+                    _eval_rows(X, n, order, um * h, xe)
+                    min_info[0] = gv
+                    min_info[1] = k * T + s + um * h
+                    min_info[2:] = xe[:n]
+
+        # Advance to the end of the accepted part of the step.
+        _eval_rows(Xr, nrows, order, h_acc, xe)
+        for i in range(nrows):
+            x[i] = xe[i]
+        s += h_acc
+        if wrap and s >= T:
+            s -= T
+            k += 1
+        nsteps += 1
+        defl = 0
+        if lyap and use_var and mode == 0:
+            for i in range(n):
+                for c in range(ncol):
+                    V[i, c] = x[n + i * ncol + c]
+            if recording and not lyap_started:
+                lyap_started = True
+                lyap_t0 = k * T + s
+                _orthonormalize(V, n, scratch)
+            elif lyap_started:
+                _orthonormalize(V, n, logs)
+            else:
+                _orthonormalize(V, n, scratch)  # transient: align V, discard growth
+            for i in range(n):
+                for c in range(ncol):
+                    x[n + i * ncol + c] = V[i, c]
+
+        if event:
+            if mode == 0:
+                # Impact: x holds the state on the stop, just before the reset.
+                vn = normal_rate(x, s, pv)
+                reset(x, s, pv, xp)
+                if use_var:
+                    for i in range(n):
+                        for c in range(ncol):
+                            V[i, c] = x[n + i * ncol + c]
+                    _saltation(x, xp, s, pv, V, ncol)
+                    for i in range(n):
+                        for c in range(ncol):
+                            xp[n + i * ncol + c] = V[i, c]
+                if record_impacts == 2 or (record_impacts == 1 and recording):
+                    imp = _grow(imp, n_imp_rec)
+                    imp[n_imp_rec, 0] = k * T + s
+                    imp[n_imp_rec, 1] = -vn
+                    imp[n_imp_rec, 2:] = x[:n]
+                    n_imp_rec += 1
+                if recording and traj_dt > 0.0:
+                    traj = _grow(traj, n_traj + 1)
+                    traj[n_traj, 0] = k * T + s
+                    traj[n_traj, 1:] = x[:n]
+                    traj[n_traj + 1, 0] = k * T + s
+                    traj[n_traj + 1, 1:] = xp[:n]
+                    n_traj += 2
+                n_imp += 1
+                for i in range(nrows):
+                    x[i] = xp[i]
+                defl = 1
+                if HAS_STICK:
+                    w = normal_rate(x, s, pv)
+                    acc = normal_accel(x, s, pv)
+                    speed = -vn
+                    if acc < 0.0:
+                        stick = False
+                        dt_acc = 0.0
+                        if speed <= 0.0 or w <= 0.0:
+                            stick = True
+                        else:
+                            ratio = w / speed
+                            if ratio < 1.0:
+                                dt_acc = 2.0 * w / (-acc * (1.0 - ratio))
+                                stick = dt_acc < chatter_time
+                        if stick:
+                            s += dt_acc
+                            if wrap and s >= T:
+                                s -= T
+                                k += 1
+                            _enter_contact(x, s, pv)
+                            mode = 1
+                            defl = 0
+                            jac_valid = False
+                            if recording:
+                                sticks = _grow(sticks, n_stick)
+                                sticks[n_stick, 0] = k * T + s
+                                sticks[n_stick, 1] = math.nan
+                                n_stick += 1
+            else:
+                # Release from sticking: the contact force changes sign.
+                mode = 0
+                defl = 3
+                if recording and n_stick > 0 and math.isnan(sticks[n_stick - 1, 1]):
+                    sticks[n_stick - 1, 1] = k * T + s
+        if isamp >= n_samples:
+            break
+
+    if track_min and mode == 0 and recording:
+        g_end = guard(x, s, pv)
+        if g_end < min_info[0]:
+            min_info[0] = g_end
+            min_info[1] = k * T + s
+            min_info[2:] = x[:n]
+    if n_stick > 0 and math.isnan(sticks[n_stick - 1, 1]):
+        sticks[n_stick - 1, 1] = k * T + s
+    lyap_span = k * T + s - lyap_t0 if (lyap and lyap_started) else 0.0
+    Vout = np.zeros((n, ncol))
+    if use_var:
+        for i in range(n):
+            for c in range(ncol):
+                Vout[i, c] = x[n + i * ncol + c]
+    return (
+        status,
+        x[:n].copy(),
+        Vout,
+        k,
+        s,
+        mode,
+        nsteps,
+        n_imp,
+        samples[: max(0, min(n_keep, isamp - keep_from))].copy(),
+        imp[:n_imp_rec].copy(),
+        sticks[:n_stick].copy(),
+        traj[:n_traj].copy(),
+        logs,
+        lyap_span,
+        min_info,
+        jac_valid,
+    )

@@ -1,0 +1,266 @@
+"""Assemble, cache and load the compiled kernels of a hybrid model.
+
+For each model (and each set of parameters to differentiate with respect to)
+one Python module is generated: Taylor-coefficient kernels for free flight,
+free flight with variational equations, and sticking; scalar functions for the
+vector field, guard, reset and their Jacobians; and the integration driver
+(``_driver_template.py``).  The module is written to a cache directory named
+by a hash of its source and imported; numba then caches the machine code next
+to it, so a model is compiled once per machine, not once per process.
+
+The cache directory is ``$GRAZING_CACHE_DIR`` if set, else
+``$XDG_CACHE_HOME/grazing`` (``~/.cache/grazing``).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import os
+import sys
+import tempfile
+from collections.abc import Sequence
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+from types import ModuleType
+
+import numba
+import sympy as sp
+
+from grazing.engine.polyroots import work_shape
+from grazing.engine.taylor import ScalarPrinter, taylor_kernel
+
+_TEMPLATE = Path(__file__).with_name("_driver_template.py")
+# Bump when the generated code changes meaning without its text changing.
+_CODEGEN_VERSION = "1"
+
+
+@dataclass(frozen=True)
+class SymbolicSystem:
+    """The symbolic pieces of a hybrid model that the code generator needs.
+
+    Attributes
+    ----------
+    states, time, params
+        Symbols of the state vector, time and parameters (in the order of the
+        parameter vector).
+    vector_field
+        ``f(x, t)``, one expression per state.
+    guard
+        ``h(x, t)``; the allowed region is ``h > 0``, impacts happen when ``h``
+        reaches 0.
+    reset
+        ``g(x, t)``, the state just after an impact.
+    contact_direction
+        Direction ``e(x, t)`` along which the reset changes the state (the
+        velocity direction of a mechanical impact), used to constrain the flow
+        to the stop during sticking; ``None`` disables sticking.
+    """
+
+    states: tuple[sp.Symbol, ...]
+    time: sp.Symbol
+    params: tuple[sp.Symbol, ...]
+    vector_field: tuple[sp.Expr, ...]
+    guard: sp.Expr
+    reset: tuple[sp.Expr, ...]
+    contact_direction: tuple[sp.Expr, ...] | None = None
+
+    def gradient(self, expr: sp.Expr) -> list[sp.Expr]:
+        return [sp.diff(expr, x) for x in self.states]
+
+    def lie(self, expr: sp.Expr) -> sp.Expr:
+        """Derivative of ``expr`` along the flow: grad(expr) . f + d(expr)/dt."""
+        return sp.Add(*[g * f for g, f in zip(self.gradient(expr), self.vector_field)]) + sp.diff(
+            expr, self.time
+        )
+
+    @property
+    def normal_rate(self) -> sp.Expr:
+        """``L_f h``: rate of change of the guard (negative when approaching)."""
+        return self.lie(self.guard)
+
+    @property
+    def normal_accel(self) -> sp.Expr:
+        """``L_f^2 h``: the guard's acceleration (negative when pushed into the stop)."""
+        return self.lie(self.normal_rate)
+
+    def sticking_field(self) -> tuple[sp.Expr, ...]:
+        """Vector field constrained to ``h = 0, L_f h = 0`` along the contact direction."""
+        if self.contact_direction is None:
+            raise ValueError("model has no contact direction")
+        e = self.contact_direction
+        gr = self.gradient(self.normal_rate)
+        den = sp.Add(*[g * ei for g, ei in zip(gr, e)])
+        lam = self.normal_accel / den
+        return tuple(f - lam * ei for f, ei in zip(self.vector_field, e))
+
+
+def _scalar_function(
+    name: str,
+    sys_: SymbolicSystem,
+    assigns: Sequence[tuple[str, sp.Expr]],
+    returns: sp.Expr | None = None,
+    extra_args: str = "",
+) -> str:
+    """Numba source of ``name(x, s, pv{extra_args})`` with CSE'd assignments."""
+    names: dict[sp.Symbol, str] = {x: f"x[{i}]" for i, x in enumerate(sys_.states)}
+    names[sys_.time] = "s"
+    names.update({p: f"pv[{i}]" for i, p in enumerate(sys_.params)})
+    exprs = [e for _, e in assigns] + ([returns] if returns is not None else [])
+    repl, reduced = sp.cse([sp.sympify(e) for e in exprs], symbols=sp.numbered_symbols("t_"))
+    for sym, _ in repl:
+        names[sym] = str(sym)
+    pr = ScalarPrinter(names)
+    lines = ["@njit(cache=True)", f"def {name}(x, s, pv{extra_args}):"]
+    for sym, e in repl:
+        lines.append(f"    {sym} = {pr.doprint(e)}")
+    for (target, _), e in zip(assigns, reduced):
+        lines.append(f"    {target} = {pr.doprint(e)}")
+    if returns is not None:
+        lines.append(f"    return {pr.doprint(reduced[-1])}")
+    elif not assigns:
+        lines.append("    return 0.0")
+    return "\n".join(lines) + "\n"
+
+
+def generate_source(sys_: SymbolicSystem, sensitivities: Sequence[sp.Symbol] = ()) -> str:
+    """Full source of the kernel module for ``sys_``."""
+    n = len(sys_.states)
+    m = len(sensitivities)
+    ncol = n + m
+    f = sys_.vector_field
+    parts = [
+        "# Generated by grazing.engine.compile; do not edit.",
+        "import math",
+        "import numpy as np",
+        "from numba import njit",
+        "from grazing.engine.polyroots import first_root, horner",
+        f"NX = {n}",
+        f"NSENS = {m}",
+        f"ROOT_WORK_ROWS, ROOT_WORK_MIN_COLS = {work_shape(0)}",
+    ]
+    free = taylor_kernel("tc_free", sys_.states, sys_.time, sys_.params, f, [sys_.guard])
+    # Variational equations: V' = f_x V (+ f_p on the parameter columns).
+    vsyms = sp.symbols(f"v0:{n * ncol}")
+    vmat = sp.Matrix(n, ncol, vsyms)
+    jac = sp.Matrix([[sp.diff(fi, x) for x in sys_.states] for fi in f])
+    vrhs = jac * vmat
+    for c, p in enumerate(sensitivities):
+        for i in range(n):
+            vrhs[i, n + c] += sp.diff(f[i], p)
+    var = taylor_kernel(
+        "tc_var",
+        tuple(sys_.states) + tuple(vsyms),
+        sys_.time,
+        sys_.params,
+        tuple(f) + tuple(vrhs),
+        [sys_.guard],
+    )
+    has_stick = sys_.contact_direction is not None
+    if has_stick:
+        stick = taylor_kernel(
+            "tc_stick",
+            sys_.states,
+            sys_.time,
+            sys_.params,
+            sys_.sticking_field(),
+            [sys_.normal_accel],
+        )
+    else:
+        stick = taylor_kernel("tc_stick", sys_.states, sys_.time, sys_.params, f, [sp.Integer(1)])
+    parts += [
+        f"HAS_STICK = {has_stick}",
+        f"NW_FREE = {free.n_work}",
+        f"NW_VAR = {var.n_work}",
+        f"NW_STICK = {stick.n_work}",
+    ]
+    for k in (free, var, stick):
+        parts.append("@njit(cache=True)\n" + k.source)
+
+    gx = sys_.gradient(sys_.guard)
+    parts.append(
+        _scalar_function("rhs", sys_, [(f"out[{i}]", e) for i, e in enumerate(f)], extra_args=", out")
+    )
+    parts.append(_scalar_function("guard", sys_, [], returns=sys_.guard))
+    parts.append(
+        _scalar_function(
+            "guard_grad",
+            sys_,
+            [(f"gx[{i}]", e) for i, e in enumerate(gx)],
+            returns=sp.diff(sys_.guard, sys_.time),
+            extra_args=", gx",
+        )
+    )
+    parts.append(
+        _scalar_function(
+            "guard_pgrad",
+            sys_,
+            [(f"hp[{c}]", sp.diff(sys_.guard, p)) for c, p in enumerate(sensitivities)],
+            extra_args=", hp",
+        )
+    )
+    g = sys_.reset
+    gjac = [(f"Gx[{i}, {j}]", sp.diff(gi, x)) for i, gi in enumerate(g) for j, x in enumerate(sys_.states)]
+    gjac += [(f"Gt[{i}]", sp.diff(gi, sys_.time)) for i, gi in enumerate(g)]
+    gjac += [(f"Gp[{i}, {c}]", sp.diff(gi, p)) for i, gi in enumerate(g) for c, p in enumerate(sensitivities)]
+    parts.append(
+        _scalar_function("reset", sys_, [(f"out[{i}]", e) for i, e in enumerate(g)], extra_args=", out")
+    )
+    parts.append(_scalar_function("reset_jac", sys_, gjac, extra_args=", Gx, Gt, Gp"))
+    parts.append(_scalar_function("normal_rate", sys_, [], returns=sys_.normal_rate))
+    parts.append(_scalar_function("normal_accel", sys_, [], returns=sys_.normal_accel))
+    parts.append(
+        _scalar_function(
+            "normal_rate_grad",
+            sys_,
+            [(f"gr[{i}]", e) for i, e in enumerate(sys_.gradient(sys_.normal_rate))],
+            extra_args=", gr",
+        )
+    )
+    e = sys_.contact_direction if has_stick else tuple(sp.Integer(0) for _ in range(n))
+    parts.append(
+        _scalar_function("contact_dir", sys_, [(f"e[{i}]", ei) for i, ei in enumerate(e)], extra_args=", e")
+    )
+    parts.append(_TEMPLATE.read_text())
+    return "\n\n".join(parts)
+
+
+def cache_dir() -> Path:
+    """Directory where generated kernel modules (and numba's caches) live."""
+    env = os.environ.get("GRAZING_CACHE_DIR")
+    if env:
+        return Path(env)
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "grazing"
+
+
+@lru_cache(maxsize=64)
+def load_source(source: str) -> ModuleType:
+    """Write ``source`` to the cache (once) and import it as a module."""
+    key = hashlib.sha256((source + _CODEGEN_VERSION + numba.__version__ + sys.version).encode()).hexdigest()[
+        :20
+    ]
+    modname = f"grazing_kernels_{key}"
+    if modname in sys.modules:
+        return sys.modules[modname]
+    for d in (cache_dir(), Path(tempfile.gettempdir()) / "grazing-cache"):
+        try:
+            d.mkdir(parents=True, exist_ok=True)
+            path = d / f"{modname}.py"
+            if not path.exists() or path.read_text() != source:
+                fd, tmp = tempfile.mkstemp(dir=d, suffix=".tmp")
+                with os.fdopen(fd, "w") as fh:
+                    fh.write(source)
+                os.replace(tmp, path)
+            break
+        except OSError:
+            continue
+    else:  # pragma: no cover - no writable directory at all
+        raise OSError("no writable cache directory for compiled kernels")
+    spec = importlib.util.spec_from_file_location(modname, path)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[modname] = module
+    spec.loader.exec_module(module)
+    return module

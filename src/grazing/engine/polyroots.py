@@ -1,0 +1,196 @@
+"""Robust isolation of the first root of a polynomial on [0, 1].
+
+The event functions of the engine (the guard during free flight, the contact
+force during sticking) are available on every Taylor step as polynomials in the
+normalised step time ``u`` in [0, 1].  An impact of depth 1e-12 makes the guard
+polynomial dip below zero on a tiny sub-interval without any sign change at the
+step ends, which is where sign-change event detection (MATLAB's hit-crossing,
+``scipy.integrate.solve_ivp`` events) misses it.  Here the polynomial is
+converted to the Bernstein basis, whose coefficients bound the polynomial on
+the interval (convex-hull property), and subdivided by de Casteljau's algorithm
+until every sub-interval either provably has no root or has exactly one sign
+change (Descartes' rule of signs for the Bernstein basis).  The first root is
+then polished by safeguarded Newton iteration.
+
+All functions are numba-compiled and see only arrays.
+"""
+
+from __future__ import annotations
+
+from numba import njit
+
+_MAX_DEPTH = 60
+
+
+@njit(cache=True)
+def horner(a, n, u):
+    """Value of ``sum(a[k] * u**k for k <= n)``."""
+    acc = a[n]
+    for k in range(n - 1, -1, -1):
+        acc = acc * u + a[k]
+    return acc
+
+
+@njit(cache=True)
+def horner_with_derivative(a, n, u):
+    """Value and derivative at ``u`` of the polynomial with coefficients ``a[:n+1]``."""
+    p = a[n]
+    dp = 0.0
+    for k in range(n - 1, -1, -1):
+        dp = dp * u + p
+        p = p * u + a[k]
+    return p, dp
+
+
+@njit(cache=True)
+def to_bernstein(a, n, b):
+    """Bernstein coefficients on [0, 1] of the power-basis polynomial ``a[:n+1]``."""
+    for i in range(n + 1):
+        b[i] = 0.0
+    # b_i = sum_{k<=i} C(i,k)/C(n,k) a_k; ratio(i,k) = ratio(i-1,k) * i/(i-k).
+    inv_cnk = 1.0  # 1/C(n, k), updated with k
+    for k in range(n + 1):
+        if k > 0:
+            inv_cnk *= k / (n - k + 1.0)
+        ratio = inv_cnk
+        b[k] += ratio * a[k]
+        for i in range(k + 1, n + 1):
+            ratio *= i / (i - k)
+            b[i] += ratio * a[k]
+
+
+@njit(cache=True)
+def split_half(c, n, left, right, tmp):
+    """de Casteljau subdivision at 1/2 of Bernstein coefficients ``c[:n+1]``."""
+    for i in range(n + 1):
+        tmp[i] = c[i]
+    left[0] = tmp[0]
+    right[n] = tmp[n]
+    for r in range(1, n + 1):
+        for i in range(n - r + 1):
+            tmp[i] = 0.5 * (tmp[i] + tmp[i + 1])
+        left[r] = tmp[0]
+        right[n - r] = tmp[n - r]
+
+
+@njit(cache=True)
+def _polish(a, n, lo, hi):
+    """Root of the polynomial in [lo, hi], given value(lo) > 0 >= value(hi)."""
+    x = 0.5 * (lo + hi)
+    for _ in range(200):
+        p, dp = horner_with_derivative(a, n, x)
+        if p > 0.0:
+            lo = x
+        else:
+            hi = x
+        if hi - lo <= 4e-16 * max(1.0, abs(hi)):
+            break
+        xn = x - p / dp if dp != 0.0 else 0.5 * (lo + hi)
+        if not (lo < xn < hi):
+            xn = 0.5 * (lo + hi)
+        if xn == x:
+            break
+        x = xn
+    # Return the left-most point that is certified non-positive to ~1 ulp.
+    p = horner(a, n, x)
+    if p > 0.0:
+        return hi
+    return x
+
+
+@njit(cache=True)
+def first_root(a, n, work):
+    """First ``u`` in [0, 1] where the polynomial ``a[:n+1]`` becomes <= 0.
+
+    The polynomial is expected to be positive at ``u = 0``; if it is not,
+    0.0 is returned.  Returns -1.0 when the polynomial stays positive on the
+    whole interval (to within rounding of its Bernstein coefficients).
+
+    ``work`` must be a float array of at least the shape given by
+    :func:`work_shape`.
+    """
+    if a[0] <= 0.0:
+        return 0.0
+    # Cheap certificate: on [0, 1], p(u) >= a0 + sum(min(a_k, 0)).
+    low = a[0]
+    for k in range(1, n + 1):
+        if a[k] < 0.0:
+            low += a[k]
+    if low > 0.0:
+        return -1.0
+    # Bernstein coefficients all positive => no root (convex hull property).
+    b = work[0]
+    to_bernstein(a, n, b)
+    allpos = True
+    for i in range(n + 1):
+        if b[i] <= 0.0:
+            allpos = False
+            break
+    if allpos:
+        return -1.0
+    # Depth-first search, left half first.  Stack rows hold Bernstein
+    # coefficients; intervals are kept in parallel arrays.
+    stack_lo = work[_MAX_DEPTH + 5]
+    stack_hi = work[_MAX_DEPTH + 6]
+    top = 0
+    # row 1 + top stores the coefficients of the interval on the stack.
+    for i in range(n + 1):
+        work[1, i] = b[i]
+    stack_lo[0] = 0.0
+    stack_hi[0] = 1.0
+    top = 1
+    tmp_left = work[_MAX_DEPTH + 2]
+    tmp_right = work[_MAX_DEPTH + 3]
+    while top > 0:
+        top -= 1
+        lo = stack_lo[top]
+        hi = stack_hi[top]
+        c = work[1 + top]
+        if c[0] <= 0.0:
+            return lo
+        # Sign variations and positivity.
+        nvar = 0
+        allpos = True
+        last = 1.0
+        for i in range(n + 1):
+            v = c[i]
+            if v <= 0.0:
+                allpos = False
+            if v != 0.0:
+                if (v > 0.0) != (last > 0.0):
+                    nvar += 1
+                last = v
+        if allpos:
+            continue
+        if nvar == 1 and c[n] <= 0.0:
+            return _polish(a, n, lo, hi)
+        if nvar == 0:
+            # Coefficients >= 0 with zeros: the polynomial touches zero at most
+            # at an endpoint; hi is checked by the next interval.
+            if c[n] == 0.0:
+                return hi
+            continue
+        mid = 0.5 * (lo + hi)
+        if top >= _MAX_DEPTH or hi - lo < 1e-15:
+            # Unresolvable tangency at double precision: a zero-depth graze.
+            if horner(a, n, mid) <= 0.0:
+                return mid
+            continue
+        # Split into halves; push right then left so that left is examined first.
+        split_half(c, n, tmp_left, tmp_right, work[_MAX_DEPTH + 4])
+        for i in range(n + 1):
+            work[1 + top, i] = tmp_right[i]
+        stack_lo[top] = mid
+        stack_hi[top] = hi
+        top += 1
+        for i in range(n + 1):
+            work[1 + top, i] = tmp_left[i]
+        stack_lo[top] = lo
+        stack_hi[top] = mid
+        top += 1
+    return -1.0
+
+
+def work_shape(n: int) -> tuple[int, int]:
+    """Shape of the ``work`` array needed by :func:`first_root` for degree ``n``."""
+    return (_MAX_DEPTH + 7, max(n + 1, _MAX_DEPTH + 2))

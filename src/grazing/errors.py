@@ -1,0 +1,23 @@
+"""Exceptions raised by grazing; the CLI turns each into one line on stderr."""
+
+from __future__ import annotations
+
+
+class GrazingError(Exception):
+    """Base class of the errors that grazing reports to users."""
+
+
+class InvalidParameterError(GrazingError, ValueError):
+    """A parameter value is outside its allowed range, not a number, or unknown."""
+
+
+class InvalidStateError(GrazingError, ValueError):
+    """An initial state is not in the allowed region (for example beyond the stop)."""
+
+
+class SimulationError(GrazingError, RuntimeError):
+    """The integration could not be completed (step limit, non-finite state...)."""
+
+
+class ConvergenceError(GrazingError, RuntimeError):
+    """A Newton iteration did not converge."""

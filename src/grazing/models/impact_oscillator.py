@@ -1,0 +1,57 @@
+"""The linear impact oscillator, the canonical example of grazing.
+
+::
+
+    x'' + 2 zeta x' + x = cos(omega t)      while x < sigma
+    x' <- -r x'                              when x reaches sigma
+
+References: A. B. Nordmark, "Non-periodic motion caused by grazing incidence
+in an impact oscillator", J. Sound Vib. 145 (1991) 279-297; M. di Bernardo,
+C. J. Budd, A. R. Champneys, P. Kowalczyk, *Piecewise-smooth Dynamical
+Systems*, Springer (2008), ch. 6.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+import sympy as sp
+
+from grazing.core.model import HybridModel, Parameter
+
+
+@lru_cache(maxsize=1)
+def _base() -> HybridModel:
+    x, v, t = sp.symbols("x v t")
+    zeta, omega, sigma, r = sp.symbols("zeta omega sigma r")
+    params = [
+        Parameter("zeta", 0.05, lower=0.0, description="damping ratio"),
+        Parameter("omega", 2.8, lower=0.0, lower_open=True, description="forcing frequency"),
+        Parameter("sigma", 0.1, description="stop position"),
+        Parameter("r", 0.8, lower=0.0, upper=1.0, description="coefficient of restitution"),
+    ]
+    return HybridModel(
+        "impact-oscillator",
+        [x, v],
+        t,
+        params,
+        vector_field=[v, -2 * zeta * v - x + sp.cos(omega * t)],
+        guard=sigma - x,
+        reset=[x, -r * v],
+        period=2 * sp.pi / omega,
+        contact_direction=[0, 1],
+        state_labels=["x", "x′"],
+        description="harmonically forced linear oscillator with a rigid stop",
+        reference="Nordmark, J. Sound Vib. 145 (1991) 279-297",
+    )
+
+
+def impact_oscillator(**values: float) -> HybridModel:
+    """The linear impact oscillator with parameter overrides.
+
+    Examples
+    --------
+    >>> impact_oscillator(sigma=0.0).params["sigma"]
+    0.0
+    """
+    return _base().with_params(**values)

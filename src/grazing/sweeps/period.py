@@ -1,0 +1,38 @@
+"""Period detection on stroboscopic samples."""
+
+from __future__ import annotations
+
+import numpy as np
+
+DEFAULT_PERIOD_TOL = 1e-6
+DEFAULT_MAX_PERIOD = 64
+
+
+def detect_period(
+    samples: np.ndarray,
+    tol: float = DEFAULT_PERIOD_TOL,
+    max_period: int = DEFAULT_MAX_PERIOD,
+) -> int:
+    """Smallest ``p <= max_period`` such that the samples are p-periodic to ``tol``.
+
+    The sequence ``s_0, s_1, ...`` (rows of ``samples``) is p-periodic when
+    ``max |s_{i+p} - s_i| <= tol`` over all components and all ``i``.  Only
+    periods up to half the number of samples are tested, so that every point
+    of a cycle is seen at least twice.  Returns 0 when no period fits
+    (chaos, quasi-periodicity, or a transient that has not died out).
+
+    Examples
+    --------
+    >>> detect_period(np.array([1.0, 2.0, 1.0, 2.0, 1.0, 2.0]))
+    2
+    >>> detect_period(np.array([0.1, 0.5, 0.3, 0.9]))
+    0
+    """
+    s = np.asarray(samples, dtype=float)
+    if s.ndim == 1:
+        s = s[:, None]
+    m = s.shape[0]
+    for p in range(1, min(max_period, m // 2) + 1):
+        if np.max(np.abs(s[p:] - s[:-p])) <= tol:
+            return p
+    return 0

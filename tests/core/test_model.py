@@ -1,0 +1,149 @@
+"""The hybrid model type: parameters, Jacobians, saltation, user models."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import sympy as sp
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import grazing
+from grazing import HybridModel, InvalidParameterError, InvalidStateError, Parameter
+from grazing.models import CASES, bouncing_ball, impact_oscillator, pendulum
+
+
+def _fd_jacobian(fun, x, eps=1e-6):
+    x = np.asarray(x, dtype=float)
+    cols = []
+    for j in range(x.size):
+        dx = np.zeros_like(x)
+        dx[j] = eps
+        cols.append((np.atleast_1d(fun(x + dx)) - np.atleast_1d(fun(x - dx))) / (2 * eps))
+    return np.array(cols).T
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_cases_by_name(case):
+    m = pendulum(case)
+    for k, v in CASES[case].items():
+        assert m.params[k] == v
+    assert pendulum(case.lower()).params == m.params
+
+
+def test_case_a_reduced_and_errata():
+    assert pendulum("A-reduced").params["alpha"] == pytest.approx(0.71 * 0.2254)
+    assert pendulum("D").params["beta"] == 0.068  # the paper's "0.68" is a typo
+
+
+@pytest.mark.parametrize(
+    ("changes", "message"),
+    [
+        ({"r": 1.5}, r"r = 1.5 is outside \[0, 1\]"),
+        ({"r": -0.1}, "r = -0.1 is outside"),
+        ({"eta": 0.0}, r"eta = 0 is outside \(0, inf\)"),
+        ({"beta": -1.0}, "beta = -1 is outside"),
+        ({"theta_hat": math.pi}, "theta_hat"),
+        ({"alpha": float("nan")}, "alpha must be finite"),
+        ({"alpha": "abc"}, "alpha must be a number"),
+        ({"gamma": 1.0}, "unknown parameter 'gamma'"),
+    ],
+)
+def test_bad_parameters_are_rejected(changes, message):
+    with pytest.raises(InvalidParameterError, match=message):
+        pendulum("B", **changes)
+
+
+def test_unknown_case():
+    with pytest.raises(InvalidParameterError, match="unknown case 'Z'"):
+        pendulum("Z")
+
+
+def test_with_params_shares_kernels_and_keeps_values():
+    a = pendulum("B", eta=0.4)
+    b = a.with_params(eta=0.5)
+    assert a.params["eta"] == 0.4 and b.params["eta"] == 0.5
+    assert a.kernels() is b.kernels()
+
+
+MODELS = {
+    "pendulum": pendulum("B", eta=0.45, theta_hat=0.7),
+    "oscillator": impact_oscillator(sigma=0.2, omega=2.5),
+    "ball": bouncing_ball(amplitude=0.3, omega=1.3),
+}
+
+
+@pytest.mark.parametrize("name", list(MODELS))
+@settings(max_examples=20, deadline=None)
+@given(x=st.tuples(st.floats(-1, 1), st.floats(-1, 1)), t=st.floats(0, 10))
+def test_jacobians_match_finite_differences(name, x, t):
+    m = MODELS[name]
+    fx, hx, gx = m.jacobians(x, t)
+    np.testing.assert_allclose(fx, _fd_jacobian(lambda z: m.vector_field(z, t), x), atol=1e-7)
+    np.testing.assert_allclose(hx, _fd_jacobian(lambda z: m.guard(z, t), x)[0], atol=1e-7)
+    np.testing.assert_allclose(gx, _fd_jacobian(lambda z: m.reset(z, t), x), atol=1e-7)
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    r=st.floats(0.05, 1.0),
+    v=st.floats(0.01, 2.0),
+    tau=st.floats(0, 2 * math.pi),
+    theta_hat=st.floats(-1.5, 1.5),
+)
+def test_pendulum_saltation_determinant_is_r_squared(r, v, tau, theta_hat):
+    """det S = r^2 for every impact (what makes det(monodromy) = r^(2k) e^(...))."""
+    m = pendulum("B", r=r, theta_hat=theta_hat)
+    S = m.saltation([theta_hat, v], tau)
+    assert np.linalg.det(S) == pytest.approx(r**2, rel=1e-10)
+
+
+def test_saltation_maps_flow_direction_to_flow_direction():
+    """S f(x-) = f(g(x-)): a perturbation along the flow stays along the flow."""
+    m = pendulum("B", eta=0.45, theta_hat=0.5)
+    x_im, t_im = np.array([0.5, 0.3]), 1.1
+    S = m.saltation(x_im, t_im)
+    f_minus = m.vector_field(x_im, t_im)
+    f_plus = m.vector_field(m.reset(x_im, t_im), t_im)
+    np.testing.assert_allclose(S @ f_minus, f_plus, rtol=1e-12)
+
+
+def test_initial_state_beyond_stop():
+    m = pendulum("B", theta_hat=0.5)
+    with pytest.raises(InvalidStateError, match="beyond the stop"):
+        m.check_state([0.6, 0.0])
+    with pytest.raises(InvalidStateError, match="2 components"):
+        m.check_state([0.1])
+
+
+def test_user_defined_model_runs():
+    x, v, t = sp.symbols("x v t")
+    k, r, a, w = sp.symbols("k r a w")
+    model = HybridModel(
+        "cubic",
+        [x, v],
+        t,
+        [
+            Parameter("k", 1.0),
+            Parameter("r", 0.8, lower=0, upper=1),
+            Parameter("a", 0.5),
+            Parameter("w", 1.2),
+        ],
+        vector_field=[v, -0.1 * v - k * x - x**3 + a * sp.cos(w * t)],
+        guard=0.3 - x,
+        reset=[x, -r * v],
+        period=2 * sp.pi / w,
+        contact_direction=[0, 1],
+    )
+    sol = grazing.simulate(model, [0.0, 0.0], transient=50, periods=20)
+    assert sol.samples.shape == (20, 2)
+    assert np.all(sol.samples[:, 0] <= 0.3)
+    assert sol.n_impacts > 0
+
+
+def test_model_rejects_unknown_symbols():
+    x, v, t, q = sp.symbols("x v t q")
+    with pytest.raises(ValueError, match="unknown symbols"):
+        HybridModel("bad", [x, v], t, [], [v, q], -x, [x, -v], 1)

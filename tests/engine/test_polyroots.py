@@ -1,0 +1,65 @@
+"""First-root isolation on [0, 1], including dips far below any step resolution."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from numpy.polynomial import polynomial as P  # noqa: N812
+
+from grazing.engine.polyroots import first_root, to_bernstein, work_shape
+
+
+def _first_root(coeffs):
+    a = np.asarray(coeffs, dtype=float)
+    return first_root(a, a.size - 1, np.zeros(work_shape(a.size - 1)))
+
+
+@pytest.mark.parametrize("depth", [10.0**-k for k in range(2, 13)])
+def test_shallow_dip_is_found(depth):
+    """(u - 0.3)^2 - depth, times a positive factor, at degree 20."""
+    base = P.polysub(P.polypow([-0.3, 1.0], 2), [depth])
+    a = P.polymul(base, P.polypow([1.0, 0.2], 18))
+    u = _first_root(a)
+    # The root is conditioned by the slope 2 sqrt(depth): rounding ~1e-16 / slope.
+    assert u == pytest.approx(0.3 - np.sqrt(depth), abs=1e-12 + 1e-16 / np.sqrt(depth))
+
+
+def test_no_root_and_positive_minimum():
+    a = P.polymul(P.polyadd(P.polypow([-0.5, 1.0], 2), [1e-12]), P.polypow([1.0, 0.1], 10))
+    assert _first_root(a) == -1.0
+
+
+def test_root_at_start_is_returned():
+    assert _first_root([0.0, -1.0, 0.5]) == 0.0
+    assert _first_root([-1e-20, 1.0]) == 0.0
+
+
+def test_bernstein_conversion_exact_for_monomials():
+    n = 6
+    b = np.zeros(n + 1)
+    a = np.zeros(n + 1)
+    a[2] = 1.0  # u^2: Bernstein coefficients C(i,2)/C(n,2)
+    to_bernstein(a, n, b)
+    expected = [i * (i - 1) / (n * (n - 1)) for i in range(n + 1)]
+    np.testing.assert_allclose(b, expected, rtol=1e-15, atol=1e-16)
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    roots=st.lists(st.floats(0.01, 0.99), min_size=1, max_size=6),
+    extra=st.lists(st.floats(-3.0, 3.0), min_size=0, max_size=6),
+)
+def test_matches_smallest_simple_root(roots, extra):
+    """Random polynomials with known simple roots in (0, 1) and complex/outside ones."""
+    roots = sorted(roots)
+    if np.min(np.diff(roots), initial=1.0) < 1e-3:
+        return
+    a = P.polyfromroots(roots)
+    for e in extra:  # roots outside [0, 1] or complex pairs: do not add roots inside
+        a = P.polymul(a, [1.0 + abs(e), 0.0, 1.0]) if e > 0 else P.polymul(a, [1.0 + abs(e), -1.0])
+    if a[0] < 0:
+        a = -a
+    u = _first_root(a)
+    assert u == pytest.approx(roots[0], abs=1e-9)
