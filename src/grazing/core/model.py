@@ -17,7 +17,6 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from functools import cached_property
 from types import MappingProxyType, ModuleType
 from typing import Any
 
@@ -132,6 +131,8 @@ class _Definition:
         self.description = description
         self.reference = reference
         self._kernels: dict[tuple[str, ...], ModuleType] = {}
+        self._numeric: dict[str, Callable[..., Any]] = {}
+        self._period_fn: Callable[[list[float]], float] | None = None
 
     def kernels(self, sensitivities: tuple[str, ...] = ()) -> ModuleType:
         if sensitivities not in self._kernels:
@@ -139,29 +140,35 @@ class _Definition:
             self._kernels[sensitivities] = load_source(generate_source(self.system, syms))
         return self._kernels[sensitivities]
 
-    @cached_property
-    def numeric(self) -> dict[str, Callable[..., Any]]:
-        """numpy functions of ``(x, t, p)`` for f, h, g and their Jacobians."""
-        s = self.system
-        x = sp.Matrix(s.states)
-        f = sp.Matrix(s.vector_field)
-        g = sp.Matrix(s.reset)
-        h = sp.Matrix([s.guard])
-        args = (list(s.states), s.time, list(s.params))
-        mk = lambda e: sp.lambdify(args, e, modules="numpy")  # noqa: E731
-        return {
-            "f": mk(f),
-            "h": mk(s.guard),
-            "g": mk(g),
-            "f_x": mk(f.jacobian(x)),
-            "h_x": mk(h.jacobian(x)),
-            "g_x": mk(g.jacobian(x)),
-            "h_t": mk(sp.diff(s.guard, s.time)),
-            "g_t": mk(sp.diff(g, s.time)),
-            "normal_rate": mk(s.normal_rate),
-            "normal_accel": mk(s.normal_accel),
-            "period": sp.lambdify([list(s.params)], self.period_expr, modules="math"),
-        }
+    def numeric(self, what: str) -> Callable[..., Any]:
+        """numpy function of ``(x, t, p)`` for f, h, g or a Jacobian (built on first use)."""
+        fn = self._numeric.get(what)
+        if fn is None:
+            s = self.system
+            x = sp.Matrix(s.states)
+            exprs = {
+                "f": lambda: sp.Matrix(s.vector_field),
+                "h": lambda: s.guard,
+                "g": lambda: sp.Matrix(s.reset),
+                "f_x": lambda: sp.Matrix(s.vector_field).jacobian(x),
+                "h_x": lambda: sp.Matrix([s.guard]).jacobian(x),
+                "g_x": lambda: sp.Matrix(s.reset).jacobian(x),
+                "h_t": lambda: sp.diff(s.guard, s.time),
+                "g_t": lambda: sp.diff(sp.Matrix(s.reset), s.time),
+            }
+            fn = sp.lambdify((list(s.states), s.time, list(s.params)), exprs[what](), modules="numpy")
+            self._numeric[what] = fn
+        return fn
+
+    def period(self, values: Sequence[float]) -> float:
+        """The forcing period for the parameter values ``values``."""
+        if self._period_fn is None:
+            if not self.period_expr.free_symbols:
+                const = float(self.period_expr)
+                self._period_fn = lambda _v: const
+            else:
+                self._period_fn = sp.lambdify([list(self.system.params)], self.period_expr, modules="math")
+        return float(self._period_fn(list(values)))
 
 
 class HybridModel:
@@ -270,7 +277,7 @@ class HybridModel:
                     f"unknown parameter {k!r} for model {self._def.name!r} (known: {', '.join(by_name)})"
                 )
             out[k] = by_name[k].check(v)
-        period = self._def.numeric["period"]([out[p.name] for p in self._def.parameters])
+        period = self._def.period([out[p.name] for p in self._def.parameters])
         if not (math.isfinite(period) and period > 0):
             raise InvalidParameterError(f"the forcing period must be positive, got {period}")
         return out
@@ -312,7 +319,7 @@ class HybridModel:
     @property
     def period(self) -> float:
         """Forcing period (the stroboscopic sampling interval)."""
-        return float(self._def.numeric["period"](list(self.param_vector)))
+        return self._def.period(self.param_vector)
 
     @property
     def periodic(self) -> bool:
@@ -349,7 +356,7 @@ class HybridModel:
         return self._def.kernels(tuple(sensitivities))
 
     def _call(self, what: str, x: Any, t: float) -> Any:
-        fn = self._def.numeric[what]
+        fn = self._def.numeric(what)
         return fn(list(np.asarray(x, dtype=float)), float(t), list(self.param_vector))
 
     def vector_field(self, x: Any, t: float = 0.0) -> np.ndarray:

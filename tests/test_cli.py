@@ -1,0 +1,124 @@
+"""The command line: JSON keys, trajectory files, and one-line errors."""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import subprocess
+import sys
+
+import pytest
+
+from grazing.cli import main
+
+
+def run(argv, capsys):
+    code = main(argv)
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_simulate_json_keys_and_values(capsys):
+    code, out, err = run(["simulate", "--transient", "500", "--periods", "20", "--json"], capsys)
+    assert code == 0, err
+    res = json.loads(out)
+    for key in ("params", "samples", "impacts", "sticking_intervals", "period"):
+        assert key in res
+    assert res["params"]["theta_hat_deg"] == 40.0
+    assert res["params"]["case"] == "B"
+    assert res["params"]["r"] == 0.7675
+    assert len(res["samples"]) == 20 and len(res["samples"][0]) == 2
+    assert res["period"] == 5  # paper fig 9(b): period five at theta_hat = 40 deg, eta = 0.446
+    assert res["impacts"] > 0
+    assert res["sticking_intervals"] == []
+
+
+def test_explicit_parameters_override_the_case(capsys):
+    argv = ["simulate", "--case", "A", "--beta", "0.02", "--eta", "0.5", "--theta-hat", "30"]
+    code, out, _ = run([*argv, "--periods", "2", "--transient", "0", "--json"], capsys)
+    p = json.loads(out)["params"]
+    assert code == 0
+    assert (p["r"], p["beta"], p["eta"], p["case"]) == (0.4707, 0.02, 0.5, "A")
+    assert p["theta_hat"] == pytest.approx(math.radians(30))
+
+
+def test_chattering_case_reports_sticking(capsys):
+    argv = ["simulate", "--theta-hat", "-10", "--eta", "0.45", "--initial", "-0.5,0"]
+    code, out, _ = run([*argv, "--transient", "5", "--periods", "10", "--json"], capsys)
+    res = json.loads(out)
+    assert code == 0
+    assert len(res["sticking_intervals"]) >= 10
+    assert all(b > a for a, b in res["sticking_intervals"])
+
+
+def test_trajectory_csv(tmp_path, capsys):
+    path = tmp_path / "traj.csv"
+    argv = ["simulate", "--transient", "10", "--periods", "3", "--trajectory", str(path)]
+    code, _, _ = run([*argv, "--points-per-period", "20", "--json"], capsys)
+    assert code == 0
+    rows = list(csv.reader(path.open()))
+    assert rows[0] == ["tau", "theta", "dtheta"]
+    taus = [float(r[0]) for r in rows[1:]]
+    assert taus[0] == pytest.approx(10 * 2 * math.pi)
+    assert taus[-1] == pytest.approx(13 * 2 * math.pi)
+    assert len(rows) - 1 >= 3 * 20 + 1
+    assert all(float(r[1]) <= math.radians(40) + 1e-12 for r in rows[1:])
+
+
+def test_human_output(capsys):
+    code, out, _ = run(["simulate", "--transient", "500", "--periods", "20"], capsys)
+    assert code == 0
+    assert "period 5" in out
+
+
+BAD = [
+    (["--r", "1.5"], "r = 1.5 is outside [0, 1]"),
+    (["--r", "-0.5"], "r = -0.5 is outside"),
+    (["--eta", "0"], "eta = 0 is outside"),
+    (["--eta", "-0.3"], "eta = -0.3 is outside"),
+    (["--beta", "-0.01"], "beta = -0.01 is outside"),
+    (["--theta-hat", "180"], "--theta-hat must be in (-180, 180) degrees"),
+    (["--theta-hat", "-200"], "--theta-hat must be in (-180, 180) degrees"),
+    (["--initial", "0.9,0"], "beyond the stop"),
+    (["--case", "Q"], "unknown case 'Q'"),
+    (["--alpha", "abc"], "'abc' is not a valid float"),
+    (["--alpha", "nan"], "alpha must be finite"),
+    (["--eta", "nan"], "eta must be finite"),
+    (["--theta-hat", "nan"], "--theta-hat must be in"),
+    (["--initial", "nan,0"], "--initial must be finite"),
+    (["--initial", "0;0"], "--initial must be THETA,THETADOT"),
+    (["--periods", "-2"], "'--periods': -2 is not in the range"),
+    (["--transient", "-1"], "'--transient': -1 is not in the range"),
+    (["--periods", "1.5"], "'--periods'"),
+    (["--trajectory", "/nonexistent-dir/x.csv"], "does not exist"),
+]
+
+
+@pytest.mark.parametrize(("args", "message"), BAD)
+def test_bad_input_is_one_line_and_nonzero(args, message, capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    code, out, err = run(["simulate", "--periods", "2", "--transient", "0", *args], capsys)
+    assert code != 0
+    assert out == ""
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    assert lines[0].startswith("grazing: error: ")
+    assert message in lines[0]
+    assert list(tmp_path.iterdir()) == []  # nothing written
+
+
+def test_console_script_exit_status_and_stderr():
+    proc = subprocess.run(
+        [sys.executable, "-m", "grazing.cli", "simulate", "--r", "2"], capture_output=True, text=True
+    )
+    assert proc.returncode != 0
+    assert proc.stdout == ""
+    assert proc.stderr.strip() == "grazing: error: r = 2 is outside [0, 1] (coefficient of restitution)"
+    assert "Traceback" not in proc.stderr
+
+
+def test_help_and_version(capsys):
+    assert run(["--help"], capsys)[0] == 0
+    code, out, _ = run(["--version"], capsys)
+    assert code == 0 and "grazing" in out
