@@ -306,6 +306,319 @@ def _print_simulation(
         con.print(f"trajectory written to {trajectory}")
 
 
+def _complex_list(mu: np.ndarray) -> list[list[float]]:
+    return [[float(z.real), float(z.imag)] for z in np.asarray(mu, dtype=complex)]
+
+
+def _check_out(out: Path | None, suffix: str) -> None:
+    if out is None:
+        return
+    if out.suffix.lower() != suffix:
+        raise _ErrorInput(f"--out must name a {suffix} file, got {str(out)!r}")
+    folder = out.parent if str(out.parent) else Path(".")
+    if not folder.is_dir():
+        raise _ErrorInput(f"folder {str(folder)!r} does not exist")
+
+
+def _save_dataset(ds: Any, out: Path) -> None:
+    """Write a dataset to NetCDF via a temporary file, so a failure leaves nothing."""
+    folder = out.parent if str(out.parent) else Path(".")
+    fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{out.name}.", suffix=".tmp")
+    os.close(fd)
+    try:
+        ds.to_netcdf(tmp, engine="h5netcdf")
+        os.replace(tmp, out)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def _orbit_json(orbit: Any) -> dict[str, Any]:
+    out = {
+        "period": orbit.period,
+        "impacts": orbit.impacts,
+        "state": orbit.state,
+        "multipliers": _complex_list(orbit.multipliers),
+        "abs_multipliers": np.abs(orbit.multipliers),
+        "stable": orbit.stable,
+        "residual": orbit.residual,
+        "newton_iterations": len(orbit.residuals) - 1,
+        "min_impact_speed": None if math.isnan(orbit.min_impact_speed) else orbit.min_impact_speed,
+    }
+    if "theta_hat" in orbit.model.params:
+        out["max_theta_deg"] = math.degrees(orbit.max_angle())
+    return out
+
+
+@cli.command()
+@model_options
+@click.option("--period", type=click.IntRange(min=1), help="Period in forcing periods (default: detected).")
+@click.option(
+    "--initial", metavar="THETA,THETADOT", help="Initial guess at tau = 0 (default: from simulation)."
+)
+@click.option("--transient", type=click.IntRange(min=0), default=500, show_default=True,
+              help="Forcing periods simulated for the initial guess.")  # fmt: skip
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
+def orbit(
+    case: str,
+    alpha: float | None,
+    beta: float | None,
+    r: float | None,
+    eta: float,
+    theta_hat: float,
+    period: int | None,
+    initial: str | None,
+    transient: int,
+    as_json: bool,
+) -> None:
+    """Find a periodic orbit by Newton shooting; print its multipliers and stability."""
+    from grazing.orbits import find_orbit
+
+    model = build_pendulum(case, alpha, beta, r, eta, theta_hat)
+    x0 = None
+    if initial is not None:
+        x0 = _parse_pair(initial)
+        if x0[0] > model.params["theta_hat"]:
+            raise _ErrorInput(
+                f"initial angle {x0[0]:g} rad is beyond the stop at theta-hat = {theta_hat:g} deg"
+            )
+    orb = find_orbit(model, x0, period=period, transient=transient)
+    res = {"params": model_params_json(model, case), **_orbit_json(orb)}
+    if as_json:
+        _emit_json(res)
+        return
+    kind = "stable" if orb.stable else "unstable"
+    click.echo(
+        f"period-{orb.period} orbit with {orb.impacts} impact(s) per period, {kind}; "
+        f"max theta {res['max_theta_deg']:.6f} deg"
+    )
+    click.echo(f"state at tau = 0: theta = {orb.state[0]:.12f}, theta' = {orb.state[1]:.12f}")
+    for z in orb.multipliers:
+        click.echo(f"  multiplier {z.real:+.6f} {z.imag:+.6f}i   |mu| = {abs(z):.6f}")
+
+
+def _grazing_json(g: Any) -> dict[str, Any]:
+    return {
+        "eta": g.model.params["eta"],
+        "theta_hat_deg": math.degrees(g.model.params["theta_hat"]),
+        "multipliers": _complex_list(g.multipliers),
+        "abs_lambda": g.abs_lambda,
+        "t_graze": g.phase,
+        "accel": g.accel,
+    }
+
+
+@cli.command()
+@model_options
+@click.option("--eta-min", type=float, default=0.2, show_default=True, help="Lower end of the eta range.")
+@click.option("--eta-max", type=float, default=1.0, show_default=True, help="Upper end of the eta range.")
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
+def graze(
+    case: str,
+    alpha: float | None,
+    beta: float | None,
+    r: float | None,
+    eta: float,
+    theta_hat: float,
+    eta_min: float,
+    eta_max: float,
+    as_json: bool,
+) -> None:
+    """Every grazing of the period-1 nonimpacting orbit with the stop, for eta in a range."""
+    from grazing.orbits import find_grazings
+
+    model = build_pendulum(case, alpha, beta, r, eta, theta_hat)
+    if not (math.isfinite(eta_min) and math.isfinite(eta_max) and 0 < eta_min < eta_max):
+        raise _ErrorInput(f"need 0 < --eta-min < --eta-max, got {eta_min:g} and {eta_max:g}")
+    bar = _Progress("continuing", enabled=not as_json)
+    try:
+        points, branch = find_grazings(
+            model,
+            "eta",
+            eta_min,
+            eta_max,
+            progress=lambda n, v: bar(int(1000 * (v - eta_min) / (eta_max - eta_min)), 1000),
+        )
+    finally:
+        bar.close()
+    res = {
+        "params": model_params_json(model, case),
+        "eta_range": [eta_min, eta_max],
+        "grazings": [_grazing_json(g) for g in points],
+        "folds": [s.param for s in branch.special if s.kind == "fold"],
+    }
+    if as_json:
+        _emit_json(res)
+        return
+    if not points:
+        click.echo(f"no grazing for eta in [{eta_min:g}, {eta_max:g}] at theta-hat = {theta_hat:g} deg")
+    for g in res["grazings"]:
+        mu = ", ".join(f"{a:+.4f}{b:+.4f}i" for a, b in g["multipliers"])
+        click.echo(f"eta = {g['eta']:.6f}: multipliers {mu}, |lambda| = {g['abs_lambda']:.4f}, "
+                   f"t_graze = {g['t_graze']:.4f}")  # fmt: skip
+
+
+@cli.command("graze-curve")
+@model_options
+@click.option(
+    "--start-deg", type=float, default=5.0, show_default=True, help="theta-hat where the curve starts."
+)
+@click.option("--eta-min", type=float, default=0.2, show_default=True, help="Lower end of the eta range.")
+@click.option("--eta-max", type=float, default=1.0, show_default=True, help="Upper end of the eta range.")
+@click.option("--max-step", type=float, default=0.05, show_default=True, help="Largest continuation step.")
+@click.option(
+    "--out", type=click.Path(dir_okay=False, path_type=Path), metavar="FILE.nc", help="Save as NetCDF."
+)
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
+def graze_curve(
+    case: str,
+    alpha: float | None,
+    beta: float | None,
+    r: float | None,
+    eta: float,
+    theta_hat: float,
+    start_deg: float,
+    eta_min: float,
+    eta_max: float,
+    max_step: float,
+    out: Path | None,
+    as_json: bool,
+) -> None:
+    """Two-parameter continuation of grazing in (eta, theta-hat), with theta-hat_max."""
+    from grazing.orbits import PalcSettings, grazing_curve
+
+    model = build_pendulum(case, alpha, beta, r, eta, theta_hat)
+    if not (math.isfinite(eta_min) and math.isfinite(eta_max) and 0 < eta_min < eta_max):
+        raise _ErrorInput(f"need 0 < --eta-min < --eta-max, got {eta_min:g} and {eta_max:g}")
+    if not -180 < start_deg < 180:
+        raise _ErrorInput(f"--start-deg must be in (-180, 180), got {start_deg:g}")
+    if not (math.isfinite(max_step) and max_step > 0):
+        raise _ErrorInput(f"--max-step must be positive, got {max_step:g}")
+    _check_out(out, ".nc")
+    settings = PalcSettings(ds=min(0.02, max_step), ds_max=max_step)
+    curve = grazing_curve(model, ("eta", "theta_hat"), math.radians(start_deg), search=(eta_min, eta_max),
+                          settings=settings)  # fmt: skip
+    if out is not None:
+        _save_dataset(curve.to_dataset(), out)
+    fold = curve.fold
+    res = {
+        "params": model_params_json(model, case),
+        "theta_max_deg": math.degrees(fold.model.params["theta_hat"]) if fold else None,
+        "eta_at_theta_max": fold.model.params["eta"] if fold else None,
+        "multipliers_at_theta_max": _complex_list(fold.multipliers) if fold else None,
+        "status": curve.status,
+        "curve": [_grazing_json(g) for g in curve.points],
+        "out": str(out) if out else None,
+    }
+    if as_json:
+        _emit_json(res)
+        return
+    click.echo(f"{len(curve.points)} grazing orbits from theta-hat = {start_deg:g} deg ({curve.status})")
+    if fold:
+        click.echo(f"theta-hat_max = {res['theta_max_deg']:.4f} deg at eta = {res['eta_at_theta_max']:.6f}: "
+                   "no grazing above it")  # fmt: skip
+
+
+_CONTINUE_PARAMS = {"eta": "eta", "theta-hat": "theta_hat", "alpha": "alpha", "beta": "beta", "r": "r"}
+
+
+@cli.command("continue")
+@model_options
+@click.option("--param", "cparam", required=True, type=click.Choice(list(_CONTINUE_PARAMS)),
+              help="Parameter to vary (theta-hat in degrees).")  # fmt: skip
+@click.option("--start", type=float, required=True, help="Start value of the parameter.")
+@click.option("--stop", type=float, required=True, help="End value of the parameter.")
+@click.option("--period", type=click.IntRange(min=1), help="Period of the orbit (default: detected).")
+@click.option("--initial", metavar="THETA,THETADOT", help="Initial guess at tau = 0.")
+@click.option("--virtual/--physical", default=None,
+              help="Ignore the stop (default: yes for a nonimpacting starting orbit).")  # fmt: skip
+@click.option("--max-step", type=float, default=0.04, show_default=True, help="Largest continuation step.")
+@click.option(
+    "--out", type=click.Path(dir_okay=False, path_type=Path), metavar="FILE.nc", help="Save as NetCDF."
+)
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
+def continue_(
+    case: str,
+    alpha: float | None,
+    beta: float | None,
+    r: float | None,
+    eta: float,
+    theta_hat: float,
+    cparam: str,
+    start: float,
+    stop: float,
+    period: int | None,
+    initial: str | None,
+    virtual: bool | None,
+    max_step: float,
+    out: Path | None,
+    as_json: bool,
+) -> None:
+    """Pseudo-arclength continuation of a periodic orbit, with folds, period-doublings,
+    Neimark-Sacker points and grazings located."""
+    from grazing.orbits import PalcSettings, continue_orbit
+
+    model = build_pendulum(case, alpha, beta, r, eta, theta_hat)
+    name = _CONTINUE_PARAMS[cparam]
+    conv = math.radians if name == "theta_hat" else float
+    if not (math.isfinite(start) and math.isfinite(stop)) or start == stop:
+        raise _ErrorInput(f"--start and --stop must be finite and differ, got {start:g} and {stop:g}")
+    if name == "theta_hat" and not (-180 < start < 180 and -180 < stop < 180):
+        raise _ErrorInput("--start and --stop for theta-hat must be in (-180, 180) degrees")
+    if not (math.isfinite(max_step) and max_step > 0):
+        raise _ErrorInput(f"--max-step must be positive, got {max_step:g}")
+    _check_out(out, ".nc")
+    x0 = _parse_pair(initial) if initial is not None else None
+    a, b = conv(start), conv(stop)
+    model.with_params(**{name: a})  # validates the start value (one-line error)
+    bar = _Progress("continuing", enabled=not as_json)
+    try:
+        branch = continue_orbit(
+            model, name, a, b, x0=None if x0 is None else np.array(x0), period=period, virtual=virtual,
+            settings=PalcSettings(ds=min(0.01, max_step), ds_max=max_step),
+            progress=lambda n, v: bar(int(1000 * abs(v - a) / abs(b - a)), 1000),
+        )  # fmt: skip
+    finally:
+        bar.close()
+    if out is not None:
+        _save_dataset(branch.to_dataset(), out)
+    back = math.degrees if name == "theta_hat" else float
+    res = {
+        "params": model_params_json(model, case),
+        "param": cparam,
+        "period": branch.period,
+        "virtual": branch.virtual,
+        "values": [back(v) for v in branch.values],
+        "states": branch.states,
+        "multipliers": [_complex_list(o.multipliers) for o in branch.orbits],
+        "stable": [o.stable for o in branch.orbits],
+        "impacts": [o.impacts for o in branch.orbits],
+        "special": [
+            {
+                "kind": sp_.kind,
+                "value": back(sp_.param),
+                "index": sp_.index,
+                "multipliers": _complex_list(sp_.multipliers),
+                "state": sp_.orbit.state,
+            }
+            for sp_ in branch.special
+        ],
+        "status": branch.status,
+        "out": str(out) if out else None,
+    }
+    res["max_theta_deg"] = [math.degrees(o.max_angle()) for o in branch.orbits]
+    if as_json:
+        _emit_json(res)
+        return
+    kind = "virtual (stop ignored)" if branch.virtual else "physical"
+    click.echo(f"{len(branch)} points of the period-{branch.period} orbit, {kind}; {branch.status}")
+    for sp_ in res["special"]:
+        mu = ", ".join(f"{x:+.4f}{y:+.4f}i" for x, y in sp_["multipliers"])
+        click.echo(f"  {sp_['kind']:16s} {cparam} = {sp_['value']:.8g}   multipliers {mu}")
+    if out is not None:
+        click.echo(f"branch saved to {out}")
+
+
 @cli.command()
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=Path("report"),
               show_default=True, help="Output folder for index.html and figures.")  # fmt: skip

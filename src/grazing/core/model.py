@@ -154,7 +154,13 @@ class _Definition:
                 "h_x": lambda: sp.Matrix([s.guard]).jacobian(x),
                 "g_x": lambda: sp.Matrix(s.reset).jacobian(x),
                 "h_t": lambda: sp.diff(s.guard, s.time),
+                "h_p": lambda: sp.Matrix([s.guard]).jacobian(sp.Matrix(s.params)),
                 "g_t": lambda: sp.diff(sp.Matrix(s.reset), s.time),
+                "rate": lambda: s.normal_rate,
+                "rate_x": lambda: sp.Matrix([s.normal_rate]).jacobian(x),
+                "rate_t": lambda: sp.diff(s.normal_rate, s.time),
+                "rate_p": lambda: sp.Matrix([s.normal_rate]).jacobian(sp.Matrix(s.params)),
+                "accel": lambda: s.normal_accel,
             }
             fn = sp.lambdify((list(s.states), s.time, list(s.params)), exprs[what](), modules="numpy")
             self._numeric[what] = fn
@@ -392,8 +398,32 @@ class HybridModel:
         ht = float(self._call("h_t", x, t))
         return gx + np.outer(fp - gx @ fm - gt, hx) / (hx @ fm + ht)
 
-    def check_state(self, x: Any, t: float = 0.0) -> np.ndarray:
-        """Return ``x`` as a float array, or raise if it is not an allowed state."""
+    def contact_derivatives(self, x: Any, t: float = 0.0) -> dict[str, Any]:
+        """Guard ``h`` and its rate ``L_f h`` with their derivatives at ``(x, t)``.
+
+        Keys: ``h, h_x, h_t, h_p, rate, rate_x, rate_t, rate_p, accel`` (``accel``
+        is ``L_f^2 h``); ``_p`` derivatives are with respect to every parameter,
+        in the order of :attr:`parameters`.  These define grazing: ``h = 0`` and
+        ``L_f h = 0`` with ``L_f^2 h > 0``.
+        """
+        n, m = self.n_states, len(self.parameters)
+        return {
+            "h": self.guard(x, t),
+            "h_x": np.asarray(self._call("h_x", x, t), dtype=float).reshape(n),
+            "h_t": float(self._call("h_t", x, t)),
+            "h_p": np.asarray(self._call("h_p", x, t), dtype=float).reshape(m),
+            "rate": float(self._call("rate", x, t)),
+            "rate_x": np.asarray(self._call("rate_x", x, t), dtype=float).reshape(n),
+            "rate_t": float(self._call("rate_t", x, t)),
+            "rate_p": np.asarray(self._call("rate_p", x, t), dtype=float).reshape(m),
+            "accel": float(self._call("accel", x, t)),
+        }
+
+    def check_state(self, x: Any, t: float = 0.0, allowed: bool = True) -> np.ndarray:
+        """Return ``x`` as a float array, or raise if it is not a valid state.
+
+        With ``allowed`` (the default) the state must also satisfy the guard.
+        """
         arr = np.asarray(x, dtype=float).reshape(-1)
         if arr.shape != (self.n_states,):
             raise InvalidStateError(
@@ -401,7 +431,7 @@ class HybridModel:
             )
         if not np.all(np.isfinite(arr)):
             raise InvalidStateError(f"state must be finite, got {arr.tolist()}")
-        hv = self.guard(arr, t)
+        hv = self.guard(arr, t) if allowed else 0.0
         if hv < 0:
             raise InvalidStateError(
                 f"initial state {arr.tolist()} is beyond the stop (guard h = {hv:.3g} < 0)"

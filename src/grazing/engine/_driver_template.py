@@ -194,6 +194,7 @@ def integrate(
     track_min,
     record_impacts,
     chatter_time,
+    events,
 ):
     """Integrate until the ``n_samples``-th stroboscopic sample.
 
@@ -201,7 +202,9 @@ def integrate(
     ``ss``, ``ss + T``, ... without wrapping); the last ``n_keep`` are stored
     and define the recorded span (impacts, trajectory, minimum of the guard,
     Lyapunov sums).  ``mode0`` is 0 in free flight, 1 when sticking to the
-    stop; the final mode is returned so that a run can be continued.
+    stop; the final mode is returned so that a run can be continued.  With
+    ``events`` false the guard is ignored (the "virtual" flow through the stop),
+    which is how nonimpacting orbits are continued past grazing.
     """
     n = NX
     ncol = n + NSENS
@@ -299,7 +302,7 @@ def integrate(
             a[j] = 0.0
         while 0 < d < 3 and a[d] == 0.0:
             d += 1
-        u = first_root(a[d:], order - d, work)
+        u = first_root(a[d:], order - d, work) if (events or mode == 1) else -1.0
         event = u >= 0.0 and h > 0.0
         if event and u == 0.0:
             zero_events += 1

@@ -91,6 +91,7 @@ def simulate(
     max_steps: int | None = None,
     chatter_tol: float = DEFAULT_CHATTER_TOL,
     progress: Callable[[int, int], None] | None = None,
+    events: bool = True,
 ) -> Solution:
     """Simulate a hybrid model, never missing an impact.
 
@@ -136,6 +137,9 @@ def simulate(
     chatter_tol
         Threshold (fraction of a period) below which a chattering sequence is
         summed to its accumulation point and continued as sticking.
+    events
+        If False, the guard is ignored: the flow passes through the stop (no
+        impacts).  ``guard_min`` then tells how far past the stop it reaches.
     progress
         Called as ``progress(periods_done, periods_total)`` after every chunk
         of :data:`CHUNK_PERIODS` periods (the run is always chunked the same
@@ -163,7 +167,7 @@ def simulate(
             raise InvalidParameterError(f"{name} must be a finite number, got {val!r}")
     if not 0 < tol < 1e-2:
         raise InvalidParameterError(f"tol must be in (0, 0.01), got {tol}")
-    x = model.check_state(np.zeros(model.n_states) if x0 is None else x0, t0)
+    x = model.check_state(np.zeros(model.n_states) if x0 is None else x0, t0, allowed=events)
     sens = tuple(sensitivities)
     if lyapunov and (jacobian or sens):
         raise InvalidParameterError("lyapunov and jacobian/sensitivities cannot be combined in one run")
@@ -196,6 +200,7 @@ def simulate(
             x, V, k, s, mode, pv, T, model.periodic, order, T, int(max_steps - steps),
             chunk, ks, ss, keep, use_var, bool(lyapunov),
             T / trajectory if trajectory else 0.0, bool(guard_min), _RECORD[impacts], chatter_tol * T,
+            bool(events),
         )  # fmt: skip
         (status, x, V, k, s, mode, nsteps, ni, smp, imp, sticks, traj, logs, lspan, gm, ok) = out
         steps += nsteps

@@ -1,0 +1,22 @@
+"""Periodic orbits: shooting, Floquet multipliers, continuation, grazing curves."""
+
+from grazing.orbits.continuation import Branch, ContinuationSettings, SpecialPoint, continue_orbit
+from grazing.orbits.grazing import GrazingCurve, GrazingPoint, find_grazings, grazing_curve, refine_grazing
+from grazing.orbits.palc import PalcSettings
+from grazing.orbits.shooting import PeriodicOrbit, find_orbit, flow_map
+
+__all__ = [
+    "Branch",
+    "ContinuationSettings",
+    "GrazingCurve",
+    "GrazingPoint",
+    "PalcSettings",
+    "PeriodicOrbit",
+    "SpecialPoint",
+    "continue_orbit",
+    "find_grazings",
+    "find_orbit",
+    "flow_map",
+    "grazing_curve",
+    "refine_grazing",
+]
