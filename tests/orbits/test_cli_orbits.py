@@ -73,7 +73,7 @@ def test_continue_json_and_netcdf(capsys, tmp_path):
 def test_errors_are_one_line(argv, message, capsys, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     code = main(argv)
-    out, err = capsys.readouterr()
+    _out, err = capsys.readouterr()
     assert code != 0
     assert message in err
     assert len(err.strip().splitlines()) == 1

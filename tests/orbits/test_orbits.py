@@ -11,7 +11,6 @@ import grazing
 from grazing import ConvergenceError
 from grazing.models import pendulum
 from grazing.orbits import (
-    PalcSettings,
     continue_orbit,
     find_grazings,
     find_orbit,
@@ -83,7 +82,7 @@ def test_no_orbit_of_that_period_is_a_clear_error():
 
 def test_grazings_at_40_degrees_match_the_paper():
     """Fig 6 insets (b), (c): eta = 0.4450 with 0.4606 +- 0.2137i; 0.5475 with 0.2534 +- 0.5178i."""
-    points, branch = find_grazings(pendulum("B", theta_hat=40 * DEG), "eta", 0.2, 1.0)
+    points, _branch = find_grazings(pendulum("B", theta_hat=40 * DEG), "eta", 0.2, 1.0)
     assert len(points) == 2
     g1, g2 = points
     assert g1.model.params["eta"] == pytest.approx(0.4450, abs=5e-4)

@@ -4,14 +4,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
 
 from grazing.core.model import HybridModel
 from grazing.core.solution import Impacts, Solution
-from grazing.errors import InvalidParameterError, SimulationError
+from grazing.engine.runner import RECORD_IMPACTS, Runner
+from grazing.errors import InvalidParameterError
 
 DEFAULT_TOL = 2.220446049250313e-16
 """Default local error tolerance of the Taylor integrator (machine epsilon)."""
@@ -23,46 +23,7 @@ forcing period is summed in closed form and continued as sticking."""
 CHUNK_PERIODS = 4096
 """Runs are integrated in chunks of this many forcing periods."""
 
-_RECORD = {"none": 0, "sampled": 1, "all": 2}
-
-
-def taylor_order(tol: float) -> int:
-    """Order of the Taylor method for a tolerance (Jorba & Zou): ``ceil(-ln(tol)/2 + 1)``.
-
-    Examples
-    --------
-    >>> taylor_order(2.220446049250313e-16)
-    20
-    """
-    return int(min(60, max(6, math.ceil(-math.log(tol) / 2 + 1))))
-
-
-@dataclass(frozen=True)
-class _Timing:
-    k0: int
-    s0: float
-    ks: int
-    ss: float
-
-
-def _time_layout(model: HybridModel, t0: float, phase: float) -> _Timing:
-    """Split ``t0`` into (periods, local time) and locate the first sample.
-
-    The first sample is the first time after ``t0`` at the sampling phase; a
-    ``t0`` within ``1e-9 T`` of a sampling time (say ``t0 = 405 * 2 pi``,
-    which rounds to just below the period boundary) counts as that time.
-    """
-    T = model.period
-    snap = 1e-9 * T
-    s_phase = (phase % (2 * math.pi)) / (2 * math.pi) * T
-    if not model.periodic:
-        return _Timing(0, t0, 0, t0 + T)
-    k0 = math.floor(t0 / T)
-    s0 = t0 - k0 * T
-    if s0 >= T - snap:  # just below a period boundary: keep s0 slightly negative
-        k0, s0 = k0 + 1, s0 - T
-    ks = k0 if s0 < s_phase - snap else k0 + 1
-    return _Timing(k0, s0, ks, s_phase)
+_RECORD = RECORD_IMPACTS
 
 
 def _check_count(name: str, value: int, minimum: int) -> int:
@@ -172,19 +133,16 @@ def simulate(
     if lyapunov and (jacobian or sens):
         raise InvalidParameterError("lyapunov and jacobian/sensitivities cannot be combined in one run")
     use_var = bool(jacobian or sens or lyapunov)
-    kern = model.kernels(sens if use_var else ())
     n = model.n_states
-    V = np.zeros((n, n + len(sens)))
-    V[:, :n] = np.eye(n)
     T = model.period
-    lay = _time_layout(model, float(t0), float(phase))
+    run = Runner(
+        model, x, t0=float(t0), phase=float(phase), tol=tol, variational=use_var,
+        sensitivities=sens, events=events, chatter_tol=chatter_tol,
+    )  # fmt: skip
+    first_sample = run.next_sample_time
     total = transient + periods
     if max_steps is None:
         max_steps = 20000 * total + 100_000
-    order = taylor_order(tol)
-    pv = model.param_vector
-    k, s, mode = lay.k0, lay.s0, 0
-    ks, ss = lay.ks, lay.ss
     done = 0
     steps = 0
     n_imp = 0
@@ -196,39 +154,31 @@ def simulate(
     while done < total:
         chunk = min(CHUNK_PERIODS, total - done)
         keep = max(0, done + chunk - transient) - max(0, done - transient)
-        out = kern.integrate(
-            x, V, k, s, mode, pv, T, model.periodic, order, T, int(max_steps - steps),
-            chunk, ks, ss, keep, use_var, bool(lyapunov),
-            T / trajectory if trajectory else 0.0, bool(guard_min), _RECORD[impacts], chatter_tol * T,
-            bool(events),
+        seg = run.advance(
+            chunk, keep, lyapunov=lyapunov, guard_min=guard_min, impacts=impacts,
+            trajectory=trajectory, max_steps=max_steps - steps,
         )  # fmt: skip
-        (status, x, V, k, s, mode, nsteps, ni, smp, imp, sticks, traj, logs, lspan, gm, ok) = out
-        steps += nsteps
-        if status != 0:
-            raise SimulationError(_failure(int(status), k * T + s, max_steps))
-        n_imp += ni
-        jac_ok = jac_ok and bool(ok)
-        recorded_before = done > transient
-        if traj.shape[0] and recorded_before and parts["traj"]:
+        steps += seg.steps
+        n_imp += seg.n_impacts
+        jac_ok = jac_ok and seg.jacobian_valid
+        traj = seg.trajectory
+        if traj.shape[0] and done > transient and parts["traj"]:
             traj = traj[1:]  # the chunk's first point repeats the previous chunk's last
-        for key, arr in (("samples", smp), ("imp", imp), ("sticks", sticks), ("traj", traj)):
+        for key, arr in (
+            ("samples", seg.samples),
+            ("imp", seg.impacts),
+            ("sticks", seg.sticking),
+            ("traj", traj),
+        ):
             parts[key].append(arr)
-        log_sum += logs
-        lyap_span += lspan
-        if guard_min and keep and (gmin is None or gm[0] < gmin[0]):
-            gmin = gm
+        log_sum += seg.log_sums
+        lyap_span += seg.lyap_span
+        if guard_min and keep and (gmin is None or seg.guard_min[0] < gmin[0]):
+            gmin = seg.guard_min
         done += chunk
-        if model.periodic:
-            ks += chunk
-        else:
-            ss += chunk * T
         if progress is not None:
             progress(done, total)
-    tf = k * T + s
-    if model.periodic:
-        t_samples = (lay.ks + transient + np.arange(periods)) * T + lay.ss
-    else:
-        t_samples = lay.ss + (transient + np.arange(periods)) * T
+    t_samples = first_sample + (transient + np.arange(periods)) * T
     imp = _concat(parts["imp"], 2 + n)
     traj = _concat(parts["traj"], 1 + n)
     imp_t = imp[:, 0]
@@ -239,28 +189,17 @@ def simulate(
         impacts=Impacts(t=imp_t, phase=np.mod(imp_t, T) / T * 2 * math.pi, speed=imp[:, 1], state=imp[:, 2:]),
         n_impacts=int(n_imp),
         sticking=_merge_intervals(_concat(parts["sticks"], 2)),
-        t_final=float(tf),
-        x_final=x,
+        t_final=run.t,
+        x_final=run.x,
         n_steps=int(steps),
         trajectory_t=traj[:, 0] if trajectory else None,
         trajectory=traj[:, 1:] if trajectory else None,
-        jacobian=V if (use_var and not lyapunov) else None,
+        jacobian=run.V if (use_var and not lyapunov) else None,
         jacobian_valid=jac_ok,
         lyapunov=log_sum / lyap_span if lyapunov else None,
         guard_min=(float(gmin[0]), float(gmin[1]), gmin[2:].copy()) if gmin is not None else None,
-        info={"order": order, "tol": tol, "transient": transient, "phase": phase},
+        info={"order": run.order, "tol": tol, "transient": transient, "phase": phase},
     )
-
-
-def _failure(status: int, t: float, max_steps: int) -> str:
-    return {
-        1: f"step limit of {max_steps} steps reached at t = {t:.6g}",
-        2: f"the state became non-finite at t = {t:.6g}",
-        3: (
-            f"impacts accumulate at t = {t:.6g} and cannot be continued "
-            "(the model defines no contact_direction for sticking)"
-        ),
-    }.get(status, f"integration failed with status {status}")
 
 
 def _concat(arrays: list[np.ndarray], width: int) -> np.ndarray:

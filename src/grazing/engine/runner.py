@@ -1,0 +1,176 @@
+"""A trajectory advanced in whole forcing periods: the engine's low-level interface.
+
+:class:`Runner` holds the state of one trajectory (state, variational matrix,
+time split as ``k T + s``, contact mode) and the compiled kernels, and
+advances it by a number of stroboscopic periods per call, returning the raw
+outputs of the compiled driver.  :func:`grazing.simulate` and the sweeps are
+built on it; it does no input validation.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from grazing.core.model import HybridModel
+from grazing.errors import SimulationError
+
+RECORD_IMPACTS = {"none": 0, "sampled": 1, "all": 2}
+
+
+def taylor_order(tol: float) -> int:
+    """Order of the Taylor method for a tolerance (Jorba & Zou): ``ceil(-ln(tol)/2 + 1)``.
+
+    Examples
+    --------
+    >>> taylor_order(2.220446049250313e-16)
+    20
+    """
+    return int(min(60, max(6, math.ceil(-math.log(tol) / 2 + 1))))
+
+
+@dataclass(frozen=True)
+class Segment:
+    """Raw outputs of one :meth:`Runner.advance` call (see the driver for details)."""
+
+    samples: np.ndarray
+    impacts: np.ndarray  # rows [t, speed, state...]
+    n_impacts: int
+    sticking: np.ndarray
+    trajectory: np.ndarray  # rows [t, state...]
+    log_sums: np.ndarray
+    lyap_span: float
+    guard_min: np.ndarray  # [h_min, t, state...]
+    jacobian_valid: bool
+    steps: int
+
+
+class Runner:
+    """One trajectory of ``model``, advanced period by period.
+
+    Parameters
+    ----------
+    model
+        Model with parameter values.
+    x
+        State at time ``t0`` (not validated).
+    t0
+        Initial time.
+    phase
+        Stroboscopic phase in radians: samples at ``t = (phase/2pi + k) T``.
+    tol
+        Local error tolerance.
+    variational
+        Integrate the variational equations (Jacobian or Lyapunov exponents).
+    sensitivities
+        Parameters whose derivatives are appended to the Jacobian.
+    events
+        Apply impacts (False: the flow passes through the stop).
+    chatter_tol
+        Chattering summation threshold, as a fraction of the period.
+    """
+
+    def __init__(
+        self,
+        model: HybridModel,
+        x: np.ndarray,
+        *,
+        t0: float = 0.0,
+        phase: float = 0.0,
+        tol: float = 2.220446049250313e-16,
+        variational: bool = False,
+        sensitivities: Sequence[str] = (),
+        events: bool = True,
+        chatter_tol: float = 1e-9,
+    ):
+        self.model = model
+        self.kern = model.kernels(tuple(sensitivities) if variational else ())
+        n = model.n_states
+        self.x = np.array(x, dtype=float)
+        self.V = np.zeros((n, n + len(sensitivities)))
+        self.V[:, :n] = np.eye(n)
+        self.variational = variational
+        self.events = events
+        self.T = model.period
+        self.order = taylor_order(tol)
+        self.pv = model.param_vector
+        self.chatter_time = chatter_tol * self.T
+        T = self.T
+        snap = 1e-9 * T
+        s_phase = (phase % (2 * math.pi)) / (2 * math.pi) * T
+        self.mode = 0
+        if not model.periodic:
+            self.k, self.s, self.ks, self.ss = 0, float(t0), 0, float(t0) + T
+            return
+        k0 = math.floor(t0 / T)
+        s0 = t0 - k0 * T
+        if s0 >= T - snap:  # just below a period boundary: keep s0 slightly negative
+            k0, s0 = k0 + 1, s0 - T
+        self.k, self.s = k0, s0
+        self.ks = k0 if s0 < s_phase - snap else k0 + 1
+        self.ss = s_phase
+
+    @property
+    def t(self) -> float:
+        """Current time."""
+        return self.k * self.T + self.s
+
+    @property
+    def next_sample_time(self) -> float:
+        return self.ks * self.T + self.ss if self.model.periodic else self.ss
+
+    def set_params(self, model: HybridModel) -> None:
+        """Continue with other parameter values of the same model (same period)."""
+        self.model = model
+        self.pv = model.param_vector
+
+    def reset_variational(self) -> None:
+        n = self.model.n_states
+        self.V[:] = 0.0
+        self.V[:, :n] = np.eye(n)
+
+    def advance(
+        self,
+        periods: int,
+        keep: int,
+        *,
+        lyapunov: bool = False,
+        guard_min: bool = False,
+        impacts: str = "none",
+        trajectory: int = 0,
+        max_steps: int | None = None,
+    ) -> Segment:
+        """Advance by ``periods`` samples, keeping (recording) the last ``keep``."""
+        T = self.T
+        if max_steps is None:
+            max_steps = 20000 * periods + 100_000
+        out = self.kern.integrate(
+            self.x, self.V, self.k, self.s, self.mode, self.pv, T, self.model.periodic, self.order, T,
+            int(max_steps), periods, self.ks, self.ss, keep, self.variational, lyapunov,
+            T / trajectory if trajectory else 0.0, guard_min, RECORD_IMPACTS[impacts], self.chatter_time,
+            self.events,
+        )  # fmt: skip
+        (status, x, V, k, s, mode, nsteps, n_imp, smp, imp, sticks, traj, logs, lspan, gm, ok) = out
+        if status != 0:
+            raise SimulationError(failure_message(int(status), k * T + s, max_steps))
+        self.x, self.V, self.k, self.s, self.mode = x, V, k, s, mode
+        if self.model.periodic:
+            self.ks += periods
+        else:
+            self.ss += periods * T
+        return Segment(smp, imp, int(n_imp), sticks, traj, logs, float(lspan), gm, bool(ok), int(nsteps))
+
+
+def failure_message(status: int, t: float, max_steps: int) -> str:
+    """The user-facing message for a driver status code."""
+    return {
+        1: f"step limit of {max_steps} steps reached at t = {t:.6g}",
+        2: f"the state became non-finite at t = {t:.6g}",
+        3: (
+            f"impacts accumulate at t = {t:.6g} and cannot be continued "
+            "(the model defines no contact_direction for sticking)"
+        ),
+    }.get(status, f"integration failed with status {status}")
