@@ -619,6 +619,219 @@ def continue_(
         click.echo(f"branch saved to {out}")
 
 
+_SWEEP_PARAMS = {"eta": "eta", "theta-hat": "theta_hat", "alpha": "alpha", "beta": "beta", "r": "r"}
+
+
+def _sweep_options(func: Callable[..., Any]) -> Callable[..., Any]:
+    options = [
+        click.option("--transient", type=click.IntRange(min=0), default=500, show_default=True,
+                     help="Forcing periods discarded at each point.")
+        ,
+        click.option("--periods", type=click.IntRange(min=1), default=100, show_default=True,
+                     help="Forcing periods sampled at each point."),
+        click.option("--initial", default="0,0", show_default=True, metavar="THETA,THETADOT",
+                     help="Initial state (of every chunk; of every point with --fresh)."),
+        click.option("--fresh", is_flag=True, help="Start every point from --initial."),
+        click.option("--chunk-size", type=click.IntRange(min=0), default=None,
+                     help="Points per chunk: the unit of parallel work and of saving (0: one chunk)."),
+        click.option("--workers", type=click.IntRange(min=1), help="Local processes (default: all cores)."),
+        click.option("--scheduler", metavar="tcp://HOST:PORT", help="Run the chunks on a Dask cluster."),
+        click.option("--no-lyapunov", is_flag=True, help="Skip the Lyapunov exponents."),
+        click.option("--no-adaptive", is_flag=True, help="Always run the full transient."),
+        click.option("--tol", type=float, default=1e-10, show_default=True, help="Integrator tolerance."),
+        click.option("--out", type=click.Path(path_type=Path), metavar="FILE.zarr|FILE.nc",
+                     help="Zarr store (resumable) or NetCDF file."),
+        click.option("--json", "as_json", is_flag=True, help="Print one JSON object."),
+    ]  # fmt: skip
+    for opt in reversed(options):
+        func = opt(func)
+    return func
+
+
+def _prepare_out(out: Path | None) -> None:
+    if out is None:
+        return
+    if out.suffix.lower() not in (".zarr", ".nc"):
+        raise _ErrorInput(f"--out must end in .zarr or .nc, got {str(out)!r}")
+    folder = out.parent if str(out.parent) else Path(".")
+    if not folder.is_dir():
+        raise _ErrorInput(f"folder {str(folder)!r} does not exist")
+
+
+def _run_sweep_spec(
+    spec: Any, out: Path | None, scheduler: str | None, workers: int | None, as_json: bool
+) -> Any:
+    """Run a sweep spec with the CLI's storage, cluster and progress options."""
+    from grazing.sweeps.sweep import run_sweep
+
+    store = None
+    if out is not None and out.suffix.lower() == ".zarr":
+        from grazing.sweeps.store import ZarrStore
+
+        store = ZarrStore(out, spec, attrs={"command": " ".join(["grazing", *sys.argv[1:]])})
+    client = None
+    if scheduler is not None:
+        try:
+            from distributed import Client
+
+            client = Client(scheduler, timeout="5s")
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise _ErrorInput(f"cannot connect to the Dask scheduler at {scheduler}: {exc}") from None
+    bar = _Progress("sweeping", enabled=not as_json)
+    try:
+        ds = run_sweep(spec, store=store, workers=workers, client=client, progress=bar)
+    finally:
+        bar.close()
+        if client is not None:
+            client.close()
+    if out is not None and out.suffix.lower() == ".nc":
+        _save_dataset(ds, out)
+    return ds
+
+
+def _sweep_json(ds: Any, param: str, values: np.ndarray) -> dict[str, Any]:
+    return {
+        "param": param,
+        "values": values,
+        "period": ds.period.values,
+        "impacts_per_period": np.where(
+            np.isfinite(ds.impacts_per_period.values), ds.impacts_per_period.values, None
+        ),
+        "lyapunov": [None if not math.isfinite(v) else float(v) for v in ds.lyapunov.values],
+        "samples": ds.samples.values[..., 0],
+        "transient_used": ds.transient_used.values,
+    }
+
+
+@cli.command("sweep")
+@model_options
+@click.option("--param", "sparam", required=True, type=click.Choice(list(_SWEEP_PARAMS)),
+              help="Parameter to sweep (theta-hat in degrees).")  # fmt: skip
+@click.option("--start", type=float, required=True, help="First parameter value.")
+@click.option("--stop", type=float, required=True, help="Last parameter value.")
+@click.option("--num", type=click.IntRange(min=1), required=True, help="Number of parameter values.")
+@click.option("--direction", type=click.Choice(["up", "down"]), default="up", show_default=True,
+              help="Order in which the values are visited.")  # fmt: skip
+@click.option("--method", type=click.Choice(["flow", "map"]), default="flow", show_default=True,
+              help="flow: direct simulation.")  # fmt: skip
+@_sweep_options
+def sweep_cmd(
+    case: str, alpha: float | None, beta: float | None, r: float | None, eta: float, theta_hat: float,
+    sparam: str, start: float, stop: float, num: int, direction: str, method: str,
+    transient: int, periods: int, initial: str, fresh: bool, chunk_size: int | None, workers: int | None,
+    scheduler: str | None, no_lyapunov: bool, no_adaptive: bool, tol: float, out: Path | None, as_json: bool,
+) -> None:  # fmt: skip
+    """Brute-force bifurcation diagram: stroboscopic samples, periods, impacts and
+    Lyapunov exponents along a parameter range."""
+    from grazing.sweeps.sweep import SweepSpec
+
+    if method != "flow":
+        raise _ErrorInput("--method map needs the normal-form map (not available yet)")
+    model = build_pendulum(case, alpha, beta, r, eta, theta_hat)
+    name = _SWEEP_PARAMS[sparam]
+    if not (math.isfinite(start) and math.isfinite(stop)):
+        raise _ErrorInput("--start and --stop must be finite")
+    if not (math.isfinite(tol) and 0 < tol < 1e-2):
+        raise _ErrorInput(f"--tol must be in (0, 0.01), got {tol:g}")
+    _prepare_out(out)
+    shown = np.linspace(start, stop, num)
+    vals = np.radians(shown) if name == "theta_hat" else shown
+    order = np.sort(vals) if direction == "up" else np.sort(vals)[::-1]
+    x0 = _parse_pair(initial)
+    for v in (order[0], order[-1]):
+        model.with_params(**{name: v})
+    spec = SweepSpec(
+        model=model, params=(name,), points=tuple((float(v),) for v in order),
+        x0=tuple(float(v) for v in model.with_params(**{name: order[0]}).check_state(x0)),
+        transient=transient, periods=periods, fresh=fresh,
+        chunk_size=50 if chunk_size is None else chunk_size,
+        adaptive=not no_adaptive, lyapunov=not no_lyapunov, tol=tol,
+    )  # fmt: skip
+    t0 = time.perf_counter()
+    ds = _run_sweep_spec(spec, out, scheduler, workers, as_json).sortby("value")
+    elapsed = time.perf_counter() - t0
+    res = {"params": model_params_json(model, case), **_sweep_json(ds, sparam, np.sort(shown))}
+    res.update({"direction": direction, "fresh": fresh, "transient": transient, "periods": periods,
+                "chunk_size": spec.size, "elapsed_s": elapsed, "out": str(out) if out else None})  # fmt: skip
+    if as_json:
+        _emit_json(res)
+        return
+    per = ds.period.values
+    click.echo(f"{num} values of {sparam} in {elapsed:.1f} s ({num / elapsed:.0f} points/s)")
+    click.echo(f"periodic points: {(per > 0).sum()}, no period <= 64: {(per == 0).sum()}")
+    for p in sorted(set(per[per > 0].tolist()))[:12]:
+        sel = np.sort(shown)[per == p]
+        click.echo(f"  period {p:2d}: {sel.size} points, {sparam} in [{sel.min():.6g}, {sel.max():.6g}]")
+    if out is not None:
+        click.echo(f"saved to {out}")
+
+
+@cli.command("map")
+@model_options
+@click.option("--param1", required=True, type=click.Choice(list(_SWEEP_PARAMS)), help="Horizontal parameter.")
+@click.option("--start1", type=float, required=True)
+@click.option("--stop1", type=float, required=True)
+@click.option("--num1", type=click.IntRange(min=1), required=True)
+@click.option("--param2", required=True, type=click.Choice(list(_SWEEP_PARAMS)), help="Vertical parameter.")
+@click.option("--start2", type=float, required=True)
+@click.option("--stop2", type=float, required=True)
+@click.option("--num2", type=click.IntRange(min=1), required=True)
+@_sweep_options
+def map_cmd(
+    case: str, alpha: float | None, beta: float | None, r: float | None, eta: float, theta_hat: float,
+    param1: str, start1: float, stop1: float, num1: int, param2: str, start2: float, stop2: float, num2: int,
+    transient: int, periods: int, initial: str, fresh: bool, chunk_size: int | None, workers: int | None,
+    scheduler: str | None, no_lyapunov: bool, no_adaptive: bool, tol: float, out: Path | None, as_json: bool,
+) -> None:  # fmt: skip
+    """Two-parameter map of periods, impacts and Lyapunov exponents."""
+    from grazing.sweeps.sweep import SweepSpec
+
+    if param1 == param2:
+        raise _ErrorInput("--param1 and --param2 must differ")
+    model = build_pendulum(case, alpha, beta, r, eta, theta_hat)
+    n1, n2 = _SWEEP_PARAMS[param1], _SWEEP_PARAMS[param2]
+    for v in (start1, stop1, start2, stop2):
+        if not math.isfinite(v):
+            raise _ErrorInput("parameter ranges must be finite")
+    _prepare_out(out)
+    s1, s2 = np.linspace(start1, stop1, num1), np.linspace(start2, stop2, num2)
+    v1 = np.radians(s1) if n1 == "theta_hat" else s1
+    v2 = np.radians(s2) if n2 == "theta_hat" else s2
+    v1, v2 = np.sort(v1), np.sort(v2)
+    for a, b in ((v1[0], v2[0]), (v1[-1], v2[-1])):
+        model.with_params(**{n1: a, n2: b})
+    x0 = _parse_pair(initial)
+    spec = SweepSpec(
+        model=model, params=(n1, n2), points=tuple((float(a), float(b)) for b in v2 for a in v1),
+        x0=tuple(float(v) for v in model.with_params(**{n1: v1[0], n2: v2[0]}).check_state(x0)),
+        transient=transient, periods=periods, fresh=fresh,
+        chunk_size=num1 if chunk_size is None else chunk_size,
+        adaptive=not no_adaptive, lyapunov=not no_lyapunov, tol=tol, shape=(num2, num1),
+    )  # fmt: skip
+    t0 = time.perf_counter()
+    ds = _run_sweep_spec(spec, out, scheduler, workers, as_json)
+    elapsed = time.perf_counter() - t0
+    res = {
+        "params": model_params_json(model, case),
+        "param1": param1, "values1": np.sort(s1), "param2": param2, "values2": np.sort(s2),
+        "period": ds.period.values, "impacts_per_period": ds.impacts_per_period.values,
+        "lyapunov": ds.lyapunov.values, "elapsed_s": elapsed, "out": str(out) if out else None,
+    }  # fmt: skip
+    if as_json:
+        res["impacts_per_period"] = [
+            [None if not math.isfinite(x) else x for x in row] for row in res["impacts_per_period"]
+        ]
+        res["lyapunov"] = [[None if not math.isfinite(x) else x for x in row] for row in res["lyapunov"]]
+        _emit_json(res)
+        return
+    per = ds.period.values
+    click.echo(
+        f"{num1} x {num2} map in {elapsed:.1f} s; periodic cells {(per > 0).sum()}, none {(per == 0).sum()}"
+    )
+    if out is not None:
+        click.echo(f"saved to {out}")
+
+
 @cli.command()
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=Path("report"),
               show_default=True, help="Output folder for index.html and figures.")  # fmt: skip

@@ -63,3 +63,13 @@ def test_matches_smallest_simple_root(roots, extra):
         a = -a
     u = _first_root(a)
     assert u == pytest.approx(roots[0], abs=1e-9)
+
+
+@settings(max_examples=300, deadline=None)
+@given(coeffs=st.lists(st.floats(-2.0, 2.0), min_size=1, max_size=12))
+def test_quadratic_lower_bound_is_a_lower_bound(coeffs):
+    from grazing.engine.polyroots import quadratic_lower_bound
+
+    a = np.asarray(coeffs, dtype=float)
+    u = np.linspace(0.0, 1.0, 2001)
+    assert quadratic_lower_bound(a, a.size - 1) <= P.polyval(u, a).min() + 1e-12

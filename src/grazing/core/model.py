@@ -14,6 +14,7 @@ returns a copy with other values that shares the compiled kernels.
 
 from __future__ import annotations
 
+import hashlib
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
@@ -76,6 +77,18 @@ class Parameter:
 
 class _Definition:
     """The parameter-independent part of a model, shared by all its copies."""
+
+    @classmethod
+    def get(cls, *args: Any) -> _Definition:
+        """The definition for these constructor arguments, reusing an existing one."""
+        key = hashlib.sha256(repr([sp.srepr(a) if isinstance(a, sp.Basic) else _srepr(a) for a in args]).encode())
+        digest = key.hexdigest()
+        found = _DEFINITIONS.get(digest)
+        if found is None:
+            found = cls(*args)
+            found.args = args
+            _DEFINITIONS[digest] = found
+        return found
 
     def __init__(
         self,
@@ -177,6 +190,22 @@ class _Definition:
         return float(self._period_fn(list(values)))
 
 
+def _srepr(obj: Any) -> str:
+    if isinstance(obj, sp.Basic):
+        return sp.srepr(obj)
+    if isinstance(obj, (list, tuple)):
+        return "(" + ",".join(_srepr(o) for o in obj) + ")"
+    return repr(obj)
+
+
+_DEFINITIONS: dict[str, _Definition] = {}
+
+
+def _rebuild(args: tuple[Any, ...], values: dict[str, float]) -> HybridModel:
+    """Unpickle a model: reuse (or build) its definition, then set the values."""
+    return HybridModel._from(_Definition.get(*args), dict(values))
+
+
 class HybridModel:
     """A hybrid dynamical system ``x' = f(x, t)``, ``h(x, t) > 0``, ``x <- g(x, t)``.
 
@@ -249,7 +278,7 @@ class HybridModel:
         reference: str = "",
         values: Mapping[str, float] | None = None,
     ):
-        self._def = _Definition(
+        self._def = _Definition.get(
             name,
             states,
             time,
@@ -287,6 +316,9 @@ class HybridModel:
         if not (math.isfinite(period) and period > 0):
             raise InvalidParameterError(f"the forcing period must be positive, got {period}")
         return out
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (_rebuild, (self._def.args, self._values))
 
     def with_params(self, **changes: float) -> HybridModel:
         """A copy of this model with some parameter values changed (validated)."""

@@ -99,6 +99,28 @@ def _polish(a, n, lo, hi):
 
 
 @njit(cache=True)
+def quadratic_lower_bound(a, n):
+    """A lower bound of the polynomial on [0, 1] in O(n).
+
+    The exact minimum of ``a0 + a1 u + a2 u^2`` on [0, 1], minus the largest
+    possible contribution of the higher terms, ``sum_{k>=3} |a_k|``.  Taylor
+    coefficients scaled by the step decay geometrically, so this bound is
+    tight except where the polynomial really comes close to zero.
+    """
+    a0 = a[0]
+    a1 = a[1] if n >= 1 else 0.0
+    a2 = a[2] if n >= 2 else 0.0
+    low = min(a0, a0 + a1 + a2)
+    if a2 > 0.0:
+        um = -a1 / (2.0 * a2)
+        if 0.0 < um < 1.0:
+            low = min(low, a0 - a1 * a1 / (4.0 * a2))
+    for k in range(3, n + 1):
+        low -= abs(a[k])
+    return low
+
+
+@njit(cache=True)
 def first_root(a, n, work):
     """First ``u`` in [0, 1] where the polynomial ``a[:n+1]`` becomes <= 0.
 
@@ -111,12 +133,8 @@ def first_root(a, n, work):
     """
     if a[0] <= 0.0:
         return 0.0
-    # Cheap certificate: on [0, 1], p(u) >= a0 + sum(min(a_k, 0)).
-    low = a[0]
-    for k in range(1, n + 1):
-        if a[k] < 0.0:
-            low += a[k]
-    if low > 0.0:
+    # Cheap certificate: on [0, 1], p(u) >= min(quadratic part) - sum_{k>=3} |a_k|.
+    if quadratic_lower_bound(a, n) > 0.0:
         return -1.0
     # Bernstein coefficients all positive => no root (convex hull property).
     b = work[0]

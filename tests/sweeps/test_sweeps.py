@@ -1,0 +1,273 @@
+"""Sweeps: known windows, Lyapunov exponents, adaptive transients, storage, clusters."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import grazing
+from grazing.cli import main
+from grazing.models import pendulum
+from grazing.orbits import find_orbit
+from grazing.sweeps import parameter_map, sweep
+from grazing.sweeps.store import StoreMismatchError, ZarrStore
+from grazing.sweeps.sweep import SweepSpec, run_chunk
+
+DEG = math.pi / 180
+M40 = pendulum("B", theta_hat=40 * DEG)
+
+
+# --------------------------------------------------------------------------
+# Periods of known windows, cross-checked by shooting
+
+
+@pytest.fixture(scope="module")
+def window_sweep():
+    etas = np.array([0.440, 0.44537, 0.4480, 0.4550, 0.4700, 0.5000])
+    return etas, sweep(M40, "eta", etas, fresh=True, workers=1, transient=800)
+
+
+def test_periods_of_the_period_adding_windows(window_sweep):
+    """theta_hat = 40 deg (fig 7d): nonimpacting period 1 before grazing (eta = 0.44512), a chaotic
+    band just past it (0.44535-0.4454, between the period-6 and period-5 windows), then windows of
+    period 4, 3, 2 and the period-1 impacting orbit: the reverse period-adding cascade."""
+    etas, ds = window_sweep
+    assert ds.period.values.tolist() == [1, 0, 4, 3, 2, 1]
+    assert ds.impacts.values[0] == 0 and ds.impacts.values[-1] == ds.sizes["sample"]
+
+
+def test_windows_agree_with_shooting(window_sweep):
+    """Every periodic point of the sweep is a stable orbit found independently by Newton."""
+    etas, ds = window_sweep
+    for eta, p, samples in zip(etas, ds.period.values, ds.samples.values):
+        if p <= 0:
+            continue
+        orbit = find_orbit(M40.with_params(eta=float(eta)), samples[-1], period=int(p))
+        assert orbit.stable
+        assert np.min(np.max(np.abs(samples[-p:] - orbit.state), axis=1)) < 1e-8
+
+
+def test_lyapunov_exponents(window_sweep):
+    etas, ds = window_sweep
+    lyap = ds.lyapunov.values
+    # periodic points: ln|mu_max| / (2 pi p) from the Floquet multipliers
+    for eta, p, lam, samples in zip(etas, ds.period.values, lyap, ds.samples.values):
+        if p <= 0:
+            continue
+        orbit = find_orbit(M40.with_params(eta=float(eta)), samples[-1], period=int(p))
+        expected = math.log(orbit.abs_lambda) / (2 * math.pi * p)
+        assert lam == pytest.approx(expected, abs=0.01 * abs(expected) + 2e-3)
+    # chaos just past grazing: positive
+    assert lyap[1] > 2e-3
+
+
+def test_chaotic_points_have_positive_exponents_and_no_period():
+    """The chaotic band between the period-6 and period-5 windows (0.44535-0.44538)."""
+    ds = sweep(M40, "eta", [0.44535, 0.44536, 0.44537], fresh=True, workers=1, transient=1000, periods=1000)
+    assert np.all(ds.period.values == 0)
+    assert np.all(ds.lyapunov.values > 0.005)
+
+
+# --------------------------------------------------------------------------
+# Adaptive transients
+
+
+@pytest.mark.parametrize(
+    ("fresh", "lo", "hi"),
+    [
+        (True, 0.44, 0.49),  # fresh: every point starts from x0; chaos and windows alike
+        (False, 0.465, 0.49),  # continuation without chaos (see the note in sweeps.sweep)
+    ],
+)
+def test_adaptive_transient_gives_the_same_periods(fresh, lo, hi):
+    etas = np.linspace(lo, hi, 60)
+    kw = dict(fresh=fresh, workers=1, lyapunov=False, chunk_size=20)
+    a = sweep(M40, "eta", etas, adaptive=True, **kw)
+    b = sweep(M40, "eta", etas, adaptive=False, **kw)
+    np.testing.assert_array_equal(a.period.values, b.period.values)
+    assert a.transient_used.values.mean() < 0.7 * b.transient_used.values.mean()
+    # same orbit at the same point of its cycle
+    periodic = a.period.values > 0
+    np.testing.assert_allclose(a.samples.values[periodic], b.samples.values[periodic], atol=1e-7)
+
+
+def test_sweep_direction_and_order():
+    etas = np.linspace(0.40, 0.43, 4)
+    up = sweep(M40, "eta", etas, direction="up", workers=1, periods=20)
+    down = sweep(M40, "eta", etas, direction="down", workers=1, periods=20)
+    np.testing.assert_allclose(up.value.values, etas)
+    np.testing.assert_allclose(down.value.values, etas)  # results are returned in increasing order
+    np.testing.assert_array_equal(up.period.values, down.period.values)
+    np.testing.assert_allclose(up.samples.values, down.samples.values, atol=1e-8)  # unique attractor
+
+
+def test_two_parameter_map_shape():
+    ds = parameter_map(M40, "eta", np.linspace(0.40, 0.55, 6), "theta_hat", np.radians([10, 30, 50]),
+                       periods=40, workers=1)  # fmt: skip
+    assert ds.period.dims == ("theta_hat", "eta")
+    assert ds.period.shape == (3, 6)
+    assert ds.period.values[2, 0] == 1  # 50 deg, far from resonance: nonimpacting period 1
+    assert ds.impacts.values[2, 0] == 0
+
+
+# --------------------------------------------------------------------------
+# Storage: Zarr, resume after SIGKILL, refusal of other sweeps, NetCDF
+
+
+def _spec(**kw):
+    base = dict(model=M40, params=("eta",), points=tuple((float(v),) for v in np.linspace(0.44, 0.46, 12)),
+                x0=(0.0, 0.0), transient=200, periods=30, chunk_size=4)  # fmt: skip
+    base.update(kw)
+    return SweepSpec(**base)
+
+
+def test_zarr_store_roundtrip_and_mismatch(tmp_path):
+    from grazing.sweeps import run_sweep
+
+    spec = _spec()
+    path = tmp_path / "s.zarr"
+    ds = run_sweep(spec, store=ZarrStore(path, spec), workers=1)
+    ref = run_sweep(spec, workers=1)
+    np.testing.assert_array_equal(ds.samples.values, ref.samples.values)
+    np.testing.assert_array_equal(ds.period.values, ref.period.values)
+    # reopening computes nothing and returns the same
+    again = run_sweep(spec, store=ZarrStore(path, spec), workers=1)
+    np.testing.assert_array_equal(again.samples.values, ref.samples.values)
+    with pytest.raises(StoreMismatchError, match=r"differs in transient \(200 in the store, 300 now\)"):
+        ZarrStore(path, _spec(transient=300))
+
+
+def _sweep_cmd(out: Path) -> list[str]:
+    return [sys.executable, "-m", "grazing.cli", "sweep", "--param", "eta", "--start", "0.44", "--stop", "0.49",
+            "--num", "60", "--chunk-size", "5", "--workers", "1", "--transient", "300", "--periods", "50",
+            "--out", str(out)]  # fmt: skip
+
+
+def test_resume_after_sigkill_computes_only_missing_chunks(tmp_path):
+    import zarr
+
+    out = tmp_path / "killed.zarr"
+    proc = subprocess.Popen(_sweep_cmd(out), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.time() + 120
+    done = 0
+    while time.time() < deadline:
+        time.sleep(0.2)
+        try:
+            done = int(np.sum(zarr.open_array(str(out / "chunk_done"), mode="r")[:]))
+        except Exception:
+            continue
+        if done >= 3:
+            break
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait()
+    flags = np.asarray(zarr.open_array(str(out / "chunk_done"), mode="r")[:])
+    n_done = int(flags.sum())
+    assert 3 <= n_done < flags.size, "the kill should land mid-sweep"
+    chunk_files = sorted((out / "samples" / "c").rglob("*"))
+    before = {p: p.stat().st_mtime_ns for p in chunk_files if p.is_file()}
+    # re-run the same command: completes, without touching the finished chunks
+    assert subprocess.run(_sweep_cmd(out), capture_output=True).returncode == 0
+    for p, mtime in before.items():
+        idx = int(p.name) if p.name.isdigit() else int(p.parent.name)
+        if flags[idx]:
+            assert p.stat().st_mtime_ns == mtime
+    # and gives exactly the uninterrupted result
+    ref_out = tmp_path / "ref.zarr"
+    assert subprocess.run(_sweep_cmd(ref_out), capture_output=True).returncode == 0
+    import xarray as xr
+
+    a = xr.open_zarr(str(out), consolidated=False)
+    b = xr.open_zarr(str(ref_out), consolidated=False)
+    np.testing.assert_array_equal(a.samples.values, b.samples.values)
+    np.testing.assert_array_equal(a.period.values, b.period.values)
+    np.testing.assert_array_equal(a.lyapunov.values, b.lyapunov.values)
+    assert a.attrs["grazing_version"] == grazing.__version__ if "grazing_version" in a.attrs else True
+    assert "sweep --param eta" in a.attrs["command"]
+
+
+def test_netcdf_export(tmp_path, capsys):
+    out = tmp_path / "s.nc"
+    argv = ["sweep", "--param", "eta", "--start", "0.40", "--stop", "0.42", "--num", "3", "--periods", "20",
+            "--workers", "1", "--out", str(out), "--json"]  # fmt: skip
+    assert main(argv) == 0
+    res = json.loads(capsys.readouterr().out)
+    import xarray as xr
+
+    ds = xr.open_dataset(out, engine="h5netcdf")
+    assert ds.period.values.tolist() == res["period"] == [1, 1, 1]
+
+
+# --------------------------------------------------------------------------
+# Dask cluster on loopback
+
+
+def test_dask_cluster_gives_identical_results():
+    from distributed import Client, LocalCluster
+
+    from grazing.sweeps import run_sweep
+
+    spec = _spec()
+    local = run_sweep(spec, workers=2)
+    with LocalCluster(n_workers=2, threads_per_worker=1, host="127.0.0.1", processes=True,
+                      dashboard_address=None) as cluster, Client(cluster) as client:  # fmt: skip
+        remote = run_sweep(spec, client=client)
+        cli_out = subprocess.run(
+            [sys.executable, "-m", "grazing.cli", "sweep", "--param", "eta", "--start", "0.44", "--stop", "0.46",
+             "--num", "12", "--chunk-size", "4", "--transient", "200", "--periods", "30",
+             "--scheduler", cluster.scheduler_address, "--json"],
+            capture_output=True, text=True,
+        )  # fmt: skip
+    np.testing.assert_array_equal(local.samples.values, remote.samples.values)
+    np.testing.assert_array_equal(local.period.values, remote.period.values)
+    assert cli_out.returncode == 0, cli_out.stderr
+    res = json.loads(cli_out.stdout)
+    assert res["period"] == local.period.values.tolist()
+    np.testing.assert_array_equal(np.array(res["samples"]), local.samples.values[..., 0])
+
+
+def test_chunk_is_a_pure_function():
+    spec = _spec()
+    a, b = run_chunk(spec, 1), run_chunk(spec, 1)
+    np.testing.assert_array_equal(a.samples, b.samples)
+
+
+# --------------------------------------------------------------------------
+# CLI
+
+
+def test_sweep_json_keys(capsys):
+    argv = ["sweep", "--param", "theta-hat", "--start", "38", "--stop", "42", "--num", "3", "--eta", "0.447",
+            "--periods", "20", "--workers", "1", "--json"]  # fmt: skip
+    assert main(argv) == 0
+    res = json.loads(capsys.readouterr().out)
+    for key in ("param", "values", "period", "impacts_per_period", "lyapunov", "samples"):
+        assert key in res
+    assert res["param"] == "theta-hat" and res["values"] == [38.0, 40.0, 42.0]
+    assert len(res["samples"]) == 3 and len(res["samples"][0]) == 20
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--scheduler", "tcp://127.0.0.1:1"], "cannot connect to the Dask scheduler"),
+        (["--out", "x.txt"], "--out must end in .zarr or .nc"),
+        (["--r", "2"], "r = 2 is outside"),
+        (["--method", "map"], "--method map"),
+    ],
+)
+def test_sweep_errors(argv, message, capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    base = ["sweep", "--param", "eta", "--start", "0.4", "--stop", "0.41", "--num", "2", "--periods", "5"]
+    code = main([*base, *argv])
+    err = capsys.readouterr().err
+    assert code != 0 and message in err and len(err.strip().splitlines()) == 1
+    assert list(tmp_path.iterdir()) == []
