@@ -40,7 +40,7 @@ def test_periods_of_the_period_adding_windows(window_sweep):
     """theta_hat = 40 deg (fig 7d): nonimpacting period 1 before grazing (eta = 0.44512), a chaotic
     band just past it (0.44535-0.4454, between the period-6 and period-5 windows), then windows of
     period 4, 3, 2 and the period-1 impacting orbit: the reverse period-adding cascade."""
-    etas, ds = window_sweep
+    _, ds = window_sweep
     assert ds.period.values.tolist() == [1, 0, 4, 3, 2, 1]
     assert ds.impacts.values[0] == 0 and ds.impacts.values[-1] == ds.sizes["sample"]
 
@@ -147,9 +147,9 @@ def test_zarr_store_roundtrip_and_mismatch(tmp_path):
 
 
 def _sweep_cmd(out: Path) -> list[str]:
-    return [sys.executable, "-m", "grazing.cli", "sweep", "--param", "eta", "--start", "0.44", "--stop", "0.49",
-            "--num", "60", "--chunk-size", "5", "--workers", "1", "--transient", "300", "--periods", "50",
-            "--out", str(out)]  # fmt: skip
+    args = "sweep --param eta --start 0.44 --stop 0.49 --num 60 --chunk-size 5 --workers 1"
+    args += " --transient 300 --periods 50 --out"
+    return [sys.executable, "-m", "grazing.cli", *args.split(), str(out)]
 
 
 def test_resume_after_sigkill_computes_only_missing_chunks(tmp_path):
@@ -220,12 +220,11 @@ def test_dask_cluster_gives_identical_results():
     with LocalCluster(n_workers=2, threads_per_worker=1, host="127.0.0.1", processes=True,
                       dashboard_address=None) as cluster, Client(cluster) as client:  # fmt: skip
         remote = run_sweep(spec, client=client)
+        args = "sweep --param eta --start 0.44 --stop 0.46 --num 12 --chunk-size 4 --transient 200"
+        args += f" --periods 30 --scheduler {cluster.scheduler_address} --json"
         cli_out = subprocess.run(
-            [sys.executable, "-m", "grazing.cli", "sweep", "--param", "eta", "--start", "0.44", "--stop", "0.46",
-             "--num", "12", "--chunk-size", "4", "--transient", "200", "--periods", "30",
-             "--scheduler", cluster.scheduler_address, "--json"],
-            capture_output=True, text=True,
-        )  # fmt: skip
+            [sys.executable, "-m", "grazing.cli", *args.split()], capture_output=True, text=True
+        )
     np.testing.assert_array_equal(local.samples.values, remote.samples.values)
     np.testing.assert_array_equal(local.period.values, remote.period.values)
     assert cli_out.returncode == 0, cli_out.stderr

@@ -81,8 +81,7 @@ class _Definition:
     @classmethod
     def get(cls, *args: Any) -> _Definition:
         """The definition for these constructor arguments, reusing an existing one."""
-        key = hashlib.sha256(repr([sp.srepr(a) if isinstance(a, sp.Basic) else _srepr(a) for a in args]).encode())
-        digest = key.hexdigest()
+        digest = hashlib.sha256(repr([_srepr(a) for a in args]).encode()).hexdigest()
         found = _DEFINITIONS.get(digest)
         if found is None:
             found = cls(*args)

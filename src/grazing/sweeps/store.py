@@ -248,7 +248,8 @@ def build_dataset_flat(spec: SweepSpec, arrays: dict[str, np.ndarray], attrs: di
         }
     )
     summary = spec_summary(spec)
-    ds.attrs.update({"spec": json.dumps(summary, sort_keys=True), "fingerprint": summary["fingerprint"], **attrs})
+    ds.attrs.update({"spec": json.dumps(summary, sort_keys=True), "fingerprint": summary["fingerprint"]})
+    ds.attrs.update(attrs)
     return ds
 
 
