@@ -22,9 +22,8 @@ from types import MappingProxyType, ModuleType
 from typing import Any
 
 import numpy as np
-import sympy as sp
 
-from grazing.engine.compile import SymbolicSystem, generate_source, load_source
+from grazing.engine.compile import SymbolicSystem, generate_source, kernel_key, load_kernels
 from grazing.errors import InvalidParameterError, InvalidStateError
 
 
@@ -76,86 +75,126 @@ class Parameter:
 
 
 class _Definition:
-    """The parameter-independent part of a model, shared by all its copies."""
+    """The parameter-independent part of a model, shared by all its copies.
+
+    Either eager (user models: the sympy pieces are given and validated at
+    once) or lazy (built-in models: ``builder()`` returns them on first use, so
+    that a model whose kernels are already compiled and cached is used without
+    importing sympy at all).
+    """
 
     @classmethod
-    def get(cls, *args: Any) -> _Definition:
+    def get(cls, kwargs: dict[str, Any]) -> _Definition:
         """The definition for these constructor arguments, reusing an existing one."""
-        digest = hashlib.sha256(repr([_srepr(a) for a in args]).encode()).hexdigest()
+        digest = hashlib.sha256(_srepr(sorted(kwargs.items())).encode()).hexdigest()
         found = _DEFINITIONS.get(digest)
         if found is None:
-            found = cls(*args)
-            found.args = args
+            found = cls(**kwargs)
+            found.args = kwargs
             _DEFINITIONS[digest] = found
         return found
 
     def __init__(
         self,
+        *,
         name: str,
-        states: Sequence[sp.Symbol],
-        time: sp.Symbol,
         parameters: Sequence[Parameter],
-        vector_field: Sequence[Any],
-        guard: Any,
-        reset: Sequence[Any],
-        period: Any,
-        contact_direction: Sequence[Any] | None,
+        state_names: Sequence[str],
+        period: str,
         periodic: bool,
         state_labels: Sequence[str] | None,
         description: str,
         reference: str,
+        symbolic: dict[str, Any] | None = None,
+        builder: Callable[[], dict[str, Any]] | None = None,
     ):
         self.name = name
         self.parameters = tuple(parameters)
         pnames = [p.name for p in self.parameters]
         if len(set(pnames)) != len(pnames):
             raise ValueError("parameter names must be unique")
-        psyms = tuple(sp.Symbol(p) for p in pnames)
-        states = tuple(states)
-        self.system = SymbolicSystem(
-            states=states,
-            time=time,
-            params=psyms,
-            vector_field=tuple(sp.sympify(e) for e in vector_field),
-            guard=sp.sympify(guard),
-            reset=tuple(sp.sympify(e) for e in reset),
-            contact_direction=None
-            if contact_direction is None
-            else tuple(sp.sympify(e) for e in contact_direction),
-        )
-        n = len(states)
-        if len(self.system.vector_field) != n or len(self.system.reset) != n:
-            raise ValueError("vector_field and reset need one expression per state")
-        if self.system.contact_direction is not None and len(self.system.contact_direction) != n:
-            raise ValueError("contact_direction needs one expression per state")
-        allowed = set(states) | {time} | set(psyms)
-        exprs = [*self.system.vector_field, self.system.guard, *self.system.reset]
-        for e in exprs:
-            extra = e.free_symbols - allowed
-            if extra:
-                raise ValueError(f"unknown symbols {sorted(map(str, extra))} in {e}")
-        self.period_expr = sp.sympify(period)
-        if self.period_expr.free_symbols - set(psyms):
-            raise ValueError("the period may depend on parameters only")
-        self.periodic = periodic
-        self.state_names = tuple(str(s) for s in states)
+        self.state_names = tuple(state_names)
         self.state_labels = tuple(state_labels) if state_labels else self.state_names
+        self.period_str = period
+        self.periodic = periodic
         self.description = description
         self.reference = reference
+        self._symbolic = symbolic
+        self._builder = builder
+        self._system: SymbolicSystem | None = None
         self._kernels: dict[tuple[str, ...], ModuleType] = {}
         self._numeric: dict[str, Callable[..., Any]] = {}
-        self._period_fn: Callable[[list[float]], float] | None = None
+        try:
+            code = compile(f"lambda {', '.join(pnames) or '_'}: {period}", "<period>", "eval")
+            self._period_fn = eval(code, {**vars(math), "__builtins__": {}})  # the period's expression text
+        except SyntaxError:
+            raise ValueError(f"cannot evaluate the period expression {period!r}") from None
+        if symbolic is not None:
+            self.system  # noqa: B018 - validate user models at construction
+
+    @property
+    def system(self) -> SymbolicSystem:
+        """The symbolic vector field, guard and reset (built and validated on first use)."""
+        if self._system is None:
+            import sympy as sp
+
+            pieces = self._symbolic if self._symbolic is not None else self._builder()  # type: ignore[misc]
+            psyms = tuple(sp.Symbol(p.name) for p in self.parameters)
+            states, time = tuple(pieces["states"]), pieces["time"]
+            cd = pieces.get("contact_direction")
+            system = SymbolicSystem(
+                states=states,
+                time=time,
+                params=psyms,
+                vector_field=tuple(sp.sympify(e) for e in pieces["vector_field"]),
+                guard=sp.sympify(pieces["guard"]),
+                reset=tuple(sp.sympify(e) for e in pieces["reset"]),
+                contact_direction=None if cd is None else tuple(sp.sympify(e) for e in cd),
+            )
+            n = len(states)
+            if len(system.vector_field) != n or len(system.reset) != n:
+                raise ValueError("vector_field and reset need one expression per state")
+            if system.contact_direction is not None and len(system.contact_direction) != n:
+                raise ValueError("contact_direction needs one expression per state")
+            allowed = set(states) | {time} | set(psyms)
+            for e in [*system.vector_field, system.guard, *system.reset]:
+                extra = e.free_symbols - allowed
+                if extra:
+                    raise ValueError(f"unknown symbols {sorted(map(str, extra))} in {e}")
+            period_syms = sp.sympify(self.period_str).free_symbols
+            if period_syms - set(psyms):
+                raise ValueError("the period may depend on parameters only")
+            self._system = system
+        return self._system
+
+    def _identity(self) -> str:
+        """Text that determines the compiled kernels (without building them)."""
+        if self._builder is not None:
+            import inspect
+
+            source = inspect.getsource(self._builder)
+        else:
+            source = _srepr(sorted((self._symbolic or {}).items()))
+        return repr((self.name, [p.name for p in self.parameters], self.period_str, self.periodic, source))
 
     def kernels(self, sensitivities: tuple[str, ...] = ()) -> ModuleType:
         if sensitivities not in self._kernels:
-            syms = [sp.Symbol(s) for s in sensitivities]
-            self._kernels[sensitivities] = load_source(generate_source(self.system, syms))
+
+            def source() -> str:
+                import sympy as sp
+
+                return generate_source(self.system, [sp.Symbol(s) for s in sensitivities])
+
+            key = kernel_key(self._identity(), sensitivities)
+            self._kernels[sensitivities] = load_kernels(key, source)
         return self._kernels[sensitivities]
 
     def numeric(self, what: str) -> Callable[..., Any]:
         """numpy function of ``(x, t, p)`` for f, h, g or a Jacobian (built on first use)."""
         fn = self._numeric.get(what)
         if fn is None:
+            import sympy as sp
+
             s = self.system
             x = sp.Matrix(s.states)
             exprs = {
@@ -180,29 +219,27 @@ class _Definition:
 
     def period(self, values: Sequence[float]) -> float:
         """The forcing period for the parameter values ``values``."""
-        if self._period_fn is None:
-            if not self.period_expr.free_symbols:
-                const = float(self.period_expr)
-                self._period_fn = lambda _v: const
-            else:
-                self._period_fn = sp.lambdify([list(self.system.params)], self.period_expr, modules="math")
-        return float(self._period_fn(list(values)))
+        return float(self._period_fn(*values))
 
 
 def _srepr(obj: Any) -> str:
-    if isinstance(obj, sp.Basic):
-        return sp.srepr(obj)
     if isinstance(obj, (list, tuple)):
         return "(" + ",".join(_srepr(o) for o in obj) + ")"
+    if type(obj).__module__.startswith("sympy"):
+        import sympy as sp
+
+        return sp.srepr(obj)
+    if callable(obj):
+        return f"{getattr(obj, '__module__', '')}.{getattr(obj, '__qualname__', repr(obj))}"
     return repr(obj)
 
 
 _DEFINITIONS: dict[str, _Definition] = {}
 
 
-def _rebuild(args: tuple[Any, ...], values: dict[str, float]) -> HybridModel:
+def _rebuild(args: dict[str, Any], values: dict[str, float]) -> HybridModel:
     """Unpickle a model: reuse (or build) its definition, then set the values."""
-    return HybridModel._from(_Definition.get(*args), dict(values))
+    return HybridModel._from(_Definition.get(args), dict(values))
 
 
 class HybridModel:
@@ -262,8 +299,8 @@ class HybridModel:
     def __init__(
         self,
         name: str,
-        states: Sequence[sp.Symbol],
-        time: sp.Symbol,
+        states: Sequence[Any],
+        time: Any,
         parameters: Sequence[Parameter],
         vector_field: Sequence[Any],
         guard: Any,
@@ -277,22 +314,68 @@ class HybridModel:
         reference: str = "",
         values: Mapping[str, float] | None = None,
     ):
+        symbolic = {
+            "states": tuple(states),
+            "time": time,
+            "vector_field": tuple(vector_field),
+            "guard": guard,
+            "reset": tuple(reset),
+            "contact_direction": None if contact_direction is None else tuple(contact_direction),
+        }
         self._def = _Definition.get(
-            name,
-            states,
-            time,
-            parameters,
-            vector_field,
-            guard,
-            reset,
-            period,
-            contact_direction,
-            periodic,
-            state_labels,
-            description,
-            reference,
+            {
+                "name": name,
+                "parameters": tuple(parameters),
+                "state_names": tuple(str(x) for x in states),
+                "period": str(period),
+                "periodic": periodic,
+                "state_labels": None if state_labels is None else tuple(state_labels),
+                "description": description,
+                "reference": reference,
+                "symbolic": symbolic,
+            }
         )
         self._values = self._checked({p.name: p.default for p in self._def.parameters}, values or {})
+
+    @classmethod
+    def lazy(
+        cls,
+        name: str,
+        *,
+        parameters: Sequence[Parameter],
+        state_names: Sequence[str],
+        period: str,
+        builder: Callable[[], dict[str, Any]],
+        periodic: bool = True,
+        state_labels: Sequence[str] | None = None,
+        description: str = "",
+        reference: str = "",
+    ) -> HybridModel:
+        """A model whose symbolic pieces are built by ``builder()`` only when needed.
+
+        ``builder`` (a module-level function) returns a dict with ``states``,
+        ``time``, ``vector_field``, ``guard``, ``reset`` and optionally
+        ``contact_direction``; ``period`` is the period as an expression text in
+        the parameter names (``"2*pi/omega"``).  The compiled kernels are found
+        in the cache by the builder's source text, so a cached model starts
+        without importing sympy.  The built-in models are made this way.
+        """
+        definition = _Definition.get(
+            {
+                "name": name,
+                "parameters": tuple(parameters),
+                "state_names": tuple(state_names),
+                "period": period,
+                "periodic": periodic,
+                "state_labels": None if state_labels is None else tuple(state_labels),
+                "description": description,
+                "reference": reference,
+                "builder": builder,
+            }
+        )
+        obj = cls._from(definition, {})
+        obj._values = obj._checked({p.name: p.default for p in definition.parameters}, {})
+        return obj
 
     # -- construction -------------------------------------------------------
     @classmethod
@@ -397,16 +480,20 @@ class HybridModel:
         return fn(list(np.asarray(x, dtype=float)), float(t), list(self.param_vector))
 
     def vector_field(self, x: Any, t: float = 0.0) -> np.ndarray:
-        """``f(x, t)``."""
-        return np.asarray(self._call("f", x, t), dtype=float).reshape(-1)
+        """``f(x, t)`` (evaluated by the compiled kernels)."""
+        out = np.empty(self.n_states)
+        self.kernels().rhs(np.asarray(x, dtype=float), float(t), self.param_vector, out)
+        return out
 
     def guard(self, x: Any, t: float = 0.0) -> float:
         """``h(x, t)``: positive in the allowed region."""
-        return float(self._call("h", x, t))
+        return float(self.kernels().guard(np.asarray(x, dtype=float), float(t), self.param_vector))
 
     def reset(self, x: Any, t: float = 0.0) -> np.ndarray:
         """``g(x, t)``: the state just after an impact at ``x``."""
-        return np.asarray(self._call("g", x, t), dtype=float).reshape(-1)
+        out = np.empty(self.n_states)
+        self.kernels().reset(np.asarray(x, dtype=float), float(t), self.param_vector, out)
+        return out
 
     def jacobians(self, x: Any, t: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(f_x, h_x, g_x)`` at ``(x, t)``."""

@@ -19,17 +19,16 @@ import importlib.util
 import os
 import sys
 import tempfile
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from functools import lru_cache
 from pathlib import Path
 from types import ModuleType
-
-import numba
-import sympy as sp
+from typing import TYPE_CHECKING
 
 from grazing.engine.polyroots import work_shape
-from grazing.engine.taylor import ScalarPrinter, taylor_kernel
+
+if TYPE_CHECKING:  # pragma: no cover
+    import sympy as sp
 
 _TEMPLATE = Path(__file__).with_name("_driver_template.py")
 # Bump when the generated code changes meaning without its text changing.
@@ -67,10 +66,14 @@ class SymbolicSystem:
     contact_direction: tuple[sp.Expr, ...] | None = None
 
     def gradient(self, expr: sp.Expr) -> list[sp.Expr]:
+        import sympy as sp
+
         return [sp.diff(expr, x) for x in self.states]
 
     def lie(self, expr: sp.Expr) -> sp.Expr:
         """Derivative of ``expr`` along the flow: grad(expr) . f + d(expr)/dt."""
+        import sympy as sp
+
         return sp.Add(*[g * f for g, f in zip(self.gradient(expr), self.vector_field)]) + sp.diff(
             expr, self.time
         )
@@ -87,6 +90,8 @@ class SymbolicSystem:
 
     def sticking_field(self) -> tuple[sp.Expr, ...]:
         """Vector field constrained to ``h = 0, L_f h = 0`` along the contact direction."""
+        import sympy as sp
+
         if self.contact_direction is None:
             raise ValueError("model has no contact direction")
         e = self.contact_direction
@@ -104,6 +109,10 @@ def _scalar_function(
     extra_args: str = "",
 ) -> str:
     """Numba source of ``name(x, s, pv{extra_args})`` with CSE'd assignments."""
+    import sympy as sp
+
+    from grazing.engine.taylor import ScalarPrinter
+
     names: dict[sp.Symbol, str] = {x: f"x[{i}]" for i, x in enumerate(sys_.states)}
     names[sys_.time] = "s"
     names.update({p: f"pv[{i}]" for i, p in enumerate(sys_.params)})
@@ -126,6 +135,10 @@ def _scalar_function(
 
 def generate_source(sys_: SymbolicSystem, sensitivities: Sequence[sp.Symbol] = ()) -> str:
     """Full source of the kernel module for ``sys_``."""
+    import sympy as sp
+
+    from grazing.engine.taylor import taylor_kernel
+
     n = len(sys_.states)
     m = len(sensitivities)
     ncol = n + m
@@ -235,28 +248,42 @@ def cache_dir() -> Path:
     return Path(base) / "grazing"
 
 
-@lru_cache(maxsize=64)
-def load_source(source: str) -> ModuleType:
-    """Write ``source`` to the cache (once) and import it as a module."""
-    key = hashlib.sha256((source + _CODEGEN_VERSION + numba.__version__ + sys.version).encode()).hexdigest()[
-        :20
-    ]
+def kernel_key(identity: str, sensitivities: Sequence[str]) -> str:
+    """Cache key of a kernel module: the model's identity and everything the code depends on.
+
+    numba's on-disk cache does not notice changes in functions imported from
+    other modules, so the sources of the driver template, the root finder and
+    the code generator are part of the key.
+    """
+    import numba
+
+    here = Path(__file__).parent
+    files = ("_driver_template.py", "polyroots.py", "taylor.py", "compile.py")
+    deps = "".join((here / f).read_text() for f in files)
+    text = repr((identity, tuple(sensitivities), _CODEGEN_VERSION, numba.__version__, sys.version, deps))
+    return hashlib.sha256(text.encode()).hexdigest()[:20]
+
+
+def load_kernels(key: str, source: Callable[[], str]) -> ModuleType:
+    """Import the kernel module ``key``, generating it with ``source()`` if not cached."""
     modname = f"grazing_kernels_{key}"
     if modname in sys.modules:
         return sys.modules[modname]
+    path: Path | None = None
     for d in (cache_dir(), Path(tempfile.gettempdir()) / "grazing-cache"):
         try:
             d.mkdir(parents=True, exist_ok=True)
-            path = d / f"{modname}.py"
-            if not path.exists() or path.read_text() != source:
+            candidate = d / f"{modname}.py"
+            if not candidate.exists():
                 fd, tmp = tempfile.mkstemp(dir=d, suffix=".tmp")
                 with os.fdopen(fd, "w") as fh:
-                    fh.write(source)
-                os.replace(tmp, path)
+                    fh.write(source())
+                os.replace(tmp, candidate)
+            path = candidate
             break
         except OSError:
             continue
-    else:  # pragma: no cover - no writable directory at all
+    if path is None:  # pragma: no cover - no writable directory at all
         raise OSError("no writable cache directory for compiled kernels")
     spec = importlib.util.spec_from_file_location(modname, path)
     assert spec is not None and spec.loader is not None
@@ -264,3 +291,8 @@ def load_source(source: str) -> ModuleType:
     sys.modules[modname] = module
     spec.loader.exec_module(module)
     return module
+
+
+def load_source(source: str) -> ModuleType:
+    """Import generated ``source`` as a cached kernel module (keyed by its text)."""
+    return load_kernels(kernel_key(source, ()), lambda: source)

@@ -20,32 +20,39 @@ from __future__ import annotations
 
 from functools import lru_cache
 
-import sympy as sp
-
 from grazing.core.model import HybridModel, Parameter
+
+
+def _symbolic() -> dict:
+    import sympy as sp
+
+    y, v, t = sp.symbols("y v t")
+    amplitude, omega, gravity, r = sp.symbols("amplitude omega gravity r")
+    table = amplitude * sp.sin(omega * t)
+    return {
+        "states": [y, v],
+        "time": t,
+        "vector_field": [v, -gravity],
+        "guard": y - table,
+        "reset": [y, (1 + r) * sp.diff(table, t) - r * v],
+        "contact_direction": [0, 1],
+    }
 
 
 @lru_cache(maxsize=1)
 def _base() -> HybridModel:
-    y, v, t = sp.symbols("y v t")
-    amplitude, omega, gravity, r = sp.symbols("amplitude omega gravity r")
-    table = amplitude * sp.sin(omega * t)
     params = [
         Parameter("amplitude", 0.1, lower=0.0, description="table amplitude"),
         Parameter("omega", 1.0, lower=0.0, lower_open=True, description="table frequency"),
         Parameter("gravity", 1.0, lower=0.0, lower_open=True, description="gravitational acceleration"),
         Parameter("r", 0.5, lower=0.0, upper=1.0, description="coefficient of restitution"),
     ]
-    return HybridModel(
+    return HybridModel.lazy(
         "bouncing-ball",
-        [y, v],
-        t,
-        params,
-        vector_field=[v, -gravity],
-        guard=y - table,
-        reset=[y, (1 + r) * sp.diff(table, t) - r * v],
-        period=2 * sp.pi / omega,
-        contact_direction=[0, 1],
+        parameters=params,
+        state_names=["y", "v"],
+        period="2*pi/omega",
+        builder=_symbolic,
         state_labels=["y", "y′"],
         description="ball on a vibrating table (chattering and sticking)",
         reference="Nordmark & Piiroinen, Nonlinear Dyn. 58 (2009) 85-106",

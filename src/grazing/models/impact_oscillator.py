@@ -15,31 +15,38 @@ from __future__ import annotations
 
 from functools import lru_cache
 
-import sympy as sp
-
 from grazing.core.model import HybridModel, Parameter
+
+
+def _symbolic() -> dict:
+    import sympy as sp
+
+    x, v, t = sp.symbols("x v t")
+    zeta, omega, sigma, r = sp.symbols("zeta omega sigma r")
+    return {
+        "states": [x, v],
+        "time": t,
+        "vector_field": [v, -2 * zeta * v - x + sp.cos(omega * t)],
+        "guard": sigma - x,
+        "reset": [x, -r * v],
+        "contact_direction": [0, 1],
+    }
 
 
 @lru_cache(maxsize=1)
 def _base() -> HybridModel:
-    x, v, t = sp.symbols("x v t")
-    zeta, omega, sigma, r = sp.symbols("zeta omega sigma r")
     params = [
         Parameter("zeta", 0.05, lower=0.0, description="damping ratio"),
         Parameter("omega", 2.8, lower=0.0, lower_open=True, description="forcing frequency"),
         Parameter("sigma", 0.1, description="stop position"),
         Parameter("r", 0.8, lower=0.0, upper=1.0, description="coefficient of restitution"),
     ]
-    return HybridModel(
+    return HybridModel.lazy(
         "impact-oscillator",
-        [x, v],
-        t,
-        params,
-        vector_field=[v, -2 * zeta * v - x + sp.cos(omega * t)],
-        guard=sigma - x,
-        reset=[x, -r * v],
-        period=2 * sp.pi / omega,
-        contact_direction=[0, 1],
+        parameters=params,
+        state_names=["x", "v"],
+        period="2*pi/omega",
+        builder=_symbolic,
         state_labels=["x", "x′"],
         description="harmonically forced linear oscillator with a rigid stop",
         reference="Nordmark, J. Sound Vib. 145 (1991) 279-297",

@@ -271,7 +271,7 @@ def continue_orbit(
     >>> [s.kind for s in br.special]
     ['grazing']
     >>> round(br.special[0].param, 4)
-    0.445
+    0.4451
     """
     s = settings or PalcSettings()
     for kind in detect:
