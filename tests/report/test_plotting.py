@@ -1,0 +1,102 @@
+"""Plotting helpers: resampling, delay embedding and the drawing functions."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from matplotlib.figure import Figure
+
+import grazing
+from grazing.plotting import delay_embedding, plot_delay, plot_time_series, uniform_resample
+
+
+@pytest.fixture(scope="module")
+def period5() -> grazing.Solution:
+    m = grazing.models.pendulum("B", eta=0.446, theta_hat=math.radians(40))
+    return grazing.simulate(m, [0.0, 0.0], transient=600, periods=20, trajectory=200)
+
+
+def test_uniform_resample_drops_repeated_times_and_is_exact_on_lines() -> None:
+    t = np.array([0.0, 0.3, 0.3, 1.0, 1.7, 2.0])
+    x = np.column_stack([3 * t + 1, -t])
+    tg, xg = uniform_resample(t, x, 0.25)
+    assert np.allclose(tg, np.arange(9) * 0.25)
+    assert np.allclose(xg[:, 0], 3 * tg + 1) and np.allclose(xg[:, 1], -tg)
+
+
+def test_uniform_resample_start_and_errors() -> None:
+    t = np.linspace(0.0, 1.0, 11)
+    tg, xg = uniform_resample(t, t**2, 0.2, start=0.1)
+    assert np.allclose(tg, [0.1, 0.3, 0.5, 0.7, 0.9])
+    assert np.allclose(xg, np.interp(tg, t, t**2))
+    with pytest.raises(ValueError, match="nondecreasing"):
+        uniform_resample(t[::-1], t, 0.1)
+    with pytest.raises(ValueError, match="dt"):
+        uniform_resample(t, t, 0.0)
+    with pytest.raises(ValueError, match="outside"):
+        uniform_resample(t, t, 0.1, start=-1.0)
+
+
+def test_delay_embedding_of_a_sine_is_the_circle_with_the_right_phase() -> None:
+    t = np.linspace(0.0, 6 * np.pi, 1201)  # dt = pi/200: a quarter period is 100 steps
+    tn, xd, xn = delay_embedding(t, np.sin(t), np.pi / 2)
+    assert np.isclose(tn[0], np.pi / 2) and np.isclose(tn[-1], 6 * np.pi)
+    assert np.allclose(xn, np.sin(tn), atol=1e-12)
+    assert np.allclose(xd, -np.cos(tn), atol=1e-12)  # sin(t - pi/2)
+    assert np.allclose(xd**2 + xn**2, 1.0, atol=1e-12)
+
+
+def test_delay_embedding_shrinks_the_step_to_divide_the_delay() -> None:
+    t = np.linspace(0.0, 10.0, 301)  # dt = 1/30 does not divide 0.55
+    a, w = 2.0, 1.3
+    tn, xd, xn = delay_embedding(t, a * np.cos(w * t), 0.55)
+    assert np.allclose(np.diff(tn), 0.55 / math.ceil(0.55 * 30))
+    assert np.allclose(xd, a * np.cos(w * (tn - 0.55)), atol=2e-3)
+    # an ellipse: x(t) and x(t - d) satisfy the quadratic form of a phase-shifted pair
+    c = math.cos(w * 0.55)
+    s2 = math.sin(w * 0.55) ** 2
+    assert np.allclose((xn**2 - 2 * c * xn * xd + xd**2) / (a**2 * s2), 1.0, atol=5e-3)
+    with pytest.raises(ValueError, match="shorter"):
+        delay_embedding(t, t, 20.0)
+    with pytest.raises(ValueError, match="scalar"):
+        delay_embedding(t, np.column_stack([t, t]), 1.0)
+
+
+def test_delay_embedding_of_a_trajectory_with_impacts(period5: grazing.Solution) -> None:
+    t, th = period5.trajectory_t, period5.trajectory[:, 0]
+    assert np.any(np.diff(t) == 0), "impacts should appear twice in the dense output"
+    tn, xd, xn = delay_embedding(t, th, math.pi / 2)
+    dt = np.diff(tn)
+    assert np.allclose(dt, 2 * math.pi / 200)  # 50 steps per quarter period
+    assert np.isclose(tn[0] - t[0], math.pi / 2)
+    # on the grid the dense output is taken as is: the delayed copy is a pure shift
+    assert np.array_equal(xd[50:], xn[:-50])
+    on_grid = np.isin(t, tn)
+    assert np.allclose(np.interp(t[on_grid], tn, xn), th[on_grid])
+    assert xn.max() <= period5.model.params["theta_hat"] + 1e-12
+
+
+def test_plot_time_series_and_delay_draw(period5: grazing.Solution) -> None:
+    fig = Figure()
+    ax1, ax2 = fig.subplots(1, 2)
+    plot_time_series(ax1, period5, degrees=True, span=(605, 615))
+    line, stop, samples = ax1.lines
+    assert line.get_xdata().min() >= 605 and line.get_xdata().max() <= 615
+    assert np.isclose(stop.get_ydata()[0], 40.0)
+    assert len(samples.get_xdata()) == 10  # samples at the ends of periods 606..615
+    assert ax1.get_ylabel() == "θ (degrees)" and ax1.get_xlabel().startswith("τ / 2π")
+    plot_delay(ax2, period5)
+    assert ax2.get_xlabel() == "θ(τ − π/2) (rad)" and ax2.get_ylabel() == "θ(τ) (rad)"
+    assert len(ax2.lines) == 3  # curve, stop as horizontal and vertical line
+
+
+def test_plot_needs_a_trajectory() -> None:
+    m = grazing.models.pendulum("B", eta=0.446, theta_hat=math.radians(40))
+    sol = grazing.simulate(m, [0.0, 0.0], periods=2)
+    ax = Figure().add_subplot()
+    with pytest.raises(ValueError, match="trajectory"):
+        plot_time_series(ax, sol)
+    with pytest.raises(ValueError, match="trajectory"):
+        plot_delay(ax, sol)
