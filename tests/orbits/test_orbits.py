@@ -182,3 +182,12 @@ def test_grazing_curve_fold_and_agreement_with_response_curve():
     assert thetas[0] == pytest.approx(5 * DEG)
     fold = curve.fold.model.params["theta_hat"]
     assert thetas.max() <= fold + 1e-12 and fold - thetas.max() < 1e-3  # the fold is the true top
+
+
+def test_flow_map_on_a_section_at_any_phase(pendulum_b):
+    """The map from t0 ends at t0 + n T whatever the phase of t0 (regression)."""
+    x0 = np.array([-0.3, 0.2])
+    fm = flow_map(pendulum_b, x0, t0=2.3, periods=2)
+    assert fm.solution.t_final == pytest.approx(2.3 + 4 * math.pi, abs=1e-12)
+    ref = grazing.simulate(pendulum_b, x0, t0=2.3, periods=2, phase=2.3)
+    np.testing.assert_allclose(fm.image, ref.x_final, atol=1e-14)

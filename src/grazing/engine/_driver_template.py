@@ -195,6 +195,11 @@ def integrate(
     record_impacts,
     chatter_time,
     events,
+    zdm,
+    zdm_s,
+    zdm_a,
+    zdm_e,
+    zdm_window,
 ):
     """Integrate until the ``n_samples``-th stroboscopic sample.
 
@@ -205,6 +210,13 @@ def integrate(
     stop; the final mode is returned so that a run can be continued.  With
     ``events`` false the guard is ignored (the "virtual" flow through the stop),
     which is how nonimpacting orbits are continued past grazing.
+
+    With ``zdm`` the flow ignores the stop and, once per period at local time
+    ``zdm_s`` (the grazing phase), the state is corrected by Nordmark's
+    zero-time discontinuity map at leading order: with ``v = L_f h``,
+    ``delta = v^2 / (2 a) - h`` (how far the local parabola would reach past the
+    stop, ``a = zdm_a = L_f^2 h`` at the grazing point), if ``delta > 0`` and
+    ``|v| / a < zdm_window``: ``x <- x - zdm_e * sqrt(2 a delta)``.
     """
     n = NX
     ncol = n + NSENS
@@ -251,6 +263,10 @@ def integrate(
     n_traj = 0
     kt = k
     st = s
+    kz = k if s < zdm_s - 1e-9 * T else k + 1
+    sz = zdm_s
+    zdm_gh = np.zeros(n)
+    zdm_gv = np.zeros(n)
     status = STATUS_OK
     nsteps = 0
     zero_events = 0
@@ -288,6 +304,13 @@ def integrate(
         if isamp == n_samples - 1 and h >= rem:
             h = rem
             is_last = True
+        zdm_hit = False
+        if zdm:
+            rem_z = (kz - k) * T + (sz - s)
+            if rem_z <= h:
+                h = rem_z
+                zdm_hit = True
+                is_last = is_last and rem_z >= rem
 
         # Event polynomial in the normalised step time u in [0, 1].
         sign = 1.0 if mode == 0 else -1.0
@@ -413,6 +436,40 @@ def integrate(
             for i in range(n):
                 for c in range(ncol):
                     x[n + i * ncol + c] = V[i, c]
+
+        if zdm_hit:
+            kz += 1
+            hval = guard(x, s, pv)
+            vn = normal_rate(x, s, pv)
+            dz = vn * vn / (2.0 * zdm_a) - hval
+            if dz > 0.0 and abs(vn) < zdm_window * zdm_a:
+                sp_ = math.sqrt(2.0 * zdm_a * dz)
+                if use_var:
+                    # dD/dx = I - e (grad S)^T, grad S = a grad(delta) / S
+                    guard_grad(x, s, pv, zdm_gh)
+                    normal_rate_grad(x, s, pv, zdm_gv)
+                    for i in range(n):
+                        for c in range(ncol):
+                            V[i, c] = x[n + i * ncol + c]
+                    for c in range(ncol):
+                        gs = 0.0
+                        for j in range(n):
+                            gs += (vn * zdm_gv[j] - zdm_a * zdm_gh[j]) * V[j, c]
+                        gs /= sp_
+                        for i in range(n):
+                            V[i, c] -= zdm_e[i] * gs
+                    for i in range(n):
+                        for c in range(ncol):
+                            x[n + i * ncol + c] = V[i, c]
+                if record_impacts == 2 or (record_impacts == 1 and recording):
+                    imp = _grow(imp, n_imp_rec)
+                    imp[n_imp_rec, 0] = k * T + s
+                    imp[n_imp_rec, 1] = sp_
+                    imp[n_imp_rec, 2:] = x[:n]
+                    n_imp_rec += 1
+                n_imp += 1
+                for i in range(n):
+                    x[i] -= zdm_e[i] * sp_
 
         if event:
             if mode == 0:

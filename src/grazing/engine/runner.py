@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -30,6 +31,35 @@ def taylor_order(tol: float) -> int:
     20
     """
     return int(min(60, max(6, math.ceil(-math.log(tol) / 2 + 1))))
+
+
+@dataclass(frozen=True)
+class DiscontinuityMap:
+    """Nordmark's zero-time discontinuity map, applied once per period at ``phase``.
+
+    The flow then ignores the stop; at local time ``phase`` (the grazing
+    time, in ``[0, T)``) the state is corrected by ``x <- x - e sqrt(2 a delta)``
+    where ``delta = (L_f h)^2 / (2 a) - h`` is how far the local parabola would
+    reach past the stop (only when ``delta > 0`` and ``|L_f h| / a < window``).
+
+    Attributes
+    ----------
+    phase
+        Local time of the grazing contact in ``[0, T)``.
+    accel
+        ``a = L_f^2 h`` at the grazing point (positive).
+    direction
+        ``e = (g_x - I) c / (grad(L_f h) . c)`` at the grazing point (``c`` the
+        contact direction); ``(0, 1 + r)`` for the pendulum.
+    window
+        Largest ``|L_f h| / a`` (time to the parabola's extremum) for which the
+        map is applied.
+    """
+
+    phase: float
+    accel: float
+    direction: tuple[float, ...]
+    window: float = math.inf
 
 
 @dataclass(frozen=True)
@@ -85,8 +115,12 @@ class Runner:
         sensitivities: Sequence[str] = (),
         events: bool = True,
         chatter_tol: float = 1e-9,
+        zdm: DiscontinuityMap | None = None,
     ):
         self.model = model
+        self.zdm = zdm
+        if zdm is not None:
+            events = False
         self.kern = model.kernels(tuple(sensitivities) if variational else ())
         n = model.n_states
         self.x = np.array(x, dtype=float)
@@ -127,6 +161,13 @@ class Runner:
         self.model = model
         self.pv = model.param_vector
 
+    def _zdm_args(self) -> tuple[Any, ...]:
+        z = self.zdm
+        n = self.model.n_states
+        if z is None:
+            return (False, 0.0, 1.0, np.zeros(n), 0.0)
+        return (True, float(z.phase) % self.T, float(z.accel), np.asarray(z.direction, dtype=float), z.window)
+
     def reset_variational(self) -> None:
         n = self.model.n_states
         self.V[:] = 0.0
@@ -151,7 +192,7 @@ class Runner:
             self.x, self.V, self.k, self.s, self.mode, self.pv, T, self.model.periodic, self.order, T,
             int(max_steps), periods, self.ks, self.ss, keep, self.variational, lyapunov,
             T / trajectory if trajectory else 0.0, guard_min, RECORD_IMPACTS[impacts], self.chatter_time,
-            self.events,
+            self.events, *self._zdm_args(),
         )  # fmt: skip
         (status, x, V, k, s, mode, nsteps, n_imp, smp, imp, sticks, traj, logs, lspan, gm, ok) = out
         if status != 0:

@@ -10,7 +10,7 @@ import numpy as np
 
 from grazing.core.model import HybridModel
 from grazing.core.solution import Impacts, Solution
-from grazing.engine.runner import RECORD_IMPACTS, Runner
+from grazing.engine.runner import RECORD_IMPACTS, DiscontinuityMap, Runner
 from grazing.errors import InvalidParameterError
 
 DEFAULT_TOL = 2.220446049250313e-16
@@ -53,6 +53,7 @@ def simulate(
     chatter_tol: float = DEFAULT_CHATTER_TOL,
     progress: Callable[[int, int], None] | None = None,
     events: bool = True,
+    zdm: DiscontinuityMap | None = None,
 ) -> Solution:
     """Simulate a hybrid model, never missing an impact.
 
@@ -101,6 +102,10 @@ def simulate(
     events
         If False, the guard is ignored: the flow passes through the stop (no
         impacts).  ``guard_min`` then tells how far past the stop it reaches.
+    zdm
+        A :class:`~grazing.engine.runner.DiscontinuityMap`: ignore the stop and
+        apply Nordmark's discontinuity map once per period at the grazing
+        phase instead (the map Pi of the paper's eq. 20, with the nonlinear flow).
     progress
         Called as ``progress(periods_done, periods_total)`` after every chunk
         of :data:`CHUNK_PERIODS` periods (the run is always chunked the same
@@ -128,6 +133,10 @@ def simulate(
             raise InvalidParameterError(f"{name} must be a finite number, got {val!r}")
     if not 0 < tol < 1e-2:
         raise InvalidParameterError(f"tol must be in (0, 0.01), got {tol}")
+    if zdm is not None:
+        if not model.periodic:
+            raise InvalidParameterError("the discontinuity map needs a periodically forced model")
+        events = False
     x = model.check_state(np.zeros(model.n_states) if x0 is None else x0, t0, allowed=events)
     sens = tuple(sensitivities)
     if lyapunov and (jacobian or sens):
@@ -137,7 +146,7 @@ def simulate(
     T = model.period
     run = Runner(
         model, x, t0=float(t0), phase=float(phase), tol=tol, variational=use_var,
-        sensitivities=sens, events=events, chatter_tol=chatter_tol,
+        sensitivities=sens, events=events, chatter_tol=chatter_tol, zdm=zdm,
     )  # fmt: skip
     first_sample = run.next_sample_time
     total = transient + periods

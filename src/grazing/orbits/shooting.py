@@ -51,13 +51,16 @@ def flow_map(
 ) -> FlowMap:
     """Apply the stroboscopic map ``periods`` times from ``x`` at time ``t0``.
 
-    With ``virtual`` the stop is ignored (the flow passes through it).
+    The map goes from the section ``t = t0 (mod T)`` to itself, ending at
+    ``t0 + periods T``.  With ``virtual`` the stop is ignored (the flow passes
+    through it).
     """
     sol = simulate(
         model,
         x,
         t0=t0,
         periods=periods,
+        phase=2 * math.pi * (t0 / model.period % 1.0),  # the section through t0
         jacobian=True,
         sensitivities=tuple(sensitivities),
         guard_min=True,

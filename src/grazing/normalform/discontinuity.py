@@ -1,0 +1,183 @@
+"""Nordmark's discontinuity map at a grazing periodic orbit, and the maps built from it.
+
+Conventions (derivation in ``docs/normal-form.md``): the guard ``h`` is positive
+in the allowed region; at a grazing point ``x*`` (time ``t*``) ``h = 0``,
+``v = L_f h = 0`` and ``a = L_f^2 h > 0``.  Near ``x*`` a trajectory follows a
+parabola ``h(t) = h + v t + a t^2 / 2`` whose minimum is ``-delta`` with
+
+    delta(x) = v^2 / (2 a) - h.
+
+If ``delta > 0`` the trajectory reaches the stop with normal speed
+``S = sqrt(2 a delta)``; to leading order the zero-time discontinuity map
+(ZDM) is
+
+    D(x) = x - e S        (delta > 0),        D(x) = x        (delta <= 0),
+
+where ``e = (g_x - I) c / (grad(L_f h) . c)`` is the direction and size of the
+reset's jump per unit approach speed (``c`` the contact direction).  For the
+pendulum ``e = (0, 1 + r)``: the velocity jumps by ``-(1 + r) S``, away from
+the stop.  (The paper's eq. 19 takes the square root of ``L_f^2 h`` with the
+opposite sign convention, giving an imaginary root and a kick towards the
+stop; see SPEC.md.)
+
+The Poincare map of the paper's eq. 20 is ``Pi = Phi_2 o D o Phi_1``: the
+nonlinear flow ignoring the stop, with ``D`` applied once per period at the
+grazing phase.  The *normal form* linearises both flow pieces about the
+grazing orbit on the section through the contact point ``t = t*``:
+
+    u_{k+1} = M D_mu(u_k) + b mu,
+
+with ``M`` the monodromy matrix at the contact, ``b = dP/dp`` the unfolding
+vector of the parameter ``p = p* + mu``, and ``D_mu`` using the linearised
+``h``, ``L_f h`` (including their explicit dependence on ``p``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from grazing.core.model import HybridModel
+from grazing.engine.runner import DiscontinuityMap
+from grazing.orbits.grazing import GrazingPoint
+from grazing.orbits.shooting import flow_map
+
+
+def zdm_direction(model: HybridModel, x: np.ndarray, t: float) -> np.ndarray:
+    """``e = (g_x - I) c / (grad(L_f h) . c)``: the reset's jump per unit approach speed at ``x``."""
+    _, _, gx = model.jacobians(x, t)
+    c = np.zeros(model.n_states)
+    model.kernels().contact_dir(np.asarray(x, dtype=float), float(t), model.param_vector, c)
+    if not np.any(c):
+        raise ValueError(f"model {model.name!r} defines no contact direction; the ZDM needs one")
+    grad_rate = model.contact_derivatives(x, t)["rate_x"]
+    return (gx - np.eye(model.n_states)) @ c / float(grad_rate @ c)
+
+
+@dataclass(frozen=True)
+class GrazingNormalForm:
+    """Everything the discontinuity map and the normal form need at one grazing point.
+
+    Attributes
+    ----------
+    point
+        The grazing orbit (contact state ``x*``, time ``t*``, monodromy at the
+        contact section, multipliers).
+    accel
+        ``a = L_f^2 h`` at the contact (positive).
+    direction
+        ``e``, the reset's jump per unit approach speed.
+    grad_h, grad_rate
+        Gradients of ``h`` and ``L_f h`` at the contact.
+    kappa
+        ``-grad(h) . M . e / |e|``: how a kick along ``e`` on the contact section
+        returns in the impacting coordinate after one period (the paper's
+        ``M12`` for the pendulum, whose sign decides between the scenarios).
+    unfolding
+        For each parameter name: ``(b, h_p, rate_p)``: the unfolding vector
+        ``dP/dp`` at the contact and the explicit parameter derivatives of ``h``
+        and ``L_f h``.
+    """
+
+    point: GrazingPoint
+    accel: float
+    direction: np.ndarray
+    grad_h: np.ndarray
+    grad_rate: np.ndarray
+    kappa: float
+    unfolding: dict[str, tuple[np.ndarray, float, float]] = field(default_factory=dict)
+
+    @property
+    def model(self) -> HybridModel:
+        return self.point.model
+
+    @property
+    def monodromy(self) -> np.ndarray:
+        return self.point.monodromy
+
+    @property
+    def multipliers(self) -> np.ndarray:
+        return self.point.multipliers
+
+    @property
+    def contact(self) -> np.ndarray:
+        return self.point.contact
+
+    def discontinuity_map(self, window: float | None = None) -> DiscontinuityMap:
+        """The engine's per-period discontinuity map at this grazing point.
+
+        ``window`` bounds ``|L_f h| / a`` (default: a quarter period), so that
+        the correction is only applied where the local parabola is meaningful.
+        """
+        T = self.model.period
+        return DiscontinuityMap(
+            phase=self.point.phase,
+            accel=self.accel,
+            direction=tuple(float(v) for v in self.direction),
+            window=T / 4 if window is None else window,
+        )
+
+    def zdm(self, x: np.ndarray, t: float | None = None) -> np.ndarray:
+        """Apply the leading-order ZDM to a state ``x`` (at time ``t``, default ``t*``)."""
+        t = self.point.t_graze if t is None else t
+        cd = self.model.contact_derivatives(x, t)
+        delta = cd["rate"] ** 2 / (2 * self.accel) - cd["h"]
+        if delta <= 0:
+            return np.array(x, dtype=float)
+        return np.asarray(x, dtype=float) - self.direction * math.sqrt(2 * self.accel * delta)
+
+    def normal_form(self, param: str):
+        """The linear normal form ``u -> M D_mu(u) + b mu`` for unfolding parameter ``param``.
+
+        Returns a function ``step(u, mu) -> (u_next, S)`` on deviations ``u`` from
+        the contact state on the section ``t = t*``; ``S`` is the impact speed
+        (0 when the map's square-root branch is not active).
+        """
+        b, h_p, rate_p = self.unfolding[param]
+        M, e, a = self.monodromy, self.direction, self.accel
+        gh, gv = self.grad_h, self.grad_rate
+
+        def step(u: np.ndarray, mu: float) -> tuple[np.ndarray, float]:
+            h = gh @ u + h_p * mu
+            v = gv @ u + rate_p * mu
+            delta = v * v / (2 * a) - h
+            s = math.sqrt(2 * a * delta) if delta > 0 else 0.0
+            return M @ (u - e * s) + b * mu, s
+
+        return step
+
+
+def normal_form_at(point: GrazingPoint, params: tuple[str, ...] = ("eta", "theta_hat")) -> GrazingNormalForm:
+    """Build the normal form of a grazing point (computes the unfolding vectors).
+
+    Examples
+    --------
+    >>> import math, grazing
+    >>> from grazing.orbits import find_grazings
+    >>> g, _ = find_grazings(grazing.models.pendulum("B", theta_hat=math.radians(40)), "eta", 0.4, 0.47)
+    >>> nf = normal_form_at(g[0])
+    >>> [round(v, 4) for v in nf.direction], round(nf.kappa, 3)
+    ([0.0, 1.7675], 0.265)
+    """
+    m, x, t = point.model, point.contact, point.t_graze
+    cd = m.contact_derivatives(x, t)
+    e = zdm_direction(m, x, t)
+    M = point.monodromy
+    kappa = float(-(cd["h_x"] @ M @ e) / np.linalg.norm(e))
+    names = [p.name for p in m.parameters]
+    fm = flow_map(m, x, t0=t, periods=point.period, sensitivities=list(params), virtual=True)
+    unfolding = {}
+    for j, p in enumerate(params):
+        i = names.index(p)
+        unfolding[p] = (fm.sensitivity[:, j].copy(), float(cd["h_p"][i]), float(cd["rate_p"][i]))
+    return GrazingNormalForm(
+        point=point,
+        accel=cd["accel"],
+        direction=e,
+        grad_h=cd["h_x"],
+        grad_rate=cd["rate_x"],
+        kappa=kappa,
+        unfolding=unfolding,
+    )
