@@ -712,12 +712,19 @@ def _sweep_json(ds: Any, param: str, values: np.ndarray) -> dict[str, Any]:
 @click.option("--num", type=click.IntRange(min=1), required=True, help="Number of parameter values.")
 @click.option("--direction", type=click.Choice(["up", "down"]), default="up", show_default=True,
               help="Order in which the values are visited.")  # fmt: skip
-@click.option("--method", type=click.Choice(["flow", "map"]), default="flow", show_default=True,
-              help="flow: direct simulation.")  # fmt: skip
+@click.option(
+    "--method",
+    type=click.Choice(["flow", "map"]),
+    default="flow",
+    show_default=True,
+    help="flow: direct simulation; map: the discontinuity-map Poincare map built at a grazing.",
+)
+@click.option("--which", type=click.Choice(["first", "second"]), default="first", show_default=True,
+              help="With --method map: the grazing the map is built at.")  # fmt: skip
 @_sweep_options
 def sweep_cmd(
     case: str, alpha: float | None, beta: float | None, r: float | None, eta: float, theta_hat: float,
-    sparam: str, start: float, stop: float, num: int, direction: str, method: str,
+    sparam: str, start: float, stop: float, num: int, direction: str, method: str, which: str,
     transient: int, periods: int, initial: str, fresh: bool, chunk_size: int | None, workers: int | None,
     scheduler: str | None, no_lyapunov: bool, no_adaptive: bool, tol: float, out: Path | None, as_json: bool,
 ) -> None:  # fmt: skip
@@ -725,8 +732,6 @@ def sweep_cmd(
     Lyapunov exponents along a parameter range."""
     from grazing.sweeps.sweep import SweepSpec
 
-    if method != "flow":
-        raise _ErrorInput("--method map needs the normal-form map (not available yet)")
     model = build_pendulum(case, alpha, beta, r, eta, theta_hat)
     name = _SWEEP_PARAMS[sparam]
     if not (math.isfinite(start) and math.isfinite(stop)):
@@ -740,19 +745,23 @@ def sweep_cmd(
     x0 = _parse_pair(initial)
     for v in (order[0], order[-1]):
         model.with_params(**{name: v})
+    zdm, graze_info = None, None
+    if method == "map":
+        zdm, graze_info = _map_for_sweep(model, name, float(vals.min()), float(vals.max()), which)
     spec = SweepSpec(
         model=model, params=(name,), points=tuple((float(v),) for v in order),
         x0=tuple(float(v) for v in model.with_params(**{name: order[0]}).check_state(x0)),
         transient=transient, periods=periods, fresh=fresh,
         chunk_size=50 if chunk_size is None else chunk_size,
-        adaptive=not no_adaptive, lyapunov=not no_lyapunov, tol=tol,
+        adaptive=not no_adaptive, lyapunov=not no_lyapunov, tol=tol, zdm=zdm,
     )  # fmt: skip
     t0 = time.perf_counter()
     ds = _run_sweep_spec(spec, out, scheduler, workers, as_json).sortby("value")
     elapsed = time.perf_counter() - t0
     res = {"params": model_params_json(model, case), **_sweep_json(ds, sparam, np.sort(shown))}
     res.update({"direction": direction, "fresh": fresh, "transient": transient, "periods": periods,
-                "chunk_size": spec.size, "elapsed_s": elapsed, "out": str(out) if out else None})  # fmt: skip
+                "chunk_size": spec.size, "elapsed_s": elapsed, "out": str(out) if out else None,
+                "method": method, "grazing": graze_info})  # fmt: skip
     if as_json:
         _emit_json(res)
         return
@@ -764,6 +773,95 @@ def sweep_cmd(
         click.echo(f"  period {p:2d}: {sel.size} points, {sparam} in [{sel.min():.6g}, {sel.max():.6g}]")
     if out is not None:
         click.echo(f"saved to {out}")
+
+
+_GRAZE_SEARCH = {"eta": (0.2, 1.0), "theta_hat": (-3.1, 3.1)}
+
+
+def _map_for_sweep(model: Any, name: str, lo: float, hi: float, which: str) -> tuple[Any, dict[str, Any]]:
+    """The discontinuity map at the first/second grazing for a sweep in ``name`` over ``[lo, hi]``."""
+    from grazing.normalform import find_grazing_point, normal_form_at
+
+    a, b = _GRAZE_SEARCH.get(name, (lo - 0.5 * (hi - lo), hi + 0.5 * (hi - lo)))
+    point = find_grazing_point(model, name, min(a, lo), max(b, hi), which)
+    nf = normal_form_at(point)
+    back = math.degrees if name == "theta_hat" else float
+    info = {
+        "param": name,
+        "value": back(point.model.params[name]),
+        "t_graze": point.phase,
+        "multipliers": _complex_list(point.multipliers),
+        "accel": nf.accel,
+        "direction": nf.direction,
+    }
+    return nf.discontinuity_map(), info
+
+
+@cli.command("normal-form")
+@model_options
+@click.option(
+    "--which",
+    type=click.Choice(["first", "second"]),
+    default="first",
+    show_default=True,
+    help="First or second grazing in eta at this theta-hat.",
+)
+@click.option("--eta-min", type=float, default=0.2, show_default=True, help="Lower end of the eta search.")
+@click.option("--eta-max", type=float, default=1.0, show_default=True, help="Upper end of the eta search.")
+@click.option(
+    "--check", is_flag=True, help="Also simulate just past grazing and compare with the prediction."
+)
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
+def normal_form_cmd(
+    case: str, alpha: float | None, beta: float | None, r: float | None, eta: float, theta_hat: float,
+    which: str, eta_min: float, eta_max: float, check: bool, as_json: bool,
+) -> None:  # fmt: skip
+    """Grazing normal form at a grazing of the period-1 orbit: multipliers, the
+    discontinuity map's coefficients and the predicted scenario past grazing."""
+    from grazing.normalform import find_grazing_point, normal_form_at, observe, predict
+
+    model = build_pendulum(case, alpha, beta, r, eta, theta_hat)
+    if not (math.isfinite(eta_min) and math.isfinite(eta_max) and 0 < eta_min < eta_max):
+        raise _ErrorInput(f"need 0 < --eta-min < --eta-max, got {eta_min:g} and {eta_max:g}")
+    point = find_grazing_point(model, "eta", eta_min, eta_max, which)
+    nf = normal_form_at(point)
+    pred = predict(nf)
+    b_eta, _, _ = nf.unfolding["eta"]
+    res: dict[str, Any] = {
+        "params": model_params_json(point.model, case),
+        "which": which,
+        "eta_graze": point.model.params["eta"],
+        "t_graze": point.phase,
+        "multipliers": _complex_list(point.multipliers),
+        "abs_lambda": point.abs_lambda,
+        "prediction": pred.to_json(),
+        "coefficients": {
+            "contact_state": nf.contact,
+            "accel": nf.accel,
+            "direction": nf.direction,
+            "monodromy": nf.monodromy,
+            "kappa": nf.kappa,
+            "grad_h": nf.grad_h,
+            "grad_rate": nf.grad_rate,
+            "unfolding_eta": b_eta,
+            "unfolding_theta_hat": nf.unfolding["theta_hat"][0],
+        },
+    }
+    if check:
+        obs = observe(nf)
+        res["observed"] = {"scenario": obs.scenario, "offsets": obs.offsets, "periods": obs.periods}
+        res["agrees"] = obs.scenario == pred.scenario
+    if as_json:
+        _emit_json(res)
+        return
+    mu = ", ".join(f"{z.real:+.4f}{z.imag:+.4f}i" for z in point.multipliers)
+    click.echo(f"{which} grazing at eta = {res['eta_graze']:.6f}, t_graze = {point.phase:.4f}")
+    click.echo(f"  multipliers {mu}, |lambda| = {point.abs_lambda:.4f}, kappa (M12) = {nf.kappa:+.4f}")
+    click.echo(f"  discontinuity map: a = {nf.accel:.6f}, e = {np.round(nf.direction, 6).tolist()}")
+    click.echo(f"  prediction: {pred.scenario} ({pred.rule})")
+    if check:
+        verdict = "agrees" if res["agrees"] else "differs"
+        click.echo(f"  direct simulation just past grazing: {res['observed']['scenario']} ({verdict})")
 
 
 @cli.command("map")

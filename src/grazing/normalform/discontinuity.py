@@ -181,3 +181,26 @@ def normal_form_at(point: GrazingPoint, params: tuple[str, ...] = ("eta", "theta
         kappa=kappa,
         unfolding=unfolding,
     )
+
+
+def find_grazing_point(
+    model: HybridModel, param: str, lo: float, hi: float, which: str = "first"
+) -> GrazingPoint:
+    """The first or second grazing of the period-1 nonimpacting orbit for ``param`` in ``[lo, hi]``.
+
+    Raises :class:`~grazing.errors.ConvergenceError` (one clear line) if there is none.
+    """
+    from grazing.errors import ConvergenceError, InvalidParameterError
+    from grazing.orbits.grazing import find_grazings
+
+    if which not in ("first", "second"):
+        raise InvalidParameterError(f"which must be 'first' or 'second', got {which!r}")
+    points, _ = find_grazings(model, param, lo, hi)
+    points.sort(key=lambda g: g.model.params[param])
+    k = 0 if which == "first" else 1
+    if len(points) <= k:
+        raise ConvergenceError(
+            f"no {which} grazing of the period-1 orbit for {param} in [{lo:g}, {hi:g}] "
+            f"(found {len(points)}); the discontinuity map needs a grazing orbit"
+        )
+    return points[k]

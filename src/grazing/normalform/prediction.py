@@ -218,8 +218,10 @@ def predicted_windows(lam: float, n_max: int = 12) -> list[tuple[int, float, flo
     orbit with one impact and ``n - 1`` free periods is stable for ``mu_hat`` in
     ``(3 (1-l) l^(2n-2) / (4 (1-l^n)), (1-l)^2 l^(2n-4) / (1-l^(n-1))^2)``
     (flip at the lower end, border collision at the upper); empty intervals
-    are omitted.  Windows accumulate at 0 with ratio ``lambda^2``; they are
-    non-empty iff ``lambda < 2/3`` and neighbours overlap iff ``lambda < 1/4``.
+    are omitted.  Windows accumulate at 0 with ratio ``lambda^2``; for large
+    ``n`` they are non-empty iff ``lambda < 2/3`` (``3 lambda^2 / 4 < 1 - lambda``)
+    and neighbours overlap iff ``lambda < 1/4``; a few low-period windows
+    survive above 2/3.
 
     Examples
     --------

@@ -37,7 +37,7 @@ from typing import Any
 import numpy as np
 
 from grazing.core.model import HybridModel
-from grazing.engine.runner import Runner
+from grazing.engine.runner import DiscontinuityMap, Runner
 from grazing.errors import InvalidParameterError, SimulationError
 from grazing.sweeps.period import DEFAULT_MAX_PERIOD, DEFAULT_PERIOD_TOL, detect_period
 
@@ -81,6 +81,10 @@ class SweepSpec:
         Local error tolerance of the integrator.
     shape
         Grid shape for two-parameter maps (``(n2, n1)``), else ``(n,)``.
+    zdm
+        Iterate the discontinuity-map Poincare map instead of the flow: the
+        stop is ignored and Nordmark's map applied once per period at the
+        grazing phase (``--method map``).
     """
 
     model: HybridModel
@@ -96,6 +100,7 @@ class SweepSpec:
     lyapunov: bool = True
     tol: float = DEFAULT_SWEEP_TOL
     shape: tuple[int, ...] = field(default=())
+    zdm: DiscontinuityMap | None = None
 
     def __post_init__(self) -> None:
         if not self.points:
@@ -156,6 +161,8 @@ class SweepSpec:
             "lyapunov": self.lyapunov,
             "tol": self.tol,
             "shape": list(self.shape),
+            "method": "map" if self.zdm is not None else "flow",
+            "zdm": None if self.zdm is None else [self.zdm.phase, self.zdm.accel, list(self.zdm.direction)],
             "grazing_version": grazing.__version__,
         }
         return d
@@ -180,7 +187,7 @@ class ChunkResult:
 
 def _run_point(spec: SweepSpec, model: HybridModel, x: np.ndarray, t0: float) -> tuple[Any, ...]:
     """Transient then sampled periods at one point; returns the point's results."""
-    run = Runner(model, x, t0=t0, phase=spec.phase, tol=spec.tol)
+    run = Runner(model, x, t0=t0, phase=spec.phase, tol=spec.tol, zdm=spec.zdm)
     align = min(LYAPUNOV_ALIGN, spec.transient) if spec.lyapunov else 0
     budget = spec.transient - align
     used = 0
@@ -201,7 +208,7 @@ def _run_point(spec: SweepSpec, model: HybridModel, x: np.ndarray, t0: float) ->
                     used += extra
                 break
     if spec.lyapunov:
-        var = Runner(model, run.x, t0=run.t, phase=spec.phase, tol=spec.tol, variational=True)
+        var = Runner(model, run.x, t0=run.t, phase=spec.phase, tol=spec.tol, variational=True, zdm=spec.zdm)
         var.mode = run.mode
         seg = var.advance(align + spec.periods, spec.periods, lyapunov=True, impacts="sampled")
         lyap = (
