@@ -147,8 +147,9 @@ def test_zarr_store_roundtrip_and_mismatch(tmp_path):
 
 
 def _sweep_cmd(out: Path) -> list[str]:
+    # enough work per chunk (~0.1 s) that the kill lands mid-sweep
     args = "sweep --param eta --start 0.44 --stop 0.49 --num 60 --chunk-size 5 --workers 1"
-    args += " --transient 300 --periods 50 --out"
+    args += " --transient 3000 --periods 50 --no-adaptive --no-lyapunov --out"
     return [sys.executable, "-m", "grazing.cli", *args.split(), str(out)]
 
 
@@ -160,7 +161,7 @@ def test_resume_after_sigkill_computes_only_missing_chunks(tmp_path):
     deadline = time.time() + 120
     done = 0
     while time.time() < deadline:
-        time.sleep(0.2)
+        time.sleep(0.01)
         try:
             done = int(np.sum(zarr.open_array(str(out / "chunk_done"), mode="r")[:]))
         except Exception:
@@ -260,7 +261,7 @@ def test_sweep_json_keys(capsys):
         (["--scheduler", "tcp://127.0.0.1:1"], "cannot connect to the Dask scheduler"),
         (["--out", "x.txt"], "--out must end in .zarr or .nc"),
         (["--r", "2"], "r = 2 is outside"),
-        (["--method", "map"], "--method map"),
+        (["--method", "map", "--theta-hat", "70"], "no first grazing"),
     ],
 )
 def test_sweep_errors(argv, message, capsys, tmp_path, monkeypatch):
