@@ -12,9 +12,7 @@ from __future__ import annotations
 import functools
 import json
 import math
-import os
 import sys
-import tempfile
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -24,6 +22,7 @@ import click
 import numpy as np
 
 import grazing
+from grazing.atomic import atomic_path, write_text_atomic
 from grazing.errors import GrazingError
 from grazing.models.pendulum import CASES, DEFAULT_CASE, case_values
 
@@ -147,19 +146,12 @@ class _Progress:
 
 
 def _write_atomic(path: Path, write: Callable[[Any], None]) -> None:
-    """Write a file via a temporary in the same folder, so it is never half-written."""
+    """Write a text file all at once (see :mod:`grazing.atomic`), into an existing folder."""
     path = Path(path)
     folder = path.parent if str(path.parent) else Path(".")
     if not folder.is_dir():
         raise _ErrorInput(f"folder {str(folder)!r} does not exist")
-    fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", newline="") as fh:
-            write(fh)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    write_text_atomic(path, write)
 
 
 def _emit_json(obj: dict[str, Any]) -> None:
@@ -321,16 +313,9 @@ def _check_out(out: Path | None, suffix: str) -> None:
 
 
 def _save_dataset(ds: Any, out: Path) -> None:
-    """Write a dataset to NetCDF via a temporary file, so a failure leaves nothing."""
-    folder = out.parent if str(out.parent) else Path(".")
-    fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{out.name}.", suffix=".tmp")
-    os.close(fd)
-    try:
+    """Write a dataset to NetCDF all at once, so a failure leaves nothing."""
+    with atomic_path(out, suffix=".nc") as tmp:
         ds.to_netcdf(tmp, engine="h5netcdf")
-        os.replace(tmp, out)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
 
 
 def _orbit_json(orbit: Any) -> dict[str, Any]:
@@ -946,6 +931,7 @@ def report(out: Path) -> None:
 # Entry point
 
 
+
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI; every error becomes one line on stderr and an exit status."""
     try:
@@ -970,5 +956,12 @@ def main(argv: list[str] | None = None) -> int:
     return 0
 
 
-if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())
+if __name__ == "__main__":  # pragma: no cover - `python -m grazing.cli`: use the importable module
+    from grazing.cli import main as _main
+
+    sys.exit(_main())
+else:
+    # The experiment commands import this module's helpers, so they register last.
+    from grazing.cli_experiment import register as _register_experiment
+
+    _register_experiment(cli)

@@ -1,0 +1,562 @@
+"""Command-line tools for the experimental side: damping, equal damping, fit, recordings.
+
+``register(cli)`` adds the commands ``damping``, ``iso-damping``, ``fit``,
+``analyze`` and ``synthesize`` to the ``grazing`` command group.  Like every
+``grazing`` command they print a summary, or one JSON object with
+``--json``; malformed input gets one line on stderr, a non-zero exit status,
+and nothing is written.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import click
+import numpy as np
+
+from grazing.atomic import atomic_path
+from grazing.cli import _emit_json, _ErrorInput, _Progress, _write_atomic
+from grazing.models.pendulum import CASES, DEFAULT_CASE, case_values
+
+_RELATIONS = ["model", "paper", "protocol"]
+_DEFAULT_AMPLITUDE_DEG = math.degrees(0.5)
+
+
+def _none_if_nan(v: float) -> float | None:
+    return None if not math.isfinite(v) else float(v)
+
+
+def _check_png(path: Path | None) -> None:
+    if path is None:
+        return
+    if path.suffix.lower() != ".png":
+        raise _ErrorInput(f"--plot must name a .png file, got {str(path)!r}")
+    folder = path.parent if str(path.parent) else Path(".")
+    if not folder.is_dir():
+        raise _ErrorInput(f"folder {str(folder)!r} does not exist")
+
+
+def _save_png(fig: Any, path: Path) -> None:
+    """Save a figure all at once (never half-written)."""
+    with atomic_path(path, suffix=".png") as tmp:
+        fig.savefig(tmp, dpi=150)
+
+
+def _r_beta(case: str, r: float | None, beta: float | None) -> tuple[float, float]:
+    vals = case_values(case)
+    return (vals["r"] if r is None else r), (vals["beta"] if beta is None else beta)
+
+
+def _amplitude_rad(amplitude: float) -> float:
+    if not (math.isfinite(amplitude) and 0.0 < amplitude < 180.0):
+        raise _ErrorInput(f"--amplitude must be in (0, 180) degrees, got {amplitude:g}")
+    return math.radians(amplitude)
+
+
+_case_option = click.option(
+    "--case",
+    default=DEFAULT_CASE,
+    show_default=True,
+    metavar="NAME",
+    help=f"Paper parameter case for r and beta: {', '.join(CASES)}.",
+)
+_amplitude_option = click.option(
+    "--amplitude",
+    type=float,
+    default=_DEFAULT_AMPLITUDE_DEG,
+    show_default="28.65 (0.5 rad)",
+    metavar="DEG",
+    help="Release angle of the free decay below the stop, degrees.",
+)
+_peaks_option = click.option(
+    "--peaks", type=click.IntRange(min=1), default=10, show_default=True, help="Peaks after the release used."
+)
+_norm_option = click.option(
+    "--normalisation",
+    type=click.Choice(["eq6", "eq1"]),
+    default="eq6",
+    show_default=True,
+    help="eq6: ln ratio / (2 pi k) so that D = beta at r = 1; eq1: / (4 pi k) as printed.",
+)
+_json_option = click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
+
+
+# ----------------------------------------------------------------------------
+# damping
+
+
+@click.command("damping")
+@_case_option
+@click.option("--r", "r", type=float, help="Coefficient of restitution in (0, 1].")
+@click.option("--beta", type=float, help="Linear damping.")
+@_amplitude_option
+@_peaks_option
+@click.option("--k-hat", "k_hat", type=click.IntRange(min=1), multiple=True,
+              help="Peak spacing(s) to average over (repeatable; default 1).")  # fmt: skip
+@_norm_option
+@click.option("--recording", type=click.Path(path_type=Path), metavar="FILE.csv",
+              help="Estimate D from a recorded free decay (time,angle) instead of the model.")  # fmt: skip
+@click.option("--degrees", is_flag=True, help="The recording's angle is in degrees.")
+@_json_option
+def damping_cmd(
+    case: str, r: float | None, beta: float | None, amplitude: float, peaks: int, k_hat: tuple[int, ...],
+    normalisation: str, recording: Path | None, degrees: bool, as_json: bool,
+) -> None:  # fmt: skip
+    """Logarithmic-decrement damping D (paper eq. 1) of the model's free decay, or of a recording."""
+    from grazing.experiment import damping as dmp
+
+    ks = k_hat or (1,)
+    if recording is not None:
+        from grazing.experiment.recording import load_recording
+
+        rec = load_recording(recording, degrees=degrees)
+        res = dmp.recorded_damping(rec, k_hat=ks, normalisation=normalisation)  # type: ignore[arg-type]
+        out = {
+            "source": str(recording),
+            "D": res.estimate.damping,
+            "log_ratio": res.estimate.log_ratio,
+            "spread": res.estimate.spread,
+            "k_hat": list(ks),
+            "normalisation": normalisation,
+            "amplitudes": res.amplitudes,
+            "peak_times": res.peak_t,
+            "rest_angle": res.rest_angle,
+            "noise": res.noise,
+        }
+        if as_json:
+            _emit_json(out)
+            return
+        click.echo(
+            f"{recording}: D = {res.estimate.damping:.5f} ({normalisation} normalisation) from "
+            f"{res.amplitudes.size} peaks; ln ratio per peak {res.estimate.log_ratio:.5f}; "
+            f"noise {res.noise:.2g} rad"
+        )
+        return
+    rv, bv = _r_beta(case, r, beta)
+    amp = _amplitude_rad(amplitude)
+    dmp._check_r_beta(rv, bv)
+    if max(ks) > peaks:
+        raise _ErrorInput(f"--k-hat {max(ks)} needs at least as many --peaks (got {peaks})")
+    dec = dmp.free_decay(rv, bv, amplitude=amp, peaks=peaks)
+    est = dmp.log_decrement(dec.amplitudes, ks, normalisation=normalisation)  # type: ignore[arg-type]
+    out = {
+        "r": rv,
+        "beta": bv,
+        "D": est.damping,
+        "log_ratio": est.log_ratio,
+        "spread": est.spread,
+        "k_hat": list(ks),
+        "normalisation": normalisation,
+        "amplitude_deg": amplitude,
+        "amplitudes": dec.amplitudes,
+        "D_eq6": dmp.log_decrement(dec.amplitudes, ks).damping,
+        "D_eq1": dmp.log_decrement(dec.amplitudes, ks, normalisation="eq1").damping,
+        "D_linear": dmp.linear_damping(rv, bv),
+        "D_paper_relation": dmp.paper_relation(rv, bv),
+        "D_protocol": dmp.paper_protocol_damping(rv, bv, amplitude=amp, peaks=peaks, k_hat=ks).damping,
+    }
+    if as_json:
+        _emit_json(out)
+        return
+    click.echo(f"free decay r = {rv:g}, beta = {bv:g}, released {amplitude:.4g} deg below the stop at 0")
+    click.echo(f"  D = {est.damping:.5f} ({normalisation}), ln(A_k/A_k+1) per impact = {est.log_ratio:.5f}")
+    click.echo(
+        f"  eq. 1 as printed: {out['D_eq1']:.5f}; small-amplitude formula: {out['D_linear']:.5f}; "
+        f"paper's relation beta - ln(r)/(4 pi): {out['D_paper_relation']:.5f}"
+    )
+
+
+# ----------------------------------------------------------------------------
+# iso-damping
+
+
+def _write_curve_csv(r: np.ndarray, beta: np.ndarray, fh: Any) -> None:
+    fh.write("r,beta\n")
+    np.savetxt(fh, np.column_stack([r, beta]), delimiter=",", fmt="%.12g")
+
+
+@click.command("iso-damping")
+@click.option("--damping", "damping", type=float, default=0.07, show_default=True, metavar="D",
+              help="Target damping D.")  # fmt: skip
+@click.option("--num", type=click.IntRange(min=2), default=21, show_default=True, help="Points on the curve.")
+@click.option("--relation", type=click.Choice(_RELATIONS), default="model", show_default=True,
+              help="model: root-finding on the model (eq. 6 normalisation); paper: D = beta - ln(r)/(4 pi); "
+                   "protocol: eq. 1 on the model with doubled damping.")  # fmt: skip
+@_amplitude_option
+@_peaks_option
+@_norm_option
+@click.option("--out", type=click.Path(dir_okay=False, path_type=Path), metavar="FILE.csv",
+              help="Write the curve (r,beta) to a CSV file.")  # fmt: skip
+@_json_option
+def iso_damping_cmd(
+    damping: float, num: int, relation: str, amplitude: float, peaks: int, normalisation: str,
+    out: Path | None, as_json: bool,
+) -> None:  # fmt: skip
+    """The curve of (r, beta) along which the measured damping is D (fig 4b)."""
+    from grazing.experiment import damping as dmp
+
+    amp = _amplitude_rad(amplitude)
+    if out is not None:
+        if out.suffix.lower() != ".csv":
+            raise _ErrorInput(f"--out must name a .csv file, got {str(out)!r}")
+        if not (out.parent if str(out.parent) else Path(".")).is_dir():
+            raise _ErrorInput(f"folder {str(out.parent)!r} does not exist")
+    protocol: dict[str, Any] = {}
+    if relation == "model":
+        protocol = {"amplitude": amp, "peaks": peaks, "normalisation": normalisation}
+    elif relation == "protocol":
+        protocol = {"amplitude": amp, "peaks": peaks}
+    curve = dmp.iso_damping(damping, num=num, relation=relation, **protocol)  # type: ignore[arg-type]
+    points = {}
+    for name, (pr, pb) in dmp.PAPER_POINTS.items():
+        points[name] = {
+            "r": pr,
+            "beta": pb,
+            "D_model": dmp.model_damping(pr, pb, amplitude=amp, peaks=peaks).damping,
+            "D_paper_relation": dmp.paper_relation(pr, pb),
+            "D_protocol": dmp.paper_protocol_damping(pr, pb, amplitude=amp, peaks=peaks).damping,
+        }
+    if out is not None:
+        _write_atomic(out, lambda fh: _write_curve_csv(curve.r, curve.beta, fh))
+    res = {
+        "damping": curve.damping,
+        "relation": relation,
+        "r": curve.r,
+        "beta": curve.beta,
+        "r_min": curve.r_min,
+        "beta_max": curve.beta_max,
+        "paper_points": points,
+        "out": str(out) if out else None,
+    }
+    if as_json:
+        _emit_json(res)
+        return
+    click.echo(
+        f"D = {curve.damping:g} ({relation}): from r = {curve.r_min:.4f} at beta = 0 "
+        f"to beta = {curve.beta_max:.4f} at r = 1"
+    )
+    for rv, bv in zip(curve.r, curve.beta):
+        click.echo(f"  r = {rv:.4f}   beta = {bv:.5f}")
+    for name, p in points.items():
+        click.echo(
+            f"  paper's {name} (r = {p['r']:g}, beta = {p['beta']:g}): model D = {p['D_model']:.4f}, "
+            f"beta - ln(r)/(4 pi) = {p['D_paper_relation']:.4f}"
+        )
+    if out is not None:
+        click.echo(f"curve written to {out}")
+
+
+# ----------------------------------------------------------------------------
+# fit
+
+
+@click.command("fit")
+@click.option("--theta-hat", "theta_hat", type=float, default=40.0, show_default=True, metavar="DEG",
+              help="Stop angle of the observed grazing, degrees.")  # fmt: skip
+@click.option("--eta-graze", "eta_graze", type=float, default=0.445, show_default=True, metavar="E",
+              help="Observed eta of the primary grazing.")  # fmt: skip
+@click.option("--damping", "damping", type=float, default=0.07, show_default=True, metavar="D",
+              help="Measured damping D.")  # fmt: skip
+@click.option("--alpha", type=float, default=CASES["B"]["alpha"], show_default=True, help="Forcing A/L.")
+@click.option("--relation", type=click.Choice(_RELATIONS), default="model", show_default=True,
+              help="Which equal-damping curve (see iso-damping).")  # fmt: skip
+@_json_option
+def fit_cmd(
+    theta_hat: float, eta_graze: float, damping: float, alpha: float, relation: str, as_json: bool
+) -> None:
+    """Fit beta and r: the point of the equal-damping curve whose primary grazing is at the observed eta."""
+    from grazing.experiment.fit import fit_parameters
+
+    if not (math.isfinite(theta_hat) and -180.0 < theta_hat < 180.0):
+        raise _ErrorInput(f"--theta-hat must be in (-180, 180) degrees, got {theta_hat:g}")
+    if not (math.isfinite(alpha) and alpha > 0):
+        raise _ErrorInput(f"--alpha must be positive, got {alpha:g}")
+    fit = fit_parameters(theta_hat, eta_graze, damping, alpha=alpha, relation=relation)  # type: ignore[arg-type]
+    res = {
+        "beta": fit.beta,
+        "r": fit.r,
+        "eta_graze": fit.eta_graze,
+        "theta_hat_deg": fit.theta_hat_deg,
+        "damping": fit.damping,
+        "alpha": fit.alpha,
+        "relation": fit.relation,
+        "beta_max": fit.beta_max,
+        "r_min": _none_if_nan(fit.r_min),
+        "evaluations": fit.evaluations,
+    }
+    if as_json:
+        _emit_json(res)
+        return
+    click.echo(
+        f"beta = {fit.beta:.5f}, r = {fit.r:.4f}  (primary grazing at theta-hat = {theta_hat:g} deg "
+        f"at eta = {fit.eta_graze:.6f}; D = {damping:g}, {relation} curve; "
+        f"{fit.evaluations} grazing computations)"
+    )
+
+
+# ----------------------------------------------------------------------------
+# analyze
+
+
+def _analysis_json(a: Any, rec: Any) -> dict[str, Any]:
+    ok = np.isfinite(a.samples)
+    return {
+        "file": a.source,
+        "forcing_hz": a.forcing_hz,
+        "eta": a.eta,
+        "period": a.period,
+        "samples": [float(v) if math.isfinite(v) else None for v in a.samples],
+        "quarter": [float(v) if math.isfinite(v) else None for v in a.quarter],
+        "sample_times": a.sample_times,
+        "n_samples": int(ok.sum()),
+        "noise": a.noise,
+        "sample_noise": a.sample_noise,
+        "cutoff_hz": a.cutoff_hz,
+        "phase": a.phase,
+        "from_trigger": a.from_trigger,
+        "sample_rate_hz": rec.sample_rate,
+        "duration_s": rec.duration,
+        "resampled": a.resampled,
+        "gaps": [list(g) for g in a.gaps],
+        "synthetic": bool(rec.metadata.get("synthetic", False)),
+    }
+
+
+def _plot_recording(a: Any, path: Path) -> None:
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(9.0, 3.2), layout="constrained")
+    ax1, ax2 = fig.subplots(1, 2, width_ratios=[2.2, 1.0])
+    T = 1.0 / a.forcing_hz
+    t0 = max(a.time[0], a.time[-1] - 12 * T)
+    sel = a.time >= t0
+    ax1.plot(a.time[sel], np.degrees(a.filtered[sel]), lw=0.7)
+    ok = (a.sample_times >= t0) & np.isfinite(a.samples)
+    ax1.plot(a.sample_times[ok], np.degrees(a.samples[ok]), "o", ms=3, color="k")
+    ax1.set_xlabel("t (s)")
+    ax1.set_ylabel("θ (degrees)")
+    kind = f"period {a.period}" if a.period else "no period ≤ 32"
+    ax1.set_title(f"{a.source}: η = {a.eta:.4f}, {kind}", fontsize="medium")
+    emb = a.embedding()[int(np.searchsorted(a.time, t0)) :]
+    ax2.plot(np.degrees(emb[:, 0]), np.degrees(emb[:, 1]), lw=0.5)
+    ax2.set_xlabel("θ(t − T/4) (deg)")
+    ax2.set_ylabel("θ(t) (deg)")
+    _save_png(fig, path)
+
+
+@click.command("analyze")
+@click.argument("path", type=click.Path(path_type=Path), metavar="FILE.csv|DIR")
+@click.option("--forcing-hz", "forcing_hz", type=float, metavar="F",
+              help="Forcing frequency, Hz (needed without a trigger column; t = 0 is phase 0).")  # fmt: skip
+@click.option("--phase", type=float, default=0.0, show_default=True, metavar="PHI",
+              help="Sampling phase in radians after the reference (trigger or t = 0).")  # fmt: skip
+@click.option("--degrees", is_flag=True, help="The angle column is in degrees.")
+@click.option("--cutoff-hz", type=float, help="Low-pass cutoff in Hz (default: a multiple of the forcing).")
+@click.option("--cutoff-multiple", type=float, default=20.0, show_default=True,
+              help="Default cutoff in multiples of the forcing frequency.")  # fmt: skip
+@click.option("--max-period", type=click.IntRange(min=1, max=64), default=32, show_default=True,
+              help="Largest period tested.")  # fmt: skip
+@click.option("--noise", type=float, help="Noise level of the angle in rad (default: estimated).")
+@click.option("--theta-hat", "theta_hat", type=float, metavar="DEG",
+              help="Stop angle for a folder (default: from the sidecar JSON files).")  # fmt: skip
+@click.option("--with-model", is_flag=True, help="For a folder: also sweep the model (case, same theta-hat).")
+@_case_option
+@click.option("--model-points", type=click.IntRange(min=2), default=101, show_default=True,
+              help="Model sweep points (with --with-model).")  # fmt: skip
+@click.option("--plot", type=click.Path(dir_okay=False, path_type=Path), metavar="FILE.png",
+              help="Draw the time series and embedding (file) or the diagram (folder).")  # fmt: skip
+@_json_option
+def analyze_cmd(
+    path: Path, forcing_hz: float | None, phase: float, degrees: bool, cutoff_hz: float | None,
+    cutoff_multiple: float, max_period: int, noise: float | None, theta_hat: float | None, with_model: bool,
+    case: str, model_points: int, plot: Path | None, as_json: bool,
+) -> None:  # fmt: skip
+    """Analyse a recording (period, stroboscopic samples, noise) or a folder of them (fig 2-style diagram)."""
+    from grazing.experiment.recording import load_recording
+    from grazing.experiment.signal import analyze_recording
+
+    _check_png(plot)
+    if not math.isfinite(phase):
+        raise _ErrorInput(f"--phase must be a finite number, got {phase}")
+    if noise is not None and not (math.isfinite(noise) and noise > 0):
+        raise _ErrorInput(f"--noise must be positive, got {noise:g}")
+    if theta_hat is not None and not (math.isfinite(theta_hat) and -180 < theta_hat < 180):
+        raise _ErrorInput(f"--theta-hat must be in (-180, 180) degrees, got {theta_hat:g}")
+    case_values(case)
+    if path.is_dir():
+        for name, val in (("--forcing-hz", forcing_hz), ("--cutoff-hz", cutoff_hz), ("--noise", noise)):
+            if val is not None:
+                raise _ErrorInput(f"{name} applies to a single recording, not to a folder")
+        _analyze_folder(path, phase, degrees, cutoff_multiple, max_period, theta_hat, with_model, case,
+                        model_points, plot, as_json)  # fmt: skip
+        return
+    if with_model:
+        raise _ErrorInput("--with-model applies to a folder of recordings")
+    rec = load_recording(path, degrees=degrees)
+    a = analyze_recording(
+        rec, forcing_hz, phase=phase, cutoff_hz=cutoff_hz, cutoff_multiple=cutoff_multiple,
+        max_period=max_period, noise=noise,
+    )  # fmt: skip
+    if plot is not None:
+        _plot_recording(a, plot)
+    res = _analysis_json(a, rec)
+    res["plot"] = str(plot) if plot else None
+    if as_json:
+        _emit_json(res)
+        return
+    kind = f"period {a.period}" if a.period else f"no period <= {max_period} at this noise level"
+    src = "trigger" if a.from_trigger else "--forcing-hz"
+    click.echo(
+        f"{path}: {kind}; forcing {a.forcing_hz:.6g} Hz ({src}), eta = {a.eta:.5f}; "
+        f"{res['n_samples']} samples; noise {a.noise:.2g} rad"
+    )
+    if rec.metadata.get("synthetic"):
+        click.echo("  (synthetic recording)")
+    if a.resampled:
+        click.echo("  non-uniform sampling: resampled on a uniform grid")
+    for g0, g1 in a.gaps:
+        click.echo(f"  gap in the angle from {g0:.6g} s to {g1:.6g} s (samples there left out)")
+    last = [f"{math.degrees(v):.3f}" for v in a.samples[np.isfinite(a.samples)][-max(a.period, 8) :]]
+    click.echo(f"  last samples (deg): {' '.join(last)}")
+    if plot is not None:
+        click.echo(f"plot written to {plot}")
+
+
+def _analyze_folder(
+    path: Path, phase: float, degrees: bool, cutoff_multiple: float, max_period: int, theta_hat: float | None,
+    with_model: bool, case: str, model_points: int, plot: Path | None, as_json: bool,
+) -> None:  # fmt: skip
+    from grazing.experiment.diagram import load_diagram, model_sweep, plot_diagram
+
+    bar = _Progress("analysing", enabled=not as_json)
+    try:
+        diag = load_diagram(
+            path, theta_hat_deg=theta_hat, degrees=degrees, phase=phase, cutoff_multiple=cutoff_multiple,
+            max_period=max_period, progress=bar,
+        )  # fmt: skip
+    finally:
+        bar.close()
+    model = None
+    if with_model:
+        if diag.theta_hat_deg is None:
+            raise _ErrorInput(
+                "--with-model needs the stop angle: give --theta-hat or theta_hat_deg in sidecars"
+            )
+        etas = np.linspace(diag.eta.min(), diag.eta.max(), model_points)
+        bar = _Progress("model sweep", enabled=not as_json)
+        try:
+            model = model_sweep(diag.theta_hat_deg, etas, case=case, progress=bar)
+        finally:
+            bar.close()
+    if plot is not None:
+        from matplotlib.figure import Figure
+
+        fig = Figure(figsize=(7.0, 4.0), layout="constrained")
+        label = "synthetic recordings" if diag.synthetic else "recordings"
+        plot_diagram(fig.add_subplot(), diag, model, label=label)
+        _save_png(fig, plot)
+    res: dict[str, Any] = {
+        "folder": str(path),
+        "theta_hat_deg": diag.theta_hat_deg,
+        "files": list(diag.files),
+        "synthetic": diag.synthetic,
+        "forcing_hz": diag.forcing_hz,
+        "eta": diag.eta,
+        "period": diag.period,
+        "noise": diag.noise,
+        "samples": [s.tolist() for s in diag.samples()],
+        "model": None,
+        "plot": str(plot) if plot else None,
+    }
+    if model is not None:
+        res["model"] = {
+            "case": case,
+            "eta": model["value"].values,
+            "period": model.period.values,
+            "samples": [[_none_if_nan(v) for v in row] for row in model.samples.values[..., 0]],
+        }
+    if as_json:
+        _emit_json(res)
+        return
+    th = f"{diag.theta_hat_deg:g} deg" if diag.theta_hat_deg is not None else "unknown"
+    click.echo(f"{path}: {len(diag.files)} recordings, theta-hat {th}")
+    for f, e, p in zip(diag.files, diag.eta, diag.period):
+        click.echo(f"  eta = {e:.5f}  {'period ' + str(p) if p else 'no period'}   {f}")
+    if plot is not None:
+        click.echo(f"diagram written to {plot}")
+
+
+# ----------------------------------------------------------------------------
+# synthesize
+
+
+@click.command("synthesize")
+@click.option("--eta", "etas", type=float, multiple=True, required=True,
+              help="Frequency ratio (repeat for a sweep into a folder).")  # fmt: skip
+@click.option("--theta-hat", "theta_hat", type=float, default=40.0, show_default=True, metavar="DEG",
+              help="Stop angle, degrees.")  # fmt: skip
+@_case_option
+@click.option("--periods", type=click.IntRange(min=8), default=100, show_default=True,
+              help="Forcing periods recorded.")  # fmt: skip
+@click.option("--transient", type=click.IntRange(min=0), default=500, show_default=True,
+              help="Forcing periods simulated before recording.")  # fmt: skip
+@click.option("--sample-rate", type=float, default=1000.0, show_default=True, help="Samples per second.")
+@click.option("--noise", type=float, default=1e-3, show_default=True, help="Sensor noise, rad.")
+@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the noise.")
+@click.option("--out", type=click.Path(path_type=Path), required=True, metavar="FILE.csv|DIR",
+              help="A .csv file (one --eta) or a folder (several).")  # fmt: skip
+@_json_option
+def synthesize_cmd(
+    etas: tuple[float, ...], theta_hat: float, case: str, periods: int, transient: int, sample_rate: float,
+    noise: float, seed: int, out: Path, as_json: bool,
+) -> None:  # fmt: skip
+    """Write SYNTHETIC rig-like recordings simulated from the model (1 kHz, noise, drift, trigger)."""
+    from grazing.experiment.synthetic import synthetic_recording, synthetic_sweep, write_recording
+
+    case_values(case)
+    for e in etas:
+        if not (math.isfinite(e) and e > 0):
+            raise _ErrorInput(f"--eta must be positive, got {e:g}")
+    if not (math.isfinite(theta_hat) and -180 < theta_hat < 180):
+        raise _ErrorInput(f"--theta-hat must be in (-180, 180) degrees, got {theta_hat:g}")
+    if not (math.isfinite(sample_rate) and sample_rate > 0):
+        raise _ErrorInput(f"--sample-rate must be positive, got {sample_rate:g}")
+    if not (math.isfinite(noise) and noise >= 0):
+        raise _ErrorInput(f"--noise must be >= 0, got {noise:g}")
+    kw = {"case": case, "sample_rate": sample_rate, "noise": noise}
+    if out.suffix.lower() == ".csv":
+        if len(etas) != 1:
+            raise _ErrorInput("several --eta values need a folder as --out, not a .csv file")
+        if not (out.parent if str(out.parent) else Path(".")).is_dir():
+            raise _ErrorInput(f"folder {str(out.parent)!r} does not exist")
+        rec = synthetic_recording(etas[0], theta_hat, periods=periods, transient=transient, seed=seed, **kw)
+        paths = [write_recording(rec, out)]
+    else:
+        if out.exists() and not out.is_dir():
+            raise _ErrorInput(f"--out {str(out)!r} exists and is not a folder")
+        paths = synthetic_sweep(out, theta_hat, etas, periods=periods, transient=transient, seed=seed, **kw)
+    if as_json:
+        _emit_json({"files": [str(p) for p in paths], "synthetic": True})
+        return
+    for p in paths:
+        click.echo(f"wrote {p} (synthetic)")
+
+
+COMMANDS = (damping_cmd, iso_damping_cmd, fit_cmd, analyze_cmd, synthesize_cmd)
+
+
+def register(group: click.Group) -> None:
+    """Add the experiment commands to ``group`` (idempotent).
+
+    Examples
+    --------
+    >>> from grazing.cli import cli
+    >>> register(cli); register(cli)
+    >>> sorted(c for c in cli.commands if c in ("damping", "fit", "analyze"))
+    ['analyze', 'damping', 'fit']
+    """
+    for cmd in COMMANDS:
+        if cmd.name not in group.commands:
+            group.add_command(cmd)
