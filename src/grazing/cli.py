@@ -931,7 +931,6 @@ def report(out: Path) -> None:
 # Entry point
 
 
-
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI; every error becomes one line on stderr and an exit status."""
     try:
