@@ -29,6 +29,8 @@ test-all: $(STAMP)
 bench: $(STAMP)
 	$(BIN)/python -m pip install --quiet -e ".[test,bench]"
 	$(BIN)/python benchmarks/bench_simulate.py
+	$(BIN)/python benchmarks/bench_sweep.py
+	$(BIN)/python benchmarks/bench_grazing_curve.py
 
 lint: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks

@@ -9,7 +9,7 @@ import pytest
 from matplotlib.figure import Figure
 
 import grazing
-from grazing.plotting import delay_embedding, plot_delay, plot_time_series, uniform_resample
+from grazing.plotting import delay_coordinates, plot_delay, plot_time_series, uniform_resample
 
 
 @pytest.fixture(scope="module")
@@ -39,19 +39,19 @@ def test_uniform_resample_start_and_errors() -> None:
         uniform_resample(t, t, 0.1, start=-1.0)
 
 
-def test_delay_embedding_of_a_sine_is_the_circle_with_the_right_phase() -> None:
+def test_delay_coordinates_of_a_sine_is_the_circle_with_the_right_phase() -> None:
     t = np.linspace(0.0, 6 * np.pi, 1201)  # dt = pi/200: a quarter period is 100 steps
-    tn, xd, xn = delay_embedding(t, np.sin(t), np.pi / 2)
+    tn, xd, xn = delay_coordinates(t, np.sin(t), np.pi / 2)
     assert np.isclose(tn[0], np.pi / 2) and np.isclose(tn[-1], 6 * np.pi)
     assert np.allclose(xn, np.sin(tn), atol=1e-12)
     assert np.allclose(xd, -np.cos(tn), atol=1e-12)  # sin(t - pi/2)
     assert np.allclose(xd**2 + xn**2, 1.0, atol=1e-12)
 
 
-def test_delay_embedding_shrinks_the_step_to_divide_the_delay() -> None:
+def test_delay_coordinates_shrinks_the_step_to_divide_the_delay() -> None:
     t = np.linspace(0.0, 10.0, 301)  # dt = 1/30 does not divide 0.55
     a, w = 2.0, 1.3
-    tn, xd, xn = delay_embedding(t, a * np.cos(w * t), 0.55)
+    tn, xd, xn = delay_coordinates(t, a * np.cos(w * t), 0.55)
     assert np.allclose(np.diff(tn), 0.55 / math.ceil(0.55 * 30))
     assert np.allclose(xd, a * np.cos(w * (tn - 0.55)), atol=2e-3)
     # an ellipse: x(t) and x(t - d) satisfy the quadratic form of a phase-shifted pair
@@ -59,15 +59,15 @@ def test_delay_embedding_shrinks_the_step_to_divide_the_delay() -> None:
     s2 = math.sin(w * 0.55) ** 2
     assert np.allclose((xn**2 - 2 * c * xn * xd + xd**2) / (a**2 * s2), 1.0, atol=5e-3)
     with pytest.raises(ValueError, match="shorter"):
-        delay_embedding(t, t, 20.0)
+        delay_coordinates(t, t, 20.0)
     with pytest.raises(ValueError, match="scalar"):
-        delay_embedding(t, np.column_stack([t, t]), 1.0)
+        delay_coordinates(t, np.column_stack([t, t]), 1.0)
 
 
-def test_delay_embedding_of_a_trajectory_with_impacts(period5: grazing.Solution) -> None:
+def test_delay_coordinates_of_a_trajectory_with_impacts(period5: grazing.Solution) -> None:
     t, th = period5.trajectory_t, period5.trajectory[:, 0]
     assert np.any(np.diff(t) == 0), "impacts should appear twice in the dense output"
-    tn, xd, xn = delay_embedding(t, th, math.pi / 2)
+    tn, xd, xn = delay_coordinates(t, th, math.pi / 2)
     dt = np.diff(tn)
     assert np.allclose(dt, 2 * math.pi / 200)  # 50 steps per quarter period
     assert np.isclose(tn[0] - t[0], math.pi / 2)

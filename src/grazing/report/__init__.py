@@ -11,8 +11,8 @@ figure, write ``figNN.py`` with such a ``build`` and list it in
 Examples
 --------
 >>> from grazing.report import FIGURES, PAPER_FIGURES
->>> [m.FIGURE_ID for m in FIGURES][:1], PAPER_FIGURES[0]
-(['9'], '4')
+>>> [m.FIGURE_ID for m in FIGURES], PAPER_FIGURES[0]
+(['6', '7', '8', '9', '12', 'map'], '4')
 """
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ from datetime import datetime
 from pathlib import Path
 
 import grazing
-from grazing.report import fig09
+from grazing.report import fig02, fig04, fig06, fig07, fig08, fig09, fig10, fig11, fig12, figmap
 from grazing.report.base import Comparison, Dynamics, FigureResult, Image, Progress
 from grazing.report.html import ReportMeta, render
 
@@ -39,7 +39,7 @@ __all__ = [
     "build_report",
 ]
 
-FIGURES = (fig09,)
+FIGURES = (fig02, fig04, fig06, fig07, fig08, fig09, fig10, fig11, fig12, figmap)
 """The figure modules, in the order the page shows them."""
 
 PAPER_FIGURES = ("4", "6", "7", "8", "9", "10", "11", "12")

@@ -350,6 +350,7 @@ def sweep(
     adaptive: bool = True,
     lyapunov: bool = True,
     tol: float = DEFAULT_SWEEP_TOL,
+    zdm: DiscontinuityMap | None = None,
     store: Any = None,
     workers: int | None = None,
     client: Any = None,
@@ -390,6 +391,7 @@ def sweep(
         adaptive=adaptive,
         lyapunov=lyapunov,
         tol=tol,
+        zdm=zdm,
     )
     ds = run_sweep(spec, store=store, workers=workers, client=client, progress=progress)
     return ds.sortby("value")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -14,52 +15,111 @@ class Window:
     Attributes
     ----------
     period
-        The period (0 for a run of aperiodic points).
-    start, end
-        First and last parameter value of the run.
-    count
-        Number of points.
+        The detected period (0: aperiodic, no period up to the detection
+        limit; -1: the point could not be simulated).
+    impacting
+        Whether the points have impacts (a nonimpacting period-1 orbit and an
+        impacting one are different windows).
+    first, last
+        Indices of the first and last point of the run (in increasing
+        parameter order).
+    start, stop
+        Parameter values of the first and last point (in the dataset's units,
+        radians for angles).
+    lo, hi
+        The extent of the run on the parameter axis: half-way to the
+        neighbouring points outside it (the end points at the ends of the sweep).
     """
 
     period: int
+    impacting: bool
+    first: int
+    last: int
     start: float
-    end: float
-    count: int
+    stop: float
+    lo: float
+    hi: float
+
+    @property
+    def points(self) -> int:
+        """Number of sweep points in the run."""
+        return self.last - self.first + 1
 
     @property
     def width(self) -> float:
-        return self.end - self.start
+        """``hi - lo``: the extent of the run on the parameter axis."""
+        return self.hi - self.lo
+
+    @property
+    def center(self) -> float:
+        """Middle of the run's extent."""
+        return 0.5 * (self.lo + self.hi)
+
+    @property
+    def label(self) -> str:
+        """``"5"``, ``"1 (no impacts)"``, ``"aperiodic"`` or ``"failed"``."""
+        if self.period > 0:
+            return f"{self.period}" if self.impacting or self.period > 1 else "1 (no impacts)"
+        return "aperiodic" if self.period == 0 else "failed"
 
 
-def window_runs(values: np.ndarray, periods: np.ndarray, min_points: int = 2) -> list[Window]:
-    """Maximal runs of equal period in a sweep ordered by parameter value.
+def find_windows(ds: Any) -> list[Window]:
+    """Split a one-parameter sweep into runs of equal period (and impacting or not).
 
-    Runs shorter than ``min_points`` are dropped (isolated points are not windows).
+    Parameters
+    ----------
+    ds
+        A dataset from :func:`grazing.sweeps.sweep` (variables ``period`` and
+        ``impacts_per_period`` along ``point``, coordinate ``value``).
+
+    Returns
+    -------
+    list of Window
+        Every run, in increasing parameter order, covering all points:
+        periodic windows, aperiodic stretches (period 0) and failed points
+        (period -1) alike.  Filter them as needed.
 
     Examples
     --------
-    >>> window_runs(np.arange(8.0), np.array([1, 1, 0, 3, 3, 3, 0, 2]))
-    [Window(period=1, start=0.0, end=1.0, count=2), Window(period=3, start=3.0, end=5.0, count=3)]
+    >>> import xarray as xr
+    >>> ds = xr.Dataset(
+    ...     {"period": ("point", [1, 1, 0, 3, 3, 3, 1]),
+    ...      "impacts_per_period": ("point", [0, 0, 0.7, 1, 1, 1, 1.0])},
+    ...     coords={"value": ("point", [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7])})
+    >>> [(w.label, w.points) for w in find_windows(ds)]
+    [('1 (no impacts)', 2), ('aperiodic', 1), ('3', 3), ('1', 1)]
+    >>> w = find_windows(ds)[2]
+    >>> round(w.lo, 3), round(w.hi, 3)
+    (0.35, 0.65)
     """
-    v = np.asarray(values, dtype=float)
-    p = np.asarray(periods)
-    order = np.argsort(v)
-    v, p = v[order], p[order]
-    out: list[Window] = []
-    i = 0
-    while i < v.size:
-        j = i
-        while j + 1 < v.size and p[j + 1] == p[i]:
-            j += 1
-        if j - i + 1 >= min_points and p[i] > 0:
-            out.append(Window(int(p[i]), float(v[i]), float(v[j]), j - i + 1))
-        i = j + 1
+    order = np.argsort(np.asarray(ds["value"].values, dtype=float), kind="stable")
+    value = np.asarray(ds["value"].values, dtype=float)[order]
+    period = np.asarray(ds["period"].values, dtype=int)[order]
+    impacting = np.asarray(ds["impacts_per_period"].values, dtype=float)[order] > 0
+    n = value.size
+    if n == 0:
+        return []
+    # boundaries of the runs: where the period or the impacting flag changes
+    change = np.flatnonzero((np.diff(period) != 0) | (np.diff(impacting) != 0)) + 1
+    starts = np.concatenate(([0], change))
+    ends = np.concatenate((change - 1, [n - 1]))
+    mid = 0.5 * (value[1:] + value[:-1])
+    out = []
+    for i, j in zip(starts, ends):
+        lo = value[0] if i == 0 else mid[i - 1]
+        hi = value[-1] if j == n - 1 else mid[j]
+        out.append(
+            Window(
+                period=int(period[i]), impacting=bool(impacting[i]), first=int(i), last=int(j),
+                start=float(value[i]), stop=float(value[j]), lo=float(lo), hi=float(hi),
+            )
+        )  # fmt: skip
     return out
 
 
 @dataclass(frozen=True)
 class WindowComparison:
-    """The same period's window in a reference sweep and in another one."""
+    """The same window in a reference sweep (e.g. direct simulation) and in another one (e.g. the map)."""
 
     period: int
     reference: Window
@@ -72,23 +132,24 @@ class WindowComparison:
 
     @property
     def end_error(self) -> float:
-        return float("nan") if self.other is None else self.other.end - self.reference.end
+        return float("nan") if self.other is None else self.other.stop - self.reference.stop
 
 
-def compare_windows(
-    values: np.ndarray, reference: np.ndarray, other: np.ndarray, origin: float, min_points: int = 2
-) -> list[WindowComparison]:
-    """Pair each window of ``reference`` (e.g. direct simulation) with ``other``'s window of that period.
+def compare_windows(reference: Any, other: Any, origin: float, min_points: int = 2) -> list[WindowComparison]:
+    """Pair each impacting periodic window of ``reference`` with ``other``'s window of that period.
 
-    Windows are ordered by their distance from ``origin`` (the grazing value);
-    when a period has several windows, the one nearest to the reference
-    window is paired.
+    Both are datasets of :func:`grazing.sweeps.sweep` over the same values.
+    Windows are listed by their distance from ``origin`` (the grazing value);
+    when a period has several windows in ``other``, the nearest is paired.
     """
-    ref = window_runs(values, reference, min_points)
-    oth = window_runs(values, other, min_points)
+
+    def periodic(ds: Any) -> list[Window]:
+        return [w for w in find_windows(ds) if w.period > 0 and w.impacting and w.points >= min_points]
+
+    oth = periodic(other)
     rows = []
-    for w in sorted(ref, key=lambda w: abs(w.start - origin)):
+    for w in sorted(periodic(reference), key=lambda w: abs(w.start - origin)):
         same = [o for o in oth if o.period == w.period]
-        best = min(same, key=lambda o: abs(o.start - w.start) + abs(o.end - w.end)) if same else None
+        best = min(same, key=lambda o: abs(o.start - w.start) + abs(o.stop - w.stop)) if same else None
         rows.append(WindowComparison(w.period, w, best, abs(w.start - origin)))
     return rows
