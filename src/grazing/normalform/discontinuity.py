@@ -158,7 +158,7 @@ def normal_form_at(point: GrazingPoint, params: tuple[str, ...] = ("eta", "theta
     >>> from grazing.orbits import find_grazings
     >>> g, _ = find_grazings(grazing.models.pendulum("B", theta_hat=math.radians(40)), "eta", 0.4, 0.47)
     >>> nf = normal_form_at(g[0])
-    >>> [round(v, 4) + 0.0 for v in nf.direction], round(nf.kappa, 3)
+    >>> [float(round(v, 4)) + 0.0 for v in nf.direction], round(nf.kappa, 3)
     ([0.0, 1.7675], 0.28)
     """
     m, x, t = point.model, point.contact, point.t_graze

@@ -11,8 +11,10 @@ figure, write ``figNN.py`` with such a ``build`` and list it in
 Examples
 --------
 >>> from grazing.report import FIGURES, PAPER_FIGURES
->>> [m.FIGURE_ID for m in FIGURES], PAPER_FIGURES[0]
-(['6', '7', '8', '9', '12', 'map'], '4')
+>>> [m.FIGURE_ID for m in FIGURES]
+['2', '4', '6', '7', '8', '9', '10', '11', '12', 'map']
+>>> set(PAPER_FIGURES) <= {m.FIGURE_ID for m in FIGURES}
+True
 """
 
 from __future__ import annotations
