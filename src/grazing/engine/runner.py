@@ -215,3 +215,29 @@ def failure_message(status: int, t: float, max_steps: int) -> str:
             "(the model defines no contact_direction for sticking)"
         ),
     }.get(status, f"integration failed with status {status}")
+
+
+def _compile_one(job: tuple[HybridModel, tuple[str, ...]]) -> None:
+    model, sens = job
+    Runner(model, np.zeros(model.n_states), variational=bool(sens), sensitivities=sens).advance(1, 1)
+
+
+def precompile(jobs: Sequence[tuple[HybridModel, tuple[str, ...]]], workers: int | None = None) -> None:
+    """Compile (or load) the kernels of several model variants in parallel processes.
+
+    Each job is ``(model, sensitivities)``.  numba caches the machine code on
+    disk, so afterwards every process loads it instead of compiling.  Useful
+    before a long computation on a machine that has not compiled them yet.
+    """
+    import multiprocessing as mp
+    import os
+
+    todo = list(jobs)
+    workers = min(workers or os.cpu_count() or 1, len(todo))
+    if workers <= 1:
+        for job in todo:
+            _compile_one(job)
+        return
+    ctx = mp.get_context("spawn")  # a fresh interpreter per worker: no half-initialised numba state
+    with ctx.Pool(workers) as pool:
+        pool.map(_compile_one, todo)
