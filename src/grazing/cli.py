@@ -106,8 +106,9 @@ def _parse_pair(text: str) -> tuple[float, float]:
 class _Progress:
     """A progress bar on stderr that appears only if the work lasts over a second."""
 
-    def __init__(self, label: str, enabled: bool):
+    def __init__(self, label: str, enabled: bool, unit: str = "items"):
         self.label = label
+        self.unit = unit
         self.enabled = enabled and sys.stderr.isatty()
         self.start = time.perf_counter()
         self._bar: Any = None
@@ -132,13 +133,16 @@ class _Progress:
                 TextColumn(self.label),
                 BarColumn(),
                 MofNCompleteColumn(),
+                TextColumn("{task.fields[rate]}"),
                 TimeRemainingColumn(),
                 console=Console(stderr=True),
                 transient=True,
             )
             self._bar.start()
-            self._task = self._bar.add_task(self.label, total=total)
-        self._bar.update(self._task, completed=done)
+            self._task = self._bar.add_task(self.label, total=total, rate="")
+        elapsed = time.perf_counter() - self.start
+        rate = f"{done / elapsed:,.0f} {self.unit}/s" if elapsed > 0 else ""
+        self._bar.update(self._task, completed=done, rate=rate)
 
     def close(self) -> None:
         if self._bar is not None:
@@ -221,7 +225,7 @@ def simulate(
         raise _ErrorInput(f"--trajectory must name a .csv file, got {str(trajectory)!r}")
     if trajectory is not None and not (trajectory.parent if str(trajectory.parent) else Path(".")).is_dir():
         raise _ErrorInput(f"folder {str(trajectory.parent)!r} does not exist")
-    bar = _Progress("simulating", enabled=not as_json)
+    bar = _Progress("simulating", enabled=not as_json, unit="periods")
     t0 = time.perf_counter()
     try:
         sol = grazing.simulate(
@@ -662,7 +666,7 @@ def _run_sweep_spec(
             client = Client(scheduler, timeout="5s")
         except (OSError, TimeoutError, ValueError) as exc:
             raise _ErrorInput(f"cannot connect to the Dask scheduler at {scheduler}: {exc}") from None
-    bar = _Progress("sweeping", enabled=not as_json)
+    bar = _Progress("sweeping", enabled=not as_json, unit="points")
     try:
         ds = run_sweep(spec, store=store, workers=workers, client=client, progress=bar)
     finally:

@@ -191,3 +191,30 @@ def test_flow_map_on_a_section_at_any_phase(pendulum_b):
     assert fm.solution.t_final == pytest.approx(2.3 + 4 * math.pi, abs=1e-12)
     ref = grazing.simulate(pendulum_b, x0, t0=2.3, periods=2, phase=2.3)
     np.testing.assert_allclose(fm.image, ref.x_final, atol=1e-14)
+
+
+def test_neimark_sacker_is_located_for_the_forced_van_der_pol_oscillator():
+    """The impacting pendulum is uniformly dissipative (det < 1: no NS); the forced van der Pol
+    oscillator is not: its entrained orbit loses stability to a torus as the forcing weakens."""
+    import sympy as sp
+
+    from grazing import HybridModel, Parameter
+
+    x, v, t = sp.symbols("x v t")
+    eps, F, w = sp.symbols("eps F w")
+    vdp = HybridModel(
+        "van-der-pol", [x, v], t,
+        [Parameter("eps", 0.2), Parameter("F", 1.0), Parameter("w", 1.15, lower=0, lower_open=True)],
+        vector_field=[v, eps * (1 - x**2) * v - x + F * sp.cos(w * t)],
+        guard=10 - x, reset=[x, -v], period=2 * sp.pi / w,
+    )  # fmt: skip
+    br = continue_orbit(vdp, "F", 1.0, 0.1, period=1, virtual=True)
+    ns = [s for s in br.special if s.kind == "neimark-sacker"]
+    assert len(ns) == 1
+    mu = ns[0].multipliers
+    np.testing.assert_allclose(np.abs(mu), 1.0, atol=1e-6)
+    assert abs(mu[0].imag) > 0.1  # a complex pair, not +-1
+    f_ns = ns[0].param
+    above = grazing.simulate(vdp.with_params(F=f_ns + 0.05), [0, 0], transient=1500, periods=100)
+    below = grazing.simulate(vdp.with_params(F=f_ns - 0.05), [0, 0], transient=1500, periods=100)
+    assert above.period() == 1 and below.period() == 0  # entrained vs quasi-periodic
