@@ -40,7 +40,20 @@ class _ErrorInput(click.ClickException):
 
 
 def model_options(func: Callable[..., Any]) -> Callable[..., Any]:
-    """Options selecting the pendulum's parameters: a named case plus overrides."""
+    """Options selecting the pendulum's parameters: a named case plus overrides.
+
+    The decorated command receives the validated model as ``model`` and the
+    case name as ``case`` (for its JSON output).
+    """
+
+    @functools.wraps(func)
+    def wrapper(
+        *args: Any, case: str, alpha: float | None, beta: float | None, r: float | None, eta: float,
+        theta_hat: float, **kwargs: Any,
+    ) -> Any:  # fmt: skip
+        model = build_pendulum(case, alpha, beta, r, eta, theta_hat)
+        return func(*args, model=model, case=case, **kwargs)
+
     options = [
         click.option(
             "--case",
@@ -64,8 +77,8 @@ def model_options(func: Callable[..., Any]) -> Callable[..., Any]:
         ),
     ]
     for opt in reversed(options):
-        func = opt(func)
-    return func
+        wrapper = opt(wrapper)
+    return wrapper
 
 
 def build_pendulum(
@@ -197,12 +210,8 @@ def cli() -> None:
               help="Trajectory resolution (with --trajectory).")  # fmt: skip
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
 def simulate(
+    model: grazing.HybridModel,
     case: str,
-    alpha: float | None,
-    beta: float | None,
-    r: float | None,
-    eta: float,
-    theta_hat: float,
     initial: str,
     transient: int,
     periods: int,
@@ -212,12 +221,11 @@ def simulate(
     as_json: bool,
 ) -> None:
     """Simulate the impacting pendulum; print stroboscopic samples, impacts, period."""
-    model = build_pendulum(case, alpha, beta, r, eta, theta_hat)
     theta0, dtheta0 = _parse_pair(initial)
     if theta0 > model.params["theta_hat"]:
         raise _ErrorInput(
-            f"initial angle {theta0:g} rad is beyond the stop at theta-hat = {theta_hat:g} deg "
-            f"({model.params['theta_hat']:.6g} rad)"
+            f"initial angle {theta0:g} rad is beyond the stop at theta-hat = "
+            f"{math.degrees(model.params['theta_hat']):g} deg ({model.params['theta_hat']:.6g} rad)"
         )
     if not math.isfinite(phase):
         raise _ErrorInput(f"--phase must be a finite number, got {phase}")
@@ -306,11 +314,12 @@ def _complex_list(mu: np.ndarray) -> list[list[float]]:
     return [[float(z.real), float(z.imag)] for z in np.asarray(mu, dtype=complex)]
 
 
-def _check_out(out: Path | None, suffix: str) -> None:
+def _check_out(out: Path | None, suffix: str, option: str = "--out") -> None:
+    """An output path must have ``suffix`` and an existing folder (checked before any work)."""
     if out is None:
         return
     if out.suffix.lower() != suffix:
-        raise _ErrorInput(f"--out must name a {suffix} file, got {str(out)!r}")
+        raise _ErrorInput(f"{option} must name a {suffix} file, got {str(out)!r}")
     folder = out.parent if str(out.parent) else Path(".")
     if not folder.is_dir():
         raise _ErrorInput(f"folder {str(folder)!r} does not exist")
@@ -349,12 +358,8 @@ def _orbit_json(orbit: Any) -> dict[str, Any]:
               help="Forcing periods simulated for the initial guess.")  # fmt: skip
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
 def orbit(
+    model: grazing.HybridModel,
     case: str,
-    alpha: float | None,
-    beta: float | None,
-    r: float | None,
-    eta: float,
-    theta_hat: float,
     period: int | None,
     initial: str | None,
     transient: int,
@@ -363,13 +368,13 @@ def orbit(
     """Find a periodic orbit by Newton shooting; print its multipliers and stability."""
     from grazing.orbits import find_orbit
 
-    model = build_pendulum(case, alpha, beta, r, eta, theta_hat)
     x0 = None
     if initial is not None:
         x0 = _parse_pair(initial)
         if x0[0] > model.params["theta_hat"]:
             raise _ErrorInput(
-                f"initial angle {x0[0]:g} rad is beyond the stop at theta-hat = {theta_hat:g} deg"
+                f"initial angle {x0[0]:g} rad is beyond the stop at theta-hat = "
+                f"{math.degrees(model.params['theta_hat']):g} deg"
             )
     orb = find_orbit(model, x0, period=period, transient=transient)
     res = {"params": model_params_json(model, case), **_orbit_json(orb)}
@@ -403,12 +408,8 @@ def _grazing_json(g: Any) -> dict[str, Any]:
 @click.option("--eta-max", type=float, default=1.0, show_default=True, help="Upper end of the eta range.")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
 def graze(
+    model: grazing.HybridModel,
     case: str,
-    alpha: float | None,
-    beta: float | None,
-    r: float | None,
-    eta: float,
-    theta_hat: float,
     eta_min: float,
     eta_max: float,
     as_json: bool,
@@ -416,7 +417,6 @@ def graze(
     """Every grazing of the period-1 nonimpacting orbit with the stop, for eta in a range."""
     from grazing.orbits import find_grazings
 
-    model = build_pendulum(case, alpha, beta, r, eta, theta_hat)
     if not (math.isfinite(eta_min) and math.isfinite(eta_max) and 0 < eta_min < eta_max):
         raise _ErrorInput(f"need 0 < --eta-min < --eta-max, got {eta_min:g} and {eta_max:g}")
     bar = _Progress("continuing", enabled=not as_json)
@@ -440,7 +440,8 @@ def graze(
         _emit_json(res)
         return
     if not points:
-        click.echo(f"no grazing for eta in [{eta_min:g}, {eta_max:g}] at theta-hat = {theta_hat:g} deg")
+        th = math.degrees(model.params["theta_hat"])
+        click.echo(f"no grazing for eta in [{eta_min:g}, {eta_max:g}] at theta-hat = {th:g} deg")
     for g in res["grazings"]:
         mu = ", ".join(f"{a:+.4f}{b:+.4f}i" for a, b in g["multipliers"])
         click.echo(f"eta = {g['eta']:.6f}: multipliers {mu}, |lambda| = {g['abs_lambda']:.4f}, "
@@ -460,12 +461,8 @@ def graze(
 )
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
 def graze_curve(
+    model: grazing.HybridModel,
     case: str,
-    alpha: float | None,
-    beta: float | None,
-    r: float | None,
-    eta: float,
-    theta_hat: float,
     start_deg: float,
     eta_min: float,
     eta_max: float,
@@ -476,7 +473,6 @@ def graze_curve(
     """Two-parameter continuation of grazing in (eta, theta-hat), with theta-hat_max."""
     from grazing.orbits import PalcSettings, grazing_curve
 
-    model = build_pendulum(case, alpha, beta, r, eta, theta_hat)
     if not (math.isfinite(eta_min) and math.isfinite(eta_max) and 0 < eta_min < eta_max):
         raise _ErrorInput(f"need 0 < --eta-min < --eta-max, got {eta_min:g} and {eta_max:g}")
     if not -180 < start_deg < 180:
@@ -527,12 +523,8 @@ _CONTINUE_PARAMS = {"eta": "eta", "theta-hat": "theta_hat", "alpha": "alpha", "b
 )
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
 def continue_(
+    model: grazing.HybridModel,
     case: str,
-    alpha: float | None,
-    beta: float | None,
-    r: float | None,
-    eta: float,
-    theta_hat: float,
     cparam: str,
     start: float,
     stop: float,
@@ -547,7 +539,6 @@ def continue_(
     Neimark-Sacker points and grazings located."""
     from grazing.orbits import PalcSettings, continue_orbit
 
-    model = build_pendulum(case, alpha, beta, r, eta, theta_hat)
     name = _CONTINUE_PARAMS[cparam]
     conv = math.radians if name == "theta_hat" else float
     if not (math.isfinite(start) and math.isfinite(stop)) or start == stop:
@@ -712,7 +703,7 @@ def _sweep_json(ds: Any, param: str, values: np.ndarray) -> dict[str, Any]:
               help="With --method map: the grazing the map is built at.")  # fmt: skip
 @_sweep_options
 def sweep_cmd(
-    case: str, alpha: float | None, beta: float | None, r: float | None, eta: float, theta_hat: float,
+    model: grazing.HybridModel, case: str,
     sparam: str, start: float, stop: float, num: int, direction: str, method: str, which: str,
     transient: int, periods: int, initial: str, fresh: bool, chunk_size: int | None, workers: int | None,
     scheduler: str | None, no_lyapunov: bool, no_adaptive: bool, tol: float, out: Path | None, as_json: bool,
@@ -721,7 +712,6 @@ def sweep_cmd(
     Lyapunov exponents along a parameter range."""
     from grazing.sweeps.sweep import SweepSpec
 
-    model = build_pendulum(case, alpha, beta, r, eta, theta_hat)
     name = _SWEEP_PARAMS[sparam]
     if not (math.isfinite(start) and math.isfinite(stop)):
         raise _ErrorInput("--start and --stop must be finite")
@@ -802,14 +792,13 @@ def _map_for_sweep(model: Any, name: str, lo: float, hi: float, which: str) -> t
 )
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
 def normal_form_cmd(
-    case: str, alpha: float | None, beta: float | None, r: float | None, eta: float, theta_hat: float,
+    model: grazing.HybridModel, case: str,
     which: str, eta_min: float, eta_max: float, check: bool, as_json: bool,
 ) -> None:  # fmt: skip
     """Grazing normal form at a grazing of the period-1 orbit: multipliers, the
     discontinuity map's coefficients and the predicted scenario past grazing."""
     from grazing.normalform import find_grazing_point, normal_form_at, observe, predict
 
-    model = build_pendulum(case, alpha, beta, r, eta, theta_hat)
     if not (math.isfinite(eta_min) and math.isfinite(eta_max) and 0 < eta_min < eta_max):
         raise _ErrorInput(f"need 0 < --eta-min < --eta-max, got {eta_min:g} and {eta_max:g}")
     point = find_grazing_point(model, "eta", eta_min, eta_max, which)
@@ -865,7 +854,7 @@ def normal_form_cmd(
 @click.option("--num2", type=click.IntRange(min=1), required=True)
 @_sweep_options
 def map_cmd(
-    case: str, alpha: float | None, beta: float | None, r: float | None, eta: float, theta_hat: float,
+    model: grazing.HybridModel, case: str,
     param1: str, start1: float, stop1: float, num1: int, param2: str, start2: float, stop2: float, num2: int,
     transient: int, periods: int, initial: str, fresh: bool, chunk_size: int | None, workers: int | None,
     scheduler: str | None, no_lyapunov: bool, no_adaptive: bool, tol: float, out: Path | None, as_json: bool,
@@ -875,7 +864,6 @@ def map_cmd(
 
     if param1 == param2:
         raise _ErrorInput("--param1 and --param2 must differ")
-    model = build_pendulum(case, alpha, beta, r, eta, theta_hat)
     n1, n2 = _SWEEP_PARAMS[param1], _SWEEP_PARAMS[param2]
     for v in (start1, stop1, start2, stop2):
         if not math.isfinite(v):

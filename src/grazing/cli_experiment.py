@@ -17,7 +17,7 @@ import click
 import numpy as np
 
 from grazing.atomic import atomic_path
-from grazing.cli import _emit_json, _ErrorInput, _Progress, _write_atomic
+from grazing.cli import _check_out, _emit_json, _ErrorInput, _Progress, _write_atomic
 from grazing.models.pendulum import CASES, DEFAULT_CASE, case_values
 
 _RELATIONS = ["model", "paper", "protocol"]
@@ -26,16 +26,6 @@ _DEFAULT_AMPLITUDE_DEG = math.degrees(0.5)
 
 def _none_if_nan(v: float) -> float | None:
     return None if not math.isfinite(v) else float(v)
-
-
-def _check_png(path: Path | None) -> None:
-    if path is None:
-        return
-    if path.suffix.lower() != ".png":
-        raise _ErrorInput(f"--plot must name a .png file, got {str(path)!r}")
-    folder = path.parent if str(path.parent) else Path(".")
-    if not folder.is_dir():
-        raise _ErrorInput(f"folder {str(folder)!r} does not exist")
 
 
 def _save_png(fig: Any, path: Path) -> None:
@@ -377,7 +367,7 @@ def analyze_cmd(
     from grazing.experiment.recording import load_recording
     from grazing.experiment.signal import analyze_recording
 
-    _check_png(plot)
+    _check_out(plot, ".png", "--plot")
     if not math.isfinite(phase):
         raise _ErrorInput(f"--phase must be a finite number, got {phase}")
     if noise is not None and not (math.isfinite(noise) and noise > 0):
