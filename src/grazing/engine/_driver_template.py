@@ -67,6 +67,31 @@ def _poly_derivative(c, order, u):
 
 
 @njit(cache=True)
+def _unpack_var(x, n, ncol, V):
+    """The variational matrix stored row by row after the state in ``x``, into ``V``."""
+    for i in range(n):
+        for c in range(ncol):
+            V[i, c] = x[n + i * ncol + c]
+
+
+@njit(cache=True)
+def _pack_var(V, n, ncol, x):
+    for i in range(n):
+        for c in range(ncol):
+            x[n + i * ncol + c] = V[i, c]
+
+
+@njit(cache=True)
+def _record(buf, count, t, value, x, n):
+    """Append the row ``[t, value, x[:n]]`` to ``buf`` (grown as needed); return the buffer."""
+    buf = _grow(buf, count)
+    buf[count, 0] = t
+    buf[count, 1] = value
+    buf[count, 2:] = x[:n]
+    return buf
+
+
+@njit(cache=True)
 def _grow(buf, count):
     if count < buf.shape[0]:
         return buf
@@ -422,9 +447,7 @@ def integrate(
         nsteps += 1
         defl = 0
         if lyap and use_var and mode == 0:
-            for i in range(n):
-                for c in range(ncol):
-                    V[i, c] = x[n + i * ncol + c]
+            _unpack_var(x, n, ncol, V)
             if recording and not lyap_started:
                 lyap_started = True
                 lyap_t0 = k * T + s
@@ -433,9 +456,7 @@ def integrate(
                 _orthonormalize(V, n, logs)
             else:
                 _orthonormalize(V, n, scratch)  # transient: align V, discard growth
-            for i in range(n):
-                for c in range(ncol):
-                    x[n + i * ncol + c] = V[i, c]
+            _pack_var(V, n, ncol, x)
 
         if zdm_hit:
             kz += 1
@@ -448,9 +469,7 @@ def integrate(
                     # dD/dx = I - e (grad S)^T, grad S = a grad(delta) / S
                     guard_grad(x, s, pv, zdm_gh)
                     normal_rate_grad(x, s, pv, zdm_gv)
-                    for i in range(n):
-                        for c in range(ncol):
-                            V[i, c] = x[n + i * ncol + c]
+                    _unpack_var(x, n, ncol, V)
                     for c in range(ncol):
                         gs = 0.0
                         for j in range(n):
@@ -458,14 +477,9 @@ def integrate(
                         gs /= sp_
                         for i in range(n):
                             V[i, c] -= zdm_e[i] * gs
-                    for i in range(n):
-                        for c in range(ncol):
-                            x[n + i * ncol + c] = V[i, c]
+                    _pack_var(V, n, ncol, x)
                 if record_impacts == 2 or (record_impacts == 1 and recording):
-                    imp = _grow(imp, n_imp_rec)
-                    imp[n_imp_rec, 0] = k * T + s
-                    imp[n_imp_rec, 1] = sp_
-                    imp[n_imp_rec, 2:] = x[:n]
+                    imp = _record(imp, n_imp_rec, k * T + s, sp_, x, n)
                     n_imp_rec += 1
                 n_imp += 1
                 for i in range(n):
@@ -477,18 +491,11 @@ def integrate(
                 vn = normal_rate(x, s, pv)
                 reset(x, s, pv, xp)
                 if use_var:
-                    for i in range(n):
-                        for c in range(ncol):
-                            V[i, c] = x[n + i * ncol + c]
+                    _unpack_var(x, n, ncol, V)
                     _saltation(x, xp, s, pv, V, ncol)
-                    for i in range(n):
-                        for c in range(ncol):
-                            xp[n + i * ncol + c] = V[i, c]
+                    _pack_var(V, n, ncol, xp)
                 if record_impacts == 2 or (record_impacts == 1 and recording):
-                    imp = _grow(imp, n_imp_rec)
-                    imp[n_imp_rec, 0] = k * T + s
-                    imp[n_imp_rec, 1] = -vn
-                    imp[n_imp_rec, 2:] = x[:n]
+                    imp = _record(imp, n_imp_rec, k * T + s, -vn, x, n)
                     n_imp_rec += 1
                 if recording and traj_dt > 0.0:
                     traj = _grow(traj, n_traj + 1)
@@ -549,9 +556,7 @@ def integrate(
     lyap_span = k * T + s - lyap_t0 if (lyap and lyap_started) else 0.0
     Vout = np.zeros((n, ncol))
     if use_var:
-        for i in range(n):
-            for c in range(ncol):
-                Vout[i, c] = x[n + i * ncol + c]
+        _unpack_var(x, n, ncol, Vout)
     return (
         status,
         x[:n].copy(),
