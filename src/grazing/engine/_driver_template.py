@@ -22,7 +22,7 @@ STATUS_NONFINITE = 2
 STATUS_ZENO = 3
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _step_size(X, n, O, order, max_step):
     """Jorba-Zou step size from the last two Taylor coefficients.
 
@@ -49,7 +49,7 @@ def _step_size(X, n, O, order, max_step):
     return min(h, max_step)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _eval_rows(X, nrows, order, dt, out):
     for i in range(nrows):
         acc = X[i, order]
@@ -58,7 +58,7 @@ def _eval_rows(X, nrows, order, dt, out):
         out[i] = acc
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _poly_derivative(c, order, u):
     acc = 0.0
     for j in range(order, 0, -1):
@@ -66,7 +66,7 @@ def _poly_derivative(c, order, u):
     return acc
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _unpack_var(x, n, ncol, V):
     """The variational matrix stored row by row after the state in ``x``, into ``V``."""
     for i in range(n):
@@ -74,7 +74,7 @@ def _unpack_var(x, n, ncol, V):
             V[i, c] = x[n + i * ncol + c]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _pack_var(V, n, ncol, x):
     for i in range(n):
         for c in range(ncol):

@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from grazing.errors import GrazingError, InvalidParameterError
-from grazing.sweeps.sweep import ChunkResult, SweepSpec, spec_summary
+from grazing.sweeps.brute_force import ChunkResult, SweepSpec, spec_summary
 
 
 class StoreMismatchError(GrazingError, ValueError):

@@ -13,8 +13,8 @@ a Dask cluster, and each finished chunk is written to the result store, so
 the chunking - not the machine - defines the result.  ``chunk_size = 0`` makes
 the whole sweep one chunk (a strictly sequential experimenter sweep).
 
-Adaptive transients: the transient is run in blocks of 64 periods and stopped
-as soon as the samples repeat with a period p <= 32 to 1e-9, at the point of
+Adaptive transients: the transient is run in blocks of 32 periods and stopped
+as soon as the samples repeat with a period p <= 16 to 1e-9, at the point of
 the cycle where the full transient would have ended (the periods run are
 congruent to the full transient modulo p).  The samples, and in a continuation
 sweep the next point's starting state, are then those of the full transient to
@@ -44,8 +44,8 @@ from grazing.sweeps.period import DEFAULT_MAX_PERIOD, DEFAULT_PERIOD_TOL, detect
 DEFAULT_SWEEP_TOL = 1e-10
 """Local error tolerance of sweeps: far below the 1e-6 of period detection."""
 
-ADAPTIVE_BLOCK = 64
-ADAPTIVE_MAX_PERIOD = 32
+ADAPTIVE_BLOCK = 32
+ADAPTIVE_MAX_PERIOD = 16
 ADAPTIVE_TOL = 1e-9
 LYAPUNOV_ALIGN = 16
 """Periods of the transient during which the tangent vectors are aligned (not counted)."""
