@@ -642,7 +642,7 @@ def _run_sweep_spec(
     spec: Any, out: Path | None, scheduler: str | None, workers: int | None, as_json: bool
 ) -> Any:
     """Run a sweep spec with the CLI's storage, cluster and progress options."""
-    from grazing.sweeps.sweep import run_sweep
+    from grazing.sweeps.brute_force import run_sweep
 
     store = None
     if out is not None and out.suffix.lower() == ".zarr":
@@ -710,7 +710,7 @@ def sweep_cmd(
 ) -> None:  # fmt: skip
     """Brute-force bifurcation diagram: stroboscopic samples, periods, impacts and
     Lyapunov exponents along a parameter range."""
-    from grazing.sweeps.sweep import SweepSpec
+    from grazing.sweeps.brute_force import SweepSpec
 
     name = _SWEEP_PARAMS[sparam]
     if not (math.isfinite(start) and math.isfinite(stop)):
@@ -860,7 +860,7 @@ def map_cmd(
     scheduler: str | None, no_lyapunov: bool, no_adaptive: bool, tol: float, out: Path | None, as_json: bool,
 ) -> None:  # fmt: skip
     """Two-parameter map of periods, impacts and Lyapunov exponents."""
-    from grazing.sweeps.sweep import SweepSpec
+    from grazing.sweeps.brute_force import SweepSpec
 
     if param1 == param2:
         raise _ErrorInput("--param1 and --param2 must differ")
