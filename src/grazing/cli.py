@@ -39,6 +39,12 @@ class _ErrorInput(click.ClickException):
 # Shared options
 
 
+_json_option = click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
+_netcdf_out_option = click.option(
+    "--out", type=click.Path(dir_okay=False, path_type=Path), metavar="FILE.nc", help="Save as NetCDF."
+)
+
+
 def model_options(func: Callable[..., Any]) -> Callable[..., Any]:
     """Options selecting the pendulum's parameters: a named case plus overrides.
 
@@ -208,7 +214,7 @@ def cli() -> None:
               help="Write the dense trajectory of the sampled span to a CSV file.")  # fmt: skip
 @click.option("--points-per-period", type=click.IntRange(min=4), default=100, show_default=True,
               help="Trajectory resolution (with --trajectory).")  # fmt: skip
-@click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
+@_json_option
 def simulate(
     model: grazing.HybridModel,
     case: str,
@@ -356,7 +362,7 @@ def _orbit_json(orbit: Any) -> dict[str, Any]:
 )
 @click.option("--transient", type=click.IntRange(min=0), default=500, show_default=True,
               help="Forcing periods simulated for the initial guess.")  # fmt: skip
-@click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
+@_json_option
 def orbit(
     model: grazing.HybridModel,
     case: str,
@@ -406,7 +412,7 @@ def _grazing_json(g: Any) -> dict[str, Any]:
 @model_options
 @click.option("--eta-min", type=float, default=0.2, show_default=True, help="Lower end of the eta range.")
 @click.option("--eta-max", type=float, default=1.0, show_default=True, help="Upper end of the eta range.")
-@click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
+@_json_option
 def graze(
     model: grazing.HybridModel,
     case: str,
@@ -456,10 +462,8 @@ def graze(
 @click.option("--eta-min", type=float, default=0.2, show_default=True, help="Lower end of the eta range.")
 @click.option("--eta-max", type=float, default=1.0, show_default=True, help="Upper end of the eta range.")
 @click.option("--max-step", type=float, default=0.05, show_default=True, help="Largest continuation step.")
-@click.option(
-    "--out", type=click.Path(dir_okay=False, path_type=Path), metavar="FILE.nc", help="Save as NetCDF."
-)
-@click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
+@_netcdf_out_option
+@_json_option
 def graze_curve(
     model: grazing.HybridModel,
     case: str,
@@ -518,10 +522,8 @@ _CONTINUE_PARAMS = {"eta": "eta", "theta-hat": "theta_hat", "alpha": "alpha", "b
 @click.option("--virtual/--physical", default=None,
               help="Ignore the stop (default: yes for a nonimpacting starting orbit).")  # fmt: skip
 @click.option("--max-step", type=float, default=0.04, show_default=True, help="Largest continuation step.")
-@click.option(
-    "--out", type=click.Path(dir_okay=False, path_type=Path), metavar="FILE.nc", help="Save as NetCDF."
-)
-@click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
+@_netcdf_out_option
+@_json_option
 def continue_(
     model: grazing.HybridModel,
     case: str,
@@ -621,7 +623,7 @@ def _sweep_options(func: Callable[..., Any]) -> Callable[..., Any]:
         click.option("--tol", type=float, default=1e-10, show_default=True, help="Integrator tolerance."),
         click.option("--out", type=click.Path(path_type=Path), metavar="FILE.zarr|FILE.nc",
                      help="Zarr store (resumable) or NetCDF file."),
-        click.option("--json", "as_json", is_flag=True, help="Print one JSON object."),
+        _json_option,
     ]  # fmt: skip
     for opt in reversed(options):
         func = opt(func)
@@ -790,7 +792,7 @@ def _map_for_sweep(model: Any, name: str, lo: float, hi: float, which: str) -> t
 @click.option(
     "--check", is_flag=True, help="Also simulate just past grazing and compare with the prediction."
 )
-@click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
+@_json_option
 def normal_form_cmd(
     model: grazing.HybridModel, case: str,
     which: str, eta_min: float, eta_max: float, check: bool, as_json: bool,

@@ -17,7 +17,7 @@ import click
 import numpy as np
 
 from grazing.atomic import atomic_path
-from grazing.cli import _check_out, _emit_json, _ErrorInput, _Progress, _write_atomic
+from grazing.cli import _check_out, _emit_json, _ErrorInput, _json_option, _Progress, _write_atomic
 from grazing.models.pendulum import CASES, DEFAULT_CASE, case_values
 
 _RELATIONS = ["model", "paper", "protocol"]
@@ -70,7 +70,6 @@ _norm_option = click.option(
     show_default=True,
     help="eq6: ln ratio / (2 pi k) so that D = beta at r = 1; eq1: / (4 pi k) as printed.",
 )
-_json_option = click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
 
 
 # ----------------------------------------------------------------------------
