@@ -162,6 +162,11 @@ class PanelRun:
         return float(v[non[0] - 1]) if non.size else float(v[-1])
 
 
+def zoom_of(run: PanelRun, zoomed: Sequence[PanelRun]) -> PanelRun | None:
+    """The magnified sweep of ``run``'s panel among ``zoomed`` (None if that panel has none)."""
+    return next((z for z in zoomed if z.panel == run.panel), None)
+
+
 def _grazings(model: grazing.HybridModel) -> list[Grazing]:
     points, _ = find_grazings(model, "eta", 0.2, 1.0)
     return [

@@ -93,10 +93,6 @@ def build(out_dir: Path, progress: Progress | None = None, settings: Settings | 
     )
 
 
-def _zoom_of(run: PanelRun, zoomed: list[PanelRun]) -> PanelRun | None:
-    return next((z for z in zoomed if z.panel == run.panel), None)
-
-
 def cascade(run: PanelRun) -> list[diagrams.Window]:
     """The clearly resolved windows past the first grazing: ≥ 3 points and ≥ 1 % of the sweep's span."""
     span = run.eta_range[1] - run.eta_range[0]
@@ -108,7 +104,7 @@ def comparisons(main: list[PanelRun], zoomed: list[PanelRun]) -> tuple[Compariso
     for run in main:
         th = run.panel.theta_hat_deg
         want, paper = PAPER_FIRST_WINDOW[th]
-        z = _zoom_of(run, zoomed)
+        z = diagrams.zoom_of(run, zoomed)
         first = (z.first_appreciable() if z is not None else None) or run.first_appreciable()
         ours = (
             f"period-{first.period} (η {first.start:.4f}–{first.stop:.4f})"
@@ -165,11 +161,11 @@ def comparisons(main: list[PanelRun], zoomed: list[PanelRun]) -> tuple[Compariso
         )
     )
     a = main[0]
-    za = _zoom_of(a, zoomed)
+    za = diagrams.zoom_of(a, zoomed)
     if za is not None:
         rows.append(_ten_degrees(a, za))
     d = main[-1]
-    zd = _zoom_of(d, zoomed) or d
+    zd = diagrams.zoom_of(d, zoomed) or d
     for eta, paper, source in ((0.45, "chaotic", "§6.1 (on fig 3(d) and fig 7(d))"),
                                (0.446, "period-5", "fig 9(b); §6.1")):  # fmt: skip
         i = int(np.argmin(np.abs(zd.ds.value.values - eta)))
@@ -207,12 +203,12 @@ def _period_adding(main: list[PanelRun], zoomed: list[PanelRun]) -> Comparison:
     seqs = []
     ok = True
     for run in main:
-        src = _zoom_of(run, zoomed) or run
+        src = diagrams.zoom_of(run, zoomed) or run
         per = [w.period for w in cascade(src)]
         seqs.append(f"({run.panel.key}) {', '.join(map(str, per)) or '—'}")
         if run is not main[0]:
             ok &= len(per) >= 2 and all(b == a - 1 for a, b in itertools.pairwise(per))
-    za = _zoom_of(main[0], zoomed)
+    za = diagrams.zoom_of(main[0], zoomed)
     note = (
         "The verdict is on (b)–(d), whose windows the paper's figure resolves. Narrower windows of higher "
         "period sit in the chaotic gaps (see the first table rows)."

@@ -86,11 +86,6 @@ def build(out_dir: Path, progress: Progress | None = None, settings: Settings | 
     )
 
 
-def _detail(run: PanelRun, zoomed: list[PanelRun]) -> PanelRun:
-    """The magnified sweep of a panel if there is one (finer), else the panel."""
-    return next((z for z in zoomed if z.panel == run.panel), run)
-
-
 def large_window(run: PanelRun) -> tuple[Window | None, bool]:
     """The widest window of period ≥ 3 past the first grazing, and whether chaos lies on both sides of it.
 
@@ -114,7 +109,7 @@ def comparisons(main: list[PanelRun], zoomed: list[PanelRun]) -> tuple[Compariso
     for run in main:
         th = run.panel.theta_hat_deg
         want, eta_c, text = EXPERIMENT[th]
-        det = _detail(run, zoomed)
+        det = diagrams.zoom_of(run, zoomed) or run
         first = det.first_appreciable()
         ours = (
             f"first grazing η_g = {run.first_grazing:.4f}; first appreciable window: "
@@ -135,7 +130,7 @@ def comparisons(main: list[PanelRun], zoomed: list[PanelRun]) -> tuple[Compariso
         )
     parts, ok = [], True
     for run in main:
-        det = _detail(run, zoomed)
+        det = diagrams.zoom_of(run, zoomed) or run
         big, surrounded = large_window(det)
         seq = [w.period for w in det.after_grazing(2)]
         last_two = len(seq) >= 2 and seq[-1] == 1 and seq[-2] == 2
@@ -179,7 +174,7 @@ def comparisons(main: list[PanelRun], zoomed: list[PanelRun]) -> tuple[Compariso
 
 
 def _first_matches(run: PanelRun, zoomed: list[PanelRun]) -> bool:
-    first = _detail(run, zoomed).first_appreciable()
+    first = (diagrams.zoom_of(run, zoomed) or run).first_appreciable()
     return first is not None and first.period == EXPERIMENT[run.panel.theta_hat_deg][0]
 
 
