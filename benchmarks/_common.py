@@ -1,17 +1,53 @@
-"""Helpers shared by the benchmark scripts: machine description, load average, fresh-process timing."""
+"""Helpers shared by the benchmark scripts: command line, output, machine description, load average,
+fresh-process timing."""
 
 from __future__ import annotations
 
+import argparse
+import json
 import math
 import os
 import platform
 import subprocess
 import sys
 import time
+from collections.abc import Callable
 from importlib.metadata import PackageNotFoundError, version
 from typing import Any
 
 PACKAGES = ("numpy", "scipy", "numba", "heyoka", "grazing")
+
+
+def bench_parser(doc: str, quiet_wait: float | None = None) -> argparse.ArgumentParser:
+    """The options every benchmark has (``--markdown``, ``--json``; ``--quiet-wait`` given its default)."""
+    parser = argparse.ArgumentParser(description=doc.splitlines()[0])
+    parser.add_argument("--markdown", action="store_true", help="also print a Markdown table")
+    parser.add_argument("--json", metavar="FILE", help="write all numbers to FILE")
+    if quiet_wait is not None:
+        parser.add_argument(
+            "--quiet-wait",
+            type=float,
+            default=quiet_wait,
+            metavar="S",
+            help="before each timed run, wait up to S seconds for other processes to go quiet (0: never)",
+        )
+    return parser
+
+
+def emit(
+    args: argparse.Namespace,
+    print_table: Callable[[], None],
+    markdown: Callable[[], str],
+    data: Callable[[], Any],
+) -> None:
+    """Print the table, then the Markdown table with ``--markdown``, and write ``data()`` to ``--json``."""
+    print_table()
+    if args.markdown:
+        print()
+        print(markdown())
+    if args.json:
+        with open(args.json, "w") as fh:
+            json.dump(data(), fh, indent=2, default=float)
 
 
 def log(msg: str) -> None:

@@ -33,7 +33,6 @@ Run::
 
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import shutil
@@ -46,7 +45,17 @@ from typing import Any
 import numpy as np
 
 import grazing
-from _common import Meter, best_command, loadavg, log, machine_info, versions_line, wait_quiet
+from _common import (
+    Meter,
+    bench_parser,
+    best_command,
+    emit,
+    loadavg,
+    log,
+    machine_info,
+    versions_line,
+    wait_quiet,
+)
 from grazing.orbits import GrazingCurve, PalcSettings, continue_orbit, find_grazings, grazing_curve
 
 CASE = "B"
@@ -366,17 +375,8 @@ def markdown(res: dict[str, Any]) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--markdown", action="store_true", help="also print a Markdown table")
-    parser.add_argument("--json", metavar="FILE", help="write all numbers to FILE")
+    parser = bench_parser(__doc__, quiet_wait=QUIET_WAIT)
     parser.add_argument("--figure", metavar="PNG", default=str(FIGURE), help="where to save the figure")
-    parser.add_argument(
-        "--quiet-wait",
-        type=float,
-        default=QUIET_WAIT,
-        metavar="S",
-        help="before each timed run, wait up to S seconds for other processes to go quiet (0: never)",
-    )
     args = parser.parse_args(argv)
     res: dict[str, Any] = {
         "machine": machine_info(PACKAGES),
@@ -389,13 +389,7 @@ def main(argv: list[str] | None = None) -> int:
     amplitude_cross_check(res)
     res["machine"]["loadavg_end"] = loadavg()
     figure(curve, res, Path(args.figure))
-    print_report(res)
-    if args.markdown:
-        print()
-        print(markdown(res))
-    if args.json:
-        with open(args.json, "w") as fh:
-            json.dump(res, fh, indent=2, default=float)
+    emit(args, lambda: print_report(res), lambda: markdown(res), lambda: res)
     return 0
 
 

@@ -48,9 +48,7 @@ Run (``make bench`` installs heyoka and runs the default)::
 
 from __future__ import annotations
 
-import argparse
 import inspect
-import json
 import math
 import sys
 import time
@@ -64,7 +62,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 import grazing
-from _common import loadavg, log, machine_info, process_seconds, versions_line
+from _common import bench_parser, emit, loadavg, log, machine_info, process_seconds, versions_line
 
 # ----------------------------------------------------------------------------- problem
 
@@ -209,10 +207,15 @@ def make_heyoka(alpha: float, beta: float, eta: float) -> hy.taylor_adaptive:
 def heyoka_loop(
     ta: hy.taylor_adaptive, x0: tuple[float, float], t0: float, n_periods: int, theta_hat: float, r: float
 ) -> tuple[np.ndarray, np.ndarray]:
-    """3-D form: samples (theta, theta') at t0 + 2 pi k, k = 1..n_periods, and the impact times."""
+    """Samples (theta, theta') at t0 + 2 pi k, k = 1..n_periods, and the impact times.
+
+    For either form: the paper's 3-D x = (theta - theta_hat, theta', tau) of :func:`make_heyoka`
+    or explicit time (:func:`make_heyoka_time`), told apart by the size of the state.
+    """
+    shift = theta_hat if len(ta.state) == 3 else 0.0
     ta.pars[0] = theta_hat
     ta.time = t0
-    ta.state[:] = [x0[0] - theta_hat, x0[1], t0]
+    ta.state[:] = [x0[0] - shift, x0[1], t0][: len(ta.state)]
     ta.reset_cooldowns()
     samples = np.empty((n_periods, 2))
     impacts = []
@@ -227,7 +230,8 @@ def heyoka_loop(
                 ta.state[1] *= -r
                 continue
             raise RuntimeError(f"heyoka stopped with {outcome} at t = {ta.time}")
-        samples[k - 1] = ta.state[0] + theta_hat, ta.state[1]
+        samples[k - 1] = ta.state[:2]
+    samples[:, 0] += shift
     return samples, np.array(impacts)
 
 
@@ -247,31 +251,6 @@ def make_heyoka_time(alpha: float, beta: float, eta: float, fp_type: type = floa
     stop = hy.t_event(theta - hy.par[0], direction=hy.event_direction.positive, fp_type=fp_type)
     zero = c(0.0)
     return hy.taylor_adaptive(ode, [zero, zero], pars=[zero], t_events=[stop], fp_type=fp_type)
-
-
-def heyoka_time_loop(
-    ta: hy.taylor_adaptive, x0: tuple[float, float], t0: float, n_periods: int, theta_hat: float, r: float
-) -> tuple[np.ndarray, np.ndarray]:
-    """Explicit time: samples (theta, theta') at t0 + 2 pi k, k = 1..n_periods, and the impact times."""
-    ta.pars[0] = theta_hat
-    ta.time = t0
-    ta.state[:] = x0
-    ta.reset_cooldowns()
-    samples = np.empty((n_periods, 2))
-    impacts = []
-    for k in range(1, n_periods + 1):
-        t_k = t0 + 2.0 * math.pi * k
-        while True:
-            outcome = ta.propagate_until(t_k)[0]
-            if outcome == hy.taylor_outcome.time_limit:
-                break
-            if -1000 < int(outcome) < 0:  # the terminal event: the stop is reached
-                impacts.append(ta.time)
-                ta.state[1] *= -r
-                continue
-            raise RuntimeError(f"heyoka stopped with {outcome} at t = {ta.time}")
-        samples[k - 1] = ta.state
-    return samples, np.array(impacts)
 
 
 def make_reference() -> hy.taylor_adaptive:
@@ -386,8 +365,8 @@ def process_code(engine: str, n_periods: int) -> str:
             [f"ta = make_heyoka({ALPHA!r}, {BETA!r}, {ETA!r})", f"heyoka_loop(ta, {args})"],
         ),
         "heyoka-t": (
-            ["import heyoka as hy", inspect.getsource(make_heyoka_time), inspect.getsource(heyoka_time_loop)],
-            [f"ta = make_heyoka_time({ALPHA!r}, {BETA!r}, {ETA!r})", f"heyoka_time_loop(ta, {args})"],
+            ["import heyoka as hy", inspect.getsource(make_heyoka_time), inspect.getsource(heyoka_loop)],
+            [f"ta = make_heyoka_time({ALPHA!r}, {BETA!r}, {ETA!r})", f"heyoka_loop(ta, {args})"],
         ),
         "scipy": (
             [
@@ -426,7 +405,7 @@ def time_engines(res: Results, quick: bool) -> dict[tuple[str, int], Run]:
     runners: dict[str, Callable[[int], Run]] = {
         "grazing": lambda n: grazing_run(model, n),
         "heyoka-3d": lambda n: Run(*heyoka_loop(ta3, X0, 0.0, n, THETA_HAT, R)),
-        "heyoka-t": lambda n: Run(*heyoka_time_loop(tat, X0, 0.0, n, THETA_HAT, R)),
+        "heyoka-t": lambda n: Run(*heyoka_loop(tat, X0, 0.0, n, THETA_HAT, R)),
         "scipy": lambda n: Run(*scipy_loop(rhs, X0, 0.0, n, THETA_HAT, R)),
     }
     runs: dict[tuple[str, int], Run] = {}
@@ -612,7 +591,7 @@ def shallow_impacts(res: Results) -> None:
         sol = grazing.simulate(grazing_model(SHALLOW_ETA, stop), list(x0), t0=t0, periods=1, impacts="all")
         counts["grazing"].append(sol.n_impacts)
         counts["heyoka-3d"].append(heyoka_loop(ta3, x0, t0, 1, stop, R)[1].size)
-        counts["heyoka-t"].append(heyoka_time_loop(tat, x0, t0, 1, stop, R)[1].size)
+        counts["heyoka-t"].append(heyoka_loop(tat, x0, t0, 1, stop, R)[1].size)
         counts["scipy"].append(scipy_loop(rhs, x0, t0, 1, stop, R)[1].size)
     res.shallow = {
         "eta": SHALLOW_ETA,
@@ -854,10 +833,8 @@ def to_json(res: Results) -> dict[str, Any]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = bench_parser(__doc__)
     parser.add_argument("--quick", action="store_true", help="skip scipy's 100,000-period run")
-    parser.add_argument("--markdown", action="store_true", help="also print a Markdown table")
-    parser.add_argument("--json", metavar="FILE", help="write all numbers to FILE")
     args = parser.parse_args(argv)
     res = Results(machine=machine_info(), settings=settings())
     runs = time_engines(res, args.quick)
@@ -867,13 +844,7 @@ def main(argv: list[str] | None = None) -> int:
     log("shallow impacts ...")
     shallow_impacts(res)
     res.machine["loadavg_end"] = loadavg()
-    print_table(res)
-    if args.markdown:
-        print()
-        print(markdown(res))
-    if args.json:
-        with open(args.json, "w") as fh:
-            json.dump(to_json(res), fh, indent=2, default=float)
+    emit(args, lambda: print_table(res), lambda: markdown(res), lambda: to_json(res))
     check_agreement(res)
     return 0
 

@@ -47,8 +47,6 @@ Run::
 
 from __future__ import annotations
 
-import argparse
-import json
 import math
 import os
 import shutil
@@ -67,8 +65,10 @@ from scipy.integrate import solve_ivp
 import grazing
 from _common import (
     Meter,
+    bench_parser,
     best_command,
     command_seconds,
+    emit,
     loadavg,
     log,
     machine_info,
@@ -595,17 +595,8 @@ def to_json(res: Results) -> dict[str, Any]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = bench_parser(__doc__, quiet_wait=QUIET_WAIT)
     parser.add_argument("--quick", action="store_true", help=f"{QUICK_POINTS} points instead of {N_POINTS}")
-    parser.add_argument("--markdown", action="store_true", help="also print a Markdown table")
-    parser.add_argument("--json", metavar="FILE", help="write all numbers to FILE")
-    parser.add_argument(
-        "--quiet-wait",
-        type=float,
-        default=QUIET_WAIT,
-        metavar="S",
-        help="before each timed run, wait up to S seconds for other processes to go quiet (0: never)",
-    )
     args = parser.parse_args(argv)
     n = QUICK_POINTS if args.quick else N_POINTS
     etas = np.linspace(ETA_START, ETA_STOP, n)
@@ -616,13 +607,7 @@ def main(argv: list[str] | None = None) -> int:
     time_process(res, n, args.quiet_wait)
     fill_agreement(res)
     res.machine["loadavg_end"] = loadavg()
-    print_table(res)
-    if args.markdown:
-        print()
-        print(markdown(res))
-    if args.json:
-        with open(args.json, "w") as fh:
-            json.dump(to_json(res), fh, indent=2, default=float)
+    emit(args, lambda: print_table(res), lambda: markdown(res), lambda: to_json(res))
     return 0
 
 
