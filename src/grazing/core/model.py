@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from grazing.engine.compile import SymbolicSystem, generate_source, kernel_key, load_kernels
+from grazing.engine.compile import DEFAULT_ORDER, SymbolicSystem, generate_source, kernel_key, load_kernels
 from grazing.errors import InvalidParameterError, InvalidStateError
 
 
@@ -122,7 +122,7 @@ class _Definition:
         self._symbolic = symbolic
         self._builder = builder
         self._system: SymbolicSystem | None = None
-        self._kernels: dict[tuple[str, ...], ModuleType] = {}
+        self._kernels: dict[tuple[tuple[str, ...], int], ModuleType] = {}
         self._numeric: dict[str, Callable[..., Any]] = {}
         try:
             code = compile(f"lambda {', '.join(pnames) or '_'}: {period}", "<period>", "eval")
@@ -177,17 +177,17 @@ class _Definition:
             source = _srepr(sorted((self._symbolic or {}).items()))
         return repr((self.name, [p.name for p in self.parameters], self.period_str, self.periodic, source))
 
-    def kernels(self, sensitivities: tuple[str, ...] = ()) -> ModuleType:
-        if sensitivities not in self._kernels:
+    def kernels(self, sensitivities: tuple[str, ...] = (), order: int = DEFAULT_ORDER) -> ModuleType:
+        if (sensitivities, order) not in self._kernels:
 
             def source() -> str:
                 import sympy as sp
 
-                return generate_source(self.system, [sp.Symbol(s) for s in sensitivities])
+                return generate_source(self.system, [sp.Symbol(s) for s in sensitivities], order)
 
-            key = kernel_key(self._identity(), sensitivities)
-            self._kernels[sensitivities] = load_kernels(key, source)
-        return self._kernels[sensitivities]
+            key = kernel_key(self._identity(), sensitivities, order)
+            self._kernels[sensitivities, order] = load_kernels(key, source)
+        return self._kernels[sensitivities, order]
 
     def numeric(self, what: str) -> Callable[..., Any]:
         """numpy function of ``(x, t, p)`` for f, h, g or a Jacobian (built on first use)."""
@@ -467,13 +467,18 @@ class HybridModel:
         return f"<HybridModel {self.name}: {vals}>"
 
     # -- numerics -------------------------------------------------------------
-    def kernels(self, sensitivities: Sequence[str] = ()) -> ModuleType:
-        """The compiled kernel module (generated and cached on first use)."""
+    def kernels(self, sensitivities: Sequence[str] = (), order: int = DEFAULT_ORDER) -> ModuleType:
+        """The compiled kernel module (generated and cached on first use).
+
+        One module per set of ``sensitivities`` (parameters in the variational
+        equations) and Taylor ``order``; the model's scalar functions (vector
+        field, guard, reset and their derivatives) are in every module.
+        """
         names = {p.name for p in self._def.parameters}
         for s in sensitivities:
             if s not in names:
                 raise InvalidParameterError(f"unknown parameter {s!r}")
-        return self._def.kernels(tuple(sensitivities))
+        return self._def.kernels(tuple(sensitivities), int(order))
 
     def _call(self, what: str, x: Any, t: float) -> Any:
         fn = self._def.numeric(what)

@@ -3,8 +3,8 @@
 This file is not imported on its own: :mod:`grazing.engine.compile` appends its
 text to the module generated for a model, where the model functions it calls
 (``tc_free``, ``tc_var``, ``tc_stick``, ``rhs``, ``guard``, ``reset`` ...) and
-the constants ``NX``, ``NSENS``, ``HAS_STICK``, ``NW_FREE``, ``NW_VAR``,
-``NW_STICK`` are defined.  Keeping the driver in the same module as the model
+the constants ``NX``, ``NSENS``, ``ORDER`` (degree of the Taylor polynomials)
+and ``HAS_STICK`` are defined.  Keeping the driver in the same module as the model
 functions lets numba resolve them as globals and cache the compiled result on
 disk.
 
@@ -206,7 +206,6 @@ def integrate(
     pv,
     T,
     wrap,
-    order,
     max_step,
     max_steps,
     n_samples,
@@ -244,6 +243,7 @@ def integrate(
     ``|v| / a < zdm_window``: ``x <- x - zdm_e * sqrt(2 a delta)``.
     """
     n = NX
+    order = ORDER
     ncol = n + NSENS
     nv = n * ncol if use_var else 0
     ntot = n + nv
@@ -255,8 +255,6 @@ def integrate(
                 x[n + i * ncol + c] = V_init[i, c]
     X = np.zeros((ntot, order + 1))
     O = np.zeros((1, order + 1))
-    W = np.zeros((NW_VAR if use_var else NW_FREE, order + 1))
-    WS = np.zeros((NW_STICK, order + 1))
     XS = np.zeros((n, order + 1))
     work = np.zeros((ROOT_WORK_ROWS, max(order + 1, ROOT_WORK_MIN_COLS)))
     a = np.zeros(order + 1)
@@ -317,12 +315,12 @@ def integrate(
             break
         if mode == 0:
             if use_var:
-                tc_var(x, s, pv, order, X, O, W)
+                tc_var(x, s, pv, X, O)
             else:
-                tc_free(x, s, pv, order, X, O, W)
+                tc_free(x, s, pv, X, O)
             h = _step_size(X, ntot, O, order, max_step)
         else:
-            tc_stick(x, s, pv, order, XS, O, WS)
+            tc_stick(x, s, pv, XS, O)
             h = _step_size(XS, n, O, order, max_step)
         rem = (ks - k) * T + (ss - s)
         is_last = False

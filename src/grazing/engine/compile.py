@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import hashlib
 import importlib.util
+import math
 import os
 import sys
 import tempfile
@@ -33,6 +34,21 @@ if TYPE_CHECKING:  # pragma: no cover
 _TEMPLATE = Path(__file__).with_name("_driver_template.py")
 # Bump when the generated code changes meaning without its text changing.
 _CODEGEN_VERSION = "1"
+
+
+def taylor_order(tol: float) -> int:
+    """Order of the Taylor method for a tolerance (Jorba & Zou): ``ceil(-ln(tol)/2 + 1)``.
+
+    Examples
+    --------
+    >>> taylor_order(2.220446049250313e-16)
+    20
+    """
+    return int(min(60, max(6, math.ceil(-math.log(tol) / 2 + 1))))
+
+
+DEFAULT_ORDER = taylor_order(2.220446049250313e-16)
+"""Order of the kernels for the default tolerance (machine epsilon): 20."""
 
 
 @dataclass(frozen=True)
@@ -133,8 +149,8 @@ def _scalar_function(
     return "\n".join(lines) + "\n"
 
 
-def generate_source(sys_: SymbolicSystem, sensitivities: Sequence[sp.Symbol] = ()) -> str:
-    """Full source of the kernel module for ``sys_``."""
+def generate_source(sys_: SymbolicSystem, sensitivities: Sequence[sp.Symbol] = (), order: int = DEFAULT_ORDER) -> str:
+    """Full source of the kernel module for ``sys_`` with Taylor polynomials of degree ``order``."""
     import sympy as sp
 
     from grazing.engine.taylor import taylor_kernel
@@ -151,9 +167,10 @@ def generate_source(sys_: SymbolicSystem, sensitivities: Sequence[sp.Symbol] = (
         "from grazing.engine.polyroots import first_root, horner",
         f"NX = {n}",
         f"NSENS = {m}",
+        f"ORDER = {order}",
         f"ROOT_WORK_ROWS, ROOT_WORK_MIN_COLS = {work_shape(0)}",
     ]
-    free = taylor_kernel("tc_free", sys_.states, sys_.time, sys_.params, f, [sys_.guard])
+    free = taylor_kernel("tc_free", sys_.states, sys_.time, sys_.params, f, [sys_.guard], order)
     # Variational equations: V' = f_x V (+ f_p on the parameter columns).
     vsyms = sp.symbols(f"v0:{n * ncol}")
     vmat = sp.Matrix(n, ncol, vsyms)
@@ -169,6 +186,7 @@ def generate_source(sys_: SymbolicSystem, sensitivities: Sequence[sp.Symbol] = (
         sys_.params,
         tuple(f) + tuple(vrhs),
         [sys_.guard],
+        order,
     )
     has_stick = sys_.contact_direction is not None
     if has_stick:
@@ -179,15 +197,11 @@ def generate_source(sys_: SymbolicSystem, sensitivities: Sequence[sp.Symbol] = (
             sys_.params,
             sys_.sticking_field(),
             [sys_.normal_accel],
+            order,
         )
     else:
-        stick = taylor_kernel("tc_stick", sys_.states, sys_.time, sys_.params, f, [sp.Integer(1)])
-    parts += [
-        f"HAS_STICK = {has_stick}",
-        f"NW_FREE = {free.n_work}",
-        f"NW_VAR = {var.n_work}",
-        f"NW_STICK = {stick.n_work}",
-    ]
+        stick = taylor_kernel("tc_stick", sys_.states, sys_.time, sys_.params, f, [sp.Integer(1)], order)
+    parts.append(f"HAS_STICK = {has_stick}")
     for k in (free, var, stick):
         parts.append("@njit(cache=True)\n" + k.source)
 
@@ -248,7 +262,7 @@ def cache_dir() -> Path:
     return Path(base) / "grazing"
 
 
-def kernel_key(identity: str, sensitivities: Sequence[str]) -> str:
+def kernel_key(identity: str, sensitivities: Sequence[str], order: int = DEFAULT_ORDER) -> str:
     """Cache key of a kernel module: the model's identity and everything the code depends on.
 
     numba's on-disk cache does not notice changes in functions imported from
@@ -260,7 +274,7 @@ def kernel_key(identity: str, sensitivities: Sequence[str]) -> str:
     here = Path(__file__).parent
     files = ("_driver_template.py", "polyroots.py", "taylor.py", "compile.py")
     deps = "".join((here / f).read_text() for f in files)
-    text = repr((identity, tuple(sensitivities), _CODEGEN_VERSION, numba.__version__, sys.version, deps))
+    text = repr((identity, tuple(sensitivities), order, _CODEGEN_VERSION, numba.__version__, sys.version, deps))
     return hashlib.sha256(text.encode()).hexdigest()[:20]
 
 

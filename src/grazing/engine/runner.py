@@ -17,20 +17,10 @@ from typing import Any
 import numpy as np
 
 from grazing.core.model import HybridModel
+from grazing.engine.compile import taylor_order
 from grazing.errors import SimulationError
 
 RECORD_IMPACTS = {"none": 0, "sampled": 1, "all": 2}
-
-
-def taylor_order(tol: float) -> int:
-    """Order of the Taylor method for a tolerance (Jorba & Zou): ``ceil(-ln(tol)/2 + 1)``.
-
-    Examples
-    --------
-    >>> taylor_order(2.220446049250313e-16)
-    20
-    """
-    return int(min(60, max(6, math.ceil(-math.log(tol) / 2 + 1))))
 
 
 @dataclass(frozen=True)
@@ -121,7 +111,6 @@ class Runner:
         self.zdm = zdm
         if zdm is not None:
             events = False
-        self.kern = model.kernels(tuple(sensitivities) if variational else ())
         n = model.n_states
         self.x = np.array(x, dtype=float)
         self.V = np.zeros((n, n + len(sensitivities)))
@@ -130,6 +119,7 @@ class Runner:
         self.events = events
         self.T = model.period
         self.order = taylor_order(tol)
+        self.kern = model.kernels(tuple(sensitivities) if variational else (), self.order)
         self.pv = model.param_vector
         self.chatter_time = chatter_tol * self.T
         T = self.T
@@ -189,7 +179,7 @@ class Runner:
         if max_steps is None:
             max_steps = 20000 * periods + 100_000
         out = self.kern.integrate(
-            self.x, self.V, self.k, self.s, self.mode, self.pv, T, self.model.periodic, self.order, T,
+            self.x, self.V, self.k, self.s, self.mode, self.pv, T, self.model.periodic, T,
             int(max_steps), periods, self.ks, self.ss, keep, self.variational, lyapunov,
             T / trajectory if trajectory else 0.0, guard_min, RECORD_IMPACTS[impacts], self.chatter_time,
             self.events, *self._zdm_args(),

@@ -8,7 +8,14 @@ elementary operations (sums, products, quotients, ``sin``/``cos`` pairs,
 coefficient from lower ones (Jorba & Zou 2005; Biscani & Izzo 2021, the
 heyoka paper).  This module turns a sympy vector field into the Python source
 of one numba function that runs those recurrences; the engine compiles it
-once per model and caches it on disk.
+once per model and order and caches it on disk.
+
+As in heyoka, the kernel is generated for a fixed order and fully unrolled:
+every coefficient of every sub-expression is a scalar local variable, every
+convolution sum is written out term by term (as a balanced tree of additions,
+so that the processor can overlap them), and terms that are zero by
+construction are left out at generation time.  Compared with loops over
+coefficient arrays this is 2-3 times faster.
 
 Every sub-expression is classified at generation time as
 
@@ -16,7 +23,7 @@ Every sub-expression is classified at generation time as
   computed once per call;
 * affine in time (``a*t + b`` with constant ``a``, ``b``): two scalars, so that
   forcing terms such as ``sin(omega*t)`` cost O(1) per order instead of O(k);
-* general: an array of coefficients.
+* general: one scalar per order.
 
 Extra *output* expressions (event functions such as the guard) are expanded
 to the same order as the state, so the engine sees them as polynomials in the
@@ -25,7 +32,7 @@ step time.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import sympy as sp
@@ -49,10 +56,26 @@ class _Affine:
 
 @dataclass(frozen=True)
 class _General:
-    name: str  # name of the coefficient array in the generated code
+    name: str  # coefficient k is the local variable ``{name}_{k}`` of the generated code
 
 
 _Ref = _Const | _Affine | _General
+_Emitter = Callable[[int], list[str]]
+
+
+def _sum(terms: Sequence[str]) -> str:
+    """Sum of ``terms`` as a balanced tree of additions (short dependency chains)."""
+    if not terms:
+        return "0.0"
+    if len(terms) == 1:
+        return terms[0]
+    mid = len(terms) // 2
+    return f"({_sum(terms[:mid])} + {_sum(terms[mid:])})"
+
+
+def _inv(k: int) -> str:
+    """The literal ``1/k``."""
+    return repr(1.0 / k)
 
 
 class ScalarPrinter(PythonCodePrinter):
@@ -81,12 +104,12 @@ class _Builder:
     time: sp.Symbol
     param_names: dict[sp.Symbol, str]
     prologue: list[str] = field(default_factory=list)
-    nodes: list[tuple[str, list[str], set[str]]] = field(default_factory=list)
-    # (array name, code lines using `k`, names of arrays it depends on)
+    nodes: list[tuple[str, _Emitter, set[str]]] = field(default_factory=list)
+    # (name, code assigning coefficient k, names of the nodes it depends on)
     memo: dict[sp.Expr, _Ref] = field(default_factory=dict)
     trig: dict[sp.Expr, tuple[str, str]] = field(default_factory=dict)
     n_scalar: int = 0
-    n_array: int = 0
+    n_node: int = 0
 
     def __post_init__(self) -> None:
         self.state_index = {s: i for i, s in enumerate(self.states)}
@@ -99,14 +122,14 @@ class _Builder:
         self.prologue.append(f"{name} = {code}")
         return name
 
-    def _array(self) -> str:
-        name = f"w{self.n_array}"
-        self.n_array += 1
+    def _name(self) -> str:
+        name = f"w{self.n_node}"
+        self.n_node += 1
         return name
 
-    def _node(self, lines: list[str], deps: set[str]) -> _General:
-        name = self._array()
-        self.nodes.append((name, [ln.replace("@", name) for ln in lines], deps))
+    def _node(self, emit: _Emitter, *refs: _Ref) -> _General:
+        name = self._name()
+        self.nodes.append((name, lambda k: [f"{name}_{k} = {emit(k)[0]}"], self.deps(*refs)))
         return _General(name)
 
     # -- classification -------------------------------------------------
@@ -115,22 +138,32 @@ class _Builder:
         return self.time not in syms and not any(s in self.state_index for s in syms)
 
     @staticmethod
-    def coef(ref: _Ref, k: str) -> str:
-        """Code for the ``k``-th Taylor coefficient of ``ref``."""
+    def term(ref: _Ref, k: int) -> str | None:
+        """Code for the ``k``-th Taylor coefficient of ``ref``; None where it is zero."""
         if isinstance(ref, _General):
-            return f"{ref.name}[{k}]"
+            return f"{ref.name}_{k}"
         if isinstance(ref, _Const):
-            return f"({ref.name} if {k} == 0 else 0.0)"
-        return f"({ref.v0} if {k} == 0 else ({ref.v1} if {k} == 1 else 0.0))"
+            return ref.name if k == 0 else None
+        return ref.v0 if k == 0 else (ref.v1 if k == 1 else None)
+
+    @classmethod
+    def coef(cls, ref: _Ref, k: int) -> str:
+        """Like :meth:`term`, with ``0.0`` for the zero coefficients."""
+        return cls.term(ref, k) or "0.0"
+
+    @classmethod
+    def products(cls, a: _Ref, b: _Ref, k: int, lo: int = 0, weight: bool = False) -> list[str]:
+        """Nonzero terms ``[j *] a_j * b_(k-j)`` for ``j = lo .. k``."""
+        out = []
+        for j in range(lo, k + 1):
+            ta, tb = cls.term(a, j), cls.term(b, k - j)
+            if ta is not None and tb is not None:
+                out.append(f"{float(j)!r} * {ta} * {tb}" if weight else f"{ta} * {tb}")
+        return out
 
     @staticmethod
     def deps(*refs: _Ref) -> set[str]:
         return {r.name for r in refs if isinstance(r, _General)}
-
-    def materialize(self, ref: _Ref) -> _General:
-        if isinstance(ref, _General):
-            return ref
-        return self._node([f"@[k] = {self.coef(ref, 'k')}"], set())
 
     # -- expression visitor -----------------------------------------------
     def visit(self, expr: sp.Expr) -> _Ref:
@@ -175,43 +208,26 @@ class _Builder:
             return _Affine(self._scalar(c0), self._scalar(c1))
         v0 = self._scalar(c0) if (consts or affs) else None
         v1 = self._scalar(c1) if affs else None
-        lines = [f"acc = {' + '.join(g.name + '[k]' for g in gens)}"]
-        if v0 is not None:
-            lines.append(f"if k == 0: acc += {v0}")
-        if v1 is not None:
-            lines.append(f"if k == 1: acc += {v1}")
-        lines.append("@[k] = acc")
-        return self._node(lines, self.deps(*gens))
+
+        def emit(k: int) -> list[str]:
+            extra = [v for v, kk in ((v0, 0), (v1, 1)) if v is not None and k == kk]
+            return [_sum([f"{g.name}_{k}" for g in gens] + extra)]
+
+        return self._node(emit, *gens)
 
     def _scale(self, ref: _Ref, c: str) -> _Ref:
         if isinstance(ref, _Const):
             return _Const(self._scalar(f"{c} * {ref.name}"))
         if isinstance(ref, _Affine):
             return _Affine(self._scalar(f"{c} * {ref.v0}"), self._scalar(f"{c} * {ref.v1}"))
-        return self._node([f"@[k] = {c} * {ref.name}[k]"], {ref.name})
+        return self._node(lambda k: [f"{c} * {ref.name}_{k}"], ref)
 
     def _mul(self, a: _Ref, b: _Ref) -> _Ref:
         if isinstance(a, _Const):
             return self._scale(b, a.name)
         if isinstance(b, _Const):
             return self._scale(a, b.name)
-        if isinstance(a, _General) and isinstance(b, _Affine):
-            a, b = b, a
-        if isinstance(a, _Affine) and isinstance(b, _General):
-            lines = [
-                f"acc = {a.v0} * {b.name}[k]",
-                f"if k >= 1: acc += {a.v1} * {b.name}[k - 1]",
-                "@[k] = acc",
-            ]
-            return self._node(lines, {b.name})
-        ga, gb = self.materialize(a), self.materialize(b)
-        lines = [
-            "acc = 0.0",
-            "for j in range(k + 1):",
-            f"    acc += {ga.name}[j] * {gb.name}[k - j]",
-            "@[k] = acc",
-        ]
-        return self._node(lines, {ga.name, gb.name})
+        return self._node(lambda k: [_sum(self.products(a, b, k))], a, b)
 
     def _product(self, refs: Sequence[_Ref]) -> _Ref:
         consts = [r.name for r in refs if isinstance(r, _Const)]
@@ -228,21 +244,18 @@ class _Builder:
     def _div(self, num: _Ref, den: _Ref) -> _Ref:
         if isinstance(den, _Const):
             return self._scale(num, self._scalar(f"1.0 / {den.name}"))
-        u = self.coef(num, "k")
-        if isinstance(den, _Affine):
-            lines = [
-                f"acc = {u}",
-                f"if k >= 1: acc -= {den.v1} * @[k - 1]",
-                f"@[k] = acc / {den.v0}",
-            ]
-            return self._node(lines, self.deps(num))
-        lines = [
-            f"acc = {u}",
-            "for j in range(1, k + 1):",
-            f"    acc -= {den.name}[j] * @[k - j]",
-            f"@[k] = acc / {den.name}[0]",
-        ]
-        return self._node(lines, self.deps(num) | {den.name})
+        name = self._name()
+        q = _General(name)
+        d0 = self.term(den, 0)
+
+        def emit(k: int) -> list[str]:
+            lines = [f"{name}_inv = 1.0 / {d0}"] if k == 0 else []
+            rest = _sum(self.products(den, q, k, lo=1))
+            lines.append(f"{name}_{k} = ({self.coef(num, k)} - {rest}) * {name}_inv")
+            return lines
+
+        self.nodes.append((name, emit, self.deps(num, den)))
+        return q
 
     def _mul_expr(self, expr: sp.Mul) -> _Ref:
         num, den = [], []
@@ -279,94 +292,79 @@ class _Builder:
                 return result
         e = self.visit(exponent)
         assert isinstance(e, _Const)
-        g = self.materialize(b)
-        lines = [
-            "if k == 0:",
-            f"    @[0] = {g.name}[0] ** {e.name}",
-            "else:",
-            "    acc = 0.0",
-            "    for j in range(k):",
-            f"        acc += ({e.name} * (k - j) - j) * {g.name}[k - j] * @[j]",
-            f"    @[k] = acc / (k * {g.name}[0])",
-        ]
-        return self._node(lines, {g.name})
+        name = self._name()
+        b0 = self.term(b, 0)
+
+        def emit(k: int) -> list[str]:
+            if k == 0:
+                return [f"{name}_0 = {b0} ** {e.name}", f"{name}_inv = 1.0 / {b0}"]
+            terms = []
+            for j in range(k):
+                tb = self.term(b, k - j)
+                if tb is not None:
+                    terms.append(f"({e.name} * {float(k - j)!r} - {float(j)!r}) * {tb} * {name}_{j}")
+            return [f"{name}_{k} = {_sum(terms)} * ({_inv(k)} * {name}_inv)"]
+
+        self.nodes.append((name, emit, self.deps(b)))
+        return _General(name)
 
     def _sincos(self, arg: sp.Expr) -> tuple[str, str]:
         if arg in self.trig:
             return self.trig[arg]
         u = self.visit(arg)
-        s, c = self._array(), self._array()
-        if isinstance(u, _Affine):
-            lines = [
-                "if k == 0:",
-                f"    {s}[0] = math.sin({u.v0})",
-                f"    {c}[0] = math.cos({u.v0})",
-                "else:",
-                f"    {s}[k] = {u.v1} / k * {c}[k - 1]",
-                f"    {c}[k] = -{u.v1} / k * {s}[k - 1]",
+        if isinstance(u, _Const):  # pragma: no cover - constant arguments are folded by visit
+            raise AssertionError("constant argument")
+        s, c = self._name(), self._name()
+        S, C = _General(s), _General(c)
+        u0 = self.term(u, 0)
+
+        def emit(k: int) -> list[str]:
+            if k == 0:
+                return [f"{s}_0 = math.sin({u0})", f"{c}_0 = math.cos({u0})"]
+            return [
+                f"{s}_{k} = {_sum(self.products(u, C, k, lo=1, weight=True))} * {_inv(k)}",
+                f"{c}_{k} = -{_sum(self.products(u, S, k, lo=1, weight=True))} * {_inv(k)}",
             ]
-            deps: set[str] = set()
-        else:
-            assert isinstance(u, _General)
-            lines = [
-                "if k == 0:",
-                f"    {s}[0] = math.sin({u.name}[0])",
-                f"    {c}[0] = math.cos({u.name}[0])",
-                "else:",
-                "    acc_s = 0.0",
-                "    acc_c = 0.0",
-                "    for j in range(1, k + 1):",
-                f"        tj = j * {u.name}[j]",
-                f"        acc_s += tj * {c}[k - j]",
-                f"        acc_c += tj * {s}[k - j]",
-                f"    {s}[k] = acc_s / k",
-                f"    {c}[k] = -acc_c / k",
-            ]
-            deps = {u.name}
-        # One node computes both arrays; the cosine array is registered as an
-        # alias whose code is empty but which depends on the sine node.
-        self.nodes.append((s, lines, deps))
-        self.nodes.append((c, [], {s}))
+
+        # One node computes both; the cosine is registered as an alias with no
+        # code of its own that depends on the sine node.
+        self.nodes.append((s, emit, self.deps(u)))
+        self.nodes.append((c, lambda k: [], {s}))
         self.trig[arg] = (s, c)
         return s, c
 
     def _exp(self, u: _Ref) -> _Ref:
-        if isinstance(u, _Affine):
-            lines = [
-                "if k == 0:",
-                f"    @[0] = math.exp({u.v0})",
-                "else:",
-                f"    @[k] = {u.v1} / k * @[k - 1]",
-            ]
-            return self._node(lines, set())
-        g = self.materialize(u)
-        lines = [
-            "if k == 0:",
-            f"    @[0] = math.exp({g.name}[0])",
-            "else:",
-            "    acc = 0.0",
-            "    for j in range(1, k + 1):",
-            f"        acc += j * {g.name}[j] * @[k - j]",
-            "    @[k] = acc / k",
-        ]
-        return self._node(lines, {g.name})
+        name = self._name()
+        p = _General(name)
+        u0 = self.term(u, 0)
+
+        def emit(k: int) -> list[str]:
+            if k == 0:
+                return [f"{name}_0 = math.exp({u0})"]
+            return [f"{name}_{k} = {_sum(self.products(u, p, k, lo=1, weight=True))} * {_inv(k)}"]
+
+        self.nodes.append((name, emit, self.deps(u)))
+        return p
 
     def _log(self, u: _Ref) -> _Ref:
-        g = self.materialize(u)
-        lines = [
-            "if k == 0:",
-            f"    @[0] = math.log({g.name}[0])",
-            "else:",
-            "    acc = k * " + g.name + "[k]",
-            "    for j in range(1, k):",
-            f"        acc -= j * @[j] * {g.name}[k - j]",
-            f"    @[k] = acc / (k * {g.name}[0])",
-        ]
-        return self._node(lines, {g.name})
+        name = self._name()
+        p = _General(name)
+        u0 = self.term(u, 0)
+
+        def emit(k: int) -> list[str]:
+            if k == 0:
+                return [f"{name}_0 = math.log({u0})", f"{name}_inv = 1.0 / {u0}"]
+            rest = [f"{float(j)!r} * {name}_{j} * {t}" for j in range(1, k) if (t := self.term(u, k - j))]
+            uk = self.term(u, k)
+            lead = f"{float(k)!r} * {uk}" if uk is not None else "0.0"
+            return [f"{name}_{k} = ({lead} - {_sum(rest)}) * ({_inv(k)} * {name}_inv)"]
+
+        self.nodes.append((name, emit, self.deps(u)))
+        return p
 
 
-def _cone(nodes: list[tuple[str, list[str], set[str]]], roots: set[str]) -> set[str]:
-    """Names of the nodes that the arrays ``roots`` depend on (inclusive)."""
+def _cone(nodes: list[tuple[str, _Emitter, set[str]]], roots: set[str]) -> set[str]:
+    """Names of the nodes that the nodes ``roots`` depend on (inclusive)."""
     deps = {name: d for name, _, d in nodes}
     seen: set[str] = set()
     stack = [r for r in roots if r in deps]
@@ -387,7 +385,7 @@ class TaylorKernel:
     source: str
     n_states: int
     n_outputs: int
-    n_work: int
+    order: int
 
 
 def taylor_kernel(
@@ -397,61 +395,61 @@ def taylor_kernel(
     params: Sequence[sp.Symbol],
     rhs: Sequence[sp.Expr],
     outputs: Sequence[sp.Expr] = (),
+    order: int = 20,
 ) -> TaylorKernel:
-    """Generate ``name(x0, s0, pv, order, X, O, W)``.
+    """Generate ``name(x0, s0, pv, X, O)`` for Taylor polynomials of degree ``order``.
 
     The generated function writes the normalised Taylor coefficients of the
     solution of ``states' = rhs`` through ``x0`` at time ``s0`` into
     ``X[i, 0..order]`` and those of each output expression into
     ``O[m, 0..order]``.  ``pv`` holds the parameter values in the order of
-    ``params``; ``W`` is a work array of shape ``(n_work, order + 1)``.
+    ``params``.
 
     Examples
     --------
     >>> import sympy as sp
     >>> x, t, w = sp.symbols("x t w")
-    >>> k = taylor_kernel("tc", [x], t, [w], [sp.cos(w * t)], outputs=[x - 1])
-    >>> (k.n_states, k.n_outputs)
-    (1, 1)
+    >>> k = taylor_kernel("tc", [x], t, [w], [sp.cos(w * t)], outputs=[x - 1], order=3)
+    >>> (k.n_states, k.n_outputs, k.order)
+    (1, 1, 3)
+    >>> print(next(ln for ln in k.source.splitlines() if "xs0_2 =" in ln).strip())
+    xs0_2 = w1_1 * 0.5
     """
     states = tuple(states)
     if len(rhs) != len(states):
         raise ValueError("rhs must have one expression per state")
+    if order < 1:
+        raise ValueError("order must be at least 1")
     names = {p: f"p{i}" for i, p in enumerate(params)}
     b = _Builder(states, time, names)
     rhs_refs = [b.visit(e) for e in rhs]
     out_refs = [b.visit(e) for e in outputs]
-
-    out_arrays = {r.name for r in out_refs if isinstance(r, _General) and not r.name.startswith("xs")}
-    cone = _cone(b.nodes, out_arrays)
+    cone = _cone(b.nodes, b.deps(*out_refs))
 
     ind = "    "
-    src = [f"def {name}(x0, s0, pv, order, X, O, W):"]
+    src = [f"def {name}(x0, s0, pv, X, O):"]
     for p_, pname in names.items():
         src.append(f"{ind}{pname} = pv[{params.index(p_)}]")
     src += [ind + ln for ln in b.prologue]
     for i in range(len(states)):
-        src.append(f"{ind}xs{i} = X[{i}]")
-        src.append(f"{ind}xs{i}[0] = x0[{i}]")
-    for j in range(b.n_array):
-        src.append(f"{ind}w{j} = W[{j}]")
-    src.append(f"{ind}for k in range(order + 1):")
-    src.append(f"{ind * 2}if k < order:")
-    for _, lines, _ in b.nodes:
-        src += [ind * 3 + ln for ln in lines]
-    for i, ref in enumerate(rhs_refs):
-        src.append(f"{ind * 3}xs{i}[k + 1] = {b.coef(ref, 'k')} / (k + 1)")
-    src.append(f"{ind * 2}else:")
-    body = [ind * 3 + ln for n_, lines, _ in b.nodes if n_ in cone for ln in lines]
-    src += body or [ind * 3 + "pass"]
+        src.append(f"{ind}xs{i}_0 = x0[{i}]")
+    for k in range(order + 1):
+        for node, emit, _ in b.nodes:
+            if k < order or node in cone:
+                src += [ind + ln for ln in emit(k)]
+        if k < order:
+            for i, ref in enumerate(rhs_refs):
+                t = b.term(ref, k)
+                src.append(f"{ind}xs{i}_{k + 1} = {t} * {_inv(k + 1)}" if t else f"{ind}xs{i}_{k + 1} = 0.0")
+    for i in range(len(states)):
+        src += [f"{ind}X[{i}, {k}] = xs{i}_{k}" for k in range(order + 1)]
     for m, ref in enumerate(out_refs):
-        src.append(f"{ind}for k in range(order + 1):")
-        src.append(f"{ind * 2}O[{m}, k] = {b.coef(ref, 'k')}")
+        src += [f"{ind}O[{m}, {k}] = {b.coef(ref, k)}" for k in range(order + 1)]
     src.append(f"{ind}return")
     return TaylorKernel(
         name=name,
         source="\n".join(src) + "\n",
         n_states=len(states),
         n_outputs=len(out_refs),
-        n_work=max(b.n_array, 1),
+        order=order,
     )
