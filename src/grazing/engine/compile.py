@@ -149,7 +149,9 @@ def _scalar_function(
     return "\n".join(lines) + "\n"
 
 
-def generate_source(sys_: SymbolicSystem, sensitivities: Sequence[sp.Symbol] = (), order: int = DEFAULT_ORDER) -> str:
+def generate_source(
+    sys_: SymbolicSystem, sensitivities: Sequence[sp.Symbol] = (), order: int = DEFAULT_ORDER
+) -> str:
     """Full source of the kernel module for ``sys_`` with Taylor polynomials of degree ``order``."""
     import sympy as sp
 
@@ -274,7 +276,8 @@ def kernel_key(identity: str, sensitivities: Sequence[str], order: int = DEFAULT
     here = Path(__file__).parent
     files = ("_driver_template.py", "polyroots.py", "taylor.py", "compile.py")
     deps = "".join((here / f).read_text() for f in files)
-    text = repr((identity, tuple(sensitivities), order, _CODEGEN_VERSION, numba.__version__, sys.version, deps))
+    versions = (_CODEGEN_VERSION, numba.__version__, sys.version)
+    text = repr((identity, tuple(sensitivities), order, versions, deps))
     return hashlib.sha256(text.encode()).hexdigest()[:20]
 
 
