@@ -6,7 +6,8 @@ text to the module generated for a model, where the model functions it calls
 the constants ``NX``, ``NSENS``, ``ORDER`` (degree of the Taylor polynomials)
 and ``HAS_STICK`` are defined.  Keeping the driver in the same module as the model
 functions lets numba resolve them as globals and cache the compiled result on
-disk.
+disk.  What does not depend on the model is in :mod:`grazing.engine.stepping`
+(and :mod:`grazing.engine.polyroots`), compiled once per machine.
 
 Time is kept as ``k * T + s`` with ``s`` in [0, T) for models whose vector
 field is T-periodic in time (``wrap``), so that the forcing phase does not lose
@@ -20,84 +21,6 @@ STATUS_OK = 0
 STATUS_STEP_LIMIT = 1
 STATUS_NONFINITE = 2
 STATUS_ZENO = 3
-
-
-@njit(cache=True, inline="always")
-def _step_size(X, n, O, order, max_step):
-    """Jorba-Zou step size from the last two Taylor coefficients.
-
-    The norms run over the first ``n`` rows of ``X`` (the state, and the
-    variational equations when they are integrated) and the event function
-    (``O[0]``), so that the event polynomial and the Jacobian are as accurate
-    as the state even where the state itself is constant (sticking, an
-    equilibrium).
-    """
-    nx = abs(O[0, 0])
-    n1 = abs(O[0, order - 1])
-    n2 = abs(O[0, order])
-    for i in range(n):
-        nx = max(nx, abs(X[i, 0]))
-        n1 = max(n1, abs(X[i, order - 1]))
-        n2 = max(n2, abs(X[i, order]))
-    sc = max(1.0, nx)
-    rho = math.inf
-    if n1 > 0.0:
-        rho = min(rho, (sc / n1) ** (1.0 / (order - 1)))
-    if n2 > 0.0:
-        rho = min(rho, (sc / n2) ** (1.0 / order))
-    h = rho * math.exp(-2.0 - 0.7 / (order - 1))
-    return min(h, max_step)
-
-
-@njit(cache=True, inline="always")
-def _eval_rows(X, nrows, order, dt, out):
-    for i in range(nrows):
-        acc = X[i, order]
-        for j in range(order - 1, -1, -1):
-            acc = acc * dt + X[i, j]
-        out[i] = acc
-
-
-@njit(cache=True, inline="always")
-def _poly_derivative(c, order, u):
-    acc = 0.0
-    for j in range(order, 0, -1):
-        acc = acc * u + j * c[j]
-    return acc
-
-
-@njit(cache=True, inline="always")
-def _unpack_var(x, n, ncol, V):
-    """The variational matrix stored row by row after the state in ``x``, into ``V``."""
-    for i in range(n):
-        for c in range(ncol):
-            V[i, c] = x[n + i * ncol + c]
-
-
-@njit(cache=True, inline="always")
-def _pack_var(V, n, ncol, x):
-    for i in range(n):
-        for c in range(ncol):
-            x[n + i * ncol + c] = V[i, c]
-
-
-@njit(cache=True)
-def _record(buf, count, t, value, x, n):
-    """Append the row ``[t, value, x[:n]]`` to ``buf`` (grown as needed); return the buffer."""
-    buf = _grow(buf, count)
-    buf[count, 0] = t
-    buf[count, 1] = value
-    buf[count, 2:] = x[:n]
-    return buf
-
-
-@njit(cache=True)
-def _grow(buf, count):
-    if count < buf.shape[0]:
-        return buf
-    new = np.empty((2 * buf.shape[0] + 8, buf.shape[1]))
-    new[: buf.shape[0]] = buf
-    return new
 
 
 @njit(cache=True)
@@ -143,27 +66,9 @@ def _saltation(xm, xp, s, pv, V, ncol):
             if c >= n:
                 acc += Gp[i, c - n]
             Vn[i, c] = acc + w[i] * hv[c]
-    V[:, :] = Vn
-
-
-@njit(cache=True)
-def _orthonormalize(V, n, logs):
-    """Modified Gram-Schmidt on the first n columns of V; adds log norms to logs."""
-    for c in range(n):
-        for q in range(c):
-            d = 0.0
-            for i in range(n):
-                d += V[i, c] * V[i, q]
-            for i in range(n):
-                V[i, c] -= d * V[i, q]
-        nrm = 0.0
-        for i in range(n):
-            nrm += V[i, c] * V[i, c]
-        nrm = math.sqrt(nrm)
-        logs[c] += math.log(nrm) if nrm > 0.0 else -math.inf
-        if nrm > 0.0:
-            for i in range(n):
-                V[i, c] /= nrm
+    for i in range(n):
+        for c in range(ncol):
+            V[i, c] = Vn[i, c]
 
 
 @njit(cache=True)
@@ -207,6 +112,7 @@ def integrate(
     T,
     wrap,
     max_step,
+    safety,
     max_steps,
     n_samples,
     ks,
@@ -248,7 +154,8 @@ def integrate(
     nv = n * ncol if use_var else 0
     ntot = n + nv
     x = np.empty(ntot)
-    x[:n] = x_init
+    for i in range(n):
+        x[i] = x_init[i]
     if use_var:
         for i in range(n):
             for c in range(ncol):
@@ -296,7 +203,7 @@ def integrate(
     jac_valid = True
     if recording and traj_dt > 0.0:
         traj[0, 0] = k * T + s
-        traj[0, 1:] = x[:n]
+        set_row(traj, 0, 1, x, n)
         n_traj = 1
         st += traj_dt
         while wrap and st >= T:
@@ -318,10 +225,10 @@ def integrate(
                 tc_var(x, s, pv, X, O)
             else:
                 tc_free(x, s, pv, X, O)
-            h = _step_size(X, ntot, O, order, max_step)
+            h = step_size(X, ntot, O, order, max_step, safety)
         else:
             tc_stick(x, s, pv, XS, O)
-            h = _step_size(XS, n, O, order, max_step)
+            h = step_size(XS, n, O, order, max_step, safety)
         rem = (ks - k) * T + (ss - s)
         is_last = False
         if isamp == n_samples - 1 and h >= rem:
@@ -371,8 +278,8 @@ def integrate(
             if is_last and isamp == n_samples - 1:
                 dt = h_acc
             if isamp >= keep_from:
-                _eval_rows(Xr, n, order, dt, xe)
-                samples[isamp - keep_from, :] = xe[:n]
+                eval_rows(Xr, n, order, dt, xe)
+                set_row(samples, isamp - keep_from, 0, xe, n)
             isamp += 1
             if wrap:
                 ks += 1
@@ -381,10 +288,10 @@ def integrate(
             if isamp == keep_from and not recording and n_keep > 0:
                 recording = True
                 if traj_dt > 0.0:
-                    _eval_rows(Xr, n, order, dt, xe)
-                    traj = _grow(traj, n_traj)
+                    eval_rows(Xr, n, order, dt, xe)
+                    traj = grow(traj, n_traj)
                     traj[n_traj, 0] = k * T + s + dt
-                    traj[n_traj, 1:] = xe[:n]
+                    set_row(traj, n_traj, 1, xe, n)
                     n_traj += 1
                     kt = k
                     st = s + dt + traj_dt
@@ -396,10 +303,10 @@ def integrate(
                 dt = (kt - k) * T + (st - s)
                 if dt > h_acc:
                     break
-                _eval_rows(Xr, n, order, dt, xe)
-                traj = _grow(traj, n_traj)
+                eval_rows(Xr, n, order, dt, xe)
+                traj = grow(traj, n_traj)
                 traj[n_traj, 0] = k * T + s + dt
-                traj[n_traj, 1:] = xe[:n]
+                set_row(traj, n_traj, 1, xe, n)
                 n_traj += 1
                 st += traj_dt
                 while wrap and st >= T:
@@ -415,27 +322,27 @@ def integrate(
             if gm[0] < min_info[0]:
                 min_info[0] = gm[0]
                 min_info[1] = k * T + s
-                min_info[2:] = x[:n]
+                set_slice(min_info, 2, x, n)
             uend = h_acc / h
-            if gm[1] < 0.0 and _poly_derivative(gm, order, uend) > 0.0:
+            if gm[1] < 0.0 and poly_derivative(gm, order, uend) > 0.0:
                 lo = 0.0
                 hi = uend
                 for _ in range(80):
                     mid = 0.5 * (lo + hi)
-                    if _poly_derivative(gm, order, mid) < 0.0:
+                    if poly_derivative(gm, order, mid) < 0.0:
                         lo = mid
                     else:
                         hi = mid
                 um = 0.5 * (lo + hi)
                 gv = horner(gm, order, um)
                 if gv < min_info[0]:
-                    _eval_rows(X, n, order, um * h, xe)
+                    eval_rows(X, n, order, um * h, xe)
                     min_info[0] = gv
                     min_info[1] = k * T + s + um * h
-                    min_info[2:] = xe[:n]
+                    set_slice(min_info, 2, xe, n)
 
         # Advance to the end of the accepted part of the step.
-        _eval_rows(Xr, nrows, order, h_acc, xe)
+        eval_rows(Xr, nrows, order, h_acc, xe)
         for i in range(nrows):
             x[i] = xe[i]
         s += h_acc
@@ -445,16 +352,16 @@ def integrate(
         nsteps += 1
         defl = 0
         if lyap and use_var and mode == 0:
-            _unpack_var(x, n, ncol, V)
+            unpack_var(x, n, ncol, V)
             if recording and not lyap_started:
                 lyap_started = True
                 lyap_t0 = k * T + s
-                _orthonormalize(V, n, scratch)
+                orthonormalize(V, n, scratch)
             elif lyap_started:
-                _orthonormalize(V, n, logs)
+                orthonormalize(V, n, logs)
             else:
-                _orthonormalize(V, n, scratch)  # transient: align V, discard growth
-            _pack_var(V, n, ncol, x)
+                orthonormalize(V, n, scratch)  # transient: align V, discard growth
+            pack_var(V, n, ncol, x)
 
         if zdm_hit:
             kz += 1
@@ -467,7 +374,7 @@ def integrate(
                     # dD/dx = I - e (grad S)^T, grad S = a grad(delta) / S
                     guard_grad(x, s, pv, zdm_gh)
                     normal_rate_grad(x, s, pv, zdm_gv)
-                    _unpack_var(x, n, ncol, V)
+                    unpack_var(x, n, ncol, V)
                     for c in range(ncol):
                         gs = 0.0
                         for j in range(n):
@@ -475,9 +382,9 @@ def integrate(
                         gs /= sp_
                         for i in range(n):
                             V[i, c] -= zdm_e[i] * gs
-                    _pack_var(V, n, ncol, x)
+                    pack_var(V, n, ncol, x)
                 if record_impacts == 2 or (record_impacts == 1 and recording):
-                    imp = _record(imp, n_imp_rec, k * T + s, sp_, x, n)
+                    imp = record(imp, n_imp_rec, k * T + s, sp_, x, n)
                     n_imp_rec += 1
                 n_imp += 1
                 for i in range(n):
@@ -489,18 +396,18 @@ def integrate(
                 vn = normal_rate(x, s, pv)
                 reset(x, s, pv, xp)
                 if use_var:
-                    _unpack_var(x, n, ncol, V)
+                    unpack_var(x, n, ncol, V)
                     _saltation(x, xp, s, pv, V, ncol)
-                    _pack_var(V, n, ncol, xp)
+                    pack_var(V, n, ncol, xp)
                 if record_impacts == 2 or (record_impacts == 1 and recording):
-                    imp = _record(imp, n_imp_rec, k * T + s, -vn, x, n)
+                    imp = record(imp, n_imp_rec, k * T + s, -vn, x, n)
                     n_imp_rec += 1
                 if recording and traj_dt > 0.0:
-                    traj = _grow(traj, n_traj + 1)
+                    traj = grow(traj, n_traj + 1)
                     traj[n_traj, 0] = k * T + s
-                    traj[n_traj, 1:] = x[:n]
+                    set_row(traj, n_traj, 1, x, n)
                     traj[n_traj + 1, 0] = k * T + s
-                    traj[n_traj + 1, 1:] = xp[:n]
+                    set_row(traj, n_traj + 1, 1, xp, n)
                     n_traj += 2
                 n_imp += 1
                 for i in range(nrows):
@@ -530,7 +437,7 @@ def integrate(
                             defl = 0
                             jac_valid = False
                             if recording:
-                                sticks = _grow(sticks, n_stick)
+                                sticks = grow(sticks, n_stick)
                                 sticks[n_stick, 0] = k * T + s
                                 sticks[n_stick, 1] = math.nan
                                 n_stick += 1
@@ -548,13 +455,13 @@ def integrate(
         if g_end < min_info[0]:
             min_info[0] = g_end
             min_info[1] = k * T + s
-            min_info[2:] = x[:n]
+            set_slice(min_info, 2, x, n)
     if n_stick > 0 and math.isnan(sticks[n_stick - 1, 1]):
         sticks[n_stick - 1, 1] = k * T + s
     lyap_span = k * T + s - lyap_t0 if (lyap and lyap_started) else 0.0
     Vout = np.zeros((n, ncol))
     if use_var:
-        _unpack_var(x, n, ncol, Vout)
+        unpack_var(x, n, ncol, Vout)
     return (
         status,
         x[:n].copy(),

@@ -167,6 +167,8 @@ def generate_source(
         "import numpy as np",
         "from numba import njit",
         "from grazing.engine.polyroots import first_root, horner",
+        "from grazing.engine.stepping import (eval_rows, grow, orthonormalize, pack_var, poly_derivative,"
+        " record, set_row, set_slice, step_size, unpack_var)",
         f"NX = {n}",
         f"NSENS = {m}",
         f"ORDER = {order}",
@@ -274,7 +276,7 @@ def kernel_key(identity: str, sensitivities: Sequence[str], order: int = DEFAULT
     import numba
 
     here = Path(__file__).parent
-    files = ("_driver_template.py", "polyroots.py", "taylor.py", "compile.py")
+    files = ("_driver_template.py", "polyroots.py", "stepping.py", "taylor.py", "compile.py")
     deps = "".join((here / f).read_text() for f in files)
     versions = (_CODEGEN_VERSION, numba.__version__, sys.version)
     text = repr((identity, tuple(sensitivities), order, versions, deps))

@@ -78,6 +78,11 @@ def _inv(k: int) -> str:
     return repr(1.0 / k)
 
 
+def _div_by(expr: str, k: int) -> str:
+    """``expr / k`` as a multiplication by the literal ``1/k`` (nothing for ``k = 1``)."""
+    return expr if k == 1 else f"{expr} * {_inv(k)}"
+
+
 class ScalarPrinter(PythonCodePrinter):
     """Prints constant sub-expressions as plain ``math`` scalar code."""
 
@@ -152,14 +157,32 @@ class _Builder:
         return cls.term(ref, k) or "0.0"
 
     @classmethod
-    def products(cls, a: _Ref, b: _Ref, k: int, lo: int = 0, weight: bool = False) -> list[str]:
-        """Nonzero terms ``[j *] a_j * b_(k-j)`` for ``j = lo .. k``."""
+    def products(cls, a: _Ref, b: _Ref, k: int, lo: int = 0) -> list[str]:
+        """Nonzero terms ``a_j * b_(k-j)`` for ``j = lo .. k``."""
         out = []
         for j in range(lo, k + 1):
             ta, tb = cls.term(a, j), cls.term(b, k - j)
             if ta is not None and tb is not None:
-                out.append(f"{float(j)!r} * {ta} * {tb}" if weight else f"{ta} * {tb}")
+                out.append(f"{ta} * {tb}")
         return out
+
+    @classmethod
+    def weighted(cls, u: _Ref, prefix: str) -> tuple[_Emitter, _Ref]:
+        """The series ``j * u_j`` (the time derivative of ``u`` times t): code and reference.
+
+        The returned emitter defines coefficient ``k`` as ``{prefix}_{k}``;
+        the reference names it so that :meth:`products` can use it.
+        """
+
+        def emit(k: int) -> list[str]:
+            t = cls.term(u, k)
+            if k == 0 or t is None:
+                return []
+            return [f"{prefix}_{k} = {t}" if k == 1 else f"{prefix}_{k} = {float(k)!r} * {t}"]
+
+        if isinstance(u, _Affine):  # j * u_j is v1 at j = 1, zero elsewhere
+            return (lambda k: []), _Affine("0.0", u.v1)
+        return emit, _General(prefix)
 
     @staticmethod
     def deps(*refs: _Ref) -> set[str]:
@@ -317,13 +340,15 @@ class _Builder:
         s, c = self._name(), self._name()
         S, C = _General(s), _General(c)
         u0 = self.term(u, 0)
+        emit_du, du = self.weighted(u, f"{s}_du")
 
         def emit(k: int) -> list[str]:
             if k == 0:
                 return [f"{s}_0 = math.sin({u0})", f"{c}_0 = math.cos({u0})"]
             return [
-                f"{s}_{k} = {_sum(self.products(u, C, k, lo=1, weight=True))} * {_inv(k)}",
-                f"{c}_{k} = -{_sum(self.products(u, S, k, lo=1, weight=True))} * {_inv(k)}",
+                *emit_du(k),
+                f"{s}_{k} = {_div_by(_sum(self.products(du, C, k, lo=1)), k)}",
+                f"{c}_{k} = -{_div_by(_sum(self.products(du, S, k, lo=1)), k)}",
             ]
 
         # One node computes both; the cosine is registered as an alias with no
@@ -337,11 +362,12 @@ class _Builder:
         name = self._name()
         p = _General(name)
         u0 = self.term(u, 0)
+        emit_du, du = self.weighted(u, f"{name}_du")
 
         def emit(k: int) -> list[str]:
             if k == 0:
                 return [f"{name}_0 = math.exp({u0})"]
-            return [f"{name}_{k} = {_sum(self.products(u, p, k, lo=1, weight=True))} * {_inv(k)}"]
+            return [*emit_du(k), f"{name}_{k} = {_div_by(_sum(self.products(du, p, k, lo=1)), k)}"]
 
         self.nodes.append((name, emit, self.deps(u)))
         return p
@@ -440,7 +466,7 @@ def taylor_kernel(
         if k < order:
             for i, ref in enumerate(rhs_refs):
                 t = b.term(ref, k)
-                src.append(f"{ind}xs{i}_{k + 1} = {t} * {_inv(k + 1)}" if t else f"{ind}xs{i}_{k + 1} = 0.0")
+                src.append(f"{ind}xs{i}_{k + 1} = {_div_by(t, k + 1) if t else '0.0'}")
     for i in range(len(states)):
         src += [f"{ind}X[{i}, {k}] = xs{i}_{k}" for k in range(order + 1)]
     for m, ref in enumerate(out_refs):
