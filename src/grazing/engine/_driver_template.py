@@ -150,6 +150,7 @@ def integrate(
     """
     n = NX
     order = ORDER
+    factor = step_factor(safety, order)
     ncol = n + NSENS
     nv = n * ncol if use_var else 0
     ntot = n + nv
@@ -162,7 +163,6 @@ def integrate(
                 x[n + i * ncol + c] = V_init[i, c]
     X = np.zeros((ntot, order + 1))
     O = np.zeros((1, order + 1))
-    XS = np.zeros((n, order + 1))
     work = np.zeros((ROOT_WORK_ROWS, max(order + 1, ROOT_WORK_MIN_COLS)))
     a = np.zeros(order + 1)
     gm = np.zeros(order + 1)
@@ -171,9 +171,9 @@ def integrate(
     V = np.empty((n, ncol))
 
     samples = np.empty((n_keep, n))
-    imp = np.empty((16, 2 + n))
-    sticks = np.empty((4, 2))
-    traj = np.empty((64 if traj_dt > 0.0 else 1, 1 + n))
+    imp = new_table(16, 2 + n)
+    sticks = new_table(4, 2)
+    traj = new_table(64 if traj_dt > 0.0 else 1, 1 + n)
     logs = np.zeros(n)
     scratch = np.zeros(n)
     min_info = np.full(2 + n, math.inf)
@@ -202,8 +202,7 @@ def integrate(
     zero_events = 0
     jac_valid = True
     if recording and traj_dt > 0.0:
-        traj[0, 0] = k * T + s
-        set_row(traj, 0, 1, x, n)
+        append_row(traj, 0, k * T + s, x, n)
         n_traj = 1
         st += traj_dt
         while wrap and st >= T:
@@ -225,10 +224,10 @@ def integrate(
                 tc_var(x, s, pv, X, O)
             else:
                 tc_free(x, s, pv, X, O)
-            h = step_size(X, ntot, O, order, max_step, safety)
+            h = step_size(X, ntot, O, order, max_step, factor)
         else:
-            tc_stick(x, s, pv, XS, O)
-            h = step_size(XS, n, O, order, max_step, safety)
+            tc_stick(x, s, pv, X, O)  # the first n rows only
+            h = step_size(X, n, O, order, max_step, factor)
         rem = (ks - k) * T + (ss - s)
         is_last = False
         if isamp == n_samples - 1 and h >= rem:
@@ -255,7 +254,17 @@ def integrate(
             a[j] = 0.0
         while 0 < d < 3 and a[d] == 0.0:
             d += 1
-        u = first_root(a[d:], order - d, work) if (events or mode == 1) else -1.0
+        if d > 0:  # divide by u^d (a fresh reset or release: the root at u = 0 is known)
+            for j in range(order + 1 - d):
+                a[j] = a[j + d]
+        u = -1.0
+        if events or mode == 1:
+            # The certificate of first_root, on scalars: most steps stop here.
+            tail = 0.0
+            for j in range(3, order - d + 1):
+                tail += abs(a[j])
+            if a[0] <= 0.0 or quadratic_bound(a[0], a[1], a[2], tail) <= 0.0:
+                u = first_root(a, order - d, work)
         event = u >= 0.0 and h > 0.0
         if event and u == 0.0:
             zero_events += 1
@@ -267,7 +276,6 @@ def integrate(
         h_acc = u * h if event else h
         if event and is_last and u >= 1.0:
             event = False
-        Xr = X if mode == 0 else XS
         nrows = ntot if mode == 0 else n
 
         # Samples and trajectory points within (0, h_acc].
@@ -278,7 +286,7 @@ def integrate(
             if is_last and isamp == n_samples - 1:
                 dt = h_acc
             if isamp >= keep_from:
-                eval_rows(Xr, n, order, dt, xe)
+                eval_rows(X, n, order, dt, xe)
                 set_row(samples, isamp - keep_from, 0, xe, n)
             isamp += 1
             if wrap:
@@ -288,10 +296,8 @@ def integrate(
             if isamp == keep_from and not recording and n_keep > 0:
                 recording = True
                 if traj_dt > 0.0:
-                    eval_rows(Xr, n, order, dt, xe)
-                    traj = grow(traj, n_traj)
-                    traj[n_traj, 0] = k * T + s + dt
-                    set_row(traj, n_traj, 1, xe, n)
+                    eval_rows(X, n, order, dt, xe)
+                    append_row(traj, n_traj, k * T + s + dt, xe, n)
                     n_traj += 1
                     kt = k
                     st = s + dt + traj_dt
@@ -303,10 +309,8 @@ def integrate(
                 dt = (kt - k) * T + (st - s)
                 if dt > h_acc:
                     break
-                eval_rows(Xr, n, order, dt, xe)
-                traj = grow(traj, n_traj)
-                traj[n_traj, 0] = k * T + s + dt
-                set_row(traj, n_traj, 1, xe, n)
+                eval_rows(X, n, order, dt, xe)
+                append_row(traj, n_traj, k * T + s + dt, xe, n)
                 n_traj += 1
                 st += traj_dt
                 while wrap and st >= T:
@@ -342,7 +346,7 @@ def integrate(
                     set_slice(min_info, 2, xe, n)
 
         # Advance to the end of the accepted part of the step.
-        eval_rows(Xr, nrows, order, h_acc, xe)
+        eval_rows(X, nrows, order, h_acc, xe)
         for i in range(nrows):
             x[i] = xe[i]
         s += h_acc
@@ -384,7 +388,7 @@ def integrate(
                             V[i, c] -= zdm_e[i] * gs
                     pack_var(V, n, ncol, x)
                 if record_impacts == 2 or (record_impacts == 1 and recording):
-                    imp = record(imp, n_imp_rec, k * T + s, sp_, x, n)
+                    append_record(imp, n_imp_rec, k * T + s, sp_, x, n)
                     n_imp_rec += 1
                 n_imp += 1
                 for i in range(n):
@@ -400,14 +404,11 @@ def integrate(
                     _saltation(x, xp, s, pv, V, ncol)
                     pack_var(V, n, ncol, xp)
                 if record_impacts == 2 or (record_impacts == 1 and recording):
-                    imp = record(imp, n_imp_rec, k * T + s, -vn, x, n)
+                    append_record(imp, n_imp_rec, k * T + s, -vn, x, n)
                     n_imp_rec += 1
                 if recording and traj_dt > 0.0:
-                    traj = grow(traj, n_traj + 1)
-                    traj[n_traj, 0] = k * T + s
-                    set_row(traj, n_traj, 1, x, n)
-                    traj[n_traj + 1, 0] = k * T + s
-                    set_row(traj, n_traj + 1, 1, xp, n)
+                    append_row(traj, n_traj, k * T + s, x, n)
+                    append_row(traj, n_traj + 1, k * T + s, xp, n)
                     n_traj += 2
                 n_imp += 1
                 for i in range(nrows):
@@ -437,16 +438,14 @@ def integrate(
                             defl = 0
                             jac_valid = False
                             if recording:
-                                sticks = grow(sticks, n_stick)
-                                sticks[n_stick, 0] = k * T + s
-                                sticks[n_stick, 1] = math.nan
+                                append_pair(sticks, n_stick, k * T + s, math.nan)
                                 n_stick += 1
             else:
                 # Release from sticking: the contact force changes sign.
                 mode = 0
                 defl = 3
-                if recording and n_stick > 0 and math.isnan(sticks[n_stick - 1, 1]):
-                    sticks[n_stick - 1, 1] = k * T + s
+                if recording and n_stick > 0 and math.isnan(sticks[0][n_stick - 1, 1]):
+                    sticks[0][n_stick - 1, 1] = k * T + s
         if isamp >= n_samples:
             break
 
@@ -456,8 +455,8 @@ def integrate(
             min_info[0] = g_end
             min_info[1] = k * T + s
             set_slice(min_info, 2, x, n)
-    if n_stick > 0 and math.isnan(sticks[n_stick - 1, 1]):
-        sticks[n_stick - 1, 1] = k * T + s
+    if n_stick > 0 and math.isnan(sticks[0][n_stick - 1, 1]):
+        sticks[0][n_stick - 1, 1] = k * T + s
     lyap_span = k * T + s - lyap_t0 if (lyap and lyap_started) else 0.0
     Vout = np.zeros((n, ncol))
     if use_var:
@@ -472,9 +471,9 @@ def integrate(
         nsteps,
         n_imp,
         samples[: max(0, min(n_keep, isamp - keep_from))].copy(),
-        imp[:n_imp_rec].copy(),
-        sticks[:n_stick].copy(),
-        traj[:n_traj].copy(),
+        table_rows(imp, n_imp_rec),
+        table_rows(sticks, n_stick),
+        table_rows(traj, n_traj),
         logs,
         lyap_span,
         min_info,

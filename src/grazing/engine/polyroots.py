@@ -99,25 +99,37 @@ def _polish(a, n, lo, hi):
 
 
 @njit(cache=True)
+def quadratic_bound(a0, a1, a2, tail):
+    """A lower bound on [0, 1] of ``a0 + a1 u + a2 u^2 + r(u)`` where ``|r| <= tail``.
+
+    The exact minimum of the quadratic on [0, 1], minus ``tail``.  Scalars only,
+    so that the integration driver can call it on every step without touching
+    arrays (numba reference-counts arrays passed to functions it cannot prove
+    do not keep them).
+    """
+    low = min(a0, a0 + a1 + a2)
+    if a2 > 0.0:
+        um = -a1 / (2.0 * a2)
+        if 0.0 < um < 1.0:
+            low = min(low, a0 - a1 * a1 / (4.0 * a2))
+    return low - tail
+
+
+@njit(cache=True)
 def quadratic_lower_bound(a, n):
-    """A lower bound of the polynomial on [0, 1] in O(n).
+    """A lower bound of the polynomial ``a[:n+1]`` on [0, 1] in O(n).
 
     The exact minimum of ``a0 + a1 u + a2 u^2`` on [0, 1], minus the largest
     possible contribution of the higher terms, ``sum_{k>=3} |a_k|``.  Taylor
     coefficients scaled by the step decay geometrically, so this bound is
     tight except where the polynomial really comes close to zero.
     """
-    a0 = a[0]
+    tail = 0.0
+    for k in range(3, n + 1):
+        tail += abs(a[k])
     a1 = a[1] if n >= 1 else 0.0
     a2 = a[2] if n >= 2 else 0.0
-    low = min(a0, a0 + a1 + a2)
-    if a2 > 0.0:
-        um = -a1 / (2.0 * a2)
-        if 0.0 < um < 1.0:
-            low = min(low, a0 - a1 * a1 / (4.0 * a2))
-    for k in range(3, n + 1):
-        low -= abs(a[k])
-    return low
+    return quadratic_bound(a[0], a1, a2, tail)
 
 
 @njit(cache=True)

@@ -26,16 +26,23 @@ from numba import njit
 
 
 @njit(cache=True)
-def step_size(X, n, O, order, max_step, safety):
+def step_factor(safety, order):
+    """The factor ``exp(-safety - 0.7 / (order - 1))`` of :func:`step_size`."""
+    return math.exp(-safety - 0.7 / (order - 1))
+
+
+@njit(cache=True, inline="always")
+def step_size(X, n, O, order, max_step, factor):
     """Jorba-Zou step size from the last two Taylor coefficients.
 
-    ``h = rho * exp(-safety - 0.7 / (order - 1))`` where ``rho`` estimates the
-    radius of convergence; Jorba & Zou (and heyoka) use ``safety = 2``.  The
-    norms run over the first ``n`` rows of ``X`` (the state, and the
-    variational equations when they are integrated) and the event function
-    (``O[0]``), so that the event polynomial and the Jacobian are as accurate
-    as the state even where the state itself is constant (sticking, an
-    equilibrium).
+    ``h = rho * factor`` where ``rho`` estimates the radius of convergence and
+    ``factor = exp(-safety - 0.7 / (order - 1))`` (:func:`step_factor`);
+    Jorba & Zou (and heyoka) use ``safety = 2``.  The norms run over the first
+    ``n`` rows of ``X`` (the state, and the variational equations when they are
+    integrated) and the event function (``O[0]``), so that the event
+    polynomial and the Jacobian are as accurate as the state even where the
+    state itself is constant (sticking, an equilibrium).  Inlined into the
+    driver (no reference counting of its arrays on the hot path).
     """
     nx = abs(O[0, 0])
     n1 = abs(O[0, order - 1])
@@ -45,16 +52,18 @@ def step_size(X, n, O, order, max_step, safety):
         n1 = max(n1, abs(X[i, order - 1]))
         n2 = max(n2, abs(X[i, order]))
     sc = max(1.0, nx)
-    rho = math.inf
+    # log rho = min(log(sc/n1)/(order-1), log(sc/n2)/order): two logs and one exp
+    log_rho = math.inf
     if n1 > 0.0:
-        rho = min(rho, (sc / n1) ** (1.0 / (order - 1)))
+        log_rho = min(log_rho, math.log(sc / n1) / (order - 1))
     if n2 > 0.0:
-        rho = min(rho, (sc / n2) ** (1.0 / order))
-    h = rho * math.exp(-safety - 0.7 / (order - 1))
-    return min(h, max_step)
+        log_rho = min(log_rho, math.log(sc / n2) / order)
+    if log_rho == math.inf:
+        return max_step
+    return min(math.exp(log_rho) * factor, max_step)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def eval_rows(X, nrows, order, dt, out):
     """``out[i]`` = value at ``dt`` of the polynomial ``X[i, :order + 1]``, for ``i < nrows``."""
     for i in range(nrows):
@@ -115,14 +124,49 @@ def set_slice(out, first, x, n):
         out[first + i] = x[i]
 
 
+# Growable tables of rows.  The table is held in a one-element list so that
+# growing it does not rebind a variable of the driver's loop: numba would turn
+# such a variable into a loop phi and reference-count it on every step.
+
+
 @njit(cache=True)
-def record(buf, count, t, value, x, n):
-    """Append the row ``[t, value, x[:n]]`` to ``buf`` (grown as needed); return the buffer."""
-    buf = grow(buf, count)
+def new_table(rows, width):
+    """An empty growable table: ``[array of shape (rows, width)]``."""
+    return [np.empty((rows, width))]
+
+
+@njit(cache=True)
+def append_row(table, count, t, x, n):
+    """Row ``count`` of ``table`` = ``[t, x[:n]]`` (the table grows as needed)."""
+    buf = grow(table[0], count)
+    table[0] = buf
+    buf[count, 0] = t
+    set_row(buf, count, 1, x, n)
+
+
+@njit(cache=True)
+def append_record(table, count, t, value, x, n):
+    """Row ``count`` of ``table`` = ``[t, value, x[:n]]`` (the table grows as needed)."""
+    buf = grow(table[0], count)
+    table[0] = buf
     buf[count, 0] = t
     buf[count, 1] = value
     set_row(buf, count, 2, x, n)
-    return buf
+
+
+@njit(cache=True)
+def append_pair(table, count, a, b):
+    """Row ``count`` of ``table`` = ``[a, b]`` (the table grows as needed)."""
+    buf = grow(table[0], count)
+    table[0] = buf
+    buf[count, 0] = a
+    buf[count, 1] = b
+
+
+@njit(cache=True)
+def table_rows(table, count):
+    """A copy of the first ``count`` rows."""
+    return table[0][:count].copy()
 
 
 @njit(cache=True)

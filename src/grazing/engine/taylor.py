@@ -102,6 +102,14 @@ class ScalarPrinter(PythonCodePrinter):
     def _print_Float(self, expr):  # noqa: N802
         return repr(float(expr))
 
+    def _print_Pow(self, expr, rational=False):  # noqa: N802
+        # Small integer powers as products: x**-2.0 would cost a call to pow.
+        e = expr.exp
+        if e.is_Integer and 1 <= abs(int(e)) <= 4:
+            prod = " * ".join([f"({self._print(expr.base)})"] * abs(int(e)))
+            return f"({prod})" if e > 0 else f"(1.0 / ({prod}))"
+        return super()._print_Pow(expr, rational=rational)
+
 
 @dataclass
 class _Builder:
