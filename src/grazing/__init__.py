@@ -7,8 +7,6 @@
 (10, 2)
 """
 
-from importlib.metadata import PackageNotFoundError, version
-
 from grazing import models
 from grazing.core import HybridModel, Impacts, Parameter, Solution
 from grazing.engine.simulate import simulate
@@ -21,10 +19,18 @@ from grazing.errors import (
 )
 from grazing.sweeps import detect_period
 
-try:
-    __version__ = version("grazing")
-except PackageNotFoundError:  # pragma: no cover - running from a source tree
-    __version__ = "0.0.0"
+
+def __getattr__(name: str) -> str:
+    # The version is looked up on first use: importlib.metadata costs ~50 ms at import.
+    if name == "__version__":
+        from importlib.metadata import PackageNotFoundError, version
+
+        try:
+            return version("grazing")
+        except PackageNotFoundError:  # pragma: no cover - running from a source tree
+            return "0.0.0"
+    raise AttributeError(f"module 'grazing' has no attribute {name!r}")
+
 
 __all__ = [
     "ConvergenceError",

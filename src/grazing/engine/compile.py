@@ -284,11 +284,34 @@ def kernel_key(identity: str, sensitivities: Sequence[str], order: int = DEFAULT
     return hashlib.sha256(text.encode()).hexdigest()[:20]
 
 
+def _init_numba_without_blas_probe() -> None:
+    """Initialise numba's array support without importing scipy.linalg.
+
+    The first compiled function numba loads in a process initialises its CPU
+    target, which imports ``numba.np.arraymath``; that module probes for BLAS
+    by importing ``scipy.linalg.cython_blas``, which costs ~0.2 s (a third of
+    this package's start-up) and is only used to pick a BLAS inner product
+    for ``np.convolve``/``np.correlate`` in numba code, which no kernel here
+    calls.  If scipy.linalg is not imported yet, it is hidden during that one
+    import (the probe then reports no BLAS; numba's linear algebra still
+    imports scipy when it is used).
+    """
+    if "numba.np.arraymath" in sys.modules or "scipy.linalg" in sys.modules:
+        return
+    sys.modules["scipy.linalg"] = None  # type: ignore[assignment]  # import raises ImportError
+    try:
+        import numba.np.arraymath  # noqa: F401
+    finally:
+        if sys.modules.get("scipy.linalg", 0) is None:
+            del sys.modules["scipy.linalg"]
+
+
 def load_kernels(key: str, source: Callable[[], str]) -> ModuleType:
     """Import the kernel module ``key``, generating it with ``source()`` if not cached."""
     modname = f"grazing_kernels_{key}"
     if modname in sys.modules:
         return sys.modules[modname]
+    _init_numba_without_blas_probe()
     path: Path | None = None
     for d in (cache_dir(), Path(tempfile.gettempdir()) / "grazing-cache"):
         try:
