@@ -10,6 +10,7 @@ $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e ".[test]"
+	$(BIN)/python -m compileall -q src/grazing > /dev/null  # editable installs are not byte-compiled by pip
 	rm -f $(VENV)/.installed-*
 	touch $(STAMP)
 

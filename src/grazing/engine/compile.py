@@ -306,6 +306,24 @@ def _init_numba_without_blas_probe() -> None:
             del sys.modules["scipy.linalg"]
 
 
+def _write_bytecode(path: Path) -> None:
+    """Byte-compile a generated module once, even under ``PYTHONDONTWRITEBYTECODE``.
+
+    A kernel module is thousands of lines; compiling its source on every import
+    costs ~80 ms per process.  The ``.pyc`` is checked against the source as
+    usual, so it is never stale.
+    """
+    import py_compile
+
+    pyc = importlib.util.cache_from_source(str(path))
+    if os.path.exists(pyc):
+        return
+    try:
+        py_compile.compile(str(path), cfile=pyc, doraise=True)
+    except (OSError, py_compile.PyCompileError):  # pragma: no cover - read-only cache: compile on import
+        pass
+
+
 def load_kernels(key: str, source: Callable[[], str]) -> ModuleType:
     """Import the kernel module ``key``, generating it with ``source()`` if not cached."""
     modname = f"grazing_kernels_{key}"
@@ -328,6 +346,7 @@ def load_kernels(key: str, source: Callable[[], str]) -> ModuleType:
             continue
     if path is None:  # pragma: no cover - no writable directory at all
         raise OSError("no writable cache directory for compiled kernels")
+    _write_bytecode(path)
     spec = importlib.util.spec_from_file_location(modname, path)
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)
