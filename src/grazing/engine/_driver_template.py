@@ -259,12 +259,14 @@ def integrate(
                 a[j] = a[j + d]
         u = -1.0
         if events or mode == 1:
-            # The certificate of first_root, on scalars: most steps stop here.
+            # first_root, with its certificate on scalars (no array call): most steps stop here.
             tail = 0.0
             for j in range(3, order - d + 1):
                 tail += abs(a[j])
-            if a[0] <= 0.0 or quadratic_bound(a[0], a[1], a[2], tail) <= 0.0:
-                u = first_root(a, order - d, work)
+            if a[0] <= 0.0:
+                u = 0.0
+            elif quadratic_bound(a[0], a[1], a[2], tail) <= 0.0:
+                u = isolate_first_root(a, order - d, work)
         event = u >= 0.0 and h > 0.0
         if event and u == 0.0:
             zero_events += 1

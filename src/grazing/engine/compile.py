@@ -166,7 +166,7 @@ def generate_source(
         "import math",
         "import numpy as np",
         "from numba import njit",
-        "from grazing.engine.polyroots import first_root, horner, quadratic_bound",
+        "from grazing.engine.polyroots import horner, isolate_first_root, quadratic_bound",
         "from grazing.engine.stepping import (append_pair, append_record, append_row, eval_rows,"
         " new_table, orthonormalize, pack_var, poly_derivative, set_row, set_slice, step_factor, step_size,"
         " table_rows, unpack_var)",

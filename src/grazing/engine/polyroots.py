@@ -148,6 +148,15 @@ def first_root(a, n, work):
     # Cheap certificate: on [0, 1], p(u) >= min(quadratic part) - sum_{k>=3} |a_k|.
     if quadratic_lower_bound(a, n) > 0.0:
         return -1.0
+    return isolate_first_root(a, n, work)
+
+
+@njit(cache=True)
+def isolate_first_root(a, n, work):
+    """:func:`first_root` without its O(n) certificate, for callers that ran it already.
+
+    Requires ``a[0] > 0``.  Bernstein subdivision and Newton polishing.
+    """
     # Bernstein coefficients all positive => no root (convex hull property).
     b = work[0]
     to_bernstein(a, n, b)
