@@ -26,6 +26,10 @@ import numpy as np
 from grazing.engine.compile import DEFAULT_ORDER, SymbolicSystem, generate_source, kernel_key, load_kernels
 from grazing.errors import InvalidParameterError, InvalidStateError
 
+ON_STOP_TOL = 1e-9
+"""A state whose guard is above ``-ON_STOP_TOL * max(1, |x|)`` counts as on the stop, not beyond
+it (a state sampled while sticking, or an impact state, is on the stop only to rounding)."""
+
 
 @dataclass(frozen=True)
 class Parameter:
@@ -100,7 +104,7 @@ class _Definition:
         name: str,
         parameters: Sequence[Parameter],
         state_names: Sequence[str],
-        period: str,
+        period: Any,
         periodic: bool,
         state_labels: Sequence[str] | None,
         description: str,
@@ -115,7 +119,8 @@ class _Definition:
             raise ValueError("parameter names must be unique")
         self.state_names = tuple(state_names)
         self.state_labels = tuple(state_labels) if state_labels else self.state_names
-        self.period_str = period
+        self.period_expr = period
+        self.period_str = str(period)
         self.periodic = periodic
         self.description = description
         self.reference = reference
@@ -124,13 +129,16 @@ class _Definition:
         self._system: SymbolicSystem | None = None
         self._kernels: dict[tuple[tuple[str, ...], int], ModuleType] = {}
         self._numeric: dict[str, Callable[..., Any]] = {}
-        try:
-            code = compile(f"lambda {', '.join(pnames) or '_'}: {period}", "<period>", "eval")
-            self._period_fn = eval(code, {**vars(math), "__builtins__": {}})  # the period's expression text
-        except SyntaxError:
-            raise ValueError(f"cannot evaluate the period expression {period!r}") from None
         if symbolic is not None:
             self.system  # noqa: B018 - validate user models at construction
+            self._period_fn = _compiled_period(self.system)
+        else:
+            # Built-in (lazy) models give the period as text in their parameter names.
+            try:
+                code = compile(f"lambda {', '.join(pnames) or '_'}: {period}", "<period>", "eval")
+                self._period_fn = eval(code, {**vars(math), "__builtins__": {}})  # the period's text
+            except SyntaxError:
+                raise ValueError(f"cannot evaluate the period expression {period!r}") from None
 
     @property
     def system(self) -> SymbolicSystem:
@@ -141,15 +149,28 @@ class _Definition:
             pieces = self._symbolic if self._symbolic is not None else self._builder()  # type: ignore[misc]
             psyms = tuple(sp.Symbol(p.name) for p in self.parameters)
             states, time = tuple(pieces["states"]), pieces["time"]
+            names = [str(x) for x in states] + [str(time)] + [p.name for p in self.parameters]
+            clash = sorted({nm for nm in names if names.count(nm) > 1})
+            if clash:
+                raise ValueError(
+                    f"the names of states, time and parameters must differ; used twice: {', '.join(clash)}"
+                )
+            local = {str(sym): sym for sym in (*states, time, *psyms)}
+
+            def expr(e: Any) -> Any:
+                # Text is read with the model's own names (a state called "E" or "pi" is that state).
+                return sp.sympify(e, locals=local) if isinstance(e, str) else sp.sympify(e)
+
             cd = pieces.get("contact_direction")
             system = SymbolicSystem(
                 states=states,
                 time=time,
                 params=psyms,
-                vector_field=tuple(sp.sympify(e) for e in pieces["vector_field"]),
-                guard=sp.sympify(pieces["guard"]),
-                reset=tuple(sp.sympify(e) for e in pieces["reset"]),
-                contact_direction=None if cd is None else tuple(sp.sympify(e) for e in cd),
+                vector_field=tuple(expr(e) for e in pieces["vector_field"]),
+                guard=expr(pieces["guard"]),
+                reset=tuple(expr(e) for e in pieces["reset"]),
+                contact_direction=None if cd is None else tuple(expr(e) for e in cd),
+                period=expr(self.period_expr),
             )
             n = len(states)
             if len(system.vector_field) != n or len(system.reset) != n:
@@ -161,8 +182,7 @@ class _Definition:
                 extra = e.free_symbols - allowed
                 if extra:
                     raise ValueError(f"unknown symbols {sorted(map(str, extra))} in {e}")
-            period_syms = sp.sympify(self.period_str).free_symbols
-            if period_syms - set(psyms):
+            if system.period.free_symbols - set(psyms):
                 raise ValueError("the period may depend on parameters only")
             self._system = system
         return self._system
@@ -175,15 +195,15 @@ class _Definition:
             source = inspect.getsource(self._builder)
         else:
             source = _srepr(sorted((self._symbolic or {}).items()))
-        return repr((self.name, [p.name for p in self.parameters], self.period_str, self.periodic, source))
+        period = _srepr(self.period_expr)
+        return repr((self.name, [p.name for p in self.parameters], period, self.periodic, source))
 
     def kernels(self, sensitivities: tuple[str, ...] = (), order: int = DEFAULT_ORDER) -> ModuleType:
         if (sensitivities, order) not in self._kernels:
 
             def source() -> str:
-                import sympy as sp
-
-                return generate_source(self.system, [sp.Symbol(s) for s in sensitivities], order)
+                names = [p.name for p in self.parameters]
+                return generate_source(self.system, [names.index(s) for s in sensitivities], order)
 
             key = kernel_key(self._identity(), sensitivities, order)
             self._kernels[sensitivities, order] = load_kernels(key, source)
@@ -195,7 +215,7 @@ class _Definition:
         if fn is None:
             import sympy as sp
 
-            s = self.system
+            s = self.system.canonical()  # no user name can collide with numpy's or Python's
             x = sp.Matrix(s.states)
             exprs = {
                 "f": lambda: sp.Matrix(s.vector_field),
@@ -213,13 +233,33 @@ class _Definition:
                 "rate_p": lambda: sp.Matrix([s.normal_rate]).jacobian(sp.Matrix(s.params)),
                 "accel": lambda: s.normal_accel,
             }
-            fn = sp.lambdify((list(s.states), s.time, list(s.params)), exprs[what](), modules="numpy")
+            fn = sp.lambdify(
+                (list(s.states), s.time, list(s.params)), exprs[what](), modules="numpy", dummify=True
+            )
             self._numeric[what] = fn
         return fn
 
     def period(self, values: Sequence[float]) -> float:
         """The forcing period for the parameter values ``values``."""
         return float(self._period_fn(*values))
+
+
+def _compiled_period(system: SymbolicSystem) -> Callable[..., float]:
+    """A plain-Python function of the parameter values for the symbolic period.
+
+    The expression is printed with the parameters renamed ``_p[i]`` and every
+    function qualified by its module, so no parameter name can shadow ``pi``,
+    ``e`` or a function.
+    """
+    from sympy.printing.pycode import PythonCodePrinter
+
+    class _Printer(PythonCodePrinter):
+        def _print_Symbol(self, sym: Any) -> str:  # noqa: N802 - sympy printer protocol
+            return f"_p[{system.params.index(sym)}]"
+
+    text = _Printer({"fully_qualified_modules": True, "standard": "python3"}).doprint(system.period)
+    fn = eval(compile(f"lambda *_p: {text}", "<period>", "eval"), {"math": math, "__builtins__": {}})
+    return fn  # type: ignore[no-any-return]
 
 
 def _srepr(obj: Any) -> str:
@@ -327,7 +367,7 @@ class HybridModel:
                 "name": name,
                 "parameters": tuple(parameters),
                 "state_names": tuple(str(x) for x in states),
-                "period": str(period),
+                "period": period,
                 "periodic": periodic,
                 "state_labels": None if state_labels is None else tuple(state_labels),
                 "description": description,
@@ -500,6 +540,10 @@ class HybridModel:
         self.kernels().reset(np.asarray(x, dtype=float), float(t), self.param_vector, out)
         return out
 
+    def normal_accel(self, x: Any, t: float = 0.0) -> float:
+        """``L_f^2 h`` at ``(x, t)``: the guard's acceleration along the flow (compiled)."""
+        return float(self.kernels().normal_accel(np.asarray(x, dtype=float), float(t), self.param_vector))
+
     def jacobians(self, x: Any, t: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(f_x, h_x, g_x)`` at ``(x, t)``."""
         n = self.n_states
@@ -545,7 +589,8 @@ class HybridModel:
     def check_state(self, x: Any, t: float = 0.0, allowed: bool = True) -> np.ndarray:
         """Return ``x`` as a float array, or raise if it is not a valid state.
 
-        With ``allowed`` (the default) the state must also satisfy the guard.
+        With ``allowed`` (the default) the state must also satisfy the guard (to
+        :data:`ON_STOP_TOL`: a state on the stop to rounding is allowed).
         """
         arr = np.asarray(x, dtype=float).reshape(-1)
         if arr.shape != (self.n_states,):
@@ -555,7 +600,7 @@ class HybridModel:
         if not np.all(np.isfinite(arr)):
             raise InvalidStateError(f"state must be finite, got {arr.tolist()}")
         hv = self.guard(arr, t) if allowed else 0.0
-        if hv < 0:
+        if hv < -ON_STOP_TOL * max(1.0, float(np.max(np.abs(arr)))):
             raise InvalidStateError(
                 f"initial state {arr.tolist()} is beyond the stop (guard h = {hv:.3g} < 0)"
             )

@@ -72,6 +72,11 @@ class Solution:
     guard_min
         ``(h_min, t, x)``: the smallest value of the guard over the sampled
         span, if requested (``theta_hat - max theta`` for the pendulum).
+    approach_min
+        ``(h, t, x)``: the closest approach to the stop in free flight (the
+        smallest local minimum of the guard, away from impacts and sticking),
+        if requested and there is one.  For an impacting orbit it says how
+        near the orbit is to gaining an impact.
     n_steps
         Number of Taylor steps taken.
     """
@@ -91,6 +96,7 @@ class Solution:
     jacobian_valid: bool = True
     lyapunov: np.ndarray | None = None
     guard_min: tuple[float, float, np.ndarray] | None = None
+    approach_min: tuple[float, float, np.ndarray] | None = None
     info: dict[str, Any] = field(default_factory=dict)
 
     def period(self, tol: float = DEFAULT_PERIOD_TOL, max_period: int = DEFAULT_MAX_PERIOD) -> int:

@@ -72,6 +72,22 @@ def _saltation(xm, xp, s, pv, V, ncol):
 
 
 @njit(cache=True)
+def _shift_period(x, s, pv, Tp, ncol, f):
+    """Parameter columns of V at a period boundary: ``V_p += f(x, s) dT/dp``.
+
+    Time is kept as ``k T + s``; the variational equations give derivatives at
+    fixed ``(k, s)``.  Relabelling ``(k, s)`` as ``(k + 1, s - T)`` keeps the
+    time only at the current parameter values: where ``T`` depends on a
+    parameter the two labels are different instants, ``dT/dp`` apart per
+    period, and the state moves by ``f dT/dp`` between them.
+    """
+    rhs(x, s, pv, f)
+    for i in range(NX):
+        for c in range(NSENS):
+            x[NX + i * ncol + NX + c] += f[i] * Tp[c]
+
+
+@njit(cache=True)
 def _enter_contact(x, s, pv):
     """Project x onto the contact manifold {h = 0, L_f h = 0}."""
     n = NX
@@ -130,6 +146,9 @@ def integrate(
     zdm_a,
     zdm_e,
     zdm_window,
+    Tp,
+    touch_start,
+    touch_end,
 ):
     """Integrate until the ``n_samples``-th stroboscopic sample.
 
@@ -147,6 +166,22 @@ def integrate(
     ``delta = v^2 / (2 a) - h`` (how far the local parabola would reach past the
     stop, ``a = zdm_a = L_f^2 h`` at the grazing point), if ``delta > 0`` and
     ``|v| / a < zdm_window``: ``x <- x - zdm_e * sqrt(2 a delta)``.
+
+    ``Tp`` holds ``dT/dp`` for the sensitivity parameters: the parameter
+    columns of the variational matrix are derivatives at fixed ``(k, s)``, the
+    instant ``k T(p) + s`` (see :func:`_shift_period`).
+
+    ``touch_start`` / ``touch_end``: the run starts / ends in tangential contact
+    with the stop (a grazing point: ``h = 0``, ``L_f h = 0``); that double root
+    of the guard is divided out of the event polynomial of the first / last
+    step, so the contact is not taken for an impact.
+
+    With ``track_min`` the recorded span's smallest guard value is returned
+    (``min_info[:2 + n]``: value, time, state) and so is its closest approach
+    *away from contacts* (``min_info[2 + n:]``): the smallest local minimum of
+    the guard in free flight, where ``L_f h`` changes sign from negative to
+    positive.  An impacting orbit touches the stop (its guard minimum is 0);
+    its closest approach tells how near it is to gaining an impact.
     """
     n = NX
     order = ORDER
@@ -176,12 +211,16 @@ def integrate(
     traj = new_table(64 if traj_dt > 0.0 else 1, 1 + n)
     logs = np.zeros(n)
     scratch = np.zeros(n)
-    min_info = np.full(2 + n, math.inf)
+    min_info = np.full(2 * (2 + n), math.inf)
+    slope_end = math.nan  # d guard / dt at the end of the previous free-flight step
+    slope_first = math.nan  # ... at the start of the first recorded one
+    fbuf = np.empty(n)
+    shift_sens = use_var and NSENS > 0 and wrap
 
     k = k0
     s = s0
     mode = mode0
-    defl = 0
+    defl = 2 if touch_start else 0
     isamp = 0
     keep_from = n_samples - n_keep
     recording = keep_from == 0
@@ -208,6 +247,9 @@ def integrate(
         while wrap and st >= T:
             st -= T
             kt += 1
+    if recording and mode == 1:  # the recorded span starts while sticking
+        append_pair(sticks, n_stick, k * T + s, math.nan)
+        n_stick += 1
 
     while True:
         if nsteps >= max_steps:
@@ -257,16 +299,19 @@ def integrate(
         if d > 0:  # divide by u^d (a fresh reset or release: the root at u = 0 is known)
             for j in range(order + 1 - d):
                 a[j] = a[j + d]
+        deg = order - d
+        if touch_end and is_last and mode == 0:
+            deg = divide_double_root_at_one(a, deg)  # the final tangential contact at u = 1
         u = -1.0
         if events or mode == 1:
             # first_root, with its certificate on scalars (no array call): most steps stop here.
             tail = 0.0
-            for j in range(3, order - d + 1):
+            for j in range(3, deg + 1):
                 tail += abs(a[j])
             if a[0] <= 0.0:
                 u = 0.0
             elif quadratic_bound(a[0], a[1], a[2], tail) <= 0.0:
-                u = isolate_first_root(a, order - d, work)
+                u = isolate_first_root(a, deg, work)
         event = u >= 0.0 and h > 0.0
         if event and u == 0.0:
             zero_events += 1
@@ -297,6 +342,9 @@ def integrate(
                 ss += T
             if isamp == keep_from and not recording and n_keep > 0:
                 recording = True
+                if mode == 1:  # recording starts while sticking: the interval starts here
+                    append_pair(sticks, n_stick, k * T + s + dt, math.nan)
+                    n_stick += 1
                 if traj_dt > 0.0:
                     eval_rows(X, n, order, dt, xe)
                     append_row(traj, n_traj, k * T + s + dt, xe, n)
@@ -329,8 +377,16 @@ def integrate(
                 min_info[0] = gm[0]
                 min_info[1] = k * T + s
                 set_slice(min_info, 2, x, n)
+            if defl == 0:  # not leaving a contact
+                if math.isnan(slope_first):
+                    slope_first = gm[1] / h
+                elif slope_end < 0.0 <= gm[1] and gm[0] < min_info[2 + n]:
+                    min_info[2 + n] = gm[0]  # a local minimum exactly at the step boundary
+                    min_info[3 + n] = k * T + s
+                    set_slice(min_info, 4 + n, x, n)
             uend = h_acc / h
-            if gm[1] < 0.0 and poly_derivative(gm, order, uend) > 0.0:
+            slope_end = poly_derivative(gm, order, uend) / h
+            if gm[1] < 0.0 and slope_end > 0.0:
                 lo = 0.0
                 hi = uend
                 for _ in range(80):
@@ -341,11 +397,15 @@ def integrate(
                         hi = mid
                 um = 0.5 * (lo + hi)
                 gv = horner(gm, order, um)
-                if gv < min_info[0]:
+                if gv < min_info[0] or gv < min_info[2 + n]:
                     eval_rows(X, n, order, um * h, xe)
-                    min_info[0] = gv
-                    min_info[1] = k * T + s + um * h
-                    set_slice(min_info, 2, xe, n)
+                for base in (0, 2 + n):
+                    if gv < min_info[base]:
+                        min_info[base] = gv
+                        min_info[base + 1] = k * T + s + um * h
+                        set_slice(min_info, base + 2, xe, n)
+            if event:
+                slope_end = math.nan  # an impact or a release follows: no free-flight minimum here
 
         # Advance to the end of the accepted part of the step.
         eval_rows(X, nrows, order, h_acc, xe)
@@ -353,6 +413,8 @@ def integrate(
             x[i] = xe[i]
         s += h_acc
         if wrap and s >= T:
+            if shift_sens and mode == 0:
+                _shift_period(x, s, pv, Tp, ncol, fbuf)
             s -= T
             k += 1
         nsteps += 1
@@ -432,7 +494,7 @@ def integrate(
                                 stick = dt_acc < chatter_time
                         if stick:
                             s += dt_acc
-                            if wrap and s >= T:
+                            if wrap and s >= T:  # (the Jacobian is not valid after sticking)
                                 s -= T
                                 k += 1
                             _enter_contact(x, s, pv)
@@ -457,6 +519,11 @@ def integrate(
             min_info[0] = g_end
             min_info[1] = k * T + s
             set_slice(min_info, 2, x, n)
+        # A run over whole periods of an orbit ends where it started: a minimum there.
+        if slope_end < 0.0 <= slope_first and g_end < min_info[2 + n]:
+            min_info[2 + n] = g_end
+            min_info[3 + n] = k * T + s
+            set_slice(min_info, 4 + n, x, n)
     if n_stick > 0 and math.isnan(sticks[0][n_stick - 1, 1]):
         sticks[0][n_stick - 1, 1] = k * T + s
     lyap_span = k * T + s - lyap_t0 if (lyap and lyap_started) else 0.0

@@ -33,7 +33,7 @@ if TYPE_CHECKING:  # pragma: no cover
 
 _TEMPLATE = Path(__file__).with_name("_driver_template.py")
 # Bump when the generated code changes meaning without its text changing.
-_CODEGEN_VERSION = "1"
+_CODEGEN_VERSION = "2"
 
 
 def taylor_order(tol: float) -> int:
@@ -80,6 +80,37 @@ class SymbolicSystem:
     guard: sp.Expr
     reset: tuple[sp.Expr, ...]
     contact_direction: tuple[sp.Expr, ...] | None = None
+    period: sp.Expr | None = None
+
+    def canonical(self) -> SymbolicSystem:
+        """The same system with every user symbol replaced by a fresh :class:`sympy.Dummy`.
+
+        The code generator creates symbols of its own (the variational matrix,
+        common subexpressions); working on the canonical system guarantees that
+        no name a user chooses for a state, parameter or time (``v1``, ``t_0``,
+        ``pi``, ``sin`` ...) can be the same sympy object as one of those.
+        """
+        import sympy as sp
+
+        sub = {x: sp.Dummy(f"x{i}") for i, x in enumerate(self.states)}
+        sub[self.time] = sp.Dummy("t")
+        sub.update({p: sp.Dummy(f"p{i}") for i, p in enumerate(self.params)})
+
+        def tr(e: sp.Expr) -> sp.Expr:
+            return sp.sympify(e).xreplace(sub)
+
+        return SymbolicSystem(
+            states=tuple(sub[x] for x in self.states),
+            time=sub[self.time],
+            params=tuple(sub[p] for p in self.params),
+            vector_field=tuple(tr(e) for e in self.vector_field),
+            guard=tr(self.guard),
+            reset=tuple(tr(e) for e in self.reset),
+            contact_direction=(
+                None if self.contact_direction is None else tuple(map(tr, self.contact_direction))
+            ),
+            period=None if self.period is None else tr(self.period),
+        )
 
     def gradient(self, expr: sp.Expr) -> list[sp.Expr]:
         import sympy as sp
@@ -150,13 +181,19 @@ def _scalar_function(
 
 
 def generate_source(
-    sys_: SymbolicSystem, sensitivities: Sequence[sp.Symbol] = (), order: int = DEFAULT_ORDER
+    system: SymbolicSystem, sensitivities: Sequence[int] = (), order: int = DEFAULT_ORDER
 ) -> str:
-    """Full source of the kernel module for ``sys_`` with Taylor polynomials of degree ``order``."""
+    """Full source of the kernel module for ``system`` with Taylor polynomials of degree ``order``.
+
+    ``sensitivities`` are indices into ``system.params``: the parameters whose
+    derivatives are integrated as extra columns of the variational matrix.
+    """
     import sympy as sp
 
     from grazing.engine.taylor import taylor_kernel
 
+    sys_ = system.canonical()
+    sensitivities = [sys_.params[i] for i in sensitivities]
     n = len(sys_.states)
     m = len(sensitivities)
     ncol = n + m
@@ -167,9 +204,9 @@ def generate_source(
         "import numpy as np",
         "from numba import njit",
         "from grazing.engine.polyroots import horner, isolate_first_root, quadratic_bound",
-        "from grazing.engine.stepping import (append_pair, append_record, append_row, eval_rows,"
-        " new_table, orthonormalize, pack_var, poly_derivative, set_row, set_slice, step_factor, step_size,"
-        " table_rows, unpack_var)",
+        "from grazing.engine.stepping import (append_pair, append_record, append_row,"
+        " divide_double_root_at_one, eval_rows, new_table, orthonormalize, pack_var, poly_derivative,"
+        " set_row, set_slice, step_factor, step_size, table_rows, unpack_var)",
         f"NX = {n}",
         f"NSENS = {m}",
         f"ORDER = {order}",
@@ -177,7 +214,7 @@ def generate_source(
     ]
     free = taylor_kernel("tc_free", sys_.states, sys_.time, sys_.params, f, [sys_.guard], order)
     # Variational equations: V' = f_x V (+ f_p on the parameter columns).
-    vsyms = sp.symbols(f"v0:{n * ncol}")
+    vsyms = tuple(sp.Dummy(f"v{i}") for i in range(n * ncol))
     vmat = sp.Matrix(n, ncol, vsyms)
     jac = sp.Matrix([[sp.diff(fi, x) for x in sys_.states] for fi in f])
     vrhs = jac * vmat
@@ -254,6 +291,14 @@ def generate_source(
     parts.append(
         _scalar_function("contact_dir", sys_, [(f"e[{i}]", ei) for i, ei in enumerate(e)], extra_args=", e")
     )
+    # dT/dp for every parameter: a sample "one period later" moves when the period does.
+    period = sp.Integer(0) if sys_.period is None else sys_.period
+    parts.append(
+        _scalar_function(
+            "period_grad", sys_, [(f"tp[{i}]", sp.diff(period, p)) for i, p in enumerate(sys_.params)],
+            extra_args=", tp",
+        )
+    )  # fmt: skip
     parts.append(_TEMPLATE.read_text())
     return "\n\n".join(parts)
 

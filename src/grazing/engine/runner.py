@@ -64,6 +64,7 @@ class Segment:
     log_sums: np.ndarray
     lyap_span: float
     guard_min: np.ndarray  # [h_min, t, state...]
+    approach_min: np.ndarray  # [h, t, state...] at the closest approach away from contacts
     jacobian_valid: bool
     steps: int
 
@@ -114,6 +115,13 @@ class Runner:
         Apply impacts (False: the flow passes through the stop).
     chatter_tol
         Chattering summation threshold, as a fraction of the period.
+    zdm
+        Apply a discontinuity map once per period instead of the impacts.
+    touching
+        The trajectory starts at a grazing contact with the stop (a grazing
+        orbit from its contact point): that tangential contact is not an
+        impact.  Set :attr:`touch_end` before the call of :meth:`advance` that
+        ends at a contact.
     """
 
     def __init__(
@@ -129,9 +137,12 @@ class Runner:
         events: bool = True,
         chatter_tol: float = 1e-9,
         zdm: DiscontinuityMap | None = None,
+        touching: bool = False,
     ):
         self.model = model
         self.zdm = zdm
+        self.touch_start = touching
+        self.touch_end = False  # set by the caller for the call that ends at a contact
         if zdm is not None:
             events = False
         n = model.n_states
@@ -143,8 +154,10 @@ class Runner:
         self.T = model.period
         self.order = taylor_order(tol)
         self.safety = step_safety(tol, self.order)
-        self.kern = model.kernels(tuple(sensitivities) if variational else (), self.order)
+        self.sensitivities = tuple(sensitivities) if variational else ()
+        self.kern = model.kernels(self.sensitivities, self.order)
         self.pv = model.param_vector
+        self.Tp = self.period_gradient()
         self.chatter_time = chatter_tol * self.T
         T = self.T
         snap = 1e-9 * T
@@ -152,12 +165,14 @@ class Runner:
         self.mode = 0
         if not model.periodic:
             self.k, self.s, self.ks, self.ss = 0, float(t0), 0, float(t0) + T
+            self.k_start = 0
             return
         k0 = math.floor(t0 / T)
         s0 = t0 - k0 * T
         if s0 >= T - snap:  # just below a period boundary: keep s0 slightly negative
             k0, s0 = k0 + 1, s0 - T
         self.k, self.s = k0, s0
+        self.k_start = k0
         self.ks = k0 if s0 < s_phase - snap else k0 + 1
         self.ss = s_phase
 
@@ -174,6 +189,20 @@ class Runner:
         """Continue with other parameter values of the same model (same period)."""
         self.model = model
         self.pv = model.param_vector
+        self.Tp = self.period_gradient()
+
+    def vector_field(self, x: np.ndarray, s: float) -> np.ndarray:
+        """``f(x, s)`` with the kernels this runner already loaded."""
+        out = np.empty(self.model.n_states)
+        self.kern.rhs(np.asarray(x, dtype=float), float(s), self.pv, out)
+        return out
+
+    def period_gradient(self) -> np.ndarray:
+        """``dT/dp`` for each sensitivity parameter (zero for parameters that do not set the period)."""
+        names = [p.name for p in self.model.parameters]
+        full = np.zeros(len(names))
+        self.kern.period_grad(self.x, 0.0, self.pv, full)
+        return np.array([full[names.index(p)] for p in self.sensitivities])
 
     def _zdm_args(self) -> tuple[Any, ...]:
         z = self.zdm
@@ -206,17 +235,21 @@ class Runner:
             self.x, self.V, self.k, self.s, self.mode, self.pv, T, self.model.periodic, T, self.safety,
             int(max_steps), periods, self.ks, self.ss, keep, self.variational, lyapunov,
             T / trajectory if trajectory else 0.0, guard_min, RECORD_IMPACTS[impacts], self.chatter_time,
-            self.events, *self._zdm_args(),
+            self.events, *self._zdm_args(), self.Tp, self.touch_start, self.touch_end,
         )  # fmt: skip
         (status, x, V, k, s, mode, nsteps, n_imp, smp, imp, sticks, traj, logs, lspan, gm, ok) = out
         if status != 0:
             raise SimulationError(failure_message(int(status), k * T + s, max_steps))
         self.x, self.V, self.k, self.s, self.mode = x, V, k, s, mode
+        self.touch_start = False  # only the first call starts at the contact
         if self.model.periodic:
             self.ks += periods
         else:
             self.ss += periods * T
-        return Segment(smp, imp, int(n_imp), sticks, traj, logs, float(lspan), gm, bool(ok), int(nsteps))
+        n = self.model.n_states
+        gmin, amin = gm[: 2 + n], gm[2 + n :]
+        lspan = float(lspan)
+        return Segment(smp, imp, int(n_imp), sticks, traj, logs, lspan, gmin, amin, bool(ok), int(nsteps))
 
 
 def failure_message(status: int, t: float, max_steps: int) -> str:

@@ -54,6 +54,7 @@ def simulate(
     progress: Callable[[int, int], None] | None = None,
     events: bool = True,
     zdm: DiscontinuityMap | None = None,
+    touching: bool = False,
 ) -> Solution:
     """Simulate a hybrid model, never missing an impact.
 
@@ -89,7 +90,9 @@ def simulate(
         Compute the Lyapunov exponents over the sampled span (tangent dynamics
         with saltation matrices at impacts).
     guard_min
-        Track the smallest value of the guard over the sampled span.
+        Track the smallest value of the guard over the sampled span, and the
+        closest approach to the stop away from contacts
+        (:attr:`Solution.approach_min`).
     impacts
         Which impacts to record: ``"sampled"`` span (default), ``"all"``, ``"none"``.
     tol
@@ -106,6 +109,10 @@ def simulate(
         A :class:`~grazing.engine.runner.DiscontinuityMap`: ignore the stop and
         apply Nordmark's discontinuity map once per period at the grazing
         phase instead (the map Pi of the paper's eq. 20, with the nonlinear flow).
+    touching
+        The run starts and ends in tangential contact with the stop (``h = 0``
+        and ``L_f h = 0``: a grazing orbit followed from its contact point);
+        these two contacts are not impacts, every other one is.
     progress
         Called as ``progress(periods_done, periods_total)`` after every chunk
         of :data:`CHUNK_PERIODS` periods (the run is always chunked the same
@@ -146,9 +153,10 @@ def simulate(
     T = model.period
     run = Runner(
         model, x, t0=float(t0), phase=float(phase), tol=tol, variational=use_var,
-        sensitivities=sens, events=events, chatter_tol=chatter_tol, zdm=zdm,
+        sensitivities=sens, events=events, chatter_tol=chatter_tol, zdm=zdm, touching=touching,
     )  # fmt: skip
     first_sample = run.next_sample_time
+    ks_start = run.ks
     total = transient + periods
     if max_steps is None:
         max_steps = 20000 * total + 100_000
@@ -159,10 +167,12 @@ def simulate(
     log_sum = np.zeros(n)
     lyap_span = 0.0
     gmin: np.ndarray | None = None
+    amin: np.ndarray | None = None
     jac_ok = True
     while done < total:
         chunk = min(CHUNK_PERIODS, total - done)
         keep = max(0, done + chunk - transient) - max(0, done - transient)
+        run.touch_end = touching and done + chunk == total
         seg = run.advance(
             chunk, keep, lyapunov=lyapunov, guard_min=guard_min, impacts=impacts,
             trajectory=trajectory, max_steps=max_steps - steps,
@@ -184,10 +194,15 @@ def simulate(
         lyap_span += seg.lyap_span
         if guard_min and keep and (gmin is None or seg.guard_min[0] < gmin[0]):
             gmin = seg.guard_min
+        if guard_min and keep and (amin is None or seg.approach_min[0] < amin[0]):
+            amin = seg.approach_min
         done += chunk
         if progress is not None:
             progress(done, total)
     t_samples = first_sample + (transient + np.arange(periods)) * T
+    jac = run.V if (use_var and not lyapunov) else None
+    if jac is not None and sens and np.any(run.Tp):
+        jac = _sample_time_terms(run, x, float(t0), ks_start + total - 1, float(t_samples[-1]), jac)
     imp = _concat(parts["imp"], 2 + n)
     traj = _concat(parts["traj"], 1 + n)
     imp_t = imp[:, 0]
@@ -203,12 +218,52 @@ def simulate(
         n_steps=int(steps),
         trajectory_t=traj[:, 0] if trajectory else None,
         trajectory=traj[:, 1:] if trajectory else None,
-        jacobian=run.V if (use_var and not lyapunov) else None,
+        jacobian=jac,
         jacobian_valid=jac_ok,
         lyapunov=log_sum / lyap_span if lyapunov else None,
         guard_min=(float(gmin[0]), float(gmin[1]), gmin[2:].copy()) if gmin is not None else None,
-        info={"order": run.order, "tol": tol, "transient": transient, "phase": phase},
+        approach_min=(float(amin[0]), float(amin[1]), amin[2:].copy()) if _found(amin) else None,
+        info={
+            "order": run.order,
+            "tol": tol,
+            "transient": transient,
+            "phase": phase,
+            "period_gradient": dict(zip(sens, run.Tp.tolist())),
+        },
     )
+
+
+def _sample_time_terms(
+    run: Runner, x0: np.ndarray, t0: float, k_final: int, t_final: float, V: np.ndarray
+) -> np.ndarray:
+    """Parameter columns of ``V`` for samples whose time moves with a period-setting parameter.
+
+    The engine's columns are derivatives at fixed ``(k, s)``: the run from the
+    instant ``k0 T(p) + s0`` to ``k T(p) + s`` (:func:`~grazing.engine.runner`).
+    ``simulate`` promises the derivative of the final sample with ``t0`` fixed
+    and the sample at the same forcing phase after the same number of periods,
+    ``t_final(p) = (k_final + s_phase/T) T(p)``.  The start then does not move
+    (``+ Psi_x f(x0, t0) k0 dT/dp``) and the end moves by
+    ``f(x_final) (t_final/T - k) dT/dp`` beyond the engine's end.  Without
+    wrapping (``periodic=False``) the engine's derivatives are at fixed times
+    and the samples are ``t0 + j T``.
+    """
+    n = run.model.n_states
+    T = run.T
+    V = V.copy()
+    f_end = run.vector_field(run.x, run.s)
+    if run.model.periodic:
+        end = (k_final - run.k) + run.ss / T
+        start = V[:, :n] @ run.vector_field(x0, t0) * run.k_start
+    else:
+        end = (t_final - t0) / T
+        start = np.zeros(n)
+    V[:, n:] += np.outer(f_end * end + start, run.Tp)
+    return V
+
+
+def _found(info: np.ndarray | None) -> bool:
+    return info is not None and bool(np.isfinite(info[0]))
 
 
 def _concat(arrays: list[np.ndarray], width: int) -> np.ndarray:

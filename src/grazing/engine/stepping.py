@@ -187,3 +187,25 @@ def orthonormalize(V, n, logs):
         if nrm > 0.0:
             for i in range(n):
                 V[i, c] /= nrm
+
+
+@njit(cache=True)
+def divide_double_root_at_one(a, deg):
+    """Divide the polynomial ``a[:deg + 1]`` by ``(u - 1)^2`` in place; return the new degree.
+
+    Used where a run ends in tangential contact with the stop: the guard has a
+    double root at the end of the last step, which is known and not an impact.
+    The remainder (rounding, or how far a Newton iterate is from the contact)
+    is dropped.
+    """
+    for _ in range(2):
+        if deg < 1:
+            return deg
+        acc = 0.0
+        for j in range(deg, 0, -1):
+            acc += a[j]
+            a[j] = acc  # the coefficient of u^(j-1) of the quotient
+        for j in range(deg):
+            a[j] = a[j + 1]
+        deg -= 1
+    return deg

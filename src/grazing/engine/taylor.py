@@ -91,7 +91,12 @@ class ScalarPrinter(PythonCodePrinter):
         self._names = names
 
     def _print_Symbol(self, expr):  # noqa: N802 - sympy printer protocol
-        return self._names.get(expr, super()._print_Symbol(expr))
+        if expr not in self._names:  # every symbol is named by the generator: never print a user's name
+            raise ValueError(f"internal error: no code name for the symbol {expr!r}")
+        return self._names[expr]
+
+    def _print_Dummy(self, expr):  # noqa: N802
+        return self._print_Symbol(expr)
 
     def _print_Rational(self, expr):  # noqa: N802
         return f"({float(expr.p)!r}/{float(expr.q)!r})"

@@ -41,7 +41,7 @@ import numpy as np
 
 from grazing.core.model import HybridModel
 from grazing.engine.runner import DiscontinuityMap
-from grazing.orbits.grazing import GrazingPoint
+from grazing.orbits.contact import GrazingPoint
 from grazing.orbits.shooting import flow_map
 
 

@@ -3,10 +3,24 @@
 Unknowns ``u = (x, p)``: a point of the orbit on the stroboscopic section and
 the parameter.  Equations ``F(u) = P^n(x; p) - x = 0`` with Jacobian
 ``[P_x - I, P_p]`` from the variational equations (saltation matrices at the
-impacts, parameter sensitivities as extra columns).  Each step predicts along
-the tangent (the null vector of the Jacobian) and corrects by Newton's method
-on ``F = 0`` plus the arclength condition (Keller 1977; Kuznetsov,
+impacts, parameter sensitivities as extra columns, the moving return time
+included for a parameter that sets the forcing period).  Each step predicts
+along the tangent (the null vector of the Jacobian) and corrects by Newton's
+method on ``F = 0`` plus the arclength condition (Keller 1977; Kuznetsov,
 *Elements of Applied Bifurcation Theory*, ch. 10).
+
+A branch is one orbit.  Every point carries its *impact signature* (impacts in
+each of the ``n`` forcing periods); a corrected point with another signature
+is another orbit, reached through a grazing (an impact speed, or the distance
+of a near approach to the stop, passing through zero).  The branch therefore
+ends at that grazing: it is bracketed along the step, located exactly by
+solving the grazing equations (:mod:`grazing.orbits.contact`, Newton
+tolerance) and reported as a special point, as COCO's hybrid toolbox does.
+With ``switch=True`` the continuation goes on, deliberately, along the orbit
+with the new impact sequence, as a new *segment* of the branch.  Steps are
+halved where the corrector lands far from the predictor, where the tangent
+turns sharply, and where stability changes between two points, so that no
+special point is stepped over.
 
 Special points are detected by sign changes of test functions between
 consecutive points and located by regula falsi along the secant:
@@ -16,12 +30,18 @@ consecutive points and located by regula falsi along the secant:
 * Neimark-Sacker: ``det(P_x) - 1`` with a complex pair (2-D maps; the
   bialternate-product test in general);
 * grazing: the minimum of the guard along a nonimpacting (virtual) orbit
-  reaches zero, or the number of impacts per period of an impacting orbit
-  changes (an impact velocity reaches zero).
+  reaches zero (then refined by the grazing equations), or the end of an
+  impacting branch described above.
+
+The stroboscopic map is not smooth where an impact falls on its section, so
+the section is chosen away from impacts (``t0=None``, the default) and moved
+when an impact comes within :data:`RESECTION_MARGIN` of a period of it; each
+point records its section time.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -32,11 +52,34 @@ import numpy as np
 
 from grazing.core.model import HybridModel
 from grazing.errors import ConvergenceError, GrazingError, InvalidParameterError
-from grazing.orbits.palc import Palc, PalcPoint, PalcSettings, locate, sign_changed
-from grazing.orbits.shooting import PeriodicOrbit, _orbit_from, find_orbit, flow_map
+from grazing.orbits.contact import GrazingPoint, refine_grazing
+from grazing.orbits.palc import (
+    ACCEPT,
+    BOUNDARY,
+    REFINE,
+    STOP,
+    Palc,
+    PalcPoint,
+    PalcSettings,
+    locate,
+    sign_changed,
+)
+from grazing.orbits.shooting import (
+    SECTION_MARGIN,
+    PeriodicOrbit,
+    _orbit_from,
+    find_orbit,
+    flow_map,
+    move_section,
+    quiet_section,
+)
 
 SPECIAL_KINDS = ("fold", "period-doubling", "neimark-sacker", "grazing")
 
+RESECTION_MARGIN = 0.01
+"""An impact closer than this fraction of a period to the section moves the section."""
+
+_RESECTION = "an impact approaches the section"
 
 ContinuationSettings = PalcSettings
 """Options of :func:`continue_orbit` (see :class:`~grazing.orbits.palc.PalcSettings`)."""
@@ -44,16 +87,36 @@ ContinuationSettings = PalcSettings
 
 @dataclass(frozen=True)
 class SpecialPoint:
-    """A located special point on a branch (between points ``index`` and ``index + 1``)."""
+    """A located special point on a branch (between points ``index`` and ``index + 1``).
+
+    Attributes
+    ----------
+    kind
+        One of :data:`SPECIAL_KINDS`.
+    index
+        The branch point just before it.
+    param
+        The parameter value where it occurs.
+    orbit
+        The periodic orbit there (for a grazing: the orbit where the branch
+        ends, next to the grazing).
+    grazing
+        For a grazing: the grazing orbit itself, solved from the grazing
+        equations (contact state and time, monodromy on the section through
+        the contact with the grazing contact not an impact); None if those
+        did not converge, in which case ``param`` is the end of the bracket.
+    """
 
     kind: str
     index: int
     param: float
     orbit: PeriodicOrbit
+    grazing: GrazingPoint | None = None
 
     @property
     def multipliers(self) -> np.ndarray:
-        return self.orbit.multipliers
+        """Floquet multipliers at the point (of the grazing orbit for a grazing)."""
+        return self.grazing.multipliers if self.grazing is not None else self.orbit.multipliers
 
 
 @dataclass
@@ -67,7 +130,11 @@ class Branch:
     values
         Parameter value at each point.
     orbits
-        The periodic orbit at each point (state, multipliers, impacts...).
+        The periodic orbit at each point (state on its section ``orbit.t0``,
+        multipliers, impacts...).
+    segments
+        Segment index of each point: 0, then one more after each deliberate
+        switch onto the orbit with a new impact sequence (``switch=True``).
     special
         Located special points, in order along the branch.
     status
@@ -81,6 +148,7 @@ class Branch:
     values: list[float] = field(default_factory=list)
     orbits: list[PeriodicOrbit] = field(default_factory=list)
     arclength: list[float] = field(default_factory=list)
+    segments: list[int] = field(default_factory=list)
     special: list[SpecialPoint] = field(default_factory=list)
     status: str = ""
 
@@ -99,6 +167,11 @@ class Branch:
     def guard_min(self) -> np.ndarray:
         return np.array([o.guard_min for o in self.orbits])
 
+    @property
+    def sections(self) -> np.ndarray:
+        """The section time of each point's orbit (see the module docstring)."""
+        return np.array([o.t0 for o in self.orbits])
+
     def to_dataset(self) -> Any:
         """The branch as an :class:`xarray.Dataset` (one ``point`` per orbit)."""
         import xarray as xr
@@ -110,6 +183,8 @@ class Branch:
         data = {
             "param": ("point", np.asarray(self.values)),
             "arclength": ("point", np.asarray(self.arclength)),
+            "segment": ("point", np.asarray(self.segments, dtype=np.int32)),
+            "section_time": ("point", self.sections),
             "state": (("point", "component"), self.states),
             "multiplier_re": (("point", "multiplier"), mu.real),
             "multiplier_im": (("point", "multiplier"), mu.imag),
@@ -166,6 +241,8 @@ def _evaluator(model: HybridModel, param: str, period: int, t0: float, virtual: 
         m = model.with_params(**{param: float(u[-1])})
         x = u[:-1]
         fm = flow_map(m, x, t0=t0, periods=period, sensitivities=[param], virtual=virtual)
+        if not fm.solution.jacobian_valid:
+            raise ConvergenceError("the orbit sticks to the stop: no Jacobian across sticking")
         F = fm.image - x
         orbit = _orbit_from(m, x, t0, period, fm, virtual, [float(np.max(np.abs(F)))])
         return F, np.hstack([fm.jacobian - eye, fm.sensitivity]), orbit
@@ -174,7 +251,7 @@ def _evaluator(model: HybridModel, param: str, period: int, t0: float, virtual: 
 
 
 def _test_function(kind: str, orbit: PeriodicOrbit) -> float:
-    """Test function of a special point; for impacting grazing, the impact count."""
+    """Test function of a special point (smooth along a branch of one impact signature)."""
     J = orbit.monodromy
     eye = np.eye(J.shape[0])
     if kind == "fold":
@@ -184,8 +261,8 @@ def _test_function(kind: str, orbit: PeriodicOrbit) -> float:
     if kind == "neimark-sacker":
         complex_pair = bool(np.any(np.abs(orbit.multipliers.imag) > 1e-12))
         return float(np.linalg.det(J) - 1.0) if complex_pair else math.nan
-    if kind == "grazing":
-        return orbit.guard_min if (orbit.virtual or orbit.impacts == 0) else float(orbit.impacts)
+    if kind == "grazing":  # (a physical branch ends at its grazings instead)
+        return orbit.guard_min if orbit.virtual else math.nan
     raise ValueError(f"unknown special point kind {kind!r}")
 
 
@@ -203,20 +280,75 @@ def _verified(kind: str, orbit: PeriodicOrbit) -> bool:
 
 
 def _detect(evaluate, kind: str, a: PalcPoint, b: PalcPoint, s: PalcSettings) -> PalcPoint | None:
-    oa, ob = a.payload, b.payload
-    if kind == "grazing" and not (oa.virtual or (oa.impacts == 0 and ob.impacts == 0)):
-        # Impacting orbits: an impact appears or disappears (its speed reaches 0).
-        if oa.impacts == ob.impacts:
-            return None
-        return locate(
-            evaluate, a, b, lambda p: 1.0 if p.payload.impacts == oa.impacts else -1.0, s, bisect=True
-        )
-    if kind != "grazing" and oa.impacts != ob.impacts:
-        return None  # the monodromy jumps at a grazing: smooth test functions do not apply
-    if not sign_changed(_test_function(kind, oa), _test_function(kind, ob)):
+    if not sign_changed(_test_function(kind, a.payload), _test_function(kind, b.payload)):
         return None
     loc = locate(evaluate, a, b, lambda p: _test_function(kind, p.payload), s)
     return loc if loc is not None and _verified(kind, loc.payload) else None
+
+
+def grazing_margin(orbit: PeriodicOrbit) -> tuple[float, np.ndarray | None, float, str]:
+    """How far ``orbit`` is from grazing, and where: ``(delta, contact guess, time, what)``.
+
+    ``delta`` is the smaller of the closest approach to the stop away from the
+    impacts (``h`` at a local minimum of the guard) and, over the impacts,
+    ``v^2 / (2 a)`` (how deep the local parabola of a low-velocity impact
+    reaches, ``v`` the impact speed and ``a = L_f^2 h``).  Both tend to zero
+    linearly in the parameter as the orbit approaches a grazing from its side.
+    """
+    best: tuple[float, np.ndarray | None, float, str] = (math.inf, None, math.nan, "")
+    if orbit.approach is not None:
+        best = (orbit.approach[0], orbit.approach[2], orbit.approach[1], "gains an impact")
+    if orbit.impact_states is not None:
+        for t, v, x in zip(orbit.impact_times, orbit.impact_speeds, orbit.impact_states):
+            a = abs(orbit.model.normal_accel(x, t))
+            delta = v * v / (2 * a) if a > 0 else math.inf
+            if delta < best[0]:
+                best = (delta, x, float(t), "loses an impact")
+    return best
+
+
+def _locate_grazing(
+    last: PeriodicOrbit, beyond: PeriodicOrbit | None, param: str, virtual: bool
+) -> GrazingPoint | None:
+    """The grazing orbit at the end of a branch, from its last orbit (Newton on the contact equations)."""
+    _, y, tg, _ = grazing_margin(last)
+    if y is None:
+        return None
+    try:
+        point = refine_grazing(last.model, y, tg, param, period=last.period, events=not virtual)
+    except GrazingError:
+        return None
+    # It must be the grazing between the two sides, not some other solution of the equations.
+    p, pg = last.model.params[param], point.model.params[param]
+    scale = max(1.0, abs(p))
+    if beyond is not None:
+        q = beyond.model.params[param]
+        ok = min(p, q) - 1e-8 * scale <= pg <= max(p, q) + 1e-8 * scale
+    else:
+        ok = abs(pg - p) <= 1e-4 * scale
+    return point if ok else None
+
+
+def _switch_orbit(
+    last: PeriodicOrbit, param: str, value: float, direction: float, virtual: bool
+) -> PeriodicOrbit | None:
+    """An orbit with another impact signature than ``last``, just past the grazing at ``value``."""
+    p = last.model.params[param]
+    par = next(q for q in last.model.parameters if q.name == param)
+    for sign in (direction, -direction):
+        for eps in (1e-7, 1e-6, 1e-5, 1e-4):
+            trial = value + sign * eps * max(1.0, abs(value))
+            try:
+                par.check(trial)
+                orbit = find_orbit(
+                    last.model.with_params(**{param: trial}), last.state, period=last.period, t0=last.t0,
+                    virtual=virtual,
+                )  # fmt: skip
+            except GrazingError:
+                continue
+            if orbit.signature != last.signature and abs(trial - p) > 0:
+                return orbit
+    return None
 
 
 def continue_orbit(
@@ -228,10 +360,11 @@ def continue_orbit(
     orbit: PeriodicOrbit | None = None,
     x0: np.ndarray | None = None,
     period: int | None = None,
-    t0: float = 0.0,
+    t0: float | None = None,
     virtual: bool | None = None,
     settings: PalcSettings | None = None,
     detect: tuple[str, ...] = SPECIAL_KINDS,
+    switch: bool = False,
     progress: Callable[[int, float], None] | None = None,
 ) -> Branch:
     """Follow a periodic orbit as ``param`` goes from ``start`` towards ``stop``.
@@ -245,9 +378,12 @@ def continue_orbit(
     start, stop
         The branch starts at ``param = start`` and ends when it reaches
         ``stop`` (it may turn back at folds before; the continuation follows
-        the curve through them).
+        the curve through them).  Both must lie in the parameter's interval.
     orbit, x0, period
         Starting orbit, or a guess for it (see :func:`find_orbit`).
+    t0
+        Section time for the starting orbit's guess ``x0``; ``None`` (default):
+        0, moved away from impacts as described in the module docstring.
     virtual
         Ignore the stop (default: True when the starting orbit has no
         impacts, so nonimpacting orbits are followed through grazing, which is
@@ -256,6 +392,9 @@ def continue_orbit(
         Step control (:class:`~grazing.orbits.palc.PalcSettings`).
     detect
         Special points to detect and locate (any of ``SPECIAL_KINDS``).
+    switch
+        At a grazing where the impact sequence changes, continue onto the orbit
+        with the new sequence (a new segment of the branch) instead of ending.
     progress
         Called as ``progress(points, param_value)`` after each point.
 
@@ -270,8 +409,8 @@ def continue_orbit(
     >>> br = continue_orbit(m, "eta", 0.40, 0.47)
     >>> [s.kind for s in br.special]
     ['grazing']
-    >>> round(br.special[0].param, 4)
-    0.4451
+    >>> round(br.special[0].param, 6)
+    0.445121
     """
     s = settings or PalcSettings()
     for kind in detect:
@@ -285,49 +424,136 @@ def continue_orbit(
     if start == stop:
         raise InvalidParameterError("start and stop must differ")
     m0 = model.with_params(**{param: start})
+    model.with_params(**{param: stop})  # the end of the range must be a valid value too
     if orbit is None:
         if virtual is None:
-            probe = find_orbit(m0, x0, period=period, t0=t0)
+            probe = find_orbit(m0, x0, period=period, t0=0.0 if t0 is None else t0)
             virtual = probe.impacts == 0
             orbit = (
                 probe
                 if not virtual
-                else find_orbit(m0, probe.state, period=probe.period, t0=t0, virtual=True)
+                else find_orbit(m0, probe.state, period=probe.period, t0=probe.t0, virtual=True)
             )
         else:
-            orbit = find_orbit(m0, x0, period=period, t0=t0, virtual=virtual)
+            orbit = find_orbit(m0, x0, period=period, t0=0.0 if t0 is None else t0, virtual=virtual)
+        if t0 is None and orbit.section_clearance() < SECTION_MARGIN:
+            orbit = move_section(orbit, quiet_section(orbit))
     elif virtual is None:
         virtual = orbit.virtual
+    virtual = bool(virtual)
     n = orbit.period
-    evaluate = _evaluator(model, param, n, t0, bool(virtual))
-    branch = Branch(model=model, param=param, period=n, virtual=bool(virtual))
-    try:
-        F, DF, orb = evaluate(np.append(orbit.state, start))
-    except GrazingError as exc:
-        raise ConvergenceError(f"cannot start the continuation: {exc}") from None
-    first = PalcPoint(np.append(orbit.state, start), F, DF, orb)
-    palc = Palc(
-        evaluate,
-        first,
-        index=model.n_states,
-        sign=math.copysign(1.0, stop - start),
-        bounds={model.n_states: (min(start, stop), max(start, stop))},
-        settings=s,
-    )
+    nx = model.n_states
+    branch = Branch(model=model, param=param, period=n, virtual=virtual)
+    bounds = {nx: (min(start, stop), max(start, stop))}
+
+    def check(prev: PalcPoint, cand: PalcPoint) -> tuple[str, str]:
+        a, b = prev.payload, cand.payload
+        if not virtual and b.signature != a.signature:
+            what = "loses" if sum(b.signature) < sum(a.signature) else "gains"
+            if sum(b.signature) == sum(a.signature):
+                what = "changes"
+            return BOUNDARY, (
+                f"the orbit {what} an impact (impacts per forcing period {list(a.signature)} -> "
+                f"{list(b.signature)}): a grazing"
+            )
+        if not virtual and b.section_clearance() < RESECTION_MARGIN:
+            return STOP, _RESECTION
+        if a.stable != b.stable:
+            return REFINE, "stability changes"
+        return ACCEPT, ""
+
+    def margin(pt: PalcPoint) -> float:
+        return grazing_margin(pt.payload)[0]
+
+    sign = math.copysign(1.0, stop - start)
+    segment = 0
     prev: PalcPoint | None = None
-    for pt in palc:
-        if prev is not None:
-            for kind in detect:
-                loc = _detect(evaluate, kind, prev, pt, s)
-                if loc is not None:
-                    branch.special.append(SpecialPoint(kind, len(branch) - 1, float(loc.u[-1]), loc.payload))
-            branch.arclength.append(branch.arclength[-1] + float(np.linalg.norm(pt.u - prev.u)))
-        else:
-            branch.arclength.append(0.0)
-        branch.values.append(float(pt.u[-1]))
-        branch.orbits.append(pt.payload)
-        prev = pt
-        if progress is not None:
-            progress(len(branch), float(pt.u[-1]))
-    branch.status = palc.status
+    status = ""
+    while True:
+        evaluate = _evaluator(model, param, n, orbit.t0, virtual)
+        u0 = np.append(orbit.state, orbit.model.params[param])
+        try:
+            F, DF, orb = evaluate(u0)
+        except GrazingError as exc:
+            raise ConvergenceError(f"cannot start the continuation: {exc}") from None
+        palc = Palc(
+            evaluate, PalcPoint(u0, F, DF, orb), index=nx, sign=sign, bounds=bounds,
+            settings=dataclasses.replace(s, max_points=max(2, s.max_points - len(branch) + 1)),
+            names={nx: param}, check=check, margin=None if virtual else margin,
+        )  # fmt: skip
+        restarted = prev is not None and segment == branch.segments[-1]  # the section moved
+        for k, pt in enumerate(palc):
+            if k == 0 and restarted:
+                prev = pt  # the same orbit on a moved section: already on the branch
+                continue
+            if prev is not None and branch.segments and branch.segments[-1] == segment:
+                for kind in detect:
+                    loc = _detect(evaluate, kind, prev, pt, s)
+                    if loc is None:
+                        continue
+                    point = None
+                    if kind == "grazing":
+                        lo = loc.payload
+                        gm = lo.x_guard_min
+                        assert gm is not None
+                        try:
+                            point = refine_grazing(lo.model, gm, lo.t_guard_min, param, period=n)
+                        except GrazingError:
+                            point = None
+                    value = float(loc.u[-1]) if point is None else point.model.params[param]
+                    branch.special.append(SpecialPoint(kind, len(branch) - 1, value, loc.payload, point))
+                branch.arclength.append(branch.arclength[-1] + float(np.linalg.norm(pt.u - prev.u)))
+            else:
+                branch.arclength.append(branch.arclength[-1] if branch.arclength else 0.0)
+            branch.values.append(float(pt.u[-1]))
+            branch.orbits.append(pt.payload)
+            branch.segments.append(segment)
+            prev = pt
+            if progress is not None:
+                progress(len(branch), float(pt.u[-1]))
+        status = palc.status
+        assert prev is not None and prev.tangent is not None
+        sign = math.copysign(1.0, prev.tangent[nx]) if prev.tangent[nx] != 0 else sign
+        last: PeriodicOrbit = prev.payload
+        if status == _RESECTION and len(branch) < s.max_points:
+            try:
+                orbit = move_section(last, quiet_section(last))
+            except GrazingError as exc:
+                status = f"{_RESECTION} and the orbit could not be found on another section ({exc})"
+                break
+            continue
+        if palc.boundary is None:
+            break
+        beyond = palc.boundary.after.payload if palc.boundary.after is not None else None
+        point = _locate_grazing(last, beyond, param, virtual)
+        if point is None and not palc.boundary.reached:
+            break  # steps beyond jumped to another orbit, and no grazing is just ahead: say so
+        value = point.model.params[param] if point is not None else float(prev.u[-1])
+        branch.special.append(SpecialPoint("grazing", len(branch) - 1, value, last, point))
+        where = f"{param} = {value:.10g}"
+        if point is None:
+            where += (
+                f" (bracketed only: the grazing equations did not converge; last orbit at {prev.u[-1]:.10g})"
+            )
+        reason = palc.boundary.reason
+        if not palc.boundary.reached:
+            what = grazing_margin(last)[3]
+            reason = f"an impact speed reaches zero: the orbit {what}"
+            if what == "gains an impact":
+                reason = f"the orbit touches the stop between its impacts: it {what}"
+            reason += " (located from this side only: Newton's method fails beyond it)"
+        status = f"ended at a grazing at {where}: {reason}"
+        if not switch:
+            status += "; continue with switch=True to follow the orbit with the new impact sequence"
+            break
+        new = _switch_orbit(last, param, value, sign, virtual)
+        if new is None:
+            status += "; no orbit with another impact sequence was found just past it to switch to"
+            break
+        orbit = new
+        sign = math.copysign(1.0, new.model.params[param] - value)
+        segment += 1
+        if new.section_clearance() < SECTION_MARGIN:
+            orbit = move_section(new, quiet_section(new))
+    branch.status = status
     return branch

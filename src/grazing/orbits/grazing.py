@@ -27,123 +27,10 @@ from typing import Any
 import numpy as np
 
 from grazing.core.model import HybridModel
-from grazing.engine.simulate import simulate
 from grazing.errors import ConvergenceError, InvalidParameterError
+from grazing.orbits.contact import GrazingPoint, contact_system
 from grazing.orbits.continuation import Branch, continue_orbit
-from grazing.orbits.palc import Palc, PalcPoint, PalcSettings, locate, newton, sign_changed
-from grazing.orbits.shooting import sorted_multipliers
-
-
-@dataclass(frozen=True)
-class GrazingPoint:
-    """A grazing periodic orbit.
-
-    Attributes
-    ----------
-    model
-        Model with the parameter values at grazing.
-    contact
-        State at the grazing contact (on the stop, zero normal velocity).
-    t_graze
-        Time of the contact (any representative; see :attr:`phase`).
-    monodromy
-        Jacobian of the period-n map on the section through the contact
-        (``t = t_graze``), computed ignoring the stop.
-    multipliers
-        Its eigenvalues (the nontrivial Floquet multipliers), largest first.
-    accel
-        ``L_f^2 h`` at the contact (positive: the orbit turns back from the stop).
-    period
-        Period of the orbit in forcing periods.
-    """
-
-    model: HybridModel
-    contact: np.ndarray
-    t_graze: float
-    monodromy: np.ndarray
-    multipliers: np.ndarray
-    accel: float
-    period: int = 1
-
-    @property
-    def abs_lambda(self) -> float:
-        """Largest multiplier modulus."""
-        return float(np.max(np.abs(self.multipliers)))
-
-    @property
-    def phase(self) -> float:
-        """Forcing phase of the contact, ``t_graze mod T`` in ``[0, T)``."""
-        return float(np.mod(self.t_graze, self.model.period))
-
-    def params(self) -> dict[str, float]:
-        return dict(self.model.params)
-
-
-def _contact_system(model: HybridModel, names: tuple[str, ...], period: int):
-    """``u = (y, t_g, *params) -> (F, DF, GrazingPoint)`` for the grazing equations."""
-    n = model.n_states
-    eye = np.eye(n)
-    pidx = [[p.name for p in model.parameters].index(name) for name in names]
-
-    def evaluate(u: np.ndarray) -> tuple[np.ndarray, np.ndarray, GrazingPoint]:
-        y, tg = u[:n], float(u[n])
-        m = model.with_params(**{name: float(v) for name, v in zip(names, u[n + 1 :])})
-        T = m.period
-        sol = simulate(
-            m,
-            y,
-            t0=tg,
-            periods=period,
-            phase=2 * math.pi * (tg / T % 1.0),
-            jacobian=True,
-            sensitivities=names,
-            events=False,
-            impacts="none",
-        )
-        J, S = sol.jacobian[:, :n], sol.jacobian[:, n:]
-        fy = m.vector_field(y, tg)
-        fend = m.vector_field(sol.x_final, sol.t_final)
-        cd = m.contact_derivatives(y, tg)
-        F = np.concatenate([sol.x_final - y, [cd["h"], cd["rate"]]])
-        DF = np.zeros((n + 2, n + 1 + len(names)))
-        DF[:n, :n] = J - eye
-        DF[:n, n] = fend - J @ fy  # moving the start time along the periodic forcing
-        DF[:n, n + 1 :] = S
-        DF[n, :n], DF[n, n], DF[n, n + 1 :] = cd["h_x"], cd["h_t"], cd["h_p"][pidx]
-        DF[n + 1, :n], DF[n + 1, n], DF[n + 1, n + 1 :] = cd["rate_x"], cd["rate_t"], cd["rate_p"][pidx]
-        point = GrazingPoint(
-            model=m,
-            contact=y.copy(),
-            t_graze=tg,
-            monodromy=J,
-            multipliers=sorted_multipliers(J),
-            accel=cd["accel"],
-            period=period,
-        )
-        return F, DF, point
-
-    return evaluate
-
-
-def refine_grazing(
-    model: HybridModel,
-    contact: np.ndarray,
-    t_graze: float,
-    free: str,
-    *,
-    period: int = 1,
-    tol: float = 1e-12,
-) -> GrazingPoint:
-    """Solve the grazing equations for the contact state, time and parameter ``free``."""
-    evaluate = _contact_system(model, (free,), period)
-    u0 = np.concatenate([contact, [t_graze, model.params[free]]])
-    pt = newton(evaluate, u0, PalcSettings(tol=tol, max_newton=12))  # n + 2 equations, n + 2 unknowns
-    if pt is None:
-        raise ConvergenceError(
-            f"grazing point did not converge near {free} = {model.params[free]:.6g}; "
-            "try a finer continuation step"
-        )
-    return pt.payload
+from grazing.orbits.palc import Palc, PalcPoint, PalcSettings, locate, sign_changed
 
 
 def find_grazings(
@@ -189,9 +76,11 @@ def find_grazings(
     for sp_ in branch.special:
         if sp_.kind != "grazing":
             continue
-        orbit = sp_.orbit
-        assert orbit.x_guard_min is not None
-        points.append(refine_grazing(orbit.model, orbit.x_guard_min, orbit.t_guard_min, param, period=period))
+        if sp_.grazing is None:
+            raise ConvergenceError(
+                f"the grazing near {param} = {sp_.param:.8g} was bracketed but its equations did not converge"
+            )
+        points.append(sp_.grazing)
     return points, branch
 
 
@@ -284,7 +173,7 @@ def grazing_curve(
         )
     g0 = first[0]
     n = model.n_states
-    evaluate = _contact_system(model, params, period)
+    evaluate = contact_system(model, params, period)
     u0 = np.concatenate([g0.contact, [g0.t_graze, g0.model.params[p1], g0.model.params[p2]]])
     F, DF, pay = evaluate(u0)
     palc = Palc(
@@ -294,6 +183,7 @@ def grazing_curve(
         sign=1.0,
         bounds={n + 1: search, n + 2: (start, math.inf)},
         settings=s,
+        names={n: "t_graze", n + 1: p1, n + 2: p2},
     )
     curve = GrazingCurve(params=params)
     prev: PalcPoint | None = None

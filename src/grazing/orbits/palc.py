@@ -5,6 +5,20 @@ predict along the unit tangent (the null vector of ``DF``), correct by
 Newton's method on ``F = 0`` and ``t . (u - u_pred) = 0``, adapt the step.
 The curve starts moving in the direction ``sign`` of one component and stops,
 landing exactly on the bound, when a bounded component leaves its interval.
+
+Step control does not jump over what it should see:
+
+* a step whose corrector lands far from the predictor (more than
+  ``max_correction * ds``) or whose tangent turns by more than
+  ``acos(min_cos)`` is halved (unless the step is already tiny);
+* the caller's ``check(previous, candidate)`` may ask for a shorter step
+  (:data:`REFINE`: e.g. stability changed between the two points), or say that
+  the candidate lies beyond a *boundary* of the curve's domain
+  (:data:`BOUNDARY`: e.g. a periodic orbit that gains or loses an impact is
+  another orbit).  A boundary is then bracketed along the step by bisection,
+  with a secant on the caller's ``margin`` (positive before the boundary,
+  tending to zero at it) when given, and the iteration ends at the last point
+  before it, with :attr:`Palc.boundary` set.
 """
 
 from __future__ import annotations
@@ -17,6 +31,13 @@ from typing import Any
 import numpy as np
 
 from grazing.errors import GrazingError
+
+ACCEPT = "accept"
+REFINE = "refine"
+BOUNDARY = "boundary"
+STOP = "stop"
+"""Verdicts of a :data:`Check`: accept the candidate; halve the step; the candidate is
+beyond a boundary; accept the candidate and end the iteration."""
 
 
 @dataclass(frozen=True)
@@ -35,6 +56,16 @@ class PalcSettings:
         Newton iterations per corrector step.
     locate_tol
         Tolerance on a test function when locating a special point.
+    min_cos
+        Smallest cosine between consecutive tangents; a sharper turn halves the step.
+    max_correction
+        Largest distance from predictor to corrector, as a fraction of the step.
+    ds_refine
+        Steps on which the caller's check asks for refinement are halved down to
+        this length (default ``ds_max / 16``).
+    boundary_tol
+        A boundary is bracketed until the bounded component differs by at most
+        this (relative to ``max(1, |value|)``) across it.
     """
 
     ds: float = 0.01
@@ -44,6 +75,10 @@ class PalcSettings:
     tol: float = 1e-10
     max_newton: int = 8
     locate_tol: float = 1e-9
+    min_cos: float = 0.9
+    max_correction: float = 0.5
+    ds_refine: float | None = None
+    boundary_tol: float = 1e-10
 
 
 @dataclass
@@ -58,6 +93,20 @@ class PalcPoint:
 
 
 Evaluate = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, Any]]
+Check = Callable[[PalcPoint, PalcPoint], tuple[str, str]]
+"""``check(previous, candidate) -> (verdict, reason)``."""
+
+
+@dataclass
+class Boundary:
+    """Where the curve's domain ends: the last point before it, and the first beyond (if any)."""
+
+    before: PalcPoint
+    after: PalcPoint | None
+    reason: str
+    reached: bool = True
+    """False when the points beyond did not approach the curve as the bracket shrank (the
+    corrector jumped to another curve): then there is no boundary here."""
 
 
 def tangent(DF: np.ndarray, previous: np.ndarray | None = None) -> np.ndarray:
@@ -117,7 +166,10 @@ class Palc:
     The curve starts in the direction where ``u[index]`` moves with ``sign``.
     ``bounds`` maps component indices to ``(lo, hi)``: when a prediction
     leaves one of them, the last point is placed exactly on that bound and the
-    iteration ends.  After iteration, :attr:`status` says why it stopped.
+    iteration ends.  ``names`` gives the components' names for messages.
+    ``check`` and ``margin`` are the caller's acceptance test and boundary
+    margin (see the module docstring).  After iteration, :attr:`status` says
+    why it stopped and :attr:`boundary` is set if it stopped at a boundary.
     """
 
     def __init__(
@@ -129,16 +181,30 @@ class Palc:
         sign: float,
         bounds: dict[int, tuple[float, float]],
         settings: PalcSettings | None = None,
+        names: dict[int, str] | None = None,
+        check: Check | None = None,
+        margin: Callable[[PalcPoint], float] | None = None,
     ):
         self.evaluate = evaluate
         self.first = first
+        self.index = index
         self.bounds = bounds
         self.s = settings or PalcSettings()
+        self.names = names or {}
+        self.check = check
+        self.margin = margin
         t = tangent(first.DF)
         if t[index] * sign < 0:
             t = -t
         first.tangent = t
         self.status = ""
+        self.boundary: Boundary | None = None
+
+    def _name(self, i: int) -> str:
+        return self.names.get(i, f"u[{i}]")
+
+    def _where(self, pt: PalcPoint) -> str:
+        return f"{self._name(self.index)} = {pt.u[self.index]:.10g}"
 
     def _outside(self, u: np.ndarray) -> tuple[int, float] | None:
         """The first violated bound along the step, as (index, bound value)."""
@@ -149,12 +215,96 @@ class Palc:
                 return i, lo
         return None
 
+    def _stuck(self, cur: PalcPoint, why: str) -> None:
+        """End where no step beyond ``cur`` succeeds.
+
+        With a ``margin``, a boundary may lie just ahead (Newton's method
+        fails, or jumps to another curve, close to it): :attr:`boundary` is set,
+        unconfirmed, for the caller to check.
+        """
+        if self.margin is not None:
+            self.boundary = Boundary(cur, None, why, reached=False)
+        self.status = f"step size fell below {self.s.ds_min:g} at {self._where(cur)}: {why}"
+
+    def _jumped(self, margins: list[tuple[float, float]], cand: PalcPoint) -> bool:
+        """Is ``cand`` (beyond a boundary by the caller's check) short of where the margin predicts it?
+
+        The margin of the accepted points tends to zero linearly in ``u[index]``
+        as the boundary approaches; a candidate less than half-way from the
+        last point to the extrapolated zero cannot have crossed it.
+        """
+        if len(margins) < 2:
+            return False
+        (p0, m0), (p1, m1) = margins[-2], margins[-1]
+        pc = float(cand.u[self.index])
+        if not (m0 > m1 > 0) or p1 == p0:
+            return m1 > 0 and not m0 > m1  # moving away from the boundary: a jump
+        p_star = p1 + m1 * (p1 - p0) / (m0 - m1)
+        return (pc - p1) / (p_star - p1) < 0.5
+
+    def _step(self, cur: PalcPoint, sigma: float) -> PalcPoint | None:
+        """The corrected point at arclength ``sigma`` along ``cur``'s tangent."""
+        assert cur.tangent is not None
+        pt = correct(self.evaluate, cur.u + sigma * cur.tangent, cur.tangent, self.s)
+        if pt is not None:
+            pt.tangent = tangent(pt.DF, cur.tangent)
+        return pt
+
+    def _locate_boundary(self, cur: PalcPoint, ds: float, beyond: PalcPoint, reason: str) -> Boundary:
+        """Bracket the boundary between ``cur`` (before it) and the step ``ds`` (beyond it).
+
+        Bisection on the arclength along ``cur``'s tangent; with a ``margin``, a
+        secant through the last two points before the boundary (the margin
+        tends to zero linearly at it) proposes the next trial, kept inside the
+        bracket.
+        """
+        lo, hi = 0.0, ds
+        best, after = cur, beyond
+        history: list[tuple[float, float]] = []  # (sigma, margin) of points before the boundary
+        if self.margin is not None:
+            history.append((0.0, self.margin(cur)))
+        i = self.index
+        for _ in range(100):
+            scale = max(1.0, abs(best.u[i]))
+            if after is not None and abs(after.u[i] - best.u[i]) <= self.s.boundary_tol * scale:
+                break
+            if hi - lo <= 1e-15 * max(1.0, hi):
+                break
+            sig = 0.5 * (lo + hi)
+            if len(history) >= 2:
+                (sa, ma), (sb, mb) = history[-2], history[-1]
+                if ma > mb > 0:
+                    guess = sb + mb * (sb - sa) / (ma - mb)
+                    width = hi - lo
+                    if lo < guess < hi:  # else bisect
+                        sig = min(max(guess, lo + 1e-3 * width), hi - 1e-3 * width)
+            pt = self._step(cur, sig)
+            verdict = BOUNDARY if pt is None or self.check is None else self.check(cur, pt)[0]
+            if pt is not None and verdict != BOUNDARY:
+                lo, best = sig, pt
+                if self.margin is not None:
+                    history.append((sig, self.margin(pt)))
+            else:
+                hi, after = sig, pt
+        # A boundary of the curve is reached continuously: the margin tends to zero, the
+        # points beyond tend to the last point before it.  Otherwise the corrector jumped.
+        if history and history[0][1] > 0:
+            reached = history[-1][1] <= 1e-3 * history[0][1]
+        else:
+            gap = math.inf if after is None else float(np.linalg.norm(after.u - best.u))
+            reached = gap <= 1e-4 * max(1.0, float(np.linalg.norm(best.u)))
+        return Boundary(best, after, reason, reached)
+
     def __iter__(self) -> Iterator[PalcPoint]:
         s = self.s
+        ds_refine = s.ds_refine if s.ds_refine is not None else s.ds_max / 16
         cur = self.first
         yield cur
         ds = s.ds
         count = 1
+        margins: list[tuple[float, float]] = []  # (u[index], margin) of the accepted points
+        if self.margin is not None:
+            margins.append((float(cur.u[self.index]), self.margin(cur)))
         while count < s.max_points:
             assert cur.tangent is not None
             pred = cur.u + ds * cur.tangent
@@ -172,18 +322,64 @@ class Palc:
             if nxt is None:
                 ds *= 0.5
                 if ds < s.ds_min:
-                    self.status = f"step size fell below {s.ds_min:g}"
+                    self._stuck(
+                        cur, "Newton's method did not converge beyond this point (a singular point, or "
+                        "a step too large for the settings)",
+                    )  # fmt: skip
                     return
                 continue
             nxt.tangent = tangent(nxt.DF, cur.tangent)
-            if out is None and nxt.tangent @ cur.tangent < 0.5 and ds > 4 * s.ds_min:
-                ds *= 0.5  # sharp turn: refine
+            if out is None and ds > 4 * s.ds_min:
+                turn = float(nxt.tangent @ cur.tangent)
+                moved = float(np.linalg.norm(nxt.u - pred))
+                if turn < s.min_cos or moved > s.max_correction * ds:
+                    ds *= 0.5  # the step jumped: predictor and corrector disagree
+                    continue
+            verdict, reason = self.check(cur, nxt) if self.check is not None else (ACCEPT, "")
+            if verdict == REFINE and ds > ds_refine and out is None:
+                ds = max(0.5 * ds, ds_refine)
+                continue
+            if verdict == BOUNDARY and self._jumped(margins, nxt):
+                # The margin says the boundary is still far: the corrector jumped to another curve.
+                ds *= 0.5
+                if ds < s.ds_min:
+                    self._stuck(
+                        cur, f"beyond this point Newton's method converges to another solution ({reason})"
+                    )
+                    return
+                continue
+            if verdict == BOUNDARY:
+                found = self._locate_boundary(cur, ds, nxt, reason)
+                if found.before is not cur:
+                    count += 1
+                    yield found.before
+                if found.reached:
+                    self.boundary = found
+                    self.status = f"{reason} at {self._where(found.before)}"
+                    return
+                # The corrector jumped to another curve: go on along this one with shorter steps.
+                if found.before is not cur and self.margin is not None:
+                    margins.append((float(found.before.u[self.index]), self.margin(found.before)))
+                    del margins[:-2]
+                cur = found.before
+                ds *= 0.5
+                if ds < s.ds_min:
+                    self._stuck(
+                        cur, f"beyond this point Newton's method converges to another solution ({reason})"
+                    )
+                    return
                 continue
             count += 1
             yield nxt
             cur = nxt
+            if self.margin is not None:
+                margins.append((float(cur.u[self.index]), self.margin(cur)))
+                del margins[:-2]
             if out is not None:
-                self.status = f"reached the bound u[{out[0]}] = {out[1]:.8g}"
+                self.status = f"reached the bound {self._name(out[0])} = {out[1]:.10g}"
+                return
+            if verdict == STOP:
+                self.status = reason
                 return
             ds = min(ds * 1.3, s.ds_max)
         self.status = "maximum number of points reached"

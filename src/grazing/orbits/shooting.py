@@ -19,11 +19,15 @@ import numpy as np
 from grazing.core.model import HybridModel
 from grazing.core.solution import Solution
 from grazing.engine.simulate import simulate
-from grazing.errors import ConvergenceError, InvalidParameterError, SimulationError
+from grazing.errors import ConvergenceError, InvalidParameterError, InvalidStateError, SimulationError
 from grazing.sweeps.period import detect_period
 
 DEFAULT_TOL = 1e-11
 DEFAULT_MAX_ITER = 30
+
+SECTION_MARGIN = 0.05
+"""When an impact of the starting orbit lies within this fraction of a period of the
+stroboscopic section, an automatic section (``t0=None``) moves to a quiet phase."""
 
 
 @dataclass(frozen=True)
@@ -48,12 +52,16 @@ def flow_map(
     periods: int = 1,
     sensitivities: Sequence[str] = (),
     virtual: bool = False,
+    touching: bool = False,
 ) -> FlowMap:
     """Apply the stroboscopic map ``periods`` times from ``x`` at time ``t0``.
 
     The map goes from the section ``t = t0 (mod T)`` to itself, ending at
     ``t0 + periods T``.  With ``virtual`` the stop is ignored (the flow passes
-    through it).
+    through it).  The parameter derivatives hold ``t0`` fixed and let the end
+    ``t0 + periods T(p)`` move with a parameter that sets the period ``T``.
+    With ``touching`` the map starts and ends at a grazing contact with the
+    stop (``x`` on the stop with zero normal velocity), which is not an impact.
     """
     sol = simulate(
         model,
@@ -65,9 +73,17 @@ def flow_map(
         sensitivities=tuple(sensitivities),
         guard_min=True,
         events=not virtual,
+        touching=touching,
     )
     n = model.n_states
-    return FlowMap(sol.x_final, sol.jacobian[:, :n], sol.jacobian[:, n:], sol)
+    sens = sol.jacobian[:, n:]
+    tp = np.array([sol.info["period_gradient"][p] for p in sensitivities])
+    if np.any(tp) and model.periodic:
+        # simulate's derivative keeps the end at the forcing phase of t0, i.e. at
+        # (t0/T + periods) T(p); the map's end is t0 + periods T(p).
+        f_end = model.vector_field(sol.x_final, sol.t_final)
+        sens = sens - np.outer(f_end * (t0 / model.period), tp)
+    return FlowMap(sol.x_final, sol.jacobian[:, :n], sens, sol)
 
 
 @dataclass(frozen=True)
@@ -98,6 +114,12 @@ class PeriodicOrbit:
         True if computed with the stop ignored.
     residuals
         ``|P^n(x_k) - x_k|`` at each Newton iterate.
+    impact_times, impact_speeds, impact_states
+        The orbit's impacts over one period ``[t0, t0 + n T)``: times, approach
+        speeds and the states on the stop just before the reset.
+    approach
+        ``(h, t, x)``: the orbit's closest approach to the stop away from its
+        impacts (a local minimum of the guard in free flight), or None.
     """
 
     model: HybridModel
@@ -113,6 +135,30 @@ class PeriodicOrbit:
     virtual: bool
     residuals: tuple[float, ...] = field(default=())
     x_guard_min: np.ndarray | None = None
+    impact_times: np.ndarray = field(default_factory=lambda: np.empty(0))
+    impact_speeds: np.ndarray = field(default_factory=lambda: np.empty(0))
+    impact_states: np.ndarray | None = None
+    approach: tuple[float, float, np.ndarray] | None = None
+
+    @property
+    def signature(self) -> tuple[int, ...]:
+        """Impacts in each of the orbit's ``period`` forcing periods after ``t0``.
+
+        Two orbits with different signatures are different orbits: a branch of
+        periodic orbits keeps its signature up to a grazing.
+        """
+        T = self.model.period
+        counts = [0] * self.period
+        for t in self.impact_times:
+            counts[min(self.period - 1, max(0, math.floor((t - self.t0) / T)))] += 1
+        return tuple(counts)
+
+    def section_clearance(self) -> float:
+        """Distance, in periods, from the section ``t0 (mod T)`` to the nearest impact (0.5 if none)."""
+        if not self.impact_times.size:
+            return 0.5
+        d = np.mod((self.impact_times - self.t0) / self.model.period, 1.0)
+        return float(np.min(np.minimum(d, 1.0 - d)))
 
     @property
     def stable(self) -> bool:
@@ -166,7 +212,41 @@ def _orbit_from(model: HybridModel, x: np.ndarray, t0: float, n: int, fm: FlowMa
         virtual=virtual,
         residuals=tuple(residuals),
         x_guard_min=gmin[2],
+        impact_times=sol.impacts.t.copy(),
+        impact_speeds=speeds.copy(),
+        impact_states=sol.impacts.state.copy(),
+        approach=sol.approach_min,
     )
+
+
+def quiet_section(orbit: PeriodicOrbit) -> float:
+    """A section time in ``[0, T)`` as far as possible (in phase) from every impact of ``orbit``."""
+    T = orbit.model.period
+    if not orbit.impact_times.size:
+        return orbit.t0 % T
+    phases = np.sort(np.mod(orbit.impact_times / T, 1.0))
+    gaps = np.diff(np.append(phases, phases[0] + 1.0))
+    i = int(np.argmax(gaps))
+    return float((phases[i] + gaps[i] / 2) % 1.0 * T)
+
+
+def move_section(orbit: PeriodicOrbit, t_new: float, *, tol: float = DEFAULT_TOL) -> PeriodicOrbit:
+    """The same orbit on the section through ``t_new`` (a time in ``[0, T)``).
+
+    The orbit is followed from its section to the next time ``t_new (mod T)``
+    and Newton's method is run again there (the monodromy and the point
+    change with the section; the multipliers do not).
+    """
+    T = orbit.model.period
+    lag = (t_new - orbit.t0) % T
+    x = orbit.state
+    if lag > 0:
+        phase = 2 * math.pi * ((orbit.t0 + lag) / T % 1.0)
+        x = simulate(
+            orbit.model, orbit.state, t0=orbit.t0, periods=1, phase=phase, impacts="none",
+            events=not orbit.virtual,
+        ).x_final  # fmt: skip
+    return find_orbit(orbit.model, x, period=orbit.period, t0=t_new, virtual=orbit.virtual, tol=tol)
 
 
 def initial_guess(
@@ -194,7 +274,7 @@ def find_orbit(
     x0: Sequence[float] | np.ndarray | None = None,
     *,
     period: int | None = None,
-    t0: float = 0.0,
+    t0: float | None = 0.0,
     virtual: bool = False,
     tol: float = DEFAULT_TOL,
     max_iter: int = DEFAULT_MAX_ITER,
@@ -213,7 +293,11 @@ def find_orbit(
     period
         Period in forcing periods (default: detected by simulation, else 1).
     t0
-        Time of the section (sets the forcing phase of ``state``).
+        Time of the section (sets the forcing phase of ``state``).  ``None``:
+        chosen automatically, at 0 unless an impact of the orbit lies within
+        :data:`SECTION_MARGIN` of a period of it, else half-way between the
+        impacts furthest apart in phase (the stroboscopic map is not smooth
+        where an impact falls on the section).
     virtual
         Ignore the stop (for nonimpacting orbits continued past grazing).
     tol
@@ -236,19 +320,46 @@ def find_orbit(
     """
     if period is not None and (not isinstance(period, (int, np.integer)) or period < 1):
         raise InvalidParameterError(f"period must be a positive integer, got {period!r}")
+    if t0 is None:
+        orbit = find_orbit(
+            model, x0, period=period, t0=0.0, virtual=virtual, tol=tol, max_iter=max_iter, transient=transient
+        )
+        if orbit.section_clearance() >= SECTION_MARGIN:
+            return orbit
+        return move_section(orbit, quiet_section(orbit), tol=tol)
+    advice = "try another initial guess, another period, or a longer transient"
     if x0 is None:
         x, detected = initial_guess(model, t0=t0, transient=transient, virtual=virtual)
         n = int(period or detected or 1)
+        if not (period or detected):
+            advice = (
+                f"simulation from rest showed no period <= 64 after {transient} periods (chaos, or a "
+                f"transient not yet settled), so a period-1 orbit was tried; give the period or an "
+                "initial guess, or a longer transient"
+            )
     else:
         x = model.check_state(x0, t0, allowed=not virtual)
         n = int(period or 1)
     residuals: list[float] = []
-    step_note = ""
+    why = ""
     for it in range(max_iter + 1):
         try:
             fm = flow_map(model, x, t0=t0, periods=n, virtual=virtual)
         except SimulationError as exc:
-            raise ConvergenceError(f"Newton iterate {it} could not be integrated: {exc}") from None
+            raise ConvergenceError(
+                f"Newton's method for a period-{n} orbit failed at iterate {it} ({exc}); {advice}"
+            ) from None
+        except InvalidStateError:
+            raise ConvergenceError(
+                f"Newton's method for a period-{n} orbit left the allowed region (iterate {it} is "
+                f"beyond the stop); {advice}"
+            ) from None
+        if not fm.solution.jacobian_valid:
+            raise ConvergenceError(
+                f"the motion sticks to the stop during the period-{n} map (iterate {it}); the Jacobian "
+                "across sticking is not computed, so Newton's method and Floquet multipliers are not "
+                "available for it: simulate it instead"
+            )
         F = fm.image - x
         res = float(np.max(np.abs(F)))
         residuals.append(res)
@@ -262,7 +373,7 @@ def find_orbit(
         try:
             dx = np.linalg.solve(A, -F)
         except np.linalg.LinAlgError:
-            step_note = "; the Jacobian P_x - I is singular (a fold or multiplier 1?)"
+            why = " (the Jacobian P_x - I is singular: a fold or a multiplier 1?)"
             break
         # Backtrack so that the iterate stays in the allowed region.
         lam = 1.0
@@ -274,6 +385,5 @@ def find_orbit(
         x = trial
     raise ConvergenceError(
         f"Newton did not converge to a period-{n} orbit: residual {residuals[-1]:.3g} after "
-        f"{len(residuals) - 1} iterations{step_note}; try another initial guess, another period, "
-        "or a longer transient"
+        f"{len(residuals) - 1} iterations{why}; {advice}"
     )

@@ -240,15 +240,20 @@ def run_chunk(spec: SweepSpec, index: int) -> ChunkResult:
     x0 = np.asarray(spec.x0, dtype=float)
     x = x0.copy()
     t0 = 0.0
+    carried = False
     for j, pt in enumerate(pts):
         model = spec.model_at(pt)
-        start_x, start_t = (x0, 0.0) if spec.fresh else (x, t0)
+        if carried and model.periodic:
+            # The state carried over is the last sample, at forcing phase ``spec.phase``:
+            # start the next point at that phase of its own period (which may differ).
+            t0 = (spec.phase / (2 * math.pi)) % 1.0 * model.period
+        start_x, start_t = (x0, 0.0) if spec.fresh or not carried else (x, t0)
         try:
             samples, nimp, lyap, used, x, t0 = _run_point(spec, model, start_x, start_t)
         except SimulationError:
             # Recorded as missing (NaN samples, period -1); the next point restarts from x0.
             res.period[j] = -1
-            x, t0 = x0.copy(), 0.0
+            carried = False
             continue
         res.samples[j] = samples
         res.period[j] = detect_period(samples, DEFAULT_PERIOD_TOL, DEFAULT_MAX_PERIOD)
@@ -256,7 +261,7 @@ def run_chunk(spec: SweepSpec, index: int) -> ChunkResult:
         res.lyapunov[j] = lyap
         res.transient_used[j] = used
         res.x_final[j] = x
-        t0 = t0 % model.period if model.periodic else t0
+        carried = True
     res.seconds = time.perf_counter() - start
     return res
 

@@ -1,0 +1,140 @@
+"""Grazing periodic orbits: the contact equations and their solution.
+
+A periodic orbit grazes when it touches the stop with zero normal velocity:
+``h = 0`` and ``L_f h = 0`` (with ``L_f^2 h > 0``) at some time ``t_g``.  The
+unknowns are the state ``y`` at the contact, the contact time ``t_g`` and the
+free parameters; the equations are periodicity from the contact,
+``Phi(y, t_g -> t_g + nT) = y``, and the two contact conditions.  Taking the
+Poincare section through the contact point itself keeps the problem smooth
+and gives the monodromy matrix at the grazing point, which the normal form
+needs.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from grazing.core.model import HybridModel
+from grazing.errors import ConvergenceError
+from grazing.orbits.palc import PalcSettings, newton
+from grazing.orbits.shooting import flow_map, sorted_multipliers
+
+
+@dataclass(frozen=True)
+class GrazingPoint:
+    """A grazing periodic orbit.
+
+    Attributes
+    ----------
+    model
+        Model with the parameter values at grazing.
+    contact
+        State at the grazing contact (on the stop, zero normal velocity).
+    t_graze
+        Time of the contact (any representative; see :attr:`phase`).
+    monodromy
+        Jacobian of the period-n map on the section through the contact
+        (``t = t_graze``), with the grazing contact itself not an impact (the
+        orbit's other impacts, if any, are).
+    multipliers
+        Its eigenvalues (the nontrivial Floquet multipliers), largest first.
+    accel
+        ``L_f^2 h`` at the contact (positive: the orbit turns back from the stop).
+    period
+        Period of the orbit in forcing periods.
+    impacts
+        The orbit's other impacts per period (0 for a nonimpacting orbit that grazes).
+    """
+
+    model: HybridModel
+    contact: np.ndarray
+    t_graze: float
+    monodromy: np.ndarray
+    multipliers: np.ndarray
+    accel: float
+    period: int = 1
+    impacts: int = 0
+
+    @property
+    def abs_lambda(self) -> float:
+        """Largest multiplier modulus."""
+        return float(np.max(np.abs(self.multipliers)))
+
+    @property
+    def phase(self) -> float:
+        """Forcing phase of the contact, ``t_graze mod T`` in ``[0, T)``."""
+        return float(np.mod(self.t_graze, self.model.period))
+
+    def params(self) -> dict[str, float]:
+        return dict(self.model.params)
+
+
+def contact_system(model: HybridModel, names: tuple[str, ...], period: int, *, events: bool = False):
+    """``u = (y, t_g, *params) -> (F, DF, GrazingPoint)`` for the grazing equations.
+
+    ``F = (Phi(y, t_g -> t_g + n T) - y, h(y, t_g), L_f h(y, t_g))``: the orbit
+    through the contact state ``y`` is periodic and touches the stop there.
+    With ``events`` the flow applies the orbit's other impacts (a grazing of an
+    orbit that already impacts); the contact itself is never an impact.
+    """
+    n = model.n_states
+    eye = np.eye(n)
+    pidx = [[p.name for p in model.parameters].index(name) for name in names]
+
+    def evaluate(u: np.ndarray) -> tuple[np.ndarray, np.ndarray, GrazingPoint]:
+        y, tg = u[:n], float(u[n])
+        m = model.with_params(**{name: float(v) for name, v in zip(names, u[n + 1 :])})
+        fm = flow_map(m, y, t0=tg, periods=period, sensitivities=names, virtual=not events, touching=events)
+        J, S = fm.jacobian, fm.sensitivity
+        fy = m.vector_field(y, tg)
+        fend = m.vector_field(fm.image, fm.solution.t_final)
+        cd = m.contact_derivatives(y, tg)
+        F = np.concatenate([fm.image - y, [cd["h"], cd["rate"]]])
+        DF = np.zeros((n + 2, n + 1 + len(names)))
+        DF[:n, :n] = J - eye
+        DF[:n, n] = fend - J @ fy  # moving the start time along the periodic forcing
+        DF[:n, n + 1 :] = S
+        DF[n, :n], DF[n, n], DF[n, n + 1 :] = cd["h_x"], cd["h_t"], cd["h_p"][pidx]
+        DF[n + 1, :n], DF[n + 1, n], DF[n + 1, n + 1 :] = cd["rate_x"], cd["rate_t"], cd["rate_p"][pidx]
+        point = GrazingPoint(
+            model=m,
+            contact=y.copy(),
+            t_graze=tg,
+            monodromy=J,
+            multipliers=sorted_multipliers(J),
+            accel=cd["accel"],
+            period=period,
+            impacts=fm.impacts,
+        )
+        return F, DF, point
+
+    return evaluate
+
+
+def refine_grazing(
+    model: HybridModel,
+    contact: np.ndarray,
+    t_graze: float,
+    free: str,
+    *,
+    period: int = 1,
+    tol: float = 1e-12,
+    events: bool = False,
+) -> GrazingPoint:
+    """Solve the grazing equations for the contact state, time and parameter ``free``.
+
+    ``contact``, ``t_graze`` and the model's value of ``free`` are the initial
+    guess (for example the closest approach of a nonimpacting orbit, or the
+    weakest impact of an impacting one).  With ``events`` the orbit's other
+    impacts are applied (see :func:`contact_system`).
+    """
+    evaluate = contact_system(model, (free,), period, events=events)
+    u0 = np.concatenate([contact, [t_graze, model.params[free]]])
+    pt = newton(evaluate, u0, PalcSettings(tol=tol, max_newton=12))  # n + 2 equations, n + 2 unknowns
+    if pt is None:
+        raise ConvergenceError(
+            f"Newton's method for the grazing orbit did not converge near {free} = {model.params[free]:.8g}"
+        )
+    return pt.payload
