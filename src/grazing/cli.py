@@ -522,6 +522,9 @@ _CONTINUE_PARAMS = {"eta": "eta", "theta-hat": "theta_hat", "alpha": "alpha", "b
 @click.option("--virtual/--physical", default=None,
               help="Ignore the stop (default: yes for a nonimpacting starting orbit).")  # fmt: skip
 @click.option("--max-step", type=float, default=0.04, show_default=True, help="Largest continuation step.")
+@click.option("--switch", is_flag=True,
+              help="At a grazing where the impact sequence changes, continue on the orbit with the new "
+              "sequence (a new branch segment) instead of ending there.")  # fmt: skip
 @_netcdf_out_option
 @_json_option
 def continue_(
@@ -534,11 +537,13 @@ def continue_(
     initial: str | None,
     virtual: bool | None,
     max_step: float,
+    switch: bool,
     out: Path | None,
     as_json: bool,
 ) -> None:
     """Pseudo-arclength continuation of a periodic orbit, with folds, period-doublings,
-    Neimark-Sacker points and grazings located."""
+    Neimark-Sacker points and grazings located.  A branch of an impacting orbit ends at
+    the grazing where its impact sequence changes (see --switch)."""
     from grazing.orbits import PalcSettings, continue_orbit
 
     name = _CONTINUE_PARAMS[cparam]
@@ -557,7 +562,7 @@ def continue_(
     try:
         branch = continue_orbit(
             model, name, a, b, x0=None if x0 is None else np.array(x0), period=period, virtual=virtual,
-            settings=PalcSettings(ds=min(0.01, max_step), ds_max=max_step),
+            settings=PalcSettings(ds=min(0.01, max_step), ds_max=max_step), switch=switch,
             progress=lambda n, v: bar(int(1000 * abs(v - a) / abs(b - a)), 1000),
         )  # fmt: skip
     finally:
@@ -575,6 +580,9 @@ def continue_(
         "multipliers": [_complex_list(o.multipliers) for o in branch.orbits],
         "stable": [o.stable for o in branch.orbits],
         "impacts": [o.impacts for o in branch.orbits],
+        "segments": branch.segments,
+        "section_times": branch.sections,
+        "switch": switch,
         "special": [
             {
                 "kind": sp_.kind,
@@ -593,7 +601,9 @@ def continue_(
         _emit_json(res)
         return
     kind = "virtual (stop ignored)" if branch.virtual else "physical"
-    click.echo(f"{len(branch)} points of the period-{branch.period} orbit, {kind}; {branch.status}")
+    segs = max(branch.segments) + 1 if branch.segments else 1
+    more = f" in {segs} segments (impact sequence switched at grazings)" if segs > 1 else ""
+    click.echo(f"{len(branch)} points of the period-{branch.period} orbit{more}, {kind}; {branch.status}")
     for sp_ in res["special"]:
         mu = ", ".join(f"{x:+.4f}{y:+.4f}i" for x, y in sp_["multipliers"])
         click.echo(f"  {sp_['kind']:16s} {cparam} = {sp_['value']:.8g}   multipliers {mu}")

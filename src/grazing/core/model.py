@@ -127,7 +127,7 @@ class _Definition:
         self._symbolic = symbolic
         self._builder = builder
         self._system: SymbolicSystem | None = None
-        self._kernels: dict[tuple[tuple[str, ...], int], ModuleType] = {}
+        self._kernels: dict[tuple[int, int], ModuleType] = {}
         self._numeric: dict[str, Callable[..., Any]] = {}
         if symbolic is not None:
             self.system  # noqa: B018 - validate user models at construction
@@ -198,16 +198,15 @@ class _Definition:
         period = _srepr(self.period_expr)
         return repr((self.name, [p.name for p in self.parameters], period, self.periodic, source))
 
-    def kernels(self, sensitivities: tuple[str, ...] = (), order: int = DEFAULT_ORDER) -> ModuleType:
-        if (sensitivities, order) not in self._kernels:
+    def kernels(self, directions: int = 0, order: int = DEFAULT_ORDER) -> ModuleType:
+        if (directions, order) not in self._kernels:
 
             def source() -> str:
-                names = [p.name for p in self.parameters]
-                return generate_source(self.system, [names.index(s) for s in sensitivities], order)
+                return generate_source(self.system, directions, order)
 
-            key = kernel_key(self._identity(), sensitivities, order)
-            self._kernels[sensitivities, order] = load_kernels(key, source)
-        return self._kernels[sensitivities, order]
+            key = kernel_key(self._identity(), directions, order)
+            self._kernels[directions, order] = load_kernels(key, source)
+        return self._kernels[directions, order]
 
     def numeric(self, what: str) -> Callable[..., Any]:
         """numpy function of ``(x, t, p)`` for f, h, g or a Jacobian (built on first use)."""
@@ -507,18 +506,19 @@ class HybridModel:
         return f"<HybridModel {self.name}: {vals}>"
 
     # -- numerics -------------------------------------------------------------
-    def kernels(self, sensitivities: Sequence[str] = (), order: int = DEFAULT_ORDER) -> ModuleType:
+    def kernels(self, directions: int = 0, order: int = DEFAULT_ORDER) -> ModuleType:
         """The compiled kernel module (generated and cached on first use).
 
-        One module per set of ``sensitivities`` (parameters in the variational
-        equations) and Taylor ``order``; the model's scalar functions (vector
-        field, guard, reset and their derivatives) are in every module.
+        One module per number of sensitivity ``directions`` (columns of the
+        variational matrix holding parameter derivatives along directions
+        given at run time; see
+        :func:`~grazing.engine.compile.direction_columns`) and Taylor
+        ``order``; the model's scalar functions (vector field, guard, reset and
+        their derivatives) are in every module.
         """
-        names = {p.name for p in self._def.parameters}
-        for s in sensitivities:
-            if s not in names:
-                raise InvalidParameterError(f"unknown parameter {s!r}")
-        return self._def.kernels(tuple(sensitivities), int(order))
+        if isinstance(directions, bool) or not isinstance(directions, int) or directions < 0:
+            raise InvalidParameterError(f"directions must be a non-negative integer, got {directions!r}")
+        return self._def.kernels(directions, int(order))
 
     def _call(self, what: str, x: Any, t: float) -> Any:
         fn = self._def.numeric(what)

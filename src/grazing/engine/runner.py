@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from grazing.core.model import HybridModel
-from grazing.engine.compile import taylor_order
+from grazing.engine.compile import direction_columns, taylor_order
 from grazing.errors import SimulationError
 
 RECORD_IMPACTS = {"none": 0, "sampled": 1, "all": 2}
@@ -147,7 +147,7 @@ class Runner:
             events = False
         n = model.n_states
         self.x = np.array(x, dtype=float)
-        self.V = np.zeros((n, n + len(sensitivities)))
+        self.V = np.zeros((n, n + direction_columns(len(sensitivities) if variational else 0)))
         self.V[:, :n] = np.eye(n)
         self.variational = variational
         self.events = events
@@ -155,9 +155,9 @@ class Runner:
         self.order = taylor_order(tol)
         self.safety = step_safety(tol, self.order)
         self.sensitivities = tuple(sensitivities) if variational else ()
-        self.kern = model.kernels(self.sensitivities, self.order)
-        self.pv = model.param_vector
-        self.Tp = self.period_gradient()
+        self.directions = direction_columns(len(self.sensitivities))
+        self.kern = model.kernels(self.directions, self.order)
+        self.set_params(model)
         self.chatter_time = chatter_tol * self.T
         T = self.T
         snap = 1e-9 * T
@@ -188,8 +188,12 @@ class Runner:
     def set_params(self, model: HybridModel) -> None:
         """Continue with other parameter values of the same model (same period)."""
         self.model = model
-        self.pv = model.param_vector
-        self.Tp = self.period_gradient()
+        names = [p.name for p in model.parameters]
+        D = np.zeros((self.directions, len(names)))  # unit directions; unused columns stay zero
+        for c, name in enumerate(self.sensitivities):
+            D[c, names.index(name)] = 1.0
+        self.pv = np.concatenate([model.param_vector, D.ravel()])
+        self.Tp = D @ self.period_gradient()
 
     def vector_field(self, x: np.ndarray, s: float) -> np.ndarray:
         """``f(x, s)`` with the kernels this runner already loaded."""
@@ -198,11 +202,10 @@ class Runner:
         return out
 
     def period_gradient(self) -> np.ndarray:
-        """``dT/dp`` for each sensitivity parameter (zero for parameters that do not set the period)."""
-        names = [p.name for p in self.model.parameters]
-        full = np.zeros(len(names))
-        self.kern.period_grad(self.x, 0.0, self.pv, full)
-        return np.array([full[names.index(p)] for p in self.sensitivities])
+        """``dT/dp`` for every parameter (zero for parameters that do not set the period)."""
+        full = np.zeros(len(self.model.parameters))
+        self.kern.period_grad(self.x, 0.0, self.model.param_vector, full)
+        return full
 
     def _zdm_args(self) -> tuple[Any, ...]:
         z = self.zdm
@@ -279,7 +282,13 @@ def precompile(jobs: Sequence[tuple[HybridModel, tuple[str, ...]]], workers: int
     import multiprocessing as mp
     import os
 
-    todo = list(jobs)
+    seen: set[tuple[int, int]] = set()
+    todo = []
+    for model, sens in jobs:  # jobs needing the same module compile it once
+        key = (id(model._def), direction_columns(len(sens)))
+        if key not in seen:
+            seen.add(key)
+            todo.append((model, sens))
     workers = min(workers or os.cpu_count() or 1, len(todo))
     if workers <= 1:
         for job in todo:

@@ -203,6 +203,8 @@ def simulate(
     jac = run.V if (use_var and not lyapunov) else None
     if jac is not None and sens and np.any(run.Tp):
         jac = _sample_time_terms(run, x, float(t0), ks_start + total - 1, float(t_samples[-1]), jac)
+    if jac is not None:
+        jac = jac[:, : n + len(sens)].copy()  # the module may have more direction columns than asked
     imp = _concat(parts["imp"], 2 + n)
     traj = _concat(parts["traj"], 1 + n)
     imp_t = imp[:, 0]

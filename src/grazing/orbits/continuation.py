@@ -541,10 +541,10 @@ def continue_orbit(
             reason = f"an impact speed reaches zero: the orbit {what}"
             if what == "gains an impact":
                 reason = f"the orbit touches the stop between its impacts: it {what}"
-            reason += " (located from this side only: Newton's method fails beyond it)"
+            reason += " (located from this side: the branch does not continue beyond it)"
         status = f"ended at a grazing at {where}: {reason}"
         if not switch:
-            status += "; continue with switch=True to follow the orbit with the new impact sequence"
+            status += "; the orbit with the new impact sequence can be followed with switch (--switch)"
             break
         new = _switch_orbit(last, param, value, sign, virtual)
         if new is None:

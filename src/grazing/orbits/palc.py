@@ -229,9 +229,12 @@ class Palc:
     def _jumped(self, margins: list[tuple[float, float]], cand: PalcPoint) -> bool:
         """Is ``cand`` (beyond a boundary by the caller's check) short of where the margin predicts it?
 
-        The margin of the accepted points tends to zero linearly in ``u[index]``
-        as the boundary approaches; a candidate less than half-way from the
-        last point to the extrapolated zero cannot have crossed it.
+        The margin of the accepted points tends to zero linearly or
+        quadratically in ``u[index]`` as the boundary approaches (an impact
+        speed ``v`` may vanish like the parameter distance or like its square
+        root; the margin is ``v^2``); a candidate less than half-way from the
+        last point to the nearer of the two extrapolated zeros cannot have
+        crossed it.
         """
         if len(margins) < 2:
             return False
@@ -239,7 +242,9 @@ class Palc:
         pc = float(cand.u[self.index])
         if not (m0 > m1 > 0) or p1 == p0:
             return m1 > 0 and not m0 > m1  # moving away from the boundary: a jump
-        p_star = p1 + m1 * (p1 - p0) / (m0 - m1)
+        linear = m1 / (m0 - m1)
+        quadratic = math.sqrt(m1) / (math.sqrt(m0) - math.sqrt(m1))
+        p_star = p1 + min(linear, quadratic) * (p1 - p0)
         return (pc - p1) / (p_star - p1) < 0.5
 
     def _step(self, cur: PalcPoint, sigma: float) -> PalcPoint | None:

@@ -1,0 +1,116 @@
+"""Random small impacting models for property tests, with names chosen to collide.
+
+A drawn model is a forced oscillator (one or two degrees of freedom) with a
+stop, whose states, time and parameters are named from :data:`NAMES`: names
+the code generator or Python uses itself (``v0``/``v1`` for the variational
+matrix, ``t_0`` for common subexpressions, ``pi``, ``E``, ``I``, ``lambda``,
+numpy and math functions, the generated code's own locals...).  The forcing
+frequency sets the period, so every drawn model has a period-setting parameter.
+The first (minimal) example is the issue's case: states ``x1, v1``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import sympy as sp
+from hypothesis import strategies as st
+
+from grazing import HybridModel, Parameter
+
+NAMES = (
+    "x1", "v1", "t_0", "v0", "pi", "T", "J", "t", "t_", "x2", "v2", "E", "I", "e", "S", "N", "lambda",
+    "sin", "cos", "exp", "log", "sqrt", "math", "np", "pv", "s", "x", "out", "h", "k", "c0", "w0", "p0",
+    "xs0_0", "X", "O", "tau", "Dummy",
+)  # fmt: skip
+
+
+@dataclass(frozen=True)
+class ModelSpec:
+    """What defines a drawn model: names, degrees of freedom and parameter values."""
+
+    names: tuple[str, ...]
+    dof: int
+    damping: float
+    stiffness: float
+    amplitude: float
+    omega: float
+    stop_fraction: float
+    restitution: float
+    coupling: float
+    cubic: float
+
+    @property
+    def state_names(self) -> tuple[str, ...]:
+        return self.names[: 2 * self.dof]
+
+    @property
+    def time_name(self) -> str:
+        return self.names[2 * self.dof]
+
+    @property
+    def param_names(self) -> tuple[str, ...]:
+        """damping, stiffness, amplitude, frequency (sets the period), stop, restitution[, coupling]."""
+        return self.names[2 * self.dof + 1 : 2 * self.dof + 1 + (7 if self.dof == 2 else 6)]
+
+    @property
+    def stop(self) -> float:
+        """A stop inside the linear response amplitude, so the model impacts."""
+        k, c, w = self.stiffness, self.damping, self.omega
+        reach = self.amplitude / math.sqrt((k - w * w) ** 2 + (c * w) ** 2)
+        return self.stop_fraction * min(reach, 2.0)
+
+    def model(self) -> HybridModel:
+        states = sp.symbols(self.state_names)
+        t = sp.Symbol(self.time_name)
+        c, k, a, w, stop, r, *rest = sp.symbols(self.param_names)
+        q, p = states[0], states[1]
+        force = a * sp.cos(w * t)
+        accel = -c * p - k * q - self.cubic * q**3 + force
+        params = [
+            Parameter(str(c), self.damping, lower=0.0),
+            Parameter(str(k), self.stiffness, lower=0.0, lower_open=True),
+            Parameter(str(a), self.amplitude),
+            Parameter(str(w), self.omega, lower=0.0, lower_open=True),
+            Parameter(str(stop), self.stop),
+            Parameter(str(r), self.restitution, lower=0.0, upper=1.0),
+        ]
+        field = [p, accel]
+        reset = [q, -r * p]
+        contact = [0, 1]
+        if self.dof == 2:
+            (kc,) = rest
+            q2, p2 = states[2], states[3]
+            field = [p, accel - kc * (q - q2), p2, -c * p2 - k * q2 - kc * (q2 - q)]
+            reset = [q, -r * p, q2, p2]
+            contact = [0, 1, 0, 0]
+            params.append(Parameter(str(kc), self.coupling, lower=0.0))
+        return HybridModel(
+            "random-" + "-".join(self.names[:3]), list(states), t, params, vector_field=field,
+            guard=stop - q, reset=reset, period=2 * sp.pi / w, contact_direction=contact,
+        )  # fmt: skip
+
+    def initial_state(self) -> list[float]:
+        """At rest at the origin but moving fast enough to reach the stop in the first swing."""
+        x = [0.0] * (2 * self.dof)
+        x[1] = 1.6 * math.sqrt(self.stiffness) * self.stop + 0.3
+        return x
+
+
+@st.composite
+def model_specs(draw: st.DrawFn) -> ModelSpec:
+    """A random :class:`ModelSpec`; the names are a random selection of :data:`NAMES`."""
+    names = tuple(draw(st.permutations(NAMES)))
+    return ModelSpec(
+        names=names,
+        dof=draw(st.sampled_from([1, 2])),
+        damping=draw(st.floats(0.02, 0.2)),
+        stiffness=draw(st.floats(0.5, 2.0)),
+        amplitude=draw(st.floats(0.3, 1.0)),
+        omega=draw(st.floats(0.6, 3.0)),
+        stop_fraction=draw(st.floats(0.3, 0.8)),
+        restitution=draw(st.floats(0.5, 0.95)),
+        coupling=draw(st.floats(0.1, 1.0)),
+        cubic=draw(st.sampled_from([0.0, 0.2])),
+    )
