@@ -300,3 +300,25 @@ def test_bad_arguments(pendulum_b, kwargs, error, message):
     kwargs = {"x0": [0.0, 0.0], **kwargs}
     with pytest.raises(error, match=message):
         grazing.simulate(pendulum_b, **kwargs)
+
+
+# --------------------------------------------------------------------------
+# Sticking that begins before the recorded span (issue 11, case 6).
+
+
+def test_sticking_in_progress_when_recording_starts_is_reported(monkeypatch):
+    """The ball rides the table throughout: the recorded span is one sticking interval."""
+    m = bouncing_ball(amplitude=0.1)
+    T = m.period
+    sol = grazing.simulate(m, [0.0, 0.0], transient=50, periods=3)
+    assert len(sol.impacts) == 0
+    np.testing.assert_allclose(sol.sticking, [[50 * T, 53 * T]], atol=1e-9)
+    # From rest: a chattering sequence, then one interval to the end of the run...
+    first = grazing.simulate(m, [0.0, 0.0], periods=3)
+    assert len(first.impacts) > 10 and first.sticking.shape == (1, 2)
+    assert 0 < first.sticking[0, 0] < 0.25 and first.sticking[0, 1] == pytest.approx(3 * T, abs=1e-9)
+    # ... reported once, not cut or lost, across the engine's chunks of periods.
+    monkeypatch.setattr(simulate_module, "CHUNK_PERIODS", 2)
+    for transient, expected in ((50, sol.sticking), (0, first.sticking)):
+        chunked = grazing.simulate(m, [0.0, 0.0], transient=transient, periods=3)
+        np.testing.assert_allclose(chunked.sticking, expected, atol=1e-9)
