@@ -37,7 +37,7 @@ from grazing.cli_validate import (
     refuse_unused,
 )
 from grazing.errors import GrazingError
-from grazing.limits import MEMORY_ENV, check_memory, count_text, simulate_bytes, sweep_bytes
+from grazing.limits import MEMORY_ENV, POINT_OVERHEAD, check_memory, count_text, simulate_bytes, sweep_bytes
 from grazing.models.pendulum import CASES, DEFAULT_CASE, case_values
 
 EXIT_USAGE = 2
@@ -683,14 +683,17 @@ def _check_sweep_options(
     streamed = zarr_out and not as_json
     chunk = n_points if not chunk_size else min(chunk_size, n_points)
     n_workers = workers or os.cpu_count() or 1
+    need = sweep_bytes(n_points, periods, n_states, streamed=streamed, as_json=as_json, chunk_points=chunk,
+                       workers=n_workers)  # fmt: skip
+    chunks_dominate = streamed and need > 2 * n_points * POINT_OVERHEAD  # the samples in flight, mostly
     check_memory(
-        sweep_bytes(n_points, periods, n_states, streamed=streamed, as_json=as_json, chunk_points=chunk,
-                    workers=n_workers),
+        need,
         f"{what} of {count_text(n_points)} points x {count_text(periods)} periods",
-        "split it into several runs over parts of the range"
-        + ("" if streamed else ", or stream the results to a Zarr store (--out FILE.zarr, without --json)")
-        + ("; smaller --chunk-size" if streamed else ""),
-    )  # fmt: skip
+        "use a smaller --chunk-size (or fewer --workers): the chunks in flight hold their samples"
+        if chunks_dominate
+        else "split it into several runs over parts of the range"
+        + ("" if streamed else ", or stream the results to a Zarr store (--out FILE.zarr, without --json)"),
+    )
 
 
 class _SweepRun:

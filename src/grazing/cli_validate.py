@@ -152,9 +152,31 @@ def count(low: int) -> click.IntRange:
     return click.IntRange(min=low, max=MAX_COUNT)
 
 
+class Count(click.IntRange):
+    """An integer in a range (click's message), with the reason for the range appended.
+
+    >>> Count(1, 64, why="longer orbits are not resolved").why
+    'longer orbits are not resolved'
+    """
+
+    def __init__(self, low: int | None = None, high: int | None = None, *, why: str = ""):
+        super().__init__(min=low, max=high)
+        self.why = why
+
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        try:
+            return super().convert(value, param, ctx)
+        except click.BadParameter as exc:
+            if self.why:
+                exc.message = f"{exc.message.rstrip('.')} ({self.why})"
+            raise
+
+
 SEED = click.IntRange(min=0)
 """A random seed (numpy's generators take non-negative integers)."""
-ORBIT_PERIOD = click.IntRange(min=1, max=MAX_ORBIT_PERIOD)
+ORBIT_PERIOD = Count(
+    1, MAX_ORBIT_PERIOD, why="longer orbits are not resolved: their Floquet multipliers underflow"
+)
 WORKERS = click.IntRange(min=1, max=MAX_WORKERS)
 
 
