@@ -10,6 +10,7 @@ and nothing is written.
 from __future__ import annotations
 
 import math
+import os
 from pathlib import Path
 from typing import Any
 
@@ -539,33 +540,74 @@ def synthesize_cmd(
 ) -> None:  # fmt: skip
     """Write SYNTHETIC rig-like recordings simulated from the model (1 kHz, noise, drift, trigger)."""
     from grazing.experiment.apparatus import PAPER_RIG
-    from grazing.experiment.synthetic import synthetic_recording, synthetic_sweep, write_recording
+    from grazing.experiment.recording import MIN_SAMPLES
+    from grazing.experiment.synthetic import synthetic_recording, write_recording
 
     case_values(case)
-    n_samples = periods / PAPER_RIG.forcing_hz(min(etas)) * sample_rate
+    one_file = out.suffix.lower() == ".csv"
+    if one_file and len(etas) != 1:
+        raise _ErrorInput("several --eta values need a folder as --out, not a .csv file")
+    if not one_file and out.exists() and not out.is_dir():
+        raise _ErrorInput(f"--out {str(out)!r} exists and is not a folder")
+    if not (out.parent if str(out.parent) else Path(".")).is_dir():
+        raise _ErrorInput(f"folder {str(out.parent)!r} does not exist")
+    samples = {e: periods / PAPER_RIG.forcing_hz(e) * sample_rate for e in etas}
+    fewest = min(samples, key=samples.__getitem__)
+    if samples[fewest] < MIN_SAMPLES:
+        raise _ErrorInput(
+            f"a recording at --eta {fewest:g} would have {samples[fewest]:.3g} samples, fewer than "
+            f"{MIN_SAMPLES}: raise --sample-rate or --periods"
+        )
     check_memory(
-        recording_bytes(n_samples, periods),
-        f"a recording of {count_text(n_samples)} samples",
+        recording_bytes(max(samples.values()), periods),
+        f"a recording of {count_text(max(samples.values()))} samples",
         "lower --sample-rate or --periods (each recording is written on its own: several --eta values "
         "into a folder need no more)",
     )
     kw = {"case": case, "sample_rate": sample_rate, "noise": noise}
-    if out.suffix.lower() == ".csv":
-        if len(etas) != 1:
-            raise _ErrorInput("several --eta values need a folder as --out, not a .csv file")
-        if not (out.parent if str(out.parent) else Path(".")).is_dir():
-            raise _ErrorInput(f"folder {str(out.parent)!r} does not exist")
+    if one_file:
         rec = synthetic_recording(etas[0], theta_hat, periods=periods, transient=transient, seed=seed, **kw)
         paths = [write_recording(rec, out)]
     else:
-        if out.exists() and not out.is_dir():
-            raise _ErrorInput(f"--out {str(out)!r} exists and is not a folder")
-        paths = synthetic_sweep(out, theta_hat, etas, periods=periods, transient=transient, seed=seed, **kw)
+        kw.update(periods=periods, transient=transient, seed=seed)
+        paths = _synthesize_folder(out, theta_hat, etas, **kw)
     if as_json:
         _emit_json({"files": [str(p) for p in paths], "synthetic": True})
         return
     for p in paths:
         click.echo(f"wrote {p} (synthetic)")
+
+
+def _synthesize_folder(out: Path, theta_hat: float, etas: tuple[float, ...], **kwargs: Any) -> list[Path]:
+    """Synthetic recordings into the folder ``out``, all or nothing.
+
+    They are written into a hidden folder beside ``out``, then moved into
+    ``out`` (or the hidden folder renamed to ``out`` if it did not exist), so a
+    failure part-way leaves nothing behind.
+    """
+    import shutil
+    import tempfile
+
+    from grazing.atomic import rename_noreplace
+    from grazing.experiment.synthetic import synthetic_sweep
+
+    parent = out.parent if str(out.parent) else Path(".")
+    tmp = Path(tempfile.mkdtemp(dir=parent, prefix=f".{out.name}.partial-"))
+    try:
+        written = synthetic_sweep(tmp, theta_hat, etas, **kwargs)
+        if out.is_dir():
+            for f in sorted(tmp.iterdir()):
+                os.replace(f, out / f.name)
+            tmp.rmdir()
+        else:
+            mask = os.umask(0)
+            os.umask(mask)
+            os.chmod(tmp, 0o777 & ~mask)
+            rename_noreplace(tmp, out)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return [out / p.name for p in written]
 
 
 COMMANDS = (damping_cmd, iso_damping_cmd, fit_cmd, analyze_cmd, synthesize_cmd)

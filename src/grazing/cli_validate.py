@@ -60,7 +60,7 @@ def option_label(param: click.Parameter | None) -> str:
         if param.secondary_opts:
             return f"{longest}/{max(param.secondary_opts, key=len)}"
         return longest
-    return (param.human_readable_name or param.name or "value").upper()
+    return param.metavar or (param.name or "value").upper()
 
 
 def _fmt(v: float) -> str:
