@@ -734,7 +734,8 @@ def _run_sweep_spec(
             store = ZarrStore(
                 out, spec, attrs={"command": " ".join(["grazing", *sys.argv[1:]])}, wait=wait,
                 on_wait=lambda pid: click.echo(
-                    f"grazing: {out} is being written by another grazing run (PID {pid}); waiting", err=True
+                    f"grazing: {out} is being written by another grazing run"
+                    + (f" (PID {pid})" if pid is not None else "") + "; waiting", err=True
                 ),
             )  # fmt: skip
         ds = run_sweep(

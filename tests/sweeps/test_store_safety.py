@@ -378,6 +378,26 @@ def test_sigkill_of_the_main_process_leaves_no_process_behind(tmp_path):
     assert all_gone(workers), [p for p in workers if alive(p)]
 
 
+def test_a_worker_killed_by_the_system_is_one_line_and_takes_the_others_along(tmp_path):
+    out = tmp_path / "o.zarr"
+    proc = subprocess.Popen(_slow_cli(out), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert wait_until(lambda: len(descendants(proc.pid)) >= 2 and _chunks_done(out) >= 1)
+        workers = descendants(proc.pid)
+        os.kill(min(workers), signal.SIGKILL)  # as the OOM killer would
+        _, err = proc.communicate(timeout=300)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 1
+    assert err == (
+        "grazing: error: a worker process died (killed by the system: out of memory?); the finished "
+        "chunks are kept in a --out store: run the same command again to resume\n"
+    )
+    assert all_gone(workers)
+    assert _chunks_done(out) >= 1
+
+
 def test_ctrl_c_stops_at_once_and_keeps_the_finished_chunks(tmp_path):
     out = tmp_path / "c.zarr"
     proc = subprocess.Popen(_slow_cli(out), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,

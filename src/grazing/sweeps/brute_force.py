@@ -307,6 +307,7 @@ def _local_results(
     """
     import multiprocessing as mp
     from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+    from concurrent.futures.process import BrokenProcessPool
 
     from grazing.workers import init_worker, stop_pool_processes
 
@@ -331,9 +332,14 @@ def _local_results(
             finished, pending = wait(pending, return_when=FIRST_COMPLETED)
             for fut in finished:
                 yield fut.result()
-    except BaseException:
+    except BaseException as exc:
         stop_pool_processes(ex)  # first: shutdown() forgets the processes
         ex.shutdown(wait=False, cancel_futures=True)
+        if isinstance(exc, BrokenProcessPool):
+            raise SimulationError(
+                "a worker process died (killed by the system: out of memory?); the finished chunks "
+                "are kept in a --out store: run the same command again to resume"
+            ) from None
         raise
     ex.shutdown(wait=True)
 
@@ -366,9 +372,10 @@ def _dask_results(
     noticed = False
     try:
         while True:
+            window = max(64, in_flight(_dask_workers(client)))  # one look at the cluster per round
             for i in queue:
                 pending.add(client.submit(run_chunk, spec, i, pure=False))
-                if len(pending) >= max(64, in_flight(_dask_workers(client))):
+                if len(pending) >= window:
                     break
             if not pending:
                 break
