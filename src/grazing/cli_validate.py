@@ -9,8 +9,8 @@
 - :func:`refuse_unused` refuses an option that the other options make
   meaningless (``--which`` without ``--method map``...): no run ends with
   exit status 0 having ignored something the user asked for.
-- :func:`check_param_values` checks every value a parameter will take (both
-  ends of a continuation or sweep) before any work.
+- The values a model parameter takes (both ends of a sweep or continuation)
+  are checked by the model itself, before any work, in the commands.
 
 Every failure is an :class:`InputError`: one line, exit status 2.  This module
 imports only click (no other part of grazing), so every command module can
@@ -20,7 +20,7 @@ use it.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Iterable
+from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
@@ -220,13 +220,3 @@ def refuse_unused(names: Iterable[str], unused: bool, why: str, ctx: click.Conte
     for name in names:
         if given(ctx, name):
             raise InputError(f"{option_label(_param(ctx, name))} is not used {why}")
-
-
-def check_param_values(check: Callable[[float], Any], name: str, values: Iterable[float]) -> None:
-    """Check every value a model parameter will take (``check`` raises a one-line error).
-
-    ``check`` is typically ``lambda v: model.with_params(**{name: v})``, which
-    raises "r = 2 is outside [0, 1] ..." for the first bad value.
-    """
-    for v in values:
-        check(v)

@@ -468,3 +468,25 @@ def test_json_output_of_a_resumed_store_is_unchanged(tmp_path, monkeypatch, caps
     assert main(argv) == 0
     again = json.loads(capsys.readouterr().out)
     assert first["period"] == again["period"] and first["samples"] == again["samples"]
+
+
+def test_without_flock_the_pid_in_the_lock_file_decides(tmp_path, monkeypatch):
+    import errno
+
+    from grazing.sweeps import lock as lock_module
+
+    def no_flock(fd, op):
+        raise OSError(errno.ENOLCK, "no locks available")
+
+    monkeypatch.setattr(lock_module.fcntl, "flock", no_flock)
+    path = tmp_path / "lock"
+    path.write_text(f"{os.getppid()}\n")  # a live process holds it
+    with pytest.raises(StoreBusyError, match=f"PID {os.getppid()}"):
+        lock_module.StoreLock(path, "s.zarr").acquire()
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    path.write_text(f"{dead.pid}\n")  # its holder is gone: taken over
+    held = lock_module.StoreLock(path, "s.zarr")
+    held.acquire()
+    assert path.read_text().strip() == str(os.getpid())
+    held.release()

@@ -18,6 +18,7 @@ from __future__ import annotations
 import errno
 import fcntl
 import os
+import time
 from collections.abc import Callable
 from pathlib import Path
 
@@ -113,7 +114,8 @@ class StoreLock:
                     )
                 if on_wait is not None:
                     on_wait(holder)
-                self._flock(fd, blocking=True)
+                while not self._flock(fd, blocking=True):  # only without flock: poll the holder's PID
+                    time.sleep(0.5)
             os.ftruncate(fd, 0)
             os.pwrite(fd, f"{os.getpid()}\n".encode("ascii"), 0)
         except BaseException:
