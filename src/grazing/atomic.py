@@ -12,7 +12,11 @@ input or an error writes no half-file).
 
 from __future__ import annotations
 
+import ctypes
+import ctypes.util
+import errno
 import os
+import sys
 import tempfile
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -50,3 +54,57 @@ def write_text_atomic(path: str | Path, write: Callable[[Any], Any]) -> None:
     """Write a text file through ``write(file_handle)``, all at once."""
     with atomic_path(path) as tmp, open(tmp, "w", newline="") as fh:
         write(fh)
+
+
+_AT_FDCWD = -100
+_RENAME_NOREPLACE = 1
+
+
+def rename_noreplace(src: str | Path, dst: str | Path) -> None:
+    """Rename ``src`` to ``dst`` only if ``dst`` does not exist, atomically where the system allows.
+
+    On Linux this is ``renameat2(RENAME_NOREPLACE)``: a folder or file that
+    appears at ``dst`` meanwhile is never replaced.  Elsewhere ``dst`` is
+    checked just before an ordinary rename.
+
+    Raises
+    ------
+    FileExistsError
+        If ``dst`` exists.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> d = pathlib.Path(tempfile.mkdtemp())
+    >>> (d / "a").mkdir(); (d / "b").mkdir()
+    >>> rename_noreplace(d / "a", d / "c"); sorted(p.name for p in d.iterdir())
+    ['b', 'c']
+    >>> rename_noreplace(d / "c", d / "b")
+    Traceback (most recent call last):
+    ...
+    FileExistsError: [Errno 17] File exists: ...
+    """
+    src, dst = os.fsencode(src), os.fsencode(dst)
+    fn = _renameat2()
+    if fn is not None:
+        if fn(_AT_FDCWD, src, _AT_FDCWD, dst, _RENAME_NOREPLACE) == 0:
+            return
+        err = ctypes.get_errno()
+        if err not in (errno.ENOSYS, errno.EINVAL):
+            raise OSError(err, os.strerror(err), os.fsdecode(dst))
+    if os.path.lexists(dst):
+        raise FileExistsError(errno.EEXIST, os.strerror(errno.EEXIST), os.fsdecode(dst))
+    os.rename(src, dst)
+
+
+def _renameat2() -> Any:
+    if not sys.platform.startswith("linux"):
+        return None
+    try:
+        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
+        fn = libc.renameat2
+    except (OSError, AttributeError):
+        return None
+    fn.argtypes = [ctypes.c_int, ctypes.c_char_p, ctypes.c_int, ctypes.c_char_p, ctypes.c_uint]
+    fn.restype = ctypes.c_int
+    return fn

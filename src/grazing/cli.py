@@ -12,6 +12,7 @@ from __future__ import annotations
 import functools
 import json
 import math
+import os
 import sys
 import time
 from collections.abc import Callable
@@ -23,7 +24,20 @@ import numpy as np
 
 import grazing
 from grazing.atomic import atomic_path, write_text_atomic
+from grazing.cli_validate import (
+    ANGLE_DEG,
+    FINITE,
+    ORBIT_PERIOD,
+    POSITIVE,
+    TOLERANCE,
+    WORKERS,
+    InputError,
+    count,
+    path_type,
+    refuse_unused,
+)
 from grazing.errors import GrazingError
+from grazing.limits import MEMORY_ENV, POINT_OVERHEAD, check_memory, count_text, simulate_bytes, sweep_bytes
 from grazing.models.pendulum import CASES, DEFAULT_CASE, case_values
 
 EXIT_USAGE = 2
@@ -31,8 +45,8 @@ EXIT_FAILURE = 1
 EXIT_INTERRUPTED = 130
 
 
-class _ErrorInput(click.ClickException):
-    """A usage error reported as one line."""
+_ErrorInput = InputError
+"""A usage error reported as one line (the name the command modules use)."""
 
 
 # ----------------------------------------------------------------------------
@@ -41,7 +55,7 @@ class _ErrorInput(click.ClickException):
 
 _json_option = click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
 _netcdf_out_option = click.option(
-    "--out", type=click.Path(dir_okay=False, path_type=Path), metavar="FILE.nc", help="Save as NetCDF."
+    "--out", type=path_type(dir_okay=False), metavar="FILE.nc", help="Save as NetCDF."
 )
 
 
@@ -57,6 +71,7 @@ def model_options(func: Callable[..., Any]) -> Callable[..., Any]:
         *args: Any, case: str, alpha: float | None, beta: float | None, r: float | None, eta: float,
         theta_hat: float, **kwargs: Any,
     ) -> Any:  # fmt: skip
+        refuse_unused(["case"], None not in (alpha, beta, r), "when --alpha, --beta and --r are all given")
         model = build_pendulum(case, alpha, beta, r, eta, theta_hat)
         return func(*args, model=model, case=case, **kwargs)
 
@@ -75,7 +90,7 @@ def model_options(func: Callable[..., Any]) -> Callable[..., Any]:
         click.option(
             "--theta-hat",
             "theta_hat",
-            type=float,
+            type=ANGLE_DEG,
             default=40.0,
             show_default=True,
             metavar="DEG",
@@ -90,9 +105,7 @@ def model_options(func: Callable[..., Any]) -> Callable[..., Any]:
 def build_pendulum(
     case: str, alpha: float | None, beta: float | None, r: float | None, eta: float, theta_hat: float
 ) -> grazing.HybridModel:
-    """The pendulum model from command-line values (theta_hat in degrees)."""
-    if not math.isfinite(theta_hat) or not -180.0 < theta_hat < 180.0:
-        raise _ErrorInput(f"--theta-hat must be in (-180, 180) degrees, got {theta_hat:g}")
+    """The pendulum model from command-line values (theta_hat in degrees, checked by its option type)."""
     values = case_values(case)
     for name, val in (("alpha", alpha), ("beta", beta), ("r", r)):
         if val is not None:
@@ -204,15 +217,15 @@ def cli() -> None:
 @model_options
 @click.option("--initial", default="0,0", show_default=True, metavar="THETA,THETADOT",
               help="Initial state at tau = 0, radians.")  # fmt: skip
-@click.option("--transient", type=click.IntRange(min=0), default=500, show_default=True,
+@click.option("--transient", type=count(0), default=500, show_default=True,
               help="Forcing periods run and discarded first.")  # fmt: skip
-@click.option("--periods", type=click.IntRange(min=1), default=100, show_default=True,
+@click.option("--periods", type=count(1), default=100, show_default=True,
               help="Forcing periods sampled.")  # fmt: skip
-@click.option("--phase", type=float, default=0.0, show_default=True, metavar="PHI",
+@click.option("--phase", type=FINITE, default=0.0, show_default=True, metavar="PHI",
               help="Stroboscopic phase in radians: samples at tau = PHI mod 2 pi.")  # fmt: skip
-@click.option("--trajectory", type=click.Path(dir_okay=False, path_type=Path), metavar="FILE.csv",
+@click.option("--trajectory", type=path_type(dir_okay=False), metavar="FILE.csv",
               help="Write the dense trajectory of the sampled span to a CSV file.")  # fmt: skip
-@click.option("--points-per-period", type=click.IntRange(min=4), default=100, show_default=True,
+@click.option("--points-per-period", type=count(4), default=100, show_default=True,
               help="Trajectory resolution (with --trajectory).")  # fmt: skip
 @_json_option
 def simulate(
@@ -227,18 +240,22 @@ def simulate(
     as_json: bool,
 ) -> None:
     """Simulate the impacting pendulum; print stroboscopic samples, impacts, period."""
+    refuse_unused(["points_per_period"], trajectory is None, "without --trajectory")
     theta0, dtheta0 = _parse_pair(initial)
     if theta0 > model.params["theta_hat"]:
         raise _ErrorInput(
             f"initial angle {theta0:g} rad is beyond the stop at theta-hat = "
             f"{math.degrees(model.params['theta_hat']):g} deg ({model.params['theta_hat']:.6g} rad)"
         )
-    if not math.isfinite(phase):
-        raise _ErrorInput(f"--phase must be a finite number, got {phase}")
-    if trajectory is not None and trajectory.suffix.lower() != ".csv":
-        raise _ErrorInput(f"--trajectory must name a .csv file, got {str(trajectory)!r}")
-    if trajectory is not None and not (trajectory.parent if str(trajectory.parent) else Path(".")).is_dir():
-        raise _ErrorInput(f"folder {str(trajectory.parent)!r} does not exist")
+    _check_out(trajectory, ".csv", "--trajectory")
+    points = periods * points_per_period + 1 if trajectory is not None else 0
+    check_memory(
+        simulate_bytes(periods, model.n_states, points, as_json),
+        f"simulating {count_text(periods)} sampled periods"
+        + (f" with a trajectory of {count_text(points)} points" if points else ""),
+        "sample fewer periods (--periods; --transient runs without keeping anything)"
+        + (" or fewer --points-per-period" if points else ""),
+    )
     bar = _Progress("simulating", enabled=not as_json, unit="periods")
     t0 = time.perf_counter()
     try:
@@ -316,6 +333,12 @@ def _print_simulation(
         con.print(f"trajectory written to {trajectory}")
 
 
+def _check_eta_range(eta_min: float, eta_max: float) -> None:
+    """``--eta-min < --eta-max`` (each is positive by its option type)."""
+    if not eta_min < eta_max:
+        raise _ErrorInput(f"need 0 < --eta-min < --eta-max, got {eta_min:g} and {eta_max:g}")
+
+
 def _complex_list(mu: np.ndarray) -> list[list[float]]:
     return [[float(z.real), float(z.imag)] for z in np.asarray(mu, dtype=complex)]
 
@@ -356,12 +379,12 @@ def _orbit_json(orbit: Any) -> dict[str, Any]:
 
 @cli.command()
 @model_options
-@click.option("--period", type=click.IntRange(min=1), help="Period in forcing periods (default: detected).")
+@click.option("--period", type=ORBIT_PERIOD, help="Period in forcing periods (default: detected).")
 @click.option(
     "--initial", metavar="THETA,THETADOT", help="Initial guess at tau = 0 (default: from simulation)."
 )
-@click.option("--transient", type=click.IntRange(min=0), default=500, show_default=True,
-              help="Forcing periods simulated for the initial guess.")  # fmt: skip
+@click.option("--transient", type=count(0), default=500, show_default=True,
+              help="Forcing periods simulated for the initial guess (without --initial).")  # fmt: skip
 @_json_option
 def orbit(
     model: grazing.HybridModel,
@@ -374,6 +397,7 @@ def orbit(
     """Find a periodic orbit by Newton shooting; print its multipliers and stability."""
     from grazing.orbits import find_orbit
 
+    refuse_unused(["transient"], initial is not None, "with --initial (it runs the simulation that guesses)")
     x0 = None
     if initial is not None:
         x0 = _parse_pair(initial)
@@ -410,8 +434,8 @@ def _grazing_json(g: Any) -> dict[str, Any]:
 
 @cli.command()
 @model_options
-@click.option("--eta-min", type=float, default=0.2, show_default=True, help="Lower end of the eta range.")
-@click.option("--eta-max", type=float, default=1.0, show_default=True, help="Upper end of the eta range.")
+@click.option("--eta-min", type=POSITIVE, default=0.2, show_default=True, help="Lower end of the eta range.")
+@click.option("--eta-max", type=POSITIVE, default=1.0, show_default=True, help="Upper end of the eta range.")
 @_json_option
 def graze(
     model: grazing.HybridModel,
@@ -423,8 +447,8 @@ def graze(
     """Every grazing of the period-1 nonimpacting orbit with the stop, for eta in a range."""
     from grazing.orbits import find_grazings
 
-    if not (math.isfinite(eta_min) and math.isfinite(eta_max) and 0 < eta_min < eta_max):
-        raise _ErrorInput(f"need 0 < --eta-min < --eta-max, got {eta_min:g} and {eta_max:g}")
+    refuse_unused(["eta"], True, "by graze: it searches eta in [--eta-min, --eta-max]")
+    _check_eta_range(eta_min, eta_max)
     bar = _Progress("continuing", enabled=not as_json)
     try:
         points, branch = find_grazings(
@@ -457,11 +481,11 @@ def graze(
 @cli.command("graze-curve")
 @model_options
 @click.option(
-    "--start-deg", type=float, default=5.0, show_default=True, help="theta-hat where the curve starts."
+    "--start-deg", type=ANGLE_DEG, default=5.0, show_default=True, help="theta-hat where the curve starts."
 )
-@click.option("--eta-min", type=float, default=0.2, show_default=True, help="Lower end of the eta range.")
-@click.option("--eta-max", type=float, default=1.0, show_default=True, help="Upper end of the eta range.")
-@click.option("--max-step", type=float, default=0.05, show_default=True, help="Largest continuation step.")
+@click.option("--eta-min", type=POSITIVE, default=0.2, show_default=True, help="Lower end of the eta range.")
+@click.option("--eta-max", type=POSITIVE, default=1.0, show_default=True, help="Upper end of the eta range.")
+@click.option("--max-step", type=POSITIVE, default=0.05, show_default=True, help="Largest continuation step.")
 @_netcdf_out_option
 @_json_option
 def graze_curve(
@@ -477,12 +501,9 @@ def graze_curve(
     """Two-parameter continuation of grazing in (eta, theta-hat), with theta-hat_max."""
     from grazing.orbits import PalcSettings, grazing_curve
 
-    if not (math.isfinite(eta_min) and math.isfinite(eta_max) and 0 < eta_min < eta_max):
-        raise _ErrorInput(f"need 0 < --eta-min < --eta-max, got {eta_min:g} and {eta_max:g}")
-    if not -180 < start_deg < 180:
-        raise _ErrorInput(f"--start-deg must be in (-180, 180), got {start_deg:g}")
-    if not (math.isfinite(max_step) and max_step > 0):
-        raise _ErrorInput(f"--max-step must be positive, got {max_step:g}")
+    refuse_unused(["eta"], True, "by graze-curve: it searches eta in [--eta-min, --eta-max]")
+    refuse_unused(["theta_hat"], True, "by graze-curve: the curve starts at --start-deg")
+    _check_eta_range(eta_min, eta_max)
     _check_out(out, ".nc")
     settings = PalcSettings(ds=min(0.02, max_step), ds_max=max_step)
     curve = grazing_curve(model, ("eta", "theta_hat"), math.radians(start_deg), search=(eta_min, eta_max),
@@ -515,13 +536,13 @@ _CONTINUE_PARAMS = {"eta": "eta", "theta-hat": "theta_hat", "alpha": "alpha", "b
 @model_options
 @click.option("--param", "cparam", required=True, type=click.Choice(list(_CONTINUE_PARAMS)),
               help="Parameter to vary (theta-hat in degrees).")  # fmt: skip
-@click.option("--start", type=float, required=True, help="Start value of the parameter.")
-@click.option("--stop", type=float, required=True, help="End value of the parameter.")
-@click.option("--period", type=click.IntRange(min=1), help="Period of the orbit (default: detected).")
+@click.option("--start", type=FINITE, required=True, help="Start value of the parameter.")
+@click.option("--stop", type=FINITE, required=True, help="End value of the parameter.")
+@click.option("--period", type=ORBIT_PERIOD, help="Period of the orbit (default: detected).")
 @click.option("--initial", metavar="THETA,THETADOT", help="Initial guess at tau = 0.")
 @click.option("--virtual/--physical", default=None,
               help="Ignore the stop (default: yes for a nonimpacting starting orbit).")  # fmt: skip
-@click.option("--max-step", type=float, default=0.04, show_default=True, help="Largest continuation step.")
+@click.option("--max-step", type=POSITIVE, default=0.04, show_default=True, help="Largest continuation step.")
 @click.option("--switch", is_flag=True,
               help="At a grazing where the impact sequence changes, continue on the orbit with the new "
               "sequence (a new branch segment) instead of ending there.")  # fmt: skip
@@ -547,17 +568,19 @@ def continue_(
     from grazing.orbits import PalcSettings, continue_orbit
 
     name = _CONTINUE_PARAMS[cparam]
+    refuse_unused([name], True, f"with --param {cparam}: the branch starts at --start")
     conv = math.radians if name == "theta_hat" else float
-    if not (math.isfinite(start) and math.isfinite(stop)) or start == stop:
+    if start == stop:
         raise _ErrorInput(f"--start and --stop must be finite and differ, got {start:g} and {stop:g}")
-    if name == "theta_hat" and not (-180 < start < 180 and -180 < stop < 180):
-        raise _ErrorInput("--start and --stop for theta-hat must be in (-180, 180) degrees")
-    if not (math.isfinite(max_step) and max_step > 0):
-        raise _ErrorInput(f"--max-step must be positive, got {max_step:g}")
+    if name == "theta_hat":
+        for opt, v in (("--start", start), ("--stop", stop)):
+            if not ANGLE_DEG.accepts(v):
+                raise _ErrorInput(f"{opt} for theta-hat must be {ANGLE_DEG.describe()}, got {v:g}")
     _check_out(out, ".nc")
     x0 = _parse_pair(initial) if initial is not None else None
     a, b = conv(start), conv(stop)
-    model.with_params(**{name: a})  # validates the start value (one-line error)
+    for v in (a, b):  # both ends within the parameter's bounds, before any work ("r = 2 is outside [0, 1]")
+        model.with_params(**{name: v})
     bar = _Progress("continuing", enabled=not as_json)
     try:
         branch = continue_orbit(
@@ -616,23 +639,29 @@ _SWEEP_PARAMS = {"eta": "eta", "theta-hat": "theta_hat", "alpha": "alpha", "beta
 
 def _sweep_options(func: Callable[..., Any]) -> Callable[..., Any]:
     options = [
-        click.option("--transient", type=click.IntRange(min=0), default=500, show_default=True,
+        click.option("--transient", type=count(0), default=500, show_default=True,
                      help="Forcing periods discarded at each point.")
         ,
-        click.option("--periods", type=click.IntRange(min=1), default=100, show_default=True,
+        click.option("--periods", type=count(1), default=100, show_default=True,
                      help="Forcing periods sampled at each point."),
         click.option("--initial", default="0,0", show_default=True, metavar="THETA,THETADOT",
                      help="Initial state (of every chunk; of every point with --fresh)."),
         click.option("--fresh", is_flag=True, help="Start every point from --initial."),
-        click.option("--chunk-size", type=click.IntRange(min=0), default=None,
+        click.option("--chunk-size", type=count(0), default=None,
                      help="Points per chunk: the unit of parallel work and of saving (0: one chunk)."),
-        click.option("--workers", type=click.IntRange(min=1), help="Local processes (default: all cores)."),
+        click.option("--workers", type=WORKERS, help="Local processes (default: all cores)."),
         click.option("--scheduler", metavar="tcp://HOST:PORT", help="Run the chunks on a Dask cluster."),
+        click.option("--timeout", type=POSITIVE, metavar="SECONDS",
+                     help="With --scheduler: give up after this long without any Dask worker "
+                          "(default: wait; a message after 5 s)."),
         click.option("--no-lyapunov", is_flag=True, help="Skip the Lyapunov exponents."),
         click.option("--no-adaptive", is_flag=True, help="Always run the full transient."),
-        click.option("--tol", type=float, default=1e-10, show_default=True, help="Integrator tolerance."),
-        click.option("--out", type=click.Path(path_type=Path), metavar="FILE.zarr|FILE.nc",
-                     help="Zarr store (resumable) or NetCDF file."),
+        click.option("--tol", type=TOLERANCE, default=1e-10, show_default=True,
+                     help="Integrator tolerance, in (0, 0.01)."),
+        click.option("--out", type=path_type(), metavar="FILE.zarr|FILE.nc",
+                     help="Zarr store (resumable; one run at a time) or NetCDF file."),
+        click.option("--wait", is_flag=True,
+                     help="If another run is writing the --out store, wait for it instead of stopping."),
         _json_option,
     ]  # fmt: skip
     for opt in reversed(options):
@@ -640,27 +669,64 @@ def _sweep_options(func: Callable[..., Any]) -> Callable[..., Any]:
     return func
 
 
-def _prepare_out(out: Path | None) -> None:
-    if out is None:
-        return
-    if out.suffix.lower() not in (".zarr", ".nc"):
+def _check_sweep_options(
+    out: Path | None, scheduler: str | None, chunk_size: int | None, n_points: int, periods: int,
+    n_states: int, workers: int | None, as_json: bool, what: str,
+) -> None:  # fmt: skip
+    """The checks shared by ``sweep`` and ``map``, before any work: output, options used together, memory."""
+    if out is not None and out.suffix.lower() not in (".zarr", ".nc"):
         raise _ErrorInput(f"--out must end in .zarr or .nc, got {str(out)!r}")
-    folder = out.parent if str(out.parent) else Path(".")
-    if not folder.is_dir():
-        raise _ErrorInput(f"folder {str(folder)!r} does not exist")
+    if out is not None:
+        folder = out.parent if str(out.parent) else Path(".")
+        if not folder.is_dir():
+            raise _ErrorInput(f"folder {str(folder)!r} does not exist")
+    zarr_out = out is not None and out.suffix.lower() == ".zarr"
+    refuse_unused(["wait"], not zarr_out, "without a Zarr store (--out FILE.zarr)")
+    refuse_unused(["timeout"], scheduler is None, "without --scheduler")
+    refuse_unused(
+        ["workers"], scheduler is not None, "with --scheduler (the cluster's workers run the chunks)"
+    )
+    if zarr_out and out is not None and out.exists():
+        from grazing.sweeps.ownership import check_is_store
+
+        check_is_store(out)  # refuse what grazing did not make before computing anything
+    streamed = zarr_out and not as_json
+    chunk = n_points if not chunk_size else min(chunk_size, n_points)
+    n_workers = workers or os.cpu_count() or 1
+    need = sweep_bytes(n_points, periods, n_states, streamed=streamed, as_json=as_json, chunk_points=chunk,
+                       workers=n_workers)  # fmt: skip
+    chunks_dominate = streamed and need > 2 * n_points * POINT_OVERHEAD  # the samples in flight, mostly
+    check_memory(
+        need,
+        f"{what} of {count_text(n_points)} points x {count_text(periods)} periods",
+        "use a smaller --chunk-size (or fewer --workers): the chunks in flight hold their samples"
+        if chunks_dominate
+        else "split it into several runs over parts of the range"
+        + ("" if streamed else ", or stream the results to a Zarr store (--out FILE.zarr, without --json)"),
+    )
+
+
+class _SweepRun:
+    """What a sweep run returns to its command: the dataset, or (streamed to a store) the periods only."""
+
+    def __init__(self, ds: Any, period: np.ndarray | None):
+        self.ds = ds
+        self.period = period
 
 
 def _run_sweep_spec(
-    spec: Any, out: Path | None, scheduler: str | None, workers: int | None, as_json: bool
-) -> Any:
-    """Run a sweep spec with the CLI's storage, cluster and progress options."""
+    spec: Any, out: Path | None, scheduler: str | None, workers: int | None, as_json: bool,
+    wait: bool = False, timeout: float | None = None,
+) -> _SweepRun:  # fmt: skip
+    """Run a sweep spec with the CLI's storage, cluster and progress options.
+
+    With a Zarr store and no ``--json``, the results stream to the store and
+    only the detected periods are read back (for the summary).
+    """
     from grazing.sweeps.brute_force import run_sweep
 
-    store = None
-    if out is not None and out.suffix.lower() == ".zarr":
-        from grazing.sweeps.store import ZarrStore
-
-        store = ZarrStore(out, spec, attrs={"command": " ".join(["grazing", *sys.argv[1:]])})
+    zarr_out = out is not None and out.suffix.lower() == ".zarr"
+    streamed = zarr_out and not as_json
     client = None
     if scheduler is not None:
         try:
@@ -669,16 +735,33 @@ def _run_sweep_spec(
             client = Client(scheduler, timeout="5s")
         except (OSError, TimeoutError, ValueError) as exc:
             raise _ErrorInput(f"cannot connect to the Dask scheduler at {scheduler}: {exc}") from None
+    store: Any = None
     bar = _Progress("sweeping", enabled=not as_json, unit="points")
     try:
-        ds = run_sweep(spec, store=store, workers=workers, client=client, progress=bar)
+        if zarr_out:
+            from grazing.sweeps.store import ZarrStore
+
+            store = ZarrStore(
+                out, spec, attrs={"command": " ".join(["grazing", *sys.argv[1:]])}, wait=wait,
+                on_wait=lambda pid: click.echo(
+                    f"grazing: {out} is being written by another grazing run"
+                    + (f" (PID {pid})" if pid is not None else "") + "; waiting", err=True
+                ),
+            )  # fmt: skip
+        ds = run_sweep(
+            spec, store=store, workers=workers, client=client, progress=bar, timeout=timeout,
+            notice=lambda msg: click.echo(f"grazing: {msg}", err=True), load=not streamed,
+        )  # fmt: skip
+        period = store.read("period") if streamed else None
     finally:
         bar.close()
+        if store is not None:
+            store.close()
         if client is not None:
             client.close()
     if out is not None and out.suffix.lower() == ".nc":
         _save_dataset(ds, out)
-    return ds
+    return _SweepRun(ds, period)
 
 
 def _sweep_json(ds: Any, param: str, values: np.ndarray) -> dict[str, Any]:
@@ -699,9 +782,9 @@ def _sweep_json(ds: Any, param: str, values: np.ndarray) -> dict[str, Any]:
 @model_options
 @click.option("--param", "sparam", required=True, type=click.Choice(list(_SWEEP_PARAMS)),
               help="Parameter to sweep (theta-hat in degrees).")  # fmt: skip
-@click.option("--start", type=float, required=True, help="First parameter value.")
-@click.option("--stop", type=float, required=True, help="Last parameter value.")
-@click.option("--num", type=click.IntRange(min=1), required=True, help="Number of parameter values.")
+@click.option("--start", type=FINITE, required=True, help="First parameter value.")
+@click.option("--stop", type=FINITE, required=True, help="Last parameter value.")
+@click.option("--num", type=count(1), required=True, help="Number of parameter values.")
 @click.option("--direction", type=click.Choice(["up", "down"]), default="up", show_default=True,
               help="Order in which the values are visited.")  # fmt: skip
 @click.option(
@@ -718,18 +801,20 @@ def sweep_cmd(
     model: grazing.HybridModel, case: str,
     sparam: str, start: float, stop: float, num: int, direction: str, method: str, which: str,
     transient: int, periods: int, initial: str, fresh: bool, chunk_size: int | None, workers: int | None,
-    scheduler: str | None, no_lyapunov: bool, no_adaptive: bool, tol: float, out: Path | None, as_json: bool,
+    scheduler: str | None, timeout: float | None, no_lyapunov: bool, no_adaptive: bool, tol: float,
+    out: Path | None, wait: bool, as_json: bool,
 ) -> None:  # fmt: skip
     """Brute-force bifurcation diagram: stroboscopic samples, periods, impacts and
     Lyapunov exponents along a parameter range."""
     from grazing.sweeps.brute_force import SweepSpec
 
     name = _SWEEP_PARAMS[sparam]
-    if not (math.isfinite(start) and math.isfinite(stop)):
-        raise _ErrorInput("--start and --stop must be finite")
-    if not (math.isfinite(tol) and 0 < tol < 1e-2):
-        raise _ErrorInput(f"--tol must be in (0, 0.01), got {tol:g}")
-    _prepare_out(out)
+    refuse_unused([name], True, f"with --param {sparam}: the swept values replace it")
+    refuse_unused(["which"], method != "map", "without --method map")
+    chunk_size = 50 if chunk_size is None else chunk_size
+    _check_sweep_options(
+        out, scheduler, chunk_size, num, periods, model.n_states, workers, as_json, "a sweep"
+    )
     shown = np.linspace(start, stop, num)
     vals = np.radians(shown) if name == "theta_hat" else shown
     order = np.sort(vals) if direction == "up" else np.sort(vals)[::-1]
@@ -742,21 +827,24 @@ def sweep_cmd(
     spec = SweepSpec(
         model=model, params=(name,), points=tuple((float(v),) for v in order),
         x0=tuple(float(v) for v in model.with_params(**{name: order[0]}).check_state(x0)),
-        transient=transient, periods=periods, fresh=fresh,
-        chunk_size=50 if chunk_size is None else chunk_size,
+        transient=transient, periods=periods, fresh=fresh, chunk_size=chunk_size,
         adaptive=not no_adaptive, lyapunov=not no_lyapunov, tol=tol, zdm=zdm,
     )  # fmt: skip
     t0 = time.perf_counter()
-    ds = _run_sweep_spec(spec, out, scheduler, workers, as_json).sortby("value")
+    run = _run_sweep_spec(spec, out, scheduler, workers, as_json, wait, timeout)
     elapsed = time.perf_counter() - t0
-    res = {"params": model_params_json(model, case), **_sweep_json(ds, sparam, np.sort(shown))}
-    res.update({"direction": direction, "fresh": fresh, "transient": transient, "periods": periods,
-                "chunk_size": spec.size, "elapsed_s": elapsed, "out": str(out) if out else None,
-                "method": method, "grazing": graze_info})  # fmt: skip
     if as_json:
+        ds = run.ds.sortby("value")
+        res = {"params": model_params_json(model, case), **_sweep_json(ds, sparam, np.sort(shown))}
+        res.update({"direction": direction, "fresh": fresh, "transient": transient, "periods": periods,
+                    "chunk_size": spec.size, "elapsed_s": elapsed, "out": str(out) if out else None,
+                    "method": method, "grazing": graze_info})  # fmt: skip
         _emit_json(res)
         return
-    per = ds.period.values
+    if run.ds is not None:
+        per = run.ds.sortby("value").period.values
+    else:  # streamed to the store: the periods in visiting order, sorted like the values
+        per = run.period[np.argsort(order, kind="stable")]
     click.echo(f"{num} values of {sparam} in {elapsed:.1f} s ({num / elapsed:.0f} points/s)")
     click.echo(f"periodic points: {(per > 0).sum()}, no period <= 64: {(per == 0).sum()}")
     for p in sorted(set(per[per > 0].tolist()))[:12]:
@@ -797,8 +885,8 @@ def _map_for_sweep(model: Any, name: str, lo: float, hi: float, which: str) -> t
     show_default=True,
     help="First or second grazing in eta at this theta-hat.",
 )
-@click.option("--eta-min", type=float, default=0.2, show_default=True, help="Lower end of the eta search.")
-@click.option("--eta-max", type=float, default=1.0, show_default=True, help="Upper end of the eta search.")
+@click.option("--eta-min", type=POSITIVE, default=0.2, show_default=True, help="Lower end of the eta search.")
+@click.option("--eta-max", type=POSITIVE, default=1.0, show_default=True, help="Upper end of the eta search.")
 @click.option(
     "--check", is_flag=True, help="Also simulate just past grazing and compare with the prediction."
 )
@@ -811,8 +899,8 @@ def normal_form_cmd(
     discontinuity map's coefficients and the predicted scenario past grazing."""
     from grazing.normalform import find_grazing_point, normal_form_at, observe, predict
 
-    if not (math.isfinite(eta_min) and math.isfinite(eta_max) and 0 < eta_min < eta_max):
-        raise _ErrorInput(f"need 0 < --eta-min < --eta-max, got {eta_min:g} and {eta_max:g}")
+    refuse_unused(["eta"], True, "by normal-form: it searches eta in [--eta-min, --eta-max]")
+    _check_eta_range(eta_min, eta_max)
     point = find_grazing_point(model, "eta", eta_min, eta_max, which)
     nf = normal_form_at(point)
     pred = predict(nf)
@@ -857,19 +945,20 @@ def normal_form_cmd(
 @cli.command("map")
 @model_options
 @click.option("--param1", required=True, type=click.Choice(list(_SWEEP_PARAMS)), help="Horizontal parameter.")
-@click.option("--start1", type=float, required=True)
-@click.option("--stop1", type=float, required=True)
-@click.option("--num1", type=click.IntRange(min=1), required=True)
+@click.option("--start1", type=FINITE, required=True)
+@click.option("--stop1", type=FINITE, required=True)
+@click.option("--num1", type=count(1), required=True)
 @click.option("--param2", required=True, type=click.Choice(list(_SWEEP_PARAMS)), help="Vertical parameter.")
-@click.option("--start2", type=float, required=True)
-@click.option("--stop2", type=float, required=True)
-@click.option("--num2", type=click.IntRange(min=1), required=True)
+@click.option("--start2", type=FINITE, required=True)
+@click.option("--stop2", type=FINITE, required=True)
+@click.option("--num2", type=count(1), required=True)
 @_sweep_options
 def map_cmd(
     model: grazing.HybridModel, case: str,
     param1: str, start1: float, stop1: float, num1: int, param2: str, start2: float, stop2: float, num2: int,
     transient: int, periods: int, initial: str, fresh: bool, chunk_size: int | None, workers: int | None,
-    scheduler: str | None, no_lyapunov: bool, no_adaptive: bool, tol: float, out: Path | None, as_json: bool,
+    scheduler: str | None, timeout: float | None, no_lyapunov: bool, no_adaptive: bool, tol: float,
+    out: Path | None, wait: bool, as_json: bool,
 ) -> None:  # fmt: skip
     """Two-parameter map of periods, impacts and Lyapunov exponents."""
     from grazing.sweeps.brute_force import SweepSpec
@@ -877,10 +966,10 @@ def map_cmd(
     if param1 == param2:
         raise _ErrorInput("--param1 and --param2 must differ")
     n1, n2 = _SWEEP_PARAMS[param1], _SWEEP_PARAMS[param2]
-    for v in (start1, stop1, start2, stop2):
-        if not math.isfinite(v):
-            raise _ErrorInput("parameter ranges must be finite")
-    _prepare_out(out)
+    refuse_unused([n1, n2], True, f"with --param1 {param1} --param2 {param2}: the mapped values replace it")
+    chunk_size = num1 if chunk_size is None else chunk_size
+    _check_sweep_options(out, scheduler, chunk_size, num1 * num2, periods, model.n_states, workers, as_json,
+                         "a map")  # fmt: skip
     s1, s2 = np.linspace(start1, stop1, num1), np.linspace(start2, stop2, num2)
     v1 = np.radians(s1) if n1 == "theta_hat" else s1
     v2 = np.radians(s2) if n2 == "theta_hat" else s2
@@ -891,27 +980,27 @@ def map_cmd(
     spec = SweepSpec(
         model=model, params=(n1, n2), points=tuple((float(a), float(b)) for b in v2 for a in v1),
         x0=tuple(float(v) for v in model.with_params(**{n1: v1[0], n2: v2[0]}).check_state(x0)),
-        transient=transient, periods=periods, fresh=fresh,
-        chunk_size=num1 if chunk_size is None else chunk_size,
+        transient=transient, periods=periods, fresh=fresh, chunk_size=chunk_size,
         adaptive=not no_adaptive, lyapunov=not no_lyapunov, tol=tol, shape=(num2, num1),
     )  # fmt: skip
     t0 = time.perf_counter()
-    ds = _run_sweep_spec(spec, out, scheduler, workers, as_json)
+    run = _run_sweep_spec(spec, out, scheduler, workers, as_json, wait, timeout)
     elapsed = time.perf_counter() - t0
-    res = {
-        "params": model_params_json(model, case),
-        "param1": param1, "values1": np.sort(s1), "param2": param2, "values2": np.sort(s2),
-        "period": ds.period.values, "impacts_per_period": ds.impacts_per_period.values,
-        "lyapunov": ds.lyapunov.values, "elapsed_s": elapsed, "out": str(out) if out else None,
-    }  # fmt: skip
     if as_json:
+        ds = run.ds
+        res = {
+            "params": model_params_json(model, case),
+            "param1": param1, "values1": np.sort(s1), "param2": param2, "values2": np.sort(s2),
+            "period": ds.period.values, "impacts_per_period": ds.impacts_per_period.values,
+            "lyapunov": ds.lyapunov.values, "elapsed_s": elapsed, "out": str(out) if out else None,
+        }  # fmt: skip
         res["impacts_per_period"] = [
             [None if not math.isfinite(x) else x for x in row] for row in res["impacts_per_period"]
         ]
         res["lyapunov"] = [[None if not math.isfinite(x) else x for x in row] for row in res["lyapunov"]]
         _emit_json(res)
         return
-    per = ds.period.values
+    per = run.ds.period.values if run.ds is not None else run.period
     click.echo(
         f"{num1} x {num2} map in {elapsed:.1f} s; periodic cells {(per > 0).sum()}, none {(per == 0).sum()}"
     )
@@ -920,7 +1009,7 @@ def map_cmd(
 
 
 @cli.command()
-@click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=Path("report"),
+@click.option("--out", type=path_type(file_okay=False), default=Path("report"),
               show_default=True, help="Output folder for index.html and figures.")  # fmt: skip
 def report(out: Path) -> None:
     """Regenerate the paper's figures and tables into an HTML report."""
@@ -948,15 +1037,23 @@ def main(argv: list[str] | None = None) -> int:
         click.echo("grazing: interrupted", err=True)
         return EXIT_INTERRUPTED
     except click.ClickException as exc:
-        click.echo(f"grazing: error: {exc.format_message()}", err=True)
+        _error_line(exc.format_message())
         return EXIT_USAGE
     except GrazingError as exc:
-        click.echo(f"grazing: error: {exc}", err=True)
+        _error_line(str(exc))
         return EXIT_FAILURE
     except OSError as exc:
-        click.echo(f"grazing: error: {exc.strerror or exc}: {exc.filename or ''}".rstrip(": "), err=True)
+        _error_line(f"{exc.strerror or exc}: {exc.filename or ''}".rstrip(": "))
+        return EXIT_FAILURE
+    except MemoryError:
+        _error_line(f"out of memory (the estimate before the run was too low; {MEMORY_ENV} lowers the bound)")
         return EXIT_FAILURE
     return 0
+
+
+def _error_line(message: str) -> None:
+    """``grazing: error: MESSAGE`` as one line on stderr (click's multi-line messages are joined)."""
+    click.echo(f"grazing: error: {' '.join(message.split())}", err=True)
 
 
 if __name__ == "__main__":  # pragma: no cover - `python -m grazing.cli`: use the importable module

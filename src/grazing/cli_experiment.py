@@ -10,6 +10,7 @@ and nothing is written.
 from __future__ import annotations
 
 import math
+import os
 from pathlib import Path
 from typing import Any
 
@@ -18,6 +19,26 @@ import numpy as np
 
 from grazing.atomic import atomic_path
 from grazing.cli import _check_out, _emit_json, _ErrorInput, _json_option, _Progress, _write_atomic
+from grazing.cli_validate import (
+    AMPLITUDE_DEG,
+    ANGLE_DEG,
+    FINITE,
+    NON_NEGATIVE,
+    POSITIVE,
+    SAMPLE_RATE,
+    SEED,
+    count,
+    path_type,
+    refuse_unused,
+)
+from grazing.limits import (
+    check_memory,
+    count_text,
+    curve_bytes,
+    decay_bytes,
+    recording_bytes,
+    sweep_bytes,
+)
 from grazing.models.pendulum import CASES, DEFAULT_CASE, case_values
 
 _RELATIONS = ["model", "paper", "protocol"]
@@ -40,9 +61,20 @@ def _r_beta(case: str, r: float | None, beta: float | None) -> tuple[float, floa
 
 
 def _amplitude_rad(amplitude: float) -> float:
-    if not (math.isfinite(amplitude) and 0.0 < amplitude < 180.0):
-        raise _ErrorInput(f"--amplitude must be in (0, 180) degrees, got {amplitude:g}")
+    """The release angle in radians (its range is checked by the option's type)."""
     return math.radians(amplitude)
+
+
+def _check_decay_memory(r: float, beta: float, amplitude_rad: float, peaks: int) -> None:
+    """Refuse a free decay (``--peaks``) whose trajectory would not fit in memory."""
+    from grazing.experiment import damping as dmp
+
+    n = dmp.decay_peaks(r, beta, amplitude_rad, peaks)
+    check_memory(
+        decay_bytes(dmp.decay_cycles(n, amplitude_rad)),
+        f"a free decay of {count_text(n)} peaks",
+        "ask for fewer --peaks",
+    )
 
 
 _case_option = click.option(
@@ -54,14 +86,14 @@ _case_option = click.option(
 )
 _amplitude_option = click.option(
     "--amplitude",
-    type=float,
+    type=AMPLITUDE_DEG,
     default=_DEFAULT_AMPLITUDE_DEG,
     show_default="28.65 (0.5 rad)",
     metavar="DEG",
     help="Release angle of the free decay below the stop, degrees.",
 )
 _peaks_option = click.option(
-    "--peaks", type=click.IntRange(min=1), default=10, show_default=True, help="Peaks after the release used."
+    "--peaks", type=count(1), default=10, show_default=True, help="Peaks after the release used."
 )
 _norm_option = click.option(
     "--normalisation",
@@ -82,10 +114,10 @@ _norm_option = click.option(
 @click.option("--beta", type=float, help="Linear damping.")
 @_amplitude_option
 @_peaks_option
-@click.option("--k-hat", "k_hat", type=click.IntRange(min=1), multiple=True,
+@click.option("--k-hat", "k_hat", type=count(1), multiple=True,
               help="Peak spacing(s) to average over (repeatable; default 1).")  # fmt: skip
 @_norm_option
-@click.option("--recording", type=click.Path(path_type=Path), metavar="FILE.csv",
+@click.option("--recording", type=path_type(dir_okay=False), metavar="FILE.csv",
               help="Estimate D from a recorded free decay (time,angle) instead of the model.")  # fmt: skip
 @click.option("--degrees", is_flag=True, help="The recording's angle is in degrees.")
 @_json_option
@@ -96,6 +128,9 @@ def damping_cmd(
     """Logarithmic-decrement damping D (paper eq. 1) of the model's free decay, or of a recording."""
     from grazing.experiment import damping as dmp
 
+    model_only = ["case", "r", "beta", "amplitude", "peaks"]
+    refuse_unused(model_only, recording is not None, "with --recording (it sets the model's free decay)")
+    refuse_unused(["degrees"], recording is None, "without --recording")
     ks = k_hat or (1,)
     if recording is not None:
         from grazing.experiment.recording import load_recording
@@ -128,6 +163,7 @@ def damping_cmd(
     dmp._check_r_beta(rv, bv)
     if max(ks) > peaks:
         raise _ErrorInput(f"--k-hat {max(ks)} needs at least as many --peaks (got {peaks})")
+    _check_decay_memory(rv, bv, amp, peaks)
     dec = dmp.free_decay(rv, bv, amplitude=amp, peaks=peaks)
     est = dmp.log_decrement(dec.amplitudes, ks, normalisation=normalisation)  # type: ignore[arg-type]
     out = {
@@ -169,14 +205,14 @@ def _write_curve_csv(r: np.ndarray, beta: np.ndarray, fh: Any) -> None:
 @click.command("iso-damping")
 @click.option("--damping", "damping", type=float, default=0.07, show_default=True, metavar="D",
               help="Target damping D.")  # fmt: skip
-@click.option("--num", type=click.IntRange(min=2), default=21, show_default=True, help="Points on the curve.")
+@click.option("--num", type=count(2), default=21, show_default=True, help="Points on the curve.")
 @click.option("--relation", type=click.Choice(_RELATIONS), default="model", show_default=True,
               help="model: root-finding on the model (eq. 6 normalisation); paper: D = beta - ln(r)/(4 pi); "
                    "protocol: eq. 1 on the model with doubled damping.")  # fmt: skip
 @_amplitude_option
 @_peaks_option
 @_norm_option
-@click.option("--out", type=click.Path(dir_okay=False, path_type=Path), metavar="FILE.csv",
+@click.option("--out", type=path_type(dir_okay=False), metavar="FILE.csv",
               help="Write the curve (r,beta) to a CSV file.")  # fmt: skip
 @_json_option
 def iso_damping_cmd(
@@ -186,12 +222,12 @@ def iso_damping_cmd(
     """The curve of (r, beta) along which the measured damping is D (fig 4b)."""
     from grazing.experiment import damping as dmp
 
+    refuse_unused(["normalisation"], relation != "model", f"with --relation {relation}")
     amp = _amplitude_rad(amplitude)
-    if out is not None:
-        if out.suffix.lower() != ".csv":
-            raise _ErrorInput(f"--out must name a .csv file, got {str(out)!r}")
-        if not (out.parent if str(out.parent) else Path(".")).is_dir():
-            raise _ErrorInput(f"folder {str(out.parent)!r} does not exist")
+    _check_out(out, ".csv")
+    check_memory(curve_bytes(num), f"a curve of {count_text(num)} points", "ask for fewer --num")
+    for pr, pb in dmp.PAPER_POINTS.values():
+        _check_decay_memory(pr, pb, amp, peaks)
     protocol: dict[str, Any] = {}
     if relation == "model":
         protocol = {"amplitude": amp, "peaks": peaks, "normalisation": normalisation}
@@ -242,13 +278,13 @@ def iso_damping_cmd(
 
 
 @click.command("fit")
-@click.option("--theta-hat", "theta_hat", type=float, default=40.0, show_default=True, metavar="DEG",
+@click.option("--theta-hat", "theta_hat", type=ANGLE_DEG, default=40.0, show_default=True, metavar="DEG",
               help="Stop angle of the observed grazing, degrees.")  # fmt: skip
-@click.option("--eta-graze", "eta_graze", type=float, default=0.445, show_default=True, metavar="E",
+@click.option("--eta-graze", "eta_graze", type=POSITIVE, default=0.445, show_default=True, metavar="E",
               help="Observed eta of the primary grazing.")  # fmt: skip
 @click.option("--damping", "damping", type=float, default=0.07, show_default=True, metavar="D",
               help="Measured damping D.")  # fmt: skip
-@click.option("--alpha", type=float, default=CASES["B"]["alpha"], show_default=True, help="Forcing A/L.")
+@click.option("--alpha", type=POSITIVE, default=CASES["B"]["alpha"], show_default=True, help="Forcing A/L.")
 @click.option("--relation", type=click.Choice(_RELATIONS), default="model", show_default=True,
               help="Which equal-damping curve (see iso-damping).")  # fmt: skip
 @_json_option
@@ -258,10 +294,6 @@ def fit_cmd(
     """Fit beta and r: the point of the equal-damping curve whose primary grazing is at the observed eta."""
     from grazing.experiment.fit import fit_parameters
 
-    if not (math.isfinite(theta_hat) and -180.0 < theta_hat < 180.0):
-        raise _ErrorInput(f"--theta-hat must be in (-180, 180) degrees, got {theta_hat:g}")
-    if not (math.isfinite(alpha) and alpha > 0):
-        raise _ErrorInput(f"--alpha must be positive, got {alpha:g}")
     fit = fit_parameters(theta_hat, eta_graze, damping, alpha=alpha, relation=relation)  # type: ignore[arg-type]
     res = {
         "beta": fit.beta,
@@ -336,25 +368,26 @@ def _plot_recording(a: Any, path: Path) -> None:
 
 
 @click.command("analyze")
-@click.argument("path", type=click.Path(path_type=Path), metavar="FILE.csv|DIR")
-@click.option("--forcing-hz", "forcing_hz", type=float, metavar="F",
+@click.argument("path", type=path_type(), metavar="FILE.csv|DIR")
+@click.option("--forcing-hz", "forcing_hz", type=POSITIVE, metavar="F",
               help="Forcing frequency, Hz (needed without a trigger column; t = 0 is phase 0).")  # fmt: skip
-@click.option("--phase", type=float, default=0.0, show_default=True, metavar="PHI",
+@click.option("--phase", type=FINITE, default=0.0, show_default=True, metavar="PHI",
               help="Sampling phase in radians after the reference (trigger or t = 0).")  # fmt: skip
 @click.option("--degrees", is_flag=True, help="The angle column is in degrees.")
-@click.option("--cutoff-hz", type=float, help="Low-pass cutoff in Hz (default: a multiple of the forcing).")
-@click.option("--cutoff-multiple", type=float, default=20.0, show_default=True,
+@click.option("--cutoff-hz", type=POSITIVE,
+              help="Low-pass cutoff in Hz (default: a multiple of the forcing).")  # fmt: skip
+@click.option("--cutoff-multiple", type=POSITIVE, default=20.0, show_default=True,
               help="Default cutoff in multiples of the forcing frequency.")  # fmt: skip
 @click.option("--max-period", type=click.IntRange(min=1, max=64), default=32, show_default=True,
               help="Largest period tested.")  # fmt: skip
-@click.option("--noise", type=float, help="Noise level of the angle in rad (default: estimated).")
-@click.option("--theta-hat", "theta_hat", type=float, metavar="DEG",
+@click.option("--noise", type=POSITIVE, help="Noise level of the angle in rad (default: estimated).")
+@click.option("--theta-hat", "theta_hat", type=ANGLE_DEG, metavar="DEG",
               help="Stop angle for a folder (default: from the sidecar JSON files).")  # fmt: skip
 @click.option("--with-model", is_flag=True, help="For a folder: also sweep the model (case, same theta-hat).")
 @_case_option
-@click.option("--model-points", type=click.IntRange(min=2), default=101, show_default=True,
+@click.option("--model-points", type=count(2), default=101, show_default=True,
               help="Model sweep points (with --with-model).")  # fmt: skip
-@click.option("--plot", type=click.Path(dir_okay=False, path_type=Path), metavar="FILE.png",
+@click.option("--plot", type=path_type(dir_okay=False), metavar="FILE.png",
               help="Draw the time series and embedding (file) or the diagram (folder).")  # fmt: skip
 @_json_option
 def analyze_cmd(
@@ -367,22 +400,25 @@ def analyze_cmd(
     from grazing.experiment.signal import analyze_recording
 
     _check_out(plot, ".png", "--plot")
-    if not math.isfinite(phase):
-        raise _ErrorInput(f"--phase must be a finite number, got {phase}")
-    if noise is not None and not (math.isfinite(noise) and noise > 0):
-        raise _ErrorInput(f"--noise must be positive, got {noise:g}")
-    if theta_hat is not None and not (math.isfinite(theta_hat) and -180 < theta_hat < 180):
-        raise _ErrorInput(f"--theta-hat must be in (-180, 180) degrees, got {theta_hat:g}")
     case_values(case)
+    refuse_unused(["case", "model_points"], not with_model, "without --with-model")
+    refuse_unused(["cutoff_multiple"], cutoff_hz is not None, "with --cutoff-hz")
     if path.is_dir():
         for name, val in (("--forcing-hz", forcing_hz), ("--cutoff-hz", cutoff_hz), ("--noise", noise)):
             if val is not None:
                 raise _ErrorInput(f"{name} applies to a single recording, not to a folder")
+        if with_model:
+            check_memory(
+                sweep_bytes(model_points, 60, 2, streamed=False, as_json=as_json, chunk_points=50, workers=1),
+                f"a model sweep of {count_text(model_points)} points",
+                "ask for fewer --model-points",
+            )
         _analyze_folder(path, phase, degrees, cutoff_multiple, max_period, theta_hat, with_model, case,
                         model_points, plot, as_json)  # fmt: skip
         return
     if with_model:
         raise _ErrorInput("--with-model applies to a folder of recordings")
+    refuse_unused(["theta_hat"], True, "for a single recording (it is the stop angle of a folder's diagram)")
     rec = load_recording(path, degrees=degrees)
     a = analyze_recording(
         rec, forcing_hz, phase=phase, cutoff_hz=cutoff_hz, cutoff_multiple=cutoff_multiple,
@@ -482,19 +518,20 @@ def _analyze_folder(
 
 
 @click.command("synthesize")
-@click.option("--eta", "etas", type=float, multiple=True, required=True,
+@click.option("--eta", "etas", type=POSITIVE, multiple=True, required=True,
               help="Frequency ratio (repeat for a sweep into a folder).")  # fmt: skip
-@click.option("--theta-hat", "theta_hat", type=float, default=40.0, show_default=True, metavar="DEG",
+@click.option("--theta-hat", "theta_hat", type=ANGLE_DEG, default=40.0, show_default=True, metavar="DEG",
               help="Stop angle, degrees.")  # fmt: skip
 @_case_option
-@click.option("--periods", type=click.IntRange(min=8), default=100, show_default=True,
+@click.option("--periods", type=count(8), default=100, show_default=True,
               help="Forcing periods recorded.")  # fmt: skip
-@click.option("--transient", type=click.IntRange(min=0), default=500, show_default=True,
+@click.option("--transient", type=count(0), default=500, show_default=True,
               help="Forcing periods simulated before recording.")  # fmt: skip
-@click.option("--sample-rate", type=float, default=1000.0, show_default=True, help="Samples per second.")
-@click.option("--noise", type=float, default=1e-3, show_default=True, help="Sensor noise, rad.")
-@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the noise.")
-@click.option("--out", type=click.Path(path_type=Path), required=True, metavar="FILE.csv|DIR",
+@click.option("--sample-rate", type=SAMPLE_RATE, default=1000.0, show_default=True,
+              help="Samples per second, at most 1e6 (times are written to the microsecond).")  # fmt: skip
+@click.option("--noise", type=NON_NEGATIVE, default=1e-3, show_default=True, help="Sensor noise, rad.")
+@click.option("--seed", type=SEED, default=0, show_default=True, help="Seed of the noise (>= 0).")
+@click.option("--out", type=path_type(), required=True, metavar="FILE.csv|DIR",
               help="A .csv file (one --eta) or a folder (several).")  # fmt: skip
 @_json_option
 def synthesize_cmd(
@@ -502,35 +539,75 @@ def synthesize_cmd(
     noise: float, seed: int, out: Path, as_json: bool,
 ) -> None:  # fmt: skip
     """Write SYNTHETIC rig-like recordings simulated from the model (1 kHz, noise, drift, trigger)."""
-    from grazing.experiment.synthetic import synthetic_recording, synthetic_sweep, write_recording
+    from grazing.experiment.apparatus import PAPER_RIG
+    from grazing.experiment.recording import MIN_SAMPLES
+    from grazing.experiment.synthetic import synthetic_recording, write_recording
 
     case_values(case)
-    for e in etas:
-        if not (math.isfinite(e) and e > 0):
-            raise _ErrorInput(f"--eta must be positive, got {e:g}")
-    if not (math.isfinite(theta_hat) and -180 < theta_hat < 180):
-        raise _ErrorInput(f"--theta-hat must be in (-180, 180) degrees, got {theta_hat:g}")
-    if not (math.isfinite(sample_rate) and sample_rate > 0):
-        raise _ErrorInput(f"--sample-rate must be positive, got {sample_rate:g}")
-    if not (math.isfinite(noise) and noise >= 0):
-        raise _ErrorInput(f"--noise must be >= 0, got {noise:g}")
+    one_file = out.suffix.lower() == ".csv"
+    if one_file and len(etas) != 1:
+        raise _ErrorInput("several --eta values need a folder as --out, not a .csv file")
+    if not one_file and out.exists() and not out.is_dir():
+        raise _ErrorInput(f"--out {str(out)!r} exists and is not a folder")
+    if not (out.parent if str(out.parent) else Path(".")).is_dir():
+        raise _ErrorInput(f"folder {str(out.parent)!r} does not exist")
+    samples = {e: periods / PAPER_RIG.forcing_hz(e) * sample_rate for e in etas}
+    fewest = min(samples, key=samples.__getitem__)
+    if samples[fewest] < MIN_SAMPLES:
+        raise _ErrorInput(
+            f"a recording at --eta {fewest:g} would have {samples[fewest]:.3g} samples, fewer than "
+            f"{MIN_SAMPLES}: raise --sample-rate or --periods"
+        )
+    check_memory(
+        recording_bytes(max(samples.values()), periods),
+        f"a recording of {count_text(max(samples.values()))} samples",
+        "lower --sample-rate or --periods (each recording is written on its own: several --eta values "
+        "into a folder need no more)",
+    )
     kw = {"case": case, "sample_rate": sample_rate, "noise": noise}
-    if out.suffix.lower() == ".csv":
-        if len(etas) != 1:
-            raise _ErrorInput("several --eta values need a folder as --out, not a .csv file")
-        if not (out.parent if str(out.parent) else Path(".")).is_dir():
-            raise _ErrorInput(f"folder {str(out.parent)!r} does not exist")
+    if one_file:
         rec = synthetic_recording(etas[0], theta_hat, periods=periods, transient=transient, seed=seed, **kw)
         paths = [write_recording(rec, out)]
     else:
-        if out.exists() and not out.is_dir():
-            raise _ErrorInput(f"--out {str(out)!r} exists and is not a folder")
-        paths = synthetic_sweep(out, theta_hat, etas, periods=periods, transient=transient, seed=seed, **kw)
+        kw.update(periods=periods, transient=transient, seed=seed)
+        paths = _synthesize_folder(out, theta_hat, etas, **kw)
     if as_json:
         _emit_json({"files": [str(p) for p in paths], "synthetic": True})
         return
     for p in paths:
         click.echo(f"wrote {p} (synthetic)")
+
+
+def _synthesize_folder(out: Path, theta_hat: float, etas: tuple[float, ...], **kwargs: Any) -> list[Path]:
+    """Synthetic recordings into the folder ``out``, all or nothing.
+
+    They are written into a hidden folder beside ``out``, then moved into
+    ``out`` (or the hidden folder renamed to ``out`` if it did not exist), so a
+    failure part-way leaves nothing behind.
+    """
+    import shutil
+    import tempfile
+
+    from grazing.atomic import rename_noreplace
+    from grazing.experiment.synthetic import synthetic_sweep
+
+    parent = out.parent if str(out.parent) else Path(".")
+    tmp = Path(tempfile.mkdtemp(dir=parent, prefix=f".{out.name}.partial-"))
+    try:
+        written = synthetic_sweep(tmp, theta_hat, etas, **kwargs)
+        if out.is_dir():
+            for f in sorted(tmp.iterdir()):
+                os.replace(f, out / f.name)
+            tmp.rmdir()
+        else:
+            mask = os.umask(0)
+            os.umask(mask)
+            os.chmod(tmp, 0o777 & ~mask)
+            rename_noreplace(tmp, out)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return [out / p.name for p in written]
 
 
 COMMANDS = (damping_cmd, iso_damping_cmd, fit_cmd, analyze_cmd, synthesize_cmd)

@@ -82,7 +82,7 @@ def test_errors_are_one_line(argv, message, capsys, tmp_path, monkeypatch):
 
 
 def test_newton_failure_is_reported(capsys):
-    argv = ["orbit", "--eta", "0.4458", "--period", "2", "--initial", "0.6,0.6", "--transient", "0"]
+    argv = ["orbit", "--eta", "0.4458", "--period", "2", "--initial", "0.6,0.6"]
     code = main(argv)
     out, err = capsys.readouterr()
     assert code == 1 and out == ""

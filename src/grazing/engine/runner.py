@@ -294,6 +294,8 @@ def precompile(jobs: Sequence[tuple[HybridModel, tuple[str, ...]]], workers: int
         for job in todo:
             _compile_one(job)
         return
+    from grazing.workers import init_worker
+
     ctx = mp.get_context("spawn")  # a fresh interpreter per worker: no half-initialised numba state
-    with ctx.Pool(workers) as pool:
+    with ctx.Pool(workers, initializer=init_worker, initargs=(os.getpid(),)) as pool:  # die with us
         pool.map(_compile_one, todo)

@@ -154,14 +154,8 @@ def free_decay(
     if int(peaks) < 1:
         raise InvalidParameterError(f"peaks must be >= 1, got {peaks}")
     model = grazing.models.pendulum(None, alpha=0.0, beta=beta, r=r, eta=eta, theta_hat=0.0)
-    # Stop before the swing decays below MIN_SWING (a few hundred cycles of round-off later the
-    # impacts would accumulate at the stop); the small-amplitude decay per peak bounds it.
-    per_peak = 2.0 * math.pi * beta / math.sqrt(1.0 - 4.0 * beta * beta) - math.log(r)
-    n = int(peaks)
-    if per_peak > 0:
-        n = min(n, max(1, math.floor(math.log(amplitude / MIN_SWING) / per_peak)))
-    # One cycle lasts 2 pi in omega_0 t (2 pi eta in tau) at small amplitude, longer at large ones.
-    cycles = math.ceil((n + 1) * 1.1 * _period_factor(amplitude)) + 2
+    n = decay_peaks(r, beta, amplitude, peaks)
+    cycles = decay_cycles(n, amplitude)
     periods = max(1, math.ceil(cycles * eta))
     ppp = max(8, math.ceil(points_per_cycle / eta))
     sol = grazing.simulate(model, [-amplitude, 0.0], periods=periods, trajectory=ppp)
@@ -173,6 +167,30 @@ def free_decay(
     peak_t = np.concatenate([[0.0], pt])[: n + 1]
     amps = np.concatenate([[amplitude], -pa])[: n + 1]
     return FreeDecay(t=t, angle=th, velocity=om, peak_t=peak_t, amplitudes=amps, r=r, beta=beta)
+
+
+def decay_peaks(r: float, beta: float, amplitude: float, peaks: int) -> int:
+    """Peaks a free decay simulates: ``peaks``, or fewer if the swing decays below :data:`MIN_SWING` first.
+
+    (A few hundred cycles of round-off later the impacts would accumulate at
+    the stop; the small-amplitude decay per peak bounds the count.)
+
+    >>> decay_peaks(1.0, 0.048, 0.5, 3), decay_peaks(0.5, 0.048, 0.5, 10**9)
+    (3, 22)
+    """
+    per_peak = 2.0 * math.pi * beta / math.sqrt(1.0 - 4.0 * beta * beta) - math.log(r)
+    n = int(peaks)
+    if per_peak > 0:
+        n = min(n, max(1, math.floor(math.log(amplitude / MIN_SWING) / per_peak)))
+    return n
+
+
+def decay_cycles(n_peaks: int, amplitude: float) -> int:
+    """Forcing-free cycles simulated for ``n_peaks`` peaks after a release at ``amplitude`` rad.
+
+    One cycle lasts 2 pi in omega_0 t at small amplitude, longer at large ones.
+    """
+    return math.ceil((n_peaks + 1) * 1.1 * _period_factor(amplitude)) + 2
 
 
 def _period_factor(amplitude: float) -> float:

@@ -10,6 +10,7 @@ angle comes from the sidecars (``theta_hat_deg``) or is given.
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -85,6 +86,17 @@ def _file_frequency(path: Path, meta: dict[str, Any], has_trigger: bool) -> floa
     )
 
 
+def _sidecar_theta(path: Path, value: Any) -> float:
+    """A sidecar's ``theta_hat_deg``: a number in (-180, 180), or a one-line :class:`RecordingError`."""
+    ok = isinstance(value, (int, float)) and not isinstance(value, bool)
+    if not (ok and math.isfinite(value) and -180.0 < value < 180.0):
+        raise RecordingError(
+            f"{path.with_suffix('.json').name}: theta_hat_deg must be a number of degrees in (-180, 180), "
+            f"got {json.dumps(value)}"
+        )
+    return float(value)
+
+
 def load_diagram(
     folder: str | Path,
     *,
@@ -139,7 +151,7 @@ def load_diagram(
         )
         synthetic = synthetic and bool(rec.metadata.get("synthetic", False))
         if "theta_hat_deg" in rec.metadata:
-            thetas.add(float(rec.metadata["theta_hat_deg"]))
+            thetas.add(_sidecar_theta(path, rec.metadata["theta_hat_deg"]))
         analyses.append((res.forcing_hz, path.name, res))
         if progress is not None:
             progress(j + 1, len(paths))

@@ -30,6 +30,7 @@ import json
 import math
 import re
 import warnings
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -299,7 +300,7 @@ def load_recording(path: str | Path, *, degrees: bool = False) -> Recording:
     lines = text.splitlines()
     if not lines or not lines[0].strip():
         raise RecordingError(f"{name}: empty file (expected a header row with time,angle)")
-    header = [h.strip().lower() for h in next(csv.reader([lines[0]]))]
+    header = [h.strip().lower() for h in next(_csv_rows(lines[:1], name), (1, []))[1]]
     missing = [c for c in ("time", "angle") if c not in header]
     if missing:
         found = ", ".join(h for h in header if h) or "nothing"
@@ -313,6 +314,22 @@ def load_recording(path: str | Path, *, degrees: bool = False) -> Recording:
     if degrees:
         x = np.radians(x)
     return from_arrays(data["time"], x, data.get("trigger"), source=name, metadata=read_sidecar(path))
+
+
+def _csv_rows(lines: list[str], name: str, first: int = 1) -> Iterator[tuple[int, list[str]]]:
+    """``(line number, fields)`` of CSV lines; a malformed line (a field over the csv module's
+    limit of 128 kB, a NUL byte...) is a :class:`RecordingError` naming the file and the line."""
+    reader = csv.reader(lines)
+    while True:
+        try:
+            row = next(reader)
+        except StopIteration:
+            return
+        except csv.Error as exc:
+            raise RecordingError(
+                f"{name}: line {first + reader.line_num - 1}: not a valid CSV row ({exc})"
+            ) from None
+        yield first + reader.line_num - 1, row
 
 
 def _parse_rows(
@@ -330,7 +347,7 @@ def _parse_rows(
         pass
     out: dict[str, list[float]] = {c: [] for c in cols}
     width = len(header)
-    for lineno, row in enumerate(csv.reader(lines[1:]), start=2):
+    for lineno, row in _csv_rows(lines[1:], name, first=2):
         if not row or all(not f.strip() for f in row):
             continue
         if len(row) < width:

@@ -303,8 +303,12 @@ def run_parallel(
     import multiprocessing as mp
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
+    from grazing.workers import init_worker
+
     ctx = mp.get_context("fork" if "fork" in mp.get_all_start_methods() else "spawn")
-    with ProcessPoolExecutor(max_workers=min(workers, len(jobs)), mp_context=ctx) as ex:
+    n = min(workers, len(jobs))
+    # The workers die with this process (grazing.workers); Ctrl-C still reaches them.
+    with ProcessPoolExecutor(n, ctx, initializer=init_worker, initargs=(os.getpid(), False)) as ex:
         futures = [ex.submit(fn, job) for job in jobs]
         for fut in as_completed(futures):
             results.append(fut.result())

@@ -38,7 +38,7 @@ import numpy as np
 
 from grazing.core.model import HybridModel
 from grazing.engine.runner import DiscontinuityMap, Runner
-from grazing.errors import InvalidParameterError, SimulationError
+from grazing.errors import GrazingError, InvalidParameterError, SimulationError
 from grazing.sweeps.period import DEFAULT_MAX_PERIOD, DEFAULT_PERIOD_TOL, detect_period
 
 DEFAULT_SWEEP_TOL = 1e-10
@@ -49,6 +49,10 @@ ADAPTIVE_MAX_PERIOD = 16
 ADAPTIVE_TOL = 1e-9
 LYAPUNOV_ALIGN = 16
 """Periods of the transient during which the tangent vectors are aligned (not counted)."""
+
+
+class SweepTimeoutError(GrazingError):
+    """A Dask cluster had no worker for longer than the timeout."""
 
 
 @dataclass(frozen=True)
@@ -269,36 +273,176 @@ def run_chunk(spec: SweepSpec, index: int) -> ChunkResult:
 # ----------------------------------------------------------------------------
 # Execution
 
+DASK_NOTICE_AFTER = 5.0
+"""Seconds without any Dask worker before :func:`run_sweep` says it is waiting for one."""
+
+POLL_INTERVAL = 0.5
+"""Seconds between two looks at a Dask cluster while no chunk finishes."""
+
+_WORKER_SPEC: SweepSpec | None = None
+"""The sweep of this pool worker (set once by its initializer, not sent with every chunk)."""
+
+
+def _init_pool_worker(parent_pid: int, spec: SweepSpec) -> None:
+    global _WORKER_SPEC
+    from grazing.workers import init_worker
+
+    init_worker(parent_pid)
+    _WORKER_SPEC = spec
+
+
+def _run_chunk_in_worker(index: int) -> ChunkResult:
+    assert _WORKER_SPEC is not None
+    return run_chunk(_WORKER_SPEC, index)
+
+
+def in_flight(workers: int) -> int:
+    """Chunks submitted ahead of the results: enough to keep ``workers`` busy, few enough to hold."""
+    return 2 * max(1, workers) + 2
+
+
+def _local_results(
+    spec: SweepSpec, todo: Sequence[int], workers: int, run: Callable[[int], Any] | None = None
+) -> Iterator[Any]:
+    """Chunk results from a pool of local processes, at most :func:`in_flight` submitted at a time.
+
+    The workers die with this process (:mod:`grazing.workers`).  When the
+    consumer stops (Ctrl-C, an error), queued chunks are cancelled and the
+    workers killed at once: the chunks in flight are thrown away, not waited for.
+    """
+    import multiprocessing as mp
+    from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+    from concurrent.futures.process import BrokenProcessPool
+
+    from grazing.workers import init_worker, stop_pool_processes
+
+    ctx = mp.get_context("fork") if "fork" in mp.get_all_start_methods() else mp.get_context("spawn")
+    n = min(workers, len(todo))
+    if run is None:
+        fn: Callable[[int], Any] = _run_chunk_in_worker
+        init, initargs = _init_pool_worker, (os.getpid(), spec)
+    else:  # a stand-in for run_chunk (tests)
+        fn, init, initargs = run, init_worker, (os.getpid(),)
+    ex = ProcessPoolExecutor(max_workers=n, mp_context=ctx, initializer=init, initargs=initargs)
+    queue = iter(todo)
+    pending: set[Any] = set()
+    try:
+        while True:
+            for i in queue:
+                pending.add(ex.submit(fn, i))
+                if len(pending) >= in_flight(n):
+                    break
+            if not pending:
+                break
+            finished, pending = wait(pending, return_when=FIRST_COMPLETED)
+            for fut in finished:
+                yield fut.result()
+    except BaseException as exc:
+        stop_pool_processes(ex)  # first: shutdown() forgets the processes
+        ex.shutdown(wait=False, cancel_futures=True)
+        if isinstance(exc, BrokenProcessPool):
+            raise SimulationError(
+                "a worker process died (killed by the system: out of memory?); the finished chunks "
+                "are kept in a --out store: run the same command again to resume"
+            ) from None
+        raise
+    ex.shutdown(wait=True)
+
+
+def _dask_workers(client: Any) -> int:
+    try:
+        return len(client.scheduler_info(n_workers=-1).get("workers", {}))
+    except TypeError:  # older distributed: no n_workers argument
+        return len(client.scheduler_info().get("workers", {}))
+
+
+def _dask_results(
+    spec: SweepSpec,
+    todo: Sequence[int],
+    client: Any,
+    timeout: float | None,
+    notice: Callable[[str], None] | None,
+) -> Iterator[ChunkResult]:
+    """Chunk results from a Dask cluster, with a bounded number of chunks submitted ahead.
+
+    Without any worker for :data:`DASK_NOTICE_AFTER` seconds, ``notice`` is
+    told once; without any for ``timeout`` seconds, :class:`SweepTimeoutError`.
+    """
+    from distributed import wait
+
+    address = getattr(getattr(client, "scheduler", None), "address", "the scheduler")
+    queue = iter(todo)
+    pending: set[Any] = set()
+    idle_since: float | None = None
+    noticed = False
+    try:
+        while True:
+            window = max(64, in_flight(_dask_workers(client)))  # one look at the cluster per round
+            for i in queue:
+                pending.add(client.submit(run_chunk, spec, i, pure=False))
+                if len(pending) >= window:
+                    break
+            if not pending:
+                break
+            try:
+                res = wait(pending, timeout=POLL_INTERVAL, return_when="FIRST_COMPLETED")
+                finished, pending = set(res.done), set(res.not_done)
+            except TimeoutError:
+                finished = set()
+            if finished:
+                idle_since = None
+                for fut in finished:
+                    yield _dask_result(fut)
+                continue
+            if _dask_workers(client):
+                idle_since = None
+                continue
+            now = time.monotonic()
+            idle_since = idle_since if idle_since is not None else now
+            if not noticed and notice is not None and now - idle_since >= DASK_NOTICE_AFTER:
+                noticed = True
+                give_up = f"giving up after {timeout:g} s" if timeout is not None else "--timeout to give up"
+                notice(f"no Dask worker is connected to {address}: waiting for one ({give_up})")
+            if timeout is not None and now - idle_since >= timeout:
+                raise SweepTimeoutError(
+                    f"no Dask worker connected to {address} within {timeout:g} s; start workers "
+                    "(dask worker ADDRESS) or run without --scheduler"
+                )
+    except BaseException:
+        if pending:
+            client.cancel(list(pending))
+        raise
+
+
+def _dask_result(fut: Any) -> ChunkResult:
+    """A finished chunk's result; a failure of the cluster (a worker killed too often...) as one line."""
+    try:
+        return fut.result()
+    except GrazingError:
+        raise
+    except Exception as exc:
+        text = " ".join(str(exc).split())[:200]
+        raise GrazingError(f"a chunk failed on the Dask cluster: {type(exc).__name__}: {text}") from None
+
 
 def _executor_results(
-    spec: SweepSpec, todo: Sequence[int], workers: int | None, client: Any
+    spec: SweepSpec,
+    todo: Sequence[int],
+    workers: int | None,
+    client: Any,
+    timeout: float | None = None,
+    notice: Callable[[str], None] | None = None,
 ) -> Iterator[ChunkResult]:
     """Yield chunk results as they finish (Dask client, process pool, or in-process)."""
     if client is not None:
-        from distributed import as_completed
-
-        futures = [client.submit(run_chunk, spec, i, pure=False) for i in todo]
-        for fut in as_completed(futures):
-            yield fut.result()
+        yield from _dask_results(spec, todo, client, timeout, notice)
         return
     workers = workers or os.cpu_count() or 1
     if workers <= 1 or len(todo) <= 1:
         for i in todo:
             yield run_chunk(spec, i)
         return
-    import multiprocessing as mp
-    from concurrent.futures import ProcessPoolExecutor, as_completed
-
-    ctx = mp.get_context("fork") if "fork" in mp.get_all_start_methods() else mp.get_context("spawn")
-    with ProcessPoolExecutor(max_workers=min(workers, len(todo)), mp_context=ctx) as ex:
-        futs = [ex.submit(run_chunk, spec, i) for i in todo]
-        try:
-            for fut in as_completed(futs):
-                yield fut.result()
-        except BaseException:
-            for f in futs:
-                f.cancel()
-            raise
+    yield from _local_results(spec, todo, workers)
 
 
 def run_sweep(
@@ -308,6 +452,9 @@ def run_sweep(
     workers: int | None = None,
     client: Any = None,
     progress: Callable[[int, int], None] | None = None,
+    timeout: float | None = None,
+    notice: Callable[[str], None] | None = None,
+    load: bool = True,
 ) -> Any:
     """Run a sweep; return its :class:`xarray.Dataset`.
 
@@ -324,20 +471,38 @@ def run_sweep(
         A :class:`dask.distributed.Client`: run the chunks on its cluster.
     progress
         Called as ``progress(points_done, points_total)``.
+    timeout
+        With ``client``: give up (:class:`SweepTimeoutError`) after this many
+        seconds without any worker in the cluster (default: wait).
+    notice
+        Called with a one-line message when the cluster has had no worker
+        for :data:`DASK_NOTICE_AFTER` seconds.
+    load
+        Return the dataset; with False, return None and keep nothing of the
+        results in memory (they are in ``store``: a huge sweep streams to it).
+
+    Interrupted (Ctrl-C) or failing, the chunks not yet started are cancelled
+    and the local workers stopped at once; the finished chunks are in ``store``.
     """
     from grazing.sweeps.store import MemoryStore
 
+    if store is None and not load:
+        raise InvalidParameterError("load=False needs a store to keep the results")
     sink = store if store is not None else MemoryStore(spec)
     todo = [i for i in range(spec.n_chunks) if not sink.is_done(i)]
     done_points = spec.n_points - sum(spec.chunk(i).stop - spec.chunk(i).start for i in todo)
     if progress is not None:
         progress(done_points, spec.n_points)
-    for res in _executor_results(spec, todo, workers, client):
-        sink.write(res)
-        done_points += res.period.size
-        if progress is not None:
-            progress(done_points, spec.n_points)
-    return sink.dataset()
+    results = _executor_results(spec, todo, workers, client, timeout, notice)
+    try:
+        for res in results:
+            sink.write(res)
+            done_points += res.period.size
+            if progress is not None:
+                progress(done_points, spec.n_points)
+    finally:
+        results.close()  # cancels what is queued and stops the workers if we leave early
+    return sink.dataset() if load else None
 
 
 def sweep(
@@ -463,6 +628,7 @@ def spec_summary(spec: SweepSpec) -> dict[str, Any]:
 __all__ = [
     "ChunkResult",
     "SweepSpec",
+    "SweepTimeoutError",
     "parameter_map",
     "run_chunk",
     "run_sweep",

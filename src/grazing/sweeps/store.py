@@ -1,28 +1,55 @@
 """Where sweep results go: memory, or a resumable Zarr store.
 
-The Zarr store is created with every variable filled with NaN, chunked along
-``point`` exactly like the sweep, and a ``chunk_done`` flag per chunk.  Each
-finished chunk writes its region, *then* sets its flag; a run killed at any
-moment leaves at most one chunk without its flag, and re-running the same
-command recomputes only the chunks whose flag is unset.  A store made with a
-different sweep (other parameters, values, transient...) is refused.
+The Zarr store holds every variable chunked along ``point`` exactly like the
+sweep (unwritten chunks read as NaN, or -1 for the integer variables) and a
+``chunk_done`` flag per chunk.  Each finished chunk writes its region, *then*
+sets its flag; a run killed at any moment leaves at most one chunk without its
+flag, and re-running the same command recomputes only the chunks whose flag is
+unset.  A store made with a different sweep (other parameters, values,
+transient...) is refused; so is anything at the path that grazing did not make
+(:mod:`grazing.sweeps.ownership`), and a store another process is writing
+(:mod:`grazing.sweeps.lock`).
 """
 
 from __future__ import annotations
 
 import json
-import shutil
+import os
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from grazing.errors import GrazingError, InvalidParameterError
+from grazing.errors import GrazingError
 from grazing.sweeps.brute_force import ChunkResult, SweepSpec, spec_summary
+from grazing.sweeps.lock import StoreBusyError, StoreLock
+from grazing.sweeps.ownership import (
+    ForeignStoreError,
+    StoreDamagedError,
+    check_is_store,
+    create_store,
+    lock_for,
+)
+
+__all__ = [
+    "ForeignStoreError",
+    "MemoryStore",
+    "StoreBusyError",
+    "StoreDamagedError",
+    "StoreMismatchError",
+    "ZarrStore",
+    "build_dataset",
+    "open_store",
+]
 
 
 class StoreMismatchError(GrazingError, ValueError):
     """An existing result store was made by a different sweep."""
+
+
+_VARIABLES = ("samples", "period", "impacts", "lyapunov", "transient_used", "x_final")
+"""The per-point variables of a sweep."""
 
 
 def _empty_arrays(spec: SweepSpec) -> dict[str, np.ndarray]:
@@ -125,7 +152,13 @@ class MemoryStore:
 
 
 class ZarrStore:
-    """A resumable Zarr store for one sweep (see the module docstring).
+    """A resumable Zarr store for one sweep, written by one process at a time.
+
+    Opening the store takes its lock (:mod:`grazing.sweeps.lock`) for as long
+    as the store is open: use it as a context manager, or call :meth:`close`.
+    Only a grazing sweep store (:mod:`grazing.sweeps.ownership`) is ever
+    opened; anything else at ``path`` is refused and left untouched.  A new
+    store is built beside ``path`` and renamed into place when complete.
 
     Parameters
     ----------
@@ -135,35 +168,103 @@ class ZarrStore:
         The sweep; an existing store must have been made by the same sweep.
     attrs
         Extra attributes (for example the command line).
+    wait
+        If another process holds the store, wait for it instead of raising
+        :class:`~grazing.sweeps.lock.StoreBusyError`.
+    on_wait
+        Called with the other process's PID before waiting.
+
+    Raises
+    ------
+    ForeignStoreError
+        ``path`` holds something grazing did not make.
+    StoreMismatchError
+        ``path`` holds a different sweep.
+    StoreBusyError
+        Another process is writing the store (and ``wait`` is false).
+    StoreDamagedError
+        The store cannot be read.
     """
 
-    def __init__(self, path: str | Path, spec: SweepSpec, attrs: dict[str, Any] | None = None):
-        import zarr
-
+    def __init__(
+        self,
+        path: str | Path,
+        spec: SweepSpec,
+        attrs: dict[str, Any] | None = None,
+        *,
+        wait: bool = False,
+        on_wait: Callable[[int | None], None] | None = None,
+    ):
         self.path = Path(path)
         self.spec = spec
         self.attrs = attrs or {}
-        if self.path.exists():
-            try:
-                group = zarr.open_group(str(self.path), mode="r")
-                stored = dict(group.attrs)
-            except Exception:  # not a Zarr store, or a creation that was interrupted
-                stored = {}
-            if not stored.get("initialized"):
-                if (self.path / "zarr.json").exists() or not any(self.path.iterdir()):
-                    shutil.rmtree(self.path)  # an interrupted creation: nothing computed yet
-                else:
-                    raise InvalidParameterError(f"{self.path} exists and is not a grazing sweep store")
-            else:
-                self._check_same(stored)
-        if not self.path.exists():
-            self._create()
-        self._done = np.asarray(zarr.open_array(str(self.path / "chunk_done"), mode="r")[:], dtype=bool)
+        self._lock: StoreLock | None = None
+        if not os.path.lexists(self.path):
+            self._lock = create_store(self.path, self._build, {"fingerprint": spec.fingerprint()})
+        if self._lock is None:  # it existed, or another run created it first
+            check_is_store(self.path)
+            self._check_same(self._read_attrs())
+            lock = lock_for(self.path)
+            lock.acquire(wait=wait, on_wait=on_wait)
+            self._lock = lock
+        try:
+            self._done = self._read("chunk_done", lambda z: np.asarray(z[:], dtype=bool))
+            if self._done.shape != (spec.n_chunks,):
+                raise StoreDamagedError(self._damaged("chunk_done has the wrong shape"))
+        except BaseException:
+            self.close()
+            raise
+
+    # ------------------------------------------------------------------ lifetime
+
+    def close(self) -> None:
+        """Release the store's lock (the store stays; reopen it to resume)."""
+        if self._lock is not None:
+            self._lock.release()
+            self._lock = None
+
+    def __enter__(self) -> ZarrStore:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def __del__(self) -> None:
+        lock = getattr(self, "_lock", None)
+        if lock is not None:
+            lock.release()
+
+    # ------------------------------------------------------------------ reading
+
+    def _damaged(self, what: str) -> str:
+        return (
+            f"sweep store {self.path} is damaged ({what}); delete it (or move it away) and run the "
+            "command again to recompute it"
+        )
+
+    def _read(self, name: str, get: Callable[[Any], Any]) -> Any:
+        import zarr
+
+        try:
+            return get(zarr.open_array(str(self.path / name), mode="r"))
+        except Exception as exc:  # corrupt chunk, missing array, bad metadata
+            raise StoreDamagedError(self._damaged(f"cannot read {name!r}: {_short(exc)}")) from None
+
+    def _read_attrs(self) -> dict[str, Any]:
+        import zarr
+
+        try:
+            return dict(zarr.open_group(str(self.path), mode="r").attrs)
+        except Exception as exc:
+            raise StoreDamagedError(self._damaged(f"cannot read its attributes: {_short(exc)}")) from None
 
     def _check_same(self, stored: dict[str, Any]) -> None:
         if stored.get("fingerprint") == self.spec.fingerprint():
             return
-        old = json.loads(stored.get("spec", "{}"))
+        try:
+            old = json.loads(stored.get("spec", "{}"))
+        except (TypeError, ValueError):
+            old = {}
         new = spec_summary(self.spec)
         diffs = [
             f"{k} ({old.get(k)!r} in the store, {new.get(k)!r} now)"
@@ -177,26 +278,42 @@ class ZarrStore:
             + "; use another --out or delete it"
         )
 
-    def _create(self) -> None:
+    def _build(self, folder: Path) -> None:
+        """Write the store's metadata into ``folder``: arrays of fill values, no chunk written."""
+        import dask.array as da
         import xarray as xr
 
-        ds = build_dataset_flat(self.spec, _empty_arrays(self.spec), self.attrs)
-        ds["chunk_done"] = xr.DataArray(np.zeros(self.spec.n_chunks, dtype=np.int8), dims="chunk")
-        c = self.spec.size
-        encoding = {
-            name: {"chunks": (c, *ds[name].shape[1:])} for name in ds.data_vars if name != "chunk_done"
-        }
-        encoding["chunk_done"] = {"chunks": (1,)}
-        tmp_attrs = dict(ds.attrs)
-        ds.attrs = {}
-        ds.to_zarr(str(self.path), mode="w", encoding=encoding, consolidated=False)
-        import zarr
+        n, m, p, c = self.spec.model.n_states, self.spec.periods, self.spec.n_points, self.spec.size
+        fill = {"samples": np.nan, "period": -1, "impacts": -1, "lyapunov": np.nan, "transient_used": -1,
+                "x_final": np.nan}  # fmt: skip
+        shapes = {"samples": (p, m, n), "period": (p,), "impacts": (p,), "lyapunov": (p,),
+                  "transient_used": (p,), "x_final": (p, n)}  # fmt: skip
+        dims = {"samples": ("point", "sample", "component"), "x_final": ("point", "component")}
+        data: dict[str, Any] = {}
+        encoding: dict[str, Any] = {}
+        for name, shape in shapes.items():
+            dtype = np.float64 if isinstance(fill[name], float) else np.int32
+            chunks = (c, *shape[1:])
+            data[name] = (dims.get(name, ("point",)), da.full(shape, fill[name], dtype=dtype, chunks=chunks))
+            encoding[name] = {"chunks": chunks, "fill_value": fill[name]}
+        nc = self.spec.n_chunks
+        data["chunk_done"] = ("chunk", da.zeros(nc, dtype=np.int8, chunks=min(nc, 1 << 20)))
+        encoding["chunk_done"] = {"chunks": (1,), "fill_value": 0}
+        ds = xr.Dataset(data)
+        summary = spec_summary(self.spec)
+        ds.attrs.update({"spec": json.dumps(summary, sort_keys=True), "fingerprint": summary["fingerprint"]})
+        ds.attrs.update(self.attrs)
+        ds.to_zarr(str(folder), mode="a", encoding=encoding, compute=False, consolidated=False)
 
-        group = zarr.open_group(str(self.path), mode="r+")
-        group.attrs.update({**tmp_attrs, "initialized": 1})
+    # ------------------------------------------------------------------ the store protocol
 
     def is_done(self, i: int) -> bool:
         return bool(self._done[i])
+
+    @property
+    def n_done(self) -> int:
+        """Chunks already computed."""
+        return int(self._done.sum())
 
     def write(self, res: ChunkResult) -> None:
         import xarray as xr
@@ -217,16 +334,26 @@ class ZarrStore:
         flag.to_zarr(str(self.path), region={"chunk": slice(res.index, res.index + 1)}, consolidated=False)
         self._done[res.index] = True
 
-    def dataset(self) -> Any:
-        import xarray as xr
-
-        raw = xr.open_zarr(str(self.path), consolidated=False).load()
-        missing = int((raw["chunk_done"].values == 0).sum())
+    def _check_complete(self) -> None:
+        missing = int((~self._done).sum())
         if missing:
             raise GrazingError(f"{self.path} is incomplete: {missing} chunk(s) not computed")
-        arrays = {k: raw[k].values for k in _empty_arrays(self.spec)}
-        attrs = {k: v for k, v in raw.attrs.items() if k not in ("initialized",)}
+
+    def read(self, name: str) -> np.ndarray:
+        """One stored variable, flat along ``point`` (for example ``"period"``) — without the others."""
+        return self._read(name, lambda z: np.asarray(z[:]))
+
+    def dataset(self) -> Any:
+        self._check_complete()
+        arrays = {k: self.read(k) for k in _VARIABLES}
+        attrs = {k: v for k, v in self._read_attrs().items() if k not in ("initialized",)}
         return build_dataset(self.spec, arrays, {**attrs, **self.attrs})
+
+
+def _short(exc: BaseException) -> str:
+    """An exception as a short single line."""
+    text = " ".join(str(exc).split()) or type(exc).__name__
+    return text if len(text) <= 160 else text[:157] + "..."
 
 
 def build_dataset_flat(spec: SweepSpec, arrays: dict[str, np.ndarray], attrs: dict[str, Any]) -> Any:
@@ -253,6 +380,8 @@ def build_dataset_flat(spec: SweepSpec, arrays: dict[str, np.ndarray], attrs: di
     return ds
 
 
-def open_store(path: str | Path, spec: SweepSpec, attrs: dict[str, Any] | None = None) -> ZarrStore:
-    """Create or reopen the Zarr store for ``spec`` at ``path``."""
-    return ZarrStore(path, spec, attrs)
+def open_store(
+    path: str | Path, spec: SweepSpec, attrs: dict[str, Any] | None = None, *, wait: bool = False
+) -> ZarrStore:
+    """Create or reopen the Zarr store for ``spec`` at ``path`` (see :class:`ZarrStore`)."""
+    return ZarrStore(path, spec, attrs, wait=wait)

@@ -1,0 +1,492 @@
+"""Sweep stores: nothing grazing did not make is touched, one writer at a time, atomic creation,
+damaged stores named, workers that die with their parent, prompt Ctrl-C, clusters without workers."""
+
+from __future__ import annotations
+
+import json
+import math
+import multiprocessing as mp
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from grazing.cli import main
+from grazing.models import pendulum
+from grazing.sweeps import brute_force
+from grazing.sweeps.brute_force import SweepSpec, run_sweep
+from grazing.sweeps.lock import StoreBusyError
+from grazing.sweeps.ownership import MARKER_GROUP, ForeignStoreError, remove_stale_builds
+from grazing.sweeps.store import ZarrStore
+from tests.processes import alive, all_gone, descendants, wait_until
+
+M40 = pendulum("B", theta_hat=math.radians(40))
+FORK = mp.get_context("fork")
+
+
+def _spec(**kw):
+    base = dict(model=M40, params=("eta",), points=tuple((float(v),) for v in np.linspace(0.44, 0.46, 6)),
+                x0=(0.0, 0.0), transient=20, periods=5, chunk_size=2, lyapunov=False)  # fmt: skip
+    base.update(kw)
+    return SweepSpec(**base)
+
+
+def _snapshot(root: Path) -> dict[str, bytes | None]:
+    """Every file's bytes and every folder under ``root`` (and ``root`` itself)."""
+    if root.is_file():
+        return {".": root.read_bytes()}
+    return {str(p.relative_to(root)): (p.read_bytes() if p.is_file() else None) for p in root.rglob("*")} | {
+        ".": None
+    }
+
+
+def _hidden(folder: Path) -> list[str]:
+    return sorted(p.name for p in folder.iterdir() if p.name.startswith("."))
+
+
+def _cli(*args: str) -> list[str]:
+    return [sys.executable, "-m", "grazing.cli", *args]
+
+
+SWEEP = ["sweep", "--param", "eta", "--start", "0.44", "--stop", "0.46", "--num", "6", "--chunk-size", "2",
+         "--transient", "20", "--periods", "5", "--no-lyapunov", "--workers", "1"]  # fmt: skip
+
+
+# --------------------------------------------------------------------------
+# Only grazing's own stores are opened; anything else is refused and left as it was
+
+
+def _make_foreign(kind: str, path: Path) -> None:
+    import xarray as xr
+
+    if kind == "xarray store":
+        xr.Dataset({"a": ("x", np.arange(5.0))}, attrs={"note": "mine"}).to_zarr(path, consolidated=False)
+    elif kind == "empty folder":
+        path.mkdir()
+    elif kind == "file":
+        path.write_bytes(b"not a store")
+    elif kind == "earlier grazing store":  # what grazing wrote before the marker existed
+        ds = xr.Dataset({"chunk_done": ("chunk", np.zeros(3, dtype=np.int8))})
+        ds.attrs.update({"initialized": 1, "fingerprint": "0123"})
+        ds.to_zarr(path, consolidated=False)
+    elif kind == "store with a partial marker":
+        xr.Dataset({"a": ("x", np.arange(5.0))}).to_zarr(path, consolidated=False)
+        (path / MARKER_GROUP).mkdir()
+
+
+FOREIGN = ["xarray store", "empty folder", "file", "earlier grazing store", "store with a partial marker"]
+
+
+@pytest.mark.parametrize("kind", FOREIGN)
+def test_anything_else_at_out_is_refused_and_untouched(kind, tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    path = tmp_path / "s.zarr"
+    _make_foreign(kind, path)
+    before = _snapshot(path)
+    code = main([*SWEEP, "--out", str(path)])
+    err = capsys.readouterr().err
+    assert code == 1
+    assert err.startswith("grazing: error: ") and err.count("\n") == 1
+    assert "is not a grazing sweep store" in err
+    if kind == "earlier grazing store":
+        assert "earlier grazing" in err
+    assert _snapshot(path) == before  # byte for byte, no file added or removed
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.zarr"]
+    with pytest.raises(ForeignStoreError):
+        ZarrStore(path, _spec())
+    assert _snapshot(path) == before
+
+
+def test_a_store_is_readable_by_xarray_without_warnings(tmp_path):
+    import warnings
+
+    import xarray as xr
+
+    path = tmp_path / "s.zarr"
+    with ZarrStore(path, _spec()) as store:
+        run_sweep(_spec(), store=store, workers=1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        ds = xr.open_zarr(path, consolidated=False)
+    assert ds.chunk_done.values.tolist() == [1, 1, 1]
+
+
+# --------------------------------------------------------------------------
+# Creation: all at once
+
+
+@pytest.mark.parametrize("failure", [RuntimeError, KeyboardInterrupt])
+def test_interrupted_creation_leaves_nothing(failure, tmp_path, monkeypatch):
+    built = []
+
+    def broken_build(self, folder):
+        (folder / "period").mkdir()
+        built.append(folder)
+        raise failure("disk full")
+
+    monkeypatch.setattr(ZarrStore, "_build", broken_build)
+    with pytest.raises(failure):
+        ZarrStore(tmp_path / "s.zarr", _spec())
+    assert built and not built[0].exists()
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_builds_left_by_dead_processes_are_removed(tmp_path):
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    path = tmp_path / "s.zarr"
+    stale = tmp_path / f".s.zarr.creating-{dead.pid}-abc"  # killed while building: marker written
+    (stale / MARKER_GROUP).mkdir(parents=True)
+    (stale / MARKER_GROUP / "zarr.json").write_text("{}")
+    empty = tmp_path / f".s.zarr.creating-{dead.pid}-def"  # killed right after mkdtemp
+    empty.mkdir()
+    running = tmp_path / f".s.zarr.creating-{os.getpid()}-ghi"  # a live build: not ours to remove
+    running.mkdir()
+    foreign = tmp_path / f".s.zarr.creating-{dead.pid}-jkl"  # named like ours, holds something else
+    foreign.mkdir()
+    (foreign / "notes.txt").write_text("mine")
+    assert sorted(p.name for p in remove_stale_builds(path)) == sorted([stale.name, empty.name])
+    assert running.exists() and (foreign / "notes.txt").read_text() == "mine"
+
+
+def _race_child(path, spec, delay, results, release):
+    time.sleep(delay)
+    try:
+        store = ZarrStore(path, spec)
+    except StoreBusyError as exc:
+        results.put(("busy", os.getpid(), str(exc)))
+        return
+    except BaseException as exc:  # anything else is a failure of the test
+        results.put(("error", os.getpid(), f"{type(exc).__name__}: {exc}"))
+        return
+    results.put(("ok", os.getpid(), ""))
+    release.wait(60)
+    store.close()
+
+
+@pytest.mark.parametrize("delay", [0.0, 0.002, 0.01, 0.03, 0.1])
+def test_racing_creations_give_one_writer_and_one_whole_store(delay, tmp_path):
+    """Three processes open the same new store, started ``delay`` apart (inside creation and after)."""
+    path, spec = tmp_path / "s.zarr", _spec()
+    results, release = FORK.Queue(), FORK.Event()
+    procs = [
+        FORK.Process(target=_race_child, args=(path, spec, k * delay, results, release)) for k in range(3)
+    ]
+    for p in procs:
+        p.start()
+    got = [results.get(timeout=120) for _ in procs]
+    release.set()
+    for p in procs:
+        p.join(60)
+    kinds = sorted(g[0] for g in got)
+    assert kinds == ["busy", "busy", "ok"], got
+    winner = next(g[1] for g in got if g[0] == "ok")
+    for kind, _pid, msg in got:
+        if kind == "busy":
+            assert f"is being written by another grazing run (PID {winner})" in msg
+    assert _hidden(tmp_path) == []  # no build left over
+    with ZarrStore(path, spec) as store:  # a whole store, nothing done yet
+        assert store.n_done == 0
+        ds = run_sweep(spec, store=store, workers=1)
+    ref = run_sweep(spec, workers=1)
+    np.testing.assert_array_equal(ds.samples.values, ref.samples.values)
+
+
+def _cli_race(tmp_path: Path, delay: float) -> None:
+    out = tmp_path / f"race{delay}.zarr"
+    args = "sweep --param eta --start 0.44 --stop 0.46 --num 12 --chunk-size 2 --transient 3000 --periods 5"
+    args = [*args.split(), "--no-adaptive", "--no-lyapunov", "--workers", "1", "--out", str(out)]
+    a = subprocess.Popen(_cli(*args), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(delay)
+    b = subprocess.Popen(_cli(*args), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    runs = [(p.pid, *p.communicate(timeout=300), p.returncode) for p in (a, b)]
+    for pid, _out, err, code in runs:
+        assert "Traceback" not in err
+        if code != 0:
+            other = a.pid if pid == b.pid else b.pid
+            assert code == 1 and err.count("\n") == 1, err
+            assert f"is being written by another grazing run (PID {other})" in err
+    assert any(code == 0 for *_, code in runs)
+    assert _hidden(tmp_path) == []
+    import xarray as xr
+
+    ds = xr.open_zarr(out, consolidated=False)
+    assert ds.chunk_done.values.all() and (ds.period.values >= 0).all()
+
+
+def test_two_cli_runs_racing_on_one_store(tmp_path):
+    _cli_race(tmp_path, 0.2)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("delay", [0.0, 0.05, 0.1, 0.3, 0.6, 1.0])
+def test_two_cli_runs_racing_on_one_store_at_many_delays(delay, tmp_path):
+    _cli_race(tmp_path, delay)
+
+
+# --------------------------------------------------------------------------
+# The lock: dead holders, forked workers, --wait
+
+
+def _hold(path, spec, ready, release):
+    store = ZarrStore(path, spec)
+    ready.set()
+    release.wait(120)
+    store.close()
+
+
+def test_a_lock_left_by_a_dead_process_is_taken_over(tmp_path):
+    path, spec = tmp_path / "s.zarr", _spec()
+    ready, release = FORK.Event(), FORK.Event()
+    holder = FORK.Process(target=_hold, args=(path, spec, ready, release))
+    holder.start()
+    assert ready.wait(120)
+    with pytest.raises(StoreBusyError, match=f"PID {holder.pid}"):
+        ZarrStore(path, spec)
+    os.kill(holder.pid, signal.SIGKILL)
+    holder.join()
+    with ZarrStore(path, spec) as store:  # taken over, no waiting
+        assert (path / MARKER_GROUP / "lock").read_text().strip() == str(os.getpid())
+        assert store.n_done == 0
+
+
+def test_forked_children_do_not_keep_the_lock(tmp_path):
+    path, spec = tmp_path / "s.zarr", _spec()
+    store = ZarrStore(path, spec)
+    release = FORK.Event()
+    child = FORK.Process(target=release.wait, args=(120,))
+    child.start()  # inherits the store's open files
+    try:
+        store.close()
+        with ZarrStore(path, spec):  # would be busy if the child still held the lock
+            pass
+    finally:
+        release.set()
+        child.join()
+
+
+def test_wait_waits_for_the_other_run_and_without_it_the_pid_is_named(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    out = tmp_path / "w.zarr"
+    argv = [*SWEEP, "--out", str(out)]
+    captured = {}
+
+    def capture(spec, **kw):
+        captured["spec"] = spec
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(brute_force, "run_sweep", capture)
+    assert main(argv) == 130  # creates the store, computes nothing
+    monkeypatch.undo()
+    capsys.readouterr()
+    ready, release = FORK.Event(), FORK.Event()
+    holder = FORK.Process(target=_hold, args=(out, captured["spec"], ready, release))
+    holder.start()
+    try:
+        assert ready.wait(120)
+        busy = subprocess.run(_cli(*argv), capture_output=True, text=True, timeout=300)
+        assert busy.returncode == 1 and busy.stdout == ""
+        assert busy.stderr == (
+            f"grazing: error: {out} is being written by another grazing run (PID {holder.pid}); "
+            "wait for it to finish (--wait) or use another --out\n"
+        )
+        waiter = subprocess.Popen(
+            _cli(*argv, "--wait"), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+        )
+        line = waiter.stderr.readline()
+        assert f"(PID {holder.pid}); waiting" in line
+        release.set()
+        stdout, stderr = waiter.communicate(timeout=300)
+        assert waiter.returncode == 0, stderr
+        assert f"saved to {out}" in stdout
+    finally:
+        release.set()
+        holder.join()
+
+
+# --------------------------------------------------------------------------
+# Damaged stores: one line naming the store and what to do
+
+
+@pytest.mark.parametrize(("target", "json_out"), [("samples/c/1/0/0", True), ("chunk_done/c/0", False)])
+def test_a_damaged_store_is_named_in_one_line(target, json_out, tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    out = tmp_path / "d.zarr"
+    argv = [*SWEEP, "--out", str(out)] + (["--json"] if json_out else [])
+    assert main(argv) == 0
+    capsys.readouterr()
+    (out / target).write_bytes(b"garbage")
+    assert main(argv) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert err.startswith(
+        f"grazing: error: sweep store {out} is damaged (cannot read '{target.split('/')[0]}'"
+    )
+    assert err.rstrip().endswith("delete it (or move it away) and run the command again to recompute it")
+
+
+# --------------------------------------------------------------------------
+# Results stream to the store
+
+
+def test_a_zarr_run_without_json_never_loads_the_results(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert main([*SWEEP, "--direction", "down"]) == 0
+    in_memory = capsys.readouterr().out
+    monkeypatch.setattr(ZarrStore, "dataset", lambda self: pytest.fail("loaded the whole store"))
+    assert main([*SWEEP, "--direction", "down", "--out", "s.zarr"]) == 0
+    streamed = capsys.readouterr().out
+    summary = [line for line in in_memory.splitlines() if line.startswith("  period")]
+    assert summary and summary == [line for line in streamed.splitlines() if line.startswith("  period")]
+
+
+# --------------------------------------------------------------------------
+# Workers die with their parent; Ctrl-C stops at once and keeps what is finished
+
+
+def _slow_cli(out: Path) -> list[str]:
+    # ~0.2-0.5 s per point: the workers are busy when the signal comes
+    args = "sweep --param eta --start 0.44 --stop 0.49 --num 40 --chunk-size 1 --workers 2"
+    args += " --transient 60000 --periods 10 --no-adaptive --no-lyapunov --out"
+    return _cli(*args.split(), str(out))
+
+
+def _chunks_done(out: Path) -> int:
+    import zarr
+
+    try:
+        return int(np.sum(zarr.open_array(str(out / "chunk_done"), mode="r")[:]))
+    except Exception:
+        return 0
+
+
+def test_sigkill_of_the_main_process_leaves_no_process_behind(tmp_path):
+    proc = subprocess.Popen(
+        _slow_cli(tmp_path / "k.zarr"), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+    )
+    try:
+        assert wait_until(lambda: len(descendants(proc.pid)) >= 2), "the pool did not start"
+        workers = descendants(proc.pid)
+    finally:
+        os.kill(proc.pid, signal.SIGKILL)
+        proc.wait()
+    assert all_gone(workers), [p for p in workers if alive(p)]
+
+
+def test_a_worker_killed_by_the_system_is_one_line_and_takes_the_others_along(tmp_path):
+    out = tmp_path / "o.zarr"
+    proc = subprocess.Popen(_slow_cli(out), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert wait_until(lambda: len(descendants(proc.pid)) >= 2 and _chunks_done(out) >= 1)
+        workers = descendants(proc.pid)
+        os.kill(min(workers), signal.SIGKILL)  # as the OOM killer would
+        _, err = proc.communicate(timeout=300)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 1
+    assert err == (
+        "grazing: error: a worker process died (killed by the system: out of memory?); the finished "
+        "chunks are kept in a --out store: run the same command again to resume\n"
+    )
+    assert all_gone(workers)
+    assert _chunks_done(out) >= 1
+
+
+def test_ctrl_c_stops_at_once_and_keeps_the_finished_chunks(tmp_path):
+    out = tmp_path / "c.zarr"
+    proc = subprocess.Popen(_slow_cli(out), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)  # fmt: skip
+    try:
+        assert wait_until(lambda: _chunks_done(out) >= 1)
+        workers = descendants(proc.pid)
+        os.killpg(proc.pid, signal.SIGINT)  # as a terminal's Ctrl-C: the whole process group
+        _, err = proc.communicate(timeout=300)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 130
+    assert err.strip() == "grazing: interrupted"
+    assert all_gone(workers)
+    assert 1 <= _chunks_done(out) < 40  # what was finished is kept (and resumed by the same command)
+
+
+def _fast_or_stuck(i: int) -> int:
+    if i == 0:
+        return i
+    marks = Path(os.environ["GRAZING_TEST_MARKS"])
+    (marks / f"started-{i}").write_text(str(os.getpid()))
+    time.sleep(600)  # a chunk in flight: it never finishes unless waited for
+    (marks / f"finished-{i}").touch()
+    return i
+
+
+def test_stopping_a_pool_cancels_queued_chunks_and_kills_those_in_flight(tmp_path, monkeypatch):
+    monkeypatch.setenv("GRAZING_TEST_MARKS", str(tmp_path))
+    results = brute_force._local_results(_spec(), list(range(6)), 2, run=_fast_or_stuck)
+    assert next(results) == 0
+    assert wait_until(lambda: len(list(tmp_path.glob("started-*"))) == 2)  # both workers busy
+    workers = [int(p.read_text()) for p in tmp_path.glob("started-*")]
+    results.close()  # what Ctrl-C, or an error while writing a result, does
+    assert all_gone(workers)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["started-1", "started-2"]  # nothing else ran
+
+
+# --------------------------------------------------------------------------
+# A Dask cluster without workers
+
+
+def test_a_cluster_without_workers_says_so_and_times_out(tmp_path, monkeypatch, capsys):
+    from distributed import LocalCluster
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(brute_force, "DASK_NOTICE_AFTER", 0.0)
+    with LocalCluster(n_workers=0, processes=False, dashboard_address=None) as cluster:
+        addr = cluster.scheduler_address
+        code = main([*SWEEP[:-2], "--scheduler", addr, "--timeout", "1", "--out", "s.nc"])
+    out, err = capsys.readouterr()
+    assert code == 1 and out == ""
+    lines = err.splitlines()
+    assert lines == [
+        f"grazing: no Dask worker is connected to {addr}: waiting for one (giving up after 1 s)",
+        f"grazing: error: no Dask worker connected to {addr} within 1 s; start workers (dask worker ADDRESS) "
+        "or run without --scheduler",
+    ]
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_json_output_of_a_resumed_store_is_unchanged(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    argv = [*SWEEP, "--out", "r.zarr", "--json"]
+    assert main(argv) == 0
+    first = json.loads(capsys.readouterr().out)
+    assert main(argv) == 0
+    again = json.loads(capsys.readouterr().out)
+    assert first["period"] == again["period"] and first["samples"] == again["samples"]
+
+
+def test_without_flock_the_pid_in_the_lock_file_decides(tmp_path, monkeypatch):
+    import errno
+
+    from grazing.sweeps import lock as lock_module
+
+    def no_flock(fd, op):
+        raise OSError(errno.ENOLCK, "no locks available")
+
+    monkeypatch.setattr(lock_module.fcntl, "flock", no_flock)
+    path = tmp_path / "lock"
+    path.write_text(f"{os.getppid()}\n")  # a live process holds it
+    with pytest.raises(StoreBusyError, match=f"PID {os.getppid()}"):
+        lock_module.StoreLock(path, "s.zarr").acquire()
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    path.write_text(f"{dead.pid}\n")  # its holder is gone: taken over
+    held = lock_module.StoreLock(path, "s.zarr")
+    held.acquire()
+    assert path.read_text().strip() == str(os.getpid())
+    held.release()

@@ -1,0 +1,585 @@
+"""The command line under bad and edge input: every former traceback is one line, no option is
+silently ignored, memory is checked before work, and a property test over random argument lists."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import shutil
+import tempfile
+from pathlib import Path
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import grazing
+from grazing.cli import main
+from grazing.cli_experiment import register
+from grazing.experiment.synthetic import synthetic_sweep
+from grazing.limits import MEMORY_ENV, MemoryLimitError, check_memory, parse_size
+
+register(grazing.cli.cli)
+
+
+def _files(root: Path) -> dict[str, bytes | None]:
+    return {str(p.relative_to(root)): (p.read_bytes() if p.is_file() else None) for p in root.rglob("*")}
+
+
+def _big_field_csv(path: Path, in_header: bool = False) -> None:
+    huge = "x" * 140_000  # over the csv module's 128 kB field limit
+    head = f"time,angle,{huge}" if in_header else "time,angle"
+    rows = [f"{k / 10},0.1" + (",1" if in_header else "") for k in range(40)]
+    if not in_header:
+        rows[3] = f"0.3,{huge}"
+    path.write_text("\n".join([head, *rows]) + "\n")
+
+
+@pytest.fixture(scope="module")
+def inputs(tmp_path_factory):
+    """Files the commands read: a good recording, a folder of them, files with a huge field."""
+    root = tmp_path_factory.mktemp("inputs")
+    synthetic_sweep(root / "folder", 40.0, [0.43, 0.446], periods=10, transient=10, sample_rate=100.0)
+    shutil.copy(next((root / "folder").glob("*.csv")), root / "rec.csv")
+    _big_field_csv(root / "big.csv")
+    _big_field_csv(root / "bighead.csv", in_header=True)
+    bad = root / "forty"
+    shutil.copytree(root / "folder", bad)
+    for side in bad.glob("*.json"):
+        side.write_text(side.read_text().replace('"theta_hat_deg": 40.0', '"theta_hat_deg": "forty"'))
+    return root
+
+
+@contextlib.contextmanager
+def _workspace(template: Path):
+    """A fresh copy of ``template`` as the current folder."""
+    old = Path.cwd()
+    with tempfile.TemporaryDirectory() as tmp:
+        work = Path(tmp) / "w"
+        shutil.copytree(template, work)
+        os.chdir(work)
+        try:
+            yield work
+        finally:
+            os.chdir(old)
+
+
+def _one_line_error(argv, capsys, template, code_expected=None):
+    with _workspace(template) as work:
+        before = _files(work)
+        code = main(argv)
+        out, err = capsys.readouterr()
+        assert code != 0 and out == "", (argv, out, err)
+        if code_expected is not None:
+            assert code == code_expected
+        assert err.startswith("grazing: error: ") and err.count("\n") == 1, err
+        assert _files(work) == before  # nothing written, nothing changed
+    return err.strip()
+
+
+SWEEP = ["sweep", "--param", "eta", "--start", "0.4", "--stop", "0.41", "--num", "2", "--periods", "3"]
+MAP = [
+    "map",
+    "--param1",
+    "eta",
+    "--start1",
+    "0.4",
+    "--stop1",
+    "0.41",
+    "--num1",
+    "2",
+    "--param2",
+    "theta-hat",
+    "--start2",
+    "30",
+    "--stop2",
+    "31",
+    "--num2",
+    "2",
+    "--periods",
+    "3",
+]
+
+FORMER_TRACEBACKS = [
+    ([*MAP, "--tol", "nan"], "--tol must be in (0, 0.01), got nan"),
+    ([*MAP, "--tol", "0"], "--tol must be in (0, 0.01), got 0"),
+    ([*MAP, "--tol", "-1"], "--tol must be in (0, 0.01), got -1"),
+    ([*MAP, "--tol", "10"], "--tol must be in (0, 0.01), got 10"),
+    ([*SWEEP, "--tol", "10"], "--tol must be in (0, 0.01), got 10"),
+    (["damping", "--recording", "big.csv"], "big.csv: line 5: not a valid CSV row (field larger than"),
+    (["analyze", "big.csv", "--forcing-hz", "0.46"], "big.csv: line 5: not a valid CSV row"),
+    (["analyze", "bighead.csv", "--forcing-hz", "0.46"], "bighead.csv: line 1: not a valid CSV row"),
+    (
+        ["synthesize", "--eta", "0.446", "--sample-rate", "1e9", "--out", "x.csv"],
+        "--sample-rate must be in (0, 1e+06] Hz, got 1e+09",
+    ),
+    (
+        ["synthesize", "--eta", "0.446", "--seed", "-1", "--out", "x.csv"],
+        "'--seed': -1 is not in the range x>=0",
+    ),
+    (["analyze", "forty"], 'theta_hat_deg must be a number of degrees in (-180, 180), got "forty"'),
+]
+
+ACCEPTED_BUT_WRONG = [
+    (["continue", "--param", "r", "--start", "0.5", "--stop", "2"], "r = 2 is outside [0, 1]"),
+    (["continue", "--param", "eta", "--start", "0.4", "--stop", "-1"], "eta = -1 is outside"),
+    (
+        ["continue", "--param", "theta-hat", "--start", "30", "--stop", "190"],
+        "--stop for theta-hat must be in (-180, 180) degrees, got 190",
+    ),
+    (["orbit", "--transient", "0", "--period", "100000"], "'--period': 100000 is not in the range 1<=x<=64"),
+    ([*SWEEP, "--which", "second"], "--which is not used without --method map"),
+    (["damping", "--recording", "rec.csv", "--r", "0.5"], "--r is not used with --recording"),
+    (["report", "--out", ""], "--out must name a file or folder, got an empty string"),
+    ([*SWEEP, "--out", ""], "--out must name a file or folder, got an empty string"),
+    (["analyze", ""], "FILE.csv|DIR must name a file or folder, got an empty string"),
+]
+
+IGNORED_OPTIONS = [
+    (["simulate", "--points-per-period", "10"], "--points-per-period is not used without --trajectory"),
+    (
+        ["simulate", "--case", "A", "--alpha", "0.2", "--beta", "0.1", "--r", "0.5"],
+        "--case is not used when --alpha, --beta and --r are all given",
+    ),
+    (["orbit", "--initial", "0,0", "--transient", "3"], "--transient is not used with --initial"),
+    (["graze", "--eta", "0.4"], "--eta is not used by graze"),
+    (["graze-curve", "--theta-hat", "30"], "--theta-hat is not used by graze-curve"),
+    (["normal-form", "--eta", "0.4"], "--eta is not used by normal-form"),
+    (
+        ["continue", "--param", "r", "--r", "0.3", "--start", "0.5", "--stop", "0.6"],
+        "--r is not used with --param r",
+    ),
+    ([*SWEEP, "--eta", "0.3"], "--eta is not used with --param eta"),
+    ([*MAP, "--theta-hat", "30"], "--theta-hat is not used with --param1 eta --param2 theta-hat"),
+    ([*SWEEP, "--wait"], "--wait is not used without a Zarr store"),
+    ([*SWEEP, "--wait", "--out", "s.nc"], "--wait is not used without a Zarr store"),
+    ([*SWEEP, "--timeout", "3"], "--timeout is not used without --scheduler"),
+    (
+        [*SWEEP, "--workers", "2", "--scheduler", "tcp://127.0.0.1:1"],
+        "--workers is not used with --scheduler",
+    ),
+    (["damping", "--degrees"], "--degrees is not used without --recording"),
+    (["damping", "--recording", "rec.csv", "--peaks", "3"], "--peaks is not used with --recording"),
+    (
+        ["iso-damping", "--relation", "paper", "--normalisation", "eq1"],
+        "--normalisation is not used with --relation paper",
+    ),
+    (["analyze", "rec.csv", "--theta-hat", "40"], "--theta-hat is not used for a single recording"),
+    (["analyze", "folder", "--model-points", "5"], "--model-points is not used without --with-model"),
+    (
+        ["analyze", "rec.csv", "--cutoff-hz", "5", "--cutoff-multiple", "10"],
+        "--cutoff-multiple is not used with --cutoff-hz",
+    ),
+]
+
+MEMORY = [
+    (
+        ["simulate", "--periods", "1000000", "--trajectory", "t.csv", "--points-per-period", "100000"],
+        "with a trajectory of 1e+11 points needs about",
+    ),
+    (["simulate", "--periods", "1000000000000"], "simulating 1e+12 sampled periods needs about"),
+    (
+        ["sweep", "--param", "eta", "--start", "0.4", "--stop", "0.5", "--num", "1000000000"],
+        "a sweep of 1e+09 points x 100 periods needs about",
+    ),
+    (
+        [
+            "sweep",
+            "--param",
+            "eta",
+            "--start",
+            "0.4",
+            "--stop",
+            "0.5",
+            "--num",
+            "1000000000",
+            "--out",
+            "h.zarr",
+        ],
+        "split it into several runs over parts of the range",
+    ),
+    ([*MAP[:-2], "--num1", "100000", "--num2", "100000"], "a map of 1e+10 points"),
+    (["iso-damping", "--num", "100000000"], "a curve of 1e+08 points needs about"),
+    (["synthesize", "--eta", "0.446", "--periods", "10000000", "--out", "x.csv"], "a recording of"),
+    (["damping", "--r", "1", "--beta", "0", "--peaks", "1000000000000"], "a free decay of 1e+12 peaks"),
+]
+
+
+@pytest.mark.parametrize(("argv", "message"), FORMER_TRACEBACKS + ACCEPTED_BUT_WRONG + IGNORED_OPTIONS)
+def test_one_line_and_nothing_written(argv, message, capsys, inputs):
+    assert message in _one_line_error(argv, capsys, inputs)
+
+
+@pytest.mark.parametrize(("argv", "message"), MEMORY)
+def test_memory_is_checked_before_any_work(argv, message, capsys, inputs, monkeypatch):
+    monkeypatch.delenv(MEMORY_ENV, raising=False)
+    for name in ("simulate",):  # nothing may start: the estimate comes first
+        monkeypatch.setattr(grazing, name, lambda *a, **k: pytest.fail("work started"))
+    monkeypatch.setattr(grazing.limits, "physical_memory", lambda: 16 * 10**9)  # a stated, fixed bound
+    err = _one_line_error(argv, capsys, inputs, code_expected=1)
+    assert message in err
+    assert "more than the limit of 8 GB (half of this machine's memory; set GRAZING_MAX_MEMORY" in err
+
+
+def test_the_bound_can_be_set_and_is_applied_exactly(monkeypatch, capsys, inputs):
+    monkeypatch.setenv(MEMORY_ENV, "1M")
+    err = _one_line_error(["simulate", "--periods", "100000", "--transient", "0"], capsys, inputs)
+    assert "more than the limit of 1 MB (set by GRAZING_MAX_MEMORY)" in err
+    with _workspace(inputs):
+        assert main(["simulate", "--periods", "10", "--transient", "0", "--json"]) == 0
+    capsys.readouterr()
+    monkeypatch.setenv(MEMORY_ENV, "lots")
+    err = _one_line_error(["simulate", "--periods", "10"], capsys, inputs)
+    assert err == "grazing: error: GRAZING_MAX_MEMORY='lots' is not a size such as 8G or 512M"
+
+
+def test_check_memory_bound(monkeypatch):
+    assert parse_size("2.5G") == 2_500_000_000
+    monkeypatch.setenv(MEMORY_ENV, "1000")
+    check_memory(1000, "x", "y")  # at the bound: accepted
+    with pytest.raises(MemoryLimitError, match="x needs about 1 kB of memory, more than the limit of 1 kB"):
+        check_memory(1001, "x", "y")
+    with pytest.raises(MemoryLimitError):
+        check_memory(float("nan"), "x", "y")
+
+
+def test_click_messages_are_one_line(capsys, inputs):
+    err = _one_line_error(["sweep", "--start", "0.4"], capsys, inputs)
+    assert "Missing option '--param'" in err
+
+
+# --------------------------------------------------------------------------
+# The property: random argument lists per command
+
+
+class ReachedError(Exception):
+    """The command passed every check and started its work (the work itself is stubbed)."""
+
+
+WORK = [
+    (grazing, "simulate"),
+    ("grazing.orbits", "find_orbit"),
+    ("grazing.orbits", "find_grazings"),
+    ("grazing.orbits", "grazing_curve"),
+    ("grazing.orbits", "continue_orbit"),
+    ("grazing.normalform", "find_grazing_point"),
+    ("grazing.sweeps.brute_force", "run_sweep"),
+    ("distributed", "Client"),
+    ("grazing.experiment.damping", "free_decay"),
+    ("grazing.experiment.damping", "recorded_damping"),
+    ("grazing.experiment.damping", "iso_damping"),
+    ("grazing.experiment.fit", "fit_parameters"),
+    ("grazing.experiment.signal", "analyze_recording"),
+    ("grazing.experiment.diagram", "load_diagram"),
+    ("grazing.experiment.synthetic", "synthetic_recording"),
+    ("grazing.experiment.synthetic", "synthetic_sweep"),
+    ("grazing.report", "build_report"),
+]
+
+
+def _stub(*args, **kwargs):
+    raise ReachedError
+
+
+BAD = ["nan", "inf", "-inf", "0", "-0", "-1", "1e300", "-1e300", "1e-300", "99999999999999999999", "abc", "",
+       "1,2", "-", "--json"]  # fmt: skip
+NUMBER = st.one_of(
+    st.sampled_from(BAD),
+    st.floats(allow_nan=True, allow_infinity=True).map(repr),
+    st.integers(-(10**20), 10**20).map(str),
+)
+
+MODEL = {
+    "--case": ["A", "B", "C", "D", "A-reduced"],
+    "--alpha": ["0.2254", "0.1"],
+    "--beta": ["0.048"],
+    "--r": ["0.7675", "1", "0"],
+    "--eta": ["0.446", "0.5"],
+    "--theta-hat": ["40", "-10"],
+}
+RUN = {"--transient": ["0", "3"], "--periods": ["1", "3"], "--initial": ["0,0", "-0.5,0.1", "0;0"]}
+SWEEPS = {
+    **RUN,
+    "--fresh": None,
+    "--chunk-size": ["0", "1"],
+    "--workers": ["1", "2"],
+    "--scheduler": ["tcp://127.0.0.1:1"],
+    "--timeout": ["1"],
+    "--no-lyapunov": None,
+    "--no-adaptive": None,
+    "--tol": ["1e-10", "1e-8"],
+    "--out": ["s.zarr", "s.nc", "s.txt", "nodir/s.zarr"],
+    "--wait": None,
+    "--json": None,
+}
+PARAMS = ["eta", "theta-hat", "alpha", "beta", "r", "gamma"]
+COMMANDS: dict[str, dict[str, list[str] | None]] = {
+    "simulate": {
+        **MODEL,
+        **RUN,
+        "--phase": ["0", "1.5"],
+        "--trajectory": ["t.csv", "t.txt", "nodir/t.csv"],
+        "--points-per-period": ["4", "20"],
+        "--json": None,
+    },
+    "orbit": {
+        **MODEL,
+        "--period": ["1", "5", "64"],
+        "--initial": ["0,0"],
+        "--transient": ["0", "3"],
+        "--json": None,
+    },
+    "graze": {**MODEL, "--eta-min": ["0.3", "0.44"], "--eta-max": ["0.5", "0.46"], "--json": None},
+    "graze-curve": {
+        **MODEL,
+        "--start-deg": ["5", "30"],
+        "--eta-min": ["0.3"],
+        "--eta-max": ["0.5"],
+        "--max-step": ["0.05"],
+        "--out": ["c.nc", "c.txt"],
+        "--json": None,
+    },
+    "continue": {
+        **MODEL,
+        "--param": PARAMS,
+        "--start": ["0.4", "30", "0.5"],
+        "--stop": ["0.5", "35", "0.9"],
+        "--period": ["1", "2"],
+        "--initial": ["0,0"],
+        "--virtual": None,
+        "--physical": None,
+        "--max-step": ["0.04"],
+        "--out": ["b.nc"],
+        "--json": None,
+    },
+    "sweep": {
+        **MODEL,
+        "--param": PARAMS,
+        "--start": ["0.4", "30"],
+        "--stop": ["0.41", "31"],
+        "--num": ["1", "2"],
+        "--direction": ["up", "down"],
+        "--method": ["flow", "map"],
+        "--which": ["first", "second"],
+        **SWEEPS,
+    },
+    "map": {
+        **MODEL,
+        "--param1": PARAMS,
+        "--start1": ["0.4"],
+        "--stop1": ["0.41"],
+        "--num1": ["1", "2"],
+        "--param2": PARAMS,
+        "--start2": ["30"],
+        "--stop2": ["31"],
+        "--num2": ["1", "2"],
+        **SWEEPS,
+    },
+    "normal-form": {
+        **MODEL,
+        "--which": ["first", "second"],
+        "--eta-min": ["0.3"],
+        "--eta-max": ["0.5"],
+        "--check": None,
+        "--json": None,
+    },
+    "damping": {
+        "--case": MODEL["--case"],
+        "--r": ["0.5", "1"],
+        "--beta": ["0.05"],
+        "--amplitude": ["28", "10"],
+        "--peaks": ["3", "10"],
+        "--k-hat": ["1", "2"],
+        "--normalisation": ["eq6", "eq1"],
+        "--recording": ["rec.csv", "missing.csv", "big.csv"],
+        "--degrees": None,
+        "--json": None,
+    },
+    "iso-damping": {
+        "--damping": ["0.07"],
+        "--num": ["2", "5"],
+        "--relation": ["model", "paper", "protocol"],
+        "--amplitude": ["28"],
+        "--peaks": ["3"],
+        "--normalisation": ["eq6", "eq1"],
+        "--out": ["c.csv", "c.txt"],
+        "--json": None,
+    },
+    "fit": {
+        "--theta-hat": ["40"],
+        "--eta-graze": ["0.445"],
+        "--damping": ["0.07"],
+        "--alpha": ["0.2254"],
+        "--relation": ["model", "paper"],
+        "--json": None,
+    },
+    "analyze": {
+        "PATH": ["rec.csv", "folder", "missing.csv", "big.csv", "forty"],
+        "--forcing-hz": ["0.46"],
+        "--phase": ["0"],
+        "--degrees": None,
+        "--cutoff-hz": ["5"],
+        "--cutoff-multiple": ["20"],
+        "--max-period": ["32"],
+        "--noise": ["0.001"],
+        "--theta-hat": ["40"],
+        "--with-model": None,
+        "--case": ["B"],
+        "--model-points": ["3"],
+        "--plot": ["p.png", "p.txt"],
+        "--json": None,
+    },
+    "synthesize": {
+        "--eta": ["0.43", "0.446"],
+        "--theta-hat": ["40"],
+        "--case": ["B"],
+        "--periods": ["8", "10"],
+        "--transient": ["0", "5"],
+        "--sample-rate": ["100", "1000"],
+        "--noise": ["0.001", "0"],
+        "--seed": ["0", "3"],
+        "--out": ["one.csv", "fold"],
+        "--json": None,
+    },
+    "report": {"--out": ["rep", ""]},
+}
+REQUIRED = ["--param", "--start", "--stop", "--num", "--param1", "--start1", "--stop1", "--num1", "--param2",
+            "--start2", "--stop2", "--num2", "PATH"]  # fmt: skip
+REAL_WORK = ("simulate", "sweep", "map", "damping", "synthesize", "analyze")
+
+
+@st.composite
+def argument_lists(draw, cmd: str, numbers=NUMBER):
+    """``[cmd, options...]``: options of ``cmd`` drawn (some repeated, some missing), values
+    mostly sensible, sometimes drawn from ``numbers`` (nan, inf, 0, negatives, huge, strings)."""
+    table = COMMANDS[cmd]
+    names = draw(st.lists(st.sampled_from(sorted(table)), max_size=6))
+    if draw(st.integers(0, 3)):  # usually the required options too (otherwise "Missing option")
+        names += [n for n in REQUIRED if n in table]
+        names += ["--eta", "--out"] if cmd == "synthesize" else []
+    argv = [cmd]
+    for name in draw(st.permutations(names)):
+        good = table[name]
+        if good is None:
+            argv.append(name)
+            continue
+        value = draw(st.sampled_from(good) if draw(st.integers(0, 5)) else numbers)
+        argv += [value] if name == "PATH" else [name, value]
+    return argv
+
+
+def _given(argv: list[str]) -> dict[str, str | None]:
+    """Options given (the last value of each), and the positional path."""
+    out: dict[str, str | None] = {}
+    i = 1
+    flags = {n for t in COMMANDS.values() for n, v in t.items() if v is None}
+    while i < len(argv):
+        a = argv[i]
+        if a in flags:
+            out[a] = None
+            i += 1
+        elif a.startswith("--") and i + 1 < len(argv):
+            out[a] = argv[i + 1]
+            i += 2
+        else:
+            out["PATH"] = a
+            i += 1
+    return out
+
+
+def ignored(argv: list[str]) -> list[str]:
+    """The options that the rest of ``argv`` makes meaningless (what must be refused)."""
+    cmd, g = argv[0], _given(argv)
+    bad = []
+    if cmd in ("simulate", "orbit", "graze", "graze-curve", "continue", "sweep", "map", "normal-form"):
+        if all(o in g for o in ("--alpha", "--beta", "--r")) and "--case" in g:
+            bad.append("--case")
+    if cmd == "simulate" and "--points-per-period" in g and "--trajectory" not in g:
+        bad.append("--points-per-period")
+    if cmd == "orbit" and "--initial" in g and "--transient" in g:
+        bad.append("--transient")
+    if cmd in ("graze", "normal-form", "graze-curve") and "--eta" in g:
+        bad.append("--eta")
+    if cmd == "graze-curve" and "--theta-hat" in g:
+        bad.append("--theta-hat")
+    if cmd in ("continue", "sweep"):
+        bad += [f"--{g['--param']}"] if f"--{g.get('--param')}" in g else []
+    if cmd == "map":
+        bad += [f"--{g[p]}" for p in ("--param1", "--param2") if f"--{g.get(p)}" in g]
+    if cmd in ("sweep", "map"):
+        if cmd == "sweep" and "--which" in g and g.get("--method") != "map":
+            bad.append("--which")
+        if "--wait" in g and not str(g.get("--out", "")).endswith(".zarr"):
+            bad.append("--wait")
+        if "--timeout" in g and "--scheduler" not in g:
+            bad.append("--timeout")
+        if "--workers" in g and "--scheduler" in g:
+            bad.append("--workers")
+    if cmd == "damping":
+        model_only = ["--case", "--r", "--beta", "--amplitude", "--peaks"]
+        bad += [o for o in model_only if o in g] if "--recording" in g else []
+        bad += ["--degrees"] if "--degrees" in g and "--recording" not in g else []
+    if cmd == "iso-damping" and "--normalisation" in g and g.get("--relation", "model") != "model":
+        bad.append("--normalisation")
+    if cmd == "analyze":
+        bad += [o for o in ("--case", "--model-points") if o in g and "--with-model" not in g]
+        bad += ["--cutoff-multiple"] if "--cutoff-multiple" in g and "--cutoff-hz" in g else []
+        folder = g.get("PATH") in ("folder", "forty")
+        bad += [o for o in ("--forcing-hz", "--cutoff-hz", "--noise") if folder and o in g]
+        bad += [o for o in ("--theta-hat", "--with-model") if not folder and o in g]
+    return bad
+
+
+def _check_run(argv: list[str], capsys, template: Path) -> None:
+    with _workspace(template) as work:
+        before = _files(work)
+        try:
+            code = main(argv)
+        except ReachedError:
+            code = None
+        out, err = capsys.readouterr()
+        if code == 0 or code is None:  # passed every check: nothing it was given may be ignored
+            assert not ignored(argv), (argv, ignored(argv))
+            return
+        assert err.startswith("grazing: error: ") and err.count("\n") == 1, (argv, err)
+        assert out == "", (argv, out)
+        assert _files(work) == before, argv  # a failed run leaves nothing and changes nothing
+
+
+@pytest.fixture
+def stubbed_work(monkeypatch):
+    import importlib
+
+    for owner, name in WORK:
+        module = importlib.import_module(owner) if isinstance(owner, str) else owner
+        monkeypatch.setattr(module, name, _stub)
+
+
+PROPERTY = settings(
+    deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture]
+)
+
+
+@pytest.mark.parametrize("cmd", list(COMMANDS))
+@settings(PROPERTY, max_examples=6)
+@given(data=st.data())
+def test_random_argument_lists(cmd, data, capsys, inputs, stubbed_work):
+    """Never a traceback, never a file left by a failed run, never an option ignored (work stubbed)."""
+    _check_run(data.draw(argument_lists(cmd)), capsys, inputs)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("cmd", list(COMMANDS))
+@settings(PROPERTY, max_examples=300)
+@given(data=st.data())
+def test_random_argument_lists_many(cmd, data, capsys, inputs, stubbed_work):
+    _check_run(data.draw(argument_lists(cmd)), capsys, inputs)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("cmd", REAL_WORK)
+@settings(PROPERTY, max_examples=40)
+@given(data=st.data())
+def test_random_argument_lists_with_real_work(cmd, data, capsys, inputs):
+    """The same with the work done (cheap commands; sizes only from the small values and the bad ones)."""
+    _check_run(data.draw(argument_lists(cmd, st.sampled_from(BAD))), capsys, inputs)

@@ -1,0 +1,64 @@
+"""Worker processes die with their parent: the report's pool, and the initializer itself."""
+
+from __future__ import annotations
+
+import multiprocessing as mp
+import os
+import signal
+import time
+from pathlib import Path
+
+from grazing.workers import init_worker
+from tests.processes import all_gone, wait_until
+
+FORK = mp.get_context("fork")
+
+
+def _stuck(folder: str) -> None:
+    Path(folder, str(os.getpid())).touch()
+    time.sleep(600)
+
+
+def _report_pool(folder: str) -> None:
+    from grazing.report.diagrams import run_parallel
+
+    run_parallel(_stuck, [folder, folder], workers=2)
+
+
+def test_the_report_pool_dies_with_its_parent(tmp_path):
+    parent = FORK.Process(target=_report_pool, args=(str(tmp_path),))
+    parent.start()
+    assert wait_until(lambda: len(list(tmp_path.iterdir())) == 2)
+    workers = [int(p.name) for p in tmp_path.iterdir()]
+    os.kill(parent.pid, signal.SIGKILL)  # no chance to clean up
+    parent.join()
+    assert all_gone(workers)
+
+
+def _worker_of(parent_pid: int, folder: str) -> None:
+    init_worker(parent_pid)
+    _stuck(folder)
+
+
+def _parent(folder: str) -> None:
+    FORK.Process(target=_worker_of, args=(os.getpid(), folder)).start()
+    time.sleep(600)
+
+
+def test_a_worker_whose_parent_died_before_it_started_exits(tmp_path):
+    marks = tmp_path / "marks"
+    marks.mkdir()
+    child = FORK.Process(target=_worker_of, args=(os.getpid() + 10**6, str(marks)))  # not its parent
+    child.start()
+    child.join(60)
+    assert child.exitcode == 1 and list(marks.iterdir()) == []
+
+
+def test_init_worker_kills_the_worker_with_its_parent(tmp_path):
+    parent = FORK.Process(target=_parent, args=(str(tmp_path),))
+    parent.start()
+    assert wait_until(lambda: len(list(tmp_path.iterdir())) == 1)
+    worker = int(next(tmp_path.iterdir()).name)
+    os.kill(parent.pid, signal.SIGKILL)
+    parent.join()
+    assert all_gone([worker])
