@@ -9,6 +9,7 @@
 
 from grazing import models
 from grazing.core import HybridModel, Impacts, Parameter, Solution
+from grazing.core.period import detect_period
 from grazing.engine.simulate import simulate
 from grazing.errors import (
     ConvergenceError,
@@ -17,7 +18,6 @@ from grazing.errors import (
     InvalidStateError,
     SimulationError,
 )
-from grazing.sweeps import detect_period
 
 
 def __getattr__(name: str) -> str:

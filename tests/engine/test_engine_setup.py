@@ -9,7 +9,7 @@ import sys
 import numpy as np
 
 import grazing
-from grazing.engine.compile import taylor_order
+from grazing.engine.codegen import taylor_order
 from grazing.engine.runner import step_safety
 from grazing.models import pendulum
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from grazing.engine.compile import load_source
+from grazing.engine.codegen import load_source
 from grazing.engine.taylor import UnsupportedExpressionError, taylor_kernel
 
 x, y, t = sp.symbols("x y t")

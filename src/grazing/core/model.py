@@ -10,6 +10,10 @@ Models are written symbolically with sympy; the Jacobians ``f_x``, ``h_x``,
 automatically, and the engine generates and caches compiled kernels for them.
 A :class:`HybridModel` also carries parameter values; :meth:`with_params`
 returns a copy with other values that shares the compiled kernels.
+
+This module imports nothing from the engine: the engine registers the function
+that builds a model's compiled kernels (:func:`set_kernel_loader`) when it is
+imported, which ``import grazing`` does.
 """
 
 from __future__ import annotations
@@ -23,8 +27,21 @@ from typing import Any
 
 import numpy as np
 
-from grazing.engine.compile import DEFAULT_ORDER, SymbolicSystem, generate_source, kernel_key, load_kernels
+from grazing.core.symbolic import SymbolicSystem
 from grazing.errors import InvalidParameterError, InvalidStateError
+
+KernelLoader = Callable[["_Definition", int, "int | None"], ModuleType]
+"""``loader(definition, directions, order) -> module``: builds (or loads from the cache) the
+compiled kernels of a model definition; ``order=None`` is the engine's default order."""
+
+_kernel_loader: KernelLoader | None = None
+
+
+def set_kernel_loader(loader: KernelLoader) -> None:
+    """Register the engine's kernel builder (done by :mod:`grazing.engine.codegen` on import)."""
+    global _kernel_loader
+    _kernel_loader = loader
+
 
 ON_STOP_TOL = 1e-9
 """A state whose guard is above ``-ON_STOP_TOL * max(1, |x|)`` counts as on the stop, not beyond
@@ -33,7 +50,25 @@ it (a state sampled while sticking, or an impact state, is on the stop only to r
 
 @dataclass(frozen=True)
 class Parameter:
-    """A named model parameter with a default value and an allowed interval.
+    """A named model parameter with a default value, an allowed interval and display metadata.
+
+    Attributes
+    ----------
+    name
+        The parameter's name in the model's expressions (``sympy.Symbol(name)``).
+    default
+        Its default value, in the model's own unit.
+    lower, upper, lower_open, upper_open
+        The allowed interval.
+    description
+        A few words saying what it is (used in messages).
+    unit
+        The unit of the value in the model (``"rad"``, ``"m"``...), for labels.
+    symbol
+        How to print it (``"θ̂"``, ``"η"``); the name if empty.
+    angle
+        An angle in radians in the model, shown and entered in degrees on the
+        command line and in plots.
 
     Examples
     --------
@@ -44,6 +79,9 @@ class Parameter:
     Traceback (most recent call last):
     ...
     grazing.errors.InvalidParameterError: r = 1.5 is outside [0, 1] (restitution)
+    >>> stop = Parameter("theta_hat", 0.7, unit="rad", symbol="θ̂", angle=True)
+    >>> round(stop.to_display(0.7), 3), stop.display_unit, stop.label
+    (40.107, 'deg', 'θ̂')
     """
 
     name: str
@@ -53,6 +91,27 @@ class Parameter:
     lower_open: bool = False
     upper_open: bool = False
     description: str = ""
+    unit: str = ""
+    symbol: str = ""
+    angle: bool = False
+
+    @property
+    def label(self) -> str:
+        """The symbol to print (the name when no symbol is given)."""
+        return self.symbol or self.name
+
+    @property
+    def display_unit(self) -> str:
+        """The unit values are shown and entered in: degrees for angles, else :attr:`unit`."""
+        return "deg" if self.angle else self.unit
+
+    def to_display(self, value: float) -> float:
+        """A model value in the display unit (degrees for angles)."""
+        return math.degrees(value) if self.angle else float(value)
+
+    def from_display(self, value: float) -> float:
+        """A value given in the display unit, in the model's unit (radians for angles)."""
+        return math.radians(value) if self.angle else float(value)
 
     def interval(self) -> str:
         def fmt(v: float) -> str:
@@ -187,7 +246,7 @@ class _Definition:
             self._system = system
         return self._system
 
-    def _identity(self) -> str:
+    def identity(self) -> str:
         """Text that determines the compiled kernels (without building them)."""
         if self._builder is not None:
             import inspect
@@ -198,14 +257,11 @@ class _Definition:
         period = _srepr(self.period_expr)
         return repr((self.name, [p.name for p in self.parameters], period, self.periodic, source))
 
-    def kernels(self, directions: int = 0, order: int = DEFAULT_ORDER) -> ModuleType:
+    def kernels(self, directions: int = 0, order: int | None = None) -> ModuleType:
         if (directions, order) not in self._kernels:
-
-            def source() -> str:
-                return generate_source(self.system, directions, order)
-
-            key = kernel_key(self._identity(), directions, order)
-            self._kernels[directions, order] = load_kernels(key, source)
+            if _kernel_loader is None:  # pragma: no cover - import grazing registers the engine's
+                raise RuntimeError("no kernel loader registered: import grazing (or grazing.engine) first")
+            self._kernels[directions, order] = _kernel_loader(self, directions, order)
         return self._kernels[directions, order]
 
     def numeric(self, what: str) -> Callable[..., Any]:
@@ -506,19 +562,19 @@ class HybridModel:
         return f"<HybridModel {self.name}: {vals}>"
 
     # -- numerics -------------------------------------------------------------
-    def kernels(self, directions: int = 0, order: int = DEFAULT_ORDER) -> ModuleType:
+    def kernels(self, directions: int = 0, order: int | None = None) -> ModuleType:
         """The compiled kernel module (generated and cached on first use).
 
         One module per number of sensitivity ``directions`` (columns of the
         variational matrix holding parameter derivatives along directions
         given at run time; see
-        :func:`~grazing.engine.compile.direction_columns`) and Taylor
+        :func:`~grazing.engine.codegen.direction_columns`) and Taylor
         ``order``; the model's scalar functions (vector field, guard, reset and
         their derivatives) are in every module.
         """
         if isinstance(directions, bool) or not isinstance(directions, int) or directions < 0:
             raise InvalidParameterError(f"directions must be a non-negative integer, got {directions!r}")
-        return self._def.kernels(directions, int(order))
+        return self._def.kernels(directions, None if order is None else int(order))
 
     def _call(self, what: str, x: Any, t: float) -> Any:
         fn = self._def.numeric(what)

@@ -1,16 +1,46 @@
-"""Results of a simulation."""
+"""Results of a simulation: the :class:`Solution`, its :class:`Impacts`, and the :class:`Status` of a run."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from enum import IntEnum
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from grazing.sweeps.period import DEFAULT_MAX_PERIOD, DEFAULT_PERIOD_TOL, detect_period
+from grazing.core.period import DEFAULT_MAX_PERIOD, DEFAULT_PERIOD_TOL, detect_period
 
 if TYPE_CHECKING:  # pragma: no cover
     from grazing.core.model import HybridModel
+
+
+class Status(IntEnum):
+    """How a run of the compiled driver ended; the codes are the driver's.
+
+    Examples
+    --------
+    >>> Status(1).message(t=12.5, max_steps=1000)
+    'step limit of 1000 steps reached at t = 12.5'
+    """
+
+    OK = 0
+    STEP_LIMIT = 1
+    NONFINITE = 2
+    ZENO = 3
+    """Impacts accumulate and the model has no sticking rule (or a zero-time event loop)."""
+
+    def message(self, t: float, max_steps: int) -> str:
+        """The user-facing sentence for this status at time ``t``."""
+        if self is Status.STEP_LIMIT:
+            return f"step limit of {max_steps} steps reached at t = {t:.6g}"
+        if self is Status.NONFINITE:
+            return f"the state became non-finite at t = {t:.6g}"
+        if self is Status.ZENO:
+            return (
+                f"impacts accumulate at t = {t:.6g} and cannot be continued "
+                "(the model defines no contact_direction for sticking)"
+            )
+        return "ok"
 
 
 @dataclass(frozen=True)

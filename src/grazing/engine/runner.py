@@ -17,7 +17,8 @@ from typing import Any
 import numpy as np
 
 from grazing.core.model import HybridModel
-from grazing.engine.compile import direction_columns, taylor_order
+from grazing.core.solution import Status
+from grazing.engine.codegen import direction_columns, taylor_order
 from grazing.errors import SimulationError
 
 RECORD_IMPACTS = {"none": 0, "sampled": 1, "all": 2}
@@ -157,8 +158,8 @@ class Runner:
         self.sensitivities = tuple(sensitivities) if variational else ()
         self.directions = direction_columns(len(self.sensitivities))
         self.kern = model.kernels(self.directions, self.order)
-        self.set_params(model)
         self.chatter_time = chatter_tol * self.T
+        self.set_params(model)
         T = self.T
         snap = 1e-9 * T
         s_phase = (phase % (2 * math.pi)) / (2 * math.pi) * T
@@ -194,6 +195,20 @@ class Runner:
             D[c, names.index(name)] = 1.0
         self.pv = np.concatenate([model.param_vector, D.ravel()])
         self.Tp = D @ self.period_gradient()
+        self._static = self._static_config()
+
+    def _static_config(self) -> tuple[Any, ...]:
+        """The fields of the driver's config that stay the same for this trajectory (``records.STATIC``)."""
+        T = float(self.model.period)
+        z = self.zdm
+        n = self.model.n_states
+        return (
+            T, bool(self.model.periodic), T, float(self.safety), bool(self.variational), bool(self.events),
+            float(self.chatter_time), z is not None, float(z.phase) % T if z is not None else 0.0,
+            float(z.accel) if z is not None else 1.0,
+            np.asarray(z.direction if z is not None else np.zeros(n), dtype=float),
+            float(z.window) if z is not None else 0.0, np.asarray(self.Tp, dtype=float),
+        )  # fmt: skip
 
     def vector_field(self, x: np.ndarray, s: float) -> np.ndarray:
         """``f(x, s)`` with the kernels this runner already loaded."""
@@ -206,13 +221,6 @@ class Runner:
         full = np.zeros(len(self.model.parameters))
         self.kern.period_grad(self.x, 0.0, self.model.param_vector, full)
         return full
-
-    def _zdm_args(self) -> tuple[Any, ...]:
-        z = self.zdm
-        n = self.model.n_states
-        if z is None:
-            return (False, 0.0, 1.0, np.zeros(n), 0.0)
-        return (True, float(z.phase) % self.T, float(z.accel), np.asarray(z.direction, dtype=float), z.window)
 
     def reset_variational(self) -> None:
         n = self.model.n_states
@@ -234,37 +242,27 @@ class Runner:
         T = self.T
         if max_steps is None:
             max_steps = 20000 * periods + 100_000
-        out = self.kern.integrate(
-            self.x, self.V, self.k, self.s, self.mode, self.pv, T, self.model.periodic, T, self.safety,
-            int(max_steps), periods, self.ks, self.ss, keep, self.variational, lyapunov,
-            T / trajectory if trajectory else 0.0, guard_min, RECORD_IMPACTS[impacts], self.chatter_time,
-            self.events, *self._zdm_args(), self.Tp, self.touch_start, self.touch_end,
+        start = (self.x, self.V, self.k, self.s, self.mode)  # a records.Start, as a plain tuple
+        cfg = (  # a records.Config, as a plain tuple (see the driver's integrate)
+            int(max_steps), periods, self.ks, float(self.ss), keep, bool(lyapunov),
+            T / trajectory if trajectory else 0.0, bool(guard_min), RECORD_IMPACTS[impacts],
+            self.touch_start, self.touch_end, *self._static,
         )  # fmt: skip
-        (status, x, V, k, s, mode, nsteps, n_imp, smp, imp, sticks, traj, logs, lspan, gm, ok) = out
-        if status != 0:
-            raise SimulationError(failure_message(int(status), k * T + s, max_steps))
-        self.x, self.V, self.k, self.s, self.mode = x, V, k, s, mode
+        out = self.kern.integrate(start, self.pv, cfg)
+        if out.status != Status.OK:
+            raise SimulationError(Status(int(out.status)).message(out.k * T + out.s, max_steps))
+        self.x, self.V, self.k, self.s, self.mode = out.x, out.V, out.k, out.s, out.mode
         self.touch_start = False  # only the first call starts at the contact
         if self.model.periodic:
             self.ks += periods
         else:
             self.ss += periods * T
         n = self.model.n_states
-        gmin, amin = gm[: 2 + n], gm[2 + n :]
-        lspan = float(lspan)
-        return Segment(smp, imp, int(n_imp), sticks, traj, logs, lspan, gmin, amin, bool(ok), int(nsteps))
-
-
-def failure_message(status: int, t: float, max_steps: int) -> str:
-    """The user-facing message for a driver status code."""
-    return {
-        1: f"step limit of {max_steps} steps reached at t = {t:.6g}",
-        2: f"the state became non-finite at t = {t:.6g}",
-        3: (
-            f"impacts accumulate at t = {t:.6g} and cannot be continued "
-            "(the model defines no contact_direction for sticking)"
-        ),
-    }.get(status, f"integration failed with status {status}")
+        gm = out.guard_min
+        return Segment(
+            out.samples, out.impacts, out.n_impacts, out.sticking, out.trajectory, out.log_sums,
+            out.lyap_span, gm[: 2 + n], gm[2 + n :], out.jacobian_valid, out.steps,
+        )  # fmt: skip
 
 
 def _compile_one(job: tuple[HybridModel, tuple[str, ...]]) -> None:

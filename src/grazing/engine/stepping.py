@@ -1,6 +1,6 @@
 """Model-independent pieces of the integration driver, compiled once per machine.
 
-The driver (``_driver_template.py``) is compiled into every generated model
+The driver (:mod:`grazing.engine.driver`) is compiled into every generated model
 module because it calls the model's own kernels; the helpers here do not, so
 they live in one module that numba compiles and caches once, instead of once
 per model, sensitivity set and Taylor order.  All functions see only arrays and

@@ -336,9 +336,9 @@ def figure_3_synthetic(
     >>> res["rows"][0]["period"], res["rows"][0]["model_period"]
     (5, 5)
     """
+    from grazing.core.period import detect_period
     from grazing.experiment.signal import analyze_recording
     from grazing.experiment.synthetic import synthetic_recording
-    from grazing.sweeps.period import detect_period
 
     n = len(cases)
     own = fig is None

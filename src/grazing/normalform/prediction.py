@@ -38,8 +38,8 @@ from typing import Any
 
 import numpy as np
 
+from grazing.core.period import detect_period
 from grazing.normalform.discontinuity import GrazingNormalForm
-from grazing.sweeps.period import detect_period
 
 PERIOD_ADDING_CHAOS = "period-adding cascade with chaotic bands"
 PERIOD_ADDING_OVERLAP = "period adding with overlapping windows (no chaos)"

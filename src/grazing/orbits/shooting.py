@@ -17,10 +17,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from grazing.core.model import HybridModel
+from grazing.core.period import detect_period
 from grazing.core.solution import Solution
 from grazing.engine.simulate import simulate
 from grazing.errors import ConvergenceError, InvalidParameterError, InvalidStateError, SimulationError
-from grazing.sweeps.period import detect_period
 
 DEFAULT_TOL = 1e-11
 DEFAULT_MAX_ITER = 30

@@ -37,9 +37,9 @@ from typing import Any
 import numpy as np
 
 from grazing.core.model import HybridModel
+from grazing.core.period import DEFAULT_MAX_PERIOD, DEFAULT_PERIOD_TOL, detect_period
 from grazing.engine.runner import DiscontinuityMap, Runner
 from grazing.errors import GrazingError, InvalidParameterError, SimulationError
-from grazing.sweeps.period import DEFAULT_MAX_PERIOD, DEFAULT_PERIOD_TOL, detect_period
 
 DEFAULT_SWEEP_TOL = 1e-10
 """Local error tolerance of sweeps: far below the 1e-6 of period detection."""

@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
-DEFAULT_PERIOD_TOL = 1e-6
-DEFAULT_MAX_PERIOD = 64
+from grazing.core.options import MAX_PERIOD, PERIOD_TOL
+
+DEFAULT_PERIOD_TOL = PERIOD_TOL
+DEFAULT_MAX_PERIOD = MAX_PERIOD
 
 
 def detect_period(

@@ -1,10 +1,10 @@
-"""Assemble, cache and load the compiled kernels of a hybrid model.
+"""Code generation: the compiled kernels of a hybrid model, assembled, cached and loaded.
 
 For each model (and each set of parameters to differentiate with respect to)
 one Python module is generated: Taylor-coefficient kernels for free flight,
 free flight with variational equations, and sticking; scalar functions for the
 vector field, guard, reset and their Jacobians; and the integration driver
-(``_driver_template.py``).  The module is written to a cache directory named
+(:mod:`grazing.engine.driver`).  The module is written to a cache directory named
 by a hash of its source and imported; numba then caches the machine code next
 to it, so a model is compiled once per machine, not once per process.
 
@@ -21,17 +21,20 @@ import os
 import sys
 import tempfile
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
+from grazing.core.model import set_kernel_loader
+from grazing.core.options import MACHINE_EPSILON
+from grazing.core.solution import Status
+from grazing.core.symbolic import SymbolicSystem
+from grazing.engine import driver
 from grazing.engine.polyroots import work_shape
 
 if TYPE_CHECKING:  # pragma: no cover
     import sympy as sp
 
-_TEMPLATE = Path(__file__).with_name("_driver_template.py")
 # Bump when the generated code changes meaning without its text changing.
 _CODEGEN_VERSION = "3"
 
@@ -47,105 +50,8 @@ def taylor_order(tol: float) -> int:
     return int(min(60, max(6, math.ceil(-math.log(tol) / 2 + 1))))
 
 
-DEFAULT_ORDER = taylor_order(2.220446049250313e-16)
+DEFAULT_ORDER = taylor_order(MACHINE_EPSILON)
 """Order of the kernels for the default tolerance (machine epsilon): 20."""
-
-
-@dataclass(frozen=True)
-class SymbolicSystem:
-    """The symbolic pieces of a hybrid model that the code generator needs.
-
-    Attributes
-    ----------
-    states, time, params
-        Symbols of the state vector, time and parameters (in the order of the
-        parameter vector).
-    vector_field
-        ``f(x, t)``, one expression per state.
-    guard
-        ``h(x, t)``; the allowed region is ``h > 0``, impacts happen when ``h``
-        reaches 0.
-    reset
-        ``g(x, t)``, the state just after an impact.
-    contact_direction
-        Direction ``e(x, t)`` along which the reset changes the state (the
-        velocity direction of a mechanical impact), used to constrain the flow
-        to the stop during sticking; ``None`` disables sticking.
-    """
-
-    states: tuple[sp.Symbol, ...]
-    time: sp.Symbol
-    params: tuple[sp.Symbol, ...]
-    vector_field: tuple[sp.Expr, ...]
-    guard: sp.Expr
-    reset: tuple[sp.Expr, ...]
-    contact_direction: tuple[sp.Expr, ...] | None = None
-    period: sp.Expr | None = None
-
-    def canonical(self) -> SymbolicSystem:
-        """The same system with every user symbol replaced by a fresh :class:`sympy.Dummy`.
-
-        The code generator creates symbols of its own (the variational matrix,
-        common subexpressions); working on the canonical system guarantees that
-        no name a user chooses for a state, parameter or time (``v1``, ``t_0``,
-        ``pi``, ``sin`` ...) can be the same sympy object as one of those.
-        """
-        import sympy as sp
-
-        sub = {x: sp.Dummy(f"x{i}") for i, x in enumerate(self.states)}
-        sub[self.time] = sp.Dummy("t")
-        sub.update({p: sp.Dummy(f"p{i}") for i, p in enumerate(self.params)})
-
-        def tr(e: sp.Expr) -> sp.Expr:
-            return sp.sympify(e).xreplace(sub)
-
-        return SymbolicSystem(
-            states=tuple(sub[x] for x in self.states),
-            time=sub[self.time],
-            params=tuple(sub[p] for p in self.params),
-            vector_field=tuple(tr(e) for e in self.vector_field),
-            guard=tr(self.guard),
-            reset=tuple(tr(e) for e in self.reset),
-            contact_direction=(
-                None if self.contact_direction is None else tuple(map(tr, self.contact_direction))
-            ),
-            period=None if self.period is None else tr(self.period),
-        )
-
-    def gradient(self, expr: sp.Expr) -> list[sp.Expr]:
-        import sympy as sp
-
-        return [sp.diff(expr, x) for x in self.states]
-
-    def lie(self, expr: sp.Expr) -> sp.Expr:
-        """Derivative of ``expr`` along the flow: grad(expr) . f + d(expr)/dt."""
-        import sympy as sp
-
-        return sp.Add(*[g * f for g, f in zip(self.gradient(expr), self.vector_field)]) + sp.diff(
-            expr, self.time
-        )
-
-    @property
-    def normal_rate(self) -> sp.Expr:
-        """``L_f h``: rate of change of the guard (negative when approaching)."""
-        return self.lie(self.guard)
-
-    @property
-    def normal_accel(self) -> sp.Expr:
-        """``L_f^2 h``: the guard's acceleration (negative when pushed into the stop)."""
-        return self.lie(self.normal_rate)
-
-    def sticking_field(self) -> tuple[sp.Expr, ...]:
-        """Vector field constrained to ``h = 0, L_f h = 0`` along the contact direction."""
-        import sympy as sp
-
-        if self.contact_direction is None:
-            raise ValueError("model has no contact direction")
-        e = self.contact_direction
-        gr = self.gradient(self.normal_rate)
-        den = sp.Add(*[g * ei for g, ei in zip(gr, e)])
-        lam = self.normal_accel / den
-        return tuple(f - lam * ei for f, ei in zip(self.vector_field, e))
 
 
 def _scalar_function(
@@ -222,7 +128,7 @@ def generate_source(system: SymbolicSystem, directions: int = 0, order: int = DE
     ncol = n + directions
     f = sys_.vector_field
     parts = [
-        "# Generated by grazing.engine.compile; do not edit.",
+        "# Generated by grazing.engine.codegen; do not edit.",
         "import math",
         "import numpy as np",
         "from numba import njit",
@@ -234,6 +140,7 @@ def generate_source(system: SymbolicSystem, directions: int = 0, order: int = DE
         f"NSENS = {directions}",
         f"NPARAMS = {m}",
         f"ORDER = {order}",
+        *(f"STATUS_{status.name} = {int(status)}" for status in Status),
         f"ROOT_WORK_ROWS, ROOT_WORK_MIN_COLS = {work_shape(0)}",
     ]
     free = taylor_kernel("tc_free", sys_.states, sys_.time, sys_.params, f, [sys_.guard], order)
@@ -323,7 +230,7 @@ def generate_source(system: SymbolicSystem, directions: int = 0, order: int = DE
             extra_args=", tp",
         )
     )  # fmt: skip
-    parts.append(_TEMPLATE.read_text())
+    parts.append(driver.template_text())
     return "\n\n".join(parts)
 
 
@@ -340,14 +247,14 @@ def kernel_key(identity: str, directions: int, order: int = DEFAULT_ORDER) -> st
     """Cache key of a kernel module: the model's identity and everything the code depends on.
 
     numba's on-disk cache does not notice changes in functions imported from
-    other modules, so the sources of the driver template, the root finder and
-    the code generator are part of the key.
+    other modules, so the sources of the driver, the root finder and the code
+    generator are part of the key.
     """
     import numba
 
     here = Path(__file__).parent
-    files = ("_driver_template.py", "polyroots.py", "stepping.py", "taylor.py", "compile.py")
-    deps = "".join((here / f).read_text() for f in files)
+    files = [here / f for f in ("polyroots.py", "stepping.py", "taylor.py", "codegen.py", "records.py")]
+    deps = "".join(path.read_text() for path in [*files, *driver.template_files()])
     versions = (_CODEGEN_VERSION, numba.__version__, sys.version)
     text = repr((identity, int(directions), order, versions, deps))
     return hashlib.sha256(text.encode()).hexdigest()[:20]
@@ -427,3 +334,18 @@ def load_kernels(key: str, source: Callable[[], str]) -> ModuleType:
 def load_source(source: str) -> ModuleType:
     """Import generated ``source`` as a cached kernel module (keyed by its text)."""
     return load_kernels(kernel_key(source, 0), lambda: source)
+
+
+def load_model_kernels(definition: Any, directions: int, order: int | None) -> ModuleType:
+    """The kernel module of a model definition (:class:`grazing.core.model` calls this).
+
+    Keyed by the model's identity, the number of sensitivity directions, the
+    order and the sources of the engine, so a cached module is found without
+    building the model's symbolic form (no sympy import on a cache hit).
+    """
+    order = DEFAULT_ORDER if order is None else order
+    key = kernel_key(definition.identity(), directions, order)
+    return load_kernels(key, lambda: generate_source(definition.system, directions, order))
+
+
+set_kernel_loader(load_model_kernels)

@@ -1,0 +1,259 @@
+"""Options of the analyses, grouped into small frozen objects, and every default once.
+
+As diffrax groups what to save in ``SaveAt`` and BifurcationKit groups
+continuation settings in ``ContinuationPar``, a simulation takes three
+objects: :class:`SaveAt` (what to record), :class:`Tangent` (which tangent
+dynamics to integrate) and :class:`Solver` (integrator settings); a sweep takes
+a :class:`SweepSettings`.  Each validates its fields when it is made, so an
+invalid value is refused once, with one clear message, wherever it comes from.
+The module-level constants are the defaults, named once for the whole package.
+
+Examples
+--------
+>>> SaveAt(periods=20, transient=400).periods
+20
+>>> Solver(tol=0.5)
+Traceback (most recent call last):
+...
+grazing.errors.InvalidParameterError: tol must be in (0, 0.01), got 0.5
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, fields, replace
+from typing import Any, Literal, TypeVar
+
+from grazing.errors import InvalidParameterError
+
+MACHINE_EPSILON = 2.220446049250313e-16
+"""Unit roundoff of a double, the integrator's default local error tolerance."""
+
+SWEEP_TOL = 1e-10
+"""Local error tolerance of sweeps: far below the 1e-6 of period detection."""
+
+CHATTER_TOL = 1e-9
+"""A chattering sequence whose remaining duration is below this fraction of the forcing
+period is summed in closed form and continued as sticking."""
+
+NEWTON_TOL = 1e-11
+"""Periodic orbits: Newton's method stops when ``max |P^n(x) - x|`` is below this."""
+
+NEWTON_MAX_ITER = 30
+"""Periodic orbits: the largest number of Newton iterations."""
+
+PERIOD_TOL = 1e-6
+"""Stroboscopic samples are p-periodic when they repeat to this (absolute) tolerance."""
+
+MAX_PERIOD = 64
+"""The largest period detected on computed samples."""
+
+MAX_PERIOD_NOISY = 32
+"""The largest period detected on recorded (noisy) samples: a recording of ~100 forcing
+cycles shows a longer period fewer than three times."""
+
+CHUNK_SIZE = 50
+"""Points per chunk of a one-parameter sweep: the unit of parallel work and of saving."""
+
+IMPACTS = ("none", "sampled", "all")
+"""What :class:`SaveAt` can record of the impacts."""
+
+_Opt = TypeVar("_Opt")
+
+
+def _count(name: str, value: Any, minimum: int) -> int:
+    if isinstance(value, bool) or (not isinstance(value, int) and not hasattr(value, "__index__")):
+        raise InvalidParameterError(f"{name} must be an integer, got {value!r}")
+    value = int(value)
+    if value < minimum:
+        raise InvalidParameterError(f"{name} must be >= {minimum}, got {value}")
+    return value
+
+
+def _finite(name: str, value: Any) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InvalidParameterError(f"{name} must be a finite number, got {value!r}") from None
+    if isinstance(value, bool) or not math.isfinite(v):
+        raise InvalidParameterError(f"{name} must be a finite number, got {value!r}")
+    return v
+
+
+def _tolerance(name: str, value: Any) -> float:
+    v = _finite(name, value)
+    if not 0 < v < 1e-2:
+        raise InvalidParameterError(f"{name} must be in (0, 0.01), got {v:g}")
+    return v
+
+
+def _set(obj: Any, name: str, value: Any) -> None:
+    object.__setattr__(obj, name, value)
+
+
+@dataclass(frozen=True)
+class SaveAt:
+    """What a simulation records.
+
+    Attributes
+    ----------
+    periods
+        Forcing periods sampled (stroboscopic samples kept), at least 1.
+    transient
+        Forcing periods run first and discarded.
+    phase
+        Stroboscopic phase ``phi`` in radians: samples at ``t = (phi/2pi + k) T``.
+    trajectory
+        If positive, the dense trajectory over the sampled span with this many
+        points per forcing period (plus both states at each impact).
+    impacts
+        Which impacts to record: the ``"sampled"`` span, ``"all"`` or ``"none"``.
+    guard_min
+        Track the smallest guard value over the sampled span and the closest
+        approach to the stop away from contacts.
+    """
+
+    periods: int = 100
+    transient: int = 0
+    phase: float = 0.0
+    trajectory: int = 0
+    impacts: Literal["none", "sampled", "all"] = "sampled"
+    guard_min: bool = False
+
+    def __post_init__(self) -> None:
+        _set(self, "periods", _count("periods", self.periods, 1))
+        _set(self, "transient", _count("transient", self.transient, 0))
+        _set(self, "trajectory", _count("trajectory", self.trajectory, 0))
+        _set(self, "phase", _finite("phase", self.phase))
+        if self.impacts not in IMPACTS:
+            raise InvalidParameterError(f"impacts must be one of {sorted(IMPACTS)}, got {self.impacts!r}")
+        _set(self, "guard_min", bool(self.guard_min))
+
+
+@dataclass(frozen=True)
+class Tangent:
+    """Which tangent dynamics a simulation integrates alongside the state.
+
+    Attributes
+    ----------
+    jacobian
+        The variational equations (saltation matrices at impacts): ``d x_final / d x0``.
+    sensitivities
+        Parameter names whose derivatives ``d x_final / d p`` are appended as
+        extra Jacobian columns (implies ``jacobian``).
+    lyapunov
+        The Lyapunov exponents over the sampled span (cannot be combined with
+        the Jacobian in one run).
+    """
+
+    jacobian: bool = False
+    sensitivities: tuple[str, ...] = ()
+    lyapunov: bool = False
+
+    def __post_init__(self) -> None:
+        sens = (self.sensitivities,) if isinstance(self.sensitivities, str) else tuple(self.sensitivities)
+        _set(self, "sensitivities", sens)
+        _set(self, "jacobian", bool(self.jacobian or sens))
+        if self.lyapunov and self.jacobian:
+            raise InvalidParameterError("lyapunov and jacobian/sensitivities cannot be combined in one run")
+
+    @property
+    def variational(self) -> bool:
+        """True when the variational equations are integrated."""
+        return self.jacobian or self.lyapunov
+
+
+@dataclass(frozen=True)
+class Solver:
+    """Settings of the Taylor integrator.
+
+    Attributes
+    ----------
+    tol
+        Local error tolerance in (0, 0.01); sets the Taylor order (20 at the
+        default, machine epsilon) and the step.
+    max_steps
+        Abort after this many steps (default: ``20000 * periods + 100000``).
+    chatter_tol
+        A chattering sequence whose remaining duration is below this fraction
+        of the period is summed to its accumulation point and continued as
+        sticking.
+    """
+
+    tol: float = MACHINE_EPSILON
+    max_steps: int | None = None
+    chatter_tol: float = CHATTER_TOL
+
+    def __post_init__(self) -> None:
+        _set(self, "tol", _tolerance("tol", self.tol))
+        if self.max_steps is not None:
+            _set(self, "max_steps", _count("max_steps", self.max_steps, 1))
+        chatter = _finite("chatter_tol", self.chatter_tol)
+        if chatter < 0:
+            raise InvalidParameterError(f"chatter_tol must be >= 0, got {chatter:g}")
+        _set(self, "chatter_tol", chatter)
+
+
+@dataclass(frozen=True)
+class SweepSettings:
+    """How every point of a sweep is computed.
+
+    Attributes
+    ----------
+    transient, periods
+        Forcing periods discarded and sampled at each point.
+    phase
+        Stroboscopic phase in radians.
+    fresh
+        Start every point from the initial state instead of the previous
+        point's final state (the experimenter's sweep).
+    chunk_size
+        Points per chunk, the unit of parallel work and of saving (0: one chunk).
+    adaptive
+        Stop transients early once the samples are periodic.
+    lyapunov
+        Compute the largest Lyapunov exponent (per unit time).
+    tol
+        Local error tolerance of the integrator.
+    """
+
+    transient: int = 500
+    periods: int = 100
+    phase: float = 0.0
+    fresh: bool = False
+    chunk_size: int = CHUNK_SIZE
+    adaptive: bool = True
+    lyapunov: bool = True
+    tol: float = SWEEP_TOL
+
+    def __post_init__(self) -> None:
+        _set(self, "transient", _count("transient", self.transient, 0))
+        _set(self, "periods", _count("periods", self.periods, 1))
+        _set(self, "chunk_size", _count("chunk size", self.chunk_size, 0))
+        _set(self, "phase", _finite("phase", self.phase))
+        _set(self, "tol", _tolerance("tol", self.tol))
+
+
+def with_shorthands(
+    options: _Opt | None, cls: type[_Opt], shorthands: Mapping[str, Any], used: set[str] | None = None
+) -> _Opt:
+    """``options`` (or the defaults of ``cls``) with the fields named in ``shorthands`` replaced.
+
+    Lets ``simulate(model, periods=20)`` stand for
+    ``simulate(model, save=SaveAt(periods=20))``.  The keys taken are added to
+    ``used``, so the caller can refuse the ones no option object knows.
+    """
+    names = {f.name for f in fields(cls)}  # type: ignore[arg-type]
+    changes = {k: v for k, v in shorthands.items() if k in names}
+    if used is not None:
+        used.update(changes)
+    base = options if options is not None else cls()
+    return replace(base, **changes) if changes else base  # type: ignore[type-var]
+
+
+def refuse_unknown(function: str, shorthands: Mapping[str, Any], used: Sequence[str] | set[str]) -> None:
+    """Raise ``TypeError`` for keyword arguments that no option object took."""
+    unknown = sorted(set(shorthands) - set(used))
+    if unknown:
+        raise TypeError(f"{function}() got unexpected keyword argument(s): {', '.join(unknown)}")

@@ -1,0 +1,311 @@
+"""Driver piece: the integration loop (appended to each kernel module).
+
+``integrate(start, pv, cfg)`` takes a :class:`~grazing.engine.records.Start`,
+the parameter vector (values, then the sensitivity directions) and a
+:class:`~grazing.engine.records.Config`, and returns a
+:class:`~grazing.engine.records.Result`.  Each step: the Taylor coefficients
+and the step size (:mod:`.events`), the step cut at the last sample or at the
+discontinuity map's phase, the first event on it, what the step records
+(:mod:`.recording`), the advance to the end of its accepted part (with the
+period-boundary term of the sensitivities, :mod:`.tangent`), Lyapunov
+orthonormalisation, the discontinuity map, and at an event an impact (reset,
+saltation, chattering to sticking) or a release (:mod:`.impacts`).
+
+Time is kept as ``k * T + s`` with ``s`` in ``[0, T)`` for models whose
+vector field is T-periodic in time (``cfg.wrap``), so that the forcing phase
+does not lose precision over long runs.  Samples are taken at local times
+``(ks, ss)``, ``(ks + 1, ss)``, ... (or ``ss``, ``ss + T``, ... without
+wrapping); the last ``n_keep`` are stored and define the recorded span
+(impacts, trajectory, minimum of the guard, Lyapunov sums).  ``start.mode``
+is 0 in free flight, 1 when sticking to the stop; the final mode is returned
+so that a run can be continued.  With ``cfg.events`` false the guard is
+ignored (the "virtual" flow through the stop), which is how nonimpacting
+orbits are continued past grazing.  The parameter columns of the variational
+matrix are derivatives at fixed ``(k, s)``, the instant ``k T(p) + s``.
+"""
+
+import math
+
+import numpy as np
+from numba import njit
+
+from grazing.engine.polyroots import isolate_first_root
+from grazing.engine.records import Config, Result, Start
+from grazing.engine.stepping import (
+    append_pair,
+    append_row,
+    eval_rows,
+    new_table,
+    step_factor,
+    step_size,
+    table_rows,
+    unpack_var,
+)
+
+
+@njit(cache=True)
+def integrate(start, pv, cfg):
+    """Integrate from ``start`` until the ``cfg.n_samples``-th stroboscopic sample (see the module).
+
+    ``start`` and ``cfg`` arrive as plain tuples in the field order of their
+    records (numba types a plain tuple in C, a named tuple field by field in
+    Python: 3x faster per call) and are named again here.  Every setting used
+    in the loop is read from the record once, into a local.
+    """
+    start = Start(*start)
+    cfg = Config(*cfg)
+    n = NX
+    order = ORDER
+    # The settings read on every step, as locals (no record access in the loop).
+    T = cfg.T
+    wrap = cfg.wrap
+    use_var = cfg.use_var
+    max_step = cfg.max_step
+    max_steps = cfg.max_steps
+    n_samples = cfg.n_samples
+    n_keep = cfg.n_keep
+    events = cfg.events
+    touch_end = cfg.touch_end
+    zdm_on = cfg.zdm
+    traj_dt = cfg.traj_dt
+    track_min = cfg.track_min
+    lyap = cfg.lyapunov
+    record_impacts = cfg.record_impacts
+    Tp = cfg.Tp
+    chatter_time = cfg.chatter_time
+    zdm_a = cfg.zdm_a
+    zdm_e = cfg.zdm_e
+    zdm_window = cfg.zdm_window
+    factor = step_factor(cfg.safety, order)
+    ncol = n + NSENS
+    nv = n * ncol if use_var else 0
+    ntot = n + nv
+    x = np.empty(ntot)
+    for i in range(n):
+        x[i] = start.x[i]
+    if use_var:
+        for i in range(n):
+            for c in range(ncol):
+                x[n + i * ncol + c] = start.V[i, c]
+    X = np.zeros((ntot, order + 1))
+    O = np.zeros((1, order + 1))
+    work = np.zeros((ROOT_WORK_ROWS, max(order + 1, ROOT_WORK_MIN_COLS)))
+    a = np.zeros(order + 1)
+    gm = np.zeros(order + 1)
+    xe = np.empty(ntot)
+    xp = np.empty(ntot)
+    V = np.empty((n, ncol))
+
+    samples = np.empty((n_keep, n))
+    imp = new_table(16, 2 + n)
+    sticks = new_table(4, 2)
+    traj = new_table(64 if traj_dt > 0.0 else 1, 1 + n)
+    logs = np.zeros(n)
+    scratch = np.zeros(n)
+    min_info = np.full(2 * (2 + n), math.inf)
+    slope_end = math.nan  # d guard / dt at the end of the previous free-flight step
+    slope_first = math.nan  # ... at the start of the first recorded one
+    fbuf = np.empty(n)
+    shift_sens = use_var and NSENS > 0 and wrap
+    zdm_gh = np.zeros(n)
+    zdm_gv = np.zeros(n)
+
+    k = start.k
+    s = start.s
+    mode = start.mode
+    defl = 2 if cfg.touch_start else 0
+    ks = cfg.ks
+    ss = cfg.ss
+    isamp = 0
+    keep_from = n_samples - n_keep
+    recording = keep_from == 0
+    lyap_t0 = k * T + s
+    lyap_started = recording
+    n_imp = 0
+    n_imp_rec = 0
+    n_stick = 0
+    n_traj = 0
+    kt = k
+    st = s
+    kz = k if s < cfg.zdm_s - 1e-9 * T else k + 1
+    sz = cfg.zdm_s
+    status = STATUS_OK
+    nsteps = 0
+    zero_events = 0
+    jac_valid = True
+    if recording and traj_dt > 0.0:
+        append_row(traj, 0, k * T + s, x, n)
+        n_traj = 1
+        st += traj_dt
+        while wrap and st >= T:
+            st -= T
+            kt += 1
+    if recording and mode == 1:  # the recorded span starts while sticking
+        append_pair(sticks, n_stick, k * T + s, math.nan)
+        n_stick += 1
+
+    while True:
+        if nsteps >= max_steps:
+            status = STATUS_STEP_LIMIT
+            break
+        for i in range(n):
+            if not math.isfinite(x[i]):
+                status = STATUS_NONFINITE
+                break
+        if status != STATUS_OK:
+            break
+        # The step: Taylor coefficients of the solution (and of the event function), and the step size.
+        if mode == 0:
+            if use_var:
+                tc_var(x, s, pv, X, O)
+            else:
+                tc_free(x, s, pv, X, O)
+            h = step_size(X, ntot, O, order, max_step, factor)
+        else:
+            tc_stick(x, s, pv, X, O)  # the first n rows only
+            h = step_size(X, n, O, order, max_step, factor)
+        rem = (ks - k) * T + (ss - s)
+        is_last = False
+        if isamp == n_samples - 1 and h >= rem:
+            h = rem
+            is_last = True
+        zdm_hit = False
+        if zdm_on:
+            rem_z = (kz - k) * T + (sz - s)
+            if rem_z <= h:
+                h = rem_z
+                zdm_hit = True
+                is_last = is_last and rem_z >= rem
+
+        # The first event on the step (the guard's polynomial in u in [0, 1]).
+        deg, tail = event_polynomial(O, h, mode, defl, touch_end and is_last and mode == 0, a)
+        u = -1.0
+        if events or mode == 1:
+            u = event_certificate(a, tail)
+            if u > 0.0:  # rarely: the certificate cannot exclude a root on the step
+                u = isolate_first_root(a, deg, work)
+        event = u >= 0.0 and h > 0.0
+        if event and u == 0.0:
+            zero_events += 1
+            if zero_events > 3:
+                status = STATUS_ZENO
+                break
+        else:
+            zero_events = 0
+        h_acc = u * h if event else h
+        if event and is_last and u >= 1.0:
+            event = False
+        nrows = ntot if mode == 0 else n
+
+        # What the step records within (0, h_acc].
+        if (ks - k) * T + (ss - s) <= h_acc:  # a sample is due on this step (about once a period)
+            isamp, ks, ss, recording, n_stick, n_traj, kt, st = take_samples(
+                T, wrap, n_samples, n_keep, traj_dt, X, k, s, h_acc, event, is_last, mode, isamp, ks, ss,
+                keep_from, recording, samples, sticks, n_stick, traj, n_traj, kt, st, xe,
+            )  # fmt: skip
+        if recording and traj_dt > 0.0:
+            n_traj, kt, st = trajectory_points(T, wrap, traj_dt, X, k, s, h_acc, traj, n_traj, kt, st, xe)
+        if recording and track_min and mode == 0 and h_acc > 0.0:
+            slope_end, slope_first = track_guard(
+                O, X, x, k * T + s, h, h_acc, defl, event, gm, min_info, slope_end, slope_first, xe
+            )
+
+        # Advance to the end of the accepted part of the step.
+        eval_rows(X, nrows, order, h_acc, xe)
+        for i in range(nrows):
+            x[i] = xe[i]
+        s += h_acc
+        if wrap and s >= T:
+            if shift_sens and mode == 0:
+                shift_period(x, s, pv, Tp, ncol, fbuf)
+            s -= T
+            k += 1
+        nsteps += 1
+        defl = 0
+        if lyap and use_var and mode == 0:
+            lyap_started, lyap_t0 = lyapunov_step(
+                x, V, ncol, recording, lyap_started, lyap_t0, k * T + s, scratch, logs
+            )
+
+        if zdm_hit:
+            kz += 1
+            record = record_impacts == 2 or (record_impacts == 1 and recording)
+            applied, n_imp_rec = discontinuity_map(
+                x,
+                s,
+                k * T + s,
+                pv,
+                zdm_a,
+                zdm_e,
+                zdm_window,
+                use_var,
+                ncol,
+                V,
+                zdm_gh,
+                zdm_gv,
+                record,
+                imp,
+                n_imp_rec,
+            )
+            if applied:
+                n_imp += 1
+
+        if event:
+            if mode == 0:
+                # Impact: x holds the state on the stop, just before the reset.
+                record = record_impacts == 2 or (record_impacts == 1 and recording)
+                traj_on = recording and traj_dt > 0.0
+                speed, n_imp_rec, n_traj = apply_impact(
+                    x, xp, s, k * T + s, pv, use_var, ncol, nrows, V, record, imp, n_imp_rec, traj_on, traj,
+                    n_traj,
+                )  # fmt: skip
+                n_imp += 1
+                defl = 1
+                if HAS_STICK:
+                    dt_acc = chatter_remaining(x, s, pv, speed, chatter_time)
+                    if dt_acc >= 0.0:  # complete chattering: on to the accumulation point, then sticking
+                        s += dt_acc
+                        if wrap and s >= T:  # (the Jacobian is not valid after sticking)
+                            s -= T
+                            k += 1
+                        enter_contact(x, s, pv)
+                        mode = 1
+                        defl = 0
+                        jac_valid = False
+                        if recording:
+                            append_pair(sticks, n_stick, k * T + s, math.nan)
+                            n_stick += 1
+            else:
+                # Release from sticking: the contact force changes sign.
+                mode = 0
+                defl = 3
+                if recording:
+                    close_sticking(sticks, n_stick, k * T + s)
+        if isamp >= n_samples:
+            break
+
+    if track_min and mode == 0 and recording:
+        finish_guard(x, s, pv, k * T + s, slope_end, slope_first, min_info)
+    close_sticking(sticks, n_stick, k * T + s)
+    lyap_span = k * T + s - lyap_t0 if (lyap and lyap_started) else 0.0
+    Vout = np.zeros((n, ncol))
+    if use_var:
+        unpack_var(x, n, ncol, Vout)
+    return Result(
+        status,
+        x[:n].copy(),
+        Vout,
+        k,
+        s,
+        mode,
+        nsteps,
+        n_imp,
+        samples[: max(0, min(n_keep, isamp - keep_from))].copy(),
+        table_rows(imp, n_imp_rec),
+        table_rows(sticks, n_stick),
+        table_rows(traj, n_traj),
+        logs,
+        lyap_span,
+        min_info,
+        jac_valid,
+    )

@@ -1,0 +1,147 @@
+"""Driver piece: what a step records (appended to each kernel module).
+
+Stroboscopic samples and trajectory points are evaluated from the step's
+Taylor polynomials (dense output) at their exact times; the recorded span
+starts when the first kept sample's predecessor is taken.  The guard's minimum
+over the span, and its closest approach away from contacts (a local minimum
+in free flight), are tracked for grazing analysis.
+"""
+
+import math
+
+import numpy as np  # noqa: F401 - the names the pieces share in the generated module
+from numba import njit
+
+from grazing.engine.polyroots import horner
+from grazing.engine.stepping import append_pair, append_row, eval_rows, poly_derivative, set_row, set_slice
+
+
+@njit(cache=True, inline="always")
+def take_samples(
+    T, wrap, n_samples, n_keep, traj_dt, X, k, s, h_acc, event, is_last, mode, isamp, ks, ss, keep_from,
+    recording, samples, sticks, n_stick, traj, n_traj, kt, st, xe,
+):  # fmt: skip
+    """The samples within ``(0, h_acc]`` of the step; returns the updated sampling state.
+
+    Returns ``(isamp, ks, ss, recording, n_stick, n_traj, kt, st)``: samples
+    taken, the next sample's time, whether the recorded span has started, and
+    the sticking-interval and trajectory counters (the span may start while
+    sticking, and starts the trajectory).
+    """
+    n = NX
+    while isamp < n_samples:
+        dt = (ks - k) * T + (ss - s)
+        if dt > h_acc or (event and dt == h_acc and not is_last):
+            break
+        if is_last and isamp == n_samples - 1:
+            dt = h_acc
+        if isamp >= keep_from:
+            eval_rows(X, n, ORDER, dt, xe)
+            set_row(samples, isamp - keep_from, 0, xe, n)
+        isamp += 1
+        if wrap:
+            ks += 1
+        else:
+            ss += T
+        if isamp == keep_from and not recording and n_keep > 0:
+            recording = True
+            if mode == 1:  # recording starts while sticking: the interval starts here
+                append_pair(sticks, n_stick, k * T + s + dt, math.nan)
+                n_stick += 1
+            if traj_dt > 0.0:
+                eval_rows(X, n, ORDER, dt, xe)
+                append_row(traj, n_traj, k * T + s + dt, xe, n)
+                n_traj += 1
+                kt = k
+                st = s + dt + traj_dt
+                while wrap and st >= T:
+                    st -= T
+                    kt += 1
+    return isamp, ks, ss, recording, n_stick, n_traj, kt, st
+
+
+@njit(cache=True, inline="always")
+def trajectory_points(T, wrap, traj_dt, X, k, s, h_acc, traj, n_traj, kt, st, xe):
+    """Trajectory points within the step, every ``traj_dt``; returns ``(n_traj, kt, st)``."""
+    n = NX
+    while True:
+        dt = (kt - k) * T + (st - s)
+        if dt > h_acc:
+            break
+        eval_rows(X, n, ORDER, dt, xe)
+        append_row(traj, n_traj, k * T + s + dt, xe, n)
+        n_traj += 1
+        st += traj_dt
+        while wrap and st >= T:
+            st -= T
+            kt += 1
+    return n_traj, kt, st
+
+
+@njit(cache=True, inline="always")
+def track_guard(O, X, x, t, h, h_acc, defl, event, gm, min_info, slope_end, slope_first, xe):
+    """The guard's minimum over ``[t, t + h_acc)`` and its closest approach; returns the slopes.
+
+    ``min_info[:2 + n]`` holds the smallest value, its time and the state
+    there; ``min_info[2 + n:]`` the same for the smallest local minimum in free
+    flight (where ``L_f h`` turns from negative to positive, inside the step
+    or at its start).  Returns ``(slope_end, slope_first)``: the guard's slope
+    at the end of this step (nan when an event follows) and at the start of
+    the first recorded step.
+    """
+    n = NX
+    order = ORDER
+    hk = 1.0
+    for j in range(order + 1):
+        gm[j] = O[0, j] * hk
+        hk *= h
+    if gm[0] < min_info[0]:
+        min_info[0] = gm[0]
+        min_info[1] = t
+        set_slice(min_info, 2, x, n)
+    if defl == 0:  # not leaving a contact
+        if math.isnan(slope_first):
+            slope_first = gm[1] / h
+        elif slope_end < 0.0 <= gm[1] and gm[0] < min_info[2 + n]:
+            min_info[2 + n] = gm[0]  # a local minimum exactly at the step boundary
+            min_info[3 + n] = t
+            set_slice(min_info, 4 + n, x, n)
+    uend = h_acc / h
+    slope_end = poly_derivative(gm, order, uend) / h
+    if gm[1] < 0.0 and slope_end > 0.0:
+        lo = 0.0
+        hi = uend
+        for _ in range(80):
+            mid = 0.5 * (lo + hi)
+            if poly_derivative(gm, order, mid) < 0.0:
+                lo = mid
+            else:
+                hi = mid
+        um = 0.5 * (lo + hi)
+        gv = horner(gm, order, um)
+        if gv < min_info[0] or gv < min_info[2 + n]:
+            eval_rows(X, n, order, um * h, xe)
+        for base in (0, 2 + n):
+            if gv < min_info[base]:
+                min_info[base] = gv
+                min_info[base + 1] = t + um * h
+                set_slice(min_info, base + 2, xe, n)
+    if event:
+        slope_end = math.nan  # an impact or a release follows: no free-flight minimum here
+    return slope_end, slope_first
+
+
+@njit(cache=True)
+def finish_guard(x, s, pv, t, slope_end, slope_first, min_info):
+    """At the end of the run: the final state, and a minimum where the orbit closes."""
+    n = NX
+    g_end = guard(x, s, pv)
+    if g_end < min_info[0]:
+        min_info[0] = g_end
+        min_info[1] = t
+        set_slice(min_info, 2, x, n)
+    # A run over whole periods of an orbit ends where it started: a minimum there.
+    if slope_end < 0.0 <= slope_first and g_end < min_info[2 + n]:
+        min_info[2 + n] = g_end
+        min_info[3 + n] = t
+        set_slice(min_info, 4 + n, x, n)

@@ -1,0 +1,89 @@
+"""Driver piece: the tangent dynamics and the discontinuity map (appended to each kernel module).
+
+The variational matrix ``V`` is integrated with the state (its rows follow
+the state in ``x``): columns ``0 .. n-1`` are ``d x / d x0``, the next
+``NSENS`` the derivatives along the sensitivity directions in parameter space.
+"""
+
+import math
+
+import numpy as np  # noqa: F401 - the names the pieces share in the generated module
+from numba import njit
+
+from grazing.engine.stepping import append_record, orthonormalize, pack_var, unpack_var
+
+
+@njit(cache=True)
+def shift_period(x, s, pv, Tp, ncol, f):
+    """Parameter columns of V at a period boundary: ``V_p += f(x, s) dT/dp``.
+
+    Time is kept as ``k T + s``; the variational equations give derivatives at
+    fixed ``(k, s)``.  Relabelling ``(k, s)`` as ``(k + 1, s - T)`` keeps the
+    time only at the current parameter values: where ``T`` depends on a
+    parameter the two labels are different instants, ``dT/dp`` apart per
+    period, and the state moves by ``f dT/dp`` between them.
+    """
+    rhs(x, s, pv, f)
+    for i in range(NX):
+        for c in range(NSENS):
+            x[NX + i * ncol + NX + c] += f[i] * Tp[c]
+
+
+@njit(cache=True, inline="always")
+def lyapunov_step(x, V, ncol, recording, started, t0, t, scratch, logs):
+    """Gram-Schmidt on the tangent vectors after a step; returns ``(started, t0)``.
+
+    Before the recorded span the vectors are only aligned (their growth is
+    discarded); from its start the log norms are summed into ``logs``.
+    """
+    n = NX
+    unpack_var(x, n, ncol, V)
+    if recording and not started:
+        started = True
+        t0 = t
+        orthonormalize(V, n, scratch)
+    elif started:
+        orthonormalize(V, n, logs)
+    else:
+        orthonormalize(V, n, scratch)  # transient: align V, discard growth
+    pack_var(V, n, ncol, x)
+    return started, t0
+
+
+@njit(cache=True)
+def discontinuity_map(x, s, t, pv, a, e, window, use_var, ncol, V, gh, gv, record, imp, n_rec):
+    """Nordmark's discontinuity map at leading order, at the grazing phase; returns ``(applied, n_rec)``.
+
+    With ``v = L_f h`` and ``delta = v^2 / (2 a) - h`` (how far the local
+    parabola would reach past the stop, ``a = L_f^2 h`` at the grazing
+    point): if ``delta > 0`` and ``|v| / a < window``, ``x <- x - e sqrt(2 a
+    delta)``, and the
+    variational matrix by ``dD/dx = I - e (grad S)^T``.  The kick is recorded
+    as an impact (time, speed ``S``, state) when ``record``.
+    """
+    n = NX
+    hval = guard(x, s, pv)
+    vn = normal_rate(x, s, pv)
+    dz = vn * vn / (2.0 * a) - hval
+    if not (dz > 0.0 and abs(vn) < window * a):
+        return False, n_rec
+    sp_ = math.sqrt(2.0 * a * dz)
+    if use_var:
+        # dD/dx = I - e (grad S)^T, grad S = a grad(delta) / S
+        guard_grad(x, s, pv, gh)
+        normal_rate_grad(x, s, pv, gv)
+        unpack_var(x, n, ncol, V)
+        for c in range(ncol):
+            gs = 0.0
+            for j in range(n):
+                gs += (vn * gv[j] - a * gh[j]) * V[j, c]
+            gs /= sp_
+            for i in range(n):
+                V[i, c] -= e[i] * gs
+        pack_var(V, n, ncol, x)
+    if record:
+        append_record(imp, n_rec, t, sp_, x, n)
+        n_rec += 1
+    for i in range(n):
+        x[i] -= e[i] * sp_
+    return True, n_rec

@@ -1,0 +1,87 @@
+"""The records the compiled driver takes and returns: :class:`Start`, :class:`Config`, :class:`Result`.
+
+Named tuples, which numba compiles as structs: the driver,
+``integrate(start, pv, config) -> result``, reads its settings by name (no
+positional argument lists) and returns one record that the runner reads by
+name.  Built by :class:`grazing.engine.runner.Runner`.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+
+class Start(NamedTuple):
+    """Where a run starts: state, variational matrix, time ``k T + s`` and contact mode."""
+
+    x: np.ndarray  # state, (n,)
+    V: np.ndarray  # variational matrix, (n, n + directions)
+    k: int  # whole periods
+    s: float  # local time in [0, T) (periodic models) or the time
+    mode: int  # 0 free flight, 1 sticking to the stop
+
+
+class Config(NamedTuple):
+    """Everything else a run needs, but the parameter vector (see the driver's ``integrate``).
+
+    The parameter values (then the sensitivity directions, row by row) are the
+    driver's second argument: an array taken out of a record on every step
+    would be reference-counted on every step.  The fields that change from
+    call to call come first; :class:`~grazing.engine.runner.Runner` keeps the
+    others (:data:`STATIC`) as a tuple, so that a call builds its record in
+    one step.
+    """
+
+    # -- this call
+    max_steps: int
+    n_samples: int  # the run ends at the n_samples-th stroboscopic sample
+    ks: int  # first sample at (ks, ss), then one per period
+    ss: float
+    n_keep: int  # the last n_keep samples are kept and define the recorded span
+    lyapunov: bool  # Lyapunov sums over the recorded span
+    traj_dt: float  # trajectory spacing (0: no trajectory)
+    track_min: bool  # smallest guard value and closest approach over the recorded span
+    record_impacts: int  # 0 none, 1 in the recorded span, 2 all
+    touch_start: bool  # the run starts at a grazing contact (not an impact)
+    touch_end: bool  # the run ends at a grazing contact (not an impact)
+    # -- the trajectory's (STATIC)
+    T: float  # forcing period
+    wrap: bool  # keep time as k T + s (periodic models)
+    max_step: float
+    safety: float  # step safety exponent (see runner.step_safety)
+    use_var: bool  # integrate the variational equations
+    events: bool  # apply impacts (False: the flow passes through the stop)
+    chatter_time: float  # chattering shorter than this is summed and continued as sticking
+    zdm: bool  # apply the discontinuity map once per period instead of the impacts
+    zdm_s: float  # its local time
+    zdm_a: float  # L_f^2 h at the grazing point
+    zdm_e: np.ndarray  # its direction e
+    zdm_window: float  # largest |L_f h| / a for which it is applied
+    Tp: np.ndarray  # dT/dp along each sensitivity direction
+
+
+STATIC = Config._fields[Config._fields.index("T") :]
+"""The fields of :class:`Config` that stay the same for every call on one trajectory."""
+
+
+class Result(NamedTuple):
+    """What a run returns."""
+
+    status: int  # a grazing.core.solution.Status code
+    x: np.ndarray
+    V: np.ndarray
+    k: int
+    s: float
+    mode: int
+    steps: int
+    n_impacts: int  # over the whole run
+    samples: np.ndarray  # (kept samples, n)
+    impacts: np.ndarray  # rows [t, speed, state...]
+    sticking: np.ndarray  # rows [start, end]
+    trajectory: np.ndarray  # rows [t, state...]
+    log_sums: np.ndarray  # Lyapunov sums
+    lyap_span: float
+    guard_min: np.ndarray  # [h, t, state..., h_approach, t_approach, state...]
+    jacobian_valid: bool
