@@ -13,7 +13,7 @@ import pytest
 
 from grazing.report import diagrams, fig07, fig08, fig12, figmap
 
-QUICK_DIAGRAMS = diagrams.Settings(points=150, zoom_points=80, transient=300, periods=60)
+QUICK_DIAGRAMS = diagrams.Settings(points=150, zoom_points=80, overview_points=80, transient=300, periods=60)
 QUICK_FIG08 = fig08.Settings(points=150, transient=300, periods=60)
 QUICK_MAP = figmap.Settings(eta=(0.3, 0.9, 24), theta_hat_deg=(5.0, 58.0, 10), transient=300, periods=40)
 
