@@ -115,8 +115,7 @@ def _write_atomic(path: Path, text: str) -> None:
 
 
 def _copy_docs(out: Path) -> tuple[tuple[str, str], ...]:
-    """Copy the linked documents into ``out/docs`` (when the source tree has them); ``(title, link)`` "
-    "pairs."""
+    """Copy the linked documents into ``out/docs`` (when the source tree has them): ``(title, link)``."""
     src = source_root() / "docs"
     links = []
     for title, name in DOCS:

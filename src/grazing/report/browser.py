@@ -105,8 +105,7 @@ class PageCheck:
 
 
 def find_chromium() -> str | None:
-    """The Chromium (or Chrome) executable: ``$CHROMIUM`` if set, else the first of :data:`CANDIDATES` on "
-    "PATH."""
+    """The Chromium executable: ``$CHROMIUM`` if set, else the first of :data:`CANDIDATES` on PATH."""
     env = os.environ.get("CHROMIUM")
     if env:
         return env if shutil.which(env) or Path(env).is_file() else None

@@ -162,7 +162,7 @@ class PanelRun:
         """
         out = []
         for w in self.windows:
-            if w.start <= self.first_grazing or not w.impacting or w.period < 1 or w.points < min_points:
+            if w.stop <= self.first_grazing or not w.impacting or w.period < 1 or w.points < min_points:
                 continue
             out.append(w)
             if w.period == 1:
@@ -180,7 +180,7 @@ class PanelRun:
         return [
             w
             for w in self.windows
-            if w.period == 0 and w.impacting and w.start > self.first_grazing and w.stop < end
+            if w.period == 0 and w.impacting and w.stop > self.first_grazing and w.stop < end
         ]
 
     def aperiodic_width(self) -> float:
@@ -454,8 +454,7 @@ def spans(values: np.ndarray, mask: np.ndarray) -> list[tuple[float, float]]:
 
 
 def _shade(ax: Any, run: PanelRun, reference: PanelRun | None) -> None:
-    """Shade nonimpacting period-1 motion; where the map is nonimpacting but the full system impacts, "
-    "hatch."""
+    """Shade nonimpacting period-1 motion; hatch where the map has no impacts but the full system has."""
     v = np.asarray(run.ds.value.values)
     per = np.asarray(run.ds.period.values)
     non = (per == 1) & (np.asarray(run.ds.impacts_per_period.values) == 0)

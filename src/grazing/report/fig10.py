@@ -33,7 +33,7 @@ def _periodic(run: PanelRun, lo: float = -math.inf, hi: float = math.inf) -> lis
     return [
         w
         for w in run.windows
-        if w.period >= 2 and w.impacting and w.points >= 2 and w.start > eg and lo <= w.start and w.stop <= hi
+        if w.period >= 2 and w.impacting and w.points >= 2 and w.stop > eg and lo <= w.start and w.stop <= hi
     ]
 
 

@@ -126,8 +126,7 @@ def comparison_table(rows: Sequence[Comparison]) -> str:
 
     Examples
     --------
-    >>> r = Comparison("9", "(b) period", "period-5", "period-5", "paper", "same period", "agree", "
-                       "id="row-9-1")
+    >>> r = Comparison("9", "(b) period", "period-5", "period-5", "paper", "same", "agree", id="row-9-1")
     >>> page = comparison_table([r])
     >>> 'id="row-9-1"' in page and 'class="agree"' in page
     True

@@ -55,8 +55,7 @@ class Provenance:
 
 
 def source_root() -> Path:
-    """The directory holding the ``grazing`` package's source tree (the repository for an editable "
-    "install)."""
+    """The directory above the ``grazing`` package's source (the repository, for an editable install)."""
     return Path(grazing.__file__).resolve().parents[2]
 
 

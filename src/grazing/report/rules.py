@@ -59,7 +59,7 @@ def fmt_delta(d: float, decimals: int | None = None) -> str:
     """
     if not math.isfinite(d):
         return "—"
-    if decimals is not None and abs(d) >= 10 ** (-decimals):
+    if decimals is not None and abs(d) >= 10 ** (1 - decimals):  # at least two significant digits
         return minus(f"{d:+.{decimals}f}")
     if d == 0:
         return "0"
