@@ -29,6 +29,8 @@ def test_index_written(built) -> None:
     assert messages, "progress was never reported"
     assert not list(index.parent.glob(".*.tmp")), "temporary file left behind"
     assert not any(m.startswith("report written") for m in messages), "the CLI says it, once"
+    leftover = re.findall(r"\{[A-Za-z_][^}]*\}", page)
+    assert not leftover, f"unformatted placeholders on the page: {leftover[:3]}"
 
 
 def test_every_image_referenced_exists_is_png_and_links_to_itself(built) -> None:

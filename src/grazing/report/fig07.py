@@ -73,11 +73,12 @@ def headlines(runs: Runs) -> dict[str, str]:
         "where eq. 21's test on |λ| alone does not apply",
         "cascade": f"No reverse period-adding cascade (≥ 3 windows, periods falling by one) at θ̂ = "
         f"{_angles(no_cascade)} (case B)",
-        "eta_c": f"Case B's first grazing lies "
-        "{min(abs(d) for _, d in off):.4f}–{max(abs(d) for _, d in off):.4f} "
-        f"from the experiment's η_c at θ̂ = {_angles([t for t, _ in off])}: case B was fitted to the "
-        f"experiment "
-        "at 40° only (§3)"
+        "eta_c": (
+            f"Case B's first grazing lies {min(abs(d) for _, d in off):.4f}–"
+            f"{max(abs(d) for _, d in off):.4f} "
+            f"from the experiment's η_c at θ̂ = {_angles([t for t, _ in off])}: case B was fitted to the "
+            "experiment at 40° only (§3)"
+        )
         if off
         else "",
     }

@@ -272,7 +272,8 @@ def _draw_time_series(runs: list[CaseRun], path: Path) -> None:
         span = (t0, t0 + SHOWN_PERIODS)
         plot_time_series(ax, run.dense, degrees=True, span=span)
         ax.set_title(
-            f"{c.panel}  θ̂ = {c.theta_hat_deg:g}°, η = {c.eta:g}, {c.alpha_label}: {run.dynamics.verdict}",
+            f"{c.panel}  case B, θ̂ = {c.theta_hat_deg:g}°, η = {c.eta:g}, {c.alpha_label}: "
+            f"{run.dynamics.verdict}",
             fontsize=10,
             loc="left",
         )
@@ -318,7 +319,7 @@ def _add_inset(ax: Axes, run: CaseRun) -> None:
         )
     inset.set_xlim(sol.trajectory_t[0] / T, sol.trajectory_t[-1] / T)
     inset.set_ylim(-3.0 * depth, 0.6 * depth)
-    inset.tick_params(labelsize=7)
+    inset.tick_params(labelsize=8.5)
     inset.grid(alpha=0.3)
     n_imp = len(sol.impacts)
     head = "θ − θ̂ in degrees, magnified near the stop: "
@@ -329,7 +330,7 @@ def _add_inset(ax: Axes, run: CaseRun) -> None:
         )
     else:
         text = f"{head}no impacts; every peak stays {depth:.3f}° below the stop"
-    inset.set_title(text, fontsize=8, loc="left", pad=2)
+    inset.set_title(text, fontsize=9, loc="left", pad=2)
 
 
 def _draw_delay(runs: list[CaseRun], path: Path) -> None:
@@ -341,7 +342,9 @@ def _draw_delay(runs: list[CaseRun], path: Path) -> None:
         c = run.case
         plot_delay(ax, run.dense, math.pi / 2, degrees=True, line_kw={"lw": 0.4})
         ax.set_title(
-            f"{c.panel}  θ̂ = {c.theta_hat_deg:g}°, η = {c.eta:g}\n{c.alpha_label}", fontsize=9, loc="left"
+            f"{c.panel}  case B, θ̂ = {c.theta_hat_deg:g}°, η = {c.eta:g}\n{c.alpha_label}",
+            fontsize=9.5,
+            loc="left",
         )
         ax.set_aspect("equal", adjustable="datalim")
         ax.grid(alpha=0.3)

@@ -28,12 +28,13 @@ MAJORITY = 0.5
 """A panel agrees when more than this fraction of the simulation's windows are matched."""
 
 
-def _periodic(run: PanelRun, lo: float = -math.inf, hi: float = math.inf) -> list[Window]:
+def _periodic(run: PanelRun, stop_from: float = -math.inf, stop_to: float = math.inf) -> list[Window]:
+    """Impacting windows (period ≥ 2, ≥ 2 points) past the first grazing ending in [stop_from, stop_to]."""
     eg = run.first_grazing
     return [
         w
         for w in run.windows
-        if w.period >= 2 and w.impacting and w.points >= 2 and w.stop > eg and lo <= w.start and w.stop <= hi
+        if w.period >= 2 and w.impacting and w.points >= 2 and w.stop > eg and stop_from <= w.stop <= stop_to
     ]
 
 
@@ -41,14 +42,15 @@ def panel_windows(runs: Runs, p: Panel) -> list[tuple[str, list[Window]]]:
     """The windows of one panel by view, without double counting.
 
     The magnified sweep's windows that end inside it, then the main sweep's
-    windows beyond the magnified range (all of the main sweep's without one).
+    windows that end beyond it (all of the main sweep's without one): a window
+    running past the end of the magnified sweep is taken whole from the main one.
     """
     z, m = runs.of(p, "zoom"), runs.of(p, "main")
     assert m is not None
     if z is None:
         return [("main", _periodic(m))]
     zhi = z.eta_range[1]
-    return [("zoom", _periodic(z, hi=zhi - 0.5 * z.step)), ("main", _periodic(m, lo=zhi))]
+    return [("zoom", _periodic(z, stop_to=zhi - 0.5 * z.step)), ("main", _periodic(m, stop_from=zhi))]
 
 
 def panel_matches(flow: Runs, mapped: Runs, p: Panel) -> list[tuple[str, WindowMatch]]:
