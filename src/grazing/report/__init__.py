@@ -100,12 +100,43 @@ def select(names: Sequence[str]) -> list[ModuleType]:
     return [m for m in FIGURES if m.FIGURE_ID in wanted]
 
 
-def _precompile() -> None:
-    """Compile (or load) every kernel variant the figures use, in parallel (a few seconds when cached)."""
-    from grazing.engine.runner import precompile
+def _compile_job(job: tuple[str, Any]) -> None:
+    """Compile (or load) one kernel module: ``("flow", tol)`` or ``("tangent", sensitivities)``."""
+    import numpy as np
 
-    model = grazing.models.pendulum("B")
-    precompile([(model, ()), (model, ("eta",)), (model, ("eta", "theta_hat"))])
+    from grazing.engine.runner import Runner
+
+    kind, arg = job
+    model = grazing.models.pendulum("B", eta=0.4, theta_hat=0.5)
+    if kind == "flow":
+        grazing.simulate(model, [0.0, 0.0], periods=1, tol=arg)
+    else:
+        Runner(model, np.zeros(model.n_states), variational=True, sensitivities=arg).advance(1, 1)
+
+
+def _precompile(workers: int | None = None) -> None:
+    """Compile (or load) every kernel module the figures use, in parallel processes (seconds when cached).
+
+    The sweeps integrate at :data:`grazing.sweeps.brute_force.DEFAULT_SWEEP_TOL`, whose Taylor order
+    differs from the default one: its kernels are a module of their own.
+    """
+    import multiprocessing as mp
+
+    from grazing.sweeps.brute_force import DEFAULT_SWEEP_TOL
+
+    jobs = [
+        ("flow", DEFAULT_SWEEP_TOL),
+        ("tangent", ()),
+        ("tangent", ("eta",)),
+        ("tangent", ("eta", "theta_hat")),
+    ]
+    n = min(workers or os.cpu_count() or 1, len(jobs))
+    if n <= 1:
+        for job in jobs:
+            _compile_job(job)
+        return
+    with mp.get_context("spawn").Pool(n) as pool:  # fresh interpreters: no half-initialised numba state
+        pool.map(_compile_job, jobs)
 
 
 def _write_atomic(path: Path, text: str) -> None:

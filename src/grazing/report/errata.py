@@ -53,8 +53,7 @@ def beta_rows() -> list[Comparison]:
                     decimals=4,
                     erratum=factor == 2,
                     why_tolerance=f"half a unit of the printed β plus the rounding of the printed κ carried "
-                    f"to "
-                    f"β: {tol:.2g}",
+                    f"to β: {tol:.2g}",
                     headline="Eq. 3 prints β = κ/(2ω0); the paper's own numbers follow β = κ/(4ω0)"
                     if factor == 2
                     else "",

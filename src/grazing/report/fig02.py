@@ -142,8 +142,7 @@ def model_rows() -> list[Comparison]:
                 dyn.verdict == measured,
                 kind="experiment",
                 rule="agree when the model's attractor (period of the stroboscopic samples; chaotic: none ≤ "
-                "64 "
-                "and λ₁ > 10⁻³) is what the measured series shows",
+                "64 and λ₁ > 10⁻³) is what the measured series shows",
                 source="§2.2, fig 3",
                 paper_text=f"measured: {measured}",
                 ours_text=dyn.short(),

@@ -24,8 +24,7 @@ HEAD_NORM = (
     "Fig 4 normalisation: eq. 1 as printed contradicts eq. 6 (it gives D = β/2 at r = 1); normalised so "
     "that eq. 6 "
     "holds, the model's D is not 0.07 for the fig 4(a) decay nor at most of A–D — the paper's 0.07 comes "
-    "back "
-    "with eq. 1 as printed and the model's damping doubled (the κ of the eq. 3 erratum)"
+    "back with eq. 1 as printed and the model's damping doubled (the κ of the eq. 3 erratum)"
 )
 
 
@@ -46,8 +45,7 @@ def build(out_dir: Path, progress: Progress | None = None) -> FigureResult:
                 f"Free decay (α = 0, stop at θ̂ = 0) for r = {paper.FIG4A[0].text}, β = "
                 f"{paper.FIG4A[1].text}, "
                 "released at rest 0.5 rad from the stop; the peaks used by the logarithmic-decrement "
-                "estimator "
-                "are marked.",
+                "estimator are marked.",
                 "Free decay of the impacting pendulum",
             ),
             Image(
@@ -93,8 +91,7 @@ def comparisons(a: dict, b: dict) -> tuple[Comparison, ...]:
             kind="paper",
             decimals=4,
             note="Our reconstruction of the paper's computation: the κ of the eq. 3 erratum doubles the "
-            "model's "
-            "damping, and eq. 1 as printed halves the estimate.",
+            "model's damping, and eq. 1 as printed halves the estimate.",
         ),
     ]
     pts = b["points"]

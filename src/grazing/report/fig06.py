@@ -41,7 +41,8 @@ ALPHA = paper.ALPHA_TABLE.value
 """Forcing amplitude of all four response curves (the numerics' value as the captions print it)."""
 ALPHA_AL = paper.ALPHA_APPARATUS
 """α = A/L unrounded: the value the printed numbers of fig 6 fit (see the comparisons)."""
-DAMPING = (("A", 0.010), ("B", 0.048), ("C", 0.058), ("D", 0.068))
+DAMPING = tuple((k, float(paper.CASES[k]["beta"])) for k in ("A", "B", "C", "D"))
+BETA_B = float(paper.CASES["B"]["beta"])
 """The letters of the paper's fig 6 (left) and their β."""
 ETA_RANGE = (0.2, 1.0)
 """η range of the response curves shown."""
@@ -118,7 +119,7 @@ def compute() -> Fig6:
         letter: continue_orbit(_model(beta), "eta", ETA_RANGE[0], ETA_RANGE[1], virtual=True)
         for letter, beta in DAMPING
     }
-    far = continue_orbit(_model(0.048), "eta", ETA_RANGE[1], ETA_FAR, virtual=True)
+    far = continue_orbit(_model(BETA_B), "eta", ETA_RANGE[1], ETA_FAR, virtual=True)
     curve = grazing_curve(grazing.models.pendulum("B"), start=math.radians(5.0))
     found = {
         (alpha, th): find_grazings(
@@ -378,8 +379,7 @@ def linear_multipliers(eta: float, beta: float) -> complex:
 
 HEAD_ALPHA = (
     "Fig 6's printed grazing points and multipliers fit α = A/L = 0.225778 (printed 0.2258 in §3) to every "
-    "digit, "
-    "not the captions' α = 0.2254 that we use for figs 7–12"
+    "digit, not the captions' α = 0.2254 that we use for figs 7–12"
 )
 
 
@@ -439,8 +439,7 @@ def comparisons(data: Fig6) -> tuple[Comparison, ...]:
                 headline="§6.1 quotes |λ| = 0.5114 at 40°, η = 0.445; its own multipliers have modulus "
                 "0.5078",
                 note=f"The paper's own multipliers 0.4606 ± 0.2137i have modulus {own:.4f}, as ours; the "
-                f"quoted "
-                "0.5114 fits neither (SPEC errata). Either value lies in 1/4 < |λ| < 2/3 (eq. 21).",
+                f"quoted 0.5114 fits neither (SPEC errata). Either value lies in 1/4 < |λ| < 2/3 (eq. 21).",
             )
         )
     if c is not None:
@@ -482,7 +481,7 @@ def comparisons(data: Fig6) -> tuple[Comparison, ...]:
                 headline="Fig 6 inset (a): the multipliers' real part is printed with the wrong sign",
                 note="Near η = 1/3 the linearised pendulum turns by about 3π per forcing period, so the pair "
                 f"lies near the negative real axis: the linear oscillator alone gives "
-                f"{complex_text(linear_multipliers(_eta(a), 0.048))}.",
+                f"{complex_text(linear_multipliers(_eta(a), BETA_B))}.",
             )
         )
         flipped = paper.PrintedComplex(
@@ -531,7 +530,7 @@ def comparisons(data: Fig6) -> tuple[Comparison, ...]:
         )
     p = data.points.get("b")
     if p is not None:
-        beta = 0.048
+        beta = BETA_B
         det = float(np.prod(p.multipliers).real)
         rows.append(
             numeric_row(
@@ -558,8 +557,7 @@ def comparisons(data: Fig6) -> tuple[Comparison, ...]:
             one,
             kind="paper",
             rule="agree when the nonimpacting orbit's largest angle, followed from the grazing to η = 3, "
-            "never "
-            "comes back down to 10°",
+            "never comes back down to 10°",
             source="§6.1",
             paper_text="no second grazing at 10°",
             ours_text=f"1 grazing; largest angle ≥ {far_angle.min():.2f}° up to η = {ETA_FAR:g}",
@@ -591,8 +589,7 @@ def _above_two_thirds(curve: GrazingCurve) -> str:
         t = th[real]
         text += (
             f"Near the resonance peak the nontrivial pair is real (θ̂ from {t.min():.1f}° to {t.max():.1f}°), "
-            "the larger multiplier reaching "
-            f"{lam[real].max():.3f}. "
+            f"the larger multiplier reaching {lam[real].max():.3f}. "
         )
     if parts:
         text += "It exceeds 2/3, the upper limit of eq. 21 for period-adding, " + " and ".join(parts) + "."

@@ -40,8 +40,7 @@ SETTINGS = Settings()
 HEAD_FOLD = (
     "The impacting region ends at a fold (saddle-node) of the impacting period-1 orbit beyond the second "
     "grazing, not with the period-2 window at the second grazing: past the period-2 window our sweeps stay "
-    "on "
-    "impacting period 1 (swept downwards, they would stay nonimpacting: hysteresis)"
+    "on impacting period 1 (swept downwards, they would stay nonimpacting: hysteresis)"
 )
 
 
@@ -101,12 +100,10 @@ def build(out_dir: Path, progress: Progress | None = None, settings: Settings | 
             names[0],
             f"Brute-force bifurcation diagrams of case B (r = 0.7675, β = 0.048, α = 0.2254): θ at τ = 2πk "
             f"({s.periods} samples per η after a transient of up to {s.transient} forcing periods) against "
-            f"η, "
-            f"{s.points} η values per panel over the range of the experiment (§2.2), η increasing, each η "
+            f"η, {s.points} η values per panel over the range of the experiment (§2.2), η increasing, each η "
             "starting from the final state of the previous one. Shaded: nonimpacting period-1 motion. Dashed "
             "red: grazings of the nonimpacting period-1 orbit (continuation). Blue bars and numbers: "
-            "periodic "
-            "windows and their periods (unlabelled when too narrow to label; all are in the data).",
+            "periodic windows and their periods (unlabelled when too narrow to label; all are in the data).",
             "Bifurcation diagrams of the stroboscopic angle against eta at four stop angles, case B",
         ),
         Image(
@@ -262,8 +259,7 @@ def panel_rows(runs: Runs, p: Panel, heads: dict[str, str]) -> list[Comparison]:
             diagrams.is_reverse_adding(seq),
             kind="paper",
             rule="agree when the clearly resolved windows past the first grazing (≥ 3 points and ≥ 1 % of "
-            "the "
-            "sweep's span, period-doubled satellites left out), up to impacting period 1, are at least "
+            "the sweep's span, period-doubled satellites left out), up to impacting period 1, are at least "
             "three with periods decreasing by one",
             source="§6.1",
             paper_text="…, 4, 3, 2, 1",
@@ -326,8 +322,7 @@ def notes(runs: Runs) -> tuple[str, ...]:
         "choice: the paper does not quantify it.",
         "What the grazing normal form predicts past each first grazing (the two-dimensional normal form "
         f"iterated, docs/normal-form.md): {pred}. Eq. 21 (1/4 < |λ| < 2/3) would predict period adding at "
-        f"all "
-        "four angles; it holds for real multipliers, and the multipliers here are complex.",
+        f"all four angles; it holds for real multipliers, and the multipliers here are complex.",
         "Hysteresis: between the second grazing and the fold of the impacting orbit both period-1 motions "
         "are stable; a sweep downwards in η from the nonimpacting side would stay nonimpacting there, down "
         "to the second grazing.",

@@ -297,14 +297,12 @@ def comparisons(runs: list[PanelRun]) -> tuple[Comparison, ...]:
             FIGURE_ID,
             "(b) against (a): case A (smaller β) against case B",
             "“significantly wider intervals of chaos and also wider ... windows of the higher-period "
-            "periodic "
-            "windows”",
+            "periodic windows”",
             f"aperiodic {fa:.0%} vs {fb:.0%}; widest windows (A vs B) " + "; ".join(wide),
             fa > fb and wider and bool(wide),
             kind="paper",
             rule="agree when case A has a larger aperiodic share of its impacting points (from θ̂ = 25° to "
-            "the "
-            "grazing) and wider widest windows of periods 3, 4 and 5 than case B",
+            "the grazing) and wider widest windows of periods 3, 4 and 5 than case B",
             source="§6.2",
             paper_text="A: wider chaos, wider windows",
             ours_text=f"aperiodic {fa:.0%} (A) vs {fb:.0%} (B); windows wider in A: "
@@ -327,8 +325,7 @@ def notes(runs: list[PanelRun]) -> tuple[str, ...]:
     gap = f"{math.degrees(big[-1].stop):.1f}°" if big else "—"
     return (
         f"Case A at η = {ETA:g} grazes at θ̂_g = {ga:.2f}° with |λ| = {a.abs_lambda:.3f}, above 2/3: "
-        f"outside the "
-        "period-adding range of eq. 21. Its windows in the 5° below the grazing: "
+        f"outside the period-adding range of eq. 21. Its windows in the 5° below the grazing: "
         + (", ".join(_deg(w) for w in near_a) or "none")
         + f"; its windows of period 3, 4, 5 lie far below the grazing, and from the last of them ({gap}) "
         "almost up to the grazing the motion is aperiodic. The paper says nothing about this range.",

@@ -499,8 +499,7 @@ def _comparison(
         agrees,
         kind="paper",
         rule="agree when our attractor (period of 200 stroboscopic samples, tolerance 1e-6; chaotic: none ≤ "
-        "64 "
-        "and λ₁ > 10⁻³ per unit τ) is what the paper shows",
+        "64 and λ₁ > 10⁻³ per unit τ) is what the paper shows",
         source=c.source,
         ours_text=d.short(),
         note=note + f" In full: {d.describe()}.",

@@ -282,8 +282,7 @@ def _drift_row(deg: list[tuple[float, float]]) -> Comparison:
         holds,
         kind="self-check",
         rule="the map is exact at leading order in d, so the edge error in units of d should shrink as d → "
-        "0: "
-        "agree when its median over the matched windows with d < 10⁻³ is at most the median for d ≥ 10⁻²",
+        "0: agree when its median over the matched windows with d < 10⁻³ is at most the median for d ≥ 10⁻²",
         source="notes on the normal form",
         paper_text="error/d shrinks as d → 0",
         ours_text=f"median error/d: {stat(near)} near, {stat(far)} far",

@@ -134,14 +134,12 @@ def build(out_dir: Path, progress: Progress | None = None) -> FigureResult:
             at_paper["flow"] == 0 and at_paper["map"] == 0,
             kind="paper",
             rule="agree when both the simulation and the map are aperiodic at the paper's η (no period ≤ 50 "
-            "in "
-            "400 stroboscopic samples after 2000 transient periods)",
+            "in 400 stroboscopic samples after 2000 transient periods)",
             source="§6.1, fig 11",
             paper_text="chaotic in both",
             ours_text=f"period {at_paper['flow']} (simulation), {at_paper['map']} (map)",
             headline=f"Fig 11 is drawn at η = {chosen:.5f}, in our chaotic band: at the paper's η = "
-            f"{PAPER_ETA} "
-            "our attractor is period 5",
+            f"{PAPER_ETA} our attractor is period 5",
             note=(
                 f"In our computation η = {PAPER_ETA} is inside the period-5 window, which also contains the "
                 f"paper's own period-5 point η = 0.446 (fig 9(b)); the chaotic band just past grazing (η_g = "

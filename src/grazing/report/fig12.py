@@ -232,8 +232,7 @@ def comparisons(runs: Runs) -> tuple[Comparison, ...]:
             ok,
             kind="paper",
             rule="agree when in every panel the widest window of period ≥ 3 past grazing is at least 0.001 "
-            "wide, "
-            "has aperiodic points (no period ≤ 50) on both sides, and the sequence ends with period 2 "
+            "wide, has aperiodic points (no period ≤ 50) on both sides, and the sequence ends with period 2 "
             "then impacting period 1 (magnified sweeps)",
             source="§6.2",
             paper_text="one large window in chaos, then 2",
@@ -251,8 +250,7 @@ def comparisons(runs: Runs) -> tuple[Comparison, ...]:
                 r.first_grazing,
                 kind="experiment",
                 headline="Case A-reduced's first grazing lies away from the experiment's η_c at some stop "
-                "angles "
-                "(it was not fitted to them)",
+                "angles (it was not fitted to them)",
             )
         )
     for p in PANELS[1:]:
@@ -270,8 +268,7 @@ def comparisons(runs: Runs) -> tuple[Comparison, ...]:
                 paper_text="2 → no impacts",
                 headline=fig07.HEAD_FOLD,
                 note="As for case B (fig 7): the period-2 window gives way to impacting period-1 motion, "
-                "which "
-                "lasts up to a fold of the impacting orbit beyond the second grazing.",
+                "which lasts up to a fold of the impacting orbit beyond the second grazing.",
             )
         )
     return tuple(rows)

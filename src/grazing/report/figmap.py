@@ -283,8 +283,7 @@ def notes(run: MapRun, s: Settings) -> tuple[str, ...]:
     eta_co = c["above_impact_eta"]
     over = (
         f"{c['over_max_impact']} of the {c['over_max']} map points above θ̂_max = "
-        f"{math.degrees(c['th_max']):.2f}° "
-        "impact"
+        f"{math.degrees(c['th_max']):.2f}° impact"
         + (
             f" (θ̂ ≤ {math.degrees(c['over_max_top']):.2f}°, η {c['over_max_eta'].min():.3f}–"
             f"{c['over_max_eta'].max():.3f})"

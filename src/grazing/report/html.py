@@ -254,8 +254,7 @@ RULES_TEXT = (
     "at "
     "most half a unit in each part; a window of a sweep matches another only when their η intervals overlap "
     "and they have the same period, and a panel agrees when more than half of its windows match; rows "
-    "computed "
-    "from synthetic recordings are self-checks and never agree with the paper. All rows are in "
+    "computed from synthetic recordings are self-checks and never agree with the paper. All rows are in "
     "comparisons.json."
 )
 

@@ -276,8 +276,7 @@ FIRST_WINDOW = MappingProxyType({10.0: 1, 20.0: 2, 30.0: 3, 40.0: 4})
 for 30°, and four (actually, briefly, five) for 40°”."""
 FIRST_WINDOW_QUOTE = (
     "“the period of the first appreciable periodic window is ... one for 10°, two for 20°, three for 30°, "
-    "and "
-    "four (actually, briefly, five) for 40°”"
+    "and four (actually, briefly, five) for 40°”"
 )
 JUMP_TO_CHAOS = (
     "“For each θ̂ there is a first grazing bifurcation that leads to a rapid change in the dynamics, from "
@@ -305,8 +304,7 @@ FIG7D_CHAOTIC = Printed("0.45", "§6.1: the numerics are chaotic at η = 0.45 (f
 
 FIG10_QUOTE = (
     "the period-adding cascades are “captured and clearly visible in Figures 10(c) and (d), but the "
-    "intervals "
-    "in which they appear are somewhat shortened”"
+    "intervals in which they appear are somewhat shortened”"
 )
 FIG11_ETA = Printed("0.4458", "§6.1, fig 11 caption")
 FIG11_THETA_HAT_DEG = 40.0
@@ -317,8 +315,7 @@ UNCANNY = ("a", "c", "d")
 """§6.2: with the reduced forcing, panels (a), (c), (d) are “uncannily similar” to the experiment."""
 FIG12_PATTERN = (
     "“we can clearly see one large periodic window surrounded by chaotic regions, culminating in a "
-    "period-two "
-    "window”"
+    "period-two window”"
 )
 
 # ---------------------------------------------------------------------------- equations
