@@ -199,3 +199,13 @@ def test_every_paper_number_lives_in_paper_py() -> None:
         assert CASES[name]["r"] == float(c["r"]) and CASES[name]["beta"] == float(c["beta"])
     assert CASES["B"]["alpha"] == paper.ALPHA_TABLE.value
     assert CASES["A-reduced"]["alpha"] == pytest.approx(paper.REDUCED_FORCING.value * paper.ALPHA_TABLE.value)
+
+
+def test_drift_counts_each_resolved_edge_at_its_own_distance() -> None:
+    from grazing.report.fig10 import degradation
+
+    ms = match_windows([w(3, 1.010, 1.050), w(2, 1.0001, 1.2)], [w(3, 1.012, 1.045), w(2, 1.0001, 1.1)])
+    out = degradation(ms, 1.0, step=1e-3)
+    # the period-2 window's start is within 3 steps of grazing: left out
+    assert [round(d, 4) for d, _ in out] == [0.01, 0.05, 0.2]
+    assert dict((round(d, 4), round(e, 4)) for d, e in out) == {0.01: 0.2, 0.05: 0.1, 0.2: 0.5}
