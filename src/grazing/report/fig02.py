@@ -147,8 +147,8 @@ def model_rows() -> list[Comparison]:
                 paper_text=f"measured: {measured}",
                 ours_text=dyn.short(),
                 headline="Case B at the measured points of fig 3 does not show the measured motion: its "
-                "windows sit "
-                "at other η than the experiment's (at 40°, η = 0.45 the paper's own numerics differ too)",
+                "windows sit at other η than the experiment's (at 40°, η = 0.45 the paper's own numerics "
+                "differ too)",
                 note="The paper's own numerics differ here too (§6.1): chaotic at 40°, η = 0.45, period 5 at "
                 "η = 0.446 (fig 9)."
                 if th == 40.0

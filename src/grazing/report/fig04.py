@@ -21,10 +21,9 @@ from grazing.report.rules import numeric_row
 
 FIGURE_ID = "4"
 HEAD_NORM = (
-    "Fig 4 normalisation: eq. 1 as printed contradicts eq. 6 (it gives D = β/2 at r = 1); normalised so "
-    "that eq. 6 "
-    "holds, the model's D is not 0.07 for the fig 4(a) decay nor at most of A–D — the paper's 0.07 comes "
-    "back with eq. 1 as printed and the model's damping doubled (the κ of the eq. 3 erratum)"
+    "Normalisation: eq. 1 as printed contradicts eq. 6 (it gives D = β/2 at r = 1); normalised so that "
+    "eq. 6 holds, the model's D is not 0.07 for the fig 4(a) decay nor at most of A–D — the paper's 0.07 "
+    "comes back with eq. 1 as printed and the model's damping doubled (the κ of the eq. 3 erratum)"
 )
 
 
@@ -156,7 +155,7 @@ def comparisons(a: dict, b: dict) -> tuple[Comparison, ...]:
             erratum=True,
             tolerance=paper.D_BETA_CAPTION.unit,
             why_tolerance="one unit of the printed digit, 0.01",
-            headline="Fig 4 caption: point D's “β = 0.68” is 0.068 (§3 says β ≈ 0.068 at r = 1)",
+            headline="The caption's point D “β = 0.68” is 0.068 (§3 says β ≈ 0.068 at r = 1)",
             note="Ours: the reconstruction's β at r = 1 on the curve D = 0.07; §3 itself says β ≈ 0.068.",
         )
     )

@@ -378,7 +378,7 @@ def linear_multipliers(eta: float, beta: float) -> complex:
 
 
 HEAD_ALPHA = (
-    "Fig 6's printed grazing points and multipliers fit α = A/L = 0.225778 (printed 0.2258 in §3) to every "
+    "The printed grazing points and multipliers fit α = A/L = 0.225778 (printed 0.2258 in §3) to every "
     "digit, not the captions' α = 0.2254 that we use for figs 7–12"
 )
 
@@ -463,7 +463,7 @@ def comparisons(data: Fig6) -> tuple[Comparison, ...]:
                 _eta(a),
                 kind="paper",
                 erratum=True,
-                headline="Fig 6 inset (a): “η = 0.3229” is a typo for 0.3329",
+                headline="Inset (a): “η = 0.3229” is a typo for 0.3329",
                 note=f"The only grazing at 10° is at η = {_eta(a):.5f} (α = A/L; "
                 f"{_eta(data.points['a']):.5f} with "
                 "α = 0.2254): it rounds to 0.3329. The printed multipliers fit that η only (next rows).",
@@ -478,7 +478,7 @@ def comparisons(data: Fig6) -> tuple[Comparison, ...]:
                 mu,
                 kind="paper",
                 erratum=True,
-                headline="Fig 6 inset (a): the multipliers' real part is printed with the wrong sign",
+                headline="Inset (a): the multipliers' real part is printed with the wrong sign",
                 note="Near η = 1/3 the linearised pendulum turns by about 3π per forcing period, so the pair "
                 f"lies near the negative real axis: the linear oscillator alone gives "
                 f"{complex_text(linear_multipliers(_eta(a), BETA_B))}.",

@@ -274,7 +274,7 @@ def comparisons(runs: list[PanelRun]) -> tuple[Comparison, ...]:
             source="§6.1",
             paper_text="periods increasing by one with θ̂",
             ours_text=" → ".join(map(str, per)),
-            headline="Fig 8(a): no period-adding cascade in θ̂",
+            headline="(a): no period-adding cascade in θ̂",
             note="Windows: "
             + ", ".join(_deg(w) for w in near)
             + (f". Others (≥ 2 points): {others}." if others else "."),
@@ -307,7 +307,7 @@ def comparisons(runs: list[PanelRun]) -> tuple[Comparison, ...]:
             paper_text="A: wider chaos, wider windows",
             ours_text=f"aperiodic {fa:.0%} (A) vs {fb:.0%} (B); windows wider in A: "
             f"{'yes' if wider else 'no'}",
-            headline="Fig 8: case A's chaos or windows are not wider than case B's",
+            headline="Case A's chaos or windows are not wider than case B's",
             note=f"Over B's θ̂ range only, A is aperiodic at {fa_common:.0%} of its impacting points. Widths: "
             + "; ".join(wide)
             + f". Case A grazes at θ̂_g = {math.degrees(a.theta_graze):.2f}° at this η "

@@ -453,8 +453,8 @@ def write_data(runs: list[CaseRun], out_dir: Path) -> DataFile:
 
 
 HEAD_ALPHA = (
-    "Fig 9(a) (θ̂ = 10°, η = 0.33294) is chaotic only with α = A/L = 0.225778 unrounded; with the tabulated "
-    "α = 0.2254 η = 0.33294 lies below grazing"
+    "(a) θ̂ = 10°, η = 0.33294 is chaotic only with α = A/L = 0.225778 unrounded; with the tabulated "
+    "α = 0.2254 this η lies below the grazing point, on the nonimpacting orbit"
 )
 
 

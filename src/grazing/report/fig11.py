@@ -138,7 +138,7 @@ def build(out_dir: Path, progress: Progress | None = None) -> FigureResult:
             source="§6.1, fig 11",
             paper_text="chaotic in both",
             ours_text=f"period {at_paper['flow']} (simulation), {at_paper['map']} (map)",
-            headline=f"Fig 11 is drawn at η = {chosen:.5f}, in our chaotic band: at the paper's η = "
+            headline=f"Drawn at η = {chosen:.5f}, in our chaotic band: at the paper's η = "
             f"{PAPER_ETA} our attractor is period 5",
             note=(
                 f"In our computation η = {PAPER_ETA} is inside the period-5 window, which also contains the "
@@ -158,7 +158,7 @@ def build(out_dir: Path, progress: Progress | None = None) -> FigureResult:
             source="§6.1, fig 11",
             paper_text="same attractor (distance 0)",
             ours_text=f"distance {dist:.2f}; λ₁ = {signed(lyap_flow, 3)} (sim.), {signed(lyap_map, 3)} (map)",
-            headline="Fig 11: the map's attractor differs from the simulation's",
+            headline="The map's attractor differs from the simulation's",
             note="The fingers (the near-vertical branches at the left) come from the square-root term.",
         ),
     )
