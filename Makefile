@@ -4,7 +4,7 @@ VENV   ?= .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed-$(shell cat pyproject.toml | cksum | cut -d' ' -f1)
 
-.PHONY: install reproduce test test-all bench lint clean
+.PHONY: install reproduce check-report test test-all bench lint clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -18,6 +18,11 @@ install: $(STAMP)
 
 reproduce: $(STAMP)
 	$(BIN)/grazing report --out report
+
+# Open report/index.html in headless Chromium: every image shown, every link live (needs chromium).
+check-report: $(STAMP)
+	test -f report/index.html || $(MAKE) reproduce
+	$(BIN)/python -m grazing.report.browser report/index.html
 
 test: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks

@@ -421,16 +421,20 @@ def label_windows(
     windows: list[Window],
     *,
     scale: float = 1.0,
-    rows: tuple[float, ...] = (0.955, 0.905),
-    fontsize: float = 8.0,
-    min_gap: float = 0.025,
+    rows: tuple[float, ...] = (0.955, 0.895, 0.835),
+    fontsize: float = 9.0,
+    min_gap: float = 0.006,
     color: str = "tab:blue",
-) -> None:
-    """Write the period above each window, with a bar showing its extent.
+) -> list[Window]:
+    """Write the period above each window, with a bar showing its extent, without collisions.
 
-    The labels sit near the top of the axes (``rows`` in axes fractions);
-    a label too close to the previous one on the same row moves to the next
-    row.  Draw the diagram and set the x limits first.
+    The labels sit near the top of the axes (``rows`` in axes fractions).  Each
+    label occupies its bar and its text (estimated from the font size and the
+    axes width); the windows are placed widest first, each on the first row
+    where it collides with nothing already placed there, ``min_gap`` (axes
+    fraction) apart.  A window that fits on no row is left unlabelled: the
+    caller lists the windows in a table anyway.  Draw the diagram and set the x
+    limits first.
 
     Parameters
     ----------
@@ -446,25 +450,47 @@ def label_windows(
     fontsize
         Font size of the labels.
     min_gap
-        Smallest distance between labels on one row, in axes fractions.
+        Smallest distance between two labels' extents on one row, in axes fractions.
     color
         Colour of the labels and bars.
+
+    Returns
+    -------
+    list of Window
+        The windows labelled, in the order given.
     """
     x0, x1 = ax.get_xlim()
     trans = ax.get_xaxis_transform()  # x in data, y in axes fraction
-    last = [-math.inf] * len(rows)
-    for w in windows:
+    width_pt = max(ax.get_position().width * ax.figure.get_figwidth() * 72.0, 1.0)
+
+    def extent(w: Window) -> tuple[float, float]:
+        c = (w.center * scale - x0) / (x1 - x0)
+        half_text = 0.5 * 0.62 * fontsize * len(w.label.split(" ")[0]) / width_pt
+        lo = min((w.lo * scale - x0) / (x1 - x0), c - half_text)
+        hi = max((w.hi * scale - x0) / (x1 - x0), c + half_text)
+        return lo, hi
+
+    taken: list[list[tuple[float, float]]] = [[] for _ in rows]
+    placed: dict[int, int] = {}
+    for k in sorted(range(len(windows)), key=lambda i: -windows[i].width):
+        lo, hi = extent(windows[k])
+        for r, row in enumerate(taken):
+            if all(hi + min_gap <= a or lo - min_gap >= b for a, b in row):
+                row.append((lo, hi))
+                placed[k] = r
+                break
+    out = []
+    for k, w in enumerate(windows):
+        if k not in placed:
+            continue
+        y = rows[placed[k]]
         c = w.center * scale
-        frac = (c - x0) / (x1 - x0)
-        row = next((k for k in range(len(rows)) if frac - last[k] >= min_gap), None)
-        if row is None:
-            row = int(np.argmin(last))
-        last[row] = frac
-        y = rows[row]
         ax.plot([w.lo * scale, w.hi * scale], [y - 0.012, y - 0.012], transform=trans, color=color,
-                lw=1.2, solid_capstyle="butt", clip_on=False)  # fmt: skip
+                lw=1.4, solid_capstyle="butt", clip_on=False)  # fmt: skip
         ax.text(c, y, w.label.split(" ")[0], transform=trans, ha="center", va="bottom",
                 fontsize=fontsize, color=color, clip_on=False)  # fmt: skip
+        out.append(w)
+    return out
 
 
 def mark_grazings(
@@ -474,7 +500,7 @@ def mark_grazings(
     scale: float = 1.0,
     labels: list[str] | None = None,
     color: str = "tab:red",
-    fontsize: float = 7.5,
+    fontsize: float = 9.0,
 ) -> None:
     """Mark grazing points as dashed vertical lines (labelled at the bottom).
 
@@ -591,7 +617,7 @@ def plot_bifurcation(
         ax.plot([lo - pad, hi + pad], [(lo - pad) / xscale * yscale, (hi + pad) / xscale * yscale],
                 color="tab:red", lw=0.8, alpha=0.6, zorder=0)  # fmt: skip
     rng = max(ymax - ymin, 1e-9)
-    ax.set_ylim(ymin - 0.04 * rng, ymax + 0.22 * rng)  # headroom for the window labels
+    ax.set_ylim(ymin - 0.04 * rng, ymax + 0.32 * rng)  # headroom for three rows of window labels
     runs = find_windows(ds)
     if nonimpacting:
         trans = ax.get_xaxis_transform()
@@ -600,7 +626,7 @@ def plot_bifurcation(
                 ax.axvspan(w.lo * xscale, w.hi * xscale, color="#dfe9f3", lw=0, zorder=-1)
                 if w.width * xscale >= 0.12 * (hi - lo):
                     ax.text(w.center * xscale, 0.03, "period 1,\nno impacts", transform=trans,
-                            ha="center", va="bottom", fontsize=7.5, color="#4a6b8a")  # fmt: skip
+                            ha="center", va="bottom", fontsize=9, color="#4a6b8a")  # fmt: skip
     if windows:
         shown = visible_windows(runs, (hi - lo) / xscale if hi > lo else 1.0, **(window_kw or {}))
         label_windows(ax, shown, scale=xscale)

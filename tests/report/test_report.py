@@ -1,87 +1,153 @@
-"""The HTML report: build it once and check the page, the images and the computed numbers."""
+"""The HTML report: the page, its images and data files, its provenance, and rebuilding one figure."""
 
 from __future__ import annotations
 
+import json
 import math
 import re
+import shutil
 from pathlib import Path
 
 import pytest
+import xarray as xr
+from click.testing import CliRunner
 
 import grazing
-from grazing.report import FIGURES, PAPER_FIGURES, build_report, fig09
+from grazing.cli import cli
+from grazing.report import FIGURES, PAPER_FIGURES, build_report, fig09, select
 from grazing.report.base import Comparison, Dynamics, FigureResult, Image, signed
 from grazing.report.html import ReportMeta, comparison_table, render
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
 
-@pytest.fixture(scope="module")
-def built(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str, list[str]]:
-    out = tmp_path_factory.mktemp("report") / "nested" / "report"
-    messages: list[str] = []
-    index = build_report(out, messages.append)
-    return index, index.read_text(encoding="utf-8"), messages
-
-
-def test_index_written(built: tuple[Path, str, list[str]]) -> None:
-    index, page, messages = built
+def test_index_written(built) -> None:
+    index, page, messages = built.index, built.page, built.messages
     assert index.name == "index.html" and index.is_file()
     assert page.startswith("<!DOCTYPE html>") and page.rstrip().endswith("</html>")
     assert grazing.__version__ in page
-    assert "build time" in page
     assert messages, "progress was never reported"
     assert not list(index.parent.glob(".*.tmp")), "temporary file left behind"
+    assert not any(m.startswith("report written") for m in messages), "the CLI says it, once"
+    leftover = re.findall(r"\{[A-Za-z_][^}]*\}", page)
+    assert not leftover, f"unformatted placeholders on the page: {leftover[:3]}"
 
 
-def test_every_image_referenced_exists_and_is_png(built: tuple[Path, str, list[str]]) -> None:
-    index, page, _ = built
+def test_every_image_referenced_exists_is_png_and_links_to_itself(built) -> None:
+    page = built.page
     sources = re.findall(r'<img src="([^"]+)"', page)
-    assert len(sources) >= 2
+    assert len(sources) >= 10
     for src in sources:
-        path = index.parent / src
-        assert path.is_file(), src
-        data = path.read_bytes()
+        data = (built.out / src).read_bytes()
         assert data.startswith(PNG_SIGNATURE), src
-        assert 10_000 < len(data) < 1_500_000, (src, len(data))
-    on_disk = {p.name for p in index.parent.glob("*.png")}
+        assert 10_000 < len(data) < 2_000_000, (src, len(data))
+        assert f'<a href="{src}"><img src="{src}"' in page, f"{src} is not linked to its full size"
+    on_disk = {p.name for p in built.out.glob("*.png")}
     assert on_disk == set(sources), "images written but not shown, or shown but not written"
 
 
-def test_table_holds_our_computed_periods(built: tuple[Path, str, list[str]]) -> None:
-    _, page, _ = built
-    # fig 9(b): our own period detection, independently of the report's code path
-    m = grazing.models.pendulum("B", eta=0.446, theta_hat=math.radians(40))
-    p = grazing.simulate(m, [0.0, 0.0], transient=1000, periods=200).period()
-    assert p == 5
-    row = next(r for r in re.findall(r"<tr>.*?</tr>", page, flags=re.S) if "fig 9(b):" in r)
-    assert f"period-{p}" in row and 'class="agree"' in row
-    # fig 9(a) as tabulated (alpha = 0.2254) does not reach the stop: stated as a difference
-    rows = re.findall(r"<tr>.*?</tr>", page, flags=re.S)
-    row_a = next(r for r in rows if "fig 9(a):" in r and "0.2254" in r)
-    assert "period-1" in row_a and 'class="differ"' in row_a
-    # the paper's statements are there, with their sources
-    assert "chaotic" in page and "period-5" in page and "fig 9(b) and its caption" in page
+def test_every_figure_writes_and_links_its_data(built) -> None:
+    results = [json.loads(p.read_text()) for p in (built.out / "results").glob("*.json")]
+    with_images = [r for r in results if r["images"]]
+    assert with_images and all(r["data"] for r in with_images), "a figure without data files"
+    for r in results:
+        for d in r["data"]:
+            path = built.out / d["filename"]
+            assert path.is_file() and path.stat().st_size > 0, d["filename"]
+            assert f'href="{d["filename"]}"' in built.page
+            assert d["description"]
+    # the sweeps open as NetCDF groups, with the swept values and the samples
+    ds = xr.open_dataset(built.out / "fig07_sweeps.nc", group="d_main", engine="h5netcdf")
+    assert {"theta", "period", "impacts_per_period"} <= set(ds.data_vars)
+    assert ds.attrs["theta_hat_deg"] == 40.0
+    assert ds["eta"].values[0] == fig_range("7", "d")[0]
+    ds.close()
 
 
-def test_every_paper_figure_has_a_section(built: tuple[Path, str, list[str]]) -> None:
-    _, page, _ = built
+def fig_range(fid: str, key: str) -> tuple[float, float]:
+    module = next(m for m in FIGURES if m.FIGURE_ID == fid)
+    return next(p.eta_range for p in module.PANELS if p.key == key)
+
+
+def test_provenance_on_the_page(built) -> None:
+    page = built.page
+    for name in ("python", "numpy", "scipy", "numba", "sympy", "xarray"):
+        assert re.search(rf"\b{name} \d", page), name
+    assert "cores usable" in page and "compiling the kernels" in page
+    assert "kernel compilation (or loading from the cache)" in page
+    for m in FIGURES:
+        assert f'<a href="#fig{m.FIGURE_ID}">{m.FIGURE_ID}</a>' in page  # a compute-time row per figure
+    assert re.search(r"<dt>commit</dt><dd><code>([0-9a-f]{40}(\+dirty)?|unknown)</code>", page)
+
+
+def test_top_of_page_scoreboard_differences_cases_docs(built) -> None:
+    page = built.page
+    top = page[: page.index('<section id="fig')]
+    assert 'id="scoreboard"' in top and 'id="differences"' in top
+    assert "Where we differ from the paper, and why" in top and "Errata in the paper" in top
+    for case in ("A", "B", "C", "D", "A-reduced"):
+        assert f"<td>{case}</td>" in top
+    assert 'href="docs/normal-form.md"' in top and 'href="docs/experiment.md"' in top
+    assert (built.out / "docs" / "normal-form.md").is_file()
+    # every link of the box points to a row of the page
+    for target in re.findall(r'<a href="#(row-[^"]+)"', top):
+        assert f'<tr id="{target}">' in page, target
+
+
+def test_every_paper_figure_has_a_section(built) -> None:
+    page = built.page
     done = {m.FIGURE_ID for m in FIGURES}
-    pending = [f for f in PAPER_FIGURES if f not in done]
-    if pending:
-        assert "Not yet in this report: figure" in page
-    else:
-        assert "Not yet in this report" not in page
+    assert set(PAPER_FIGURES) <= done and "Not in this report" not in page
     for fid in done:
         assert f'<section id="fig{fid}">' in page
 
 
+def test_table_holds_our_computed_periods(built) -> None:
+    rows = json.loads((built.out / "comparisons.json").read_text())["rows"]
+    # fig 9(b): our own period detection, independently of the report's code path
+    m = grazing.models.pendulum("B", eta=0.446, theta_hat=math.radians(40))
+    p = grazing.simulate(m, [0.0, 0.0], transient=1000, periods=200).period()
+    assert p == 5
+    row = next(r for r in rows if r["figure"] == "9" and r["quantity"].startswith("(b)"))
+    assert row["ours"] == f"period-{p}" and row["verdict"] == "agree"
+    # fig 9(a) as tabulated (alpha = 0.2254) does not reach the stop: a difference, in the errata
+    row_a = next(
+        r for r in rows if r["figure"] == "9" and "0.2254" in r["quantity"] and "10°" in r["quantity"]
+    )
+    assert row_a["ours"] == "period-1" and row_a["verdict"] == "differ" and row_a["erratum"]
+
+
+def test_only_rebuilds_one_figure_and_keeps_the_others(built, tmp_path: Path) -> None:
+    out = tmp_path / "copy"
+    shutil.copytree(built.out, out)
+    before = json.loads((out / "results" / "7.json").read_text())
+    res = CliRunner().invoke(cli, ["report", "--out", str(out), "--only", "eq"])
+    assert res.exit_code == 0, res.output
+    assert res.output.count("report written") == 1
+    page = (out / "index.html").read_text()
+    for m in FIGURES:
+        assert f'<section id="fig{m.FIGURE_ID}">' in page
+    assert json.loads((out / "results" / "7.json").read_text()) == before
+    rows = json.loads((out / "comparisons.json").read_text())["rows"]
+    assert {r["figure"] for r in rows} == {m.FIGURE_ID for m in FIGURES}
+    bad = CliRunner().invoke(cli, ["report", "--out", str(out), "--only", "fig99"])
+    assert bad.exit_code != 0 and "fig99" in bad.output
+
+
+def test_select_names() -> None:
+    assert [m.FIGURE_ID for m in select(["fig07", "fig7", "7"])] == ["7"]
+    assert [m.FIGURE_ID for m in select(["map", "fig12", "fig02"])] == ["2", "12", "map"]
+    with pytest.raises(ValueError, match="no figure"):
+        select(["fig5"])
+
+
 def test_render_escapes_text() -> None:
+    row = Comparison("0", "<script>", "p", "o", "paper", "a rule", "not comparable", note="n", id="row-0-1")
     fig = FigureResult(
         figure_id="0",
         title="a <b> title",
         images=(Image("x.png", "caption & <i>"),),
-        comparisons=(Comparison("<script>", "p", "s", "o", None, "n"),),
+        comparisons=(row,),
         notes=("1 < 2",),
     )
     page = render([fig], ReportMeta(version="9.9", date="today", seconds=0.5))
@@ -108,3 +174,9 @@ def test_grazing_eta_brackets_the_first_contact() -> None:
         assert (len(sol.impacts) > 0) is impacts, eta
     with pytest.raises(ValueError, match="already reaches"):
         fig09.grazing_eta(math.radians(1), 0.2254, eta_lo=0.45)
+
+
+def test_build_report_only_unknown_name_fails_before_computing(tmp_path: Path) -> None:
+    with pytest.raises(ValueError, match="no figure"):
+        build_report(tmp_path, only=["nope"])
+    assert not (tmp_path / "index.html").exists()

@@ -40,16 +40,27 @@ if TYPE_CHECKING:  # pragma: no cover
 
 DPI = 150
 
-PAPER_FIG3 = ((10.0, 0.35), (20.0, 0.41), (30.0, 0.43), (40.0, 0.446))
-"""``(theta_hat_deg, eta)`` of the fig 3-style panels: the paper's fig 3(a) point at
-10 deg, and at 20-40 deg points of the model's first periodic windows past grazing
-(case B: period 2, 3 and 5)."""
 
-PAPER_THETA_HATS = (10.0, 20.0, 30.0, 40.0)
-"""The stop angles of the paper's figs 2 and 3 (degrees)."""
+def _paper_fig3() -> tuple[tuple[float, float], ...]:
+    """``(theta_hat_deg, eta)`` of the paper's fig 3 (:data:`grazing.report.paper.FIG3_POINTS`)."""
+    from grazing.report.paper import FIG3_POINTS
 
-PAPER_ETA_C = {10.0: 0.343, 20.0: 0.405, 30.0: 0.435, 40.0: 0.446}
-"""The grazing frequencies ``eta_c`` the paper observed on the rig (section 2.2)."""
+    return tuple((th, eta) for th, eta, _ in FIG3_POINTS)
+
+
+def _paper_theta_hats() -> tuple[float, ...]:
+    """The stop angles of the paper's figs 2 and 3 (degrees)."""
+    from grazing.report.paper import EXPERIMENT
+
+    return tuple(p.theta_hat_deg for p in EXPERIMENT.values())
+
+
+def _paper_eta_c(theta_hat_deg: float) -> float | None:
+    """The grazing frequency the paper observed on the rig at a stop angle (§2.2), if it gives one."""
+    from grazing.report.paper import EXPERIMENT
+
+    p = EXPERIMENT.get(f"{theta_hat_deg:g}")
+    return p.eta_c.value if p is not None else None
 
 
 def _new_figure(nrows: int, ncols: int, size: tuple[float, float]) -> tuple[Figure, np.ndarray]:
@@ -207,7 +218,7 @@ def figure_4b(
     ax.set_xlim(0.35, 1.02)
     ax.set_ylim(-0.002, 0.08)
     ax.set_title(f"equal damping D = {damping:g}", fontsize="medium")
-    ax.legend(loc="upper left", fontsize="x-small")
+    ax.legend(loc="upper left", fontsize="small")
     return {"damping": float(damping), "curves": curves, "points": points, "image": _finish(fig, path, dpi)}
 
 
@@ -219,7 +230,7 @@ def figure_2_synthetic(
     path: str | Path | None = None,
     fig: Figure | None = None,
     *,
-    theta_hats: Sequence[float] = PAPER_THETA_HATS,
+    theta_hats: Sequence[float] | None = None,
     num: int = 25,
     span: tuple[float, float] = (-0.01, 0.04),
     periods: int = 60,
@@ -233,7 +244,8 @@ def figure_2_synthetic(
 ) -> dict[str, Any]:
     """Fig 2-style diagrams from synthetic recordings, over the model's sweep, one panel per stop angle.
 
-    For each ``theta_hat``: the model's primary grazing ``eta_g`` is found,
+    For each ``theta_hat`` (default: the paper's 10°, 20°, 30°, 40°): the model's primary grazing
+    ``eta_g`` is found,
     ``num`` synthetic recordings (case B) are written at ``eta`` from
     ``eta_g + span[0]`` to ``eta_g + span[1]`` (an experimenter's sweep, see
     :func:`~grazing.experiment.synthetic_sweep`), read back and analysed
@@ -261,6 +273,7 @@ def figure_2_synthetic(
     from grazing.models.pendulum import CASES
 
     say = progress or (lambda _m: None)
+    theta_hats = _paper_theta_hats() if theta_hats is None else theta_hats
     n = len(theta_hats)
     own = fig is None
     if own:
@@ -285,10 +298,12 @@ def figure_2_synthetic(
             plot_diagram(ax, diag, model, label="synthetic recordings")
             if eg is not None:
                 ax.axvline(eg, color="tab:red", lw=0.7, ls="--")
-            ax.set_title(f"θ̂ = {th:g}° (synthetic recordings, case B)", fontsize="medium")
+            ax.set_title(
+                f"θ̂ = {th:g}°, case B (synthetic recordings, not the paper's data)", fontsize="medium"
+            )
             out[f"{th:g}"] = {
                 "eta_graze": eg,
-                "paper_eta_c": PAPER_ETA_C.get(float(th)),
+                "paper_eta_c": _paper_eta_c(float(th)),
                 "eta": diag.eta.tolist(),
                 "period": diag.period.tolist(),
                 "noise": diag.noise.tolist(),
@@ -307,7 +322,7 @@ def figure_3_synthetic(
     path: str | Path | None = None,
     fig: Figure | None = None,
     *,
-    cases: Sequence[tuple[float, float]] = PAPER_FIG3,
+    cases: Sequence[tuple[float, float]] | None = None,
     periods: int = 40,
     shown: int = 12,
     sample_rate: float = 1000.0,
@@ -316,7 +331,8 @@ def figure_3_synthetic(
 ) -> dict[str, Any]:
     """Fig 3-style time series and delay embeddings of synthetic recordings, beside the model.
 
-    One row per ``(theta_hat_deg, eta)``: the filtered synthetic angle against
+    One row per ``(theta_hat_deg, eta)`` (default: the paper's fig 3 points): the filtered
+    synthetic angle against
     time with its stroboscopic samples and the model's noise-free ones (last
     ``shown`` forcing periods), and the delay embedding
     ``(theta(t - T/4), theta(t))`` with the stroboscopic points on it.
@@ -340,12 +356,13 @@ def figure_3_synthetic(
     from grazing.experiment.signal import analyze_recording
     from grazing.experiment.synthetic import synthetic_recording
 
+    cases = _paper_fig3() if cases is None else cases
     n = len(cases)
     own = fig is None
     if own:
         from matplotlib.figure import Figure
 
-        fig = Figure(figsize=(8.0, 2.4 * n), layout="constrained")
+        fig = Figure(figsize=(9.0, 2.8 * n), layout="constrained")
     axes = fig.subplots(n, 2, squeeze=False, width_ratios=[2.2, 1.0])
     rows = []
     for j, (th, eta) in enumerate(cases):
@@ -375,9 +392,9 @@ def figure_3_synthetic(
         ax.set_xlabel("t (s)")
         ax.set_ylabel("θ (degrees)")
         kind = f"period {res.period}" if res.period else "no period ≤ 32"
-        ax.set_title(f"θ̂ = {th:g}°, η = {eta:g} (synthetic): {kind}", fontsize="medium")
+        ax.set_title(f"θ̂ = {th:g}°, η = {eta:g}, case B (synthetic recording): {kind}", fontsize="medium")
         if j == 0:
-            ax.legend(loc="lower left", fontsize="x-small", ncol=3)
+            ax.legend(loc="lower left", fontsize="small", ncol=3)
         ax = axes[j, 1]
         emb = res.embedding()  # row i: (theta(t_i), theta(t_i + T/4))
         tail = emb[int(np.searchsorted(res.time, t0)) :]

@@ -1,65 +1,190 @@
-"""Reproduction of the paper's numerical figures as an HTML report.
+"""Reproduction of the paper's numerical figures as an HTML report, every comparison with its rule.
 
-:func:`build_report` runs the figure modules in :data:`FIGURES` in order.
-Each module exposes ``build(out_dir, progress) -> FigureResult``: it computes
-what it shows, writes its PNG files into ``out_dir`` and returns a
-:class:`FigureResult` (images, captions, the paper's statements beside ours,
-notes).  :mod:`grazing.report.html` renders the page from those.  To add a
-figure, write ``figNN.py`` with such a ``build`` and list it in
-:data:`FIGURES`.
+:func:`build_report` compiles the model's kernels (timed on its own), then
+runs the figure modules in :data:`FIGURES` in order.  Each module exposes
+``build(out_dir, progress) -> FigureResult``: it computes what it shows,
+writes its PNG and data files into ``out_dir`` and returns a
+:class:`FigureResult` (images, data files, comparison records, notes).  Each
+result is kept as ``results/<id>.json``, so that ``only=`` rebuilds one figure
+and re-renders the page from the others.  The page (``index.html``) and every
+comparison (``comparisons.json``) are written last, through temporary files.
+To add a figure, write ``figNN.py`` with such a ``build`` and list it in
+:data:`FIGURES`; its paper numbers go into :mod:`grazing.report.paper`.
 
 Examples
 --------
 >>> from grazing.report import FIGURES, PAPER_FIGURES
 >>> [m.FIGURE_ID for m in FIGURES]
-['2', '4', '6', '7', '8', '9', '10', '11', '12', 'map']
+['2', '4', '6', '7', '8', '9', '10', '11', '12', 'map', 'eq']
 >>> set(PAPER_FIGURES) <= {m.FIGURE_ID for m in FIGURES}
 True
+>>> [m.FIGURE_ID for m in select(["fig07", "10", "figmap"])]
+['7', '10', 'map']
 """
 
 from __future__ import annotations
 
+import json
 import os
-import platform
+import shutil
 import time
+from collections.abc import Sequence
+from dataclasses import replace
 from datetime import datetime
 from pathlib import Path
+from types import ModuleType
+from typing import Any
 
 import grazing
-from grazing.report import fig02, fig04, fig06, fig07, fig08, fig09, fig10, fig11, fig12, figmap
-from grazing.report.base import Comparison, Dynamics, FigureResult, Image, Progress
-from grazing.report.html import ReportMeta, render
+from grazing.report import errata, fig02, fig04, fig06, fig07, fig08, fig09, fig10, fig11, fig12, figmap
+from grazing.report.base import Comparison, DataFile, Dynamics, FigureResult, Image, Progress, number_rows
+from grazing.report.html import RULES_TEXT, ReportMeta, render, scoreboard
+from grazing.report.provenance import collect, source_root
 
 __all__ = [
     "FIGURES",
     "PAPER_FIGURES",
     "Comparison",
+    "DataFile",
     "Dynamics",
     "FigureResult",
     "Image",
     "ReportMeta",
     "build_report",
+    "select",
 ]
 
-FIGURES = (fig02, fig04, fig06, fig07, fig08, fig09, fig10, fig11, fig12, figmap)
+FIGURES: tuple[ModuleType, ...] = (
+    fig02,
+    fig04,
+    fig06,
+    fig07,
+    fig08,
+    fig09,
+    fig10,
+    fig11,
+    fig12,
+    figmap,
+    errata,
+)
 """The figure modules, in the order the page shows them."""
 
 PAPER_FIGURES = ("4", "6", "7", "8", "9", "10", "11", "12")
 """The paper's numerical figures, all of which the report is to reproduce."""
 
 INDEX = "index.html"
+COMPARISONS = "comparisons.json"
+RESULTS = "results"
+DOCS = (("the grazing normal form", "normal-form.md"), ("the experiment tools", "experiment.md"))
+"""The documents linked from the top of the page (copied from the repository's ``docs/``)."""
 
 
-def _precompile() -> None:
-    """Compile the kernel variants the figures use, in parallel (a no-op when cached)."""
-    from grazing.engine.runner import precompile
+def select(names: Sequence[str]) -> list[ModuleType]:
+    """The figure modules named ``fig07``, ``fig7``, ``7``, ``figmap``/``map``, ``eq`` (in page order).
 
-    model = grazing.models.pendulum("B")
-    precompile([(model, ()), (model, ("eta",)), (model, ("eta", "theta_hat"))])
+    Raises
+    ------
+    ValueError
+        For a name that is no figure of the report.
+    """
+    by_id = {m.FIGURE_ID: m for m in FIGURES}
+    wanted = set()
+    for name in names:
+        key = name.strip().lower().removeprefix("fig").lstrip("0") or "0"
+        if key not in by_id:
+            known = ", ".join(
+                f"fig{m.FIGURE_ID.zfill(2)}" if m.FIGURE_ID.isdigit() else m.FIGURE_ID for m in FIGURES
+            )
+            raise ValueError(f"no figure {name!r} in the report (known: {known})")
+        wanted.add(key)
+    return [m for m in FIGURES if m.FIGURE_ID in wanted]
 
 
-def build_report(out_dir: Path | str, progress: Progress | None = None) -> Path:
-    """Compute every figure, write the PNGs and ``index.html`` into ``out_dir``.
+def _compile_job(job: tuple[str, Any]) -> None:
+    """Compile (or load) one kernel module: ``("flow", tol)`` or ``("tangent", sensitivities)``."""
+    import numpy as np
+
+    from grazing.engine.runner import Runner
+
+    kind, arg = job
+    model = grazing.models.pendulum("B", eta=0.4, theta_hat=0.5)
+    if kind == "flow":
+        grazing.simulate(model, [0.0, 0.0], periods=1, tol=arg)
+    else:
+        Runner(model, np.zeros(model.n_states), variational=True, sensitivities=arg).advance(1, 1)
+
+
+def _precompile(workers: int | None = None) -> None:
+    """Compile (or load) every kernel module the figures use, in parallel processes (seconds when cached).
+
+    The sweeps integrate at :data:`grazing.sweeps.brute_force.DEFAULT_SWEEP_TOL`, whose Taylor order
+    differs from the default one: its kernels are a module of their own.
+    """
+    import multiprocessing as mp
+
+    from grazing.sweeps.brute_force import DEFAULT_SWEEP_TOL
+
+    jobs = [
+        ("flow", DEFAULT_SWEEP_TOL),
+        ("tangent", ()),
+        ("tangent", ("eta",)),
+        ("tangent", ("eta", "theta_hat")),
+    ]
+    n = min(workers or os.cpu_count() or 1, len(jobs))
+    if n <= 1:
+        for job in jobs:
+            _compile_job(job)
+        return
+    with mp.get_context("spawn").Pool(n) as pool:  # fresh interpreters: no half-initialised numba state
+        pool.map(_compile_job, jobs)
+
+
+def _write_atomic(path: Path, text: str) -> None:
+    tmp = path.with_name(f".{path.name}.tmp")
+    tmp.write_text(text, encoding="utf-8")
+    os.replace(tmp, path)
+
+
+def _copy_docs(out: Path) -> tuple[tuple[str, str], ...]:
+    """Copy the linked documents into ``out/docs`` (when the source tree has them): ``(title, link)``."""
+    src = source_root() / "docs"
+    links = []
+    for title, name in DOCS:
+        if (src / name).is_file():
+            (out / "docs").mkdir(exist_ok=True)
+            shutil.copyfile(src / name, out / "docs" / name)
+            links.append((title, f"docs/{name}"))
+    return tuple(links)
+
+
+def load_results(out: Path) -> list[FigureResult]:
+    """The figure results kept in ``out/results``, in page order (figures never built are left out)."""
+    found = []
+    for m in FIGURES:
+        path = out / RESULTS / f"{m.FIGURE_ID}.json"
+        if path.is_file():
+            found.append(FigureResult.from_json(json.loads(path.read_text(encoding="utf-8"))))
+    return found
+
+
+def comparisons_json(results: Sequence[FigureResult], meta: ReportMeta) -> dict[str, Any]:
+    """Every comparison row of the page, with the scoreboard and the provenance."""
+    rows = [r for f in results for r in f.comparisons]
+    return {
+        "paper": "Piiroinen, Virgin & Champneys, J. Nonlinear Sci. 14 (2004) 383-404",
+        "commit": meta.commit,
+        "rendered": meta.date,
+        "versions": meta.versions,
+        "rules": RULES_TEXT,
+        "scoreboard": scoreboard(rows),
+        "rows": [r.to_json() for r in rows],
+    }
+
+
+def build_report(
+    out_dir: Path | str, progress: Progress | None = None, only: Sequence[str] | None = None
+) -> Path:
+    """Compute the figures; write their PNGs, data, ``comparisons.json`` and ``index.html`` into ``out_dir``.
 
     Parameters
     ----------
@@ -68,6 +193,9 @@ def build_report(out_dir: Path | str, progress: Progress | None = None) -> Path:
         are overwritten, other files are left alone).
     progress
         Called with one-line messages as the build proceeds.
+    only
+        Figure names (``["fig07"]``): rebuild these only, and render the page
+        from them and the results of the other figures kept from earlier builds.
 
     Returns
     -------
@@ -87,25 +215,43 @@ def build_report(out_dir: Path | str, progress: Progress | None = None) -> Path:
     matplotlib.use("Agg")
     say = progress or (lambda _msg: None)
     start = time.perf_counter()
+    modules = list(FIGURES) if only is None else select(only)
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    say("compiling the model's kernels (once per machine)")
+    (out / RESULTS).mkdir(parents=True, exist_ok=True)
+    prov = collect()
+    say("compiling the model's kernels (once per machine; loading them when cached)")
+    t0 = time.perf_counter()
     _precompile()
-    results: list[FigureResult] = []
-    for module in FIGURES:
-        results.append(module.build(out, say))
-        say(f"figure {module.FIGURE_ID} done in {results[-1].seconds:.1f} s")
+    compile_seconds = time.perf_counter() - t0
+    say(f"kernels ready in {compile_seconds:.1f} s")
+    for module in modules:
+        res = module.build(out, say)
+        res = replace(
+            res,
+            comparisons=number_rows(res.figure_id, res.comparisons),
+            built=datetime.now().astimezone().isoformat(timespec="seconds"),
+            commit=prov.commit,
+        )
+        _write_atomic(out / RESULTS / f"{res.figure_id}.json", json.dumps(res.to_json(), ensure_ascii=False))
+        say(f"figure {module.FIGURE_ID} done in {res.seconds:.1f} s")
+    results = load_results(out)
     done = {r.figure_id for r in results}
     meta = ReportMeta(
         version=grazing.__version__,
         date=datetime.now().astimezone().isoformat(timespec="seconds"),
         seconds=time.perf_counter() - start,
-        platform=f"Python {platform.python_version()} on {platform.platform(terse=True)}",
+        compile_seconds=compile_seconds,
+        commit=prov.commit,
+        versions=prov.versions,
+        cpu=prov.cpu,
+        cores=prov.cores,
+        system=prov.system,
+        docs=_copy_docs(out),
         pending=tuple(f for f in PAPER_FIGURES if f not in done),
     )
+    _write_atomic(
+        out / COMPARISONS, json.dumps(comparisons_json(results, meta), ensure_ascii=False, indent=1)
+    )
     index = out / INDEX
-    tmp = out / f".{INDEX}.tmp"
-    tmp.write_text(render(results, meta), encoding="utf-8")
-    os.replace(tmp, index)
-    say(f"report written to {index} in {meta.seconds:.1f} s")
+    _write_atomic(index, render(results, meta))
     return index

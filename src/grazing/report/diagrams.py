@@ -1,23 +1,26 @@
-"""Brute-force η bifurcation diagrams at four stop angles: the code figs 7 and 12 share.
+"""Brute-force η bifurcation diagrams at four stop angles: the code figs 7, 10 and 12 share.
 
 Each panel is an *experimenter sweep*: η increases in small steps, every
 point starting from the final state of the previous one (one sequential
 chunk per panel, so that coexisting attractors are followed as in the
-laboratory rather than re-chosen every few points).  The panels run in
-parallel, one process per core.  Each panel also gets
+laboratory rather than re-chosen every few points).  The sweeps run in
+parallel, one process per core.  A panel has up to three views:
 
-* the grazing points of the nonimpacting period-1 orbit (the stop ignored,
-  followed through folds: :func:`grazing.orbits.find_grazings`), drawn as
-  vertical lines;
-* the continuation of the impacting period-1 orbit found in the sweep, up and
-  down in η, which locates the period-doubling that ends the period-2 window
-  and the fold that ends the impacting region;
-* optionally a magnified sweep just past the first grazing, where the
-  period-adding cascade lives.
+* ``main``: the range of the experiment's fig 2 as §2.2 describes it, where
+  the cascade past the first grazing lives;
+* ``zoom``: a magnified sweep just past the first grazing ``η_g``;
+* ``overview``: a coarser sweep out to the end of the impacting region, on
+  which the impacting period-1 orbit is continued (its period-doubling and
+  the fold that ends the impacting region).
+
+Each panel also gets the grazing points of the nonimpacting period-1 orbit
+(the stop ignored, followed through folds: :func:`grazing.orbits.find_grazings`),
+drawn as vertical lines.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 import os
 import time
@@ -31,18 +34,22 @@ import numpy as np
 import grazing
 from grazing.errors import GrazingError
 from grazing.orbits import continue_orbit, find_grazings, find_orbit
-from grazing.plotting import mark_grazings, plot_bifurcation
+from grazing.plotting import label_windows, mark_grazings, plot_bifurcation, visible_windows
 from grazing.report.base import save_png
+from grazing.report.data import slim_sweep, write_csv, write_groups
 from grazing.sweeps import sweep
 from grazing.sweeps.windows import Window, find_windows
 
 APPRECIABLE_WIDTH = 1e-3
-"""A periodic window is *appreciable* when it spans at least this much in η."""
+"""A periodic window is *appreciable* when it spans at least this much in η (the paper does not say)."""
+
+VIEWS = ("main", "zoom", "overview")
+"""The views of a panel, in the order they are drawn."""
 
 
 @dataclass(frozen=True)
 class Panel:
-    """One panel: a stop angle and the η range swept.
+    """One panel: a stop angle and the η ranges swept.
 
     Attributes
     ----------
@@ -55,12 +62,20 @@ class Panel:
     zoom
         If set, an extra magnified sweep over ``(η_g + zoom[0], η_g + zoom[1])``
         around the first grazing ``η_g``.
+    overview
+        If set, an extra coarser sweep over this wider η range, out to the end of
+        the impacting region; the impacting period-1 branch is continued on it.
     """
 
     key: str
     theta_hat_deg: float
     eta_range: tuple[float, float]
     zoom: tuple[float, float] | None = None
+    overview: tuple[float, float] | None = None
+
+    def has(self, view: str) -> bool:
+        """Whether the panel has this view."""
+        return view == "main" or getattr(self, view) is not None
 
 
 @dataclass(frozen=True)
@@ -73,6 +88,8 @@ class Settings:
         η values per main panel.
     zoom_points
         η values per magnified panel.
+    overview_points
+        η values per overview panel.
     transient, periods
         Forcing periods discarded and sampled at each η (the transient stops
         early once the samples repeat; see :func:`grazing.sweeps.sweep`).
@@ -82,6 +99,7 @@ class Settings:
 
     points: int = 1000
     zoom_points: int = 400
+    overview_points: int = 500
     transient: int = 400
     periods: int = 100
     workers: int | None = None
@@ -107,16 +125,20 @@ class Special:
 
 @dataclass
 class PanelRun:
-    """What was computed for one panel (main or magnified)."""
+    """What was computed for one view of one panel."""
 
     panel: Panel
-    zoomed: bool
+    view: str
     eta_range: tuple[float, float]
     ds: Any
     grazings: list[Grazing]
     specials: list[Special] = field(default_factory=list)
     seconds: float = 0.0
     cpu_seconds: float = 0.0
+
+    @property
+    def zoomed(self) -> bool:
+        return self.view == "zoom"
 
     @property
     def windows(self) -> list[Window]:
@@ -127,6 +149,12 @@ class PanelRun:
     def first_grazing(self) -> float:
         return self.grazings[0].eta if self.grazings else math.nan
 
+    @property
+    def step(self) -> float:
+        """The η step of the sweep."""
+        v = np.asarray(self.ds.value.values)
+        return float((v[-1] - v[0]) / max(len(v) - 1, 1))
+
     def after_grazing(self, min_points: int = 2) -> list[Window]:
         """Periodic impacting windows after the first grazing, up to and with the first impacting period 1.
 
@@ -134,7 +162,7 @@ class PanelRun:
         """
         out = []
         for w in self.windows:
-            if w.start <= self.first_grazing or not w.impacting or w.period < 1 or w.points < min_points:
+            if w.stop <= self.first_grazing or not w.impacting or w.period < 1 or w.points < min_points:
                 continue
             out.append(w)
             if w.period == 1:
@@ -144,6 +172,20 @@ class PanelRun:
     def first_appreciable(self) -> Window | None:
         """The first periodic window after the first grazing spanning at least :data:`APPRECIABLE_WIDTH`."""
         return next((w for w in self.after_grazing(1) if w.width >= APPRECIABLE_WIDTH), None)
+
+    def aperiodic_windows(self) -> list[Window]:
+        """Aperiodic impacting runs past the first grazing, before the first impacting period-1 window."""
+        one = next((w for w in self.after_grazing(1) if w.period == 1), None)
+        end = one.start if one is not None else math.inf
+        return [
+            w
+            for w in self.windows
+            if w.period == 0 and w.impacting and w.stop > self.first_grazing and w.stop < end
+        ]
+
+    def aperiodic_width(self) -> float:
+        """Total η extent of :meth:`aperiodic_windows`."""
+        return float(sum(w.width for w in self.aperiodic_windows()))
 
     def aperiodic_fraction(self) -> float:
         """Fraction of the impacting points that are aperiodic (period 0)."""
@@ -160,6 +202,30 @@ class PanelRun:
             return math.nan
         non = np.flatnonzero(~imp & (v > v[idx[0]]))
         return float(v[non[0] - 1]) if non.size else float(v[-1])
+
+
+@dataclass
+class Runs:
+    """All views of all panels of one figure, each list in panel order."""
+
+    main: list[PanelRun]
+    zoom: list[PanelRun] = field(default_factory=list)
+    overview: list[PanelRun] = field(default_factory=list)
+
+    def of(self, panel: Panel, view: str) -> PanelRun | None:
+        """The run of ``panel`` in ``view`` (None if the panel has no such view)."""
+        return next((r for r in getattr(self, view) if r.panel == panel), None)
+
+    def finest(self, panel: Panel) -> PanelRun:
+        """The magnified run of the panel where there is one, else its main run."""
+        return self.of(panel, "zoom") or self.of(panel, "main")  # type: ignore[return-value]
+
+    def widest(self, panel: Panel) -> PanelRun:
+        """The overview run of the panel where there is one, else its main run."""
+        return self.of(panel, "overview") or self.of(panel, "main")  # type: ignore[return-value]
+
+    def all(self) -> list[PanelRun]:
+        return self.main + self.zoom + self.overview
 
 
 def zoom_of(run: PanelRun, zoomed: Sequence[PanelRun]) -> PanelRun | None:
@@ -212,18 +278,34 @@ def start_state(model: grazing.HybridModel) -> np.ndarray | None:
     return orbit.state.copy() if orbit.stable and orbit.guard_min > 0 else None
 
 
+def _view_range(
+    panel: Panel, view: str, grazings: list[Grazing], settings: Settings
+) -> tuple[float, float, int]:
+    if view == "zoom":
+        if panel.zoom is None or not grazings:
+            raise ValueError(f"panel {panel.key} has no zoom or no grazing")
+        return grazings[0].eta + panel.zoom[0], grazings[0].eta + panel.zoom[1], settings.zoom_points
+    if view == "overview":
+        if panel.overview is None:
+            raise ValueError(f"panel {panel.key} has no overview")
+        return panel.overview[0], panel.overview[1], settings.overview_points
+    return panel.eta_range[0], panel.eta_range[1], settings.points
+
+
 def run_panel(
     case: str,
     panel: Panel,
     settings: Settings,
-    zoomed: bool = False,
+    view: str = "main",
     alpha: float | None = None,
     method: str = "flow",
 ) -> PanelRun:
-    """Compute one panel: the grazings, the sweep and (main panels) the impacting branch.
+    """Compute one view of a panel: the grazings, the sweep and (overview) the impacting branch.
 
     With ``method="map"`` the sweep iterates the discontinuity-map Poincare map
     built at the panel's first grazing (fig 10) instead of the impacting flow.
+    The impacting period-1 branch is continued on the overview (on the main
+    view of a panel without one).
 
     Examples
     --------
@@ -231,38 +313,34 @@ def run_panel(
     >>> [round(g.eta, 4) for g in run.grazings]
     [0.4451, 0.5473]
     """
+    if view not in VIEWS:
+        raise ValueError(f"view must be one of {VIEWS}, got {view!r}")
     start, cpu = time.perf_counter(), time.process_time()
     extra = {} if alpha is None else {"alpha": alpha}
     model = grazing.models.pendulum(case, theta_hat=math.radians(panel.theta_hat_deg), **extra)
     grazings = _grazings(model)
-    if zoomed:
-        if panel.zoom is None or not grazings:
-            raise ValueError(f"panel {panel.key} has no zoom or no grazing")
-        lo, hi = grazings[0].eta + panel.zoom[0], grazings[0].eta + panel.zoom[1]
-        n = settings.zoom_points
-    else:
-        (lo, hi), n = panel.eta_range, settings.points
+    lo, hi, n = _view_range(panel, view, grazings, settings)
     zdm = None
     if method == "map":
         from grazing.normalform import find_grazing_point, normal_form_at
 
         zdm = normal_form_at(find_grazing_point(model, "eta", 0.2, 1.0)).discontinuity_map()
     ds = sweep(
-        model, "eta", np.linspace(lo, hi, n), x0=start_state(model.with_params(eta=lo)),
-        transient=settings.transient, periods=settings.periods, lyapunov=False, chunk_size=0, workers=1,
+        model,
+        "eta",
+        np.linspace(lo, hi, n),
+        x0=start_state(model.with_params(eta=lo)),
+        transient=settings.transient,
+        periods=settings.periods,
+        lyapunov=False,
+        chunk_size=0,
+        workers=1,
         zdm=zdm,
-    )  # fmt: skip
-    specials = [] if (zoomed or method == "map") else _impacting_branch(model, ds, lo, hi)
-    return PanelRun(
-        panel,
-        zoomed,
-        (lo, hi),
-        ds,
-        grazings,
-        specials,
-        time.perf_counter() - start,
-        time.process_time() - cpu,
     )
+    branch_here = view == "overview" or (view == "main" and panel.overview is None)
+    specials = _impacting_branch(model, ds, lo, hi) if (branch_here and method == "flow") else []
+    wall, cpu = time.perf_counter() - start, time.process_time() - cpu
+    return PanelRun(panel, view, (lo, hi), ds, grazings, specials, wall, cpu)
 
 
 def warm_up(case: str = "B") -> None:
@@ -281,7 +359,7 @@ _RUNS: dict[tuple[Any, ...], PanelRun] = {}
 """Panels computed in this process (figs 7 and 10 share the direct-simulation panels)."""
 
 
-def _job(args: tuple[str, Panel, Settings, bool, float | None, str]) -> PanelRun:
+def _job(args: tuple[str, Panel, Settings, str, float | None, str]) -> PanelRun:
     return run_panel(*args)
 
 
@@ -322,23 +400,15 @@ def run_panels(
     panels: Sequence[Panel],
     settings: Settings,
     *,
-    zooms: bool = True,
+    views: Sequence[str] = VIEWS,
     alpha: float | None = None,
     method: str = "flow",
     progress: Callable[[str], None] | None = None,
     tag: str = "",
-) -> tuple[list[PanelRun], list[PanelRun]]:
-    """Compute all panels (and their magnified sweeps) in parallel.
-
-    Returns
-    -------
-    main, zoomed
-        The main panels in the order given, and the magnified ones.
-    """
+) -> Runs:
+    """Compute the views of all panels in parallel (those computed before in this process are reused)."""
     say = progress or (lambda _msg: None)
-    wanted = [(case, p, settings, False, alpha, method) for p in panels]
-    if zooms:
-        wanted += [(case, p, settings, True, alpha, method) for p in panels if p.zoom is not None]
+    wanted = [(case, p, settings, v, alpha, method) for v in VIEWS if v in views for p in panels if p.has(v)]
     jobs = [j for j in wanted if j not in _RUNS]
     workers = min(settings.workers or os.cpu_count() or 1, max(len(jobs), 1))
     if jobs:
@@ -346,30 +416,106 @@ def run_panels(
 
     def report(run: PanelRun) -> None:
         lo, hi = run.eta_range
-        what = "magnified" if run.zoomed else "panel"
         say(
-            f"{tag}{what} ({run.panel.key}) θ̂ = {run.panel.theta_hat_deg:g}°: {run.ds.sizes['point']} "
+            f"{tag}{run.view} ({run.panel.key}) θ̂ = {run.panel.theta_hat_deg:g}°: {run.ds.sizes['point']} "
             f"η values in [{lo:.6g}, {hi:.6g}] in {run.seconds:.1f} s (CPU {run.cpu_seconds:.1f} s)"
         )
 
-    for run in run_parallel(_job, jobs, workers, report):  # completion order: match by panel
-        _RUNS[next(j for j in jobs if j[1] == run.panel and j[3] == run.zoomed)] = run
-    results = [_RUNS[j] for j in wanted]
-    main = [next(r for r in results if r.panel == p and not r.zoomed) for p in panels]
-    zoomed = [r for p in panels for r in results if r.panel == p and r.zoomed]
-    return main, zoomed
+    for run in run_parallel(_job, jobs, workers, report):  # completion order: match by panel and view
+        _RUNS[next(j for j in jobs if j[1] == run.panel and j[3] == run.view)] = run
+    out = Runs(main=[])
+    for v in VIEWS:
+        setattr(out, v, [_RUNS[j] for j in wanted if j[3] == v])
+    return out
+
+
+# ---------------------------------------------------------------------------- drawing
+
+
+def spans(values: np.ndarray, mask: np.ndarray) -> list[tuple[float, float]]:
+    """The η extents (half-way to the neighbouring points) of the runs where ``mask`` holds.
+
+    Examples
+    --------
+    >>> spans(np.array([0.0, 1.0, 2.0, 3.0]), np.array([True, True, False, True]))
+    [(0.0, 1.5), (2.5, 3.0)]
+    """
+    out = []
+    n = len(values)
+    i = 0
+    while i < n:
+        if not mask[i]:
+            i += 1
+            continue
+        j = i
+        while j + 1 < n and mask[j + 1]:
+            j += 1
+        lo = values[0] if i == 0 else 0.5 * (values[i - 1] + values[i])
+        hi = values[-1] if j == n - 1 else 0.5 * (values[j] + values[j + 1])
+        out.append((float(lo), float(hi)))
+        i = j + 1
+    return out
+
+
+def _shade(ax: Any, run: PanelRun, reference: PanelRun | None) -> None:
+    """Shade nonimpacting period-1 motion; hatch where the map has no impacts but the full system has."""
+    v = np.asarray(run.ds.value.values)
+    per = np.asarray(run.ds.period.values)
+    non = (per == 1) & (np.asarray(run.ds.impacts_per_period.values) == 0)
+    trans = ax.get_xaxis_transform()
+    lo, hi = ax.get_xlim()
+    both, only_map = non, np.zeros_like(non)
+    if reference is not None and reference.ds.sizes["point"] == len(v):
+        ref_imp = np.asarray(reference.ds.impacts_per_period.values) > 0
+        both, only_map = non & ~ref_imp, non & ref_imp
+    for a, b in spans(v, both):
+        ax.axvspan(a, b, color="#dfe9f3", lw=0, zorder=-1)
+        if b - a >= 0.25 * (hi - lo):
+            ax.text(
+                0.5 * (a + b),
+                0.03,
+                "period 1,\nno impacts",
+                transform=trans,
+                ha="center",
+                va="bottom",
+                fontsize=9,
+                color="#4a6b8a",
+            )
+    for a, b in spans(v, only_map):
+        ax.axvspan(a, b, facecolor="none", edgecolor="#d9a441", hatch="///", lw=0, zorder=-1)
+        if b - a >= 0.25 * (hi - lo):
+            ax.text(
+                0.5 * (a + b),
+                0.03,
+                "map: no impacts\n(the full system\nimpacts here, fig 7)",
+                transform=trans,
+                ha="center",
+                va="bottom",
+                fontsize=9,
+                color="#8a6514",
+                bbox={"fc": "white", "ec": "none", "alpha": 0.8, "pad": 1.0},
+            )
 
 
 def draw_panels(
     runs: Sequence[PanelRun],
     path: Path,
     *,
+    case_label: str,
+    reference: Sequence[PanelRun] = (),
     suptitle: str = "",
     ncols: int = 2,
-    width: float = 6.2,
-    height: float = 3.6,
+    width: float = 6.0,
+    height: float = 3.8,
 ) -> None:
-    """Draw the diagrams, one panel per run (``width`` x ``height`` inches each), windows labelled."""
+    """Draw the diagrams, one panel per run (``width`` x ``height`` inches each), windows labelled.
+
+    Every panel's title states its letter, θ̂ and ``case_label``.  With
+    ``reference`` (the direct-simulation runs of the same panels, for the map's
+    diagrams), ranges where the map has no impacts but the full system does are
+    hatched instead of shaded.  Overview panels mark the period-doubling and the
+    fold of the impacting period-1 orbit.
+    """
     from matplotlib.figure import Figure
 
     nrows = math.ceil(len(runs) / ncols)
@@ -378,16 +524,35 @@ def draw_panels(
     axes = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False)).ravel()
     for ax, run in zip(axes, runs):
         p = run.panel
-        zoom_kw = {"min_points": 2, "min_fraction": 0.004} if run.zoomed else None
-        plot_bifurcation(ax, run.ds, window_kw=zoom_kw)
+        plot_bifurcation(ax, run.ds, windows=False, nonimpacting=False)
+        ref = next((r for r in reference if r.panel == p and r.view == run.view), None)
+        _shade(ax, run, ref)
         lo, hi = ax.get_xlim()
+        min_points = 2 if run.zoomed else 3
+        shown = visible_windows(run.windows, hi - lo, min_points=min_points, min_fraction=0.004)
+        label_windows(ax, shown)
         inside = [g for g in run.grazings if lo <= g.eta <= hi]
         mark_grazings(ax, [g.eta for g in inside], labels=[f"grazing η = {g.eta:.4f}" for g in inside])
-        title = f"({p.key}) θ̂ = {p.theta_hat_deg:g}°"
+        for s in run.specials:
+            if lo <= s.eta <= hi and s.kind == "fold":
+                ax.axvline(s.eta, color="tab:purple", lw=1.0, ls=":", zorder=1)
+                ax.text(
+                    s.eta,
+                    0.5,
+                    f" fold of the impacting\n orbit, η = {s.eta:.4f}",
+                    rotation=90,
+                    transform=ax.get_xaxis_transform(),
+                    ha="right",
+                    va="center",
+                    fontsize=9,
+                    color="tab:purple",
+                    bbox={"fc": "white", "ec": "none", "alpha": 0.75, "pad": 0.8},
+                )
+        title = f"({p.key}) θ̂ = {p.theta_hat_deg:g}°, {case_label}"
         if run.zoomed:
             title += ", magnified past the first grazing"
             _offset_ticks(ax, run.first_grazing)
-        ax.set_title(title, loc="left", fontsize=10)
+        ax.set_title(title, loc="left", fontsize=10.5)
     for ax in axes[len(runs) :]:
         ax.set_visible(False)
     if suptitle:
@@ -415,6 +580,43 @@ def _offset_ticks(ax: Any, eta_g: float) -> None:
     )
     ax.set_xlim(lo, hi)
     ax.set_xlabel(f"(η − η_g) × 10{str(-exp).translate(_SUPERSCRIPT)},   first grazing η_g = {eta_g:.7f}")
+
+
+# ---------------------------------------------------------------------------- data
+
+
+def write_data(runs: Runs, out_dir: Path, stem: str, case: str) -> tuple[Path, Path]:
+    """Write every sweep (NetCDF, one group ``<panel>_<view>`` each) and every window (CSV).
+
+    Returns the two paths: ``<stem>.nc`` and ``<stem>_windows.csv``.
+    """
+    groups = {}
+    rows = []
+    for run in runs.all():
+        p = run.panel
+        groups[f"{p.key}_{run.view}"] = slim_sweep(
+            run.ds,
+            panel=p.key,
+            view=run.view,
+            case=case,
+            theta_hat_deg=p.theta_hat_deg,
+            first_grazing_eta=run.first_grazing,
+        )
+        for w in run.windows:
+            rows.append(
+                (p.key, run.view, p.theta_hat_deg, w.period, int(w.impacting), w.points, w.start, w.stop)
+            )
+    nc = write_groups(out_dir / f"{stem}.nc", groups)
+    csv = out_dir / f"{stem}_windows.csv"
+    write_csv(
+        csv,
+        ["panel", "view", "theta_hat_deg", "period", "impacting", "points", "eta_start", "eta_stop"],
+        rows,
+    )
+    return nc, csv
+
+
+# ---------------------------------------------------------------------------- text
 
 
 def describe_windows(windows: Sequence[Window], digits: int = 4, origin: float | None = None) -> str:
@@ -446,11 +648,14 @@ def _g(x: float) -> str:
     return ("0" if abs(x) < 1e-15 else f"{x:.2g}").replace("-", "−")
 
 
-def drop_doublings(windows: Sequence[Window], gap: int = 3) -> list[Window]:
+def drop_doublings(windows: Sequence[Window], gap: int = 3, min_parent: int = 2) -> list[Window]:
     """Leave out period-doubled satellites: a period-2p window within ``gap`` points of a period-p window.
 
     Such windows are the ends of the period-doubling cascades at the edges of
-    a period-p window, not new windows of the period-adding sequence.
+    a period-p window, not new windows of the period-adding sequence.  Parents
+    of period below ``min_parent`` do not count: the period-2 window that ends
+    in the period-doubling of the impacting period-1 orbit belongs to the
+    sequence.
 
     Examples
     --------
@@ -462,12 +667,35 @@ def drop_doublings(windows: Sequence[Window], gap: int = 3) -> list[Window]:
     out = []
     for w in windows:
         sat = any(
-            v.period * 2 == w.period and (0 <= w.first - v.last <= gap or 0 <= v.first - w.last <= gap)
+            v.period >= min_parent
+            and v.period * 2 == w.period
+            and (0 <= w.first - v.last <= gap or 0 <= v.first - w.last <= gap)
             for v in windows
         )
         if not sat:
             out.append(w)
     return out
+
+
+def cascade(run: PanelRun) -> list[Window]:
+    """The clearly resolved windows past the first grazing, up to impacting period 1.
+
+    Windows of ≥ 3 points and ≥ 1 % of the sweep's span, period-doubled satellites left out
+    (:func:`drop_doublings`).
+    """
+    span = run.eta_range[1] - run.eta_range[0]
+    return drop_doublings([w for w in run.after_grazing(3) if w.width >= 0.01 * span])
+
+
+def is_reverse_adding(periods: Sequence[int], min_windows: int = 3) -> bool:
+    """Whether periods decrease by one from window to window, with at least ``min_windows`` windows.
+
+    Examples
+    --------
+    >>> is_reverse_adding([5, 4, 3, 2, 1]), is_reverse_adding([2, 1]), is_reverse_adding([5, 2, 1])
+    (True, False, False)
+    """
+    return len(periods) >= min_windows and all(b == a - 1 for a, b in itertools.pairwise(periods))
 
 
 def sequence(windows: Sequence[Window]) -> list[int]:
@@ -482,37 +710,76 @@ def grazing_text(run: PanelRun) -> str:
     return ", ".join(f"{g.eta:.4f} (|λ| = {g.abs_lambda:.3f})" for g in run.grazings)
 
 
-def end_of_impacting(run: PanelRun) -> str:
-    """How the impacting region of a main panel ends, with the continuation's special points."""
-    v = np.asarray(run.ds.value.values)
-    per = np.asarray(run.ds.period.values)
-    end = run.impacting_end()
-    parts = []
+@dataclass(frozen=True)
+class ImpactingEnd:
+    """How the impacting region of a panel ends as η increases (from its overview sweep).
+
+    Attributes
+    ----------
+    last_two
+        The η interval of the last period-2 window past the first grazing (None: none).
+    after_two
+        What follows it: ``"impacting period 1"``, ``"nonimpacting period 1"``, ``"aperiodic"``, ...
+    period_doubling
+        The period-doubling of the impacting period-1 orbit near the end of that window (nan: none).
+    end
+        The last η with impacts (nan: none).
+    fold
+        The fold of the impacting period-1 orbit near ``end`` (nan: none found).
+    second_grazing
+        The second grazing of the nonimpacting orbit (nan: none).
+    """
+
+    last_two: tuple[float, float] | None
+    after_two: str
+    period_doubling: float
+    end: float
+    fold: float
+    second_grazing: float
+
+    @property
+    def paper_like(self) -> bool:
+        """The paper's picture: the period-2 window is followed by nonimpacting period 1."""
+        return self.last_two is not None and self.after_two == "nonimpacting period 1"
+
+    def short(self) -> str:
+        """``"2 → impacting 1 at 0.4471; impacts end at the fold 0.8404 (2nd grazing 0.7887)"``."""
+        parts = []
+        if self.last_two is not None:
+            parts.append(f"2 → {self.after_two} at {self.last_two[1]:.4f}")
+        if math.isfinite(self.fold):
+            parts.append(f"impacts end at the fold η = {self.fold:.4f}")
+        elif math.isfinite(self.end):
+            parts.append(f"impacts end at η = {self.end:.4f}")
+        if math.isfinite(self.second_grazing):
+            parts.append(f"(2nd grazing {self.second_grazing:.4f})")
+        return "; ".join(parts) if parts else "no impacting region"
+
+
+def impacting_end(run: PanelRun) -> ImpactingEnd:
+    """How the impacting region of ``run`` (an overview, with the continuation's special points) ends."""
     twos = [w for w in run.after_grazing(2) if w.period == 2]
-    pds = [s for s in run.specials if s.kind == "period-doubling"]
-    folds = [s for s in run.specials if s.kind == "fold"]
+    after = "none"
+    last_two = None
+    pd = math.nan
     if twos:
         w = twos[-1]
-        nxt = next((x for x in run.windows if x.first > w.last and x.points >= 3), None)
+        last_two = (w.start, w.stop)
+        nxt = next((x for x in run.windows if x.first > w.last and x.points >= 2), None)
         if nxt is None:
-            what = "the end of the sweep"
+            after = "the end of the sweep"
         elif nxt.period == 1:
-            what = "impacting period-1 motion" if nxt.impacting else "nonimpacting period-1 motion"
+            after = "impacting period 1" if nxt.impacting else "nonimpacting period 1"
         else:
-            what = "aperiodic motion" if nxt.period == 0 else f"period-{nxt.period} motion"
-        text = f"the last period-2 window ends at η ≈ {w.stop:.4f}, followed by {what}"
-        near = [s for s in pds if abs(s.eta - w.stop) < 0.01]
-        if near:
-            pd = near[0].eta
-            text += f" (the impacting period-1 orbit is stable above its period-doubling at η = {pd:.5f})"
-        parts.append(text)
-    if math.isfinite(end) and end < v[-1]:
-        i = int(np.flatnonzero(v == end)[0])
-        text = f"impacting motion (period {per[i]}) last seen at η = {end:.4f}, then nonimpacting period 1"
-        near = [s for s in folds if abs(s.eta - end) < 0.01]
-        if near:
-            text += f"; the impacting period-1 orbit ends at a fold (saddle-node) at η = {near[0].eta:.5f}"
-        parts.append(text)
-    elif math.isfinite(end):
-        parts.append(f"impacting motion up to the end of the panel (η = {v[-1]:.3f})")
-    return "; ".join(parts) if parts else "no impacting region"
+            after = "aperiodic" if nxt.period == 0 else f"period {nxt.period}"
+        near = [s.eta for s in run.specials if s.kind == "period-doubling" and abs(s.eta - w.stop) < 0.01]
+        pd = near[0] if near else math.nan
+    end = run.impacting_end()
+    v = np.asarray(run.ds.value.values)
+    if math.isfinite(end) and end >= v[-1]:
+        end = math.nan  # impacting up to the end of the sweep
+    folds = [
+        s.eta for s in run.specials if s.kind == "fold" and math.isfinite(end) and abs(s.eta - end) < 0.01
+    ]
+    second = run.grazings[1].eta if len(run.grazings) > 1 else math.nan
+    return ImpactingEnd(last_two, after, pd, end, folds[0] if folds else math.nan, second)

@@ -15,7 +15,6 @@ with the multipliers in the complex plane at the paper's three points.
 from __future__ import annotations
 
 import cmath
-import dataclasses
 import math
 import time
 from dataclasses import dataclass
@@ -26,7 +25,10 @@ import numpy as np
 
 import grazing
 from grazing.orbits import continue_orbit, find_grazings, find_orbit, grazing_curve
-from grazing.report.base import Comparison, FigureResult, Image, Progress, save_png
+from grazing.report import paper
+from grazing.report.base import Comparison, DataFile, FigureResult, Image, Progress, save_png
+from grazing.report.data import write_dataset, write_groups
+from grazing.report.rules import complex_row, complex_text, criterion_row, numeric_row
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
@@ -35,9 +37,12 @@ if TYPE_CHECKING:  # pragma: no cover
 
 FIGURE_ID = "6"
 
-ALPHA = 0.2254
-"""Forcing amplitude of all four response curves (the numerics' value, SPEC)."""
-DAMPING = (("A", 0.010), ("B", 0.048), ("C", 0.058), ("D", 0.068))
+ALPHA = paper.ALPHA_TABLE.value
+"""Forcing amplitude of all four response curves (the numerics' value as the captions print it)."""
+ALPHA_AL = paper.ALPHA_APPARATUS
+"""α = A/L unrounded: the value the printed numbers of fig 6 fit (see the comparisons)."""
+DAMPING = tuple((k, float(paper.CASES[k]["beta"])) for k in ("A", "B", "C", "D"))
+BETA_B = float(paper.CASES["B"]["beta"])
 """The letters of the paper's fig 6 (left) and their β."""
 ETA_RANGE = (0.2, 1.0)
 """η range of the response curves shown."""
@@ -45,26 +50,6 @@ ETA_FAR = 3.0
 """Case B's response curve is followed this far to see where it levels off."""
 FAR = 3.0
 """Stop angle (radians) that keeps the stop out of the way of the nonimpacting orbit."""
-
-
-@dataclass(frozen=True)
-class PaperPoint:
-    """One of the paper's three multiplier insets."""
-
-    key: str
-    theta_hat_deg: float
-    eta: float
-    multipliers: complex
-    which: int
-    """Index of our grazing at this θ̂ (0: first in η)."""
-
-
-PAPER_POINTS = (
-    PaperPoint("a", 10.0, 0.3229, 0.4040 + 0.0114j, 0),
-    PaperPoint("b", 40.0, 0.4450, 0.4606 + 0.2137j, 0),
-    PaperPoint("c", 40.0, 0.5475, 0.2534 + 0.5178j, 1),
-)
-"""The caption of fig 6: (a) θ̂ = 10°, η = 0.3229 (an erratum: see the comparison), (b), (c) θ̂ = 40°."""
 
 
 @dataclass
@@ -75,6 +60,9 @@ class Fig6:
     far: Branch
     curve: GrazingCurve
     points: dict[str, GrazingPoint]
+    """Our grazing points at the paper's insets, α = 0.2254 (drawn)."""
+    points_al: dict[str, GrazingPoint]
+    """The same with α = A/L = 0.225778."""
     grazings40: list[GrazingPoint]
     grazings10: list[GrazingPoint]
     response_max: tuple[float, float]
@@ -131,18 +119,38 @@ def compute() -> Fig6:
         letter: continue_orbit(_model(beta), "eta", ETA_RANGE[0], ETA_RANGE[1], virtual=True)
         for letter, beta in DAMPING
     }
-    far = continue_orbit(_model(0.048), "eta", ETA_RANGE[1], ETA_FAR, virtual=True)
+    far = continue_orbit(_model(BETA_B), "eta", ETA_RANGE[1], ETA_FAR, virtual=True)
     curve = grazing_curve(grazing.models.pendulum("B"), start=math.radians(5.0))
-    g10, _ = find_grazings(grazing.models.pendulum("B", theta_hat=math.radians(10.0)), "eta", 0.2, 1.0)
-    g40, _ = find_grazings(grazing.models.pendulum("B", theta_hat=math.radians(40.0)), "eta", 0.2, 1.0)
-    points = {}
-    for pp in PAPER_POINTS:
-        found = g10 if pp.theta_hat_deg == 10.0 else g40
-        if len(found) > pp.which:
-            points[pp.key] = found[pp.which]
+    found = {
+        (alpha, th): find_grazings(
+            grazing.models.pendulum("B", alpha=alpha, theta_hat=math.radians(th)), "eta", 0.2, 1.0
+        )[0]
+        for alpha in (ALPHA, ALPHA_AL)
+        for th in (10.0, 40.0)
+    }
+
+    def at(alpha: float) -> dict[str, GrazingPoint]:
+        out = {}
+        for key, inset in paper.FIG6_INSETS.items():
+            pts = found[(alpha, inset.theta_hat_deg)]
+            if len(pts) > inset.which:
+                out[key] = pts[inset.which]
+        return out
+
     top = response_maximum(branches["B"])
     check = curve_vs_response(curve)
-    return Fig6(branches, far, curve, points, g40, g10, top, check, time.process_time() - cpu)
+    return Fig6(
+        branches,
+        far,
+        curve,
+        at(ALPHA),
+        at(ALPHA_AL),
+        found[(ALPHA, 40.0)],
+        found[(ALPHA, 10.0)],
+        top,
+        check,
+        time.process_time() - cpu,
+    )
 
 
 def _segments(values: np.ndarray, angle: np.ndarray, stable: np.ndarray) -> list[tuple[Any, Any, bool]]:
@@ -161,8 +169,16 @@ def _draw_left(ax: Axes, data: Fig6) -> None:
     colors = {"A": "tab:purple", "B": "tab:blue", "C": "tab:green", "D": "tab:orange"}
     for th in (10, 20, 30, 40, 50):
         ax.axhline(th, color="0.6", lw=0.7, zorder=0)
-        ax.text(0.995, th, f"θ̂ = {th}°", transform=ax.get_yaxis_transform(), ha="right", va="bottom",
-                fontsize=7.5, color="0.4")  # fmt: skip
+        ax.text(
+            0.995,
+            th,
+            f"θ̂ = {th}°",
+            transform=ax.get_yaxis_transform(),
+            ha="right",
+            va="bottom",
+            fontsize=9,
+            color="0.4",
+        )
     for letter, beta in DAMPING:
         br = data.branches[letter]
         v = np.asarray(br.values)
@@ -172,13 +188,28 @@ def _draw_left(ax: Axes, data: Fig6) -> None:
             ax.plot(x, y, color=colors[letter], lw=1.4 if st else 1.1, ls="-" if st else "--")
         folds = [s for s in br.special if s.kind == "fold"]
         for s in folds:
-            ax.plot(s.param, math.degrees(s.orbit.max_angle()), "o", ms=5, mfc="white",
-                    mec=colors[letter], mew=1.3, zorder=4)  # fmt: skip
+            ax.plot(
+                s.param,
+                math.degrees(s.orbit.max_angle()),
+                "o",
+                ms=5,
+                mfc="white",
+                mec=colors[letter],
+                mew=1.3,
+                zorder=4,
+            )
         k = int(np.argmax(ang))
         right = letter != "A"
-        ax.annotate(letter, (v[k], ang[k]), xytext=(5 if right else -4, 1), textcoords="offset points",
-                    ha="left" if right else "right",
-                    fontsize=10, color=colors[letter], fontweight="bold")  # fmt: skip
+        ax.annotate(
+            letter,
+            (v[k], ang[k]),
+            xytext=(5 if right else -4, 1),
+            textcoords="offset points",
+            ha="left" if right else "right",
+            fontsize=10,
+            color=colors[letter],
+            fontweight="bold",
+        )
         ax.plot([], [], color=colors[letter], lw=1.4, label=f"{letter}: β = {beta:.3f}")
     ax.plot([], [], color="k", ls="--", lw=1.1, label="unstable")
     ax.plot([], [], "o", ms=5, mfc="white", mec="k", label="fold (continuation)")
@@ -208,56 +239,73 @@ def _draw_right(ax: Axes, data: Fig6) -> Any:
     cb.set_label("|λ|, largest nontrivial Floquet multiplier", fontsize=9)
     for y in (2 / 3,):
         cb.ax.axhline(y, color="k", lw=1.0)
-    cb.ax.text(1.05, 2 / 3, " 2/3", transform=cb.ax.get_yaxis_transform(), fontsize=7, va="center")
+    cb.ax.text(1.05, 2 / 3, " 2/3", transform=cb.ax.get_yaxis_transform(), fontsize=9, va="center")
     if curve.fold is not None:
         fe, ft = curve.fold.model.params["eta"], math.degrees(curve.fold.model.params["theta_hat"])
         ax.plot(fe, ft, "*", ms=12, color="tab:red", mec="k", mew=0.5, zorder=5)
-        ax.annotate(f"θ̂_max = {ft:.2f}°\nat η = {fe:.4f}", (fe, ft), xytext=(-12, -4), ha="right",
-                    va="top", textcoords="offset points", fontsize=8.5)  # fmt: skip
+        ax.annotate(
+            f"θ̂_max = {ft:.2f}°\nat η = {fe:.4f}",
+            (fe, ft),
+            xytext=(-12, -4),
+            ha="right",
+            va="top",
+            textcoords="offset points",
+            fontsize=9.5,
+        )
     for key, p in data.points.items():
         e, t = p.model.params["eta"], math.degrees(p.model.params["theta_hat"])
         ax.plot(e, t, "o", ms=7, mfc="white", mec="k", zorder=6)
-        ax.annotate(f"({key})", (e, t), xytext=(8, -10) if key == "c" else (-8, 4), ha="left" if key == "c"
-                    else "right", textcoords="offset points", fontsize=9, fontweight="bold")  # fmt: skip
+        ax.annotate(
+            f"({key})",
+            (e, t),
+            xytext=(8, -10) if key == "c" else (-8, 4),
+            ha="left" if key == "c" else "right",
+            textcoords="offset points",
+            fontsize=9,
+            fontweight="bold",
+        )
     ax.set_xlim(0.25, 1.0)
     ax.set_ylim(0, 62)
     ax.set_xlabel("η")
     ax.set_ylabel("θ̂ (degrees)")
-    ax.set_title("Grazing orbits of case B (r = 0.7675, β = 0.048)", loc="left", fontsize=10)
+    ax.set_title("Grazing orbits of case B (r = 0.7675, β = 0.048, α = 0.2254)", loc="left", fontsize=10)
     ax.grid(alpha=0.25)
-    # the multiplier insets, top right, above the descending branch
-    for k, (key, p) in enumerate(data.points.items()):
-        inset = ax.inset_axes([0.5 + 0.166 * k, 0.6, 0.15, 0.26])
-        _draw_multipliers(inset, key, p)
     return lc
 
 
 def _draw_multipliers(ax: Axes, key: str, p: GrazingPoint) -> None:
+    """The nontrivial Floquet multipliers of one grazing orbit in the complex plane, with their values."""
     t = np.linspace(0, 2 * np.pi, 200)
     ax.plot(np.cos(t), np.sin(t), color="0.5", lw=0.8)
     ax.axhline(0, color="0.8", lw=0.6)
     ax.axvline(0, color="0.8", lw=0.6)
     mu = p.multipliers
-    ax.plot(mu.real, mu.imag, "o", ms=4.5, color="tab:red")
-    ax.plot([1.0], [0.0], "o", ms=4.5, mfc="white", mec="tab:red")
-    ax.set_xlim(-1.25, 1.25)
-    ax.set_ylim(-1.25, 1.25)
+    ax.plot(mu.real, mu.imag, "o", ms=6, color="tab:red")
+    ax.plot([1.0], [0.0], "o", ms=6, mfc="white", mec="tab:red")
+    ax.set_xlim(-1.2, 1.2)
+    ax.set_ylim(-1.2, 1.2)
     ax.set_aspect("equal")
     ax.set_xticks([])
     ax.set_yticks([])
-    ax.set_title(f"({key}) η = {p.model.params['eta']:.4f}", fontsize=7.5, pad=2)
+    th = math.degrees(p.model.params["theta_hat"])
+    ax.set_title(f"({key}) θ̂ = {th:.0f}°, η = {p.model.params['eta']:.4f}", fontsize=9.5, pad=3)
     z = mu[0]
-    text = f"{z.real:.3f}\n± {abs(z.imag):.3f}i".replace("-", "−")
-    ax.text(0.03, 0.03, text, transform=ax.transAxes, fontsize=6.5, va="bottom")
+    ax.set_xlabel(
+        f"λ = {z.real:.4f} ± {abs(z.imag):.4f}i\n|λ| = {abs(z):.4f}".replace("-", "−"), fontsize=9.5
+    )
 
 
 def draw(data: Fig6, path: Path) -> None:
     from matplotlib.figure import Figure
 
-    fig = Figure(figsize=(13.0, 5.2), layout="constrained")
-    left, right = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1.0, 1.12]})
+    fig = Figure(figsize=(14.0, 5.6), layout="constrained")
+    grid = fig.add_gridspec(3, 3, width_ratios=[1.0, 1.12, 0.34])
+    left = fig.add_subplot(grid[:, 0])
+    right = fig.add_subplot(grid[:, 1])
     _draw_left(left, data)
     _draw_right(right, data)
+    for k, (key, p) in enumerate(data.points.items()):
+        _draw_multipliers(fig.add_subplot(grid[k, 2]), key, p)
     save_png(fig, path)
 
 
@@ -276,9 +324,10 @@ def build(out_dir: Path, progress: Progress | None = None) -> FigureResult:
         "the β of the points A–D (pseudo-arclength continuation; dashed: unstable; circles: folds). Each "
         "horizontal line is a stop angle θ̂: its grazings are where it meets a curve. Right: the "
         "two-parameter continuation of the grazing orbit of case B in (η, θ̂), started at θ̂ = 5°, coloured "
-        "by |λ|; the star marks θ̂_max, beyond which no grazing occurs. Insets: the Floquet multipliers at "
-        "our grazing points (a) θ̂ = 10°, (b), (c) θ̂ = 40° (filled: the nontrivial pair; open: the trivial "
-        "multiplier 1 of the autonomous form; circle: |λ| = 1).",
+        "by |λ|; the star marks θ̂_max, beyond which no grazing occurs. Right column: the Floquet "
+        "multipliers at our grazing points (a) θ̂ = 10°, (b), (c) θ̂ = 40°, α = 0.2254 (filled: the "
+        "nontrivial pair; open: the trivial multiplier 1 of the autonomous form; circle: |λ| = 1); the "
+        "paper's printed values fit α = A/L = 0.225778 instead (see the table).",
         "Response curves for four damping values and the grazing curve of case B with Floquet multipliers",
     )
     summary = (
@@ -295,12 +344,24 @@ def build(out_dir: Path, progress: Progress | None = None) -> FigureResult:
         comparisons=comparisons(data),
         notes=notes(data),
         seconds=time.perf_counter() - start,
+        data=write_data(data, out_dir),
     )
 
 
-def _cx(z: complex, digits: int = 4) -> str:
-    """``0.4612 ± 0.2127i`` with a proper minus sign."""
-    return f"{z.real:.{digits}f} ± {abs(z.imag):.{digits}f}i".replace("-", "−")
+def write_data(data: Fig6, out_dir: Path) -> tuple[DataFile, ...]:
+    """The response curves and the grazing curve as NetCDF."""
+    groups = {f"beta_{letter}": data.branches[letter].to_dataset() for letter, _ in DAMPING}
+    groups["beta_B_far"] = data.far.to_dataset()
+    resp = write_groups(out_dir / "fig06_response_curves.nc", groups)
+    curve = write_dataset(out_dir / "fig06_grazing_curve.nc", data.curve.to_dataset())
+    return (
+        DataFile(
+            resp.name,
+            "the response curves (continuation branches), NetCDF, one group per β: beta_A, "
+            "beta_B, beta_C, beta_D, and beta_B_far (case B out to η = 3)",
+        ),
+        DataFile(curve.name, "the grazing curve of case B in (η, θ̂) with the multipliers, NetCDF"),
+    )
 
 
 def linear_multipliers(eta: float, beta: float) -> complex:
@@ -316,98 +377,125 @@ def linear_multipliers(eta: float, beta: float) -> complex:
     return cmath.exp(2 * math.pi * s)
 
 
+HEAD_ALPHA = (
+    "The printed grazing points and multipliers fit α = A/L = 0.225778 (printed 0.2258 in §3) to every "
+    "digit, not the captions' α = 0.2254 that we use for figs 7–12"
+)
+
+
+def _eta(p: GrazingPoint) -> float:
+    return float(p.model.params["eta"])
+
+
+def inset_rows(data: Fig6) -> list[Comparison]:
+    """The insets (b), (c) at 40°: grazing η and multipliers, with α = A/L and with α = 0.2254."""
+    rows: list[Comparison] = []
+    for key in ("b", "c"):
+        inset = paper.FIG6_INSETS[key]
+        for alpha, pts, label in ((ALPHA_AL, data.points_al, "α = A/L"), (ALPHA, data.points, "α = 0.2254")):
+            p = pts.get(key)
+            if p is None:
+                continue
+            head = "" if alpha == ALPHA_AL else HEAD_ALPHA
+            rows.append(
+                numeric_row(
+                    FIGURE_ID,
+                    f"inset ({key}) θ̂ = 40°: grazing η, {label}",
+                    inset.eta,
+                    _eta(p),
+                    kind="paper",
+                    headline=head,
+                )
+            )
+            rows.append(
+                complex_row(
+                    FIGURE_ID,
+                    f"inset ({key}) θ̂ = 40°: multipliers, {label}",
+                    inset.multiplier,
+                    complex(p.multipliers[0]),
+                    kind="paper",
+                    headline=head,
+                    note=f"Our η_g = {_eta(p):.6f}; the trivial multiplier 1 of the autonomous "
+                    "form is not part of our stroboscopic map.",
+                )
+            )
+    return rows
+
+
 def comparisons(data: Fig6) -> tuple[Comparison, ...]:
-    rows = []
-    g40 = [p.model.params["eta"] for p in data.grazings40]
-    rows.append(
-        Comparison(
-            "fig 6 (right): grazings at θ̂ = 40°",
-            "η = 0.4450 and η = 0.5475",
-            "fig 6 caption, insets (b), (c)",
-            f"η = {', '.join(f'{e:.4f}' for e in g40)} (grazing equations solved to 1e-12)",
-            len(g40) == 2 and abs(g40[0] - 0.4450) < 5e-4 and abs(g40[1] - 0.5475) < 5e-4,
-            f"Differences {g40[0] - 0.4450:+.4f} and {g40[1] - 0.5475:+.4f} (the paper prints four "
-            "digits).".replace("-", "−")
-            if len(g40) == 2
-            else "",
-        )
-    )
-    beta = 0.048
-    for pp in PAPER_POINTS[1:]:
-        p = data.points.get(pp.key)
-        if p is None:
-            continue
-        mu = p.multipliers[0]
-        rows.append(
-            Comparison(
-                f"fig 6 inset ({pp.key}): multipliers, θ̂ = 40°, η = {pp.eta}",
-                f"1, {_cx(pp.multipliers)} (|λ| = {abs(pp.multipliers):.4f})",
-                "fig 6 caption",
-                f"{_cx(mu)} at η = {p.model.params['eta']:.4f} (|λ| = {abs(mu):.4f}); the trivial 1 of the "
-                "autonomous form is not part of our stroboscopic map",
-                abs(mu - pp.multipliers) < 3e-3,
-                f"Check: det = {np.prod(p.multipliers).real:.5f} against exp(−4πβ/η) = "
-                f"{math.exp(-4 * math.pi * beta / p.model.params['eta']):.5f} (exact for a nonimpacting "
-                "orbit).",
-            )
-        )
-    b = data.points.get("b")
+    rows = inset_rows(data)
+    al = data.points_al
+    b, c, a = al.get("b"), al.get("c"), al.get("a")
     if b is not None:
+        own = abs(paper.FIG6_INSETS["b"].multiplier.value)
         rows.append(
-            Comparison(
-                "§6.1: |λ| at the first grazing, θ̂ = 40°, η = 0.445",
-                "|λ| = 0.5114",
-                "§6.1",
-                f"|λ| = {b.abs_lambda:.4f}",
-                False,
-                f"The paper's own multipliers 0.4606 ± 0.2137i have modulus {abs(0.4606 + 0.2137j):.4f}, as "
-                "ours; the quoted 0.5114 is inconsistent with them (erratum, SPEC). Either value lies in "
-                "1/4 < |λ| < 2/3 (eq. 21), where period-adding is predicted.",
+            numeric_row(
+                FIGURE_ID,
+                "§6.1: |λ| at the first grazing, θ̂ = 40°, α = A/L",
+                paper.ABS_LAMBDA_FIRST,
+                b.abs_lambda,
+                kind="paper",
+                erratum=True,
+                headline="§6.1 quotes |λ| = 0.5114 at 40°, η = 0.445; its own multipliers have modulus "
+                "0.5078",
+                note=f"The paper's own multipliers 0.4606 ± 0.2137i have modulus {own:.4f}, as ours; the "
+                f"quoted 0.5114 fits neither (SPEC errata). Either value lies in 1/4 < |λ| < 2/3 (eq. 21).",
             )
         )
-    c = data.points.get("c")
     if c is not None:
         rows.append(
-            Comparison(
-                "§6.1: |λ| at the second grazing, θ̂ = 40°, η = 0.5475",
-                "|λ| = 0.5765",
-                "§6.1",
-                f"|λ| = {c.abs_lambda:.4f}",
-                abs(c.abs_lambda - 0.5765) < 1e-3,
-                "Closer to 2/3 than the first grazing's, as the paper says.",
+            numeric_row(
+                FIGURE_ID,
+                "§6.1: |λ| at the second grazing, θ̂ = 40°, α = A/L",
+                paper.ABS_LAMBDA_SECOND,
+                c.abs_lambda,
+                kind="paper",
+                note="Closer to 2/3 than the first grazing's, as the paper says.",
             )
         )
-    a = data.points.get("a")
     if a is not None:
-        ea = a.model.params["eta"]
-        mu = a.multipliers[0]
-        paper = PAPER_POINTS[0].multipliers
-        eta_fit = -2 * math.pi * beta / math.log(abs(paper))
+        inset = paper.FIG6_INSETS["a"]
         rows.append(
-            Comparison(
-                "fig 6 inset (a): |λ| at the grazing for θ̂ = 10°",
-                f"|λ| = {abs(paper):.4f} (from the printed 0.4040 ± 0.0114i)",
-                "fig 6 caption",
-                f"|λ| = {abs(mu):.4f} at η = {ea:.4f}",
-                abs(abs(mu) - abs(paper)) < 1e-3,
-                f"For a nonimpacting orbit |λ| = exp(−2πβ/η) exactly: the printed modulus gives η = "
-                f"{eta_fit:.4f}, close to our grazing; η = 0.3229 would give "
-                f"{math.exp(-2 * math.pi * beta / 0.3229):.4f}.",
+            numeric_row(
+                FIGURE_ID,
+                "inset (a) θ̂ = 10°: grazing η, α = A/L",
+                inset.eta,
+                _eta(a),
+                kind="paper",
+                erratum=True,
+                headline="Inset (a): “η = 0.3229” is a typo for 0.3329",
+                note=f"The only grazing at 10° is at η = {_eta(a):.5f} (α = A/L; "
+                f"{_eta(data.points['a']):.5f} with "
+                "α = 0.2254): it rounds to 0.3329. The printed multipliers fit that η only (next rows).",
             )
         )
-        lin = linear_multipliers(ea, beta)
+        mu = complex(a.multipliers[0])
         rows.append(
-            Comparison(
-                "fig 6 inset (a): where the grazing at θ̂ = 10° is, and its multipliers",
-                "η = 0.3229; multipliers 1, 0.4040 ± 0.0114i",
-                "fig 6 caption",
-                f"η = {ea:.4f}; {_cx(mu)}",
-                False,
-                "Two typos in the caption, we judge: (i) the only grazing at 10° is at η ≈ 0.333 (and the "
-                "printed modulus fits that η only, see the row above); (ii) the sign of the real part: near "
-                "η = 1/3 the linearised pendulum (natural frequency 1/(2η) in τ) turns by 2π·1/(2η) ≈ 3π per "
-                f"forcing period, so the pair must lie near the negative real axis: the linear oscillator "
-                f"alone gives {_cx(lin)}. Same modulus, opposite real part.",
+            complex_row(
+                FIGURE_ID,
+                "inset (a) θ̂ = 10°: multipliers as printed, α = A/L",
+                inset.multiplier,
+                mu,
+                kind="paper",
+                erratum=True,
+                headline="Inset (a): the multipliers' real part is printed with the wrong sign",
+                note="Near η = 1/3 the linearised pendulum turns by about 3π per forcing period, so the pair "
+                f"lies near the negative real axis: the linear oscillator alone gives "
+                f"{complex_text(linear_multipliers(_eta(a), BETA_B))}.",
+            )
+        )
+        flipped = paper.PrintedComplex(
+            paper.Printed("-" + inset.multiplier.real.text, inset.multiplier.real.source),
+            inset.multiplier.imag,
+        )
+        rows.append(
+            complex_row(
+                FIGURE_ID,
+                "inset (a) θ̂ = 10°: multipliers, real part's sign corrected, α = A/L",
+                flipped,
+                mu,
+                kind="paper",
+                paper_text="−" + inset.multiplier.text,
             )
         )
     fold = data.curve.fold
@@ -415,37 +503,70 @@ def comparisons(data: Fig6) -> tuple[Comparison, ...]:
         ft = math.degrees(fold.model.params["theta_hat"])
         te, ta = data.response_max
         rows.append(
-            Comparison(
-                "θ̂_max for case B: the largest stop angle with a grazing",
-                "“about 55° for case B”",
-                "§6.1",
-                f"{ft:.3f}° at η = {fold.model.params['eta']:.4f} (fold of the grazing curve); "
-                f"{math.degrees(ta):.3f}° at η = {te:.4f} (top of the response curve, refined)",
-                abs(ft - 55.0) < 1.5,
-                f"Two independent computations agree to {abs(ft - math.degrees(ta)):.1e}°; the grazing "
-                f"curve and the response curve agree to {math.degrees(data.curve_check):.1e}° at 12 checked "
-                "points.",
+            numeric_row(
+                FIGURE_ID,
+                "θ̂_max, the largest stop angle with a grazing (case B, α = 0.2254)",
+                paper.FIG6_THETA_MAX,
+                ft,
+                kind="paper",
+                decimals=2,
+                note=f"At η = {fold.model.params['eta']:.4f}, the fold of the grazing curve.",
+            )
+        )
+        rows.append(
+            numeric_row(
+                FIGURE_ID,
+                "θ̂_max two ways: fold of the grazing curve against the top of the response curve",
+                math.degrees(ta),
+                ft,
+                kind="self-check",
+                tolerance=1e-6,
+                decimals=6,
+                why_tolerance="1e-6° (two independent computations)",
+                paper_text=f"{math.degrees(ta):.6f}°",
+                note=f"The top of the response curve (refined) is at η = {te:.6f}. The grazing curve and the "
+                f"response curve agree to {math.degrees(data.curve_check):.1e}° at 12 checked points.",
+            )
+        )
+    p = data.points.get("b")
+    if p is not None:
+        beta = BETA_B
+        det = float(np.prod(p.multipliers).real)
+        rows.append(
+            numeric_row(
+                FIGURE_ID,
+                "inset (b): det of the monodromy against Liouville's exp(−4πβ/η)",
+                math.exp(-4 * math.pi * beta / _eta(p)),
+                det,
+                kind="self-check",
+                tolerance=1e-9,
+                decimals=10,
+                why_tolerance="1e-9 (exact for a nonimpacting orbit)",
             )
         )
     far = data.far
     far_angle = np.degrees(FAR - far.guard_min)
     lowest_right = float(np.degrees(data.curve.values("theta_hat"))[-1])
+    one = len(data.grazings10) == 1 and bool(np.all(far_angle > 10.0))
     rows.append(
-        Comparison(
+        criterion_row(
+            FIGURE_ID,
             "θ̂ = 10°: no second grazing",
-            "“for θ̂ = 10° there is no second grazing bifurcation to restore period-one nonimpacting motion”",
-            "§6.1",
-            f"one grazing at 10° (η = {data.grazings10[0].model.params['eta']:.4f}); past the resonance "
-            f"the largest angle falls to {lowest_right:.2f}° at η = 1 and {far_angle[-1]:.2f}° at "
-            f"η = {ETA_FAR:g}, levelling off towards α = {math.degrees(ALPHA):.2f}° (forcing much faster "
-            "than the pendulum)",
-            len(data.grazings10) == 1 and bool(np.all(far_angle > 10.0)),
-            "At high η the restoring term sin θ/(4η²) fades and θ ≈ −α sin τ: the amplitude tends to α "
-            "radians, above 10°, so the curve never comes back down to 10°.",
+            paper.NO_SECOND_GRAZING_10,
+            f"one grazing (η = {_eta(data.grazings10[0]):.4f}); the angle stays above {far_angle.min():.2f}°",
+            one,
+            kind="paper",
+            rule="agree when the nonimpacting orbit's largest angle, followed from the grazing to η = 3, "
+            "never comes back down to 10°",
+            source="§6.1",
+            paper_text="no second grazing at 10°",
+            ours_text=f"1 grazing; largest angle ≥ {far_angle.min():.2f}° up to η = {ETA_FAR:g}",
+            note=f"Past the resonance the largest angle falls to {lowest_right:.2f}° at η = 1 and levels off "
+            f"towards α = {math.degrees(ALPHA):.2f}° (θ ≈ −α sin τ once the forcing is much faster than the "
+            "pendulum), above 10°.",
         )
     )
-    # numpy comparisons give numpy booleans: the table wants plain ones
-    return tuple(r if r.agrees is None else dataclasses.replace(r, agrees=bool(r.agrees)) for r in rows)
+    return tuple(rows)
 
 
 def _above_two_thirds(curve: GrazingCurve) -> str:
@@ -468,8 +589,7 @@ def _above_two_thirds(curve: GrazingCurve) -> str:
         t = th[real]
         text += (
             f"Near the resonance peak the nontrivial pair is real (θ̂ from {t.min():.1f}° to {t.max():.1f}°), "
-            "the larger multiplier reaching "
-            f"{lam[real].max():.3f}. "
+            f"the larger multiplier reaching {lam[real].max():.3f}. "
         )
     if parts:
         text += "It exceeds 2/3, the upper limit of eq. 21 for period-adding, " + " and ".join(parts) + "."

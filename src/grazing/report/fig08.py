@@ -22,13 +22,15 @@ import numpy as np
 import grazing
 from grazing.orbits import find_orbit
 from grazing.plotting import mark_grazings, plot_bifurcation
-from grazing.report import diagrams
-from grazing.report.base import Comparison, FigureResult, Image, Progress, save_png
+from grazing.report import diagrams, paper
+from grazing.report.base import Comparison, DataFile, FigureResult, Image, Progress, save_png
+from grazing.report.data import slim_sweep, write_csv, write_groups
+from grazing.report.rules import criterion_row, numeric_row
 from grazing.sweeps import sweep
 from grazing.sweeps.windows import Window, find_windows
 
 FIGURE_ID = "8"
-ETA = 0.447
+ETA = paper.FIG8_ETA.value
 """The fixed forcing frequency (fig 8 caption)."""
 
 
@@ -110,9 +112,17 @@ def run_panel(args: tuple[Panel, Settings]) -> PanelRun:
     orbit = find_orbit(model.with_params(theta_hat=3.0), period=1, virtual=True)
     lo, hi = panel.theta_range
     ds = sweep(
-        model, "theta_hat", np.radians(np.linspace(lo, hi, s.points)), x0=orbit.state, direction="down",
-        transient=s.transient, periods=s.periods, lyapunov=False, chunk_size=0, workers=1,
-    )  # fmt: skip
+        model,
+        "theta_hat",
+        np.radians(np.linspace(lo, hi, s.points)),
+        x0=orbit.state,
+        direction="down",
+        transient=s.transient,
+        periods=s.periods,
+        lyapunov=False,
+        chunk_size=0,
+        workers=1,
+    )
     wall, cpu = time.perf_counter() - start, time.process_time() - cpu
     return PanelRun(panel, ds, orbit.max_angle(), orbit.abs_lambda, wall, cpu)
 
@@ -124,9 +134,13 @@ def draw(runs: list[PanelRun], path: Path) -> None:
     axes = fig.subplots(1, 2)
     for ax, run in zip(axes, runs):
         plot_bifurcation(ax, run.ds)
-        mark_grazings(ax, [run.theta_graze], scale=180 / math.pi,
-                      labels=[f"grazing θ̂ = {math.degrees(run.theta_graze):.2f}°"])  # fmt: skip
-        ax.set_title(f"({run.panel.key}) {run.panel.label}, η = {ETA:g}", loc="left", fontsize=10)
+        mark_grazings(
+            ax,
+            [run.theta_graze],
+            scale=180 / math.pi,
+            labels=[f"grazing θ̂ = {math.degrees(run.theta_graze):.2f}°"],
+        )
+        ax.set_title(f"({run.panel.key}) {run.panel.label}, η = {ETA:g}", loc="left", fontsize=10.5)
     save_png(fig, path)
 
 
@@ -161,6 +175,7 @@ def build(out_dir: Path, progress: Progress | None = None, settings: Settings | 
         "Bifurcation diagrams against the stop angle at eta = 0.447, cases B and A",
     )
     cpu = sum(r.cpu_seconds for r in runs)
+    data = write_data(runs, out_dir)
     summary = (
         "The paper's fig 8 recomputed by direct simulation. At fixed η the nonimpacting orbit is the same "
         "for every θ̂, so its largest angle is the grazing stop angle; below it the pendulum impacts. "
@@ -174,6 +189,39 @@ def build(out_dir: Path, progress: Progress | None = None, settings: Settings | 
         comparisons=comparisons(runs),
         notes=notes(runs),
         seconds=time.perf_counter() - start,
+        data=data,
+    )
+
+
+def write_data(runs: list[PanelRun], out_dir: Path) -> tuple[DataFile, ...]:
+    groups = {
+        r.panel.key: slim_sweep(
+            r.ds, panel=r.panel.key, case=r.panel.case, eta=ETA, theta_graze_deg=math.degrees(r.theta_graze)
+        )
+        for r in runs
+    }
+    nc = write_groups(out_dir / "fig08_sweeps.nc", groups)
+    csv = out_dir / "fig08_windows.csv"
+    write_csv(
+        csv,
+        ["panel", "case", "period", "impacting", "points", "theta_hat_start_deg", "theta_hat_stop_deg"],
+        [
+            (
+                r.panel.key,
+                r.panel.case,
+                w.period,
+                int(w.impacting),
+                w.points,
+                math.degrees(w.start),
+                math.degrees(w.stop),
+            )
+            for r in runs
+            for w in r.windows
+        ],
+    )
+    return (
+        DataFile(nc.name, "the two sweeps in θ̂ (radians), NetCDF, groups a (case B) and b (case A)"),
+        DataFile(csv.name, "every window of the two sweeps, θ̂ in degrees, CSV"),
     )
 
 
@@ -196,32 +244,40 @@ def comparisons(runs: list[PanelRun]) -> tuple[Comparison, ...]:
     gb = math.degrees(b.theta_graze)
     onset = math.degrees(b.first_nonimpacting())
     rows.append(
-        Comparison(
-            f"fig 8(a): case B, η = {ETA:g}: grazing stop angle",
-            "“a grazing bifurcation at θ̂ = 41°”",
-            "§6.1",
-            f"θ̂_g = {gb:.3f}° (largest angle of the nonimpacting orbit); in the sweep the motion is "
-            f"nonimpacting from θ̂ = {onset:.2f}° up",
-            abs(gb - 41.0) < 1.0,
-            f"The grazing orbit's |λ| = {b.abs_lambda:.3f}, inside 1/4 < |λ| < 2/3 (eq. 21): period-adding "
-            "is predicted.",
+        numeric_row(
+            FIGURE_ID,
+            f"(a) case B, η = {ETA:g}: grazing stop angle θ̂_g (degrees)",
+            paper.FIG8_GRAZING,
+            gb,
+            kind="paper",
+            decimals=3,
+            note=f"The largest angle of the nonimpacting orbit; in the sweep the motion is nonimpacting from "
+            f"θ̂ = {onset:.2f}° up. The grazing orbit's |λ| = {b.abs_lambda:.3f}, inside 1/4 < |λ| < 2/3 "
+            "(eq. 21).",
         )
     )
     seq = cascade(b)
     near = [w for w in seq if w.period >= 2]
     per = [w.period for w in near]
-    rising = len(per) >= 3 and all(y > x for x, y in itertools.pairwise(per))
+    rising = len(per) >= 3 and all(y == x + 1 for x, y in itertools.pairwise(per))
+    others = ", ".join(_deg(w) for w in b.impacting_windows(2) if w not in near and w.period >= 2)
     rows.append(
-        Comparison(
-            "fig 8(a): the period-adding cascade below the grazing",
+        criterion_row(
+            FIGURE_ID,
+            "(a) the period-adding cascade below the grazing",
             "“the onset of a period-adding cascade, where the period increases with θ̂”",
-            "§6.1",
-            "clearly resolved windows in increasing θ̂: " + ", ".join(_deg(w) for w in near),
+            " → ".join(map(str, per)),
             rising,
-            "Windows of ≥ 3 points, leaving out the period-doubled satellites at the edges of a window "
-            "(period 2p next to period p). Others (≥ 2 points): "
-            + ", ".join(_deg(w) for w in b.impacting_windows(2) if w not in near and w.period >= 2)
-            + ".",
+            kind="paper",
+            rule="agree when the clearly resolved windows below the grazing (≥ 3 points, period-doubled "
+            "satellites left out), in increasing θ̂, are at least three with periods increasing by one",
+            source="§6.1",
+            paper_text="periods increasing by one with θ̂",
+            ours_text=" → ".join(map(str, per)),
+            headline="(a): no period-adding cascade in θ̂",
+            note="Windows: "
+            + ", ".join(_deg(w) for w in near)
+            + (f". Others (≥ 2 points): {others}." if others else "."),
         )
     )
     lo = max(b.panel.theta_range[0], a.panel.theta_range[0])
@@ -234,44 +290,45 @@ def comparisons(runs: list[PanelRun]) -> tuple[Comparison, ...]:
         if wb is None or wa is None:
             continue
         db, da = math.degrees(wb.width), math.degrees(wa.width)
-        wide.append(f"period {p}: {da:.2f}° (A) vs {db:.2f}° (B)")
+        wide.append(f"{p}: {da:.2f}° vs {db:.2f}°")
         wider &= da > db
     rows.append(
-        Comparison(
-            "fig 8(b) against (a): case A (smaller β) against case B",
-            "“the case with smaller β has significantly wider intervals of chaos and also wider, more "
-            "appreciable windows of the higher-period periodic windows”",
-            "§6.2",
-            f"aperiodic fraction of the impacting points from θ̂ = {lo:g}° to the grazing: {fa:.0%} (A) vs "
-            f"{fb:.0%} (B) (A over B's θ̂ range only: {fa_common:.0%}); widest windows: " + "; ".join(wide),
-            fa > fb and wider,
-            f"Case A grazes at θ̂_g = {math.degrees(a.theta_graze):.2f}° at this η (case B at {gb:.2f}°): its "
-            f"response is much larger (fig 6, left), so panel (b) spans {a.panel.theta_range[0]:g}°–"
-            f"{a.panel.theta_range[1]:g}°. Widths are in θ̂; 'aperiodic' means no period ≤ 50.",
-        )
-    )
-    ga = math.degrees(a.theta_graze)
-    near_a = [w for w in a.impacting_windows(2) if ga - 5.0 < math.degrees(w.start) < ga and w.period >= 2]
-    big = [w for w in cascade(a) if w.period >= 3]
-    gap = f"{math.degrees(big[-1].stop):.1f}°" if big else "—"
-    rows.append(
-        Comparison(
-            f"fig 8(b): case A, η = {ETA:g}: at the grazing",
-            "(not stated)",
-            "fig 8 caption",
-            f"θ̂_g = {ga:.2f}° with |λ| = {a.abs_lambda:.3f}; windows in the 5° below it: "
-            + (", ".join(_deg(w) for w in near_a) or "none"),
-            None,
-            "|λ| > 2/3: outside the period-adding range of eq. 21. Case A's windows of period 3, 4, 5 lie "
-            f"far below the grazing; from the last of them ({gap}) almost up to the grazing the motion is "
-            "aperiodic.",
+        criterion_row(
+            FIGURE_ID,
+            "(b) against (a): case A (smaller β) against case B",
+            "“significantly wider intervals of chaos and also wider ... windows of the higher-period "
+            "periodic windows”",
+            f"aperiodic {fa:.0%} vs {fb:.0%}; widest windows (A vs B) " + "; ".join(wide),
+            fa > fb and wider and bool(wide),
+            kind="paper",
+            rule="agree when case A has a larger aperiodic share of its impacting points (from θ̂ = 25° to "
+            "the grazing) and wider widest windows of periods 3, 4 and 5 than case B",
+            source="§6.2",
+            paper_text="A: wider chaos, wider windows",
+            ours_text=f"aperiodic {fa:.0%} (A) vs {fb:.0%} (B); windows wider in A: "
+            f"{'yes' if wider else 'no'}",
+            headline="Case A's chaos or windows are not wider than case B's",
+            note=f"Over B's θ̂ range only, A is aperiodic at {fa_common:.0%} of its impacting points. Widths: "
+            + "; ".join(wide)
+            + f". Case A grazes at θ̂_g = {math.degrees(a.theta_graze):.2f}° at this η "
+            f"(case B at {gb:.2f}°): its response is much larger (fig 6, left).",
         )
     )
     return tuple(rows)
 
 
 def notes(runs: list[PanelRun]) -> tuple[str, ...]:
+    _, a = runs
+    ga = math.degrees(a.theta_graze)
+    near_a = [w for w in a.impacting_windows(2) if ga - 5.0 < math.degrees(w.start) < ga and w.period >= 2]
+    big = [w for w in cascade(a) if w.period >= 3]
+    gap = f"{math.degrees(big[-1].stop):.1f}°" if big else "—"
     return (
+        f"Case A at η = {ETA:g} grazes at θ̂_g = {ga:.2f}° with |λ| = {a.abs_lambda:.3f}, above 2/3: "
+        f"outside the period-adding range of eq. 21. Its windows in the 5° below the grazing: "
+        + (", ".join(_deg(w) for w in near_a) or "none")
+        + f"; its windows of period 3, 4, 5 lie far below the grazing, and from the last of them ({gap}) "
+        "almost up to the grazing the motion is aperiodic. The paper says nothing about this range.",
         "Sweeping θ̂ upwards from the period-2 region instead gives the same windows for case B; for case "
         "A, starting from rest, it stays on an impacting period-1 orbit beyond the grazing angle (a "
         "coexisting attractor), which the downward sweep from the nonimpacting orbit avoids.",

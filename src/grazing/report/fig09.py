@@ -26,19 +26,33 @@ import numpy as np
 
 import grazing
 from grazing.plotting import plot_delay, plot_time_series
-from grazing.report.base import Comparison, Dynamics, FigureResult, Image, Progress, save_png, signed
+from grazing.report import paper
+from grazing.report.base import (
+    Comparison,
+    DataFile,
+    Dynamics,
+    FigureResult,
+    Image,
+    Progress,
+    save_png,
+    signed,
+)
+from grazing.report.data import write_groups
+from grazing.report.rules import criterion_row
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
 
 FIGURE_ID = "9"
 
-ALPHA_TABLE = 0.2254
+ALPHA_TABLE = paper.ALPHA_TABLE.value
 """α of case B as tabulated (fig 7 caption; SPEC)."""
-ALPHA_PRINTED = 0.2258
+ALPHA_PRINTED = paper.ALPHA_PRINTED.value
 """α printed in §3: "In the experimental data the amplitude was set at α = 0.2258"."""
-ALPHA_APPARATUS = 50.8 / 225.0
+ALPHA_APPARATUS = paper.ALPHA_APPARATUS
 """α = A/L (eq. 3) with A = 50.8 mm and L = 225 mm (§2.1)."""
+_ETA_A, _ETA_B = paper.FIG9[0][1].value, paper.FIG9[1][1].value
+_SRC = "fig 9 and its caption; §6.1"
 
 TRANSIENT = 1000
 """Forcing periods discarded before anything is recorded."""
@@ -73,18 +87,45 @@ class Case:
 
 
 CASES: tuple[Case, ...] = (
-    Case("a", "(a)", 10.0, 0.33294, ALPHA_TABLE, "α = 0.2254 (case B as tabulated)",
-         "chaotic", "fig 9(a) and its caption; §6.1", inset=True),
-    Case("a-printed", "(a)", 10.0, 0.33294, ALPHA_PRINTED, "α = 0.2258 (as printed in §3)",
-         "chaotic", "fig 9(a) and its caption; §6.1", plotted=False),
-    Case("a-apparatus", "(a′)", 10.0, 0.33294, ALPHA_APPARATUS, "α = A/L = 50.8/225 = 0.225778",
-         "chaotic", "fig 9(a) and its caption; §6.1", inset=True),
-    Case("b", "(b)", 40.0, 0.446, ALPHA_TABLE, "α = 0.2254 (case B as tabulated)",
-         "period-5", "fig 9(b) and its caption; §6.1"),
-    Case("b-045", "(b, η = 0.45)", 40.0, 0.45, ALPHA_TABLE, "α = 0.2254 (case B as tabulated)",
-         "chaotic (numerics; the experiment shows period-5 here)",
-         "§6.1 on fig 3(d) and fig 7(d)", plotted=False),
-)  # fmt: skip
+    Case(
+        "a", "(a)", 10.0, _ETA_A, ALPHA_TABLE, "α = 0.2254 (case B as tabulated)", "chaotic", _SRC, inset=True
+    ),
+    Case(
+        "a-printed",
+        "(a)",
+        10.0,
+        _ETA_A,
+        ALPHA_PRINTED,
+        "α = 0.2258 (as printed in §3)",
+        "chaotic",
+        _SRC,
+        plotted=False,
+    ),
+    Case(
+        "a-apparatus",
+        "(a′)",
+        10.0,
+        _ETA_A,
+        ALPHA_APPARATUS,
+        "α = A/L = 50.8/225 = 0.225778",
+        "chaotic",
+        _SRC,
+        inset=True,
+    ),
+    Case("b", "(b)", 40.0, _ETA_B, ALPHA_TABLE, "α = 0.2254 (case B as tabulated)", "period-5", _SRC),
+    Case(
+        "b-045",
+        "(b, η = 0.45)",
+        40.0,
+        paper.FIG7D_CHAOTIC.value,
+        ALPHA_TABLE,
+        "α = 0.2254 (case B as tabulated)",
+        "chaotic",
+        paper.FIG7D_CHAOTIC.source,
+        plotted=False,
+    ),
+)
+"""The paper's two points (fig 9), the first with three readings of α, and η = 0.45 at 40° (§6.1)."""
 
 
 @dataclass(frozen=True)
@@ -103,9 +144,11 @@ class CaseRun:
 
 def _model(case: Case, alpha: float | None = None) -> grazing.HybridModel:
     return grazing.models.pendulum(
-        "B", eta=case.eta, theta_hat=math.radians(case.theta_hat_deg),
+        "B",
+        eta=case.eta,
+        theta_hat=math.radians(case.theta_hat_deg),
         alpha=case.alpha if alpha is None else alpha,
-    )  # fmt: skip
+    )
 
 
 def classify(model: grazing.HybridModel, x0: np.ndarray | list[float] | None = None) -> Dynamics:
@@ -132,9 +175,13 @@ def run_case(case: Case) -> CaseRun:
     """Simulate one case: a dense trajectory and the classification of its attractor."""
     model = _model(case)
     dense = grazing.simulate(
-        model, [0.0, 0.0], transient=TRANSIENT, periods=DENSE_PERIODS,
-        trajectory=POINTS_PER_PERIOD, guard_min=True,
-    )  # fmt: skip
+        model,
+        [0.0, 0.0],
+        transient=TRANSIENT,
+        periods=DENSE_PERIODS,
+        trajectory=POINTS_PER_PERIOD,
+        guard_min=True,
+    )
     fine = None
     if case.inset:
         fine = grazing.simulate(
@@ -199,10 +246,6 @@ def multistart(case: Case, n: int = MULTISTART, seed: int = 9) -> dict[str, int]
     return counts
 
 
-def _paper_verdict(text: str) -> str:
-    return text.split(" ")[0]
-
-
 def _per_period_maxima(sol: grazing.Solution) -> np.ndarray:
     """The largest θ in each forcing period of a dense trajectory."""
     T = sol.model.period
@@ -229,9 +272,11 @@ def _draw_time_series(runs: list[CaseRun], path: Path) -> None:
         span = (t0, t0 + SHOWN_PERIODS)
         plot_time_series(ax, run.dense, degrees=True, span=span)
         ax.set_title(
-            f"{c.panel}  θ̂ = {c.theta_hat_deg:g}°, η = {c.eta:g}, {c.alpha_label}: {run.dynamics.verdict}",
-            fontsize=10, loc="left",
-        )  # fmt: skip
+            f"{c.panel}  case B, θ̂ = {c.theta_hat_deg:g}°, η = {c.eta:g}, {c.alpha_label}: "
+            f"{run.dynamics.verdict}",
+            fontsize=10,
+            loc="left",
+        )
         if run.fine is not None:
             _add_inset(ax, run)
         ax.grid(alpha=0.3)
@@ -263,11 +308,18 @@ def _add_inset(ax: Axes, run: CaseRun) -> None:
     inset.plot(sol.trajectory_t / T, np.degrees(sol.trajectory[:, 0] - stop), color="tab:blue", lw=0.7)
     inset.axhline(0.0, color="tab:red", lw=1.0, ls="--")
     if len(sol.impacts):
-        inset.plot(sol.impacts.t / T, np.zeros(len(sol.impacts)), ls="none", marker="v", ms=4,
-                   color="tab:red", label="impact")  # fmt: skip
+        inset.plot(
+            sol.impacts.t / T,
+            np.zeros(len(sol.impacts)),
+            ls="none",
+            marker="v",
+            ms=4,
+            color="tab:red",
+            label="impact",
+        )
     inset.set_xlim(sol.trajectory_t[0] / T, sol.trajectory_t[-1] / T)
     inset.set_ylim(-3.0 * depth, 0.6 * depth)
-    inset.tick_params(labelsize=7)
+    inset.tick_params(labelsize=8.5)
     inset.grid(alpha=0.3)
     n_imp = len(sol.impacts)
     head = "θ − θ̂ in degrees, magnified near the stop: "
@@ -278,7 +330,7 @@ def _add_inset(ax: Axes, run: CaseRun) -> None:
         )
     else:
         text = f"{head}no impacts; every peak stays {depth:.3f}° below the stop"
-    inset.set_title(text, fontsize=8, loc="left", pad=2)
+    inset.set_title(text, fontsize=9, loc="left", pad=2)
 
 
 def _draw_delay(runs: list[CaseRun], path: Path) -> None:
@@ -290,7 +342,9 @@ def _draw_delay(runs: list[CaseRun], path: Path) -> None:
         c = run.case
         plot_delay(ax, run.dense, math.pi / 2, degrees=True, line_kw={"lw": 0.4})
         ax.set_title(
-            f"{c.panel}  θ̂ = {c.theta_hat_deg:g}°, η = {c.eta:g}\n{c.alpha_label}", fontsize=9, loc="left"
+            f"{c.panel}  case B, θ̂ = {c.theta_hat_deg:g}°, η = {c.eta:g}\n{c.alpha_label}",
+            fontsize=9.5,
+            loc="left",
         )
         ax.set_aspect("equal", adjustable="datalim")
         ax.grid(alpha=0.3)
@@ -359,17 +413,59 @@ def build(out_dir: Path, progress: Progress | None = None) -> FigureResult:
         comparisons=comparisons,
         notes=notes,
         seconds=time.perf_counter() - start,
+        data=(write_data(runs, out_dir),),
     )
+
+
+def write_data(runs: list[CaseRun], out_dir: Path) -> DataFile:
+    """The dense trajectories of every case as NetCDF, one group per case."""
+    import xarray as xr
+
+    groups = {}
+    for r in runs:
+        c = r.case
+        groups[c.key.replace("-", "_")] = xr.Dataset(
+            {
+                "theta": ("t", np.asarray(r.dense.trajectory[:, 0]), {"units": "rad"}),
+                "samples": (
+                    "k",
+                    np.asarray(r.dense.samples[:, 0]),
+                    {"units": "rad", "long_name": "θ at τ = 2πk"},
+                ),
+            },
+            coords={"t": ("t", np.asarray(r.dense.trajectory_t), {"long_name": "τ"})},
+            attrs={
+                "theta_hat_deg": c.theta_hat_deg,
+                "eta": c.eta,
+                "alpha": c.alpha,
+                "case": "B",
+                "paper": c.paper,
+                "ours": r.dynamics.verdict,
+                "lyapunov": r.dynamics.lyapunov,
+            },
+        )
+    path = write_groups(out_dir / "fig09_time_series.nc", groups)
+    return DataFile(
+        path.name,
+        "the simulated trajectories θ(τ) and stroboscopic samples, NetCDF, one group per "
+        "case: " + ", ".join(groups),
+    )
+
+
+HEAD_ALPHA = (
+    "(a) θ̂ = 10°, η = 0.33294 is chaotic only with α = A/L = 0.225778 unrounded; with the tabulated "
+    "α = 0.2254 this η lies below the grazing point, on the nonimpacting orbit"
+)
 
 
 def _comparison(
     run: CaseRun, eta_g: dict[float, float], starts: dict[str, int], alt: Dynamics | None
 ) -> Comparison:
     c, d = run.case, run.dynamics
-    item = f"fig 9{c.panel}: θ̂ = {c.theta_hat_deg:g}°, η = {c.eta:g}; {c.alpha_label}"
+    item = f"{c.panel} θ̂ = {c.theta_hat_deg:g}°, η = {c.eta:g}, {c.alpha_label}"
     if c.key == "b-045":
-        item = f"θ̂ = {c.theta_hat_deg:g}°, η = {c.eta:g} (fig 7(d)); {c.alpha_label}"
-    agrees = d.verdict == _paper_verdict(c.paper)
+        item = f"θ̂ = {c.theta_hat_deg:g}°, η = {c.eta:g} (fig 7(d)), {c.alpha_label}"
+    agrees = d.verdict == c.paper
     if c.theta_hat_deg == 10.0:
         eg = eta_g[c.alpha]
         side = "below" if c.eta < eg else "above"
@@ -395,7 +491,21 @@ def _comparison(
         note = f"With α = A/L = 0.225778 instead: {alt.verdict} (λ₁ = {signed(alt.lyapunov, 3)})."
     else:
         note = ""
-    return Comparison(item, c.paper, c.source, d.describe(), agrees, note)
+    return criterion_row(
+        FIGURE_ID,
+        item,
+        c.paper,
+        d.verdict,
+        agrees,
+        kind="paper",
+        rule="agree when our attractor (period of 200 stroboscopic samples, tolerance 1e-6; chaotic: none ≤ "
+        "64 and λ₁ > 10⁻³ per unit τ) is what the paper shows",
+        source=c.source,
+        ours_text=d.short(),
+        note=note + f" In full: {d.describe()}.",
+        headline=HEAD_ALPHA if c.theta_hat_deg == 10.0 else f"{item}: not {c.paper}",
+        erratum=c.theta_hat_deg == 10.0,
+    )
 
 
 def _notes(

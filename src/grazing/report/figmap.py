@@ -22,7 +22,9 @@ import grazing
 from grazing.orbits import find_orbit, grazing_curve
 from grazing.plotting import plot_period_map
 from grazing.report import diagrams
-from grazing.report.base import Comparison, FigureResult, Image, Progress, save_png
+from grazing.report.base import Comparison, DataFile, FigureResult, Image, Progress, save_png
+from grazing.report.data import write_dataset
+from grazing.report.rules import criterion_row
 from grazing.sweeps import parameter_map
 
 FIGURE_ID = "map"
@@ -86,9 +88,17 @@ def compute(s: Settings, progress: Progress | None = None) -> MapRun:
             say(f"map: {done}/{total} points after {time.perf_counter() - start:.1f} s")
 
     ds = parameter_map(
-        grazing.models.pendulum("B"), "eta", etas, "theta_hat", ths, transient=s.transient, periods=s.periods,
-        lyapunov=False, workers=s.workers, progress=tick,
-    )  # fmt: skip
+        grazing.models.pendulum("B"),
+        "eta",
+        etas,
+        "theta_hat",
+        ths,
+        transient=s.transient,
+        periods=s.periods,
+        lyapunov=False,
+        workers=s.workers,
+        progress=tick,
+    )
     child_cpu = _children_cpu()
     angles = max_angles(etas)
     curve = grazing_curve(grazing.models.pendulum("B"), start=math.radians(5.0))
@@ -115,25 +125,49 @@ def draw(run: MapRun, path: Path) -> None:
     ax = fig.subplots()
     plot_period_map(ax, run.ds, max_period=8)
     curve = run.curve
-    ax.plot(curve.values("eta"), np.degrees(curve.values("theta_hat")), color="tab:red", lw=1.6,
-            label="grazing curve (fig 6)")  # fmt: skip
+    ax.plot(
+        curve.values("eta"),
+        np.degrees(curve.values("theta_hat")),
+        color="tab:red",
+        lw=1.6,
+        label="grazing curve (fig 6)",
+    )
     if curve.fold is not None:
         fe, ft = curve.fold.model.params["eta"], math.degrees(curve.fold.model.params["theta_hat"])
         ax.plot(fe, ft, "*", ms=11, color="tab:red", mec="k", mew=0.5, label=f"θ̂_max = {ft:.2f}°")
     for th in (10, 20, 30, 40):
         ax.axhline(th, color="0.25", lw=0.7, ls=":")
-        ax.text(0.99, th, f"fig 7: {th}° ", transform=ax.get_yaxis_transform(), ha="right", va="bottom",
-                fontsize=7, color="0.25")  # fmt: skip
+        ax.text(
+            0.99,
+            th,
+            f"fig 7: {th}° ",
+            transform=ax.get_yaxis_transform(),
+            ha="right",
+            va="bottom",
+            fontsize=9,
+            color="0.25",
+        )
     ax.axvline(0.447, color="0.25", lw=0.7, ls=":")
-    ax.text(0.449, 0.99, "fig 8: η = 0.447", transform=ax.get_xaxis_transform(), color="0.25", fontsize=7,
-            va="top")  # fmt: skip
+    ax.text(
+        0.449,
+        0.99,
+        "fig 8: η = 0.447",
+        transform=ax.get_xaxis_transform(),
+        color="0.25",
+        fontsize=9,
+        va="top",
+    )
     eta = run.ds["eta"].values
     th = np.degrees(run.ds["theta_hat"].values)
     ax.set_xlim(eta[0] - 0.5 * (eta[1] - eta[0]), eta[-1] + 0.5 * (eta[1] - eta[0]))
     ax.set_ylim(th[0] - 0.5 * (th[1] - th[0]), th[-1] + 0.5 * (th[1] - th[0]))
     ax.legend(loc="upper right", fontsize=8.5, framealpha=0.9)
-    ax.set_title("Case B: detected period in the (η, θ̂) plane; dotted: the stop angles of fig 7 and the η of "
-                 "fig 8", loc="left", fontsize=10)  # fmt: skip
+    ax.set_title(
+        "Case B (r = 0.7675, β = 0.048, α = 0.2254): detected period in the (η, θ̂) plane; dotted: "
+        "the stop angles of fig 7 and the η of fig 8",
+        loc="left",
+        fontsize=10,
+    )
     save_png(fig, path)
 
 
@@ -172,6 +206,24 @@ def build(out_dir: Path, progress: Progress | None = None, settings: Settings | 
         comparisons=comparisons(run),
         notes=notes(run, s),
         seconds=time.perf_counter() - start,
+        data=(write_data(run, out_dir),),
+    )
+
+
+def write_data(run: MapRun, out_dir: Path) -> DataFile:
+    """The map's periods and impacts (the samples left out) as NetCDF."""
+    ds = run.ds[["period", "impacts_per_period"]].copy()
+    ds["max_angle"] = (
+        "eta",
+        run.max_angle,
+        {"units": "rad", "long_name": "largest angle of the nonimpacting period-1 orbit"},
+    )
+    ds.attrs = {k: v for k, v in run.ds.attrs.items() if isinstance(v, (str, int, float))}
+    path = write_dataset(out_dir / "map_eta_theta_hat.nc", ds)
+    return DataFile(
+        path.name,
+        "the detected period and impacts per period at every (θ̂, η) point, and the "
+        "nonimpacting orbit's largest angle at every η, NetCDF",
     )
 
 
@@ -207,58 +259,49 @@ def classify(run: MapRun, margin_deg: float = 0.2) -> dict[str, Any]:
 
 def comparisons(run: MapRun) -> tuple[Comparison, ...]:
     c = classify(run)
-    rows = [
-        Comparison(
-            "map: impacting motion above θ̂_max",
-            "“there is an upper bound θ̂_max beyond which grazing cannot occur for any value of η (about 55° "
-            "for case B)”",
-            "§6.1",
-            f"{c['over_max_impact']} of the {c['over_max']} map points above θ̂_max = "
-            f"{math.degrees(c['th_max']):.2f}° impact"
-            + (
-                f" (θ̂ ≤ {math.degrees(c['over_max_top']):.2f}°, η {c['over_max_eta'].min():.3f}–"
-                f"{c['over_max_eta'].max():.3f})"
-                if c["over_max_impact"]
-                else ""
-            ),
-            None,
-            "Grazing of the nonimpacting orbit cannot occur above θ̂_max (fig 6). Impacting motion can still "
-            "exist just above it, on an impacting period-1 orbit that coexists with the nonimpacting one: a "
-            "sweep's transient after an η step can land on it."
-            if c["over_max_impact"]
-            else "No impacting attractor was met above θ̂_max.",
-        ),
-        Comparison(
-            "map: below the grazing curve",
-            "(a consistency check, not in the paper)",
-            "—",
-            f"{c['below_no_impact']} of the {c['below']} points more than 0.2° below the curve show no "
-            "impacts",
+    return (
+        criterion_row(
+            FIGURE_ID,
+            "points more than 0.2° below the grazing curve without impacts",
+            0,
+            c["below_no_impact"],
             None if c["below"] == 0 else c["below_no_impact"] == 0,
-            "Below the curve the nonimpacting orbit passes through the stop, so the motion must impact.",
+            kind="self-check",
+            rule="below the curve the nonimpacting orbit passes through the stop, so the motion must impact: "
+            "agree when no map point more than 0.2° below the curve is nonimpacting",
+            source="fig 6 (the grazing curve)",
+            paper_text="0 (must impact)",
+            ours_text=f"{c['below_no_impact']} of {c['below']}",
+            headline="Map points below the grazing curve without impacts",
         ),
-    ]
-    eta_co = c["above_impact_eta"]
-    rows.append(
-        Comparison(
-            "map: above the grazing curve",
-            "(not in the paper)",
-            "—",
-            f"{c['above_impact']} of the {c['above']} points more than 0.2° above the curve impact"
-            + (f", at η from {eta_co.min():.3f} to {eta_co.max():.3f}" if eta_co.size else ""),
-            None,
-            "Coexistence: beyond the falling branch of the curve the impacting period-1 orbit reached by the "
-            "upward sweep persists up to its fold (as in fig 7), although the nonimpacting orbit is stable "
-            "there too.",
-        )
     )
-    return tuple(rows)
 
 
 def notes(run: MapRun, s: Settings) -> tuple[str, ...]:
     c = classify(run)
     periods = ", ".join(map(str, c["periods"]))
+    eta_co = c["above_impact_eta"]
+    over = (
+        f"{c['over_max_impact']} of the {c['over_max']} map points above θ̂_max = "
+        f"{math.degrees(c['th_max']):.2f}° impact"
+        + (
+            f" (θ̂ ≤ {math.degrees(c['over_max_top']):.2f}°, η {c['over_max_eta'].min():.3f}–"
+            f"{c['over_max_eta'].max():.3f})"
+            if c["over_max_impact"]
+            else ""
+        )
+        + ": grazing of the nonimpacting orbit cannot occur above θ̂_max (fig 6), but an impacting period-1 "
+        "orbit coexisting with the nonimpacting one can be reached by a sweep's transient after an η step."
+    )
+    above = (
+        f"{c['above_impact']} of the {c['above']} points more than 0.2° above the curve impact"
+        + (f", at η from {eta_co.min():.3f} to {eta_co.max():.3f}" if eta_co.size else "")
+        + ": beyond the falling branch of the curve the impacting period-1 orbit reached by the upward sweep "
+        "persists up to its fold (as in fig 7), although the nonimpacting orbit is stable there too."
+    )
     return (
+        over,
+        above,
         f"Of the {c['impacting']} impacting points, {c['aperiodic']} are aperiodic (no period ≤ "
         f"{s.periods // 2}); the "
         f"periods found are {periods}. Colours above 8 are lumped together."
