@@ -85,7 +85,10 @@ def model(**params: float) -> grazing.HybridModel:
 
 
 def run_curve() -> GrazingCurve:
-    return grazing_curve(model(), start=math.radians(START_DEG), settings=PalcSettings(ds=DS, ds_max=DS_MAX))
+    return grazing_curve(
+        model(), ("eta", "theta_hat"), math.radians(START_DEG), search=SEARCH,
+        settings=PalcSettings(ds=DS, ds_max=DS_MAX),
+    )  # fmt: skip
 
 
 def grazing_exe() -> str:
@@ -359,7 +362,7 @@ def markdown(res: dict[str, Any]) -> str:
     notes = [
         "",
         f"- Problem: impacting pendulum, case {CASE} (α = {ALPHA}, β = {BETA}, r = {R}); "
-        f"`grazing_curve(model, start=radians({START_DEG:g}), "
+        f"`grazing_curve(model, ('eta', 'theta_hat'), radians({START_DEG:g}), search={SEARCH}, "
         f"settings=PalcSettings(ds={DS}, ds_max={DS_MAX}))`, "
         f"Floquet multipliers at every point; η in {SEARCH}.",
         f"- Target (issue 3, not asserted): {target_line(res)}.",

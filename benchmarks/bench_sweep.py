@@ -1,4 +1,4 @@
-"""Benchmark a brute-force bifurcation diagram (``grazing.sweeps.brute_force``) against user-written loops.
+"""Benchmark a brute-force bifurcation diagram (``grazing.sweeps.sweep``) against user-written loops.
 
 Problem (issue 4's speed targets): the impacting pendulum of Piiroinen, Virgin & Champneys
 (2004), case B (alpha = 0.2254, beta = 0.048, r = 0.7675), theta_hat = 40 deg, 1000 values of

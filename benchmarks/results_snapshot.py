@@ -63,7 +63,10 @@ def main() -> None:
     show("continue period 5", br.values, br.states, [sp.param for sp in br.special])
     pts, _ = find_grazings(pendulum("B", theta_hat=math.radians(40)), "eta", 0.4, 0.6)
     show("grazings 40 deg", [p.model.params["eta"] for p in pts], [p.monodromy for p in pts])
-    curve = grazing_curve(pendulum("B"), settings=PalcSettings(ds=0.02, ds_max=0.05, max_points=20))
+    curve = grazing_curve(
+        pendulum("B"), ("eta", "theta_hat"), math.radians(5.0), search=(0.2, 1.0),
+        settings=PalcSettings(ds=0.02, ds_max=0.05, max_points=20),
+    )  # fmt: skip
     show("grazing curve (20 points)", curve.values("eta"), curve.values("theta_hat"))
     pts, _ = find_grazings(io, "omega", 2.5, 4.0)
     show("grazing oscillator omega", [p.model.params["omega"] for p in pts])
@@ -75,9 +78,9 @@ def main() -> None:
     ds = sweep(io, "omega", np.linspace(3.3, 3.6, 20), periods=20, transient=150, phase=1.3, workers=1)
     show("sweep oscillator omega", ds.samples.values, ds.impacts.values)
     point = find_grazing_point(pendulum("B", theta_hat=math.radians(40)), "eta", 0.2, 1.0, "first")
-    nf = normal_form_at(point)
+    nf = normal_form_at(point, ("eta", "theta_hat"))
     show("normal form 40 deg", nf.monodromy, nf.direction, [nf.kappa], nf.unfolding["eta"][0])
-    print(f"{'prediction 40 deg':48s} {predict(nf).scenario}")
+    print(f"{'prediction 40 deg':48s} {predict(nf, 'eta').scenario}")
     ds = sweep(point.model, "eta", np.linspace(0.4452, 0.4462, 30), periods=40, transient=300,
                zdm=nf.discontinuity_map(), workers=1)  # fmt: skip
     show("sweep map method", ds.samples.values, ds.period.values)

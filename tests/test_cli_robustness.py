@@ -263,7 +263,7 @@ WORK = [
     ("grazing.orbits", "grazing_curve"),
     ("grazing.orbits", "continue_orbit"),
     ("grazing.normalform", "find_grazing_point"),
-    ("grazing.sweeps.brute_force", "run_sweep"),
+    ("grazing.sweeps.api", "run_sweep"),
     ("distributed", "Client"),
     ("grazing.experiment.damping", "free_decay"),
     ("grazing.experiment.damping", "recorded_damping"),

@@ -38,7 +38,10 @@ from grazing.cli_validate import (
 )
 from grazing.errors import GrazingError
 from grazing.limits import MEMORY_ENV, POINT_OVERHEAD, check_memory, count_text, simulate_bytes, sweep_bytes
-from grazing.models.pendulum import CASES, DEFAULT_CASE, case_values
+from grazing.models.pendulum import CASES, DEFAULT_CASE, case_values, max_angle
+
+PENDULUM_UNFOLDING = ("eta", "theta_hat")
+"""The parameters of the pendulum's normal-form unfolding vectors (the JSON reports both)."""
 
 EXIT_USAGE = 2
 EXIT_FAILURE = 1
@@ -373,7 +376,7 @@ def _orbit_json(orbit: Any) -> dict[str, Any]:
         "min_impact_speed": None if math.isnan(orbit.min_impact_speed) else orbit.min_impact_speed,
     }
     if "theta_hat" in orbit.model.params:
-        out["max_theta_deg"] = math.degrees(orbit.max_angle())
+        out["max_theta_deg"] = math.degrees(max_angle(orbit))
     return out
 
 
@@ -619,7 +622,7 @@ def continue_(
         "status": branch.status,
         "out": str(out) if out else None,
     }
-    res["max_theta_deg"] = [math.degrees(o.max_angle()) for o in branch.orbits]
+    res["max_theta_deg"] = [math.degrees(max_angle(o)) for o in branch.orbits]
     if as_json:
         _emit_json(res)
         return
@@ -723,7 +726,7 @@ def _run_sweep_spec(
     With a Zarr store and no ``--json``, the results stream to the store and
     only the detected periods are read back (for the summary).
     """
-    from grazing.sweeps.brute_force import run_sweep
+    from grazing.sweeps.api import run_sweep
 
     zarr_out = out is not None and out.suffix.lower() == ".zarr"
     streamed = zarr_out and not as_json
@@ -806,7 +809,7 @@ def sweep_cmd(
 ) -> None:  # fmt: skip
     """Brute-force bifurcation diagram: stroboscopic samples, periods, impacts and
     Lyapunov exponents along a parameter range."""
-    from grazing.sweeps.brute_force import SweepSpec
+    from grazing.sweeps.spec import SweepSpec
 
     name = _SWEEP_PARAMS[sparam]
     refuse_unused([name], True, f"with --param {sparam}: the swept values replace it")
@@ -863,7 +866,7 @@ def _map_for_sweep(model: Any, name: str, lo: float, hi: float, which: str) -> t
 
     a, b = _GRAZE_SEARCH.get(name, (lo - 0.5 * (hi - lo), hi + 0.5 * (hi - lo)))
     point = find_grazing_point(model, name, min(a, lo), max(b, hi), which)
-    nf = normal_form_at(point)
+    nf = normal_form_at(point, PENDULUM_UNFOLDING)
     back = math.degrees if name == "theta_hat" else float
     info = {
         "param": name,
@@ -902,8 +905,8 @@ def normal_form_cmd(
     refuse_unused(["eta"], True, "by normal-form: it searches eta in [--eta-min, --eta-max]")
     _check_eta_range(eta_min, eta_max)
     point = find_grazing_point(model, "eta", eta_min, eta_max, which)
-    nf = normal_form_at(point)
-    pred = predict(nf)
+    nf = normal_form_at(point, PENDULUM_UNFOLDING)
+    pred = predict(nf, "eta")
     b_eta, _, _ = nf.unfolding["eta"]
     res: dict[str, Any] = {
         "params": model_params_json(point.model, case),
@@ -926,7 +929,7 @@ def normal_form_cmd(
         },
     }
     if check:
-        obs = observe(nf)
+        obs = observe(nf, "eta")
         res["observed"] = {"scenario": obs.scenario, "offsets": obs.offsets, "periods": obs.periods}
         res["agrees"] = obs.scenario == pred.scenario
     if as_json:
@@ -961,7 +964,7 @@ def map_cmd(
     out: Path | None, wait: bool, as_json: bool,
 ) -> None:  # fmt: skip
     """Two-parameter map of periods, impacts and Lyapunov exponents."""
-    from grazing.sweeps.brute_force import SweepSpec
+    from grazing.sweeps.spec import SweepSpec
 
     if param1 == param2:
         raise _ErrorInput("--param1 and --param2 must differ")

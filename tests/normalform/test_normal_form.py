@@ -21,13 +21,15 @@ from grazing.normalform.prediction import (
 )
 from grazing.orbits import grazing_curve
 
+UNFOLD = ("eta", "theta_hat")
+
 DEG = math.pi / 180
 
 
 @pytest.fixture(scope="module")
 def nf40():
     """Normal form at the first grazing of case B at theta_hat = 40 deg (eta = 0.44512)."""
-    return normal_form_at(find_grazing_point(pendulum("B", theta_hat=40 * DEG), "eta", 0.4, 0.47))
+    return normal_form_at(find_grazing_point(pendulum("B", theta_hat=40 * DEG), "eta", 0.4, 0.47), UNFOLD)
 
 
 def _shifted(nf, frac):
@@ -175,7 +177,7 @@ def test_prediction_at_40_degrees_is_the_papers_period_adding(nf40):
 
 def test_predictions_agree_with_simulation_along_the_grazing_curve():
     """Every non-resonant prediction matches direct simulation just past grazing."""
-    curve = grazing_curve(pendulum("B"), start=15 * DEG)
+    curve = grazing_curve(pendulum("B"), ("eta", "theta_hat"), 15 * DEG, search=(0.2, 1.0))
     thetas = np.degrees(curve.values("theta_hat"))
     chosen = []
     for target in (15, 25, 35, 45, 52):
@@ -185,7 +187,7 @@ def test_predictions_agree_with_simulation_along_the_grazing_curve():
                 chosen.append(idx[np.argmin(np.abs(thetas[idx] - target))])
     checked = 0
     for i in chosen:
-        nf = normal_form_at(curve.points[i])
+        nf = normal_form_at(curve.points[i], UNFOLD)
         pred = predict(nf)
         if pred.scenario == RESONANT:
             continue

@@ -157,7 +157,7 @@ def test_branch_to_netcdf(tmp_path):
     assert list(ds.special_kind.values) == ["grazing"]
     assert float(ds.special_param[0]) == pytest.approx(0.44512, abs=1e-4)
     assert ds.attrs["continuation_parameter"] == "eta"
-    assert "max_theta" in ds
+    assert "closest_state" in ds
 
 
 # --------------------------------------------------------------------------
@@ -165,7 +165,7 @@ def test_branch_to_netcdf(tmp_path):
 
 
 def test_grazing_curve_fold_and_agreement_with_response_curve():
-    curve = grazing_curve(pendulum("B"), start=5 * DEG)
+    curve = grazing_curve(pendulum("B"), ("eta", "theta_hat"), 5 * DEG, search=(0.2, 1.0))
     assert curve.fold is not None
     theta_max = math.degrees(curve.fold.model.params["theta_hat"])
     assert 54.0 < theta_max < 57.0  # the paper: "about 55 degrees for case B"

@@ -18,10 +18,11 @@ import pytest
 
 from grazing.cli import main
 from grazing.models import pendulum
-from grazing.sweeps import brute_force
-from grazing.sweeps.brute_force import SweepSpec, run_sweep
+from grazing.sweeps import api, executor
+from grazing.sweeps.api import run_sweep
 from grazing.sweeps.lock import StoreBusyError
 from grazing.sweeps.ownership import MARKER_GROUP, ForeignStoreError, remove_stale_builds
+from grazing.sweeps.spec import SweepSpec
 from grazing.sweeps.store import ZarrStore
 from tests.processes import alive, all_gone, descendants, wait_until
 
@@ -280,7 +281,7 @@ def test_wait_waits_for_the_other_run_and_without_it_the_pid_is_named(tmp_path, 
         captured["spec"] = spec
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(brute_force, "run_sweep", capture)
+    monkeypatch.setattr(api, "run_sweep", capture)
     assert main(argv) == 130  # creates the store, computes nothing
     monkeypatch.undo()
     capsys.readouterr()
@@ -428,7 +429,7 @@ def _fast_or_stuck(i: int) -> int:
 
 def test_stopping_a_pool_cancels_queued_chunks_and_kills_those_in_flight(tmp_path, monkeypatch):
     monkeypatch.setenv("GRAZING_TEST_MARKS", str(tmp_path))
-    results = brute_force._local_results(_spec(), list(range(6)), 2, run=_fast_or_stuck)
+    results = executor._local_results(_spec(), list(range(6)), 2, run=_fast_or_stuck)
     assert next(results) == 0
     assert wait_until(lambda: len(list(tmp_path.glob("started-*"))) == 2)  # both workers busy
     workers = [int(p.read_text()) for p in tmp_path.glob("started-*")]
@@ -445,7 +446,7 @@ def test_a_cluster_without_workers_says_so_and_times_out(tmp_path, monkeypatch, 
     from distributed import LocalCluster
 
     monkeypatch.chdir(tmp_path)
-    monkeypatch.setattr(brute_force, "DASK_NOTICE_AFTER", 0.0)
+    monkeypatch.setattr(executor, "DASK_NOTICE_AFTER", 0.0)
     with LocalCluster(n_workers=0, processes=False, dashboard_address=None) as cluster:
         addr = cluster.scheduler_address
         code = main([*SWEEP[:-2], "--scheduler", addr, "--timeout", "1", "--out", "s.nc"])

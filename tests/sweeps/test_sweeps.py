@@ -19,7 +19,8 @@ from grazing.cli import main
 from grazing.models import pendulum
 from grazing.orbits import find_orbit
 from grazing.sweeps import parameter_map, sweep
-from grazing.sweeps.brute_force import SweepSpec, run_chunk
+from grazing.sweeps.run import run_chunk
+from grazing.sweeps.spec import SweepSpec
 from grazing.sweeps.store import StoreMismatchError, ZarrStore
 
 DEG = math.pi / 180
@@ -85,7 +86,7 @@ def test_chaotic_points_have_positive_exponents_and_no_period():
     ("fresh", "lo", "hi"),
     [
         (True, 0.44, 0.49),  # fresh: every point starts from x0; chaos and windows alike
-        (False, 0.465, 0.49),  # continuation without chaos (see the note in sweeps.brute_force)
+        (False, 0.465, 0.49),  # continuation without chaos (see the note in sweeps.run)
     ],
 )
 def test_adaptive_transient_gives_the_same_periods(fresh, lo, hi):

@@ -101,7 +101,7 @@ class Solution:
         Lyapunov exponents per unit time over the sampled span, if requested.
     guard_min
         ``(h_min, t, x)``: the smallest value of the guard over the sampled
-        span, if requested (``theta_hat - max theta`` for the pendulum).
+        span, if requested (for a stop at ``x = c``, ``c - max x``).
     approach_min
         ``(h, t, x)``: the closest approach to the stop in free flight (the
         smallest local minimum of the guard, away from impacts and sticking),

@@ -277,8 +277,9 @@ def precompile(jobs: Sequence[tuple[HybridModel, tuple[str, ...]]], workers: int
     disk, so afterwards every process loads it instead of compiling.  Useful
     before a long computation on a machine that has not compiled them yet.
     """
-    import multiprocessing as mp
     import os
+
+    from grazing.parallel import map_unordered
 
     seen: set[tuple[int, int]] = set()
     todo = []
@@ -287,13 +288,6 @@ def precompile(jobs: Sequence[tuple[HybridModel, tuple[str, ...]]], workers: int
         if key not in seen:
             seen.add(key)
             todo.append((model, sens))
-    workers = min(workers or os.cpu_count() or 1, len(todo))
-    if workers <= 1:
-        for job in todo:
-            _compile_one(job)
-        return
-    from grazing.workers import init_worker
-
-    ctx = mp.get_context("spawn")  # a fresh interpreter per worker: no half-initialised numba state
-    with ctx.Pool(workers, initializer=init_worker, initargs=(os.getpid(),)) as pool:  # die with us
-        pool.map(_compile_one, todo)
+    # A fresh interpreter per worker (spawn): no half-initialised numba state is inherited.
+    for _ in map_unordered(_compile_one, todo, workers or os.cpu_count() or 1, start_method="spawn"):
+        pass

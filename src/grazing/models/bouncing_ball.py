@@ -42,10 +42,12 @@ def _symbolic() -> dict:
 @lru_cache(maxsize=1)
 def _base() -> HybridModel:
     params = [
-        Parameter("amplitude", 0.1, lower=0.0, description="table amplitude"),
-        Parameter("omega", 1.0, lower=0.0, lower_open=True, description="table frequency"),
-        Parameter("gravity", 1.0, lower=0.0, lower_open=True, description="gravitational acceleration"),
-        Parameter("r", 0.5, lower=0.0, upper=1.0, description="coefficient of restitution"),
+        Parameter("amplitude", 0.1, lower=0.0, description="table amplitude", symbol="A"),
+        Parameter("omega", 1.0, lower=0.0, lower_open=True, description="table frequency", symbol="ω"),
+        Parameter(
+            "gravity", 1.0, lower=0.0, lower_open=True, description="gravitational acceleration", symbol="g"
+        ),
+        Parameter("r", 0.5, lower=0.0, upper=1.0, description="coefficient of restitution", symbol="r"),
     ]
     return HybridModel.lazy(
         "bouncing-ball",

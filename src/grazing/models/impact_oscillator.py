@@ -36,10 +36,10 @@ def _symbolic() -> dict:
 @lru_cache(maxsize=1)
 def _base() -> HybridModel:
     params = [
-        Parameter("zeta", 0.05, lower=0.0, description="damping ratio"),
-        Parameter("omega", 2.8, lower=0.0, lower_open=True, description="forcing frequency"),
-        Parameter("sigma", 0.1, description="stop position"),
-        Parameter("r", 0.8, lower=0.0, upper=1.0, description="coefficient of restitution"),
+        Parameter("zeta", 0.05, lower=0.0, description="damping ratio", symbol="ζ"),
+        Parameter("omega", 2.8, lower=0.0, lower_open=True, description="forcing frequency", symbol="ω"),
+        Parameter("sigma", 0.1, description="stop position", symbol="σ"),
+        Parameter("r", 0.8, lower=0.0, upper=1.0, description="coefficient of restitution", symbol="r"),
     ]
     return HybridModel.lazy(
         "impact-oscillator",

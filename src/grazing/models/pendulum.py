@@ -34,6 +34,7 @@ from __future__ import annotations
 import math
 from functools import lru_cache
 from types import MappingProxyType
+from typing import Any
 
 from grazing.core.model import HybridModel, Parameter
 from grazing.errors import InvalidParameterError
@@ -90,10 +91,12 @@ def _symbolic() -> dict:
 @lru_cache(maxsize=1)
 def _base() -> HybridModel:
     params = [
-        Parameter("alpha", ALPHA, lower=0.0, description="forcing amplitude A/L"),
-        Parameter("beta", 0.048, lower=0.0, description="linear damping"),
-        Parameter("eta", 0.446, lower=0.0, lower_open=True, description="forcing frequency ratio"),
-        Parameter("r", 0.7675, lower=0.0, upper=1.0, description="coefficient of restitution"),
+        Parameter("alpha", ALPHA, lower=0.0, description="forcing amplitude A/L", symbol="α"),
+        Parameter("beta", 0.048, lower=0.0, description="linear damping", symbol="β"),
+        Parameter(
+            "eta", 0.446, lower=0.0, lower_open=True, description="forcing frequency ratio", symbol="η"
+        ),
+        Parameter("r", 0.7675, lower=0.0, upper=1.0, description="coefficient of restitution", symbol="r"),
         Parameter(
             "theta_hat",
             math.radians(40.0),
@@ -102,6 +105,9 @@ def _base() -> HybridModel:
             lower_open=True,
             upper_open=True,
             description="stop angle in radians",
+            unit="rad",
+            symbol="θ̂",
+            angle=True,
         ),
     ]
     return HybridModel.lazy(
@@ -137,3 +143,13 @@ def pendulum(case: str | None = DEFAULT_CASE, **values: float) -> HybridModel:
     vals = case_values(case) if case is not None else {}
     vals.update(values)
     return _base().with_params(**vals)
+
+
+def max_angle(orbit: Any) -> float:
+    """The largest angle of a pendulum orbit (a :class:`~grazing.orbits.PeriodicOrbit`), in radians.
+
+    The guard ``theta_hat - theta`` is smallest where ``theta`` is largest, so
+    this is the stop angle minus the orbit's smallest guard value (the stop
+    angle itself for an impacting orbit).
+    """
+    return float(orbit.model.params["theta_hat"] - orbit.guard_min)

@@ -149,15 +149,15 @@ class GrazingNormalForm:
         return step
 
 
-def normal_form_at(point: GrazingPoint, params: tuple[str, ...] = ("eta", "theta_hat")) -> GrazingNormalForm:
-    """Build the normal form of a grazing point (computes the unfolding vectors).
+def normal_form_at(point: GrazingPoint, params: tuple[str, ...]) -> GrazingNormalForm:
+    """Build the normal form of a grazing point, with unfolding vectors for the parameters ``params``.
 
     Examples
     --------
     >>> import math, grazing
     >>> from grazing.orbits import find_grazings
     >>> g, _ = find_grazings(grazing.models.pendulum("B", theta_hat=math.radians(40)), "eta", 0.4, 0.47)
-    >>> nf = normal_form_at(g[0])
+    >>> nf = normal_form_at(g[0], ("eta", "theta_hat"))
     >>> [float(round(v, 4)) + 0.0 for v in nf.direction], round(nf.kappa, 3)
     ([0.0, 1.7675], 0.28)
     """

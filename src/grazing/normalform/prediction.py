@@ -162,9 +162,11 @@ def classify_iterates(mus: np.ndarray, periods: np.ndarray, sizes: np.ndarray, i
     return ROBUST_CHAOS if chaotic else RESONANT
 
 
-def predict(nf: GrazingNormalForm, param: str = "eta", mu_range: tuple[float, float] = MU_RANGE,
+def predict(nf: GrazingNormalForm, param: str | None = None, mu_range: tuple[float, float] = MU_RANGE,
             points: int = 60) -> Prediction:  # fmt: skip
     """Predict the scenario past this grazing point when ``param`` is varied.
+
+    ``param`` is one of the normal form's unfolding parameters (default: the first).
 
     Examples
     --------
@@ -172,12 +174,13 @@ def predict(nf: GrazingNormalForm, param: str = "eta", mu_range: tuple[float, fl
     >>> from grazing.orbits import find_grazings
     >>> from grazing.normalform import normal_form_at
     >>> g, _ = find_grazings(grazing.models.pendulum("B", theta_hat=math.radians(40)), "eta", 0.4, 0.47)
-    >>> predict(normal_form_at(g[0])).scenario
+    >>> predict(normal_form_at(g[0], ("eta",))).scenario
     'period-adding cascade with chaotic bands'
     """
     mu_mult = nf.multipliers
     lam = float(np.max(np.abs(mu_mult)))
     kappa = nf.kappa
+    param = param if param is not None else next(iter(nf.unfolding))
     side = impacting_side(nf, param)
     if abs(kappa) < RESONANCE_TOL * float(np.max(np.abs(nf.monodromy))):
         return Prediction(RESONANT, "resonance", lam, kappa, side)
@@ -248,9 +251,11 @@ class Observation:
     impacting: list[bool]
 
 
-def observe(nf: GrazingNormalForm, param: str = "eta", mu_range: tuple[float, float] = MU_RANGE,
+def observe(nf: GrazingNormalForm, param: str | None = None, mu_range: tuple[float, float] = MU_RANGE,
             points: int = 24, transient: int = 1500, periods: int = 200) -> Observation:  # fmt: skip
     """Simulate the real system at ``param* + side * mu`` and classify like :func:`predict`.
+
+    ``param`` is one of the normal form's unfolding parameters (default: the first).
 
     Every run starts from the grazing orbit (on the section through the
     contact), so that the attractor reached is the one born at grazing; the
@@ -258,6 +263,7 @@ def observe(nf: GrazingNormalForm, param: str = "eta", mu_range: tuple[float, fl
     """
     from grazing.engine.simulate import simulate
 
+    param = param if param is not None else next(iter(nf.unfolding))
     side = impacting_side(nf, param)
     mus = np.geomspace(*mu_range, points)
     p0 = nf.model.params[param]

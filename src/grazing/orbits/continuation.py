@@ -205,9 +205,10 @@ class Branch:
                 np.array([np.abs(s.multipliers) for s in self.special]).reshape(-1, len(names)),
             ),
         }
-        if "theta_hat" in self.model.params:
-            theta_hat = np.array([o.model.params["theta_hat"] for o in self.orbits])
-            data["max_theta"] = ("point", theta_hat - self.guard_min)
+        # Where each orbit comes closest to the stop (its largest angle, for the pendulum).
+        nan = np.full(len(names), np.nan)
+        closest = [o.x_guard_min if o.x_guard_min is not None else nan for o in self.orbits]
+        data["closest_state"] = (("point", "component"), np.array(closest).reshape(-1, len(names)))
         ds = xr.Dataset(data, coords={"component": names, "multiplier": np.arange(len(names))})
         ds.param.attrs["long_name"] = self.param
         attrs: dict[str, Any] = {

@@ -35,9 +35,9 @@ from grazing.orbits.palc import Palc, PalcPoint, PalcSettings, locate, sign_chan
 
 def find_grazings(
     model: HybridModel,
-    param: str = "eta",
-    start: float = 0.2,
-    stop: float = 1.0,
+    param: str,
+    start: float,
+    stop: float,
     *,
     period: int = 1,
     settings: PalcSettings | None = None,
@@ -91,7 +91,8 @@ class GrazingCurve:
     Attributes
     ----------
     params
-        The two parameter names, e.g. ``("eta", "theta_hat")``.
+        The two parameter names (the first varies along the search interval,
+        the second is the one whose largest value on the curve is the fold).
     points
         Grazing orbits along the curve.
     fold
@@ -138,10 +139,10 @@ class GrazingCurve:
 
 def grazing_curve(
     model: HybridModel,
-    params: tuple[str, str] = ("eta", "theta_hat"),
-    start: float = math.radians(5.0),
+    params: tuple[str, str],
+    start: float,
     *,
-    search: tuple[float, float] = (0.2, 1.0),
+    search: tuple[float, float],
     period: int = 1,
     settings: PalcSettings | None = None,
     progress: Callable[[int, float], None] | None = None,
@@ -156,7 +157,8 @@ def grazing_curve(
     Examples
     --------
     >>> import grazing
-    >>> curve = grazing_curve(grazing.models.pendulum("B"))
+    >>> curve = grazing_curve(grazing.models.pendulum("B"), ("eta", "theta_hat"), math.radians(5),
+    ...                       search=(0.2, 1.0))
     >>> round(math.degrees(curve.fold.model.params["theta_hat"]), 1)
     55.9
     """

@@ -106,8 +106,8 @@ class PeriodicOrbit:
         Floquet multipliers (eigenvalues of the monodromy), largest modulus first.
     guard_min, t_guard_min, x_guard_min
         Smallest value of the guard along the orbit, when it occurs and the
-        state there (``theta_hat - max theta`` for the pendulum; negative for a
-        virtual orbit that passes through the stop).
+        state there (negative for a virtual orbit that passes through the stop;
+        zero at an impact).
     min_impact_speed
         Smallest impact speed along the orbit (``nan`` without impacts).
     virtual
@@ -173,12 +173,6 @@ class PeriodicOrbit:
     @property
     def residual(self) -> float:
         return self.residuals[-1] if self.residuals else math.nan
-
-    def max_angle(self) -> float:
-        """Largest angle along the orbit, for models with a ``theta_hat`` stop angle."""
-        if "theta_hat" not in self.model.params:
-            raise AttributeError("max_angle is defined for models with a theta_hat parameter")
-        return self.model.params["theta_hat"] - self.guard_min
 
 
 def sorted_multipliers(mono: np.ndarray) -> np.ndarray:

@@ -117,12 +117,12 @@ def _compile_job(job: tuple[str, Any]) -> None:
 def _precompile(workers: int | None = None) -> None:
     """Compile (or load) every kernel module the figures use, in parallel processes (seconds when cached).
 
-    The sweeps integrate at :data:`grazing.sweeps.brute_force.DEFAULT_SWEEP_TOL`, whose Taylor order
+    The sweeps integrate at :data:`grazing.core.options.SWEEP_TOL`, whose Taylor order
     differs from the default one: its kernels are a module of their own.
     """
     import multiprocessing as mp
 
-    from grazing.sweeps.brute_force import DEFAULT_SWEEP_TOL
+    from grazing.core.options import SWEEP_TOL as DEFAULT_SWEEP_TOL
 
     jobs = [
         ("flow", DEFAULT_SWEEP_TOL),

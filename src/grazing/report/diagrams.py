@@ -34,6 +34,7 @@ import numpy as np
 import grazing
 from grazing.errors import GrazingError
 from grazing.orbits import continue_orbit, find_grazings, find_orbit
+from grazing.parallel import map_unordered
 from grazing.plotting import label_windows, mark_grazings, plot_bifurcation, visible_windows
 from grazing.report.base import save_png
 from grazing.report.data import slim_sweep, write_csv, write_groups
@@ -324,7 +325,9 @@ def run_panel(
     if method == "map":
         from grazing.normalform import find_grazing_point, normal_form_at
 
-        zdm = normal_form_at(find_grazing_point(model, "eta", 0.2, 1.0)).discontinuity_map()
+        zdm = normal_form_at(
+            find_grazing_point(model, "eta", 0.2, 1.0), ("eta", "theta_hat")
+        ).discontinuity_map()
     ds = sweep(
         model,
         "eta",
@@ -369,29 +372,14 @@ def run_parallel(
     """``[fn(job) for job in jobs]`` on up to ``workers`` forked processes, in completion order.
 
     ``done`` is called with each result as it arrives.  With one worker (or
-    one job) everything runs in this process.
+    one job) everything runs in this process.  The pool is
+    :func:`grazing.parallel.map_unordered`: the workers die with this process.
     """
     results: list[Any] = []
-    if workers <= 1 or len(jobs) <= 1:
-        for job in jobs:
-            results.append(fn(job))
-            if done is not None:
-                done(results[-1])
-        return results
-    import multiprocessing as mp
-    from concurrent.futures import ProcessPoolExecutor, as_completed
-
-    from grazing.workers import init_worker
-
-    ctx = mp.get_context("fork" if "fork" in mp.get_all_start_methods() else "spawn")
-    n = min(workers, len(jobs))
-    # The workers die with this process (grazing.workers); Ctrl-C still reaches them.
-    with ProcessPoolExecutor(n, ctx, initializer=init_worker, initargs=(os.getpid(), False)) as ex:
-        futures = [ex.submit(fn, job) for job in jobs]
-        for fut in as_completed(futures):
-            results.append(fut.result())
-            if done is not None:
-                done(results[-1])
+    for res in map_unordered(fn, list(jobs), workers, ignore_sigint=False):
+        results.append(res)
+        if done is not None:
+            done(res)
     return results
 
 

@@ -98,7 +98,7 @@ def eq19_rows() -> list[Comparison]:
     from grazing.normalform import find_grazing_point, normal_form_at
 
     model = grazing.models.pendulum("B", theta_hat=math.radians(40.0))
-    nf = normal_form_at(find_grazing_point(model, "eta", 0.40, 0.47))
+    nf = normal_form_at(find_grazing_point(model, "eta", 0.40, 0.47), ("eta", "theta_hat"))
     r = float(model.params["r"])
     v = 1e-3
     x = np.array(nf.contact, dtype=float)

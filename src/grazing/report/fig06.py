@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 import grazing
+from grazing.models.pendulum import max_angle
 from grazing.orbits import continue_orbit, find_grazings, find_orbit, grazing_curve
 from grazing.report import paper
 from grazing.report.base import Comparison, DataFile, FigureResult, Image, Progress, save_png
@@ -89,7 +90,7 @@ def response_maximum(branch: Branch) -> tuple[float, float]:
     def neg(eta: float) -> float:
         orbit = find_orbit(branch.model.with_params(eta=float(eta)), state["x"], period=1, virtual=True)
         state["x"] = orbit.state
-        return -orbit.max_angle()
+        return -max_angle(orbit)
 
     res = minimize_scalar(neg, bounds=(min(lo, hi), max(lo, hi)), method="bounded", options={"xatol": 1e-9})
     return float(res.x), float(-res.fun)
@@ -108,7 +109,7 @@ def curve_vs_response(curve: GrazingCurve, n: int = 12) -> float:
         orbit = find_orbit(
             p.model.with_params(theta_hat=FAR), p.contact, t0=p.t_graze, period=1, virtual=True
         )
-        worst = max(worst, abs(p.model.params["theta_hat"] - orbit.max_angle()))
+        worst = max(worst, abs(p.model.params["theta_hat"] - max_angle(orbit)))
     return worst
 
 
@@ -120,7 +121,9 @@ def compute() -> Fig6:
         for letter, beta in DAMPING
     }
     far = continue_orbit(_model(BETA_B), "eta", ETA_RANGE[1], ETA_FAR, virtual=True)
-    curve = grazing_curve(grazing.models.pendulum("B"), start=math.radians(5.0))
+    curve = grazing_curve(
+        grazing.models.pendulum("B"), ("eta", "theta_hat"), math.radians(5.0), search=(0.2, 1.0)
+    )
     found = {
         (alpha, th): find_grazings(
             grazing.models.pendulum("B", alpha=alpha, theta_hat=math.radians(th)), "eta", 0.2, 1.0
@@ -190,7 +193,7 @@ def _draw_left(ax: Axes, data: Fig6) -> None:
         for s in folds:
             ax.plot(
                 s.param,
-                math.degrees(s.orbit.max_angle()),
+                math.degrees(max_angle(s.orbit)),
                 "o",
                 ms=5,
                 mfc="white",

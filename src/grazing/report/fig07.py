@@ -307,7 +307,7 @@ def _prediction_text(run: PanelRun) -> str:
         point = find_grazing_point(
             pendulum(CASE, theta_hat=math.radians(run.panel.theta_hat_deg)), "eta", 0.2, 1.0
         )
-        return predict(normal_form_at(point), "eta").scenario
+        return predict(normal_form_at(point, ("eta", "theta_hat")), "eta").scenario
     except Exception as exc:  # pragma: no cover - reported, not fatal
         return f"(not computed: {exc})"
 

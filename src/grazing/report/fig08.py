@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 import grazing
+from grazing.models.pendulum import max_angle
 from grazing.orbits import find_orbit
 from grazing.plotting import mark_grazings, plot_bifurcation
 from grazing.report import diagrams, paper
@@ -124,7 +125,7 @@ def run_panel(args: tuple[Panel, Settings]) -> PanelRun:
         workers=1,
     )
     wall, cpu = time.perf_counter() - start, time.process_time() - cpu
-    return PanelRun(panel, ds, orbit.max_angle(), orbit.abs_lambda, wall, cpu)
+    return PanelRun(panel, ds, max_angle(orbit), orbit.abs_lambda, wall, cpu)
 
 
 def draw(runs: list[PanelRun], path: Path) -> None:

@@ -61,7 +61,7 @@ def build(out_dir: Path, progress: Progress | None = None) -> FigureResult:
     start = time.perf_counter()
     base = pendulum("B", theta_hat=math.radians(THETA_HAT_DEG))
     point = find_grazing_point(base, "eta", 0.40, 0.47)
-    nf = normal_form_at(point)
+    nf = normal_form_at(point, ("eta", "theta_hat"))
     zdm = nf.discontinuity_map()
     eta_g = point.model.params["eta"]
     x0 = np.zeros(2)

@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 import grazing
+from grazing.models.pendulum import max_angle
 from grazing.orbits import find_orbit, grazing_curve
 from grazing.plotting import plot_period_map
 from grazing.report import diagrams
@@ -69,7 +70,7 @@ def max_angles(etas: np.ndarray) -> np.ndarray:
     for i, eta in enumerate(etas):
         orbit = find_orbit(model.with_params(eta=float(eta)), x, period=1, virtual=True)
         x = orbit.state
-        out[i] = orbit.max_angle()
+        out[i] = max_angle(orbit)
     return out
 
 
@@ -101,7 +102,9 @@ def compute(s: Settings, progress: Progress | None = None) -> MapRun:
     )
     child_cpu = _children_cpu()
     angles = max_angles(etas)
-    curve = grazing_curve(grazing.models.pendulum("B"), start=math.radians(5.0))
+    curve = grazing_curve(
+        grazing.models.pendulum("B"), ("eta", "theta_hat"), math.radians(5.0), search=(0.2, 1.0)
+    )
     return MapRun(ds, angles, curve, time.perf_counter() - start, time.process_time() - cpu + child_cpu)
 
 

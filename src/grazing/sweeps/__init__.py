@@ -1,6 +1,25 @@
-"""Brute-force bifurcation diagrams, period detection and Lyapunov exponents."""
+"""Brute-force bifurcation diagrams: sweeps in one or two parameters (periods, impacts, Lyapunov exponents).
+
+:func:`sweep` and :func:`parameter_map` (in :mod:`~grazing.sweeps.api`) build a
+:class:`~grazing.sweeps.spec.SweepSpec`, whose chunks :mod:`~grazing.sweeps.run`
+computes, :mod:`~grazing.sweeps.executor` distributes (local processes or a Dask
+cluster) and :mod:`~grazing.sweeps.store` keeps (in memory, or in a resumable
+Zarr store that grazing owns and locks).  :mod:`~grazing.sweeps.windows` finds
+the periodic windows of a one-parameter diagram.
+"""
 
 from grazing.core.period import detect_period
-from grazing.sweeps.brute_force import SweepSpec, parameter_map, run_chunk, run_sweep, sweep
+from grazing.sweeps.api import parameter_map, run_sweep, sweep
+from grazing.sweeps.run import run_chunk
+from grazing.sweeps.spec import SweepSpec, map_spec, sweep_spec
 
-__all__ = ["SweepSpec", "detect_period", "parameter_map", "run_chunk", "run_sweep", "sweep"]
+__all__ = [
+    "SweepSpec",
+    "detect_period",
+    "map_spec",
+    "parameter_map",
+    "run_chunk",
+    "run_sweep",
+    "sweep",
+    "sweep_spec",
+]

@@ -22,7 +22,6 @@ from typing import Any
 import numpy as np
 
 from grazing.errors import GrazingError
-from grazing.sweeps.brute_force import ChunkResult, SweepSpec, spec_summary
 from grazing.sweeps.lock import StoreBusyError, StoreLock
 from grazing.sweeps.ownership import (
     ForeignStoreError,
@@ -31,6 +30,7 @@ from grazing.sweeps.ownership import (
     create_store,
     lock_for,
 )
+from grazing.sweeps.spec import ChunkResult, SweepSpec, spec_summary
 
 __all__ = [
     "ForeignStoreError",

@@ -69,7 +69,7 @@ def find_windows(ds: Any) -> list[Window]:
     Parameters
     ----------
     ds
-        A dataset from :func:`grazing.sweeps.brute_force` (variables ``period`` and
+        A dataset from :func:`grazing.sweeps.sweep` (variables ``period`` and
         ``impacts_per_period`` along ``point``, coordinate ``value``).
 
     Returns
@@ -138,7 +138,7 @@ class WindowComparison:
 def compare_windows(reference: Any, other: Any, origin: float, min_points: int = 2) -> list[WindowComparison]:
     """Pair each impacting periodic window of ``reference`` with ``other``'s window of that period.
 
-    Both are datasets of :func:`grazing.sweeps.brute_force` over the same values.
+    Both are datasets of :func:`grazing.sweeps.sweep` over the same values.
     Windows are listed by their distance from ``origin`` (the grazing value);
     when a period has several windows in ``other``, the nearest is paired.
     """

@@ -8,7 +8,7 @@ import signal
 import time
 from pathlib import Path
 
-from grazing.workers import init_worker
+from grazing.parallel import init_worker
 from tests.processes import all_gone, wait_until
 
 FORK = mp.get_context("fork")

@@ -1,0 +1,177 @@
+"""The public sweeps: :func:`sweep` (one parameter), :func:`parameter_map` (two), :func:`run_sweep`.
+
+Chunks are independent units of work: they run in parallel on the local cores
+or on a Dask cluster, and each finished chunk is written to the result store,
+so the chunking - not the machine - defines the result.  ``chunk_size = 0``
+makes the whole sweep one chunk (a strictly sequential experimenter sweep).
+A store given by its path (``*.zarr``) is created or resumed: re-running the
+same sweep computes only the chunks that are missing.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
+
+from grazing.core.model import HybridModel
+from grazing.core.options import SweepSettings, refuse_unknown, with_shorthands
+from grazing.errors import InvalidParameterError
+from grazing.sweeps.executor import DASK_NOTICE_AFTER, chunk_results
+from grazing.sweeps.spec import DiscontinuityMapLike, SweepSpec, map_spec, sweep_spec
+
+__all__ = ["DASK_NOTICE_AFTER", "parameter_map", "run_sweep", "sweep"]
+
+
+def run_sweep(
+    spec: SweepSpec,
+    *,
+    store: Any = None,
+    workers: int | None = None,
+    client: Any = None,
+    progress: Callable[[int, int], None] | None = None,
+    timeout: float | None = None,
+    notice: Callable[[str], None] | None = None,
+    load: bool = True,
+) -> Any:
+    """Run a sweep; return its :class:`xarray.Dataset`.
+
+    Parameters
+    ----------
+    spec
+        The sweep (:func:`~grazing.sweeps.spec.sweep_spec`, :func:`~grazing.sweeps.spec.map_spec`).
+    store
+        A result store (:class:`~grazing.sweeps.store.ZarrStore`, or the path
+        of one): results written chunk by chunk, chunks already in it not
+        recomputed; None keeps them in memory.
+    workers
+        Local processes (default: all cores).
+    client
+        A :class:`dask.distributed.Client`: run the chunks on its cluster.
+    progress
+        Called as ``progress(points_done, points_total)``.
+    timeout
+        With ``client``: give up (:class:`~grazing.sweeps.executor.SweepTimeoutError`)
+        after this many seconds without any worker in the cluster (default: wait).
+    notice
+        Called with a one-line message when the cluster has had no worker
+        for :data:`DASK_NOTICE_AFTER` seconds.
+    load
+        Return the dataset; with False, return None and keep nothing of the
+        results in memory (they are in ``store``: a huge sweep streams to it).
+
+    Interrupted (Ctrl-C) or failing, the chunks not yet started are cancelled
+    and the local workers stopped at once; the finished chunks are in ``store``.
+    """
+    from grazing.sweeps.store import MemoryStore
+
+    if isinstance(store, (str, Path)):
+        from grazing.sweeps.store import open_store
+
+        with open_store(store, spec) as opened:
+            return run_sweep(
+                spec, store=opened, workers=workers, client=client, progress=progress, timeout=timeout,
+                notice=notice, load=load,
+            )  # fmt: skip
+    if store is None and not load:
+        raise InvalidParameterError("load=False needs a store to keep the results")
+    sink = store if store is not None else MemoryStore(spec)
+    todo = [i for i in range(spec.n_chunks) if not sink.is_done(i)]
+    done_points = spec.n_points - sum(spec.chunk(i).stop - spec.chunk(i).start for i in todo)
+    if progress is not None:
+        progress(done_points, spec.n_points)
+    results = chunk_results(spec, todo, workers, client, timeout, notice)
+    try:
+        for res in results:
+            sink.write(res)
+            done_points += res.period.size
+            if progress is not None:
+                progress(done_points, spec.n_points)
+    finally:
+        results.close()  # cancels what is queued and stops the workers if we leave early
+    return sink.dataset() if load else None
+
+
+def sweep(
+    model: HybridModel,
+    param: str,
+    values: Sequence[float],
+    *,
+    x0: Sequence[float] | None = None,
+    direction: str = "up",
+    settings: SweepSettings | None = None,
+    zdm: DiscontinuityMapLike = None,
+    store: Any = None,
+    workers: int | None = None,
+    client: Any = None,
+    progress: Callable[[int, int], None] | None = None,
+    **shorthands: Any,
+) -> Any:
+    """One-parameter brute-force bifurcation diagram.
+
+    Parameters
+    ----------
+    model, param, values
+        The model and the parameter swept over ``values``.
+    x0
+        Initial state (of every chunk; of every point with ``fresh``).
+    direction
+        ``"up"`` or ``"down"``: the order the values are visited in.
+    settings
+        How each point is computed (:class:`~grazing.core.options.SweepSettings`:
+        ``transient``, ``periods``, ``phase``, ``fresh``, ``chunk_size``,
+        ``adaptive``, ``lyapunov``, ``tol``); those names are also accepted as
+        keyword arguments.
+    zdm
+        Iterate the discontinuity-map Poincare map instead of the flow.
+    store, workers, client, progress
+        See :func:`run_sweep` (``store`` may be the path of a Zarr store).
+
+    Returns an :class:`xarray.Dataset` with, per point (in increasing parameter
+    order whatever the direction): ``samples`` (periods x states), ``period``
+    (0: none <= 64), ``impacts_per_period``, ``lyapunov`` (largest exponent
+    per unit time), ``transient_used``.
+
+    Examples
+    --------
+    >>> import math, numpy as np, grazing
+    >>> m = grazing.models.pendulum("B", theta_hat=math.radians(40))
+    >>> ds = sweep(m, "eta", np.linspace(0.40, 0.42, 3), periods=20, workers=1)
+    >>> ds.period.values.tolist()
+    [1, 1, 1]
+    """
+    used: set[str] = set()
+    settings = with_shorthands(settings, SweepSettings, shorthands, used)
+    refuse_unknown("sweep", shorthands, used)
+    spec = sweep_spec(model, param, values, x0=x0, direction=direction, settings=settings, zdm=zdm)
+    ds = run_sweep(spec, store=store, workers=workers, client=client, progress=progress)
+    return ds.sortby("value")
+
+
+def parameter_map(
+    model: HybridModel,
+    param1: str,
+    values1: Sequence[float],
+    param2: str,
+    values2: Sequence[float],
+    *,
+    x0: Sequence[float] | None = None,
+    settings: SweepSettings | None = None,
+    store: Any = None,
+    workers: int | None = None,
+    client: Any = None,
+    progress: Callable[[int, int], None] | None = None,
+    **shorthands: Any,
+) -> Any:
+    """Two-parameter period / impact / Lyapunov map.
+
+    Each row (fixed ``param2``) is swept in increasing ``param1``; with the
+    default ``chunk_size = 0`` one row is one chunk.  ``settings`` and the
+    keyword shorthands as for :func:`sweep`.  Returns a dataset with
+    dimensions ``(param2, param1)``.
+    """
+    used: set[str] = set()
+    settings = with_shorthands(settings or SweepSettings(chunk_size=0), SweepSettings, shorthands, used)
+    refuse_unknown("parameter_map", shorthands, used)
+    spec = map_spec(model, param1, values1, param2, values2, x0=x0, settings=settings)
+    return run_sweep(spec, store=store, workers=workers, client=client, progress=progress)

@@ -1,0 +1,250 @@
+"""What defines a sweep: :class:`SweepSpec` (the points and how each is computed), :class:`ChunkResult`.
+
+A sweep visits a list of parameter points, grouped in *chunks* of consecutive
+points; the spec's description (and its fingerprint) says everything that
+determines the result, so that a store can tell whether it holds this sweep.
+The builders :func:`sweep_spec` and :func:`map_spec` make the specs of a
+one-parameter sweep and of a two-parameter map from parameter values and a
+:class:`~grazing.core.options.SweepSettings`; the public functions of
+:mod:`grazing.sweeps.api` and the command line both use them.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from grazing.core.model import HybridModel
+from grazing.core.options import SWEEP_TOL, SweepSettings
+from grazing.errors import InvalidParameterError
+
+DEFAULT_SWEEP_TOL = SWEEP_TOL
+"""Local error tolerance of sweeps: far below the 1e-6 of period detection."""
+
+DiscontinuityMapLike = Any
+"""A :class:`grazing.engine.runner.DiscontinuityMap` (typed loosely: the spec does not run anything)."""
+
+
+@dataclass(frozen=True)
+class SweepSpec:
+    """Everything that defines a sweep's result.
+
+    Attributes
+    ----------
+    model
+        The model with its fixed parameter values.
+    params
+        Names of the swept parameters (one or two).
+    points
+        Parameter values, one tuple per point, in visiting order.
+    x0
+        Initial state of every chunk (and of every point with ``fresh``).
+    transient, periods
+        Forcing periods discarded and sampled at each point.
+    phase
+        Stroboscopic phase in radians.
+    fresh
+        Start every point from ``x0`` instead of the previous final state.
+    chunk_size
+        Points per chunk (0: one chunk).
+    adaptive
+        Stop transients early once the samples are periodic.
+    lyapunov
+        Compute the largest Lyapunov exponent (per unit time).
+    tol
+        Local error tolerance of the integrator.
+    shape
+        Grid shape for two-parameter maps (``(n2, n1)``), else ``(n,)``.
+    zdm
+        Iterate the discontinuity-map Poincare map instead of the flow: the
+        stop is ignored and Nordmark's map applied once per period at the
+        grazing phase (``--method map``).
+    """
+
+    model: HybridModel
+    params: tuple[str, ...]
+    points: tuple[tuple[float, ...], ...]
+    x0: tuple[float, ...]
+    transient: int = 500
+    periods: int = 100
+    phase: float = 0.0
+    fresh: bool = False
+    chunk_size: int = 50
+    adaptive: bool = True
+    lyapunov: bool = True
+    tol: float = DEFAULT_SWEEP_TOL
+    shape: tuple[int, ...] = field(default=())
+    zdm: DiscontinuityMapLike = None
+
+    def __post_init__(self) -> None:
+        if not self.points:
+            raise InvalidParameterError("a sweep needs at least one point")
+        for p in self.params:
+            if p not in self.model.params:
+                raise InvalidParameterError(
+                    f"unknown parameter {p!r} (known: {', '.join(self.model.params)})"
+                )
+        if self.transient < 0 or self.periods < 1:
+            raise InvalidParameterError("need transient >= 0 and periods >= 1")
+        if self.chunk_size < 0:
+            raise InvalidParameterError(f"chunk size must be >= 0, got {self.chunk_size}")
+        if not self.shape:
+            object.__setattr__(self, "shape", (len(self.points),))
+        # Validate every point's parameters now: one clear error before any work.
+        for pt in (self.points[0], self.points[-1]):
+            self.model_at(pt)
+
+    @property
+    def n_points(self) -> int:
+        return len(self.points)
+
+    @property
+    def size(self) -> int:
+        """Points per chunk."""
+        return self.chunk_size or self.n_points
+
+    @property
+    def n_chunks(self) -> int:
+        return math.ceil(self.n_points / self.size)
+
+    def chunk(self, i: int) -> slice:
+        return slice(i * self.size, min((i + 1) * self.size, self.n_points))
+
+    def model_at(self, point: Sequence[float]) -> HybridModel:
+        return self.model.with_params(**dict(zip(self.params, point)))
+
+    def description(self) -> dict[str, Any]:
+        """JSON-serialisable description of everything that determines the result."""
+        import grazing
+
+        d = {
+            "model": self.model.name,
+            "fixed_params": {k: v for k, v in self.model.params.items() if k not in self.params},
+            "params": list(self.params),
+            "points_sha256": hashlib.sha256(np.asarray(self.points, dtype=float).tobytes()).hexdigest(),
+            "n_points": self.n_points,
+            "first_point": list(self.points[0]),
+            "last_point": list(self.points[-1]),
+            "x0": list(self.x0),
+            "transient": self.transient,
+            "periods": self.periods,
+            "phase": self.phase,
+            "fresh": self.fresh,
+            "chunk_size": self.size,
+            "adaptive": self.adaptive,
+            "lyapunov": self.lyapunov,
+            "tol": self.tol,
+            "shape": list(self.shape),
+            "method": "map" if self.zdm is not None else "flow",
+            "zdm": None if self.zdm is None else [self.zdm.phase, self.zdm.accel, list(self.zdm.direction)],
+            "grazing_version": grazing.__version__,
+        }
+        return d
+
+    def fingerprint(self) -> str:
+        return hashlib.sha256(json.dumps(self.description(), sort_keys=True).encode()).hexdigest()[:16]
+
+
+@dataclass
+class ChunkResult:
+    """The results of one chunk of points."""
+
+    index: int
+    samples: np.ndarray  # (points, periods, n_states)
+    period: np.ndarray  # (points,) int
+    impacts: np.ndarray  # (points,) impacts in the sampled span
+    lyapunov: np.ndarray  # (points,) largest exponent per unit time (nan if sticking)
+    transient_used: np.ndarray  # (points,) transient periods actually run
+    x_final: np.ndarray  # (points, n_states)
+    seconds: float = 0.0
+
+
+def spec_summary(spec: SweepSpec) -> dict[str, Any]:
+    """The spec description plus a fingerprint, for dataset attributes."""
+    d = spec.description()
+    d["fingerprint"] = spec.fingerprint()
+    return d
+
+
+def sweep_spec(
+    model: HybridModel,
+    param: str,
+    values: Sequence[float],
+    *,
+    x0: Sequence[float] | None = None,
+    direction: str = "up",
+    settings: SweepSettings | None = None,
+    zdm: DiscontinuityMapLike = None,
+) -> SweepSpec:
+    """The spec of a one-parameter sweep of ``param`` over ``values``, visited in ``direction``."""
+    s = settings or SweepSettings()
+    vals = np.asarray(values, dtype=float)
+    if vals.ndim != 1 or vals.size == 0 or not np.all(np.isfinite(vals)):
+        raise InvalidParameterError("values must be a non-empty list of finite numbers")
+    if direction not in ("up", "down"):
+        raise InvalidParameterError(f"direction must be 'up' or 'down', got {direction!r}")
+    order = np.sort(vals) if direction == "up" else np.sort(vals)[::-1]
+    first = model.with_params(**{param: float(order[0])}) if param in model.params else model
+    x = np.zeros(model.n_states) if x0 is None else np.asarray(x0, dtype=float)
+    return SweepSpec(
+        model=model,
+        params=(param,),
+        points=tuple((float(v),) for v in order),
+        x0=tuple(float(v) for v in first.check_state(x)),
+        transient=s.transient,
+        periods=s.periods,
+        phase=s.phase,
+        fresh=s.fresh,
+        chunk_size=s.chunk_size,
+        adaptive=s.adaptive,
+        lyapunov=s.lyapunov,
+        tol=s.tol,
+        zdm=zdm,
+    )
+
+
+def map_spec(
+    model: HybridModel,
+    param1: str,
+    values1: Sequence[float],
+    param2: str,
+    values2: Sequence[float],
+    *,
+    x0: Sequence[float] | None = None,
+    settings: SweepSettings | None = None,
+) -> SweepSpec:
+    """The spec of a two-parameter map: each row (fixed ``param2``) swept in increasing ``param1``.
+
+    With ``settings.chunk_size = 0`` (``parameter_map``'s default) one row is one chunk.
+    """
+    s = settings or SweepSettings(chunk_size=0)
+    v1 = np.sort(np.asarray(values1, dtype=float))
+    v2 = np.sort(np.asarray(values2, dtype=float))
+    if v1.size == 0 or v2.size == 0:
+        raise InvalidParameterError("both parameter lists must be non-empty")
+    if not (np.all(np.isfinite(v1)) and np.all(np.isfinite(v2))):
+        raise InvalidParameterError("parameter values must be finite numbers")
+    known = param1 in model.params and param2 in model.params
+    first = model.with_params(**{param1: float(v1[0]), param2: float(v2[0])}) if known else model
+    x = np.zeros(model.n_states) if x0 is None else np.asarray(x0, dtype=float)
+    return SweepSpec(
+        model=model,
+        params=(param1, param2),
+        points=tuple((float(a), float(b)) for b in v2 for a in v1),
+        x0=tuple(float(v) for v in first.check_state(x)),
+        transient=s.transient,
+        periods=s.periods,
+        phase=s.phase,
+        fresh=s.fresh,
+        chunk_size=s.chunk_size or v1.size,
+        adaptive=s.adaptive,
+        lyapunov=s.lyapunov,
+        tol=s.tol,
+        shape=(v2.size, v1.size),
+    )
