@@ -9,7 +9,8 @@ import pytest
 from matplotlib.figure import Figure
 
 import grazing
-from grazing.plotting import delay_coordinates, plot_delay, plot_time_series, uniform_resample
+from grazing.experiment.signal import delay_coordinates, uniform_resample
+from grazing.plotting import plot_delay, plot_time_series
 
 
 @pytest.fixture(scope="module")

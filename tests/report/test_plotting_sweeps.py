@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import itertools
+import json
 import math
 
 import numpy as np
@@ -10,6 +11,7 @@ import pytest
 import xarray as xr
 from matplotlib.figure import Figure
 
+from grazing.models import pendulum
 from grazing.plotting import (
     Window,
     find_windows,
@@ -33,15 +35,26 @@ def synthetic_sweep(param: str = "eta", values: np.ndarray | None = None) -> xr.
     for i, p in enumerate(period):
         base = rng.uniform(-0.5, 0.0, size=max(p, 1))
         samples[i, :, 0] = rng.uniform(-0.5, 0.0, 12) if p == 0 else np.resize(base, 12)
-    return xr.Dataset(
+    # The metadata a real sweep of the pendulum carries (grazing.sweeps.store.build_dataset).
+    model = pendulum("B")
+    par = model.parameter(param)
+    stop = value if param == "theta_hat" else np.full(40, model.params["theta_hat"])
+    ds = xr.Dataset(
         {
             "samples": (("point", "sample", "component"), samples),
             "period": ("point", period),
             "impacts_per_period": ("point", impacts),
+            "stop_level": (("point", "component"), np.column_stack([stop, np.full(40, np.nan)])),
         },
         coords={"value": ("point", value), param: ("point", value), "component": ["theta", "dtheta"]},
-        attrs={"params": param},
-    )
+        attrs={
+            "params": param, "state_labels": json.dumps(list(model.state_labels)),
+            "state_units": json.dumps(list(model.state_units)), "time_label": model.time_label,
+            "forcing_period": model.period,
+        },
+    )  # fmt: skip
+    ds[param].attrs.update({"symbol": par.label, "units": par.unit, "angle": int(par.angle)})
+    return ds
 
 
 def test_find_windows_covers_every_point_in_order() -> None:
@@ -130,6 +143,9 @@ def test_period_classes_and_map() -> None:
         coords={"theta_hat": np.radians([10.0, 20.0]), "eta": [0.3, 0.4, 0.5]},
         attrs={"params": "eta,theta_hat"},
     )  # fmt: skip
+    for name in ("eta", "theta_hat"):
+        par = pendulum("B").parameter(name)
+        ds[name].attrs.update({"symbol": par.label, "units": par.unit, "angle": int(par.angle)})
     fig = Figure()
     ax = fig.add_subplot()
     plot_period_map(ax, ds)

@@ -170,6 +170,8 @@ class _Definition:
         reference: str,
         symbolic: dict[str, Any] | None = None,
         builder: Callable[[], dict[str, Any]] | None = None,
+        state_units: Sequence[str] | None = None,
+        time_label: str | None = None,
     ):
         self.name = name
         self.parameters = tuple(parameters)
@@ -178,6 +180,10 @@ class _Definition:
             raise ValueError("parameter names must be unique")
         self.state_names = tuple(state_names)
         self.state_labels = tuple(state_labels) if state_labels else self.state_names
+        self.state_units = tuple(state_units) if state_units else ("",) * len(self.state_names)
+        if len(self.state_labels) != len(self.state_names) or len(self.state_units) != len(self.state_names):
+            raise ValueError("state_labels and state_units need one entry per state")
+        self.time_label = time_label
         self.period_expr = period
         self.period_str = str(period)
         self.periodic = periodic
@@ -299,6 +305,23 @@ class _Definition:
         return float(self._period_fn(*values))
 
 
+def _greek(name: str) -> str:
+    """``"tau"`` -> ``"τ"``: a symbol spelled as a Greek letter's name, printed as the letter.
+
+    Examples
+    --------
+    >>> _greek("tau"), _greek("t"), _greek("Omega")
+    ('τ', 't', 'Ω')
+    """
+    import unicodedata
+
+    case = "CAPITAL" if name[:1].isupper() else "SMALL"
+    try:
+        return unicodedata.lookup(f"GREEK {case} LETTER {name.upper()}")
+    except KeyError:
+        return name
+
+
 def _compiled_period(system: SymbolicSystem) -> Callable[..., float]:
     """A plain-Python function of the parameter values for the symbolic period.
 
@@ -369,6 +392,9 @@ class HybridModel:
         the engine keep the forcing phase exact over long runs).
     state_labels
         Display names of the states (defaults to the symbol names).
+    state_units
+        Units of the states, for labels (``"rad"`` marks an angle, shown in
+        degrees when a plot asks for degrees); empty by default.
     values
         Parameter values (defaults from ``parameters``).
 
@@ -408,6 +434,7 @@ class HybridModel:
         description: str = "",
         reference: str = "",
         values: Mapping[str, float] | None = None,
+        state_units: Sequence[str] | None = None,
     ):
         symbolic = {
             "states": tuple(states),
@@ -428,6 +455,8 @@ class HybridModel:
                 "description": description,
                 "reference": reference,
                 "symbolic": symbolic,
+                "state_units": None if state_units is None else tuple(state_units),
+                "time_label": _greek(str(time)),
             }
         )
         self._values = self._checked({p.name: p.default for p in self._def.parameters}, values or {})
@@ -445,6 +474,8 @@ class HybridModel:
         state_labels: Sequence[str] | None = None,
         description: str = "",
         reference: str = "",
+        state_units: Sequence[str] | None = None,
+        time_label: str = "t",
     ) -> HybridModel:
         """A model whose symbolic pieces are built by ``builder()`` only when needed.
 
@@ -466,6 +497,8 @@ class HybridModel:
                 "description": description,
                 "reference": reference,
                 "builder": builder,
+                "state_units": None if state_units is None else tuple(state_units),
+                "time_label": time_label,
             }
         )
         obj = cls._from(definition, {})
@@ -526,6 +559,50 @@ class HybridModel:
     @property
     def state_labels(self) -> tuple[str, ...]:
         return self._def.state_labels
+
+    @property
+    def state_units(self) -> tuple[str, ...]:
+        """Units of the states (for labels; ``""`` when not given)."""
+        return self._def.state_units
+
+    @property
+    def time_label(self) -> str:
+        """How to print time (``"t"``, ``"τ"`` ...)."""
+        return self._def.time_label or "t"
+
+    def parameter(self, name: str) -> Parameter:
+        """The :class:`Parameter` called ``name``."""
+        for p in self._def.parameters:
+            if p.name == name:
+                return p
+        known = ", ".join(p.name for p in self._def.parameters)
+        raise InvalidParameterError(f"unknown parameter {name!r} for model {self.name!r} (known: {known})")
+
+    def stop_level(self, component: int, t: float = 0.0) -> float | None:
+        """The value of state ``component`` on the stop, when the guard depends on it alone.
+
+        For a stop at ``x_c = c`` (a guard affine in ``x_c``, independent of the
+        other states and of time, as the pendulum's ``theta_hat - theta``) this
+        is ``c``; otherwise None.  Found numerically from the compiled guard
+        (two evaluations, checked at three random states and times), for
+        drawing the stop in plots.
+        """
+        n = self.n_states
+        x0 = np.zeros(n)
+        unit = np.zeros(n)
+        unit[component] = 1.0
+        h0 = self.guard(x0, t)
+        slope = self.guard(unit, t) - h0
+        if slope == 0.0 or not math.isfinite(slope):
+            return None
+        rng = np.random.default_rng(0)
+        for _ in range(3):
+            x = rng.normal(size=n)
+            tt = float(rng.uniform(0.0, self.period))
+            expected = h0 + slope * x[component]
+            if abs(self.guard(x, tt) - expected) > 1e-9 * (1.0 + abs(h0) + abs(slope * x[component])):
+                return None
+        return -h0 / slope
 
     @property
     def n_states(self) -> int:

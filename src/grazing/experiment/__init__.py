@@ -16,8 +16,6 @@ The paper's experimental side, linked to the model:
   a folder of recordings, beside the model's sweep;
 * :mod:`~grazing.experiment.synthetic` -- synthetic rig recordings simulated
   from the model (the paper's measured data are not public);
-* :mod:`~grazing.experiment.figures` -- fig 4(a, b), fig 2- and fig 3-style
-  figures, with their numbers.
 
 Examples
 --------

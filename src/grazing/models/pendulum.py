@@ -117,6 +117,8 @@ def _base() -> HybridModel:
         period="2*pi",
         builder=_symbolic,
         state_labels=["θ", "θ′"],
+        state_units=["rad", "rad per unit time"],
+        time_label="τ",
         description="horizontally forced inclined pendulum with a rigid stop (paper eqs. 4-5)",
         reference="Piiroinen, Virgin & Champneys, J. Nonlinear Sci. 14 (2004) 383-404",
     )

@@ -41,8 +41,8 @@ import numpy as np
 
 from grazing.core.model import HybridModel
 from grazing.engine.runner import DiscontinuityMap
+from grazing.maps import flow_map
 from grazing.orbits.contact import GrazingPoint
-from grazing.orbits.shooting import flow_map
 
 
 def zdm_direction(model: HybridModel, x: np.ndarray, t: float) -> np.ndarray:

@@ -1,10 +1,11 @@
 """Periodic orbits: shooting, Floquet multipliers, continuation, grazing curves."""
 
+from grazing.maps import flow_map
 from grazing.orbits.contact import GrazingPoint, refine_grazing
 from grazing.orbits.continuation import Branch, ContinuationSettings, SpecialPoint, continue_orbit
 from grazing.orbits.grazing import GrazingCurve, find_grazings, grazing_curve
 from grazing.orbits.palc import PalcSettings
-from grazing.orbits.shooting import PeriodicOrbit, find_orbit, flow_map
+from grazing.orbits.shooting import PeriodicOrbit, find_orbit
 
 __all__ = [
     "Branch",

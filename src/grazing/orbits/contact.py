@@ -18,8 +18,9 @@ import numpy as np
 
 from grazing.core.model import HybridModel
 from grazing.errors import ConvergenceError
+from grazing.maps import flow_map
 from grazing.orbits.palc import PalcSettings, newton
-from grazing.orbits.shooting import flow_map, sorted_multipliers
+from grazing.orbits.shooting import sorted_multipliers
 
 
 @dataclass(frozen=True)

@@ -52,6 +52,7 @@ import numpy as np
 
 from grazing.core.model import HybridModel
 from grazing.errors import ConvergenceError, GrazingError, InvalidParameterError
+from grazing.maps import flow_map
 from grazing.orbits.contact import GrazingPoint, refine_grazing
 from grazing.orbits.palc import (
     ACCEPT,
@@ -69,7 +70,6 @@ from grazing.orbits.shooting import (
     PeriodicOrbit,
     _orbit_from,
     find_orbit,
-    flow_map,
     move_section,
     quiet_section,
 )

@@ -17,73 +17,18 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from grazing.core.model import HybridModel
+from grazing.core.options import NEWTON_MAX_ITER, NEWTON_TOL
 from grazing.core.period import detect_period
-from grazing.core.solution import Solution
 from grazing.engine.simulate import simulate
 from grazing.errors import ConvergenceError, InvalidParameterError, InvalidStateError, SimulationError
+from grazing.maps import FlowMap, flow_map
 
-DEFAULT_TOL = 1e-11
-DEFAULT_MAX_ITER = 30
+DEFAULT_TOL = NEWTON_TOL
+DEFAULT_MAX_ITER = NEWTON_MAX_ITER
 
 SECTION_MARGIN = 0.05
 """When an impact of the starting orbit lies within this fraction of a period of the
 stroboscopic section, an automatic section (``t0=None``) moves to a quiet phase."""
-
-
-@dataclass(frozen=True)
-class FlowMap:
-    """``P^n`` at a point: the image, its Jacobians and what happened on the way."""
-
-    image: np.ndarray
-    jacobian: np.ndarray  # d P^n / d x
-    sensitivity: np.ndarray  # d P^n / d p for the requested parameters (columns)
-    solution: Solution
-
-    @property
-    def impacts(self) -> int:
-        return self.solution.n_impacts
-
-
-def flow_map(
-    model: HybridModel,
-    x: np.ndarray,
-    *,
-    t0: float = 0.0,
-    periods: int = 1,
-    sensitivities: Sequence[str] = (),
-    virtual: bool = False,
-    touching: bool = False,
-) -> FlowMap:
-    """Apply the stroboscopic map ``periods`` times from ``x`` at time ``t0``.
-
-    The map goes from the section ``t = t0 (mod T)`` to itself, ending at
-    ``t0 + periods T``.  With ``virtual`` the stop is ignored (the flow passes
-    through it).  The parameter derivatives hold ``t0`` fixed and let the end
-    ``t0 + periods T(p)`` move with a parameter that sets the period ``T``.
-    With ``touching`` the map starts and ends at a grazing contact with the
-    stop (``x`` on the stop with zero normal velocity), which is not an impact.
-    """
-    sol = simulate(
-        model,
-        x,
-        t0=t0,
-        periods=periods,
-        phase=2 * math.pi * (t0 / model.period % 1.0),  # the section through t0
-        jacobian=True,
-        sensitivities=tuple(sensitivities),
-        guard_min=True,
-        events=not virtual,
-        touching=touching,
-    )
-    n = model.n_states
-    sens = sol.jacobian[:, n:]
-    tp = np.array([sol.info["period_gradient"][p] for p in sensitivities])
-    if np.any(tp) and model.periodic:
-        # simulate's derivative keeps the end at the forcing phase of t0, i.e. at
-        # (t0/T + periods) T(p); the map's end is t0 + periods T(p).
-        f_end = model.vector_field(sol.x_final, sol.t_final)
-        sens = sens - np.outer(f_end * (t0 / model.period), tp)
-    return FlowMap(sol.x_final, sol.jacobian[:, :n], sens, sol)
 
 
 @dataclass(frozen=True)

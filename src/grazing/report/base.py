@@ -396,3 +396,21 @@ def save_png(fig: Figure, path: Path) -> Path:
     """Save a matplotlib figure as a PNG of :data:`DPI` dots per inch and return the path."""
     fig.savefig(path, dpi=DPI, format="png", metadata={"Software": None})
     return path
+
+
+def new_figure(nrows: int, ncols: int, size: tuple[float, float]) -> tuple[Figure, Any]:
+    """A matplotlib :class:`~matplotlib.figure.Figure` (no pyplot state) with a 2-D array of axes."""
+    import numpy as np
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=size, layout="constrained")
+    axes = np.atleast_2d(fig.subplots(nrows, ncols, squeeze=False))
+    return fig, axes
+
+
+def finish_figure(fig: Figure | None, path: str | Path | None, dpi: int = DPI) -> str | None:
+    """Save ``fig`` at ``path`` (if both are given); the path written, or None."""
+    if fig is None or path is None:
+        return None
+    fig.savefig(path, dpi=dpi)
+    return str(path)

@@ -14,15 +14,28 @@ the model itself (no recording) is compared with what fig 3 shows was measured.
 from __future__ import annotations
 
 import math
+import tempfile
 import time
+from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 import grazing
-from grazing.experiment.figures import figure_2_synthetic, figure_3_synthetic
 from grazing.report import paper
-from grazing.report.base import Comparison, DataFile, FigureResult, Image, Progress
+from grazing.report.base import (
+    DPI,
+    Comparison,
+    DataFile,
+    FigureResult,
+    Image,
+    Progress,
+    finish_figure,
+)
+
+if TYPE_CHECKING:  # pragma: no cover
+    from matplotlib.figure import Figure
 from grazing.report.data import write_csv
 from grazing.report.rules import criterion_row
 
@@ -33,6 +46,212 @@ PIPELINE_SHARE = 0.9
 """The pipeline self-check agrees when at least this share of the recordings give the model's period."""
 FIG3_CASES = (*((th, eta) for th, eta, _ in paper.FIG3_POINTS), (paper.FIG9[1][0], paper.FIG9[1][1].value))
 """The fig 3-style panels: the paper's two points (§2.2, fig 3) and the model's period-5 point (fig 9(b))."""
+
+
+def _paper_fig3() -> tuple[tuple[float, float], ...]:
+    """``(theta_hat_deg, eta)`` of the paper's fig 3 (:data:`grazing.report.paper.FIG3_POINTS`)."""
+    return tuple((th, eta) for th, eta, _ in paper.FIG3_POINTS)
+
+
+def _paper_theta_hats() -> tuple[float, ...]:
+    """The stop angles of the paper's figs 2 and 3 (degrees)."""
+    return tuple(p.theta_hat_deg for p in paper.EXPERIMENT.values())
+
+
+def _paper_eta_c(theta_hat_deg: float) -> float | None:
+    """The grazing frequency the paper observed on the rig at a stop angle (§2.2), if it gives one."""
+    p = paper.EXPERIMENT.get(f"{theta_hat_deg:g}")
+    return p.eta_c.value if p is not None else None
+
+
+def figure_2_synthetic(
+    path: str | Path | None = None,
+    fig: Figure | None = None,
+    *,
+    theta_hats: Sequence[float] | None = None,
+    num: int = 25,
+    span: tuple[float, float] = (-0.01, 0.04),
+    periods: int = 60,
+    transient: int = 300,
+    sample_rate: float = 1000.0,
+    model_num: int = 101,
+    workdir: str | Path | None = None,
+    workers: int | None = None,
+    progress: Callable[[str], None] | None = None,
+    dpi: int = DPI,
+) -> dict[str, Any]:
+    """Fig 2-style diagrams from synthetic recordings, over the model's sweep, one panel per stop angle.
+
+    For each ``theta_hat`` (default: the paper's 10°, 20°, 30°, 40°): the model's primary grazing
+    ``eta_g`` is found,
+    ``num`` synthetic recordings (case B) are written at ``eta`` from
+    ``eta_g + span[0]`` to ``eta_g + span[1]`` (an experimenter's sweep, see
+    :func:`~grazing.experiment.synthetic_sweep`), read back and analysed
+    (:func:`~grazing.experiment.load_diagram`), and drawn over the model's
+    sweep at ``model_num`` values.
+
+    Returns
+    -------
+    dict
+        Per stop angle (key ``"10"``, ...): ``eta_graze`` (model),
+        ``paper_eta_c`` (observed on the rig), ``eta``, ``period`` (detected
+        on the synthetic recordings), ``noise``, ``model_eta``,
+        ``model_period``; and ``image``, ``synthetic: True``.
+
+    Examples
+    --------
+    >>> res = figure_2_synthetic(theta_hats=[40.0], num=2, span=(-0.015, 0.001), periods=20,
+    ...                          transient=100, sample_rate=100.0, model_num=2, workers=1)
+    >>> res["40"]["period"], res["40"]["model_period"]
+    ([1, 5], [1, 5])
+    """
+    from grazing.experiment.diagram import load_diagram, model_sweep, plot_diagram
+    from grazing.experiment.fit import grazing_eta
+    from grazing.experiment.synthetic import synthetic_sweep
+    from grazing.models.pendulum import CASES
+
+    say = progress or (lambda _m: None)
+    theta_hats = _paper_theta_hats() if theta_hats is None else theta_hats
+    n = len(theta_hats)
+    own = fig is None
+    if own:
+        from matplotlib.figure import Figure
+
+        fig = Figure(figsize=(6.4, 2.6 * n), layout="constrained")
+    axes = fig.subplots(n, 1, squeeze=False)[:, 0]
+    out: dict[str, Any] = {"synthetic": True}
+    with tempfile.TemporaryDirectory() as tmp:
+        base = Path(workdir) if workdir is not None else Path(tmp)
+        for ax, th in zip(axes, theta_hats):
+            eg = grazing_eta(th, CASES["B"]["beta"], alpha=CASES["B"]["alpha"])
+            centre = eg if eg is not None else 0.45
+            etas = np.linspace(centre + span[0], centre + span[1], num)
+            folder = base / f"theta{th:g}"
+            say(f"synthetic recordings at theta_hat = {th:g} deg ({num} frequencies)")
+            synthetic_sweep(folder, th, etas, periods=periods, transient=transient, sample_rate=sample_rate)
+            diag = load_diagram(folder)
+            model = model_sweep(
+                th, np.linspace(etas[0], etas[-1], model_num), periods=periods, workers=workers
+            )
+            plot_diagram(ax, diag, model, label="synthetic recordings")
+            if eg is not None:
+                ax.axvline(eg, color="tab:red", lw=0.7, ls="--")
+            ax.set_title(
+                f"θ̂ = {th:g}°, case B (synthetic recordings, not the paper's data)", fontsize="medium"
+            )
+            out[f"{th:g}"] = {
+                "eta_graze": eg,
+                "paper_eta_c": _paper_eta_c(float(th)),
+                "eta": diag.eta.tolist(),
+                "period": diag.period.tolist(),
+                "noise": diag.noise.tolist(),
+                "model_eta": model["value"].values.tolist(),
+                "model_period": model.period.values.tolist(),
+            }
+    out["image"] = finish_figure(fig if own else None, path, dpi)
+    return out
+
+
+# ----------------------------------------------------------------------------
+# Fig 3 style: time series and delay embeddings
+
+
+def figure_3_synthetic(
+    path: str | Path | None = None,
+    fig: Figure | None = None,
+    *,
+    cases: Sequence[tuple[float, float]] | None = None,
+    periods: int = 40,
+    shown: int = 12,
+    sample_rate: float = 1000.0,
+    seed: int = 0,
+    dpi: int = DPI,
+) -> dict[str, Any]:
+    """Fig 3-style time series and delay embeddings of synthetic recordings, beside the model.
+
+    One row per ``(theta_hat_deg, eta)`` (default: the paper's fig 3 points): the filtered
+    synthetic angle against
+    time with its stroboscopic samples and the model's noise-free ones (last
+    ``shown`` forcing periods), and the delay embedding
+    ``(theta(t - T/4), theta(t))`` with the stroboscopic points on it.
+
+    Returns
+    -------
+    dict
+        ``rows``: per case ``theta_hat_deg``, ``eta``, ``forcing_hz``,
+        ``period`` (detected on the synthetic recording), ``model_period``
+        (of the model's noise-free samples), ``noise``, ``samples`` (the
+        last stroboscopic angles, rad); ``image``; ``synthetic: True``.
+
+    Examples
+    --------
+    >>> from matplotlib.figure import Figure
+    >>> res = figure_3_synthetic(fig=Figure(), cases=[(40.0, 0.446)], periods=20, sample_rate=200.0)
+    >>> res["rows"][0]["period"], res["rows"][0]["model_period"]
+    (5, 5)
+    """
+    from grazing.core.period import detect_period
+    from grazing.experiment.signal import analyze_recording
+    from grazing.experiment.synthetic import synthetic_recording
+
+    cases = _paper_fig3() if cases is None else cases
+    n = len(cases)
+    own = fig is None
+    if own:
+        from matplotlib.figure import Figure
+
+        fig = Figure(figsize=(9.0, 2.8 * n), layout="constrained")
+    axes = fig.subplots(n, 2, squeeze=False, width_ratios=[2.2, 1.0])
+    rows = []
+    for j, (th, eta) in enumerate(cases):
+        rec = synthetic_recording(eta, th, periods=periods, sample_rate=sample_rate, seed=seed + j)
+        res = analyze_recording(rec)
+        model_samples = np.asarray(rec.metadata["model_samples"])
+        mp = detect_period(model_samples, tol=1e-6, max_period=32)
+        T = 1.0 / res.forcing_hz
+        t0 = rec.time[-1] - shown * T
+        sel = res.time >= t0
+        ax = axes[j, 0]
+        ax.plot(
+            res.time[sel],
+            np.degrees(res.filtered[sel]),
+            lw=0.7,
+            color="tab:blue",
+            label="synthetic, filtered",
+        )
+        ok = (res.sample_times >= t0) & np.isfinite(res.samples)
+        ax.plot(
+            res.sample_times[ok], np.degrees(res.samples[ok]), "o", ms=3.5, color="k", label="once per cycle"
+        )
+        tm = np.arange(model_samples.size) * T
+        om = tm >= t0
+        ax.plot(tm[om], np.degrees(model_samples[om]), "x", ms=5, color="tab:red", label="model, noise-free")
+        ax.axhline(th, color="tab:red", lw=0.7, ls="--")
+        ax.set_xlabel("t (s)")
+        ax.set_ylabel("θ (degrees)")
+        kind = f"period {res.period}" if res.period else "no period ≤ 32"
+        ax.set_title(f"θ̂ = {th:g}°, η = {eta:g}, case B (synthetic recording): {kind}", fontsize="medium")
+        if j == 0:
+            ax.legend(loc="lower left", fontsize="small", ncol=3)
+        ax = axes[j, 1]
+        emb = res.embedding()  # row i: (theta(t_i), theta(t_i + T/4))
+        tail = emb[int(np.searchsorted(res.time, t0)) :]
+        ax.plot(np.degrees(tail[:, 0]), np.degrees(tail[:, 1]), lw=0.5, color="tab:blue")
+        ax.plot(np.degrees(res.samples[ok]), np.degrees(res.quarter[ok]), "o", ms=3, color="k")
+        ax.set_xlabel("θ(t − T/4) (deg)")
+        ax.set_ylabel("θ(t) (deg)")
+        rows.append(
+            {
+                "theta_hat_deg": float(th),
+                "eta": float(eta),
+                "forcing_hz": res.forcing_hz,
+                "period": int(res.period),
+                "model_period": int(mp),
+                "noise": res.noise,
+                "samples": res.samples[np.isfinite(res.samples)][-16:].tolist(),
+            }
+        )
+    return {"rows": rows, "image": finish_figure(fig if own else None, path, dpi), "synthetic": True}
 
 
 def build(out_dir: Path, progress: Progress | None = None) -> FigureResult:

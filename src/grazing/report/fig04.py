@@ -10,12 +10,40 @@ erratum).
 
 from __future__ import annotations
 
+import math
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
-from grazing.experiment.figures import figure_4a, figure_4b
+import numpy as np
+
+from grazing.experiment.damping import (
+    DEFAULT_AMPLITUDE,
+    DEFAULT_PEAKS,
+    FIG4A,
+    PAPER_DAMPING,
+    PAPER_POINTS,
+    beta_for_damping,
+    free_decay,
+    iso_damping,
+    log_decrement,
+    paper_protocol_damping,
+    paper_relation,
+)
 from grazing.report import paper
-from grazing.report.base import Comparison, DataFile, FigureResult, Image, Progress
+from grazing.report.base import (
+    DPI,
+    Comparison,
+    DataFile,
+    FigureResult,
+    Image,
+    Progress,
+    finish_figure,
+    new_figure,
+)
+
+if TYPE_CHECKING:  # pragma: no cover
+    from matplotlib.axes import Axes
 from grazing.report.data import write_csv
 from grazing.report.rules import numeric_row
 
@@ -25,6 +53,155 @@ HEAD_NORM = (
     "eq. 6 holds, the model's D is not 0.07 for the fig 4(a) decay nor at most of A–D — the paper's 0.07 "
     "comes back with eq. 1 as printed and the model's damping doubled (the κ of the eq. 3 erratum)"
 )
+
+
+# ----------------------------------------------------------------------------
+# Fig 4(a)
+
+
+def figure_4a(
+    path: str | Path | None = None,
+    ax: Axes | None = None,
+    *,
+    r: float = FIG4A[0],
+    beta: float = FIG4A[1],
+    amplitude: float = DEFAULT_AMPLITUDE,
+    peaks: int = DEFAULT_PEAKS,
+    dpi: int = DPI,
+) -> dict[str, Any]:
+    """Free decay of the impacting pendulum (``alpha = 0``, ``theta_hat = 0``), as fig 4(a).
+
+    Returns
+    -------
+    dict
+        ``r``, ``beta``, ``amplitudes`` (release and peaks), ``log_ratio``
+        (mean per peak), ``D_eq6`` (our estimator), ``D_eq1`` (eq. 1 as
+        printed), ``D_protocol`` (:func:`paper_protocol_damping`),
+        ``D_paper_relation``, ``paper_D`` (0.07), ``image``.
+
+    Examples
+    --------
+    >>> from matplotlib.figure import Figure
+    >>> res = figure_4a(ax=Figure().add_subplot())
+    >>> round(res["D_eq6"], 4), round(res["D_protocol"], 3)
+    (0.0964, 0.07)
+    """
+    dec = free_decay(r, beta, amplitude=amplitude, peaks=peaks)
+    est = log_decrement(dec.amplitudes)
+    est1 = log_decrement(dec.amplitudes, normalisation="eq1")
+    proto = paper_protocol_damping(r, beta, amplitude=amplitude, peaks=peaks).damping
+    fig = None
+    if ax is None:
+        fig, axes = new_figure(1, 1, (6.4, 3.4))
+        ax = axes[0, 0]
+    end = dec.peak_t[-1] + math.pi
+    sel = dec.t <= end
+    ax.plot(dec.t[sel], np.degrees(dec.angle[sel]), lw=0.9, color="tab:blue", label="θ (model, free decay)")
+    ax.plot(dec.peak_t, -np.degrees(dec.amplitudes), "o", ms=3.5, color="k", label="peaks A_k")
+    ax.axhline(0.0, color="tab:red", ls="--", lw=0.8, label="stop θ̂ = 0")
+    ax.set_xlabel("ω₀ t")
+    ax.set_ylabel("θ (degrees)")
+    ax.set_title(
+        f"free decay, r = {r:g}, β = {beta:g}: D = {est.damping:.4f} (eq. 6 norm.)", fontsize="medium"
+    )
+    ax.legend(loc="lower right", fontsize="small")
+    return {
+        "r": float(r),
+        "beta": float(beta),
+        "amplitude": float(amplitude),
+        "amplitudes": dec.amplitudes.tolist(),
+        "log_ratio": est.log_ratio,
+        "D_eq6": est.damping,
+        "D_eq1": est1.damping,
+        "D_protocol": proto,
+        "D_paper_relation": paper_relation(r, beta),
+        "paper_D": PAPER_DAMPING,
+        "image": finish_figure(fig, path, dpi),
+    }
+
+
+# ----------------------------------------------------------------------------
+# Fig 4(b)
+
+
+def figure_4b(
+    path: str | Path | None = None,
+    ax: Axes | None = None,
+    *,
+    damping: float = PAPER_DAMPING,
+    num: int = 21,
+    dpi: int = DPI,
+) -> dict[str, Any]:
+    """The equal-damping curve ``D = 0.07`` (fig 4b): the model's, the paper's relation, the paper's points.
+
+    Three curves: the model's (root-finding on the eq.-6-normalised estimator),
+    the relation ``D = beta - ln(r) / (4 pi)`` that the paper's points satisfy,
+    and our reconstruction of the paper's computation (eq. 1 as printed on the
+    model with doubled damping, :func:`paper_protocol_damping`).
+
+    Returns
+    -------
+    dict
+        ``damping``; ``curves``: for ``model``, ``paper``, ``protocol`` the
+        lists ``r``, ``beta`` and the ends ``r_min``, ``beta_max``;
+        ``points``: for A-D, ``r``, ``beta`` (paper), ``D_model``, ``D_eq1``,
+        ``D_paper_relation``, ``D_protocol``, ``beta_model_curve`` (the
+        model's ``beta`` at that ``r`` for ``D``, None below its ``r_min``),
+        ``beta_protocol_curve``; ``image``.
+
+    Examples
+    --------
+    >>> from matplotlib.figure import Figure
+    >>> res = figure_4b(ax=Figure().add_subplot(), num=3)
+    >>> round(res["points"]["B"]["D_model"], 4), round(res["curves"]["protocol"]["beta_max"], 4)
+    (0.0905, 0.0673)
+    """
+    from grazing.experiment.damping import model_damping
+
+    curves = {}
+    for rel in ("model", "paper", "protocol"):
+        c = iso_damping(damping, num=num, relation=rel)  # type: ignore[arg-type]
+        curves[rel] = {"r": c.r.tolist(), "beta": c.beta.tolist(), "r_min": c.r_min, "beta_max": c.beta_max}
+    points = {}
+    for name, (r, b) in PAPER_POINTS.items():
+        row: dict[str, Any] = {"r": r, "beta": b}
+        row["D_model"] = model_damping(r, b).damping
+        row["D_eq1"] = model_damping(r, b, normalisation="eq1").damping
+        row["D_paper_relation"] = paper_relation(r, b)
+        row["D_protocol"] = paper_protocol_damping(r, b).damping
+        for rel in ("model", "protocol"):
+            try:
+                row[f"beta_{rel}_curve"] = beta_for_damping(r, damping, relation=rel)  # type: ignore[arg-type]
+            except ValueError:
+                row[f"beta_{rel}_curve"] = None
+        points[name] = row
+    fig = None
+    if ax is None:
+        fig, axes = new_figure(1, 1, (6.0, 4.2))
+        ax = axes[0, 0]
+    styles = {
+        "model": ("tab:blue", "-", "model, eq. 6 normalisation (this package)"),
+        "protocol": ("tab:orange", "--", "eq. 1 as printed, damping doubled (reconstruction)"),
+        "paper": ("0.4", ":", "D = β − ln(r)/(4π) (relation of the paper's points)"),
+    }
+    for rel, (color, ls, label) in styles.items():
+        ax.plot(curves[rel]["r"], curves[rel]["beta"], color=color, ls=ls, lw=1.4, label=label)
+    for name, row in points.items():
+        ax.plot(row["r"], row["beta"], "o", color="k", ms=5)
+        ax.annotate(name, (row["r"], row["beta"]), textcoords="offset points", xytext=(5, -11))
+    ax.plot([], [], "o", color="k", ms=5, label="paper's points A-D")
+    ax.set_xlabel("r")
+    ax.set_ylabel("β")
+    ax.set_xlim(0.35, 1.02)
+    ax.set_ylim(-0.002, 0.08)
+    ax.set_title(f"equal damping D = {damping:g}", fontsize="medium")
+    ax.legend(loc="upper left", fontsize="small")
+    image = finish_figure(fig, path, dpi)
+    return {"damping": float(damping), "curves": curves, "points": points, "image": image}
+
+
+# ----------------------------------------------------------------------------
+# Fig 2 style: bifurcation diagrams from synthetic recordings
 
 
 def build(out_dir: Path, progress: Progress | None = None) -> FigureResult:

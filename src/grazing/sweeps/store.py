@@ -64,6 +64,20 @@ def _empty_arrays(spec: SweepSpec) -> dict[str, np.ndarray]:
     }
 
 
+def _stop_levels(spec: SweepSpec) -> np.ndarray:
+    """Each point's :meth:`~grazing.core.model.HybridModel.stop_level` of each state component (nan: none)."""
+    n = spec.model.n_states
+    out = np.full((spec.n_points, n), np.nan)
+    first = spec.model_at(spec.points[0])
+    for c in range(n):
+        if first.stop_level(c) is None:
+            continue
+        for i, pt in enumerate(spec.points):
+            level = spec.model_at(pt).stop_level(c)
+            out[i, c] = np.nan if level is None else level
+    return out
+
+
 def build_dataset(spec: SweepSpec, arrays: dict[str, np.ndarray], attrs: dict[str, Any] | None = None) -> Any:
     """The xarray Dataset of a sweep from its flat per-point arrays."""
     import xarray as xr
@@ -90,7 +104,15 @@ def build_dataset(spec: SweepSpec, arrays: dict[str, np.ndarray], attrs: dict[st
         coords[name] = ("point", pts[:, j])
     if len(spec.params) == 1:
         coords["value"] = ("point", pts[:, 0])
+    data["stop_level"] = (("point", "component"), _stop_levels(spec))
     ds = xr.Dataset(data, coords=coords)
+    for name in spec.params:  # what plots need to label the parameter axes
+        par = spec.model.parameter(name)
+        meta = {"long_name": par.description or name, "symbol": par.label, "units": par.unit}
+        ds[name].attrs.update({**meta, "angle": int(par.angle)})
+    ds["stop_level"].attrs["description"] = (
+        "the state component's value on the stop, where the guard depends on that component alone (else nan)"
+    )
     ds["period"].attrs["description"] = (
         "smallest p <= 64 with the samples p-periodic to 1e-6; 0 none; -1 failed"
     )
@@ -108,6 +130,10 @@ def build_dataset(spec: SweepSpec, arrays: dict[str, np.ndarray], attrs: dict[st
             "params": ",".join(spec.params),
             "model": spec.model.name,
             "grazing_version": summary["grazing_version"],
+            "state_labels": json.dumps(list(spec.model.state_labels)),
+            "state_units": json.dumps(list(spec.model.state_units)),
+            "time_label": spec.model.time_label,
+            "forcing_period": spec.model_at(spec.points[0]).period,
         }
     )
     for k, v in spec.model.params.items():

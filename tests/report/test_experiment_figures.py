@@ -6,15 +6,15 @@ import json
 
 import pytest
 
-from grazing.experiment import figures
+from grazing.report import fig02, fig04
 
 
 def test_figure_4a_and_4b_write_pngs_and_numbers(tmp_path):
-    a = figures.figure_4a(tmp_path / "fig4a.png")
+    a = fig04.figure_4a(tmp_path / "fig4a.png")
     assert (tmp_path / "fig4a.png").stat().st_size > 10_000
     assert a["D_eq6"] == pytest.approx(0.0964, abs=2e-4)
     assert a["D_protocol"] == pytest.approx(0.07, abs=1e-3)
-    b = figures.figure_4b(tmp_path / "fig4b.png", num=4)
+    b = fig04.figure_4b(tmp_path / "fig4b.png", num=4)
     assert (tmp_path / "fig4b.png").is_file()
     assert b["points"]["A"]["beta_model_curve"] is None  # A lies beyond the model's curve (r < r_min)
     assert b["points"]["D"]["D_paper_relation"] == pytest.approx(0.068)
@@ -22,13 +22,13 @@ def test_figure_4a_and_4b_write_pngs_and_numbers(tmp_path):
 
 
 def test_figure_3_and_2_synthetic(tmp_path):
-    res = figures.figure_3_synthetic(
+    res = fig02.figure_3_synthetic(
         tmp_path / "fig3.png", cases=[(40.0, 0.446), (40.0, 0.4504)], periods=36, sample_rate=250.0
     )
     assert [r["period"] for r in res["rows"]] == [5, 0]
     assert [r["model_period"] for r in res["rows"]] == [5, 0]
     assert res["synthetic"] is True and (tmp_path / "fig3.png").is_file()
-    res = figures.figure_2_synthetic(
+    res = fig02.figure_2_synthetic(
         tmp_path / "fig2.png",
         theta_hats=[40.0],
         num=3,

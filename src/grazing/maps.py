@@ -1,0 +1,181 @@
+"""Poincare maps of a hybrid model as discrete systems: the stroboscopic map and the impact map.
+
+As in DynamicalSystems.jl, a map derived from the flow is a system of its own:
+:class:`StroboscopicMap` (``P^n``, the state from the section ``t = t0 (mod T)``
+to itself ``n`` periods later) and :class:`ImpactMap` (the state on the stop
+from one impact to the next) can be iterated, and the stroboscopic map
+linearised (:func:`flow_map`: its Jacobian with saltation matrices at the
+impacts, and its parameter derivatives), which is what shooting, continuation
+and the normal form are built on.
+
+Examples
+--------
+>>> import math, grazing
+>>> m = grazing.models.pendulum("B", eta=0.446, theta_hat=math.radians(40))
+>>> P = StroboscopicMap(m, periods=5)
+>>> x = P.iterate([0.0, 0.0], 120)[-1]
+>>> bool(abs(P(x) - x).max() < 1e-9)
+True
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from grazing.core.model import HybridModel
+from grazing.core.solution import Impacts, Solution
+from grazing.engine.simulate import simulate
+from grazing.errors import InvalidParameterError
+
+
+@dataclass(frozen=True)
+class FlowMap:
+    """``P^n`` at a point: the image, its Jacobians and what happened on the way."""
+
+    image: np.ndarray
+    jacobian: np.ndarray  # d P^n / d x
+    sensitivity: np.ndarray  # d P^n / d p for the requested parameters (columns)
+    solution: Solution
+
+    @property
+    def impacts(self) -> int:
+        return self.solution.n_impacts
+
+
+def flow_map(
+    model: HybridModel,
+    x: np.ndarray,
+    *,
+    t0: float = 0.0,
+    periods: int = 1,
+    sensitivities: Sequence[str] = (),
+    virtual: bool = False,
+    touching: bool = False,
+) -> FlowMap:
+    """Apply the stroboscopic map ``periods`` times from ``x`` at time ``t0``.
+
+    The map goes from the section ``t = t0 (mod T)`` to itself, ending at
+    ``t0 + periods T``.  With ``virtual`` the stop is ignored (the flow passes
+    through it).  The parameter derivatives hold ``t0`` fixed and let the end
+    ``t0 + periods T(p)`` move with a parameter that sets the period ``T``.
+    With ``touching`` the map starts and ends at a grazing contact with the
+    stop (``x`` on the stop with zero normal velocity), which is not an impact.
+    """
+    sol = simulate(
+        model,
+        x,
+        t0=t0,
+        periods=periods,
+        phase=2 * math.pi * (t0 / model.period % 1.0),  # the section through t0
+        jacobian=True,
+        sensitivities=tuple(sensitivities),
+        guard_min=True,
+        events=not virtual,
+        touching=touching,
+    )
+    n = model.n_states
+    sens = sol.jacobian[:, n:]
+    tp = np.array([sol.info["period_gradient"][p] for p in sensitivities])
+    if np.any(tp) and model.periodic:
+        # simulate's derivative keeps the end at the forcing phase of t0, i.e. at
+        # (t0/T + periods) T(p); the map's end is t0 + periods T(p).
+        f_end = model.vector_field(sol.x_final, sol.t_final)
+        sens = sens - np.outer(f_end * (t0 / model.period), tp)
+    return FlowMap(sol.x_final, sol.jacobian[:, :n], sens, sol)
+
+
+@dataclass(frozen=True)
+class StroboscopicMap:
+    """``P^n``: the state at ``t0 (mod T)`` to the state ``periods`` forcing periods later.
+
+    Attributes
+    ----------
+    model
+        The model with its parameter values.
+    t0
+        Time of the section.
+    periods
+        ``n``: forcing periods per application.
+    virtual
+        Ignore the stop (the flow passes through it).
+    """
+
+    model: HybridModel
+    t0: float = 0.0
+    periods: int = 1
+    virtual: bool = False
+
+    def __call__(self, x: Sequence[float] | np.ndarray) -> np.ndarray:
+        """The image of ``x``."""
+        return self._run(x, 1).x_final
+
+    def iterate(self, x: Sequence[float] | np.ndarray, n: int) -> np.ndarray:
+        """The ``n`` iterates ``P(x), P^2(x), ...`` (rows), from one continuous run."""
+        if n < 1:
+            raise InvalidParameterError(f"n must be >= 1, got {n}")
+        samples = self._run(x, n).samples
+        return samples[self.periods - 1 :: self.periods] if self.periods > 1 else samples
+
+    def linearize(self, x: Sequence[float] | np.ndarray, sensitivities: Sequence[str] = ()) -> FlowMap:
+        """The image of ``x`` with its Jacobian and parameter derivatives (see :func:`flow_map`)."""
+        return flow_map(
+            self.model, np.asarray(x, dtype=float), t0=self.t0, periods=self.periods,
+            sensitivities=sensitivities, virtual=self.virtual,
+        )  # fmt: skip
+
+    def _run(self, x: Sequence[float] | np.ndarray, n: int) -> Solution:
+        return simulate(
+            self.model, x, t0=self.t0, periods=n * self.periods,
+            phase=2 * math.pi * (self.t0 / self.model.period % 1.0), impacts="none", events=not self.virtual,
+        )  # fmt: skip
+
+
+@dataclass(frozen=True)
+class ImpactMap:
+    """The impact map: the state on the stop at one impact to the state at the next.
+
+    Attributes
+    ----------
+    model
+        The model with its parameter values.
+    max_periods
+        Give up looking for the next impacts after this many forcing periods.
+    """
+
+    model: HybridModel
+    max_periods: int = 10_000
+
+    def iterate(self, x: Sequence[float] | np.ndarray, t: float, n: int) -> Impacts:
+        """The next ``n`` impacts after the state ``x`` at time ``t`` (times, phases, speeds, states).
+
+        ``x`` may be an impact state itself (on the stop, after its reset):
+        the impacts returned are the ones that follow it.  Fewer than ``n``
+        are returned if the motion stops impacting (or sticks to the stop)
+        within :attr:`max_periods`.
+        """
+        if n < 1:
+            raise InvalidParameterError(f"n must be >= 1, got {n}")
+        T = self.model.period
+        t_start = float(t)
+        found: list[tuple[np.ndarray, ...]] = []
+        count, done, block = 0, 0, 8
+        while count < n and done < self.max_periods:
+            sol = simulate(
+                self.model, x, t0=t, periods=block, phase=2 * math.pi * (t / T % 1.0), impacts="all"
+            )
+            imp = sol.impacts
+            after = imp.t > t_start  # an impact state given as x is not its own successor
+            found.append((imp.t[after], imp.phase[after], imp.speed[after], imp.state[after]))
+            count += int(after.sum())
+            done += block
+            if len(sol.sticking):
+                break
+            x, t = sol.x_final, sol.t_final
+            block = min(2 * block, 1024)
+        t_all, phase, speed, state = (np.concatenate(parts) for parts in zip(*found))
+        state = state[:n].reshape(-1, self.model.n_states)
+        return Impacts(t=t_all[:n], phase=phase[:n], speed=speed[:n], state=state)
