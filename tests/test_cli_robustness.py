@@ -15,11 +15,8 @@ from hypothesis import strategies as st
 
 import grazing
 from grazing.cli import main
-from grazing.cli_experiment import register
+from grazing.cli.limits import MEMORY_ENV, MemoryLimitError, check_memory, parse_size
 from grazing.experiment.synthetic import synthetic_sweep
-from grazing.limits import MEMORY_ENV, MemoryLimitError, check_memory, parse_size
-
-register(grazing.cli.cli)
 
 
 def _files(root: Path) -> dict[str, bytes | None]:
@@ -215,7 +212,7 @@ def test_memory_is_checked_before_any_work(argv, message, capsys, inputs, monkey
     monkeypatch.delenv(MEMORY_ENV, raising=False)
     for name in ("simulate",):  # nothing may start: the estimate comes first
         monkeypatch.setattr(grazing, name, lambda *a, **k: pytest.fail("work started"))
-    monkeypatch.setattr(grazing.limits, "physical_memory", lambda: 16 * 10**9)  # a stated, fixed bound
+    monkeypatch.setattr(grazing.cli.limits, "physical_memory", lambda: 16 * 10**9)  # a stated, fixed bound
     err = _one_line_error(argv, capsys, inputs, code_expected=1)
     assert message in err
     assert "more than the limit of 8 GB (half of this machine's memory; set GRAZING_MAX_MEMORY" in err

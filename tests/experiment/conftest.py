@@ -31,10 +31,7 @@ def period5_csv(tmp_path_factory, period5_recording):
 
 @pytest.fixture
 def cli():
-    """``grazing.cli.main`` with the experiment commands registered."""
-    from grazing.cli import cli as group
+    """``grazing.cli.main`` (which has the experiment commands)."""
     from grazing.cli import main
-    from grazing.cli_experiment import register
 
-    register(group)
     return main

@@ -17,12 +17,10 @@ def run(main, argv, capsys):
     return code, out, err
 
 
-def test_register_is_idempotent():
+def test_the_experiment_commands_are_in_the_group():
     from grazing.cli import cli
-    from grazing.cli_experiment import COMMANDS, register
+    from grazing.cli.experiment import COMMANDS
 
-    register(cli)
-    register(cli)
     for cmd in COMMANDS:
         assert cli.commands[cmd.name] is cmd
 

@@ -1,7 +1,6 @@
-"""Command-line tools for the experimental side: damping, equal damping, fit, recordings.
+"""``grazing damping``, ``iso-damping``, ``fit``, ``analyze``, ``synthesize``: the experimental side.
 
-``register(cli)`` adds the commands ``damping``, ``iso-damping``, ``fit``,
-``analyze`` and ``synthesize`` to the ``grazing`` command group.  Like every
+:data:`COMMANDS` are added to the ``grazing`` command group.  Like every
 ``grazing`` command they print a summary, or one JSON object with
 ``--json``; malformed input gets one line on stderr, a non-zero exit status,
 and nothing is written.
@@ -18,8 +17,16 @@ import click
 import numpy as np
 
 from grazing.atomic import atomic_path
-from grazing.cli import _check_out, _emit_json, _ErrorInput, _json_option, _Progress, _write_atomic
-from grazing.cli_validate import (
+from grazing.cli.common import InputError, Progress, check_out, emit_json, json_option, write_atomic
+from grazing.cli.limits import (
+    check_memory,
+    count_text,
+    curve_bytes,
+    decay_bytes,
+    recording_bytes,
+    sweep_bytes,
+)
+from grazing.cli.validate import (
     AMPLITUDE_DEG,
     ANGLE_DEG,
     FINITE,
@@ -30,14 +37,6 @@ from grazing.cli_validate import (
     count,
     path_type,
     refuse_unused,
-)
-from grazing.limits import (
-    check_memory,
-    count_text,
-    curve_bytes,
-    decay_bytes,
-    recording_bytes,
-    sweep_bytes,
 )
 from grazing.models.pendulum import CASES, DEFAULT_CASE, case_values
 
@@ -120,7 +119,7 @@ _norm_option = click.option(
 @click.option("--recording", type=path_type(dir_okay=False), metavar="FILE.csv",
               help="Estimate D from a recorded free decay (time,angle) instead of the model.")  # fmt: skip
 @click.option("--degrees", is_flag=True, help="The recording's angle is in degrees.")
-@_json_option
+@json_option
 def damping_cmd(
     case: str, r: float | None, beta: float | None, amplitude: float, peaks: int, k_hat: tuple[int, ...],
     normalisation: str, recording: Path | None, degrees: bool, as_json: bool,
@@ -150,7 +149,7 @@ def damping_cmd(
             "noise": res.noise,
         }
         if as_json:
-            _emit_json(out)
+            emit_json(out)
             return
         click.echo(
             f"{recording}: D = {res.estimate.damping:.5f} ({normalisation} normalisation) from "
@@ -162,7 +161,7 @@ def damping_cmd(
     amp = _amplitude_rad(amplitude)
     dmp._check_r_beta(rv, bv)
     if max(ks) > peaks:
-        raise _ErrorInput(f"--k-hat {max(ks)} needs at least as many --peaks (got {peaks})")
+        raise InputError(f"--k-hat {max(ks)} needs at least as many --peaks (got {peaks})")
     _check_decay_memory(rv, bv, amp, peaks)
     dec = dmp.free_decay(rv, bv, amplitude=amp, peaks=peaks)
     est = dmp.log_decrement(dec.amplitudes, ks, normalisation=normalisation)  # type: ignore[arg-type]
@@ -183,7 +182,7 @@ def damping_cmd(
         "D_protocol": dmp.paper_protocol_damping(rv, bv, amplitude=amp, peaks=peaks, k_hat=ks).damping,
     }
     if as_json:
-        _emit_json(out)
+        emit_json(out)
         return
     click.echo(f"free decay r = {rv:g}, beta = {bv:g}, released {amplitude:.4g} deg below the stop at 0")
     click.echo(f"  D = {est.damping:.5f} ({normalisation}), ln(A_k/A_k+1) per impact = {est.log_ratio:.5f}")
@@ -214,7 +213,7 @@ def _write_curve_csv(r: np.ndarray, beta: np.ndarray, fh: Any) -> None:
 @_norm_option
 @click.option("--out", type=path_type(dir_okay=False), metavar="FILE.csv",
               help="Write the curve (r,beta) to a CSV file.")  # fmt: skip
-@_json_option
+@json_option
 def iso_damping_cmd(
     damping: float, num: int, relation: str, amplitude: float, peaks: int, normalisation: str,
     out: Path | None, as_json: bool,
@@ -224,7 +223,7 @@ def iso_damping_cmd(
 
     refuse_unused(["normalisation"], relation != "model", f"with --relation {relation}")
     amp = _amplitude_rad(amplitude)
-    _check_out(out, ".csv")
+    check_out(out, ".csv")
     check_memory(curve_bytes(num), f"a curve of {count_text(num)} points", "ask for fewer --num")
     for pr, pb in dmp.PAPER_POINTS.values():
         _check_decay_memory(pr, pb, amp, peaks)
@@ -244,7 +243,7 @@ def iso_damping_cmd(
             "D_protocol": dmp.paper_protocol_damping(pr, pb, amplitude=amp, peaks=peaks).damping,
         }
     if out is not None:
-        _write_atomic(out, lambda fh: _write_curve_csv(curve.r, curve.beta, fh))
+        write_atomic(out, lambda fh: _write_curve_csv(curve.r, curve.beta, fh))
     res = {
         "damping": curve.damping,
         "relation": relation,
@@ -256,7 +255,7 @@ def iso_damping_cmd(
         "out": str(out) if out else None,
     }
     if as_json:
-        _emit_json(res)
+        emit_json(res)
         return
     click.echo(
         f"D = {curve.damping:g} ({relation}): from r = {curve.r_min:.4f} at beta = 0 "
@@ -287,7 +286,7 @@ def iso_damping_cmd(
 @click.option("--alpha", type=POSITIVE, default=CASES["B"]["alpha"], show_default=True, help="Forcing A/L.")
 @click.option("--relation", type=click.Choice(_RELATIONS), default="model", show_default=True,
               help="Which equal-damping curve (see iso-damping).")  # fmt: skip
-@_json_option
+@json_option
 def fit_cmd(
     theta_hat: float, eta_graze: float, damping: float, alpha: float, relation: str, as_json: bool
 ) -> None:
@@ -308,7 +307,7 @@ def fit_cmd(
         "evaluations": fit.evaluations,
     }
     if as_json:
-        _emit_json(res)
+        emit_json(res)
         return
     click.echo(
         f"beta = {fit.beta:.5f}, r = {fit.r:.4f}  (primary grazing at theta-hat = {theta_hat:g} deg "
@@ -389,7 +388,7 @@ def _plot_recording(a: Any, path: Path) -> None:
               help="Model sweep points (with --with-model).")  # fmt: skip
 @click.option("--plot", type=path_type(dir_okay=False), metavar="FILE.png",
               help="Draw the time series and embedding (file) or the diagram (folder).")  # fmt: skip
-@_json_option
+@json_option
 def analyze_cmd(
     path: Path, forcing_hz: float | None, phase: float, degrees: bool, cutoff_hz: float | None,
     cutoff_multiple: float, max_period: int, noise: float | None, theta_hat: float | None, with_model: bool,
@@ -399,14 +398,14 @@ def analyze_cmd(
     from grazing.experiment.recording import load_recording
     from grazing.experiment.signal import analyze_recording
 
-    _check_out(plot, ".png", "--plot")
+    check_out(plot, ".png", "--plot")
     case_values(case)
     refuse_unused(["case", "model_points"], not with_model, "without --with-model")
     refuse_unused(["cutoff_multiple"], cutoff_hz is not None, "with --cutoff-hz")
     if path.is_dir():
         for name, val in (("--forcing-hz", forcing_hz), ("--cutoff-hz", cutoff_hz), ("--noise", noise)):
             if val is not None:
-                raise _ErrorInput(f"{name} applies to a single recording, not to a folder")
+                raise InputError(f"{name} applies to a single recording, not to a folder")
         if with_model:
             check_memory(
                 sweep_bytes(model_points, 60, 2, streamed=False, as_json=as_json, chunk_points=50, workers=1),
@@ -417,7 +416,7 @@ def analyze_cmd(
                         model_points, plot, as_json)  # fmt: skip
         return
     if with_model:
-        raise _ErrorInput("--with-model applies to a folder of recordings")
+        raise InputError("--with-model applies to a folder of recordings")
     refuse_unused(["theta_hat"], True, "for a single recording (it is the stop angle of a folder's diagram)")
     rec = load_recording(path, degrees=degrees)
     a = analyze_recording(
@@ -429,7 +428,7 @@ def analyze_cmd(
     res = _analysis_json(a, rec)
     res["plot"] = str(plot) if plot else None
     if as_json:
-        _emit_json(res)
+        emit_json(res)
         return
     kind = f"period {a.period}" if a.period else f"no period <= {max_period} at this noise level"
     src = "trigger" if a.from_trigger else "--forcing-hz"
@@ -455,7 +454,7 @@ def _analyze_folder(
 ) -> None:  # fmt: skip
     from grazing.experiment.diagram import load_diagram, model_sweep, plot_diagram
 
-    bar = _Progress("analysing", enabled=not as_json)
+    bar = Progress("analysing", enabled=not as_json)
     try:
         diag = load_diagram(
             path, theta_hat_deg=theta_hat, degrees=degrees, phase=phase, cutoff_multiple=cutoff_multiple,
@@ -466,11 +465,11 @@ def _analyze_folder(
     model = None
     if with_model:
         if diag.theta_hat_deg is None:
-            raise _ErrorInput(
+            raise InputError(
                 "--with-model needs the stop angle: give --theta-hat or theta_hat_deg in sidecars"
             )
         etas = np.linspace(diag.eta.min(), diag.eta.max(), model_points)
-        bar = _Progress("model sweep", enabled=not as_json)
+        bar = Progress("model sweep", enabled=not as_json)
         try:
             model = model_sweep(diag.theta_hat_deg, etas, case=case, progress=bar)
         finally:
@@ -503,7 +502,7 @@ def _analyze_folder(
             "samples": [[_none_if_nan(v) for v in row] for row in model.samples.values[..., 0]],
         }
     if as_json:
-        _emit_json(res)
+        emit_json(res)
         return
     th = f"{diag.theta_hat_deg:g} deg" if diag.theta_hat_deg is not None else "unknown"
     click.echo(f"{path}: {len(diag.files)} recordings, theta-hat {th}")
@@ -533,7 +532,7 @@ def _analyze_folder(
 @click.option("--seed", type=SEED, default=0, show_default=True, help="Seed of the noise (>= 0).")
 @click.option("--out", type=path_type(), required=True, metavar="FILE.csv|DIR",
               help="A .csv file (one --eta) or a folder (several).")  # fmt: skip
-@_json_option
+@json_option
 def synthesize_cmd(
     etas: tuple[float, ...], theta_hat: float, case: str, periods: int, transient: int, sample_rate: float,
     noise: float, seed: int, out: Path, as_json: bool,
@@ -546,15 +545,15 @@ def synthesize_cmd(
     case_values(case)
     one_file = out.suffix.lower() == ".csv"
     if one_file and len(etas) != 1:
-        raise _ErrorInput("several --eta values need a folder as --out, not a .csv file")
+        raise InputError("several --eta values need a folder as --out, not a .csv file")
     if not one_file and out.exists() and not out.is_dir():
-        raise _ErrorInput(f"--out {str(out)!r} exists and is not a folder")
+        raise InputError(f"--out {str(out)!r} exists and is not a folder")
     if not (out.parent if str(out.parent) else Path(".")).is_dir():
-        raise _ErrorInput(f"folder {str(out.parent)!r} does not exist")
+        raise InputError(f"folder {str(out.parent)!r} does not exist")
     samples = {e: periods / PAPER_RIG.forcing_hz(e) * sample_rate for e in etas}
     fewest = min(samples, key=samples.__getitem__)
     if samples[fewest] < MIN_SAMPLES:
-        raise _ErrorInput(
+        raise InputError(
             f"a recording at --eta {fewest:g} would have {samples[fewest]:.3g} samples, fewer than "
             f"{MIN_SAMPLES}: raise --sample-rate or --periods"
         )
@@ -572,7 +571,7 @@ def synthesize_cmd(
         kw.update(periods=periods, transient=transient, seed=seed)
         paths = _synthesize_folder(out, theta_hat, etas, **kw)
     if as_json:
-        _emit_json({"files": [str(p) for p in paths], "synthetic": True})
+        emit_json({"files": [str(p) for p in paths], "synthetic": True})
         return
     for p in paths:
         click.echo(f"wrote {p} (synthetic)")
@@ -611,18 +610,3 @@ def _synthesize_folder(out: Path, theta_hat: float, etas: tuple[float, ...], **k
 
 
 COMMANDS = (damping_cmd, iso_damping_cmd, fit_cmd, analyze_cmd, synthesize_cmd)
-
-
-def register(group: click.Group) -> None:
-    """Add the experiment commands to ``group`` (idempotent).
-
-    Examples
-    --------
-    >>> from grazing.cli import cli
-    >>> register(cli); register(cli)
-    >>> sorted(c for c in cli.commands if c in ("damping", "fit", "analyze"))
-    ['analyze', 'damping', 'fit']
-    """
-    for cmd in COMMANDS:
-        if cmd.name not in group.commands:
-            group.add_command(cmd)

@@ -1,0 +1,228 @@
+"""What every command shares: errors, options, progress, JSON, atomic writes, the pendulum's options.
+
+Bad input is an :class:`InputError` (one line, exit 2); the work's own errors
+are :class:`~grazing.errors.GrazingError` (one line, exit 1); :func:`main`
+turns both into ``grazing: error: ...`` on stderr.  Every file a command
+writes is written all at once (:func:`write_atomic`, :func:`save_dataset`),
+so a failed run leaves nothing half-written.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import math
+import sys
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import click
+import numpy as np
+
+import grazing
+from grazing.atomic import atomic_path, write_text_atomic
+from grazing.cli.validate import (
+    ANGLE_DEG,
+    InputError,
+    path_type,
+    refuse_unused,
+)
+from grazing.models.pendulum import CASES, DEFAULT_CASE, case_values
+
+PENDULUM_UNFOLDING = ("eta", "theta_hat")
+"""The parameters of the pendulum's normal-form unfolding vectors (the JSON reports both)."""
+
+EXIT_USAGE = 2
+EXIT_FAILURE = 1
+EXIT_INTERRUPTED = 130
+
+
+InputError = InputError
+"""A usage error reported as one line (the name the command modules use)."""
+
+
+# ----------------------------------------------------------------------------
+# Shared options
+
+
+json_option = click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
+netcdf_out_option = click.option(
+    "--out", type=path_type(dir_okay=False), metavar="FILE.nc", help="Save as NetCDF."
+)
+
+
+def model_options(func: Callable[..., Any]) -> Callable[..., Any]:
+    """Options selecting the pendulum's parameters: a named case plus overrides.
+
+    The decorated command receives the validated model as ``model`` and the
+    case name as ``case`` (for its JSON output).
+    """
+
+    @functools.wraps(func)
+    def wrapper(
+        *args: Any, case: str, alpha: float | None, beta: float | None, r: float | None, eta: float,
+        theta_hat: float, **kwargs: Any,
+    ) -> Any:  # fmt: skip
+        refuse_unused(["case"], None not in (alpha, beta, r), "when --alpha, --beta and --r are all given")
+        model = build_pendulum(case, alpha, beta, r, eta, theta_hat)
+        return func(*args, model=model, case=case, **kwargs)
+
+    options = [
+        click.option(
+            "--case",
+            default=DEFAULT_CASE,
+            show_default=True,
+            metavar="NAME",
+            help=f"Paper parameter case: {', '.join(CASES)} (sets r, beta, alpha).",
+        ),
+        click.option("--alpha", type=float, help="Forcing amplitude A/L (overrides the case)."),
+        click.option("--beta", type=float, help="Linear damping (overrides the case)."),
+        click.option("--r", "r", type=float, help="Coefficient of restitution in [0, 1]."),
+        click.option("--eta", type=float, default=0.446, show_default=True, help="Frequency ratio."),
+        click.option(
+            "--theta-hat",
+            "theta_hat",
+            type=ANGLE_DEG,
+            default=40.0,
+            show_default=True,
+            metavar="DEG",
+            help="Stop angle in degrees, in (-180, 180).",
+        ),
+    ]
+    for opt in reversed(options):
+        wrapper = opt(wrapper)
+    return wrapper
+
+
+def build_pendulum(
+    case: str, alpha: float | None, beta: float | None, r: float | None, eta: float, theta_hat: float
+) -> grazing.HybridModel:
+    """The pendulum model from command-line values (theta_hat in degrees, checked by its option type)."""
+    values = case_values(case)
+    for name, val in (("alpha", alpha), ("beta", beta), ("r", r)):
+        if val is not None:
+            values[name] = val
+    values["eta"] = eta
+    values["theta_hat"] = math.radians(theta_hat)
+    return grazing.models.pendulum(None, **values)
+
+
+def model_params_json(model: grazing.HybridModel, case: str) -> dict[str, Any]:
+    p = dict(model.params)
+    p["theta_hat_deg"] = math.degrees(p["theta_hat"])
+    p["case"] = case
+    return p
+
+
+def parse_pair(text: str) -> tuple[float, float]:
+    parts = text.split(",")
+    try:
+        if len(parts) != 2:
+            raise ValueError
+        a, b = (float(s) for s in parts)
+    except ValueError:
+        raise InputError(f"--initial must be THETA,THETADOT in radians, got {text!r}") from None
+    if not (math.isfinite(a) and math.isfinite(b)):
+        raise InputError(f"--initial must be finite numbers, got {text!r}")
+    return a, b
+
+
+class Progress:
+    """A progress bar on stderr that appears only if the work lasts over a second."""
+
+    def __init__(self, label: str, enabled: bool, unit: str = "items"):
+        self.label = label
+        self.unit = unit
+        self.enabled = enabled and sys.stderr.isatty()
+        self.start = time.perf_counter()
+        self._bar: Any = None
+        self._task: Any = None
+
+    def __call__(self, done: int, total: int) -> None:
+        if not self.enabled:
+            return
+        if self._bar is None:
+            if time.perf_counter() - self.start < 1.0 or done >= total:
+                return
+            from rich.console import Console
+            from rich.progress import (
+                BarColumn,
+                MofNCompleteColumn,
+                Progress,
+                TextColumn,
+                TimeRemainingColumn,
+            )
+
+            self._bar = Progress(
+                TextColumn(self.label),
+                BarColumn(),
+                MofNCompleteColumn(),
+                TextColumn("{task.fields[rate]}"),
+                TimeRemainingColumn(),
+                console=Console(stderr=True),
+                transient=True,
+            )
+            self._bar.start()
+            self._task = self._bar.add_task(self.label, total=total, rate="")
+        elapsed = time.perf_counter() - self.start
+        rate = f"{done / elapsed:,.0f} {self.unit}/s" if elapsed > 0 else ""
+        self._bar.update(self._task, completed=done, rate=rate)
+
+    def close(self) -> None:
+        if self._bar is not None:
+            self._bar.stop()
+
+
+def write_atomic(path: Path, write: Callable[[Any], None]) -> None:
+    """Write a text file all at once (see :mod:`grazing.atomic`), into an existing folder."""
+    path = Path(path)
+    folder = path.parent if str(path.parent) else Path(".")
+    if not folder.is_dir():
+        raise InputError(f"folder {str(folder)!r} does not exist")
+    write_text_atomic(path, write)
+
+
+def emit_json(obj: dict[str, Any]) -> None:
+    click.echo(json.dumps(obj, allow_nan=False, default=json_default))
+
+
+def json_default(o: Any) -> Any:
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    if isinstance(o, np.generic):
+        return o.item()
+    raise TypeError(f"not JSON serialisable: {type(o).__name__}")
+
+
+def check_eta_range(eta_min: float, eta_max: float) -> None:
+    """``--eta-min < --eta-max`` (each is positive by its option type)."""
+    if not eta_min < eta_max:
+        raise InputError(f"need 0 < --eta-min < --eta-max, got {eta_min:g} and {eta_max:g}")
+
+
+def complex_list(mu: np.ndarray) -> list[list[float]]:
+    return [[float(z.real), float(z.imag)] for z in np.asarray(mu, dtype=complex)]
+
+
+def check_out(out: Path | None, suffix: str, option: str = "--out") -> None:
+    """An output path must have ``suffix`` and an existing folder (checked before any work)."""
+    if out is None:
+        return
+    if out.suffix.lower() != suffix:
+        raise InputError(f"{option} must name a {suffix} file, got {str(out)!r}")
+    folder = out.parent if str(out.parent) else Path(".")
+    if not folder.is_dir():
+        raise InputError(f"folder {str(folder)!r} does not exist")
+
+
+def save_dataset(ds: Any, out: Path) -> None:
+    """Write a dataset to NetCDF all at once, so a failure leaves nothing."""
+    with atomic_path(out, suffix=".nc") as tmp:
+        ds.to_netcdf(tmp, engine="h5netcdf")
+
+
+def error_line(message: str) -> None:
+    """``grazing: error: MESSAGE`` as one line on stderr (click's multi-line messages are joined)."""
+    click.echo(f"grazing: error: {' '.join(message.split())}", err=True)

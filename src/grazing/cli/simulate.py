@@ -1,0 +1,147 @@
+"""``grazing simulate``: simulate a model; stroboscopic samples, impacts, the period, a dense trajectory."""
+
+from __future__ import annotations
+
+import functools
+import math
+import time
+from pathlib import Path
+from typing import Any
+
+import click
+import numpy as np
+
+import grazing
+from grazing.cli.common import (
+    InputError,
+    Progress,
+    check_out,
+    emit_json,
+    json_option,
+    model_options,
+    model_params_json,
+    parse_pair,
+    write_atomic,
+)
+from grazing.cli.limits import check_memory, count_text, simulate_bytes
+from grazing.cli.validate import FINITE, count, path_type, refuse_unused
+
+
+@click.command()
+@model_options
+@click.option("--initial", default="0,0", show_default=True, metavar="THETA,THETADOT",
+              help="Initial state at tau = 0, radians.")  # fmt: skip
+@click.option("--transient", type=count(0), default=500, show_default=True,
+              help="Forcing periods run and discarded first.")  # fmt: skip
+@click.option("--periods", type=count(1), default=100, show_default=True,
+              help="Forcing periods sampled.")  # fmt: skip
+@click.option("--phase", type=FINITE, default=0.0, show_default=True, metavar="PHI",
+              help="Stroboscopic phase in radians: samples at tau = PHI mod 2 pi.")  # fmt: skip
+@click.option("--trajectory", type=path_type(dir_okay=False), metavar="FILE.csv",
+              help="Write the dense trajectory of the sampled span to a CSV file.")  # fmt: skip
+@click.option("--points-per-period", type=count(4), default=100, show_default=True,
+              help="Trajectory resolution (with --trajectory).")  # fmt: skip
+@json_option
+def simulate(
+    model: grazing.HybridModel,
+    case: str,
+    initial: str,
+    transient: int,
+    periods: int,
+    phase: float,
+    trajectory: Path | None,
+    points_per_period: int,
+    as_json: bool,
+) -> None:
+    """Simulate the impacting pendulum; print stroboscopic samples, impacts, period."""
+    refuse_unused(["points_per_period"], trajectory is None, "without --trajectory")
+    theta0, dtheta0 = parse_pair(initial)
+    if theta0 > model.params["theta_hat"]:
+        raise InputError(
+            f"initial angle {theta0:g} rad is beyond the stop at theta-hat = "
+            f"{math.degrees(model.params['theta_hat']):g} deg ({model.params['theta_hat']:.6g} rad)"
+        )
+    check_out(trajectory, ".csv", "--trajectory")
+    points = periods * points_per_period + 1 if trajectory is not None else 0
+    check_memory(
+        simulate_bytes(periods, model.n_states, points, as_json),
+        f"simulating {count_text(periods)} sampled periods"
+        + (f" with a trajectory of {count_text(points)} points" if points else ""),
+        "sample fewer periods (--periods; --transient runs without keeping anything)"
+        + (" or fewer --points-per-period" if points else ""),
+    )
+    bar = Progress("simulating", enabled=not as_json, unit="periods")
+    t0 = time.perf_counter()
+    try:
+        sol = grazing.simulate(
+            model,
+            [theta0, dtheta0],
+            transient=transient,
+            periods=periods,
+            phase=phase,
+            trajectory=points_per_period if trajectory is not None else 0,
+            progress=bar,
+        )
+    finally:
+        bar.close()
+    elapsed = time.perf_counter() - t0
+    if trajectory is not None:
+        write_atomic(trajectory, functools.partial(_write_trajectory_csv, sol))
+    period = sol.period()
+    result = {
+        "params": model_params_json(model, case),
+        "initial": [theta0, dtheta0],
+        "transient": transient,
+        "periods": periods,
+        "phase": phase,
+        "samples": sol.samples,
+        "impacts": sol.n_impacts,
+        "impacts_sampled": len(sol.impacts),
+        "impact_map": np.column_stack([sol.impacts.t, sol.impacts.phase, sol.impacts.speed]),
+        "sticking_intervals": sol.sticking,
+        "period": period,
+        "t_final": sol.t_final,
+        "x_final": sol.x_final,
+        "steps": sol.n_steps,
+        "elapsed_s": elapsed,
+        "trajectory_file": str(trajectory) if trajectory is not None else None,
+        "version": grazing.__version__,
+    }
+    if as_json:
+        emit_json(result)
+        return
+    _print_simulation(model, sol, period, elapsed, trajectory)
+
+
+def _write_trajectory_csv(sol: grazing.Solution, fh: Any) -> None:
+    fh.write("tau,theta,dtheta\n")
+    assert sol.trajectory_t is not None and sol.trajectory is not None
+    np.savetxt(fh, np.column_stack([sol.trajectory_t, sol.trajectory]), delimiter=",", fmt="%.17g")
+
+
+def _print_simulation(
+    model: grazing.HybridModel, sol: grazing.Solution, period: int, elapsed: float, trajectory: Path | None
+) -> None:
+    from rich.console import Console
+    from rich.table import Table
+
+    con = Console()
+    p = model.params
+    con.print(
+        f"[bold]impacting pendulum[/bold]  alpha={p['alpha']:g} beta={p['beta']:g} r={p['r']:g} "
+        f"eta={p['eta']:g} theta-hat={math.degrees(p['theta_hat']):g} deg"
+    )
+    n = sol.samples.shape[0]
+    kind = f"period {period}" if period else "no period <= 64 (chaotic, quasi-periodic or not settled)"
+    con.print(f"{n} sampled periods after {sol.info['transient']} transient: [bold]{kind}[/bold]")
+    con.print(
+        f"impacts: {sol.n_impacts} in the whole run, {len(sol.impacts)} in the sampled span; "
+        f"sticking intervals: {len(sol.sticking)}; {sol.n_steps} steps in {elapsed:.3f} s"
+    )
+    table = Table("k", "tau", "theta [rad]", "theta' ", title="last stroboscopic samples")
+    show = min(n, max(period, 5) if period else 8)
+    for i in range(n - show, n):
+        table.add_row(str(i), f"{sol.t[i]:.6f}", f"{sol.samples[i, 0]: .10f}", f"{sol.samples[i, 1]: .10f}")
+    con.print(table)
+    if trajectory is not None:
+        con.print(f"trajectory written to {trajectory}")

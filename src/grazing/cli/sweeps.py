@@ -1,0 +1,337 @@
+"""``grazing sweep``, ``grazing map``: brute-force bifurcation diagrams and two-parameter maps."""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import click
+import numpy as np
+
+import grazing
+from grazing.cli.common import (
+    PENDULUM_UNFOLDING,
+    InputError,
+    Progress,
+    complex_list,
+    emit_json,
+    json_option,
+    model_options,
+    model_params_json,
+    parse_pair,
+    save_dataset,
+)
+from grazing.cli.limits import POINT_OVERHEAD, check_memory, count_text, sweep_bytes
+from grazing.cli.validate import FINITE, POSITIVE, TOLERANCE, WORKERS, count, path_type, refuse_unused
+
+_SWEEP_PARAMS = {"eta": "eta", "theta-hat": "theta_hat", "alpha": "alpha", "beta": "beta", "r": "r"}
+
+
+def _sweep_options(func: Callable[..., Any]) -> Callable[..., Any]:
+    options = [
+        click.option("--transient", type=count(0), default=500, show_default=True,
+                     help="Forcing periods discarded at each point.")
+        ,
+        click.option("--periods", type=count(1), default=100, show_default=True,
+                     help="Forcing periods sampled at each point."),
+        click.option("--initial", default="0,0", show_default=True, metavar="THETA,THETADOT",
+                     help="Initial state (of every chunk; of every point with --fresh)."),
+        click.option("--fresh", is_flag=True, help="Start every point from --initial."),
+        click.option("--chunk-size", type=count(0), default=None,
+                     help="Points per chunk: the unit of parallel work and of saving (0: one chunk)."),
+        click.option("--workers", type=WORKERS, help="Local processes (default: all cores)."),
+        click.option("--scheduler", metavar="tcp://HOST:PORT", help="Run the chunks on a Dask cluster."),
+        click.option("--timeout", type=POSITIVE, metavar="SECONDS",
+                     help="With --scheduler: give up after this long without any Dask worker "
+                          "(default: wait; a message after 5 s)."),
+        click.option("--no-lyapunov", is_flag=True, help="Skip the Lyapunov exponents."),
+        click.option("--no-adaptive", is_flag=True, help="Always run the full transient."),
+        click.option("--tol", type=TOLERANCE, default=1e-10, show_default=True,
+                     help="Integrator tolerance, in (0, 0.01)."),
+        click.option("--out", type=path_type(), metavar="FILE.zarr|FILE.nc",
+                     help="Zarr store (resumable; one run at a time) or NetCDF file."),
+        click.option("--wait", is_flag=True,
+                     help="If another run is writing the --out store, wait for it instead of stopping."),
+        json_option,
+    ]  # fmt: skip
+    for opt in reversed(options):
+        func = opt(func)
+    return func
+
+
+def _check_sweep_options(
+    out: Path | None, scheduler: str | None, chunk_size: int | None, n_points: int, periods: int,
+    n_states: int, workers: int | None, as_json: bool, what: str,
+) -> None:  # fmt: skip
+    """The checks shared by ``sweep`` and ``map``, before any work: output, options used together, memory."""
+    if out is not None and out.suffix.lower() not in (".zarr", ".nc"):
+        raise InputError(f"--out must end in .zarr or .nc, got {str(out)!r}")
+    if out is not None:
+        folder = out.parent if str(out.parent) else Path(".")
+        if not folder.is_dir():
+            raise InputError(f"folder {str(folder)!r} does not exist")
+    zarr_out = out is not None and out.suffix.lower() == ".zarr"
+    refuse_unused(["wait"], not zarr_out, "without a Zarr store (--out FILE.zarr)")
+    refuse_unused(["timeout"], scheduler is None, "without --scheduler")
+    refuse_unused(
+        ["workers"], scheduler is not None, "with --scheduler (the cluster's workers run the chunks)"
+    )
+    if zarr_out and out is not None and out.exists():
+        from grazing.sweeps.ownership import check_is_store
+
+        check_is_store(out)  # refuse what grazing did not make before computing anything
+    streamed = zarr_out and not as_json
+    chunk = n_points if not chunk_size else min(chunk_size, n_points)
+    n_workers = workers or os.cpu_count() or 1
+    need = sweep_bytes(n_points, periods, n_states, streamed=streamed, as_json=as_json, chunk_points=chunk,
+                       workers=n_workers)  # fmt: skip
+    chunks_dominate = streamed and need > 2 * n_points * POINT_OVERHEAD  # the samples in flight, mostly
+    check_memory(
+        need,
+        f"{what} of {count_text(n_points)} points x {count_text(periods)} periods",
+        "use a smaller --chunk-size (or fewer --workers): the chunks in flight hold their samples"
+        if chunks_dominate
+        else "split it into several runs over parts of the range"
+        + ("" if streamed else ", or stream the results to a Zarr store (--out FILE.zarr, without --json)"),
+    )
+
+
+class _SweepRun:
+    """What a sweep run returns to its command: the dataset, or (streamed to a store) the periods only."""
+
+    def __init__(self, ds: Any, period: np.ndarray | None):
+        self.ds = ds
+        self.period = period
+
+
+def _run_sweep_spec(
+    spec: Any, out: Path | None, scheduler: str | None, workers: int | None, as_json: bool,
+    wait: bool = False, timeout: float | None = None,
+) -> _SweepRun:  # fmt: skip
+    """Run a sweep spec with the CLI's storage, cluster and progress options.
+
+    With a Zarr store and no ``--json``, the results stream to the store and
+    only the detected periods are read back (for the summary).
+    """
+    from grazing.sweeps.api import run_sweep
+
+    zarr_out = out is not None and out.suffix.lower() == ".zarr"
+    streamed = zarr_out and not as_json
+    client = None
+    if scheduler is not None:
+        try:
+            from distributed import Client
+
+            client = Client(scheduler, timeout="5s")
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise InputError(f"cannot connect to the Dask scheduler at {scheduler}: {exc}") from None
+    store: Any = None
+    bar = Progress("sweeping", enabled=not as_json, unit="points")
+    try:
+        if zarr_out:
+            from grazing.sweeps.store import ZarrStore
+
+            store = ZarrStore(
+                out, spec, attrs={"command": " ".join(["grazing", *sys.argv[1:]])}, wait=wait,
+                on_wait=lambda pid: click.echo(
+                    f"grazing: {out} is being written by another grazing run"
+                    + (f" (PID {pid})" if pid is not None else "") + "; waiting", err=True
+                ),
+            )  # fmt: skip
+        ds = run_sweep(
+            spec, store=store, workers=workers, client=client, progress=bar, timeout=timeout,
+            notice=lambda msg: click.echo(f"grazing: {msg}", err=True), load=not streamed,
+        )  # fmt: skip
+        period = store.read("period") if streamed else None
+    finally:
+        bar.close()
+        if store is not None:
+            store.close()
+        if client is not None:
+            client.close()
+    if out is not None and out.suffix.lower() == ".nc":
+        save_dataset(ds, out)
+    return _SweepRun(ds, period)
+
+
+def _sweep_json(ds: Any, param: str, values: np.ndarray) -> dict[str, Any]:
+    return {
+        "param": param,
+        "values": values,
+        "period": ds.period.values,
+        "impacts_per_period": np.where(
+            np.isfinite(ds.impacts_per_period.values), ds.impacts_per_period.values, None
+        ),
+        "lyapunov": [None if not math.isfinite(v) else float(v) for v in ds.lyapunov.values],
+        "samples": ds.samples.values[..., 0],
+        "transient_used": ds.transient_used.values,
+    }
+
+
+@click.command("sweep")
+@model_options
+@click.option("--param", "sparam", required=True, type=click.Choice(list(_SWEEP_PARAMS)),
+              help="Parameter to sweep (theta-hat in degrees).")  # fmt: skip
+@click.option("--start", type=FINITE, required=True, help="First parameter value.")
+@click.option("--stop", type=FINITE, required=True, help="Last parameter value.")
+@click.option("--num", type=count(1), required=True, help="Number of parameter values.")
+@click.option("--direction", type=click.Choice(["up", "down"]), default="up", show_default=True,
+              help="Order in which the values are visited.")  # fmt: skip
+@click.option(
+    "--method",
+    type=click.Choice(["flow", "map"]),
+    default="flow",
+    show_default=True,
+    help="flow: direct simulation; map: the discontinuity-map Poincare map built at a grazing.",
+)
+@click.option("--which", type=click.Choice(["first", "second"]), default="first", show_default=True,
+              help="With --method map: the grazing the map is built at.")  # fmt: skip
+@_sweep_options
+def sweep_cmd(
+    model: grazing.HybridModel, case: str,
+    sparam: str, start: float, stop: float, num: int, direction: str, method: str, which: str,
+    transient: int, periods: int, initial: str, fresh: bool, chunk_size: int | None, workers: int | None,
+    scheduler: str | None, timeout: float | None, no_lyapunov: bool, no_adaptive: bool, tol: float,
+    out: Path | None, wait: bool, as_json: bool,
+) -> None:  # fmt: skip
+    """Brute-force bifurcation diagram: stroboscopic samples, periods, impacts and
+    Lyapunov exponents along a parameter range."""
+    from grazing.sweeps.spec import SweepSpec
+
+    name = _SWEEP_PARAMS[sparam]
+    refuse_unused([name], True, f"with --param {sparam}: the swept values replace it")
+    refuse_unused(["which"], method != "map", "without --method map")
+    chunk_size = 50 if chunk_size is None else chunk_size
+    _check_sweep_options(
+        out, scheduler, chunk_size, num, periods, model.n_states, workers, as_json, "a sweep"
+    )
+    shown = np.linspace(start, stop, num)
+    vals = np.radians(shown) if name == "theta_hat" else shown
+    order = np.sort(vals) if direction == "up" else np.sort(vals)[::-1]
+    x0 = parse_pair(initial)
+    for v in (order[0], order[-1]):
+        model.with_params(**{name: v})
+    zdm, graze_info = None, None
+    if method == "map":
+        zdm, graze_info = _map_for_sweep(model, name, float(vals.min()), float(vals.max()), which)
+    spec = SweepSpec(
+        model=model, params=(name,), points=tuple((float(v),) for v in order),
+        x0=tuple(float(v) for v in model.with_params(**{name: order[0]}).check_state(x0)),
+        transient=transient, periods=periods, fresh=fresh, chunk_size=chunk_size,
+        adaptive=not no_adaptive, lyapunov=not no_lyapunov, tol=tol, zdm=zdm,
+    )  # fmt: skip
+    t0 = time.perf_counter()
+    run = _run_sweep_spec(spec, out, scheduler, workers, as_json, wait, timeout)
+    elapsed = time.perf_counter() - t0
+    if as_json:
+        ds = run.ds.sortby("value")
+        res = {"params": model_params_json(model, case), **_sweep_json(ds, sparam, np.sort(shown))}
+        res.update({"direction": direction, "fresh": fresh, "transient": transient, "periods": periods,
+                    "chunk_size": spec.size, "elapsed_s": elapsed, "out": str(out) if out else None,
+                    "method": method, "grazing": graze_info})  # fmt: skip
+        emit_json(res)
+        return
+    if run.ds is not None:
+        per = run.ds.sortby("value").period.values
+    else:  # streamed to the store: the periods in visiting order, sorted like the values
+        per = run.period[np.argsort(order, kind="stable")]
+    click.echo(f"{num} values of {sparam} in {elapsed:.1f} s ({num / elapsed:.0f} points/s)")
+    click.echo(f"periodic points: {(per > 0).sum()}, no period <= 64: {(per == 0).sum()}")
+    for p in sorted(set(per[per > 0].tolist()))[:12]:
+        sel = np.sort(shown)[per == p]
+        click.echo(f"  period {p:2d}: {sel.size} points, {sparam} in [{sel.min():.6g}, {sel.max():.6g}]")
+    if out is not None:
+        click.echo(f"saved to {out}")
+
+
+_GRAZE_SEARCH = {"eta": (0.2, 1.0), "theta_hat": (-3.1, 3.1)}
+
+
+def _map_for_sweep(model: Any, name: str, lo: float, hi: float, which: str) -> tuple[Any, dict[str, Any]]:
+    """The discontinuity map at the first/second grazing for a sweep in ``name`` over ``[lo, hi]``."""
+    from grazing.normalform import find_grazing_point, normal_form_at
+
+    a, b = _GRAZE_SEARCH.get(name, (lo - 0.5 * (hi - lo), hi + 0.5 * (hi - lo)))
+    point = find_grazing_point(model, name, min(a, lo), max(b, hi), which)
+    nf = normal_form_at(point, PENDULUM_UNFOLDING)
+    back = math.degrees if name == "theta_hat" else float
+    info = {
+        "param": name,
+        "value": back(point.model.params[name]),
+        "t_graze": point.phase,
+        "multipliers": complex_list(point.multipliers),
+        "accel": nf.accel,
+        "direction": nf.direction,
+    }
+    return nf.discontinuity_map(), info
+
+
+@click.command("map")
+@model_options
+@click.option("--param1", required=True, type=click.Choice(list(_SWEEP_PARAMS)), help="Horizontal parameter.")
+@click.option("--start1", type=FINITE, required=True)
+@click.option("--stop1", type=FINITE, required=True)
+@click.option("--num1", type=count(1), required=True)
+@click.option("--param2", required=True, type=click.Choice(list(_SWEEP_PARAMS)), help="Vertical parameter.")
+@click.option("--start2", type=FINITE, required=True)
+@click.option("--stop2", type=FINITE, required=True)
+@click.option("--num2", type=count(1), required=True)
+@_sweep_options
+def map_cmd(
+    model: grazing.HybridModel, case: str,
+    param1: str, start1: float, stop1: float, num1: int, param2: str, start2: float, stop2: float, num2: int,
+    transient: int, periods: int, initial: str, fresh: bool, chunk_size: int | None, workers: int | None,
+    scheduler: str | None, timeout: float | None, no_lyapunov: bool, no_adaptive: bool, tol: float,
+    out: Path | None, wait: bool, as_json: bool,
+) -> None:  # fmt: skip
+    """Two-parameter map of periods, impacts and Lyapunov exponents."""
+    from grazing.sweeps.spec import SweepSpec
+
+    if param1 == param2:
+        raise InputError("--param1 and --param2 must differ")
+    n1, n2 = _SWEEP_PARAMS[param1], _SWEEP_PARAMS[param2]
+    refuse_unused([n1, n2], True, f"with --param1 {param1} --param2 {param2}: the mapped values replace it")
+    chunk_size = num1 if chunk_size is None else chunk_size
+    _check_sweep_options(out, scheduler, chunk_size, num1 * num2, periods, model.n_states, workers, as_json,
+                         "a map")  # fmt: skip
+    s1, s2 = np.linspace(start1, stop1, num1), np.linspace(start2, stop2, num2)
+    v1 = np.radians(s1) if n1 == "theta_hat" else s1
+    v2 = np.radians(s2) if n2 == "theta_hat" else s2
+    v1, v2 = np.sort(v1), np.sort(v2)
+    for a, b in ((v1[0], v2[0]), (v1[-1], v2[-1])):
+        model.with_params(**{n1: a, n2: b})
+    x0 = parse_pair(initial)
+    spec = SweepSpec(
+        model=model, params=(n1, n2), points=tuple((float(a), float(b)) for b in v2 for a in v1),
+        x0=tuple(float(v) for v in model.with_params(**{n1: v1[0], n2: v2[0]}).check_state(x0)),
+        transient=transient, periods=periods, fresh=fresh, chunk_size=chunk_size,
+        adaptive=not no_adaptive, lyapunov=not no_lyapunov, tol=tol, shape=(num2, num1),
+    )  # fmt: skip
+    t0 = time.perf_counter()
+    run = _run_sweep_spec(spec, out, scheduler, workers, as_json, wait, timeout)
+    elapsed = time.perf_counter() - t0
+    if as_json:
+        ds = run.ds
+        res = {
+            "params": model_params_json(model, case),
+            "param1": param1, "values1": np.sort(s1), "param2": param2, "values2": np.sort(s2),
+            "period": ds.period.values, "impacts_per_period": ds.impacts_per_period.values,
+            "lyapunov": ds.lyapunov.values, "elapsed_s": elapsed, "out": str(out) if out else None,
+        }  # fmt: skip
+        res["impacts_per_period"] = [
+            [None if not math.isfinite(x) else x for x in row] for row in res["impacts_per_period"]
+        ]
+        res["lyapunov"] = [[None if not math.isfinite(x) else x for x in row] for row in res["lyapunov"]]
+        emit_json(res)
+        return
+    per = run.ds.period.values if run.ds is not None else run.period
+    click.echo(
+        f"{num1} x {num2} map in {elapsed:.1f} s; periodic cells {(per > 0).sum()}, none {(per == 0).sum()}"
+    )
+    if out is not None:
+        click.echo(f"saved to {out}")
