@@ -9,7 +9,6 @@ non-zero exit status; nothing is written.
 
 from __future__ import annotations
 
-
 import click
 
 import grazing
@@ -60,5 +59,3 @@ def main(argv: list[str] | None = None) -> int:
         error_line(f"out of memory (the estimate before the run was too low; {MEMORY_ENV} lowers the bound)")
         return EXIT_FAILURE
     return 0
-
-
