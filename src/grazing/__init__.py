@@ -9,6 +9,7 @@
 
 from grazing import models
 from grazing.core import HybridModel, Impacts, Parameter, Solution
+from grazing.core.options import SaveAt, Solver, SweepSettings, Tangent
 from grazing.core.period import detect_period
 from grazing.engine.simulate import simulate
 from grazing.errors import (
@@ -40,8 +41,12 @@ __all__ = [
     "InvalidParameterError",
     "InvalidStateError",
     "Parameter",
+    "SaveAt",
     "SimulationError",
     "Solution",
+    "Solver",
+    "SweepSettings",
+    "Tangent",
     "__version__",
     "detect_period",
     "models",

@@ -28,6 +28,7 @@ from grazing.cli.common import (
 )
 from grazing.cli.limits import POINT_OVERHEAD, check_memory, count_text, sweep_bytes
 from grazing.cli.validate import FINITE, POSITIVE, TOLERANCE, WORKERS, count, path_type, refuse_unused
+from grazing.core.options import CHUNK_SIZE, SweepSettings
 
 _SWEEP_PARAMS = {"eta": "eta", "theta-hat": "theta_hat", "alpha": "alpha", "beta": "beta", "r": "r"}
 
@@ -201,12 +202,12 @@ def sweep_cmd(
 ) -> None:  # fmt: skip
     """Brute-force bifurcation diagram: stroboscopic samples, periods, impacts and
     Lyapunov exponents along a parameter range."""
-    from grazing.sweeps.spec import SweepSpec
+    from grazing.sweeps.spec import sweep_spec
 
     name = _SWEEP_PARAMS[sparam]
     refuse_unused([name], True, f"with --param {sparam}: the swept values replace it")
     refuse_unused(["which"], method != "map", "without --method map")
-    chunk_size = 50 if chunk_size is None else chunk_size
+    chunk_size = CHUNK_SIZE if chunk_size is None else chunk_size
     _check_sweep_options(
         out, scheduler, chunk_size, num, periods, model.n_states, workers, as_json, "a sweep"
     )
@@ -219,12 +220,11 @@ def sweep_cmd(
     zdm, graze_info = None, None
     if method == "map":
         zdm, graze_info = _map_for_sweep(model, name, float(vals.min()), float(vals.max()), which)
-    spec = SweepSpec(
-        model=model, params=(name,), points=tuple((float(v),) for v in order),
-        x0=tuple(float(v) for v in model.with_params(**{name: order[0]}).check_state(x0)),
-        transient=transient, periods=periods, fresh=fresh, chunk_size=chunk_size,
-        adaptive=not no_adaptive, lyapunov=not no_lyapunov, tol=tol, zdm=zdm,
+    settings = SweepSettings(
+        transient=transient, periods=periods, fresh=fresh, chunk_size=chunk_size, adaptive=not no_adaptive,
+        lyapunov=not no_lyapunov, tol=tol,
     )  # fmt: skip
+    spec = sweep_spec(model, name, vals, x0=x0, direction=direction, settings=settings, zdm=zdm)
     t0 = time.perf_counter()
     run = _run_sweep_spec(spec, out, scheduler, workers, as_json, wait, timeout)
     elapsed = time.perf_counter() - t0
@@ -290,7 +290,7 @@ def map_cmd(
     out: Path | None, wait: bool, as_json: bool,
 ) -> None:  # fmt: skip
     """Two-parameter map of periods, impacts and Lyapunov exponents."""
-    from grazing.sweeps.spec import SweepSpec
+    from grazing.sweeps.spec import map_spec
 
     if param1 == param2:
         raise InputError("--param1 and --param2 must differ")
@@ -306,12 +306,11 @@ def map_cmd(
     for a, b in ((v1[0], v2[0]), (v1[-1], v2[-1])):
         model.with_params(**{n1: a, n2: b})
     x0 = parse_pair(initial)
-    spec = SweepSpec(
-        model=model, params=(n1, n2), points=tuple((float(a), float(b)) for b in v2 for a in v1),
-        x0=tuple(float(v) for v in model.with_params(**{n1: v1[0], n2: v2[0]}).check_state(x0)),
-        transient=transient, periods=periods, fresh=fresh, chunk_size=chunk_size,
-        adaptive=not no_adaptive, lyapunov=not no_lyapunov, tol=tol, shape=(num2, num1),
+    settings = SweepSettings(
+        transient=transient, periods=periods, fresh=fresh, chunk_size=chunk_size, adaptive=not no_adaptive,
+        lyapunov=not no_lyapunov, tol=tol,
     )  # fmt: skip
+    spec = map_spec(model, n1, v1, n2, v2, x0=x0, settings=settings)
     t0 = time.perf_counter()
     run = _run_sweep_spec(spec, out, scheduler, workers, as_json, wait, timeout)
     elapsed = time.perf_counter() - t0

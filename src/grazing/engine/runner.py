@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from grazing.core.model import HybridModel
+from grazing.core.options import CHATTER_TOL, MACHINE_EPSILON
 from grazing.core.solution import Status
 from grazing.engine.codegen import direction_columns, taylor_order
 from grazing.errors import SimulationError
@@ -132,11 +133,11 @@ class Runner:
         *,
         t0: float = 0.0,
         phase: float = 0.0,
-        tol: float = 2.220446049250313e-16,
+        tol: float = MACHINE_EPSILON,
         variational: bool = False,
         sensitivities: Sequence[str] = (),
         events: bool = True,
-        chatter_tol: float = 1e-9,
+        chatter_tol: float = CHATTER_TOL,
         zdm: DiscontinuityMap | None = None,
         touching: bool = False,
     ):

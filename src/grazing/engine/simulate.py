@@ -4,34 +4,33 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from typing import Literal
+from typing import Any
 
 import numpy as np
 
 from grazing.core.model import HybridModel
+from grazing.core.options import (
+    CHATTER_TOL,
+    MACHINE_EPSILON,
+    SaveAt,
+    Solver,
+    Tangent,
+    refuse_unknown,
+    with_shorthands,
+)
 from grazing.core.solution import Impacts, Solution
-from grazing.engine.runner import RECORD_IMPACTS, DiscontinuityMap, Runner
+from grazing.engine.runner import DiscontinuityMap, Runner
 from grazing.errors import InvalidParameterError
 
-DEFAULT_TOL = 2.220446049250313e-16
+DEFAULT_TOL = MACHINE_EPSILON
 """Default local error tolerance of the Taylor integrator (machine epsilon)."""
 
-DEFAULT_CHATTER_TOL = 1e-9
+DEFAULT_CHATTER_TOL = CHATTER_TOL
 """A chattering sequence whose remaining duration is below this fraction of the
 forcing period is summed in closed form and continued as sticking."""
 
 CHUNK_PERIODS = 4096
 """Runs are integrated in chunks of this many forcing periods."""
-
-_RECORD = RECORD_IMPACTS
-
-
-def _check_count(name: str, value: int, minimum: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise InvalidParameterError(f"{name} must be an integer, got {value!r}")
-    if value < minimum:
-        raise InvalidParameterError(f"{name} must be >= {minimum}, got {value}")
-    return int(value)
 
 
 def simulate(
@@ -39,22 +38,14 @@ def simulate(
     x0: Sequence[float] | np.ndarray | None = None,
     *,
     t0: float = 0.0,
-    periods: int = 100,
-    transient: int = 0,
-    phase: float = 0.0,
-    trajectory: int = 0,
-    jacobian: bool = False,
-    sensitivities: Sequence[str] = (),
-    lyapunov: bool = False,
-    guard_min: bool = False,
-    impacts: Literal["none", "sampled", "all"] = "sampled",
-    tol: float = DEFAULT_TOL,
-    max_steps: int | None = None,
-    chatter_tol: float = DEFAULT_CHATTER_TOL,
-    progress: Callable[[int, int], None] | None = None,
+    save: SaveAt | None = None,
+    tangent: Tangent | None = None,
+    solver: Solver | None = None,
     events: bool = True,
     zdm: DiscontinuityMap | None = None,
     touching: bool = False,
+    progress: Callable[[int, int], None] | None = None,
+    **shorthands: Any,
 ) -> Solution:
     """Simulate a hybrid model, never missing an impact.
 
@@ -71,37 +62,31 @@ def simulate(
         Initial state at time ``t0`` (default: zeros). Must satisfy the guard.
     t0
         Initial time (for forced models, this sets the forcing phase).
-    periods
-        Number of forcing periods sampled (stroboscopic samples kept).
-    transient
-        Number of forcing periods run first and discarded.
-    phase
-        Stroboscopic phase ``phi`` in radians: samples at ``t = (phi/2pi + k) T``.
-    trajectory
-        If positive, record the dense trajectory over the sampled span with
-        this many points per forcing period (plus both states at each impact).
-    jacobian
-        Also integrate the variational equations (with the saltation matrix at
-        every impact) and return ``d x_final / d x0``.
-    sensitivities
-        Parameter names whose derivatives ``d x_final / d p`` are appended as
-        extra Jacobian columns (implies ``jacobian``).
-    lyapunov
-        Compute the Lyapunov exponents over the sampled span (tangent dynamics
-        with saltation matrices at impacts).
-    guard_min
-        Track the smallest value of the guard over the sampled span, and the
-        closest approach to the stop away from contacts
-        (:attr:`Solution.approach_min`).
-    impacts
-        Which impacts to record: ``"sampled"`` span (default), ``"all"``, ``"none"``.
-    tol
-        Local error tolerance; sets the Taylor order.
-    max_steps
-        Abort after this many steps (default: ``20000 * (transient + periods) + 10**5``).
-    chatter_tol
-        Threshold (fraction of a period) below which a chattering sequence is
-        summed to its accumulation point and continued as sticking.
+    save
+        What to record (:class:`~grazing.core.options.SaveAt`): ``periods``
+        sampled (default 100), ``transient`` periods run first and discarded,
+        the stroboscopic ``phase`` (samples at ``t = (phase/2pi + k) T``),
+        ``trajectory`` points per period over the sampled span (plus both
+        states at each impact), which ``impacts`` to record (``"sampled"``
+        span, ``"all"``, ``"none"``), ``guard_min`` (the smallest guard value
+        and the closest approach to the stop, :attr:`Solution.approach_min`).
+    tangent
+        Tangent dynamics (:class:`~grazing.core.options.Tangent`):
+        ``jacobian`` (``d x_final / d x0``, saltation matrices at impacts),
+        ``sensitivities`` (parameter names whose derivatives are appended as
+        columns: the final sample at the same forcing phase after the same
+        number of periods, ``t0`` fixed, so a parameter that sets the period
+        moves the sample time), ``lyapunov`` (exponents over the sampled span).
+    solver
+        Integrator settings (:class:`~grazing.core.options.Solver`): ``tol``
+        (local error tolerance, sets the Taylor order), ``max_steps``
+        (default ``20000 * (transient + periods) + 10**5``), ``chatter_tol``
+        (chattering shorter than this fraction of a period is summed to its
+        accumulation point and continued as sticking).
+    **shorthands
+        Any field of the three option objects by name, as a keyword
+        (``periods=20``, ``jacobian=True``, ``tol=1e-10`` ...): it replaces
+        that field of the object given (or of the defaults).
     events
         If False, the guard is ignored: the flow passes through the stop (no
         impacts).  ``guard_min`` then tells how far past the stop it reaches.
@@ -129,26 +114,27 @@ def simulate(
     >>> sol = grazing.simulate(model, [0.0, 0.0], transient=400, periods=20)
     >>> sol.period()
     5
+    >>> save, tangent = grazing.SaveAt(periods=5), grazing.Tangent(sensitivities=("eta",))
+    >>> grazing.simulate(model, sol.x_final, save=save, tangent=tangent).jacobian.shape
+    (2, 3)
     """
-    if impacts not in _RECORD:
-        raise InvalidParameterError(f"impacts must be one of {sorted(_RECORD)}, got {impacts!r}")
-    periods = _check_count("periods", periods, 1)
-    transient = _check_count("transient", transient, 0)
-    trajectory = _check_count("trajectory", trajectory, 0)
-    for name, val in (("t0", t0), ("phase", phase), ("tol", tol), ("chatter_tol", chatter_tol)):
-        if not isinstance(val, (int, float, np.floating, np.integer)) or not math.isfinite(val):
-            raise InvalidParameterError(f"{name} must be a finite number, got {val!r}")
-    if not 0 < tol < 1e-2:
-        raise InvalidParameterError(f"tol must be in (0, 0.01), got {tol}")
+    used: set[str] = set()
+    save = with_shorthands(save, SaveAt, shorthands, used)
+    tangent = with_shorthands(tangent, Tangent, shorthands, used)
+    solver = with_shorthands(solver, Solver, shorthands, used)
+    refuse_unknown("simulate", shorthands, used)
+    if not isinstance(t0, (int, float, np.floating, np.integer)) or not math.isfinite(t0):
+        raise InvalidParameterError(f"t0 must be a finite number, got {t0!r}")
+    periods, transient, phase, trajectory = save.periods, save.transient, save.phase, save.trajectory
+    impacts, guard_min = save.impacts, save.guard_min
+    sens, lyapunov = tangent.sensitivities, tangent.lyapunov
+    tol, max_steps, chatter_tol = solver.tol, solver.max_steps, solver.chatter_tol
     if zdm is not None:
         if not model.periodic:
             raise InvalidParameterError("the discontinuity map needs a periodically forced model")
         events = False
     x = model.check_state(np.zeros(model.n_states) if x0 is None else x0, t0, allowed=events)
-    sens = tuple(sensitivities)
-    if lyapunov and (jacobian or sens):
-        raise InvalidParameterError("lyapunov and jacobian/sensitivities cannot be combined in one run")
-    use_var = bool(jacobian or sens or lyapunov)
+    use_var = tangent.variational
     n = model.n_states
     T = model.period
     run = Runner(

@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from grazing.core.options import MAX_PERIOD_NOISY
 from grazing.errors import InvalidParameterError
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -36,8 +37,8 @@ DEFAULT_CUTOFF_MULTIPLE = 20.0
 FILTER_ORDER = 4
 """Order of the Butterworth filter (applied forwards and backwards: zero phase)."""
 
-DEFAULT_MAX_PERIOD = 32
-"""Largest period tested on recorded samples."""
+DEFAULT_MAX_PERIOD = MAX_PERIOD_NOISY
+"""Largest period tested on recorded samples (:data:`grazing.core.options.MAX_PERIOD_NOISY`)."""
 
 SAMPLE_NOISE_FLOOR = 1e-5
 """Smallest noise level assumed on a stroboscopic sample, relative to the signal's range."""
