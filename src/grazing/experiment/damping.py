@@ -146,19 +146,20 @@ def free_decay(
     >>> dec.amplitudes.round(4).tolist()
     [0.5, 0.3668, 0.27, 0.199]
     """
-    import grazing
+    from grazing.engine.simulate import simulate
+    from grazing.models.pendulum import pendulum
 
     r, beta = _check_r_beta(r, beta)
     if not (math.isfinite(amplitude) and 0.0 < amplitude < math.pi):
         raise InvalidParameterError(f"amplitude must be in (0, pi) rad, got {amplitude:g}")
     if int(peaks) < 1:
         raise InvalidParameterError(f"peaks must be >= 1, got {peaks}")
-    model = grazing.models.pendulum(None, alpha=0.0, beta=beta, r=r, eta=eta, theta_hat=0.0)
+    model = pendulum(None, alpha=0.0, beta=beta, r=r, eta=eta, theta_hat=0.0)
     n = decay_peaks(r, beta, amplitude, peaks)
     cycles = decay_cycles(n, amplitude)
     periods = max(1, math.ceil(cycles * eta))
     ppp = max(8, math.ceil(points_per_cycle / eta))
-    sol = grazing.simulate(model, [-amplitude, 0.0], periods=periods, trajectory=ppp)
+    sol = simulate(model, [-amplitude, 0.0], periods=periods, trajectory=ppp)
     assert sol.trajectory is not None and sol.trajectory_t is not None
     t = sol.trajectory_t * (1.0 / eta)
     th = sol.trajectory[:, 0]

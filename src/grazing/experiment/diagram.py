@@ -191,10 +191,10 @@ def model_sweep(
     >>> ds.period.values.tolist()
     [1, 5]
     """
-    import grazing
+    from grazing.models.pendulum import pendulum
     from grazing.sweeps import sweep
 
-    model = grazing.models.pendulum(case, theta_hat=math.radians(theta_hat_deg), **params)
+    model = pendulum(case, theta_hat=math.radians(theta_hat_deg), **params)
     return sweep(
         model, "eta", np.asarray(etas, dtype=float), periods=periods, transient=transient,
         workers=workers, lyapunov=False, progress=progress,

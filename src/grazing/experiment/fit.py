@@ -42,10 +42,10 @@ def grazing_eta(
     >>> grazing_eta(40.0, 0.2) is None
     True
     """
-    import grazing
+    from grazing.models.pendulum import pendulum
     from grazing.orbits import find_grazings
 
-    model = grazing.models.pendulum(
+    model = pendulum(
         None, alpha=alpha, beta=beta, r=1.0, eta=eta_range[0], theta_hat=math.radians(theta_hat_deg)
     )
     points, _ = find_grazings(model, "eta", eta_range[0], eta_range[1])

@@ -129,7 +129,8 @@ def synthetic_recording(
     >>> rec.metadata["synthetic"], round(rec.metadata["forcing_hz"], 5), rec.trigger_times.size
     (True, 0.45923, 21)
     """
-    import grazing
+    from grazing.engine.simulate import simulate
+    from grazing.models.pendulum import pendulum
 
     if int(periods) < 1 or int(transient) < 0:
         raise InvalidParameterError(f"need periods >= 1 and transient >= 0, got {periods} and {transient}")
@@ -137,13 +138,13 @@ def synthetic_recording(
         raise InvalidParameterError(f"sample rate must be positive, got {sample_rate!r}")
     if not -180.0 < float(theta_hat_deg) < 180.0:
         raise InvalidParameterError(f"theta_hat must be in (-180, 180) degrees, got {theta_hat_deg:g}")
-    model = grazing.models.pendulum(case, eta=float(eta), theta_hat=math.radians(theta_hat_deg), **params)
+    model = pendulum(case, eta=float(eta), theta_hat=math.radians(theta_hat_deg), **params)
     omega = apparatus.omega(eta)
     forcing_hz = apparatus.forcing_hz(eta)
     duration = periods / forcing_hz
     n = math.floor(duration * sample_rate) + 1
     ppp = 400
-    sol = grazing.simulate(model, list(x0), transient=transient, periods=periods + 1, trajectory=ppp)
+    sol = simulate(model, list(x0), transient=transient, periods=periods + 1, trajectory=ppp)
     assert sol.trajectory is not None and sol.trajectory_t is not None
     t = np.arange(n) / sample_rate
     tau0 = 2.0 * math.pi * transient

@@ -1,0 +1,227 @@
+"""The package's structure: one-way layers, no cycles, no pendulum in generic code, modules import alone.
+
+The layers, bottom to top (docs/architecture.md): a module may import its own
+layer and the layers below it, never one above.  Imports inside functions
+count too.  The one exception is reading the package version
+(``grazing.__version__``).
+"""
+
+from __future__ import annotations
+
+import ast
+import subprocess
+import sys
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import pytest
+
+SRC = Path(__file__).resolve().parents[1] / "src"
+PACKAGE = SRC / "grazing"
+
+LAYERS = {
+    "grazing.errors": 0,
+    "grazing.atomic": 0,
+    "grazing.parallel": 0,
+    "grazing.core": 1,
+    "grazing.models": 2,
+    "grazing.engine": 3,
+    "grazing.maps": 4,
+    "grazing.orbits": 5,
+    "grazing.normalform": 6,
+    "grazing.sweeps": 6,
+    "grazing.experiment": 7,
+    "grazing.plotting": 8,
+    "grazing.report": 9,
+    "grazing.cli": 10,
+}
+"""The layer of every part of the package (the facade ``grazing/__init__`` is above them all)."""
+
+GENERIC = ("grazing.core", "grazing.engine", "grazing.maps", "grazing.orbits", "grazing.sweeps",
+           "grazing.normalform", "grazing.plotting", "grazing.parallel")  # fmt: skip
+"""The layers that know no particular model."""
+
+PENDULUM_NAMES = {"eta", "theta_hat", "theta", "dtheta", "tau", "alpha", "beta"}
+"""Names of the pendulum's parameters, states and time."""
+
+
+def modules() -> dict[str, Path]:
+    out = {}
+    for path in sorted(PACKAGE.rglob("*.py")):
+        parts = list(path.relative_to(SRC).with_suffix("").parts)
+        if parts[-1] == "__init__":
+            parts = parts[:-1]
+        out[".".join(parts)] = path
+    return out
+
+
+def part(module: str) -> str | None:
+    """The part of the package (a key of :data:`LAYERS`) a module belongs to."""
+    for name in sorted(LAYERS, key=len, reverse=True):
+        if module == name or module.startswith(name + "."):
+            return name
+    return None
+
+
+def imports(path: Path, module: str) -> list[tuple[str, int]]:
+    """The grazing modules a file imports (anywhere in it), with line numbers."""
+    tree = ast.parse(path.read_text())
+    out = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            out += [(a.name, node.lineno) for a in node.names if a.name.split(".")[0] == "grazing"]
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:  # relative import
+                base = module.split(".")[: -node.level or None]
+                target = ".".join([*base, node.module] if node.module else base)
+            else:
+                target = node.module or ""
+            if target.split(".")[0] != "grazing":
+                continue
+            for a in node.names:  # "from grazing.x import y" may import the module grazing.x.y
+                sub = f"{target}.{a.name}"
+                out.append((sub if sub in modules() else target, node.lineno))
+    return out
+
+
+def uses_only_the_version(path: Path) -> bool:
+    """Does the file use the facade ``grazing`` only as ``grazing.__version__``?"""
+    tree = ast.parse(path.read_text())
+    for node in ast.walk(tree):
+        if (
+            isinstance(node, ast.Attribute)
+            and isinstance(node.value, ast.Name)
+            and node.value.id == "grazing"
+        ):
+            if node.attr != "__version__":
+                return False
+    return True
+
+
+def test_every_part_of_the_package_has_a_layer():
+    unplaced = [m for m in modules() if m not in ("grazing", "grazing.__main__") and part(m) is None]
+    assert not unplaced
+
+
+def test_no_import_runs_up_the_layers():
+    problems = []
+    for module, path in modules().items():
+        here = part(module)
+        if here is None:
+            continue
+        for target, line in imports(path, module):
+            if target == "grazing":
+                if LAYERS[here] < LAYERS["grazing.report"] and not uses_only_the_version(path):
+                    problems.append(f"{path.relative_to(SRC)}:{line} uses the facade grazing")
+                continue
+            there = part(target)
+            if there is not None and LAYERS[there] > LAYERS[here]:
+                problems.append(
+                    f"{path.relative_to(SRC)}:{line} imports {target} (layer {there} above {here})"
+                )
+    assert not problems, "\n".join(problems)
+
+
+def test_no_import_cycles_between_files():
+    mods = modules()
+    graph = {m: {t for t, _ in imports(p, m) if t in mods and t != m} for m, p in mods.items()}
+    # A package's __init__ re-exporting its modules is not a cycle with them: drop the edges
+    # from a module to its own package (they only re-export).
+    for m in graph:
+        graph[m] = {t for t in graph[m] if not m.startswith(t + ".")}
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on: set[str] = set()
+    cycles: list[list[str]] = []
+    counter = [0]
+
+    def visit(v: str) -> None:  # Tarjan's strongly connected components
+        index[v] = low[v] = counter[0]
+        counter[0] += 1
+        stack.append(v)
+        on.add(v)
+        for w in graph[v]:
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                cycles.append(sorted(comp))
+
+    for v in graph:
+        if v not in index:
+            visit(v)
+    assert not cycles, cycles
+
+
+def _names_in_code(path: Path) -> set[str]:
+    """Identifiers and string constants of a file, docstrings left out."""
+    tree = ast.parse(path.read_text())
+    docstrings = set()
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)):
+            body = node.body
+            if body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant):
+                docstrings.add(id(body[0].value))
+        elif isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant):
+            docstrings.add(id(node.value))  # attribute docstrings
+    found = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Name):
+            found.add(node.id)
+        elif isinstance(node, ast.Attribute):
+            found.add(node.attr)
+        elif isinstance(node, ast.arg):
+            found.add(node.arg)
+        elif isinstance(node, ast.Constant) and isinstance(node.value, str) and id(node) not in docstrings:
+            found.add(node.value)
+    return found
+
+
+def test_no_generic_layer_names_a_pendulum_parameter():
+    problems = []
+    for module, path in modules().items():
+        if part(module) in GENERIC and "driver" not in module:
+            hits = _names_in_code(path) & PENDULUM_NAMES
+            if module.startswith("grazing.plotting"):
+                hits -= {"alpha"}  # matplotlib's transparency
+            if hits:
+                problems.append(f"{path.relative_to(SRC)}: {sorted(hits)}")
+    assert not problems, "\n".join(problems)
+
+
+def test_the_model_layer_imports_no_engine_orbit_sweep_report_or_cli():
+    for module, path in modules().items():
+        if part(module) == "grazing.core":
+            for target, line in imports(path, module):
+                assert part(target) in (None, "grazing.core", "grazing.errors"), (module, target, line)
+
+
+def _import_alone(module: str) -> tuple[str, int, str]:
+    proc = subprocess.run(
+        [sys.executable, "-c", f"import {module}"], capture_output=True, text=True, timeout=300
+    )
+    return (
+        module,
+        proc.returncode,
+        proc.stderr.strip().splitlines()[-1:] and proc.stderr.strip().splitlines()[-1],
+    )
+
+
+@pytest.mark.parametrize("batch", [0, 1])
+def test_every_module_imports_on_its_own_in_a_fresh_interpreter(batch):
+    """Half of the modules per test (the two halves run as two tests), two interpreters at a time."""
+    mods = [m for m in modules() if m != "grazing.__main__" and not m.endswith(".__main__")][batch::2]
+    with ThreadPoolExecutor(2) as pool:
+        failures = [r for r in pool.map(_import_alone, mods) if r[1] != 0]
+    assert not failures, failures
