@@ -10,6 +10,8 @@ from hypothesis import HealthCheck, settings
 
 import grazing
 
+pytest_plugins = ["tests.recordings"]
+
 # Property tests must not fail on a busy machine: no deadlines, no too-slow health
 # check (the engine's examples compile and integrate), and on CI a fixed, derandomized
 # profile so that a run is reproducible.
@@ -38,3 +40,9 @@ def period5_orbit(pendulum_b):
     sol = grazing.simulate(pendulum_b, [0.0, 0.0], transient=600, periods=10)
     assert sol.period() == 5
     return sol.samples[-1].copy(), float(sol.t[-1])
+
+
+@pytest.fixture(scope="session")
+def period5_trajectory(pendulum_b) -> grazing.Solution:
+    """Twenty periods of the period-5 orbit with dense output (200 points per period)."""
+    return grazing.simulate(pendulum_b, [0.0, 0.0], transient=600, periods=20, trajectory=200)

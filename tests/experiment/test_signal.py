@@ -17,8 +17,7 @@ from grazing.experiment import (
 )
 from grazing.experiment.signal import noise_gain
 from grazing.experiment.synthetic import synthetic_recording
-
-from .conftest import FAST_RATE
+from tests.recordings import FAST_RATE
 
 
 def test_lowpass_is_zero_phase_and_removes_noise():

@@ -1,4 +1,4 @@
-"""Plotting helpers: resampling, delay embedding and the drawing functions."""
+"""Resampling on a uniform grid and delay coordinates (the embedding of figs 2 and 3)."""
 
 from __future__ import annotations
 
@@ -6,17 +6,9 @@ import math
 
 import numpy as np
 import pytest
-from matplotlib.figure import Figure
 
 import grazing
 from grazing.experiment.signal import delay_coordinates, uniform_resample
-from grazing.plotting import plot_delay, plot_time_series
-
-
-@pytest.fixture(scope="module")
-def period5() -> grazing.Solution:
-    m = grazing.models.pendulum("B", eta=0.446, theta_hat=math.radians(40))
-    return grazing.simulate(m, [0.0, 0.0], transient=600, periods=20, trajectory=200)
 
 
 def test_uniform_resample_drops_repeated_times_and_is_exact_on_lines() -> None:
@@ -65,8 +57,8 @@ def test_delay_coordinates_shrinks_the_step_to_divide_the_delay() -> None:
         delay_coordinates(t, np.column_stack([t, t]), 1.0)
 
 
-def test_delay_coordinates_of_a_trajectory_with_impacts(period5: grazing.Solution) -> None:
-    t, th = period5.trajectory_t, period5.trajectory[:, 0]
+def test_delay_coordinates_of_a_trajectory_with_impacts(period5_trajectory: grazing.Solution) -> None:
+    t, th = period5_trajectory.trajectory_t, period5_trajectory.trajectory[:, 0]
     assert np.any(np.diff(t) == 0), "impacts should appear twice in the dense output"
     tn, xd, xn = delay_coordinates(t, th, math.pi / 2)
     dt = np.diff(tn)
@@ -76,28 +68,4 @@ def test_delay_coordinates_of_a_trajectory_with_impacts(period5: grazing.Solutio
     assert np.array_equal(xd[50:], xn[:-50])
     on_grid = np.isin(t, tn)
     assert np.allclose(np.interp(t[on_grid], tn, xn), th[on_grid])
-    assert xn.max() <= period5.model.params["theta_hat"] + 1e-12
-
-
-def test_plot_time_series_and_delay_draw(period5: grazing.Solution) -> None:
-    fig = Figure()
-    ax1, ax2 = fig.subplots(1, 2)
-    plot_time_series(ax1, period5, degrees=True, span=(605, 615))
-    line, stop, samples = ax1.lines
-    assert line.get_xdata().min() >= 605 and line.get_xdata().max() <= 615
-    assert np.isclose(stop.get_ydata()[0], 40.0)
-    assert len(samples.get_xdata()) == 10  # samples at the ends of periods 606..615
-    assert ax1.get_ylabel() == "θ (degrees)" and ax1.get_xlabel().startswith("τ / 2π")
-    plot_delay(ax2, period5)
-    assert ax2.get_xlabel() == "θ(τ − π/2) (rad)" and ax2.get_ylabel() == "θ(τ) (rad)"
-    assert len(ax2.lines) == 3  # curve, stop as horizontal and vertical line
-
-
-def test_plot_needs_a_trajectory() -> None:
-    m = grazing.models.pendulum("B", eta=0.446, theta_hat=math.radians(40))
-    sol = grazing.simulate(m, [0.0, 0.0], periods=2)
-    ax = Figure().add_subplot()
-    with pytest.raises(ValueError, match="trajectory"):
-        plot_time_series(ax, sol)
-    with pytest.raises(ValueError, match="trajectory"):
-        plot_delay(ax, sol)
+    assert xn.max() <= period5_trajectory.model.params["theta_hat"] + 1e-12

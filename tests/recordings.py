@@ -1,4 +1,7 @@
-"""Fixtures of the experiment tests: synthetic recordings (from the model, never the paper's data)."""
+"""Synthetic recordings shared by the experiment and CLI tests (from the model, never the paper's data).
+
+Loaded as a pytest plugin by ``tests/conftest.py``.
+"""
 
 from __future__ import annotations
 
