@@ -3,7 +3,8 @@
 For random models (:mod:`tests.random_models`) whose states, time and
 parameters are named like the code generator's own symbols, numpy or math
 functions: the samples are the same with the Jacobian and the Lyapunov
-exponents switched on and off, the Jacobian matches central finite differences,
+exponents switched on and off, they agree with scipy's event loop
+(:mod:`tests.engine.reference`), the Jacobian matches central finite differences,
 and so do the parameter sensitivities, including the frequency, which sets the
 forcing period.  Each model compiles its kernels (~15 s per variant), so the
 default suite draws two models and the slow suite many.
@@ -18,6 +19,7 @@ import pytest
 from hypothesis import assume, given, settings
 
 import grazing
+from tests.engine.reference import assert_agrees
 from tests.random_models import ModelSpec, model_specs
 
 PERIODS = 2
@@ -62,6 +64,9 @@ def check_model(spec: ModelSpec) -> None:
         assume(len(a.impacts) == len(b.impacts) == len(plain.impacts))
         fd[:, j] = (a.x_final - b.x_final) / (2 * h)
     np.testing.assert_allclose(J, fd, rtol=0, atol=2e-5 * max(1.0, float(np.max(np.abs(fd)))))
+
+    # 2b. The samples and impacts agree with scipy's event loop on the sympy expressions.
+    assert_agrees(model, x0, t0=t0, phase=phase, periods=PERIODS)
 
     # 3. Parameter sensitivities, the period-setting frequency included.
     for pair, run in zip(pairs, runs):

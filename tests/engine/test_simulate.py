@@ -204,45 +204,6 @@ def test_lyapunov_of_periodic_orbit_matches_floquet_multipliers(pendulum_b, peri
 
 
 # --------------------------------------------------------------------------
-# An independent reference: scipy's DOP853 with event location and restarts.
-
-
-def _scipy_reference(model, x0, n_periods):
-    from scipy.integrate import solve_ivp
-
-    p = model.params
-
-    def f(t, x):
-        return model.vector_field(x, t)
-
-    def hit(t, x):
-        return x[0] - p["theta_hat"]
-
-    hit.terminal, hit.direction = True, 1
-    t, x, impacts, samples = 0.0, np.array(x0, float), [], []
-    for k in range(1, n_periods + 1):
-        while True:
-            sol = solve_ivp(f, (t, 2 * math.pi * k), x, method="DOP853", rtol=1e-13, atol=1e-14, events=hit)
-            t, x = sol.t[-1], sol.y[:, -1]
-            if sol.status == 1 and t < 2 * math.pi * k:
-                impacts.append(t)
-                x = model.reset(x, t)
-                t += 1e-12  # step off the stop
-            else:
-                break
-        samples.append(x.copy())
-    return np.array(impacts), np.array(samples)
-
-
-def test_agrees_with_scipy_reference(pendulum_b):
-    imp_ref, smp_ref = _scipy_reference(pendulum_b, [0.0, 0.0], 60)
-    sol = grazing.simulate(pendulum_b, [0.0, 0.0], periods=60, impacts="all")
-    assert len(sol.impacts) == len(imp_ref)
-    np.testing.assert_allclose(sol.impacts.t, imp_ref, atol=1e-8)
-    np.testing.assert_allclose(sol.samples, smp_ref, atol=1e-8)
-
-
-# --------------------------------------------------------------------------
 # Sampling, chunking, errors.
 
 

@@ -653,6 +653,23 @@ class HybridModel:
             raise InvalidParameterError(f"directions must be a non-negative integer, got {directions!r}")
         return self._def.kernels(directions, None if order is None else int(order))
 
+    def numeric(self, what: str) -> Callable[..., Any]:
+        """The model's ``what`` as a numpy function of ``(x, t, p)``, straight from sympy.
+
+        ``what`` is one of ``f``, ``h``, ``g``, ``f_x``, ``h_x``, ``g_x``,
+        ``h_t``, ``h_p``, ``g_t``, ``rate``, ``rate_x``, ``rate_t``,
+        ``rate_p``, ``accel``.  These are ``sympy.lambdify`` functions, slow
+        but independent of the compiled kernels: for checks and references.
+
+        Examples
+        --------
+        >>> from grazing.models import impact_oscillator
+        >>> m = impact_oscillator(sigma=0.1)
+        >>> float(m.numeric("h")([0.0, 1.0], 0.0, list(m.param_vector)))
+        0.1
+        """
+        return self._def.numeric(what)
+
     def _call(self, what: str, x: Any, t: float) -> Any:
         fn = self._def.numeric(what)
         return fn(list(np.asarray(x, dtype=float)), float(t), list(self.param_vector))
