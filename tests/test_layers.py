@@ -225,3 +225,15 @@ def test_every_module_imports_on_its_own_in_a_fresh_interpreter(batch):
     with ThreadPoolExecutor(2) as pool:
         failures = [r for r in pool.map(_import_alone, mods) if r[1] != 0]
     assert not failures, failures
+
+
+def test_architecture_doc_lists_the_same_layers() -> None:
+    """docs/architecture.md's table and :data:`LAYERS` say the same thing."""
+    import re
+
+    doc = (SRC.parent / "docs" / "architecture.md").read_text()
+    documented = {}
+    for layer, packages in re.findall(r"^\|\s*(\d+)\s*\|([^|]+)\|", doc, re.M):
+        for name in re.findall(r"`([a-z_]+)(?:/|\.py)`", packages):
+            documented[f"grazing.{name}"] = int(layer)
+    assert documented == LAYERS
