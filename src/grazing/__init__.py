@@ -8,7 +8,7 @@
 """
 
 from grazing import models
-from grazing.core import HybridModel, Impacts, Parameter, Solution
+from grazing.core import HybridModel, Impacts, Parameter, Solution, Stop
 from grazing.core.options import SaveAt, Solver, SweepSettings, Tangent
 from grazing.core.period import detect_period
 from grazing.engine.simulate import simulate
@@ -45,6 +45,7 @@ __all__ = [
     "SimulationError",
     "Solution",
     "Solver",
+    "Stop",
     "SweepSettings",
     "Tangent",
     "__version__",

@@ -55,6 +55,7 @@ def flow_map(
     sensitivities: Sequence[str] = (),
     virtual: bool = False,
     touching: bool = False,
+    stop_name: int | str | None = None,
 ) -> FlowMap:
     """Apply the stroboscopic map ``periods`` times from ``x`` at time ``t0``.
 
@@ -64,6 +65,8 @@ def flow_map(
     ``t0 + periods T(p)`` move with a parameter that sets the period ``T``.
     With ``touching`` the map starts and ends at a grazing contact with the
     stop (``x`` on the stop with zero normal velocity), which is not an impact.
+    ``stop_name`` names the stop that the contact and the solution's ``guard_min``
+    refer to (the first by default).
     """
     sol = simulate(
         model,
@@ -76,6 +79,7 @@ def flow_map(
         guard_min=True,
         events=not virtual,
         touching=touching,
+        stop_name=stop_name,
     )
     n = model.n_states
     sens = sol.jacobian[:, n:]
@@ -169,13 +173,22 @@ class ImpactMap:
             )
             imp = sol.impacts
             after = imp.t > t_start  # an impact state given as x is not its own successor
-            found.append((imp.t[after], imp.phase[after], imp.speed[after], imp.state[after]))
+            found.append(
+                (imp.t[after], imp.phase[after], imp.speed[after], imp.state[after], imp.stop[after])
+            )
             count += int(after.sum())
             done += block
             if len(sol.sticking):
                 break
             x, t = sol.x_final, sol.t_final
             block = min(2 * block, 1024)
-        t_all, phase, speed, state = (np.concatenate(parts) for parts in zip(*found))
+        t_all, phase, speed, state, stop = (np.concatenate(parts) for parts in zip(*found))
         state = state[:n].reshape(-1, self.model.n_states)
-        return Impacts(t=t_all[:n], phase=phase[:n], speed=speed[:n], state=state)
+        return Impacts(
+            t=t_all[:n],
+            phase=phase[:n],
+            speed=speed[:n],
+            state=state,
+            stop=stop[:n].astype(int),
+            stop_names=self.model.stop_names,
+        )

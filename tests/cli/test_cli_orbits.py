@@ -64,7 +64,7 @@ def test_continue_json_and_netcdf(capsys, tmp_path):
         (["orbit", "--r", "3"], "r = 3 is outside"),
         (["graze", "--eta-min", "0.5", "--eta-max", "0.4"], "need 0 < --eta-min < --eta-max"),
         (["continue", "--param", "eta", "--start", "0.4", "--stop", "0.4"], "must be finite and differ"),
-        (["continue", "--param", "gamma", "--start", "0", "--stop", "1"], "Invalid value for '--param'"),
+        (["continue", "--param", "gamma", "--start", "0", "--stop", "1"], "unknown parameter 'gamma'"),
         (["continue", "--param", "eta", "--start", "0.4", "--stop", "0.5", "--out", "x.txt"],
          "--out must name a .nc file"),
         (["graze-curve", "--out", "/nonexistent/c.nc"], "does not exist"),

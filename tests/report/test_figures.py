@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from grazing.report import FIGURES, diagrams, fig06, fig07, fig08, fig12, figmap
+from grazing.report import FIGURES, diagrams, fig06, fig07, fig08, fig12, figmap, figstops
 from grazing.report.base import Comparison, FigureResult
 from grazing.report.diagrams import Panel, Settings
 from grazing.sweeps.windows import Window
@@ -207,3 +207,14 @@ def test_map_classify_counts(tmp_path: Path) -> None:
     assert c["below_no_impact"] == 0
     assert abs(math.degrees(c["th_max"]) - 55.856) < 0.01
     assert np.all(np.diff(run.max_angle[:3]) > 0)  # rising branch of the response below the peak
+
+
+def test_two_stop_section_checks_every_closed_form(built) -> None:
+    """The two-sided oscillator's section: every closed form agrees, each stop's two grazings are marked."""
+    out, res = _built(figstops, built)
+    assert (out / "stops_sweep.png").stat().st_size > 10_000
+    rows = {c.quantity: c for c in res.comparisons}
+    assert sum("grazing" in q and ": ω" in q for q in rows) == 4
+    assert all(c.verdict == "agree" and c.kind == "self-check" for c in res.comparisons), [
+        (c.quantity, c.ours) for c in res.comparisons if c.verdict != "agree"
+    ]

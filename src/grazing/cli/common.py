@@ -53,23 +53,119 @@ netcdf_out_option = click.option(
 )
 
 
-def model_options(func: Callable[..., Any]) -> Callable[..., Any]:
-    """Options selecting the pendulum's parameters: a named case plus overrides.
+PENDULUM_OPTIONS = ("case", "alpha", "beta", "r", "eta", "theta_hat")
+
+
+def load_model(spec: str) -> grazing.HybridModel:
+    """The model a ``--model`` value names: a built-in name, or ``path/to/file.py:OBJECT``.
+
+    ``OBJECT`` is a :class:`~grazing.HybridModel` or a function returning one
+    (called without arguments).  Anything else is an :class:`InputError`.
+    """
+    from grazing.models import BUILT_IN
+
+    if spec in BUILT_IN:
+        return BUILT_IN[spec]()
+    if ":" not in spec:
+        raise InputError(f"unknown model {spec!r} (built-in: {', '.join(BUILT_IN)}; or FILE.py:OBJECT)")
+    path_text, _, name = spec.rpartition(":")
+    path = Path(path_text)
+    if not path.is_file():
+        raise InputError(f"--model: no such file {path_text!r}")
+    import importlib.util
+
+    module_spec = importlib.util.spec_from_file_location(f"grazing_user_model_{abs(hash(str(path)))}", path)
+    if module_spec is None or module_spec.loader is None:
+        raise InputError(f"--model: cannot load {path_text!r} as Python")
+    module = importlib.util.module_from_spec(module_spec)
+    try:
+        module_spec.loader.exec_module(module)
+    except Exception as exc:  # the user's file: any error is theirs, reported in one line
+        raise InputError(f"--model: {path_text} failed to load: {type(exc).__name__}: {exc}") from None
+    obj = getattr(module, name, None)
+    if obj is None:
+        raise InputError(f"--model: {path_text} defines no {name!r}")
+    if callable(obj) and not isinstance(obj, grazing.HybridModel):
+        try:
+            obj = obj()
+        except Exception as exc:
+            raise InputError(f"--model: {name}() failed: {type(exc).__name__}: {exc}") from None
+    if not isinstance(obj, grazing.HybridModel):
+        raise InputError(
+            f"--model: {name} in {path_text} is not a grazing.HybridModel (or a function returning one)"
+        )
+    return obj
+
+
+def apply_sets(model: grazing.HybridModel, sets: tuple[str, ...]) -> grazing.HybridModel:
+    """``--set NAME=VALUE`` (repeatable, last wins): any parameter, angles in degrees."""
+    changes: dict[str, float] = {}
+    for item in sets:
+        name, eq, text = item.partition("=")
+        name = name.strip()
+        if not eq or not name:
+            raise InputError(f"--set {item!r}: expected NAME=VALUE")
+        par = model.parameter(name)  # unknown names: one line naming the known ones
+        try:
+            value = float(text)
+        except ValueError:
+            raise InputError(f"--set {item!r}: {text!r} is not a number") from None
+        if not math.isfinite(value):
+            raise InputError(f"--set {item!r}: the value must be finite")
+        changes[name] = par.from_display(value)
+    return model.with_params(**changes) if changes else model
+
+
+def model_options(func: Callable[..., Any] | None = None, *, any_model: bool = False) -> Any:
+    """Options selecting the model: ``--model``, ``--set``, and the pendulum's case and overrides.
 
     The decorated command receives the validated model as ``model`` and the
-    case name as ``case`` (for its JSON output).
+    pendulum case name as ``case`` (for its JSON output).  Commands decorated
+    with ``any_model=True`` take every model; the others refuse any model but
+    the pendulum in one line.
     """
+    if func is None:
+        return functools.partial(model_options, any_model=any_model)
 
     @functools.wraps(func)
     def wrapper(
-        *args: Any, case: str, alpha: float | None, beta: float | None, r: float | None, eta: float,
-        theta_hat: float, **kwargs: Any,
+        *args: Any, model_spec: str, sets: tuple[str, ...], case: str, alpha: float | None,
+        beta: float | None, r: float | None, eta: float, theta_hat: float, **kwargs: Any,
     ) -> Any:  # fmt: skip
-        refuse_unused(["case"], None not in (alpha, beta, r), "when --alpha, --beta and --r are all given")
-        model = build_pendulum(case, alpha, beta, r, eta, theta_hat)
-        return func(*args, model=model, case=case, **kwargs)
+        if model_spec == "pendulum":
+            refuse_unused(
+                ["case"], None not in (alpha, beta, r), "when --alpha, --beta and --r are all given"
+            )
+            model = build_pendulum(case, alpha, beta, r, eta, theta_hat)
+        else:
+            refuse_unused(
+                PENDULUM_OPTIONS, True, "with a model other than the pendulum (use --set NAME=VALUE)"
+            )
+            model = load_model(model_spec)
+            if not any_model:
+                raise InputError(
+                    f"--model {model_spec}: this command works on the pendulum only so far "
+                    "(simulate takes any model)"
+                )
+        return func(*args, model=apply_sets(model, sets), case=case, **kwargs)
 
     options = [
+        click.option(
+            "--model",
+            "model_spec",
+            default="pendulum",
+            show_default=True,
+            metavar="NAME|FILE.py:OBJECT",
+            help="A built-in model (pendulum, two-sided-oscillator, impact-oscillator, bouncing-ball, "
+            "impact-damper) or a HybridModel (or a function returning one) in a Python file.",
+        ),
+        click.option(
+            "--set",
+            "sets",
+            multiple=True,
+            metavar="NAME=VALUE",
+            help="Set any parameter of the model (repeatable; angles in degrees).",
+        ),
         click.option(
             "--case",
             default=DEFAULT_CASE,
@@ -109,23 +205,67 @@ def build_pendulum(
     return grazing.models.pendulum(None, **values)
 
 
+def model_parameter(model: grazing.HybridModel, text: str, option: str = "--param") -> grazing.Parameter:
+    """The parameter an option names (``theta-hat`` is ``theta_hat``); one line if the model has none such."""
+    name = text.strip().replace("-", "_")
+    try:
+        return model.parameter(name)
+    except grazing.InvalidParameterError as exc:
+        raise InputError(f"{option}: {exc}") from None
+
+
+def stop_option_index(model: grazing.HybridModel, name: str | None) -> int:
+    """``--stop-name``: the index of the stop (default: the model's first)."""
+    try:
+        return model.stop_index(name)
+    except grazing.InvalidParameterError as exc:
+        raise InputError(f"--stop-name: {exc}") from None
+
+
+stop_name_option = click.option(
+    "--stop-name", default=None, metavar="NAME", help="The stop to look at (default: the model's first stop)."
+)
+
+
 def model_params_json(model: grazing.HybridModel, case: str) -> dict[str, Any]:
-    p = dict(model.params)
-    p["theta_hat_deg"] = math.degrees(p["theta_hat"])
-    p["case"] = case
+    """Every parameter by name; for the pendulum also ``theta_hat_deg`` and ``case``."""
+    p: dict[str, Any] = dict(model.params)
+    if model.name == "pendulum":
+        p["theta_hat_deg"] = math.degrees(p["theta_hat"])
+        p["case"] = case
     return p
 
 
-def parse_pair(text: str) -> tuple[float, float]:
+def parse_state(text: str, model: grazing.HybridModel) -> np.ndarray:
+    """``--initial``: one comma-separated number per state of the model."""
+    n = model.n_states
+    form = "THETA,THETADOT in radians" if model.name == "pendulum" else ",".join(model.state_names).upper()
+    try:
+        values = np.array([float(t) for t in text.split(",")])
+        if values.size != n:
+            raise ValueError
+    except ValueError:
+        raise InputError(
+            f"--initial must be {form}, got {text!r} (model {model.name} has {n} states)"
+        ) from None
+    if not np.all(np.isfinite(values)):
+        raise InputError(f"--initial must be finite numbers, got {text!r}")
+    return values
+
+
+def parse_pair(
+    text: str, option: str = "--initial", form: str = "THETA,THETADOT in radians"
+) -> tuple[float, float]:
+    """Two comma-separated finite numbers (``--initial`` of the pendulum, ``--range LO,HI``)."""
     parts = text.split(",")
     try:
         if len(parts) != 2:
             raise ValueError
         a, b = (float(s) for s in parts)
     except ValueError:
-        raise InputError(f"--initial must be THETA,THETADOT in radians, got {text!r}") from None
+        raise InputError(f"{option} must be {form}, got {text!r}") from None
     if not (math.isfinite(a) and math.isfinite(b)):
-        raise InputError(f"--initial must be finite numbers, got {text!r}")
+        raise InputError(f"{option} must be finite numbers, got {text!r}")
     return a, b
 
 

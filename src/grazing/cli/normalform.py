@@ -15,13 +15,17 @@ from grazing.cli.common import (
     emit_json,
     json_option,
     model_options,
+    model_parameter,
     model_params_json,
+    parse_pair,
+    stop_name_option,
+    stop_option_index,
 )
-from grazing.cli.validate import POSITIVE, refuse_unused
+from grazing.cli.validate import POSITIVE, InputError, refuse_unused
 
 
 @click.command("normal-form")
-@model_options
+@model_options(any_model=True)
 @click.option(
     "--which",
     type=click.Choice(["first", "second"]),
@@ -32,27 +36,54 @@ from grazing.cli.validate import POSITIVE, refuse_unused
 @click.option("--eta-min", type=POSITIVE, default=0.2, show_default=True, help="Lower end of the eta search.")
 @click.option("--eta-max", type=POSITIVE, default=1.0, show_default=True, help="Upper end of the eta search.")
 @click.option(
+    "--param",
+    "gparam",
+    default=None,
+    metavar="NAME",
+    help="Any parameter of the model to search (pendulum default: eta over --eta-min/--eta-max).",
+)
+@click.option(
+    "--range", "prange", default=None, metavar="LO,HI", help="The interval of --param (display unit)."
+)
+@stop_name_option
+@click.option(
     "--check", is_flag=True, help="Also simulate just past grazing and compare with the prediction."
 )
 @json_option
 def normal_form_cmd(
-    model: grazing.HybridModel, case: str,
-    which: str, eta_min: float, eta_max: float, check: bool, as_json: bool,
+    model: grazing.HybridModel, case: str, which: str, eta_min: float, eta_max: float, gparam: str | None,
+    prange: str | None, stop_name: str | None, check: bool, as_json: bool,
 ) -> None:  # fmt: skip
     """Grazing normal form at a grazing of the period-1 orbit: multipliers, the
     discontinuity map's coefficients and the predicted scenario past grazing."""
     from grazing.normalform import find_grazing_point, normal_form_at, observe, predict
 
-    refuse_unused(["eta"], True, "by normal-form: it searches eta in [--eta-min, --eta-max]")
-    check_eta_range(eta_min, eta_max)
-    point = find_grazing_point(model, "eta", eta_min, eta_max, which)
-    nf = normal_form_at(point, PENDULUM_UNFOLDING)
-    pred = predict(nf, "eta")
-    b_eta, _, _ = nf.unfolding["eta"]
+    stop = stop_option_index(model, stop_name)
+    pendulum = gparam is None and prange is None and model.name == "pendulum"
+    if pendulum:
+        refuse_unused(["eta"], True, "by normal-form: it searches eta in [--eta-min, --eta-max]")
+        check_eta_range(eta_min, eta_max)
+        par, lo, hi = model.parameter("eta"), eta_min, eta_max
+    else:
+        refuse_unused(["eta_min", "eta_max"], True, "with --param/--range (use --range LO,HI)")
+        if gparam is None or prange is None:
+            raise InputError("normal-form needs --param NAME and --range LO,HI (for this model)")
+        par = model_parameter(model, gparam)
+        refuse_unused([par.name], True, "by normal-form: it searches --param over --range")
+        lo, hi = (par.from_display(v) for v in parse_pair(prange, "--range", "LO,HI"))
+        if not lo < hi:
+            raise InputError(f"--range: LO must be below HI, got {prange}")
+        for v in (lo, hi):
+            model.with_params(**{par.name: v})
+    point = find_grazing_point(model, par.name, lo, hi, which, stop_name=stop)
+    nf = normal_form_at(point, PENDULUM_UNFOLDING if pendulum else (par.name,))
+    pred = predict(nf, par.name)
     res: dict[str, Any] = {
         "params": model_params_json(point.model, case),
         "which": which,
-        "eta_graze": point.model.params["eta"],
+        "param": par.name,
+        "value": par.to_display(point.model.params[par.name]),
+        "stop": point.stop_name,
         "t_graze": point.phase,
         "multipliers": complex_list(point.multipliers),
         "abs_lambda": point.abs_lambda,
@@ -65,19 +96,22 @@ def normal_form_cmd(
             "kappa": nf.kappa,
             "grad_h": nf.grad_h,
             "grad_rate": nf.grad_rate,
-            "unfolding_eta": b_eta,
-            "unfolding_theta_hat": nf.unfolding["theta_hat"][0],
+            f"unfolding_{par.name}": nf.unfolding[par.name][0],
         },
     }
+    if pendulum:
+        res["eta_graze"] = point.model.params["eta"]
+        res["coefficients"]["unfolding_theta_hat"] = nf.unfolding["theta_hat"][0]
     if check:
-        obs = observe(nf, "eta")
+        obs = observe(nf, par.name)
         res["observed"] = {"scenario": obs.scenario, "offsets": obs.offsets, "periods": obs.periods}
         res["agrees"] = obs.scenario == pred.scenario
     if as_json:
         emit_json(res)
         return
     mu = ", ".join(f"{z.real:+.4f}{z.imag:+.4f}i" for z in point.multipliers)
-    click.echo(f"{which} grazing at eta = {res['eta_graze']:.6f}, t_graze = {point.phase:.4f}")
+    where = "" if point.stop_name == "stop" else f" (stop {point.stop_name})"
+    click.echo(f"{which} grazing at {par.name} = {res['value']:.6f}{where}, t_graze = {point.phase:.4f}")
     click.echo(f"  multipliers {mu}, |lambda| = {point.abs_lambda:.4f}, kappa (M12) = {nf.kappa:+.4f}")
     click.echo(f"  discontinuity map: a = {nf.accel:.6f}, e = {np.round(nf.direction, 6).tolist()}")
     click.echo(f"  prediction: {pred.scenario} ({pred.rule})")

@@ -19,10 +19,14 @@ from grazing.cli.common import (
     emit_json,
     json_option,
     model_options,
+    model_parameter,
     model_params_json,
     netcdf_out_option,
     parse_pair,
+    parse_state,
     save_dataset,
+    stop_name_option,
+    stop_option_index,
 )
 from grazing.cli.validate import ANGLE_DEG, FINITE, ORBIT_PERIOD, POSITIVE, count, refuse_unused
 from grazing.models.pendulum import max_angle
@@ -39,17 +43,37 @@ def _orbit_json(orbit: Any) -> dict[str, Any]:
         "residual": orbit.residual,
         "newton_iterations": len(orbit.residuals) - 1,
         "min_impact_speed": None if math.isnan(orbit.min_impact_speed) else orbit.min_impact_speed,
+        "impacts_per_stop": {
+            name: int(np.sum(orbit.impact_stops == j)) for j, name in enumerate(orbit.model.stop_names)
+        },
     }
-    if "theta_hat" in orbit.model.params:
+    if orbit.model.name == "pendulum":
         out["max_theta_deg"] = math.degrees(max_angle(orbit))
     return out
 
 
+def _initial_state(model: grazing.HybridModel, initial: str) -> np.ndarray:
+    """``--initial`` for a model: one number per state, inside every stop."""
+    x0 = parse_state(initial, model)
+    if model.name == "pendulum" and x0[0] > model.params["theta_hat"]:
+        raise InputError(
+            f"initial angle {x0[0]:g} rad is beyond the stop at theta-hat = "
+            f"{math.degrees(model.params['theta_hat']):g} deg"
+        )
+    try:
+        model.check_state(x0)
+    except grazing.InvalidStateError as exc:
+        raise InputError(f"--initial: {exc}") from None
+    return x0
+
+
 @click.command()
-@model_options
+@model_options(any_model=True)
 @click.option("--period", type=ORBIT_PERIOD, help="Period in forcing periods (default: detected).")
 @click.option(
-    "--initial", metavar="THETA,THETADOT", help="Initial guess at tau = 0 (default: from simulation)."
+    "--initial",
+    metavar="X1,X2,...",
+    help="Initial guess at time 0, one per state (default: from simulation).",
 )
 @click.option("--transient", type=count(0), default=500, show_default=True,
               help="Forcing periods simulated for the initial guess (without --initial).")  # fmt: skip
@@ -66,91 +90,140 @@ def orbit(
     from grazing.orbits import find_orbit
 
     refuse_unused(["transient"], initial is not None, "with --initial (it runs the simulation that guesses)")
-    x0 = None
-    if initial is not None:
-        x0 = parse_pair(initial)
-        if x0[0] > model.params["theta_hat"]:
-            raise InputError(
-                f"initial angle {x0[0]:g} rad is beyond the stop at theta-hat = "
-                f"{math.degrees(model.params['theta_hat']):g} deg"
-            )
+    x0 = _initial_state(model, initial) if initial is not None else None
     orb = find_orbit(model, x0, period=period, transient=transient)
     res = {"params": model_params_json(model, case), **_orbit_json(orb)}
     if as_json:
         emit_json(res)
         return
     kind = "stable" if orb.stable else "unstable"
-    click.echo(
-        f"period-{orb.period} orbit with {orb.impacts} impact(s) per period, {kind}; "
-        f"max theta {res['max_theta_deg']:.6f} deg"
-    )
-    click.echo(f"state at tau = 0: theta = {orb.state[0]:.12f}, theta' = {orb.state[1]:.12f}")
+    extra = f"; max theta {res['max_theta_deg']:.6f} deg" if "max_theta_deg" in res else ""
+    if model.n_stops > 1:
+        extra += " (" + ", ".join(f"{k}: {v}" for k, v in res["impacts_per_stop"].items()) + ")"
+    click.echo(f"period-{orb.period} orbit with {orb.impacts} impact(s) per period, {kind}{extra}")
+    state = ", ".join(f"{nm} = {v:.12f}" for nm, v in zip(model.state_names, orb.state))
+    click.echo(f"state at {model.time_label} = 0: {state}")
     for z in orb.multipliers:
         click.echo(f"  multiplier {z.real:+.6f} {z.imag:+.6f}i   |mu| = {abs(z):.6f}")
 
 
-def _grazing_json(g: Any) -> dict[str, Any]:
-    return {
-        "eta": g.model.params["eta"],
-        "theta_hat_deg": math.degrees(g.model.params["theta_hat"]),
-        "multipliers": complex_list(g.multipliers),
-        "abs_lambda": g.abs_lambda,
-        "t_graze": g.phase,
-        "accel": g.accel,
-    }
+def _grazing_json(g: Any, param: str | None = None) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    if g.model.name == "pendulum":
+        out["eta"] = g.model.params["eta"]
+        out["theta_hat_deg"] = math.degrees(g.model.params["theta_hat"])
+    if param is not None:
+        out["value"] = g.model.parameter(param).to_display(g.model.params[param])
+    out.update(
+        {
+            "stop": g.stop_name,
+            "multipliers": complex_list(g.multipliers),
+            "abs_lambda": g.abs_lambda,
+            "t_graze": g.phase,
+            "accel": g.accel,
+        }
+    )
+    return out
 
 
 @click.command()
-@model_options
+@model_options(any_model=True)
 @click.option("--eta-min", type=POSITIVE, default=0.2, show_default=True, help="Lower end of the eta range.")
 @click.option("--eta-max", type=POSITIVE, default=1.0, show_default=True, help="Upper end of the eta range.")
+@click.option(
+    "--param",
+    "gparam",
+    default=None,
+    metavar="NAME",
+    help="Any parameter of the model to search (default for the pendulum: eta, over --eta-min/--eta-max).",
+)
+@click.option(
+    "--range",
+    "prange",
+    default=None,
+    metavar="LO,HI",
+    help="The interval of --param to search (in its display unit: degrees for angles).",
+)
+@stop_name_option
 @json_option
 def graze(
     model: grazing.HybridModel,
     case: str,
     eta_min: float,
     eta_max: float,
+    gparam: str | None,
+    prange: str | None,
+    stop_name: str | None,
     as_json: bool,
 ) -> None:
-    """Every grazing of the period-1 nonimpacting orbit with the stop, for eta in a range."""
+    """Every grazing of the period-1 nonimpacting orbit with a stop, for a parameter in a range."""
     from grazing.orbits import find_grazings
 
-    refuse_unused(["eta"], True, "by graze: it searches eta in [--eta-min, --eta-max]")
-    check_eta_range(eta_min, eta_max)
+    stop = stop_option_index(model, stop_name)
+    if gparam is None and prange is None and model.name == "pendulum":
+        refuse_unused(["eta"], True, "by graze: it searches eta in [--eta-min, --eta-max]")
+        check_eta_range(eta_min, eta_max)
+        par, lo, hi = model.parameter("eta"), eta_min, eta_max
+    else:
+        refuse_unused(["eta_min", "eta_max"], True, "with --param/--range (use --range LO,HI)")
+        if gparam is None or prange is None:
+            raise InputError("graze needs --param NAME and --range LO,HI (for this model)")
+        par = model_parameter(model, gparam)
+        refuse_unused([par.name], True, "by graze: it searches --param over --range")
+        lo, hi = (par.from_display(v) for v in parse_pair(prange, "--range", "LO,HI"))
+        if not lo < hi:
+            raise InputError(f"--range: LO must be below HI, got {prange}")
+        for v in (lo, hi):
+            model.with_params(**{par.name: v})  # both ends inside the parameter's interval
     bar = Progress("continuing", enabled=not as_json)
     try:
         points, branch = find_grazings(
             model,
-            "eta",
-            eta_min,
-            eta_max,
-            progress=lambda n, v: bar(int(1000 * (v - eta_min) / (eta_max - eta_min)), 1000),
+            par.name,
+            lo,
+            hi,
+            stop_name=stop,
+            progress=lambda n, v: bar(int(1000 * (v - lo) / (hi - lo)), 1000),
         )
     finally:
         bar.close()
     res = {
         "params": model_params_json(model, case),
-        "eta_range": [eta_min, eta_max],
-        "grazings": [_grazing_json(g) for g in points],
-        "folds": [s.param for s in branch.special if s.kind == "fold"],
+        "param": par.name,
+        "range": [par.to_display(lo), par.to_display(hi)],
+        "stop": model.stop_names[stop],
+        "grazings": [_grazing_json(g, par.name) for g in points],
+        "folds": [par.to_display(s.param) for s in branch.special if s.kind == "fold"],
     }
+    if par.name == "eta":
+        res["eta_range"] = [lo, hi]
     if as_json:
         emit_json(res)
         return
+    unit = f" {par.display_unit}" if par.angle else ""
     if not points:
-        th = math.degrees(model.params["theta_hat"])
-        click.echo(f"no grazing for eta in [{eta_min:g}, {eta_max:g}] at theta-hat = {th:g} deg")
+        click.echo(f"no grazing with stop {model.stop_names[stop]} for {par.name} in "
+                   f"[{par.to_display(lo):g}, {par.to_display(hi):g}]{unit}")  # fmt: skip
     for g in res["grazings"]:
         mu = ", ".join(f"{a:+.4f}{b:+.4f}i" for a, b in g["multipliers"])
-        click.echo(f"eta = {g['eta']:.6f}: multipliers {mu}, |lambda| = {g['abs_lambda']:.4f}, "
-                   f"t_graze = {g['t_graze']:.4f}")  # fmt: skip
+        where = "" if g["stop"] == "stop" else f" (stop {g['stop']})"
+        click.echo(f"{par.name} = {g['value']:.6f}{unit}{where}: multipliers {mu}, "
+                   f"|lambda| = {g['abs_lambda']:.4f}, t_graze = {g['t_graze']:.4f}")  # fmt: skip
 
 
 @click.command("graze-curve")
-@model_options
+@model_options(any_model=True)
 @click.option(
     "--start-deg", type=ANGLE_DEG, default=5.0, show_default=True, help="theta-hat where the curve starts."
 )
+@click.option("--params", "gparams", default=None, metavar="P1,P2",
+              help="Any two parameters (pendulum default: eta,theta_hat): P1 is searched over --range, "
+              "P2 starts at --start-value and moves along the curve.")  # fmt: skip
+@click.option("--range", "prange", default=None, metavar="LO,HI", help="Interval of P1 (display unit).")
+@click.option(
+    "--start-value", type=FINITE, default=None, help="Value of P2 where the curve starts (display unit)."
+)
+@stop_name_option
 @click.option("--eta-min", type=POSITIVE, default=0.2, show_default=True, help="Lower end of the eta range.")
 @click.option("--eta-max", type=POSITIVE, default=1.0, show_default=True, help="Upper end of the eta range.")
 @click.option("--max-step", type=POSITIVE, default=0.05, show_default=True, help="Largest continuation step.")
@@ -163,51 +236,91 @@ def graze_curve(
     eta_min: float,
     eta_max: float,
     max_step: float,
+    gparams: str | None,
+    prange: str | None,
+    start_value: float | None,
+    stop_name: str | None,
     out: Path | None,
     as_json: bool,
 ) -> None:
-    """Two-parameter continuation of grazing in (eta, theta-hat), with theta-hat_max."""
+    """Two-parameter continuation of grazing (the pendulum: in (eta, theta-hat), with theta-hat_max)."""
     from grazing.orbits import PalcSettings, grazing_curve
 
-    refuse_unused(["eta"], True, "by graze-curve: it searches eta in [--eta-min, --eta-max]")
-    refuse_unused(["theta_hat"], True, "by graze-curve: the curve starts at --start-deg")
-    check_eta_range(eta_min, eta_max)
+    stop = stop_option_index(model, stop_name)
+    generic = gparams is not None or prange is not None or start_value is not None or model.name != "pendulum"
+    if not generic:
+        refuse_unused(["eta"], True, "by graze-curve: it searches eta in [--eta-min, --eta-max]")
+        refuse_unused(["theta_hat"], True, "by graze-curve: the curve starts at --start-deg")
+        check_eta_range(eta_min, eta_max)
+        p1, p2 = model.parameter("eta"), model.parameter("theta_hat")
+        lo, hi, start = eta_min, eta_max, math.radians(start_deg)
+    else:
+        refuse_unused(["eta_min", "eta_max", "start_deg"], True, "with --params/--range/--start-value")
+        if gparams is None or prange is None or start_value is None:
+            raise InputError(
+                "graze-curve needs --params P1,P2, --range LO,HI and --start-value (for this model)"
+            )
+        names = [t for t in gparams.split(",") if t.strip()]
+        if len(names) != 2:
+            raise InputError(f"--params {gparams!r}: expected two parameter names P1,P2")
+        p1, p2 = (model_parameter(model, t, "--params") for t in names)
+        if p1.name == p2.name:
+            raise InputError("--params: the two parameters must differ")
+        refuse_unused([p1.name, p2.name], True, "by graze-curve: it moves both --params")
+        lo, hi = (p1.from_display(v) for v in parse_pair(prange, "--range", "LO,HI"))
+        if not lo < hi:
+            raise InputError(f"--range: LO must be below HI, got {prange}")
+        start = p2.from_display(start_value)
+        model.with_params(**{p2.name: start})
     check_out(out, ".nc")
     settings = PalcSettings(ds=min(0.02, max_step), ds_max=max_step)
-    curve = grazing_curve(model, ("eta", "theta_hat"), math.radians(start_deg), search=(eta_min, eta_max),
-                          settings=settings)  # fmt: skip
+    curve = grazing_curve(
+        model, (p1.name, p2.name), start, search=(lo, hi), settings=settings, stop_name=stop
+    )
     if out is not None:
         save_dataset(curve.to_dataset(), out)
     fold = curve.fold
-    res = {
+    res: dict[str, Any] = {
         "params": model_params_json(model, case),
-        "theta_max_deg": math.degrees(fold.model.params["theta_hat"]) if fold else None,
-        "eta_at_theta_max": fold.model.params["eta"] if fold else None,
-        "multipliers_at_theta_max": complex_list(fold.multipliers) if fold else None,
+        "curve_params": [p1.name, p2.name],
+        "stop": model.stop_names[stop],
+        "fold": {p.name: p.to_display(fold.model.params[p.name]) for p in (p1, p2)} if fold else None,
+        "multipliers_at_fold": complex_list(fold.multipliers) if fold else None,
         "status": curve.status,
-        "curve": [_grazing_json(g) for g in curve.points],
+        "curve": [{**_grazing_json(g), p1.name: p1.to_display(g.model.params[p1.name]),
+                   p2.name: p2.to_display(g.model.params[p2.name])} for g in curve.points],
         "out": str(out) if out else None,
-    }
+    }  # fmt: skip
+    if not generic:  # the pendulum's keys
+        res["theta_max_deg"] = math.degrees(fold.model.params["theta_hat"]) if fold else None
+        res["eta_at_theta_max"] = fold.model.params["eta"] if fold else None
+        res["multipliers_at_theta_max"] = complex_list(fold.multipliers) if fold else None
     if as_json:
         emit_json(res)
         return
-    click.echo(f"{len(curve.points)} grazing orbits from theta-hat = {start_deg:g} deg ({curve.status})")
+    if not generic:
+        click.echo(f"{len(curve.points)} grazing orbits from theta-hat = {start_deg:g} deg ({curve.status})")
+        if fold:
+            tmax, eta_at = res["theta_max_deg"], res["eta_at_theta_max"]
+            click.echo(f"theta-hat_max = {tmax:.4f} deg at eta = {eta_at:.6f}: no grazing above it")
+        return
+    first = f"{p2.name} = {p2.to_display(start):g}{' deg' if p2.angle else ''}"
+    click.echo(f"{len(curve.points)} grazing orbits from {first} ({curve.status})")
     if fold:
-        click.echo(f"theta-hat_max = {res['theta_max_deg']:.4f} deg at eta = {res['eta_at_theta_max']:.6f}: "
-                   "no grazing above it")  # fmt: skip
-
-
-_CONTINUE_PARAMS = {"eta": "eta", "theta-hat": "theta_hat", "alpha": "alpha", "beta": "beta", "r": "r"}
+        where = ", ".join(f"{k} = {v:.6g}" for k, v in res["fold"].items())
+        click.echo(f"fold of the grazing curve (largest {p2.name}) at {where}: no grazing beyond it")
 
 
 @click.command("continue")
-@model_options
-@click.option("--param", "cparam", required=True, type=click.Choice(list(_CONTINUE_PARAMS)),
-              help="Parameter to vary (theta-hat in degrees).")  # fmt: skip
+@model_options(any_model=True)
+@click.option("--param", "cparam", required=True, metavar="NAME",
+              help="Parameter to vary: any of the model's (the pendulum's eta, theta-hat, alpha, beta, r); "
+              "angles in degrees.")  # fmt: skip
 @click.option("--start", type=FINITE, required=True, help="Start value of the parameter.")
 @click.option("--stop", type=FINITE, required=True, help="End value of the parameter.")
 @click.option("--period", type=ORBIT_PERIOD, help="Period of the orbit (default: detected).")
-@click.option("--initial", metavar="THETA,THETADOT", help="Initial guess at tau = 0.")
+@click.option("--initial", metavar="X1,X2,...", help="Initial guess at time 0, one number per state.")
+@stop_name_option
 @click.option("--virtual/--physical", default=None,
               help="Ignore the stop (default: yes for a nonimpacting starting orbit).")  # fmt: skip
 @click.option("--max-step", type=POSITIVE, default=0.04, show_default=True, help="Largest continuation step.")
@@ -224,6 +337,7 @@ def continue_(
     stop: float,
     period: int | None,
     initial: str | None,
+    stop_name: str | None,
     virtual: bool | None,
     max_step: float,
     switch: bool,
@@ -235,32 +349,33 @@ def continue_(
     the grazing where its impact sequence changes (see --switch)."""
     from grazing.orbits import PalcSettings, continue_orbit
 
-    name = _CONTINUE_PARAMS[cparam]
+    par = model_parameter(model, cparam)
+    name = par.name
     refuse_unused([name], True, f"with --param {cparam}: the branch starts at --start")
-    conv = math.radians if name == "theta_hat" else float
+    watch = stop_option_index(model, stop_name)
     if start == stop:
         raise InputError(f"--start and --stop must be finite and differ, got {start:g} and {stop:g}")
-    if name == "theta_hat":
+    if name == "theta_hat" and model.name == "pendulum":
         for opt, v in (("--start", start), ("--stop", stop)):
             if not ANGLE_DEG.accepts(v):
                 raise InputError(f"{opt} for theta-hat must be {ANGLE_DEG.describe()}, got {v:g}")
     check_out(out, ".nc")
-    x0 = parse_pair(initial) if initial is not None else None
-    a, b = conv(start), conv(stop)
+    x0 = _initial_state(model.with_params(**{name: par.from_display(start)}), initial) if initial else None
+    a, b = par.from_display(start), par.from_display(stop)
     for v in (a, b):  # both ends within the parameter's bounds, before any work ("r = 2 is outside [0, 1]")
         model.with_params(**{name: v})
     bar = Progress("continuing", enabled=not as_json)
     try:
         branch = continue_orbit(
             model, name, a, b, x0=None if x0 is None else np.array(x0), period=period, virtual=virtual,
-            settings=PalcSettings(ds=min(0.01, max_step), ds_max=max_step), switch=switch,
+            settings=PalcSettings(ds=min(0.01, max_step), ds_max=max_step), switch=switch, stop_name=watch,
             progress=lambda n, v: bar(int(1000 * abs(v - a) / abs(b - a)), 1000),
         )  # fmt: skip
     finally:
         bar.close()
     if out is not None:
         save_dataset(branch.to_dataset(), out)
-    back = math.degrees if name == "theta_hat" else float
+    back = par.to_display
     res = {
         "params": model_params_json(model, case),
         "param": cparam,
@@ -287,7 +402,8 @@ def continue_(
         "status": branch.status,
         "out": str(out) if out else None,
     }
-    res["max_theta_deg"] = [math.degrees(max_angle(o)) for o in branch.orbits]
+    if model.name == "pendulum":
+        res["max_theta_deg"] = [math.degrees(max_angle(o)) for o in branch.orbits]
     if as_json:
         emit_json(res)
         return

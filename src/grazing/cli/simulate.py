@@ -20,7 +20,7 @@ from grazing.cli.common import (
     json_option,
     model_options,
     model_params_json,
-    parse_pair,
+    parse_state,
     write_atomic,
 )
 from grazing.cli.limits import check_memory, count_text, simulate_bytes
@@ -28,9 +28,9 @@ from grazing.cli.validate import FINITE, count, path_type, refuse_unused
 
 
 @click.command()
-@model_options
-@click.option("--initial", default="0,0", show_default=True, metavar="THETA,THETADOT",
-              help="Initial state at tau = 0, radians.")  # fmt: skip
+@model_options(any_model=True)
+@click.option("--initial", default=None, metavar="X1,X2,...",
+              help="Initial state at time 0, one per state (default: zero; pendulum: rad).")  # fmt: skip
 @click.option("--transient", type=count(0), default=500, show_default=True,
               help="Forcing periods run and discarded first.")  # fmt: skip
 @click.option("--periods", type=count(1), default=100, show_default=True,
@@ -53,14 +53,18 @@ def simulate(
     points_per_period: int,
     as_json: bool,
 ) -> None:
-    """Simulate the impacting pendulum; print stroboscopic samples, impacts, period."""
+    """Simulate a model (the pendulum by default); print stroboscopic samples, impacts, period."""
     refuse_unused(["points_per_period"], trajectory is None, "without --trajectory")
-    theta0, dtheta0 = parse_pair(initial)
-    if theta0 > model.params["theta_hat"]:
+    x0 = parse_state(initial, model) if initial is not None else np.zeros(model.n_states)
+    if model.name == "pendulum" and x0[0] > model.params["theta_hat"]:
         raise InputError(
-            f"initial angle {theta0:g} rad is beyond the stop at theta-hat = "
+            f"initial angle {x0[0]:g} rad is beyond the stop at theta-hat = "
             f"{math.degrees(model.params['theta_hat']):g} deg ({model.params['theta_hat']:.6g} rad)"
         )
+    try:
+        model.check_state(x0)
+    except grazing.InvalidStateError as exc:
+        raise InputError(f"--initial: {exc}") from None
     check_out(trajectory, ".csv", "--trajectory")
     points = periods * points_per_period + 1 if trajectory is not None else 0
     check_memory(
@@ -75,7 +79,7 @@ def simulate(
     try:
         sol = grazing.simulate(
             model,
-            [theta0, dtheta0],
+            x0,
             transient=transient,
             periods=periods,
             phase=phase,
@@ -90,7 +94,7 @@ def simulate(
     period = sol.period()
     result = {
         "params": model_params_json(model, case),
-        "initial": [theta0, dtheta0],
+        "initial": x0,
         "transient": transient,
         "periods": periods,
         "phase": phase,
@@ -98,6 +102,8 @@ def simulate(
         "impacts": sol.n_impacts,
         "impacts_sampled": len(sol.impacts),
         "impact_map": np.column_stack([sol.impacts.t, sol.impacts.phase, sol.impacts.speed]),
+        "impact_stops": [sol.impacts.stop_name(i) for i in range(len(sol.impacts))],
+        "impacts_per_stop": sol.impacts.per_stop(),
         "sticking_intervals": sol.sticking,
         "period": period,
         "t_final": sol.t_final,
@@ -114,7 +120,8 @@ def simulate(
 
 
 def _write_trajectory_csv(sol: grazing.Solution, fh: Any) -> None:
-    fh.write("tau,theta,dtheta\n")
+    time = "tau" if sol.model.name == "pendulum" else "t"
+    fh.write(",".join([time, *sol.model.state_names]) + "\n")
     assert sol.trajectory_t is not None and sol.trajectory is not None
     np.savetxt(fh, np.column_stack([sol.trajectory_t, sol.trajectory]), delimiter=",", fmt="%.17g")
 
@@ -126,11 +133,11 @@ def _print_simulation(
     from rich.table import Table
 
     con = Console()
-    p = model.params
-    con.print(
-        f"[bold]impacting pendulum[/bold]  alpha={p['alpha']:g} beta={p['beta']:g} r={p['r']:g} "
-        f"eta={p['eta']:g} theta-hat={math.degrees(p['theta_hat']):g} deg"
+    values = "  ".join(
+        f"{p.name}={p.to_display(model.params[p.name]):g}{' deg' if p.angle else ''}"
+        for p in model.parameters
     )
+    con.print(f"[bold]{model.name}[/bold]  {values}")
     n = sol.samples.shape[0]
     kind = f"period {period}" if period else "no period <= 64 (chaotic, quasi-periodic or not settled)"
     con.print(f"{n} sampled periods after {sol.info['transient']} transient: [bold]{kind}[/bold]")
@@ -138,10 +145,15 @@ def _print_simulation(
         f"impacts: {sol.n_impacts} in the whole run, {len(sol.impacts)} in the sampled span; "
         f"sticking intervals: {len(sol.sticking)}; {sol.n_steps} steps in {elapsed:.3f} s"
     )
-    table = Table("k", "tau", "theta [rad]", "theta' ", title="last stroboscopic samples")
+    if model.n_stops > 1:
+        con.print(
+            "impacts per stop in the sampled span: "
+            + ", ".join(f"{k} {v}" for k, v in sol.impacts.per_stop().items())
+        )
+    table = Table("k", model.time_label, *model.state_labels, title="last stroboscopic samples")
     show = min(n, max(period, 5) if period else 8)
     for i in range(n - show, n):
-        table.add_row(str(i), f"{sol.t[i]:.6f}", f"{sol.samples[i, 0]: .10f}", f"{sol.samples[i, 1]: .10f}")
+        table.add_row(str(i), f"{sol.t[i]:.6f}", *(f"{v: .10f}" for v in sol.samples[i]))
     con.print(table)
     if trajectory is not None:
         con.print(f"trajectory written to {trajectory}")

@@ -22,15 +22,14 @@ from grazing.cli.common import (
     emit_json,
     json_option,
     model_options,
+    model_parameter,
     model_params_json,
-    parse_pair,
+    parse_state,
     save_dataset,
 )
 from grazing.cli.limits import POINT_OVERHEAD, check_memory, count_text, sweep_bytes
 from grazing.cli.validate import FINITE, POSITIVE, TOLERANCE, WORKERS, count, path_type, refuse_unused
 from grazing.core.options import CHUNK_SIZE, SweepSettings
-
-_SWEEP_PARAMS = {"eta": "eta", "theta-hat": "theta_hat", "alpha": "alpha", "beta": "beta", "r": "r"}
 
 
 def _sweep_options(func: Callable[..., Any]) -> Callable[..., Any]:
@@ -40,8 +39,9 @@ def _sweep_options(func: Callable[..., Any]) -> Callable[..., Any]:
         ,
         click.option("--periods", type=count(1), default=100, show_default=True,
                      help="Forcing periods sampled at each point."),
-        click.option("--initial", default="0,0", show_default=True, metavar="THETA,THETADOT",
-                     help="Initial state (of every chunk; of every point with --fresh)."),
+        click.option("--initial", default=None, metavar="X1,X2,...",
+                     help="Initial state (of every chunk; of every point with --fresh), one number per "
+                     "state; default zero."),
         click.option("--fresh", is_flag=True, help="Start every point from --initial."),
         click.option("--chunk-size", type=count(0), default=None,
                      help="Points per chunk: the unit of parallel work and of saving (0: one chunk)."),
@@ -160,6 +160,16 @@ def _run_sweep_spec(
     return _SweepRun(ds, period)
 
 
+def _initial(model: grazing.HybridModel, initial: str | None) -> np.ndarray:
+    """``--initial`` of a sweep: one number per state (default zero), inside every stop."""
+    x0 = parse_state(initial, model) if initial is not None else np.zeros(model.n_states)
+    try:
+        model.check_state(x0)
+    except grazing.InvalidStateError as exc:
+        raise InputError(f"--initial: {exc}") from None
+    return x0
+
+
 def _sweep_json(ds: Any, param: str, values: np.ndarray) -> dict[str, Any]:
     return {
         "param": param,
@@ -171,13 +181,21 @@ def _sweep_json(ds: Any, param: str, values: np.ndarray) -> dict[str, Any]:
         "lyapunov": [None if not math.isfinite(v) else float(v) for v in ds.lyapunov.values],
         "samples": ds.samples.values[..., 0],
         "transient_used": ds.transient_used.values,
+        "impacts_per_period_by_stop": {
+            str(name): [
+                None if not math.isfinite(v) else float(v)
+                for v in ds.impacts_per_period_by_stop.sel(stop=name).values
+            ]
+            for name in ds.stop.values
+        },
     }
 
 
 @click.command("sweep")
-@model_options
-@click.option("--param", "sparam", required=True, type=click.Choice(list(_SWEEP_PARAMS)),
-              help="Parameter to sweep (theta-hat in degrees).")  # fmt: skip
+@model_options(any_model=True)
+@click.option("--param", "sparam", required=True, metavar="NAME",
+              help="Parameter to sweep: any of the model's (the pendulum's eta, theta-hat, alpha, beta, r); "
+              "angles in degrees.")  # fmt: skip
 @click.option("--start", type=FINITE, required=True, help="First parameter value.")
 @click.option("--stop", type=FINITE, required=True, help="Last parameter value.")
 @click.option("--num", type=count(1), required=True, help="Number of parameter values.")
@@ -204,7 +222,8 @@ def sweep_cmd(
     Lyapunov exponents along a parameter range."""
     from grazing.sweeps.spec import sweep_spec
 
-    name = _SWEEP_PARAMS[sparam]
+    par = model_parameter(model, sparam)
+    name = par.name
     refuse_unused([name], True, f"with --param {sparam}: the swept values replace it")
     refuse_unused(["which"], method != "map", "without --method map")
     chunk_size = CHUNK_SIZE if chunk_size is None else chunk_size
@@ -212,9 +231,9 @@ def sweep_cmd(
         out, scheduler, chunk_size, num, periods, model.n_states, workers, as_json, "a sweep"
     )
     shown = np.linspace(start, stop, num)
-    vals = np.radians(shown) if name == "theta_hat" else shown
+    vals = np.array([par.from_display(v) for v in shown])
     order = np.sort(vals) if direction == "up" else np.sort(vals)[::-1]
-    x0 = parse_pair(initial)
+    x0 = _initial(model, initial)
     for v in (order[0], order[-1]):
         model.with_params(**{name: v})
     zdm, graze_info = None, None
@@ -256,9 +275,10 @@ def _map_for_sweep(model: Any, name: str, lo: float, hi: float, which: str) -> t
     """The discontinuity map at the first/second grazing for a sweep in ``name`` over ``[lo, hi]``."""
     from grazing.normalform import find_grazing_point, normal_form_at
 
-    a, b = _GRAZE_SEARCH.get(name, (lo - 0.5 * (hi - lo), hi + 0.5 * (hi - lo)))
+    pendulum = model.name == "pendulum"
+    a, b = _GRAZE_SEARCH.get(name, (lo, hi)) if pendulum else (lo, hi)
     point = find_grazing_point(model, name, min(a, lo), max(b, hi), which)
-    nf = normal_form_at(point, PENDULUM_UNFOLDING)
+    nf = normal_form_at(point, PENDULUM_UNFOLDING if pendulum else (name,))
     back = math.degrees if name == "theta_hat" else float
     info = {
         "param": name,
@@ -272,12 +292,12 @@ def _map_for_sweep(model: Any, name: str, lo: float, hi: float, which: str) -> t
 
 
 @click.command("map")
-@model_options
-@click.option("--param1", required=True, type=click.Choice(list(_SWEEP_PARAMS)), help="Horizontal parameter.")
+@model_options(any_model=True)
+@click.option("--param1", required=True, metavar="NAME", help="Horizontal parameter (any of the model's).")
 @click.option("--start1", type=FINITE, required=True)
 @click.option("--stop1", type=FINITE, required=True)
 @click.option("--num1", type=count(1), required=True)
-@click.option("--param2", required=True, type=click.Choice(list(_SWEEP_PARAMS)), help="Vertical parameter.")
+@click.option("--param2", required=True, metavar="NAME", help="Vertical parameter (any of the model's).")
 @click.option("--start2", type=FINITE, required=True)
 @click.option("--stop2", type=FINITE, required=True)
 @click.option("--num2", type=count(1), required=True)
@@ -292,20 +312,21 @@ def map_cmd(
     """Two-parameter map of periods, impacts and Lyapunov exponents."""
     from grazing.sweeps.spec import map_spec
 
-    if param1 == param2:
+    par1, par2 = model_parameter(model, param1, "--param1"), model_parameter(model, param2, "--param2")
+    n1, n2 = par1.name, par2.name
+    if n1 == n2:
         raise InputError("--param1 and --param2 must differ")
-    n1, n2 = _SWEEP_PARAMS[param1], _SWEEP_PARAMS[param2]
     refuse_unused([n1, n2], True, f"with --param1 {param1} --param2 {param2}: the mapped values replace it")
     chunk_size = num1 if chunk_size is None else chunk_size
     _check_sweep_options(out, scheduler, chunk_size, num1 * num2, periods, model.n_states, workers, as_json,
                          "a map")  # fmt: skip
     s1, s2 = np.linspace(start1, stop1, num1), np.linspace(start2, stop2, num2)
-    v1 = np.radians(s1) if n1 == "theta_hat" else s1
-    v2 = np.radians(s2) if n2 == "theta_hat" else s2
+    v1 = np.array([par1.from_display(v) for v in s1])
+    v2 = np.array([par2.from_display(v) for v in s2])
     v1, v2 = np.sort(v1), np.sort(v2)
     for a, b in ((v1[0], v2[0]), (v1[-1], v2[-1])):
         model.with_params(**{n1: a, n2: b})
-    x0 = parse_pair(initial)
+    x0 = _initial(model, initial)
     settings = SweepSettings(
         transient=transient, periods=periods, fresh=fresh, chunk_size=chunk_size, adaptive=not no_adaptive,
         lyapunov=not no_lyapunov, tol=tol,

@@ -2,5 +2,6 @@
 
 from grazing.core.model import HybridModel, Parameter
 from grazing.core.solution import Impacts, Solution
+from grazing.core.symbolic import Stop
 
-__all__ = ["HybridModel", "Impacts", "Parameter", "Solution"]
+__all__ = ["HybridModel", "Impacts", "Parameter", "Solution", "Stop"]

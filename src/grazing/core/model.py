@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from grazing.core.symbolic import SymbolicSystem
+from grazing.core.symbolic import Stop, SymbolicSystem
 from grazing.errors import InvalidParameterError, InvalidStateError
 
 KernelLoader = Callable[["_Definition", int, "int | None"], ModuleType]
@@ -172,6 +172,7 @@ class _Definition:
         builder: Callable[[], dict[str, Any]] | None = None,
         state_units: Sequence[str] | None = None,
         time_label: str | None = None,
+        stop_names: Sequence[str] | None = None,
     ):
         self.name = name
         self.parameters = tuple(parameters)
@@ -184,6 +185,12 @@ class _Definition:
         if len(self.state_labels) != len(self.state_names) or len(self.state_units) != len(self.state_names):
             raise ValueError("state_labels and state_units need one entry per state")
         self.time_label = time_label
+        if symbolic is not None:
+            stop_names = [st[0] for st in symbolic["stops"]] if "stops" in symbolic else ["stop"]
+        self.stop_names = tuple(stop_names or ("stop",))
+        bad = [nm for nm in self.stop_names if not (isinstance(nm, str) and nm.isidentifier())]
+        if bad or len(set(self.stop_names)) != len(self.stop_names):
+            raise ValueError(f"stop names must be distinct identifiers, got {list(self.stop_names)}")
         self.period_expr = period
         self.period_str = str(period)
         self.periodic = periodic
@@ -193,7 +200,7 @@ class _Definition:
         self._builder = builder
         self._system: SymbolicSystem | None = None
         self._kernels: dict[tuple[int, int], ModuleType] = {}
-        self._numeric: dict[str, Callable[..., Any]] = {}
+        self._numeric: dict[tuple[str, int], Callable[..., Any]] = {}
         if symbolic is not None:
             self.system  # noqa: B018 - validate user models at construction
             self._period_fn = _compiled_period(self.system)
@@ -226,24 +233,49 @@ class _Definition:
                 # Text is read with the model's own names (a state called "E" or "pi" is that state).
                 return sp.sympify(e, locals=local) if isinstance(e, str) else sp.sympify(e)
 
-            cd = pieces.get("contact_direction")
+            raw = pieces.get("stops")
+            if raw is None:
+                raw = [("stop", pieces["guard"], pieces["reset"], pieces.get("contact_direction"))]
+            stops = []
+            for item in raw:
+                name, guard, reset, cd = (
+                    (item.name, item.guard, item.reset, item.contact_direction)
+                    if isinstance(item, Stop)
+                    else item
+                )
+                stops.append(Stop(
+                    name, expr(guard), tuple(expr(e) for e in reset),
+                    None if cd is None else tuple(expr(e) for e in cd),
+                ))  # fmt: skip
+            if tuple(st.name for st in stops) != self.stop_names:
+                raise ValueError(
+                    f"the model's stops are {[st.name for st in stops]}, declared {list(self.stop_names)}"
+                )
             system = SymbolicSystem(
                 states=states,
                 time=time,
                 params=psyms,
                 vector_field=tuple(expr(e) for e in pieces["vector_field"]),
-                guard=expr(pieces["guard"]),
-                reset=tuple(expr(e) for e in pieces["reset"]),
-                contact_direction=None if cd is None else tuple(expr(e) for e in cd),
+                guard=stops[0].guard,
+                reset=tuple(stops[0].reset),
+                contact_direction=None
+                if stops[0].contact_direction is None
+                else tuple(stops[0].contact_direction),
                 period=expr(self.period_expr),
+                stops=tuple(stops),
             )
             n = len(states)
-            if len(system.vector_field) != n or len(system.reset) != n:
-                raise ValueError("vector_field and reset need one expression per state")
-            if system.contact_direction is not None and len(system.contact_direction) != n:
-                raise ValueError("contact_direction needs one expression per state")
+            if len(system.vector_field) != n:
+                raise ValueError("vector_field needs one expression per state")
+            for st in stops:
+                if len(st.reset) != n:
+                    raise ValueError(f"the reset of stop {st.name!r} needs one expression per state")
+                if st.contact_direction is not None and len(st.contact_direction) != n:
+                    raise ValueError(
+                        f"the contact_direction of stop {st.name!r} needs one expression per state"
+                    )
             allowed = set(states) | {time} | set(psyms)
-            for e in [*system.vector_field, system.guard, *system.reset]:
+            for e in [*system.vector_field, *(e for st in stops for e in (st.guard, *st.reset))]:
                 extra = e.free_symbols - allowed
                 if extra:
                     raise ValueError(f"unknown symbols {sorted(map(str, extra))} in {e}")
@@ -270,13 +302,13 @@ class _Definition:
             self._kernels[directions, order] = _kernel_loader(self, directions, order)
         return self._kernels[directions, order]
 
-    def numeric(self, what: str) -> Callable[..., Any]:
-        """numpy function of ``(x, t, p)`` for f, h, g or a Jacobian (built on first use)."""
-        fn = self._numeric.get(what)
+    def numeric(self, what: str, stop: int = 0) -> Callable[..., Any]:
+        """numpy function of ``(x, t, p)`` for f, h, g or a Jacobian at a stop (built on first use)."""
+        fn = self._numeric.get((what, stop))
         if fn is None:
             import sympy as sp
 
-            s = self.system.canonical()  # no user name can collide with numpy's or Python's
+            s = self.system.canonical().at_stop(stop)  # no user name can collide with numpy's or Python's
             x = sp.Matrix(s.states)
             exprs = {
                 "f": lambda: sp.Matrix(s.vector_field),
@@ -297,7 +329,7 @@ class _Definition:
             fn = sp.lambdify(
                 (list(s.states), s.time, list(s.params)), exprs[what](), modules="numpy", dummify=True
             )
-            self._numeric[what] = fn
+            self._numeric[what, stop] = fn
         return fn
 
     def period(self, values: Sequence[float]) -> float:
@@ -377,12 +409,19 @@ class HybridModel:
     vector_field
         ``f(x, t)``, one expression per state.
     guard
-        ``h(x, t)``: positive in the allowed region, zero on the stop.
+        ``h(x, t)``: positive in the allowed region, zero on the stop (a
+        model with one stop, named ``"stop"``).
     reset
         ``g(x, t)``: the state just after an impact.
     period
         Forcing period (expression in the parameters): stroboscopic samples are
         taken once per period.
+    stops
+        Several stops instead of ``guard``/``reset``/``contact_direction``: a
+        list of :class:`Stop` (name, guard, reset, contact direction).  The
+        allowed region is where every guard is positive; on each step the
+        earliest root of any guard is the next impact, and of two stops hit at
+        the same instant (to rounding) the first in this list is applied.
     contact_direction
         Direction in which the reset acts (for a mechanical impact, the
         velocity direction). Needed to continue complete chattering as
@@ -415,6 +454,17 @@ class HybridModel:
     ...     contact_direction=[0, 1])
     >>> model.with_params(r=0.5).params["r"]
     0.5
+
+    Two stops, one on each side (``stops=`` instead of ``guard``/``reset``):
+
+    >>> from grazing import Stop
+    >>> two = HybridModel(
+    ...     "two-sided", [x, v], t, [Parameter("omega", 1.5, lower=0, lower_open=True),
+    ...     Parameter("r", 0.8, lower=0, upper=1)],
+    ...     vector_field=[v, -x + sp.cos(w * t)], period=2 * sp.pi / w,
+    ...     stops=[Stop("right", 1 - x, [x, -r * v]), Stop("left", x + 1, [x, -r * v])])
+    >>> two.stop_names
+    ('right', 'left')
     """
 
     def __init__(
@@ -424,10 +474,11 @@ class HybridModel:
         time: Any,
         parameters: Sequence[Parameter],
         vector_field: Sequence[Any],
-        guard: Any,
-        reset: Sequence[Any],
-        period: Any,
+        guard: Any = None,
+        reset: Sequence[Any] | None = None,
+        period: Any = None,
         *,
+        stops: Sequence[Stop] | None = None,
         contact_direction: Sequence[Any] | None = None,
         periodic: bool = True,
         state_labels: Sequence[str] | None = None,
@@ -436,14 +487,33 @@ class HybridModel:
         values: Mapping[str, float] | None = None,
         state_units: Sequence[str] | None = None,
     ):
-        symbolic = {
+        if period is None:
+            raise ValueError("a model needs its forcing period (period=...)")
+        symbolic: dict[str, Any] = {
             "states": tuple(states),
             "time": time,
             "vector_field": tuple(vector_field),
-            "guard": guard,
-            "reset": tuple(reset),
-            "contact_direction": None if contact_direction is None else tuple(contact_direction),
         }
+        if stops is not None:
+            if guard is not None or reset is not None or contact_direction is not None:
+                raise ValueError("give either stops= or guard=/reset=/contact_direction=, not both")
+            if not stops or not all(isinstance(st, Stop) for st in stops):
+                raise ValueError("stops must be a non-empty list of grazing.Stop")
+            symbolic["stops"] = tuple(
+                (
+                    st.name,
+                    st.guard,
+                    tuple(st.reset),
+                    None if st.contact_direction is None else tuple(st.contact_direction),
+                )
+                for st in stops
+            )
+        else:
+            if guard is None or reset is None:
+                raise ValueError("a model needs a guard and a reset (or stops=[...])")
+            symbolic["guard"] = guard
+            symbolic["reset"] = tuple(reset)
+            symbolic["contact_direction"] = None if contact_direction is None else tuple(contact_direction)
         self._def = _Definition.get(
             {
                 "name": name,
@@ -476,12 +546,14 @@ class HybridModel:
         reference: str = "",
         state_units: Sequence[str] | None = None,
         time_label: str = "t",
+        stop_names: Sequence[str] = ("stop",),
     ) -> HybridModel:
         """A model whose symbolic pieces are built by ``builder()`` only when needed.
 
         ``builder`` (a module-level function) returns a dict with ``states``,
         ``time``, ``vector_field``, ``guard``, ``reset`` and optionally
-        ``contact_direction``; ``period`` is the period as an expression text in
+        ``contact_direction`` (or ``stops``, a list of :class:`Stop` named
+        ``stop_names``); ``period`` is the period as an expression text in
         the parameter names (``"2*pi/omega"``).  The compiled kernels are found
         in the cache by the builder's source text, so a cached model starts
         without importing sympy.  The built-in models are made this way.
@@ -499,6 +571,7 @@ class HybridModel:
                 "builder": builder,
                 "state_units": None if state_units is None else tuple(state_units),
                 "time_label": time_label,
+                "stop_names": tuple(stop_names),
             }
         )
         obj = cls._from(definition, {})
@@ -578,8 +651,8 @@ class HybridModel:
         known = ", ".join(p.name for p in self._def.parameters)
         raise InvalidParameterError(f"unknown parameter {name!r} for model {self.name!r} (known: {known})")
 
-    def stop_level(self, component: int, t: float = 0.0) -> float | None:
-        """The value of state ``component`` on the stop, when the guard depends on it alone.
+    def stop_level(self, component: int, t: float = 0.0, stop: int | str | None = None) -> float | None:
+        """The value of state ``component`` on a stop (the first by default) whose guard depends on it alone.
 
         For a stop at ``x_c = c`` (a guard affine in ``x_c``, independent of the
         other states and of time, as the pendulum's ``theta_hat - theta``) this
@@ -587,12 +660,12 @@ class HybridModel:
         (two evaluations, checked at three random states and times), for
         drawing the stop in plots.
         """
-        n = self.n_states
+        n, j = self.n_states, self.stop_index(stop)
         x0 = np.zeros(n)
         unit = np.zeros(n)
         unit[component] = 1.0
-        h0 = self.guard(x0, t)
-        slope = self.guard(unit, t) - h0
+        h0 = self.guard(x0, t, j)
+        slope = self.guard(unit, t, j) - h0
         if slope == 0.0 or not math.isfinite(slope):
             return None
         rng = np.random.default_rng(0)
@@ -600,13 +673,44 @@ class HybridModel:
             x = rng.normal(size=n)
             tt = float(rng.uniform(0.0, self.period))
             expected = h0 + slope * x[component]
-            if abs(self.guard(x, tt) - expected) > 1e-9 * (1.0 + abs(h0) + abs(slope * x[component])):
+            if abs(self.guard(x, tt, j) - expected) > 1e-9 * (1.0 + abs(h0) + abs(slope * x[component])):
                 return None
         return -h0 / slope
 
     @property
     def n_states(self) -> int:
         return len(self._def.state_names)
+
+    @property
+    def stop_names(self) -> tuple[str, ...]:
+        """The names of the model's stops (``("stop",)`` for a model given by one guard)."""
+        return self._def.stop_names
+
+    @property
+    def n_stops(self) -> int:
+        return len(self._def.stop_names)
+
+    def stop_index(self, stop: int | str | None) -> int:
+        """The index of a stop given by name or index (None: the first).
+
+        Examples
+        --------
+        >>> from grazing.models import two_sided_oscillator
+        >>> two_sided_oscillator().stop_index("left")
+        1
+        """
+        if stop is None:
+            return 0
+        if isinstance(stop, str):
+            if stop in self._def.stop_names:
+                return self._def.stop_names.index(stop)
+            known = ", ".join(self._def.stop_names)
+            raise InvalidParameterError(f"unknown stop {stop!r} for model {self.name!r} (stops: {known})")
+        if isinstance(stop, (int, np.integer)) and not isinstance(stop, bool) and 0 <= stop < self.n_stops:
+            return int(stop)
+        raise InvalidParameterError(
+            f"stop must be a stop name or an index below {self.n_stops}, got {stop!r}"
+        )
 
     @property
     def period(self) -> float:
@@ -619,7 +723,8 @@ class HybridModel:
 
     @property
     def has_sticking(self) -> bool:
-        return self._def.system.contact_direction is not None
+        """True when some stop has a contact direction (chattering on it continues as sticking)."""
+        return any(st.contact_direction is not None for st in self._def.system.stops)
 
     @property
     def symbolic(self) -> SymbolicSystem:
@@ -653,13 +758,14 @@ class HybridModel:
             raise InvalidParameterError(f"directions must be a non-negative integer, got {directions!r}")
         return self._def.kernels(directions, None if order is None else int(order))
 
-    def numeric(self, what: str) -> Callable[..., Any]:
+    def numeric(self, what: str, stop: int | str | None = None) -> Callable[..., Any]:
         """The model's ``what`` as a numpy function of ``(x, t, p)``, straight from sympy.
 
         ``what`` is one of ``f``, ``h``, ``g``, ``f_x``, ``h_x``, ``g_x``,
         ``h_t``, ``h_p``, ``g_t``, ``rate``, ``rate_x``, ``rate_t``,
-        ``rate_p``, ``accel``.  These are ``sympy.lambdify`` functions, slow
-        but independent of the compiled kernels: for checks and references.
+        ``rate_p``, ``accel``, of stop ``stop`` (name or index; the first by
+        default).  These are ``sympy.lambdify`` functions, slow but
+        independent of the compiled kernels: for checks and references.
 
         Examples
         --------
@@ -668,10 +774,10 @@ class HybridModel:
         >>> float(m.numeric("h")([0.0, 1.0], 0.0, list(m.param_vector)))
         0.1
         """
-        return self._def.numeric(what)
+        return self._def.numeric(what, self.stop_index(stop))
 
-    def _call(self, what: str, x: Any, t: float) -> Any:
-        fn = self._def.numeric(what)
+    def _call(self, what: str, x: Any, t: float, stop: int = 0) -> Any:
+        fn = self._def.numeric(what, stop)
         return fn(list(np.asarray(x, dtype=float)), float(t), list(self.param_vector))
 
     def vector_field(self, x: Any, t: float = 0.0) -> np.ndarray:
@@ -680,60 +786,70 @@ class HybridModel:
         self.kernels().rhs(np.asarray(x, dtype=float), float(t), self.param_vector, out)
         return out
 
-    def guard(self, x: Any, t: float = 0.0) -> float:
-        """``h(x, t)``: positive in the allowed region."""
-        return float(self.kernels().guard(np.asarray(x, dtype=float), float(t), self.param_vector))
+    def guard(self, x: Any, t: float = 0.0, stop: int | str | None = None) -> float:
+        """``h(x, t)`` of a stop (the first by default): positive in the allowed region."""
+        j = self.stop_index(stop)
+        return float(self.kernels().guard(np.asarray(x, dtype=float), float(t), self.param_vector, j))
 
-    def reset(self, x: Any, t: float = 0.0) -> np.ndarray:
-        """``g(x, t)``: the state just after an impact at ``x``."""
+    def guards(self, x: Any, t: float = 0.0) -> np.ndarray:
+        """Every stop's guard at ``(x, t)``, in the order of :attr:`stop_names`."""
+        return np.array([self.guard(x, t, j) for j in range(self.n_stops)])
+
+    def reset(self, x: Any, t: float = 0.0, stop: int | str | None = None) -> np.ndarray:
+        """``g(x, t)`` of a stop: the state just after an impact at ``x``."""
         out = np.empty(self.n_states)
-        self.kernels().reset(np.asarray(x, dtype=float), float(t), self.param_vector, out)
+        j = self.stop_index(stop)
+        self.kernels().reset(np.asarray(x, dtype=float), float(t), self.param_vector, out, j)
         return out
 
-    def normal_accel(self, x: Any, t: float = 0.0) -> float:
-        """``L_f^2 h`` at ``(x, t)``: the guard's acceleration along the flow (compiled)."""
-        return float(self.kernels().normal_accel(np.asarray(x, dtype=float), float(t), self.param_vector))
+    def normal_accel(self, x: Any, t: float = 0.0, stop: int | str | None = None) -> float:
+        """``L_f^2 h`` at ``(x, t)``: a guard's acceleration along the flow (compiled)."""
+        j = self.stop_index(stop)
+        return float(self.kernels().normal_accel(np.asarray(x, dtype=float), float(t), self.param_vector, j))
 
-    def jacobians(self, x: Any, t: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(f_x, h_x, g_x)`` at ``(x, t)``."""
-        n = self.n_states
+    def jacobians(
+        self, x: Any, t: float = 0.0, stop: int | str | None = None
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(f_x, h_x, g_x)`` at ``(x, t)`` for a stop."""
+        n, j = self.n_states, self.stop_index(stop)
         fx = np.asarray(self._call("f_x", x, t), dtype=float).reshape(n, n)
-        hx = np.asarray(self._call("h_x", x, t), dtype=float).reshape(n)
-        gx = np.asarray(self._call("g_x", x, t), dtype=float).reshape(n, n)
+        hx = np.asarray(self._call("h_x", x, t, j), dtype=float).reshape(n)
+        gx = np.asarray(self._call("g_x", x, t, j), dtype=float).reshape(n, n)
         return fx, hx, gx
 
-    def saltation(self, x: Any, t: float = 0.0) -> np.ndarray:
+    def saltation(self, x: Any, t: float = 0.0, stop: int | str | None = None) -> np.ndarray:
         """Saltation matrix (paper eq. 14) of an impact at ``x`` on the stop.
 
         ``S = g_x + (f(g(x)) - g_x f(x) - g_t) h_x / (h_x f(x) + h_t)``; the
         time terms vanish for autonomous guards and resets, giving eq. 14.
         """
-        _, hx, gx = self.jacobians(x, t)
+        j = self.stop_index(stop)
+        _, hx, gx = self.jacobians(x, t, j)
         fm = self.vector_field(x, t)
-        fp = self.vector_field(self.reset(x, t), t)
-        gt = np.asarray(self._call("g_t", x, t), dtype=float).reshape(-1)
-        ht = float(self._call("h_t", x, t))
+        fp = self.vector_field(self.reset(x, t, j), t)
+        gt = np.asarray(self._call("g_t", x, t, j), dtype=float).reshape(-1)
+        ht = float(self._call("h_t", x, t, j))
         return gx + np.outer(fp - gx @ fm - gt, hx) / (hx @ fm + ht)
 
-    def contact_derivatives(self, x: Any, t: float = 0.0) -> dict[str, Any]:
-        """Guard ``h`` and its rate ``L_f h`` with their derivatives at ``(x, t)``.
+    def contact_derivatives(self, x: Any, t: float = 0.0, stop: int | str | None = None) -> dict[str, Any]:
+        """A stop's guard ``h`` and its rate ``L_f h`` with their derivatives at ``(x, t)``.
 
         Keys: ``h, h_x, h_t, h_p, rate, rate_x, rate_t, rate_p, accel`` (``accel``
         is ``L_f^2 h``); ``_p`` derivatives are with respect to every parameter,
         in the order of :attr:`parameters`.  These define grazing: ``h = 0`` and
         ``L_f h = 0`` with ``L_f^2 h > 0``.
         """
-        n, m = self.n_states, len(self.parameters)
+        n, m, j = self.n_states, len(self.parameters), self.stop_index(stop)
         return {
-            "h": self.guard(x, t),
-            "h_x": np.asarray(self._call("h_x", x, t), dtype=float).reshape(n),
-            "h_t": float(self._call("h_t", x, t)),
-            "h_p": np.asarray(self._call("h_p", x, t), dtype=float).reshape(m),
-            "rate": float(self._call("rate", x, t)),
-            "rate_x": np.asarray(self._call("rate_x", x, t), dtype=float).reshape(n),
-            "rate_t": float(self._call("rate_t", x, t)),
-            "rate_p": np.asarray(self._call("rate_p", x, t), dtype=float).reshape(m),
-            "accel": float(self._call("accel", x, t)),
+            "h": self.guard(x, t, j),
+            "h_x": np.asarray(self._call("h_x", x, t, j), dtype=float).reshape(n),
+            "h_t": float(self._call("h_t", x, t, j)),
+            "h_p": np.asarray(self._call("h_p", x, t, j), dtype=float).reshape(m),
+            "rate": float(self._call("rate", x, t, j)),
+            "rate_x": np.asarray(self._call("rate_x", x, t, j), dtype=float).reshape(n),
+            "rate_t": float(self._call("rate_t", x, t, j)),
+            "rate_p": np.asarray(self._call("rate_p", x, t, j), dtype=float).reshape(m),
+            "accel": float(self._call("accel", x, t, j)),
         }
 
     def check_state(self, x: Any, t: float = 0.0, allowed: bool = True) -> np.ndarray:
@@ -749,9 +865,13 @@ class HybridModel:
             )
         if not np.all(np.isfinite(arr)):
             raise InvalidStateError(f"state must be finite, got {arr.tolist()}")
-        hv = self.guard(arr, t) if allowed else 0.0
-        if hv < -ON_STOP_TOL * max(1.0, float(np.max(np.abs(arr)))):
-            raise InvalidStateError(
-                f"initial state {arr.tolist()} is beyond the stop (guard h = {hv:.3g} < 0)"
-            )
+        if not allowed:
+            return arr
+        for j, name in enumerate(self.stop_names):
+            hv = self.guard(arr, t, j)
+            if hv < -ON_STOP_TOL * max(1.0, float(np.max(np.abs(arr)))):
+                where = "the stop" if name == "stop" else f"stop {name!r}"
+                raise InvalidStateError(
+                    f"initial state {arr.tolist()} is beyond {where} (guard h = {hv:.3g} < 0)"
+                )
         return arr

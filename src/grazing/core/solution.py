@@ -58,15 +58,42 @@ class Impacts:
         the angular velocity ``theta'`` hitting the stop).
     state
         State just before the impact, shape ``(n_impacts, n_states)``.
+    stop
+        Index of the stop each impact is on (into ``stop_names``).
+    stop_names
+        The model's stop names.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> imp = Impacts(np.array([1.0, 2.0, 3.0]), np.zeros(3), np.ones(3), np.zeros((3, 2)),
+    ...               stop=np.array([0, 1, 1]), stop_names=("right", "left"))
+    >>> imp.per_stop(), imp.stop_name(2)
+    ({'right': 1, 'left': 2}, 'left')
     """
 
     t: np.ndarray
     phase: np.ndarray
     speed: np.ndarray
     state: np.ndarray
+    stop: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+    stop_names: tuple[str, ...] = ("stop",)
+
+    def __post_init__(self) -> None:
+        if self.stop.shape != self.t.shape:  # impacts of a one-stop model given without their stops
+            object.__setattr__(self, "stop", np.zeros(self.t.shape, dtype=int))
 
     def __len__(self) -> int:
         return int(self.t.size)
+
+    def stop_name(self, i: int) -> str:
+        """The name of the stop impact ``i`` is on."""
+        return self.stop_names[int(self.stop[i])]
+
+    def per_stop(self) -> dict[str, int]:
+        """The number of impacts on each stop, by name (every stop listed)."""
+        counts = np.bincount(self.stop.astype(int), minlength=len(self.stop_names))
+        return {name: int(c) for name, c in zip(self.stop_names, counts)}
 
 
 @dataclass(frozen=True)

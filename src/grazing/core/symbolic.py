@@ -11,11 +11,46 @@ the code generator creates.  sympy is imported only when a method needs it.
 
 from __future__ import annotations
 
+import dataclasses
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:  # pragma: no cover
     import sympy as sp
+
+
+@dataclass(frozen=True)
+class Stop:
+    """One stop of a hybrid model: where impacts happen and what they do.
+
+    Attributes
+    ----------
+    name
+        The stop's name (``"right"``, ``"left"``, ``"back"``), used in results
+        and on the command line.
+    guard
+        ``h(x, t)``: positive in the allowed region, zero on this stop.
+    reset
+        ``g(x, t)``: the state just after an impact on this stop.
+    contact_direction
+        Direction in which the reset acts (for a mechanical impact, the
+        velocity direction): with it, complete chattering on this stop is
+        summed and continued as sticking; without it an accumulation of
+        impacts on this stop stops the run.
+
+    Examples
+    --------
+    >>> import sympy as sp
+    >>> x, v, r = sp.symbols("x v r")
+    >>> Stop("right", 1 - x, [x, -r * v], contact_direction=[0, 1]).name
+    'right'
+    """
+
+    name: str
+    guard: Any
+    reset: Sequence[Any]
+    contact_direction: Sequence[Any] | None = None
 
 
 @dataclass(frozen=True)
@@ -38,6 +73,10 @@ class SymbolicSystem:
         Direction ``e(x, t)`` along which the reset changes the state (the
         velocity direction of a mechanical impact), used to constrain the flow
         to the stop during sticking; ``None`` disables sticking.
+    stops
+        Every stop (:class:`Stop`, expressions sympified); ``guard``, ``reset``
+        and ``contact_direction`` are those of the first, and
+        :meth:`at_stop` gives the system seen from any other.
     """
 
     states: tuple[sp.Symbol, ...]
@@ -48,6 +87,26 @@ class SymbolicSystem:
     reset: tuple[sp.Expr, ...]
     contact_direction: tuple[sp.Expr, ...] | None = None
     period: sp.Expr | None = None
+    stops: tuple[Stop, ...] = ()
+
+    def __post_init__(self) -> None:
+        if not self.stops:
+            stop = Stop("stop", self.guard, tuple(self.reset), self.contact_direction)
+            object.__setattr__(self, "stops", (stop,))
+
+    @property
+    def stop_names(self) -> tuple[str, ...]:
+        return tuple(stop.name for stop in self.stops)
+
+    def at_stop(self, index: int) -> SymbolicSystem:
+        """The same system with stop ``index``'s guard, reset and contact direction as *the* stop."""
+        stop = self.stops[index]
+        return dataclasses.replace(
+            self,
+            guard=stop.guard,
+            reset=tuple(stop.reset),
+            contact_direction=None if stop.contact_direction is None else tuple(stop.contact_direction),
+        )
 
     def canonical(self) -> SymbolicSystem:
         """The same system with every user symbol replaced by a fresh :class:`sympy.Dummy`.
@@ -66,6 +125,9 @@ class SymbolicSystem:
         def tr(e: sp.Expr) -> sp.Expr:
             return sp.sympify(e).xreplace(sub)
 
+        def cd(d: Sequence[Any] | None) -> tuple[sp.Expr, ...] | None:
+            return None if d is None else tuple(map(tr, d))
+
         return SymbolicSystem(
             states=tuple(sub[x] for x in self.states),
             time=sub[self.time],
@@ -73,10 +135,12 @@ class SymbolicSystem:
             vector_field=tuple(tr(e) for e in self.vector_field),
             guard=tr(self.guard),
             reset=tuple(tr(e) for e in self.reset),
-            contact_direction=(
-                None if self.contact_direction is None else tuple(map(tr, self.contact_direction))
-            ),
+            contact_direction=cd(self.contact_direction),
             period=None if self.period is None else tr(self.period),
+            stops=tuple(
+                Stop(st.name, tr(st.guard), tuple(tr(e) for e in st.reset), cd(st.contact_direction))
+                for st in self.stops
+            ),
         )
 
     def gradient(self, expr: sp.Expr) -> list[sp.Expr]:

@@ -86,6 +86,19 @@ def _scalar_function(
     return "\n".join(lines) + "\n"
 
 
+def _dispatch(name: str, args: str, stops: Sequence[int]) -> str:
+    """Numba source of ``name(args, j=0)``: the function ``name_s{j}`` of stop ``j``.
+
+    ``stops`` lists the stops that have the function; any other ``j`` calls
+    the last of them (the driver never asks for it).
+    """
+    lines = ["@njit(cache=True)", f"def {name}({args}, j=0):"]
+    for j in stops[:-1]:
+        lines += [f"    if j == {j}:", f"        return {name}_s{j}({args})"]
+    lines.append(f"    return {name}_s{stops[-1]}({args})")
+    return "\n".join(lines) + "\n"
+
+
 def direction_columns(k: int) -> int:
     """Sensitivity columns of the kernel module that serves ``k`` parameter sensitivities.
 
@@ -100,6 +113,54 @@ def direction_columns(k: int) -> int:
     [0, 2, 2, 5]
     """
     return 0 if k == 0 else max(2, int(k))
+
+
+def _stop_functions(
+    on: SymbolicSystem, ond: SymbolicSystem, j: int, along: Callable[..., Any], directions: int
+) -> list[str]:
+    """The scalar functions of stop ``j`` (guard, reset, their derivatives, contact), named ``*_s{j}``.
+
+    ``on`` is the system seen from the stop, ``ond`` the same with the
+    sensitivity directions among its parameters.
+    """
+    import sympy as sp
+
+    n = len(on.states)
+    gx = on.gradient(on.guard)
+    gr = on.gradient(on.normal_rate)
+    g = on.reset
+    gjac = [(f"Gx[{i}, {k}]", sp.diff(gi, x)) for i, gi in enumerate(g) for k, x in enumerate(on.states)]
+    gjac += [(f"Gt[{i}]", sp.diff(gi, on.time)) for i, gi in enumerate(g)]
+    gjac += [(f"Gp[{i}, {c}]", along(c, gi)) for i, gi in enumerate(g) for c in range(directions)]
+    e = on.contact_direction if on.contact_direction is not None else tuple(sp.Integer(0) for _ in range(n))
+    return [
+        _scalar_function(f"guard_s{j}", on, [], returns=on.guard),
+        _scalar_function(
+            f"guard_grad_s{j}",
+            on,
+            [(f"gx[{i}]", ei) for i, ei in enumerate(gx)],
+            returns=sp.diff(on.guard, on.time),
+            extra_args=", gx",
+        ),
+        _scalar_function(
+            f"guard_pgrad_s{j}",
+            ond,
+            [(f"hp[{c}]", along(c, on.guard)) for c in range(directions)],
+            extra_args=", hp",
+        ),
+        _scalar_function(
+            f"reset_s{j}", on, list(zip([f"out[{i}]" for i in range(n)], g)), extra_args=", out"
+        ),
+        _scalar_function(f"reset_jac_s{j}", ond, gjac, extra_args=", Gx, Gt, Gp"),
+        _scalar_function(f"normal_rate_s{j}", on, [], returns=on.normal_rate),
+        _scalar_function(f"normal_accel_s{j}", on, [], returns=on.normal_accel),
+        _scalar_function(
+            f"normal_rate_grad_s{j}", on, [(f"gr[{i}]", ei) for i, ei in enumerate(gr)], extra_args=", gr"
+        ),
+        _scalar_function(
+            f"contact_dir_s{j}", on, list(zip([f"e[{i}]" for i in range(n)], e)), extra_args=", e"
+        ),
+    ]
 
 
 def generate_source(system: SymbolicSystem, directions: int = 0, order: int = DEFAULT_ORDER) -> str:
@@ -117,6 +178,7 @@ def generate_source(system: SymbolicSystem, directions: int = 0, order: int = DE
 
     sys_ = system.canonical()
     n = len(sys_.states)
+    nstops = len(sys_.stops)
     m = len(sys_.params)
     dsyms = [[sp.Dummy(f"d{c}_{j}") for j in range(m)] for c in range(directions)]
     sysd = dataclasses.replace(sys_, params=tuple(sys_.params) + tuple(d for row in dsyms for d in row))
@@ -139,11 +201,13 @@ def generate_source(system: SymbolicSystem, directions: int = 0, order: int = DE
         f"NX = {n}",
         f"NSENS = {directions}",
         f"NPARAMS = {m}",
+        f"NSTOPS = {nstops}",
         f"ORDER = {order}",
         *(f"STATUS_{status.name} = {int(status)}" for status in Status),
         f"ROOT_WORK_ROWS, ROOT_WORK_MIN_COLS = {work_shape(0)}",
     ]
-    free = taylor_kernel("tc_free", sys_.states, sys_.time, sys_.params, f, [sys_.guard], order)
+    guards = [stop.guard for stop in sys_.stops]  # the event rows of free flight, one per stop
+    free = taylor_kernel("tc_free", sys_.states, sys_.time, sys_.params, f, guards, order)
     # Variational equations: V' = f_x V (+ f_p D[c] on the direction columns).
     vsyms = tuple(sp.Dummy(f"v{i}") for i in range(n * ncol))
     vmat = sp.Matrix(n, ncol, vsyms)
@@ -158,70 +222,42 @@ def generate_source(system: SymbolicSystem, directions: int = 0, order: int = DE
         sys_.time,
         sysd.params,
         tuple(f) + tuple(vrhs),
-        [sys_.guard],
+        guards,
         order,
     )
-    has_stick = sys_.contact_direction is not None
-    if has_stick:
-        stick = taylor_kernel(
-            "tc_stick",
-            sys_.states,
-            sys_.time,
-            sys_.params,
-            sys_.sticking_field(),
-            [sys_.normal_accel],
-            order,
+    sticky = [j for j, stop in enumerate(sys_.stops) if stop.contact_direction is not None]
+    kernels = [free, var]
+    # Sticking on stop j: the event rows are the contact force (row j) and the other stops' guards.
+    for j in sticky:
+        on = sys_.at_stop(j)
+        rows = [on.normal_accel if i == j else g for i, g in enumerate(guards)]
+        kernels.append(
+            taylor_kernel(
+                f"tc_stick_s{j}", sys_.states, sys_.time, sys_.params, on.sticking_field(), rows, order
+            )
         )
-    else:
-        stick = taylor_kernel("tc_stick", sys_.states, sys_.time, sys_.params, f, [sp.Integer(1)], order)
-    parts.append(f"HAS_STICK = {has_stick}")
-    for k in (free, var, stick):
+    if not sticky:
+        kernels.append(
+            taylor_kernel("tc_stick_s0", sys_.states, sys_.time, sys_.params, f, [sp.Integer(1)], order)
+        )
+    parts.append(f"HAS_STICK = {bool(sticky)}")
+    parts.append(f"STICKS = {tuple(j in sticky for j in range(nstops))!r}")
+    for k in kernels:
         parts.append("@njit(cache=True)\n" + k.source)
+    parts.append(_dispatch("tc_stick", "x0, s0, pv, X, O", sticky or [0]))
 
-    gx = sys_.gradient(sys_.guard)
     parts.append(
         _scalar_function("rhs", sys_, [(f"out[{i}]", e) for i, e in enumerate(f)], extra_args=", out")
     )
-    parts.append(_scalar_function("guard", sys_, [], returns=sys_.guard))
-    parts.append(
-        _scalar_function(
-            "guard_grad",
-            sys_,
-            [(f"gx[{i}]", e) for i, e in enumerate(gx)],
-            returns=sp.diff(sys_.guard, sys_.time),
-            extra_args=", gx",
-        )
-    )
-    parts.append(
-        _scalar_function(
-            "guard_pgrad",
-            sysd,
-            [(f"hp[{c}]", along(c, sys_.guard)) for c in range(directions)],
-            extra_args=", hp",
-        )
-    )
-    g = sys_.reset
-    gjac = [(f"Gx[{i}, {j}]", sp.diff(gi, x)) for i, gi in enumerate(g) for j, x in enumerate(sys_.states)]
-    gjac += [(f"Gt[{i}]", sp.diff(gi, sys_.time)) for i, gi in enumerate(g)]
-    gjac += [(f"Gp[{i}, {c}]", along(c, gi)) for i, gi in enumerate(g) for c in range(directions)]
-    parts.append(
-        _scalar_function("reset", sys_, [(f"out[{i}]", e) for i, e in enumerate(g)], extra_args=", out")
-    )
-    parts.append(_scalar_function("reset_jac", sysd, gjac, extra_args=", Gx, Gt, Gp"))
-    parts.append(_scalar_function("normal_rate", sys_, [], returns=sys_.normal_rate))
-    parts.append(_scalar_function("normal_accel", sys_, [], returns=sys_.normal_accel))
-    parts.append(
-        _scalar_function(
-            "normal_rate_grad",
-            sys_,
-            [(f"gr[{i}]", e) for i, e in enumerate(sys_.gradient(sys_.normal_rate))],
-            extra_args=", gr",
-        )
-    )
-    e = sys_.contact_direction if has_stick else tuple(sp.Integer(0) for _ in range(n))
-    parts.append(
-        _scalar_function("contact_dir", sys_, [(f"e[{i}]", ei) for i, ei in enumerate(e)], extra_args=", e")
-    )
+    every = list(range(nstops))
+    for j in every:
+        parts.extend(_stop_functions(sys_.at_stop(j), sysd.at_stop(j), j, along, directions))
+    for name, args in (
+        ("guard", "x, s, pv"), ("guard_grad", "x, s, pv, gx"), ("guard_pgrad", "x, s, pv, hp"),
+        ("reset", "x, s, pv, out"), ("reset_jac", "x, s, pv, Gx, Gt, Gp"), ("normal_rate", "x, s, pv"),
+        ("normal_accel", "x, s, pv"), ("normal_rate_grad", "x, s, pv, gr"), ("contact_dir", "x, s, pv, e"),
+    ):  # fmt: skip
+        parts.append(_dispatch(name, args, every))
     # dT/dp for every parameter: a sample "one period later" moves when the period does.
     period = sp.Integer(0) if sys_.period is None else sys_.period
     parts.append(

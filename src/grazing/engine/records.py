@@ -20,7 +20,7 @@ class Start(NamedTuple):
     V: np.ndarray  # variational matrix, (n, n + directions)
     k: int  # whole periods
     s: float  # local time in [0, T) (periodic models) or the time
-    mode: int  # 0 free flight, 1 sticking to the stop
+    mode: int  # 0 free flight, 1 + j sticking to stop j
 
 
 class Config(NamedTuple):
@@ -60,6 +60,7 @@ class Config(NamedTuple):
     zdm_e: np.ndarray  # its direction e
     zdm_window: float  # largest |L_f h| / a for which it is applied
     Tp: np.ndarray  # dT/dp along each sensitivity direction
+    stop: int  # the stop a grazing analysis looks at (tracked guard, grazing contacts, discontinuity map)
 
 
 STATIC = Config._fields[Config._fields.index("T") :]
@@ -78,7 +79,7 @@ class Result(NamedTuple):
     steps: int
     n_impacts: int  # over the whole run
     samples: np.ndarray  # (kept samples, n)
-    impacts: np.ndarray  # rows [t, speed, state...]
+    impacts: np.ndarray  # rows [t, speed, state..., stop]
     sticking: np.ndarray  # rows [start, end]
     trajectory: np.ndarray  # rows [t, state...]
     log_sums: np.ndarray  # Lyapunov sums

@@ -46,12 +46,16 @@ class DiscontinuityMap:
     window
         Largest ``|L_f h| / a`` (time to the parabola's extremum) for which the
         map is applied.
+    stop
+        Index of the stop it stands for; impacts on the model's other stops
+        are applied as usual.
     """
 
     phase: float
     accel: float
     direction: tuple[float, ...]
     window: float = math.inf
+    stop: int = 0
 
 
 @dataclass(frozen=True)
@@ -59,7 +63,7 @@ class Segment:
     """Raw outputs of one :meth:`Runner.advance` call (see the driver for details)."""
 
     samples: np.ndarray
-    impacts: np.ndarray  # rows [t, speed, state...]
+    impacts: np.ndarray  # rows [t, speed, state..., stop index]
     n_impacts: int
     sticking: np.ndarray
     trajectory: np.ndarray  # rows [t, state...]
@@ -118,12 +122,17 @@ class Runner:
     chatter_tol
         Chattering summation threshold, as a fraction of the period.
     zdm
-        Apply a discontinuity map once per period instead of the impacts.
+        Apply a discontinuity map once per period instead of the impacts on
+        its stop (the other stops' impacts are applied).
     touching
         The trajectory starts at a grazing contact with the stop (a grazing
         orbit from its contact point): that tangential contact is not an
         impact.  Set :attr:`touch_end` before the call of :meth:`advance` that
         ends at a contact.
+    stop
+        Index of the stop a grazing analysis looks at: its guard's minimum is
+        tracked (``guard_min``), the contacts of ``touching`` are on it, and
+        ``zdm`` stands for its impacts.
     """
 
     def __init__(
@@ -140,13 +149,13 @@ class Runner:
         chatter_tol: float = CHATTER_TOL,
         zdm: DiscontinuityMap | None = None,
         touching: bool = False,
+        stop: int = 0,
     ):
         self.model = model
         self.zdm = zdm
+        self.stop = int(zdm.stop if zdm is not None else stop)
         self.touch_start = touching
         self.touch_end = False  # set by the caller for the call that ends at a contact
-        if zdm is not None:
-            events = False
         n = model.n_states
         self.x = np.array(x, dtype=float)
         self.V = np.zeros((n, n + direction_columns(len(sensitivities) if variational else 0)))
@@ -208,7 +217,7 @@ class Runner:
             float(self.chatter_time), z is not None, float(z.phase) % T if z is not None else 0.0,
             float(z.accel) if z is not None else 1.0,
             np.asarray(z.direction if z is not None else np.zeros(n), dtype=float),
-            float(z.window) if z is not None else 0.0, np.asarray(self.Tp, dtype=float),
+            float(z.window) if z is not None else 0.0, np.asarray(self.Tp, dtype=float), self.stop,
         )  # fmt: skip
 
     def vector_field(self, x: np.ndarray, s: float) -> np.ndarray:

@@ -44,6 +44,7 @@ def simulate(
     events: bool = True,
     zdm: DiscontinuityMap | None = None,
     touching: bool = False,
+    stop_name: int | str | None = None,
     progress: Callable[[int, int], None] | None = None,
     **shorthands: Any,
 ) -> Solution:
@@ -98,6 +99,11 @@ def simulate(
         The run starts and ends in tangential contact with the stop (``h = 0``
         and ``L_f h = 0``: a grazing orbit followed from its contact point);
         these two contacts are not impacts, every other one is.
+    stop_name
+        The stop (name or index; the first by default) that ``guard_min``,
+        ``touching`` and ``zdm`` refer to, for models with several stops.
+        Impacts on every stop are always found and recorded
+        (:attr:`Impacts.stop`).
     progress
         Called as ``progress(periods_done, periods_total)`` after every chunk
         of :data:`CHUNK_PERIODS` periods (the run is always chunked the same
@@ -129,17 +135,17 @@ def simulate(
     impacts, guard_min = save.impacts, save.guard_min
     sens, lyapunov = tangent.sensitivities, tangent.lyapunov
     tol, max_steps, chatter_tol = solver.tol, solver.max_steps, solver.chatter_tol
-    if zdm is not None:
-        if not model.periodic:
-            raise InvalidParameterError("the discontinuity map needs a periodically forced model")
-        events = False
-    x = model.check_state(np.zeros(model.n_states) if x0 is None else x0, t0, allowed=events)
+    if zdm is not None and not model.periodic:
+        raise InvalidParameterError("the discontinuity map needs a periodically forced model")
+    allowed = events and zdm is None  # (with the map, the state may be past the grazing stop)
+    x = model.check_state(np.zeros(model.n_states) if x0 is None else x0, t0, allowed=allowed)
+    stop_index = model.stop_index(stop_name)
     use_var = tangent.variational
     n = model.n_states
     T = model.period
     run = Runner(
-        model, x, t0=float(t0), phase=float(phase), tol=tol, variational=use_var,
-        sensitivities=sens, events=events, chatter_tol=chatter_tol, zdm=zdm, touching=touching,
+        model, x, t0=float(t0), phase=float(phase), tol=tol, variational=use_var, sensitivities=sens,
+        events=events, chatter_tol=chatter_tol, zdm=zdm, touching=touching, stop=stop_index,
     )  # fmt: skip
     first_sample = run.next_sample_time
     ks_start = run.ks
@@ -191,14 +197,21 @@ def simulate(
         jac = _sample_time_terms(run, x, float(t0), ks_start + total - 1, float(t_samples[-1]), jac)
     if jac is not None:
         jac = jac[:, : n + len(sens)].copy()  # the module may have more direction columns than asked
-    imp = _concat(parts["imp"], 2 + n)
+    imp = _concat(parts["imp"], 3 + n)
     traj = _concat(parts["traj"], 1 + n)
     imp_t = imp[:, 0]
     return Solution(
         model=model,
         t=t_samples,
         samples=_concat(parts["samples"], n),
-        impacts=Impacts(t=imp_t, phase=np.mod(imp_t, T) / T * 2 * math.pi, speed=imp[:, 1], state=imp[:, 2:]),
+        impacts=Impacts(
+            t=imp_t,
+            phase=np.mod(imp_t, T) / T * 2 * math.pi,
+            speed=imp[:, 1],
+            state=imp[:, 2 : 2 + n],
+            stop=imp[:, 2 + n].astype(int),
+            stop_names=model.stop_names,
+        ),
         n_impacts=int(n_imp),
         sticking=_merge_intervals(_concat(parts["sticks"], 2)),
         t_final=run.t,

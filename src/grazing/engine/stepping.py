@@ -32,21 +32,28 @@ def step_factor(safety, order):
 
 
 @njit(cache=True, inline="always")
-def step_size(X, n, O, order, max_step, factor):
+def step_size(X, n, O, nout, orow, order, max_step, factor):
     """Jorba-Zou step size from the last two Taylor coefficients.
 
     ``h = rho * factor`` where ``rho`` estimates the radius of convergence and
     ``factor = exp(-safety - 0.7 / (order - 1))`` (:func:`step_factor`);
     Jorba & Zou (and heyoka) use ``safety = 2``.  The norms run over the first
     ``n`` rows of ``X`` (the state, and the variational equations when they are
-    integrated) and the event function (``O[0]``), so that the event
-    polynomial and the Jacobian are as accurate as the state even where the
-    state itself is constant (sticking, an equilibrium).  Inlined into the
-    driver (no reference counting of its arrays on the hot path).
+    integrated) and the ``nout`` event rows of ``O`` (every stop's guard, or
+    while sticking the contact force), so that the event polynomials and the
+    Jacobian are as accurate as the state even where the state itself is
+    constant (sticking, an equilibrium).  The scale of the values counts the
+    state and one event row, ``orow`` (the first stop's guard in free flight,
+    the contact force while sticking): another stop's guard is offset by its
+    distance, which says nothing about the scale of the solution.  Inlined
+    into the driver (no reference counting of its arrays on the hot path).
     """
-    nx = abs(O[0, 0])
-    n1 = abs(O[0, order - 1])
-    n2 = abs(O[0, order])
+    nx = abs(O[orow, 0])
+    n1 = 0.0
+    n2 = 0.0
+    for r in range(nout):
+        n1 = max(n1, abs(O[r, order - 1]))
+        n2 = max(n2, abs(O[r, order]))
     for i in range(n):
         nx = max(nx, abs(X[i, 0]))
         n1 = max(n1, abs(X[i, order - 1]))

@@ -1,7 +1,28 @@
 """Built-in models, each citing its source."""
 
 from grazing.models.bouncing_ball import bouncing_ball
+from grazing.models.impact_damper import impact_damper
 from grazing.models.impact_oscillator import impact_oscillator
 from grazing.models.pendulum import CASES, DEFAULT_CASE, case_values, pendulum
+from grazing.models.two_sided_oscillator import two_sided_oscillator
 
-__all__ = ["CASES", "DEFAULT_CASE", "bouncing_ball", "case_values", "impact_oscillator", "pendulum"]
+BUILT_IN = {
+    "pendulum": pendulum,
+    "two-sided-oscillator": two_sided_oscillator,
+    "impact-oscillator": impact_oscillator,
+    "bouncing-ball": bouncing_ball,
+    "impact-damper": impact_damper,
+}
+"""The built-in models by their command-line names (each a function of parameter overrides)."""
+
+__all__ = [
+    "BUILT_IN",
+    "CASES",
+    "DEFAULT_CASE",
+    "bouncing_ball",
+    "case_values",
+    "impact_damper",
+    "impact_oscillator",
+    "pendulum",
+    "two_sided_oscillator",
+]

@@ -3,7 +3,12 @@
 Nondimensional equations (paper eqs. 4-5), with ``tau = omega t`` as time::
 
     theta'' + (2 beta/eta) theta' + sin(theta)/(4 eta^2) = alpha cos(theta) sin(tau)
-    theta' <- -r theta'            when theta reaches theta_hat (from below)
+    theta' <- -r theta'            when theta reaches theta_hat (from below): stop "stop"
+    theta' <- -r theta'            when theta reaches theta_hat - 2 pi (from above): stop "back"
+
+The second stop is the back face of the same stop: a pendulum rotating over
+the top (backwards) reaches it at ``theta_hat - 2 pi``; no orbit of the paper
+does.
 
 The state is ``(theta, theta')``.  The paper writes the state as
 ``x1 = theta - theta_hat``; the shift changes no Jacobian or multiplier, and
@@ -37,6 +42,7 @@ from types import MappingProxyType
 from typing import Any
 
 from grazing.core.model import HybridModel, Parameter
+from grazing.core.symbolic import Stop
 from grazing.errors import InvalidParameterError
 
 ALPHA = 0.2254
@@ -82,9 +88,11 @@ def _symbolic() -> dict:
             dtheta,
             alpha * sp.cos(theta) * sp.sin(tau) - 2 * beta / eta * dtheta - sp.sin(theta) / (4 * eta**2),
         ],
-        "guard": theta_hat - theta,
-        "reset": [theta, -r * dtheta],
-        "contact_direction": [0, 1],
+        "stops": [
+            Stop("stop", theta_hat - theta, [theta, -r * dtheta], [0, 1]),
+            # The back of the stop: a rotation over the top reaches it at theta_hat - 2 pi.
+            Stop("back", theta - theta_hat + 2 * sp.pi, [theta, -r * dtheta], [0, 1]),
+        ],
     }
 
 
@@ -119,6 +127,7 @@ def _base() -> HybridModel:
         state_labels=["θ", "θ′"],
         state_units=["rad", "rad per unit time"],
         time_label="τ",
+        stop_names=["stop", "back"],
         description="horizontally forced inclined pendulum with a rigid stop (paper eqs. 4-5)",
         reference="Piiroinen, Virgin & Champneys, J. Nonlinear Sci. 14 (2004) 383-404",
     )

@@ -45,14 +45,14 @@ from grazing.maps import flow_map
 from grazing.orbits.contact import GrazingPoint
 
 
-def zdm_direction(model: HybridModel, x: np.ndarray, t: float) -> np.ndarray:
-    """``e = (g_x - I) c / (grad(L_f h) . c)``: the reset's jump per unit approach speed at ``x``."""
-    _, _, gx = model.jacobians(x, t)
+def zdm_direction(model: HybridModel, x: np.ndarray, t: float, stop: int = 0) -> np.ndarray:
+    """``e = (g_x - I) c / (grad(L_f h) . c)``: ``stop``'s reset jump per unit approach speed at ``x``."""
+    _, _, gx = model.jacobians(x, t, stop)
     c = np.zeros(model.n_states)
-    model.kernels().contact_dir(np.asarray(x, dtype=float), float(t), model.param_vector, c)
+    model.kernels().contact_dir(np.asarray(x, dtype=float), float(t), model.param_vector, c, stop)
     if not np.any(c):
         raise ValueError(f"model {model.name!r} defines no contact direction; the ZDM needs one")
-    grad_rate = model.contact_derivatives(x, t)["rate_x"]
+    grad_rate = model.contact_derivatives(x, t, stop)["rate_x"]
     return (gx - np.eye(model.n_states)) @ c / float(grad_rate @ c)
 
 
@@ -117,12 +117,13 @@ class GrazingNormalForm:
             accel=self.accel,
             direction=tuple(float(v) for v in self.direction),
             window=T / 4 if window is None else window,
+            stop=self.point.stop,
         )
 
     def zdm(self, x: np.ndarray, t: float | None = None) -> np.ndarray:
         """Apply the leading-order ZDM to a state ``x`` (at time ``t``, default ``t*``)."""
         t = self.point.t_graze if t is None else t
-        cd = self.model.contact_derivatives(x, t)
+        cd = self.model.contact_derivatives(x, t, self.point.stop)
         delta = cd["rate"] ** 2 / (2 * self.accel) - cd["h"]
         if delta <= 0:
             return np.array(x, dtype=float)
@@ -162,8 +163,8 @@ def normal_form_at(point: GrazingPoint, params: tuple[str, ...]) -> GrazingNorma
     ([0.0, 1.7675], 0.28)
     """
     m, x, t = point.model, point.contact, point.t_graze
-    cd = m.contact_derivatives(x, t)
-    e = zdm_direction(m, x, t)
+    cd = m.contact_derivatives(x, t, point.stop)
+    e = zdm_direction(m, x, t, point.stop)
     M = point.monodromy
     kappa = float(-(cd["h_x"] @ M @ e) / np.linalg.norm(e))
     names = [p.name for p in m.parameters]
@@ -184,9 +185,16 @@ def normal_form_at(point: GrazingPoint, params: tuple[str, ...]) -> GrazingNorma
 
 
 def find_grazing_point(
-    model: HybridModel, param: str, lo: float, hi: float, which: str = "first"
+    model: HybridModel,
+    param: str,
+    lo: float,
+    hi: float,
+    which: str = "first",
+    stop_name: int | str | None = None,
 ) -> GrazingPoint:
     """The first or second grazing of the period-1 nonimpacting orbit for ``param`` in ``[lo, hi]``.
+
+    ``stop_name``: the stop grazed (name or index; the first by default).
 
     Raises :class:`~grazing.errors.ConvergenceError` (one clear line) if there is none.
     """
@@ -195,7 +203,7 @@ def find_grazing_point(
 
     if which not in ("first", "second"):
         raise InvalidParameterError(f"which must be 'first' or 'second', got {which!r}")
-    points, _ = find_grazings(model, param, lo, hi)
+    points, _ = find_grazings(model, param, lo, hi, stop_name=stop_name)
     points.sort(key=lambda g: g.model.params[param])
     k = 0 if which == "first" else 1
     if len(points) <= k:

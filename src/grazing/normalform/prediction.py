@@ -274,7 +274,7 @@ def observe(nf: GrazingNormalForm, param: str | None = None, mu_range: tuple[flo
     for i, mu in enumerate(mus):
         m = nf.model.with_params(**{param: p0 + side * mu})
         x0 = nf.contact.copy()
-        if m.guard(x0, t0) < 0:
+        if m.guard(x0, t0, nf.point.stop) < 0:
             x0 = x0 + 1e-12 * nf.grad_h / float(nf.grad_h @ nf.grad_h)  # start on the allowed side
         sol = simulate(m, x0, t0=t0, transient=transient, periods=periods,
                        phase=2 * np.pi * (t0 / m.period % 1.0))  # fmt: skip

@@ -47,6 +47,8 @@ class GrazingPoint:
         Period of the orbit in forcing periods.
     impacts
         The orbit's other impacts per period (0 for a nonimpacting orbit that grazes).
+    stop
+        Index of the stop it grazes (:attr:`stop_name` its name).
     """
 
     model: HybridModel
@@ -57,6 +59,12 @@ class GrazingPoint:
     accel: float
     period: int = 1
     impacts: int = 0
+    stop: int = 0
+
+    @property
+    def stop_name(self) -> str:
+        """The name of the stop it grazes."""
+        return self.model.stop_names[self.stop]
 
     @property
     def abs_lambda(self) -> float:
@@ -72,13 +80,16 @@ class GrazingPoint:
         return dict(self.model.params)
 
 
-def contact_system(model: HybridModel, names: tuple[str, ...], period: int, *, events: bool = False):
+def contact_system(
+    model: HybridModel, names: tuple[str, ...], period: int, *, events: bool = False, stop: int = 0
+):
     """``u = (y, t_g, *params) -> (F, DF, GrazingPoint)`` for the grazing equations.
 
     ``F = (Phi(y, t_g -> t_g + n T) - y, h(y, t_g), L_f h(y, t_g))``: the orbit
     through the contact state ``y`` is periodic and touches the stop there.
     With ``events`` the flow applies the orbit's other impacts (a grazing of an
     orbit that already impacts); the contact itself is never an impact.
+    ``stop`` is the index of the stop touched.
     """
     n = model.n_states
     eye = np.eye(n)
@@ -87,11 +98,20 @@ def contact_system(model: HybridModel, names: tuple[str, ...], period: int, *, e
     def evaluate(u: np.ndarray) -> tuple[np.ndarray, np.ndarray, GrazingPoint]:
         y, tg = u[:n], float(u[n])
         m = model.with_params(**{name: float(v) for name, v in zip(names, u[n + 1 :])})
-        fm = flow_map(m, y, t0=tg, periods=period, sensitivities=names, virtual=not events, touching=events)
+        fm = flow_map(
+            m,
+            y,
+            t0=tg,
+            periods=period,
+            sensitivities=names,
+            virtual=not events,
+            touching=events,
+            stop_name=stop,
+        )
         J, S = fm.jacobian, fm.sensitivity
         fy = m.vector_field(y, tg)
         fend = m.vector_field(fm.image, fm.solution.t_final)
-        cd = m.contact_derivatives(y, tg)
+        cd = m.contact_derivatives(y, tg, stop)
         F = np.concatenate([fm.image - y, [cd["h"], cd["rate"]]])
         DF = np.zeros((n + 2, n + 1 + len(names)))
         DF[:n, :n] = J - eye
@@ -108,6 +128,7 @@ def contact_system(model: HybridModel, names: tuple[str, ...], period: int, *, e
             accel=cd["accel"],
             period=period,
             impacts=fm.impacts,
+            stop=stop,
         )
         return F, DF, point
 
@@ -123,15 +144,17 @@ def refine_grazing(
     period: int = 1,
     tol: float = 1e-12,
     events: bool = False,
+    stop_name: int | str | None = None,
 ) -> GrazingPoint:
     """Solve the grazing equations for the contact state, time and parameter ``free``.
 
     ``contact``, ``t_graze`` and the model's value of ``free`` are the initial
     guess (for example the closest approach of a nonimpacting orbit, or the
     weakest impact of an impacting one).  With ``events`` the orbit's other
-    impacts are applied (see :func:`contact_system`).
+    impacts are applied (see :func:`contact_system`).  ``stop_name``: the stop
+    touched (name or index; the first by default).
     """
-    evaluate = contact_system(model, (free,), period, events=events)
+    evaluate = contact_system(model, (free,), period, events=events, stop=model.stop_index(stop_name))
     u0 = np.concatenate([contact, [t_graze, model.params[free]]])
     pt = newton(evaluate, u0, PalcSettings(tol=tol, max_newton=12))  # n + 2 equations, n + 2 unknowns
     if pt is None:

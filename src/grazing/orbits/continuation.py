@@ -233,7 +233,7 @@ class Branch:
 # ----------------------------------------------------------------------------
 
 
-def _evaluator(model: HybridModel, param: str, period: int, t0: float, virtual: bool):
+def _evaluator(model: HybridModel, param: str, period: int, t0: float, virtual: bool, stop: int = 0):
     """``u = (x, p) -> (F, DF, orbit)`` for the branch equations ``P^n(x; p) - x = 0``."""
     n = model.n_states
     eye = np.eye(n)
@@ -241,11 +241,11 @@ def _evaluator(model: HybridModel, param: str, period: int, t0: float, virtual: 
     def evaluate(u: np.ndarray) -> tuple[np.ndarray, np.ndarray, PeriodicOrbit]:
         m = model.with_params(**{param: float(u[-1])})
         x = u[:-1]
-        fm = flow_map(m, x, t0=t0, periods=period, sensitivities=[param], virtual=virtual)
+        fm = flow_map(m, x, t0=t0, periods=period, sensitivities=[param], virtual=virtual, stop_name=stop)
         if not fm.solution.jacobian_valid:
             raise ConvergenceError("the orbit sticks to the stop: no Jacobian across sticking")
         F = fm.image - x
-        orbit = _orbit_from(m, x, t0, period, fm, virtual, [float(np.max(np.abs(F)))])
+        orbit = _orbit_from(m, x, t0, period, fm, virtual, [float(np.max(np.abs(F)))], stop)
         return F, np.hstack([fm.jacobian - eye, fm.sensitivity]), orbit
 
     return evaluate
@@ -287,24 +287,28 @@ def _detect(evaluate, kind: str, a: PalcPoint, b: PalcPoint, s: PalcSettings) ->
     return loc if loc is not None and _verified(kind, loc.payload) else None
 
 
-def grazing_margin(orbit: PeriodicOrbit) -> tuple[float, np.ndarray | None, float, str]:
-    """How far ``orbit`` is from grazing, and where: ``(delta, contact guess, time, what)``.
+def grazing_margin(orbit: PeriodicOrbit) -> tuple[float, np.ndarray | None, float, str, int]:
+    """How far ``orbit`` is from grazing, and where: ``(delta, contact guess, time, what, stop)``.
 
     ``delta`` is the smaller of the closest approach to the stop away from the
     impacts (``h`` at a local minimum of the guard) and, over the impacts,
     ``v^2 / (2 a)`` (how deep the local parabola of a low-velocity impact
     reaches, ``v`` the impact speed and ``a = L_f^2 h``).  Both tend to zero
     linearly in the parameter as the orbit approaches a grazing from its side.
+    ``stop`` is the index of the stop concerned: the closest approach is to
+    the orbit's own :attr:`~PeriodicOrbit.stop`, the impacts are on any stop.
     """
-    best: tuple[float, np.ndarray | None, float, str] = (math.inf, None, math.nan, "")
+    best: tuple[float, np.ndarray | None, float, str, int] = (math.inf, None, math.nan, "", orbit.stop)
     if orbit.approach is not None:
-        best = (orbit.approach[0], orbit.approach[2], orbit.approach[1], "gains an impact")
+        best = (orbit.approach[0], orbit.approach[2], orbit.approach[1], "gains an impact", orbit.stop)
     if orbit.impact_states is not None:
-        for t, v, x in zip(orbit.impact_times, orbit.impact_speeds, orbit.impact_states):
-            a = abs(orbit.model.normal_accel(x, t))
+        stops = orbit.impact_stops if orbit.impact_stops.size == orbit.impact_times.size else None
+        for i, (t, v, x) in enumerate(zip(orbit.impact_times, orbit.impact_speeds, orbit.impact_states)):
+            j = int(stops[i]) if stops is not None else 0
+            a = abs(orbit.model.normal_accel(x, t, j))
             delta = v * v / (2 * a) if a > 0 else math.inf
             if delta < best[0]:
-                best = (delta, x, float(t), "loses an impact")
+                best = (delta, x, float(t), "loses an impact", j)
     return best
 
 
@@ -312,11 +316,13 @@ def _locate_grazing(
     last: PeriodicOrbit, beyond: PeriodicOrbit | None, param: str, virtual: bool
 ) -> GrazingPoint | None:
     """The grazing orbit at the end of a branch, from its last orbit (Newton on the contact equations)."""
-    _, y, tg, _ = grazing_margin(last)
+    _, y, tg, _, stop = grazing_margin(last)
     if y is None:
         return None
     try:
-        point = refine_grazing(last.model, y, tg, param, period=last.period, events=not virtual)
+        point = refine_grazing(
+            last.model, y, tg, param, period=last.period, events=not virtual, stop_name=stop
+        )
     except GrazingError:
         return None
     # It must be the grazing between the two sides, not some other solution of the equations.
@@ -343,7 +349,7 @@ def _switch_orbit(
                 par.check(trial)
                 orbit = find_orbit(
                     last.model.with_params(**{param: trial}), last.state, period=last.period, t0=last.t0,
-                    virtual=virtual,
+                    virtual=virtual, stop_name=last.stop,
                 )  # fmt: skip
             except GrazingError:
                 continue
@@ -367,6 +373,7 @@ def continue_orbit(
     detect: tuple[str, ...] = SPECIAL_KINDS,
     switch: bool = False,
     progress: Callable[[int, float], None] | None = None,
+    stop_name: int | str | None = None,
 ) -> Branch:
     """Follow a periodic orbit as ``param`` goes from ``start`` towards ``stop``.
 
@@ -393,6 +400,12 @@ def continue_orbit(
         Step control (:class:`~grazing.orbits.palc.PalcSettings`).
     detect
         Special points to detect and locate (any of ``SPECIAL_KINDS``).
+    stop_name
+        For models with several stops: the stop (name or index; default the
+        starting orbit's, else the first) whose grazing a nonimpacting branch
+        looks for.  An impacting branch ends where it loses an impact on any
+        stop, or gains one on this stop; it also ends (without a located
+        grazing) where it gains an impact on another.
     switch
         At a grazing where the impact sequence changes, continue onto the orbit
         with the new sequence (a new segment of the branch) instead of ending.
@@ -426,17 +439,24 @@ def continue_orbit(
         raise InvalidParameterError("start and stop must differ")
     m0 = model.with_params(**{param: start})
     model.with_params(**{param: stop})  # the end of the range must be a valid value too
+    watch = model.stop_index(
+        stop_name if stop_name is not None else (orbit.stop if orbit is not None else None)
+    )
     if orbit is None:
         if virtual is None:
-            probe = find_orbit(m0, x0, period=period, t0=0.0 if t0 is None else t0)
+            probe = find_orbit(m0, x0, period=period, t0=0.0 if t0 is None else t0, stop_name=watch)
             virtual = probe.impacts == 0
             orbit = (
                 probe
                 if not virtual
-                else find_orbit(m0, probe.state, period=probe.period, t0=probe.t0, virtual=True)
+                else find_orbit(
+                    m0, probe.state, period=probe.period, t0=probe.t0, virtual=True, stop_name=watch
+                )
             )
         else:
-            orbit = find_orbit(m0, x0, period=period, t0=0.0 if t0 is None else t0, virtual=virtual)
+            orbit = find_orbit(
+                m0, x0, period=period, t0=0.0 if t0 is None else t0, virtual=virtual, stop_name=watch
+            )
         if t0 is None and orbit.section_clearance() < SECTION_MARGIN:
             orbit = move_section(orbit, quiet_section(orbit))
     elif virtual is None:
@@ -471,7 +491,7 @@ def continue_orbit(
     prev: PalcPoint | None = None
     status = ""
     while True:
-        evaluate = _evaluator(model, param, n, orbit.t0, virtual)
+        evaluate = _evaluator(model, param, n, orbit.t0, virtual, orbit.stop)
         u0 = np.append(orbit.state, orbit.model.params[param])
         try:
             F, DF, orb = evaluate(u0)
@@ -498,7 +518,9 @@ def continue_orbit(
                         gm = lo.x_guard_min
                         assert gm is not None
                         try:
-                            point = refine_grazing(lo.model, gm, lo.t_guard_min, param, period=n)
+                            point = refine_grazing(
+                                lo.model, gm, lo.t_guard_min, param, period=n, stop_name=lo.stop
+                            )
                         except GrazingError:
                             point = None
                     value = float(loc.u[-1]) if point is None else point.model.params[param]

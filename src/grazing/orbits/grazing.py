@@ -42,11 +42,14 @@ def find_grazings(
     period: int = 1,
     settings: PalcSettings | None = None,
     progress: Callable[[int, float], None] | None = None,
+    stop_name: int | str | None = None,
 ) -> tuple[list[GrazingPoint], Branch]:
     """Every grazing of the period-n nonimpacting orbit for ``param`` in ``[start, stop]``.
 
     The orbit is followed with the stop ignored, through folds, and every zero
-    of its minimum guard value is located and refined.
+    of its minimum guard value is located and refined.  ``stop_name``: for
+    models with several stops, the stop whose grazings are sought (name or
+    index; the first by default).
 
     Returns
     -------
@@ -71,6 +74,7 @@ def find_grazings(
         settings=settings,
         detect=("fold", "grazing"),
         progress=progress,
+        stop_name=stop_name,
     )
     points = []
     for sp_ in branch.special:
@@ -146,6 +150,7 @@ def grazing_curve(
     period: int = 1,
     settings: PalcSettings | None = None,
     progress: Callable[[int, float], None] | None = None,
+    stop_name: int | str | None = None,
 ) -> GrazingCurve:
     """Follow the grazing condition in two parameters, over the top and back down.
 
@@ -168,14 +173,14 @@ def grazing_curve(
             raise InvalidParameterError(f"unknown parameter {p!r}")
     s = settings or PalcSettings(ds=0.02, ds_max=0.05)
     base = model.with_params(**{p2: start})
-    first, _ = find_grazings(base, p1, search[0], search[1], period=period)
+    first, _ = find_grazings(base, p1, search[0], search[1], period=period, stop_name=stop_name)
     if not first:
         raise ConvergenceError(
             f"no grazing of the period-{period} orbit for {p1} in {search} at {p2} = {start:g}"
         )
     g0 = first[0]
     n = model.n_states
-    evaluate = contact_system(model, params, period)
+    evaluate = contact_system(model, params, period, stop=g0.stop)
     u0 = np.concatenate([g0.contact, [g0.t_graze, g0.model.params[p1], g0.model.params[p2]]])
     F, DF, pay = evaluate(u0)
     palc = Palc(

@@ -65,6 +65,9 @@ class PeriodicOrbit:
     approach
         ``(h, t, x)``: the orbit's closest approach to the stop away from its
         impacts (a local minimum of the guard in free flight), or None.
+    stop
+        Index of the stop that ``guard_min`` and ``approach`` refer to (models
+        with several stops); ``impact_stops`` gives the stop of each impact.
     """
 
     model: HybridModel
@@ -84,6 +87,8 @@ class PeriodicOrbit:
     impact_speeds: np.ndarray = field(default_factory=lambda: np.empty(0))
     impact_states: np.ndarray | None = None
     approach: tuple[float, float, np.ndarray] | None = None
+    stop: int = 0
+    impact_stops: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
 
     @property
     def signature(self) -> tuple[int, ...]:
@@ -128,7 +133,7 @@ def sorted_multipliers(mono: np.ndarray) -> np.ndarray:
 
 
 def _orbit_from(model: HybridModel, x: np.ndarray, t0: float, n: int, fm: FlowMap, virtual: bool,
-                residuals: list[float]) -> PeriodicOrbit:  # fmt: skip
+                residuals: list[float], stop: int = 0) -> PeriodicOrbit:  # fmt: skip
     sol = fm.solution
     if not sol.jacobian_valid:
         raise ConvergenceError(
@@ -155,6 +160,8 @@ def _orbit_from(model: HybridModel, x: np.ndarray, t0: float, n: int, fm: FlowMa
         impact_speeds=speeds.copy(),
         impact_states=sol.impacts.state.copy(),
         approach=sol.approach_min,
+        stop=stop,
+        impact_stops=sol.impacts.stop.copy(),
     )
 
 
@@ -185,7 +192,9 @@ def move_section(orbit: PeriodicOrbit, t_new: float, *, tol: float = DEFAULT_TOL
             orbit.model, orbit.state, t0=orbit.t0, periods=1, phase=phase, impacts="none",
             events=not orbit.virtual,
         ).x_final  # fmt: skip
-    return find_orbit(orbit.model, x, period=orbit.period, t0=t_new, virtual=orbit.virtual, tol=tol)
+    return find_orbit(
+        orbit.model, x, period=orbit.period, t0=t_new, virtual=orbit.virtual, tol=tol, stop_name=orbit.stop
+    )
 
 
 def initial_guess(
@@ -218,6 +227,7 @@ def find_orbit(
     tol: float = DEFAULT_TOL,
     max_iter: int = DEFAULT_MAX_ITER,
     transient: int = 500,
+    stop_name: int | str | None = None,
 ) -> PeriodicOrbit:
     """Find a periodic orbit by Newton's method on the stroboscopic map.
 
@@ -243,6 +253,9 @@ def find_orbit(
         Convergence when ``max |P^n(x) - x| <= tol``.
     max_iter
         Newton iteration limit.
+    stop_name
+        The stop (name or index; the first by default) whose closest approach
+        the orbit reports (``guard_min``, ``approach``), for grazing analysis.
 
     Raises
     ------
@@ -261,12 +274,14 @@ def find_orbit(
         raise InvalidParameterError(f"period must be a positive integer, got {period!r}")
     if t0 is None:
         orbit = find_orbit(
-            model, x0, period=period, t0=0.0, virtual=virtual, tol=tol, max_iter=max_iter, transient=transient
-        )
+            model, x0, period=period, t0=0.0, virtual=virtual, tol=tol, max_iter=max_iter,
+            transient=transient, stop_name=stop_name,
+        )  # fmt: skip
         if orbit.section_clearance() >= SECTION_MARGIN:
             return orbit
         return move_section(orbit, quiet_section(orbit), tol=tol)
     advice = "try another initial guess, another period, or a longer transient"
+    stop = model.stop_index(stop_name)
     if x0 is None:
         x, detected = initial_guess(model, t0=t0, transient=transient, virtual=virtual)
         n = int(period or detected or 1)
@@ -283,7 +298,7 @@ def find_orbit(
     why = ""
     for it in range(max_iter + 1):
         try:
-            fm = flow_map(model, x, t0=t0, periods=n, virtual=virtual)
+            fm = flow_map(model, x, t0=t0, periods=n, virtual=virtual, stop_name=stop)
         except SimulationError as exc:
             raise ConvergenceError(
                 f"Newton's method for a period-{n} orbit failed at iterate {it} ({exc}); {advice}"
@@ -305,7 +320,7 @@ def find_orbit(
         if not np.isfinite(res):
             break
         if res <= tol:
-            return _orbit_from(model, x, t0, n, fm, virtual, residuals)
+            return _orbit_from(model, x, t0, n, fm, virtual, residuals, stop)
         if it == max_iter:
             break
         A = fm.jacobian - np.eye(model.n_states)
@@ -318,7 +333,7 @@ def find_orbit(
         lam = 1.0
         for _ in range(30):
             trial = x + lam * dx
-            if virtual or model.guard(trial, t0) >= 0:
+            if virtual or np.min(model.guards(trial, t0)) >= 0:
                 break
             lam *= 0.5
         x = trial

@@ -15,7 +15,7 @@ Examples
 --------
 >>> from grazing.report import FIGURES, PAPER_FIGURES
 >>> [m.FIGURE_ID for m in FIGURES]
-['2', '4', '6', '7', '8', '9', '10', '11', '12', 'map', 'eq']
+['2', '4', '6', '7', '8', '9', '10', '11', '12', 'map', 'stops', 'eq']
 >>> set(PAPER_FIGURES) <= {m.FIGURE_ID for m in FIGURES}
 True
 >>> [m.FIGURE_ID for m in select(["fig07", "10", "figmap"])]
@@ -36,7 +36,20 @@ from types import ModuleType
 from typing import Any
 
 import grazing
-from grazing.report import errata, fig02, fig04, fig06, fig07, fig08, fig09, fig10, fig11, fig12, figmap
+from grazing.report import (
+    errata,
+    fig02,
+    fig04,
+    fig06,
+    fig07,
+    fig08,
+    fig09,
+    fig10,
+    fig11,
+    fig12,
+    figmap,
+    figstops,
+)
 from grazing.report.base import Comparison, DataFile, Dynamics, FigureResult, Image, Progress, number_rows
 from grazing.report.html import RULES_TEXT, ReportMeta, render, scoreboard
 from grazing.report.provenance import collect, source_root
@@ -65,6 +78,7 @@ FIGURES: tuple[ModuleType, ...] = (
     fig11,
     fig12,
     figmap,
+    figstops,
     errata,
 )
 """The figure modules, in the order the page shows them."""

@@ -78,7 +78,9 @@ def run_point(spec: SweepSpec, model: HybridModel, x: np.ndarray, t0: float) -> 
         seg = run.advance(spec.periods, spec.periods, impacts="sampled")
         lyap = math.nan
         final = run
-    return seg.samples, len(seg.impacts), lyap, used + align, final.x, final.t
+    n = model.n_states
+    by_stop = np.bincount(seg.impacts[:, 2 + n].astype(np.int64), minlength=model.n_stops)
+    return seg.samples, by_stop, lyap, used + align, final.x, final.t
 
 
 def run_chunk(spec: SweepSpec, index: int) -> ChunkResult:
@@ -95,6 +97,7 @@ def run_chunk(spec: SweepSpec, index: int) -> ChunkResult:
         lyapunov=np.full(len(pts), np.nan),
         transient_used=np.zeros(len(pts), dtype=np.int32),
         x_final=np.full((len(pts), n), np.nan),
+        impacts_by_stop=np.zeros((len(pts), spec.model.n_stops), dtype=np.int32),
     )
     x0 = np.asarray(spec.x0, dtype=float)
     x = x0.copy()
@@ -108,15 +111,17 @@ def run_chunk(spec: SweepSpec, index: int) -> ChunkResult:
             t0 = (spec.phase / (2 * math.pi)) % 1.0 * model.period
         start_x, start_t = (x0, 0.0) if spec.fresh or not carried else (x, t0)
         try:
-            samples, nimp, lyap, used, x, t0 = run_point(spec, model, start_x, start_t)
+            samples, by_stop, lyap, used, x, t0 = run_point(spec, model, start_x, start_t)
         except SimulationError:
             # Recorded as missing (NaN samples, period -1); the next point restarts from x0.
             res.period[j] = -1
+            res.impacts_by_stop[j] = -1
             carried = False
             continue
         res.samples[j] = samples
         res.period[j] = detect_period(samples, DEFAULT_PERIOD_TOL, DEFAULT_MAX_PERIOD)
-        res.impacts[j] = nimp
+        res.impacts[j] = int(by_stop.sum())
+        res.impacts_by_stop[j] = by_stop
         res.lyapunov[j] = lyap
         res.transient_used[j] = used
         res.x_final[j] = x

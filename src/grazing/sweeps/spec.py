@@ -162,6 +162,7 @@ class ChunkResult:
     lyapunov: np.ndarray  # (points,) largest exponent per unit time (nan if sticking)
     transient_used: np.ndarray  # (points,) transient periods actually run
     x_final: np.ndarray  # (points, n_states)
+    impacts_by_stop: np.ndarray | None = None  # (points, n_stops) impacts on each stop in the sampled span
     seconds: float = 0.0
 
 

@@ -48,7 +48,7 @@ class StoreMismatchError(GrazingError, ValueError):
     """An existing result store was made by a different sweep."""
 
 
-_VARIABLES = ("samples", "period", "impacts", "lyapunov", "transient_used", "x_final")
+_VARIABLES = ("samples", "period", "impacts", "lyapunov", "transient_used", "x_final", "impacts_by_stop")
 """The per-point variables of a sweep."""
 
 
@@ -61,6 +61,7 @@ def _empty_arrays(spec: SweepSpec) -> dict[str, np.ndarray]:
         "lyapunov": np.full(p, np.nan),
         "transient_used": np.full(p, -1, dtype=np.int32),
         "x_final": np.full((p, n), np.nan),
+        "impacts_by_stop": np.full((p, spec.model.n_stops), -1, dtype=np.int32),
     }
 
 
@@ -85,8 +86,10 @@ def build_dataset(spec: SweepSpec, arrays: dict[str, np.ndarray], attrs: dict[st
     pts = np.asarray(spec.points, dtype=float)
     period = arrays["period"]
     impacts = arrays["impacts"]
+    by_stop = arrays["impacts_by_stop"]
     with np.errstate(invalid="ignore", divide="ignore"):
         ipp = np.where(impacts >= 0, impacts / spec.periods * np.maximum(period, 1), np.nan)
+        ipp_stop = np.where(by_stop >= 0, by_stop / spec.periods * np.maximum(period, 1)[:, None], np.nan)
     data = {
         "samples": (("point", "sample", "component"), arrays["samples"]),
         "period": ("point", period),
@@ -95,9 +98,12 @@ def build_dataset(spec: SweepSpec, arrays: dict[str, np.ndarray], attrs: dict[st
         "lyapunov": ("point", arrays["lyapunov"]),
         "transient_used": ("point", arrays["transient_used"]),
         "x_final": (("point", "component"), arrays["x_final"]),
+        "impacts_by_stop": (("point", "stop"), by_stop),
+        "impacts_per_period_by_stop": (("point", "stop"), ipp_stop),
     }
     coords: dict[str, Any] = {
         "component": list(spec.model.state_names),
+        "stop": list(spec.model.stop_names),
         "sample": np.arange(spec.periods),
     }
     for j, name in enumerate(spec.params):
@@ -119,6 +125,7 @@ def build_dataset(spec: SweepSpec, arrays: dict[str, np.ndarray], attrs: dict[st
     ds["impacts_per_period"].attrs["description"] = (
         "impacts per period p of the detected orbit (per forcing period when p = 0)"
     )
+    ds["impacts_per_period_by_stop"].attrs["description"] = "impacts_per_period on each stop"
     ds["lyapunov"].attrs["description"] = (
         "largest Lyapunov exponent per unit time (nan: not computed / sticking)"
     )
@@ -310,11 +317,13 @@ class ZarrStore:
         import xarray as xr
 
         n, m, p, c = self.spec.model.n_states, self.spec.periods, self.spec.n_points, self.spec.size
+        k = self.spec.model.n_stops
         fill = {"samples": np.nan, "period": -1, "impacts": -1, "lyapunov": np.nan, "transient_used": -1,
-                "x_final": np.nan}  # fmt: skip
+                "x_final": np.nan, "impacts_by_stop": -1}  # fmt: skip
         shapes = {"samples": (p, m, n), "period": (p,), "impacts": (p,), "lyapunov": (p,),
-                  "transient_used": (p,), "x_final": (p, n)}  # fmt: skip
-        dims = {"samples": ("point", "sample", "component"), "x_final": ("point", "component")}
+                  "transient_used": (p,), "x_final": (p, n), "impacts_by_stop": (p, k)}  # fmt: skip
+        dims = {"samples": ("point", "sample", "component"), "x_final": ("point", "component"),
+                "impacts_by_stop": ("point", "stop")}  # fmt: skip
         data: dict[str, Any] = {}
         encoding: dict[str, Any] = {}
         for name, shape in shapes.items():
@@ -353,6 +362,7 @@ class ZarrStore:
                 "lyapunov": ("point", res.lyapunov),
                 "transient_used": ("point", res.transient_used),
                 "x_final": (("point", "component"), res.x_final),
+                "impacts_by_stop": (("point", "stop"), res.impacts_by_stop),
             }
         )
         part.to_zarr(str(self.path), region={"point": sl}, consolidated=False)
@@ -398,6 +408,7 @@ def build_dataset_flat(spec: SweepSpec, arrays: dict[str, np.ndarray], attrs: di
             "lyapunov": ("point", arrays["lyapunov"]),
             "transient_used": ("point", arrays["transient_used"]),
             "x_final": (("point", "component"), arrays["x_final"]),
+            "impacts_by_stop": (("point", "stop"), arrays["impacts_by_stop"]),
         }
     )
     summary = spec_summary(spec)

@@ -1,8 +1,9 @@
 """Driver piece: the location of events on a step (appended to each kernel module).
 
-On every step the guard ``h`` (or, while sticking, the contact force) is
-expanded as a Taylor polynomial alongside the state; written in the normalised
-step time ``u`` in ``[0, 1]`` its first root is the first event of the step.
+On every step every stop's guard ``h`` (or, for the stop it sticks to, the
+contact force) is expanded as a Taylor polynomial alongside the state; written
+in the normalised step time ``u`` in ``[0, 1]``, the first root of any of them
+is the first event of the step (of roots at the same ``u``, the first stop's).
 Roots known in advance are divided out first: the one at ``u = 0`` just after
 an impact (``h = 0``), a release (force 0) or a start at a grazing contact
 (``h = L_f h = 0``), and the one at ``u = 1`` of a run that ends at a grazing
@@ -14,13 +15,13 @@ import math  # noqa: F401 - the names the pieces share in the generated module
 import numpy as np  # noqa: F401
 from numba import njit
 
-from grazing.engine.polyroots import quadratic_bound
+from grazing.engine.polyroots import isolate_first_root, quadratic_bound
 from grazing.engine.stepping import divide_double_root_at_one
 
 
 @njit(cache=True, inline="always")
-def event_polynomial(O, h, mode, defl, end_contact, a):
-    """The event function over the step as ``a[0] + a[1] u + ...``; returns ``(degree, tail)``.
+def event_polynomial(O, row, h, mode, defl, end_contact, a):
+    """Event row ``row`` over the step as ``a[0] + a[1] u + ...``; returns ``(degree, tail)``.
 
     ``defl`` roots at ``u = 0`` are known (1 after an impact, 2 at a grazing
     contact, 3 after a release) and divided out, and so is a root at ``u = 0``
@@ -32,15 +33,15 @@ def event_polynomial(O, h, mode, defl, end_contact, a):
     order = ORDER
     hk = 1.0
     for j in range(min(3, order + 1)):
-        a[j] = O[0, j] * hk
+        a[j] = O[row, j] * hk
         hk *= h
     tail = 0.0
     for j in range(3, order + 1):
-        c = O[0, j] * hk
+        c = O[row, j] * hk
         a[j] = c
         tail += abs(c)
         hk *= h
-    if mode == 1:  # sticking: the event is the contact force reaching zero from above
+    if mode == 1:  # the stop it sticks to: the event is the contact force reaching zero from above
         for j in range(order + 1):
             a[j] = -a[j]
     d = defl
@@ -76,3 +77,31 @@ def event_certificate(a, tail):
     if quadratic_bound(a[0], a[1], a[2], tail) <= 0.0:
         return 1.0
     return -1.0
+
+
+@njit(cache=True, inline="always")
+def first_event(O, h, mode, stuck, events, skip, defl, defl_stop, end_contact, end_stop, a, work):
+    """The first event on the step over every stop: ``(u, stop)``, ``u < 0`` when there is none.
+
+    ``mode`` 1 is sticking to stop ``stuck`` (its row is the contact force);
+    the known roots at ``u = 0`` (``defl``) belong to stop ``defl_stop``, a
+    final grazing contact (``end_contact``) to ``end_stop``.  Without
+    ``events`` only the contact force is watched; stop ``skip`` (the one the
+    discontinuity map stands for; -1: none) is not.
+    """
+    u = -1.0
+    stop = 0
+    for r in range(NSTOPS):
+        force = mode == 1 and r == stuck
+        if not (events or force) or r == skip:
+            continue
+        deg, tail = event_polynomial(
+            O, r, h, 1 if force else 0, defl if r == defl_stop else 0, end_contact and r == end_stop, a
+        )
+        ur = event_certificate(a, tail)
+        if ur > 0.0:  # rarely: the certificate cannot exclude a root on the step
+            ur = isolate_first_root(a, deg, work)
+        if ur >= 0.0 and (u < 0.0 or ur < u):
+            u = ur
+            stop = r
+    return u, stop

@@ -17,8 +17,8 @@ from grazing.engine.stepping import append_record, append_row, pack_var, unpack_
 
 
 @njit(cache=True)
-def saltation(xm, xp, s, pv, V, ncol):
-    """Apply the saltation matrix (paper eq. 14, with time and parameter terms) to V."""
+def saltation(xm, xp, s, pv, j, V, ncol):
+    """Apply the saltation matrix of stop ``j`` (paper eq. 14, with time and parameter terms) to V."""
     n = NX
     fm = np.empty(n)
     fp = np.empty(n)
@@ -27,11 +27,11 @@ def saltation(xm, xp, s, pv, V, ncol):
     Gx = np.zeros((n, n))
     Gt = np.zeros(n)
     Gp = np.zeros((n, max(NSENS, 1)))
-    reset_jac(xm, s, pv, Gx, Gt, Gp)
+    reset_jac(xm, s, pv, Gx, Gt, Gp, j)
     hx = np.zeros(n)
     hp = np.zeros(max(NSENS, 1))
-    ht = guard_grad(xm, s, pv, hx)
-    guard_pgrad(xm, s, pv, hp)
+    ht = guard_grad(xm, s, pv, hx, j)
+    guard_pgrad(xm, s, pv, hp, j)
     den = ht
     for i in range(n):
         den += hx[i] * fm[i]
@@ -65,13 +65,13 @@ def saltation(xm, xp, s, pv, V, ncol):
 
 
 @njit(cache=True)
-def enter_contact(x, s, pv):
-    """Project x onto the contact manifold {h = 0, L_f h = 0}."""
+def enter_contact(x, s, pv, j):
+    """Project x onto the contact manifold {h = 0, L_f h = 0} of stop ``j``."""
     n = NX
     gx = np.zeros(n)
     for _ in range(3):
-        hval = guard(x, s, pv)
-        guard_grad(x, s, pv, gx)
+        hval = guard(x, s, pv, j)
+        guard_grad(x, s, pv, gx, j)
         nn = 0.0
         for i in range(n):
             nn += gx[i] * gx[i]
@@ -80,11 +80,11 @@ def enter_contact(x, s, pv):
         for i in range(n):
             x[i] -= hval * gx[i] / nn
     e = np.zeros(n)
-    contact_dir(x, s, pv, e)
+    contact_dir(x, s, pv, e, j)
     gr = np.zeros(n)
     for _ in range(3):
-        vn = normal_rate(x, s, pv)
-        normal_rate_grad(x, s, pv, gr)
+        vn = normal_rate(x, s, pv, j)
+        normal_rate_grad(x, s, pv, gr, j)
         d = 0.0
         for i in range(n):
             d += gr[i] * e[i]
@@ -95,24 +95,25 @@ def enter_contact(x, s, pv):
 
 
 @njit(cache=True)
-def apply_impact(x, xp, s, t, pv, use_var, ncol, nrows, V, record, imp, n_rec, traj_on, traj, n_traj):
-    """Reset the state on the stop (``x`` holds it) and its variational matrix; returns the speed.
+def apply_impact(x, xp, s, t, pv, j, use_var, ncol, nrows, V, record, imp, n_rec, traj_on, traj, n_traj):
+    """Reset the state on stop ``j`` (``x`` holds it) and its variational matrix; returns the speed.
 
     Returns ``(speed, n_rec, n_traj)``: the approach speed ``-L_f h``, and
     the impact and trajectory counters (the impact is recorded as
-    ``[t, speed, state before]`` when ``record``; both states go into the
+    ``[t, speed, state before, j]`` when ``record``; both states go into the
     trajectory when ``traj_on``).  Afterwards ``x`` holds the state after the
     reset.
     """
     n = NX
-    vn = normal_rate(x, s, pv)
-    reset(x, s, pv, xp)
+    vn = normal_rate(x, s, pv, j)
+    reset(x, s, pv, xp, j)
     if use_var:
         unpack_var(x, n, ncol, V)
-        saltation(x, xp, s, pv, V, ncol)
+        saltation(x, xp, s, pv, j, V, ncol)
         pack_var(V, n, ncol, xp)
     if record:
         append_record(imp, n_rec, t, -vn, x, n)
+        imp[0][n_rec, 2 + n] = j
         n_rec += 1
     if traj_on:
         append_row(traj, n_traj, t, x, n)
@@ -124,8 +125,8 @@ def apply_impact(x, xp, s, t, pv, use_var, ncol, nrows, V, record, imp, n_rec, t
 
 
 @njit(cache=True)
-def chatter_remaining(x, s, pv, speed, chatter_time):
-    """The time to the accumulation point of a chattering sequence starting now, or -1.
+def chatter_remaining(x, s, pv, j, speed, chatter_time):
+    """The time to the accumulation point of a chattering sequence on stop ``j`` starting now, or -1.
 
     After the reset the body leaves the stop with speed ``w`` while the stop
     pushes it back (``L_f^2 h < 0``): the next bounces form a geometric
@@ -133,8 +134,8 @@ def chatter_remaining(x, s, pv, speed, chatter_time):
     Returns that time when it is below ``chatter_time`` (or 0 when the body
     does not leave the stop at all), else -1: no sticking.
     """
-    w = normal_rate(x, s, pv)
-    acc = normal_accel(x, s, pv)
+    w = normal_rate(x, s, pv, j)
+    acc = normal_accel(x, s, pv, j)
     if not acc < 0.0:
         return -1.0
     if speed <= 0.0 or w <= 0.0:

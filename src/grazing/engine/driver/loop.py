@@ -17,11 +17,13 @@ does not lose precision over long runs.  Samples are taken at local times
 ``(ks, ss)``, ``(ks + 1, ss)``, ... (or ``ss``, ``ss + T``, ... without
 wrapping); the last ``n_keep`` are stored and define the recorded span
 (impacts, trajectory, minimum of the guard, Lyapunov sums).  ``start.mode``
-is 0 in free flight, 1 when sticking to the stop; the final mode is returned
-so that a run can be continued.  With ``cfg.events`` false the guard is
-ignored (the "virtual" flow through the stop), which is how nonimpacting
-orbits are continued past grazing.  The parameter columns of the variational
-matrix are derivatives at fixed ``(k, s)``, the instant ``k T(p) + s``.
+is 0 in free flight, ``1 + j`` when sticking to stop ``j``; the final mode is
+returned so that a run can be continued.  ``cfg.stop`` is the stop a grazing
+analysis looks at: its guard's minimum is tracked, a grazing contact at the
+start or end of the run is on it, and the discontinuity map stands for it.
+With ``cfg.events`` false the guards are ignored (the "virtual" flow through
+the stops), which is how nonimpacting orbits are continued past grazing.  The
+parameter columns of the variational matrix are derivatives at fixed ``(k, s)``, the instant ``k T(p) + s``.
 """
 
 import math
@@ -29,7 +31,6 @@ import math
 import numpy as np
 from numba import njit
 
-from grazing.engine.polyroots import isolate_first_root
 from grazing.engine.records import Config, Result, Start
 from grazing.engine.stepping import (
     append_pair,
@@ -76,6 +77,7 @@ def integrate(start, pv, cfg):
     zdm_a = cfg.zdm_a
     zdm_e = cfg.zdm_e
     zdm_window = cfg.zdm_window
+    watch = cfg.stop
     factor = step_factor(cfg.safety, order)
     ncol = n + NSENS
     nv = n * ncol if use_var else 0
@@ -88,7 +90,7 @@ def integrate(start, pv, cfg):
             for c in range(ncol):
                 x[n + i * ncol + c] = start.V[i, c]
     X = np.zeros((ntot, order + 1))
-    O = np.zeros((1, order + 1))
+    O = np.zeros((NSTOPS, order + 1))
     work = np.zeros((ROOT_WORK_ROWS, max(order + 1, ROOT_WORK_MIN_COLS)))
     a = np.zeros(order + 1)
     gm = np.zeros(order + 1)
@@ -97,7 +99,7 @@ def integrate(start, pv, cfg):
     V = np.empty((n, ncol))
 
     samples = np.empty((n_keep, n))
-    imp = new_table(16, 2 + n)
+    imp = new_table(16, 3 + n)
     sticks = new_table(4, 2)
     traj = new_table(64 if traj_dt > 0.0 else 1, 1 + n)
     logs = np.zeros(n)
@@ -112,8 +114,10 @@ def integrate(start, pv, cfg):
 
     k = start.k
     s = start.s
-    mode = start.mode
+    mode = 1 if start.mode > 0 else 0
+    stuck = max(start.mode - 1, 0)  # the stop it sticks to
     defl = 2 if cfg.touch_start else 0
+    defl_stop = watch  # the stop the known roots at u = 0 belong to
     ks = cfg.ks
     ss = cfg.ss
     isamp = 0
@@ -160,10 +164,10 @@ def integrate(start, pv, cfg):
                 tc_var(x, s, pv, X, O)
             else:
                 tc_free(x, s, pv, X, O)
-            h = step_size(X, ntot, O, order, max_step, factor)
+            h = step_size(X, ntot, O, NSTOPS, 0, order, max_step, factor)
         else:
-            tc_stick(x, s, pv, X, O)  # the first n rows only
-            h = step_size(X, n, O, order, max_step, factor)
+            tc_stick(x, s, pv, X, O, stuck)  # the first n rows only
+            h = step_size(X, n, O, NSTOPS, stuck, order, max_step, factor)
         rem = (ks - k) * T + (ss - s)
         is_last = False
         if isamp == n_samples - 1 and h >= rem:
@@ -177,13 +181,11 @@ def integrate(start, pv, cfg):
                 zdm_hit = True
                 is_last = is_last and rem_z >= rem
 
-        # The first event on the step (the guard's polynomial in u in [0, 1]).
-        deg, tail = event_polynomial(O, h, mode, defl, touch_end and is_last and mode == 0, a)
-        u = -1.0
-        if events or mode == 1:
-            u = event_certificate(a, tail)
-            if u > 0.0:  # rarely: the certificate cannot exclude a root on the step
-                u = isolate_first_root(a, deg, work)
+        # The first event on the step (each guard's polynomial in u in [0, 1]).
+        u, ev_stop = first_event(
+            O, h, mode, stuck, events, watch if zdm_on else -1, defl, defl_stop,
+            touch_end and is_last and mode == 0, watch, a, work,
+        )  # fmt: skip
         event = u >= 0.0 and h > 0.0
         if event and u == 0.0:
             zero_events += 1
@@ -207,8 +209,9 @@ def integrate(start, pv, cfg):
             n_traj, kt, st = trajectory_points(T, wrap, traj_dt, X, k, s, h_acc, traj, n_traj, kt, st, xe)
         if recording and track_min and mode == 0 and h_acc > 0.0:
             slope_end, slope_first = track_guard(
-                O, X, x, k * T + s, h, h_acc, defl, event, gm, min_info, slope_end, slope_first, xe
-            )
+                O, watch, X, x, k * T + s, h, h_acc, defl if defl_stop == watch else 0, event, gm, min_info,
+                slope_end, slope_first, xe,
+            )  # fmt: skip
 
         # Advance to the end of the accepted part of the step.
         eval_rows(X, nrows, order, h_acc, xe)
@@ -235,6 +238,7 @@ def integrate(start, pv, cfg):
                 s,
                 k * T + s,
                 pv,
+                watch,
                 zdm_a,
                 zdm_e,
                 zdm_window,
@@ -251,41 +255,48 @@ def integrate(start, pv, cfg):
                 n_imp += 1
 
         if event:
-            if mode == 0:
-                # Impact: x holds the state on the stop, just before the reset.
+            if mode == 1 and ev_stop == stuck:
+                # Release from sticking: the contact force changes sign.
+                mode = 0
+                defl = 3
+                defl_stop = stuck
+                if recording:
+                    close_sticking(sticks, n_stick, k * T + s)
+            else:
+                if mode == 1:  # sticking to one stop, it hits another: the contact ends
+                    mode = 0
+                    if recording:
+                        close_sticking(sticks, n_stick, k * T + s)
+                # Impact: x holds the state on stop ev_stop, just before its reset.
                 record = record_impacts == 2 or (record_impacts == 1 and recording)
                 traj_on = recording and traj_dt > 0.0
                 speed, n_imp_rec, n_traj = apply_impact(
-                    x, xp, s, k * T + s, pv, use_var, ncol, nrows, V, record, imp, n_imp_rec, traj_on, traj,
-                    n_traj,
+                    x, xp, s, k * T + s, pv, ev_stop, use_var, ncol, nrows, V, record, imp, n_imp_rec,
+                    traj_on, traj, n_traj,
                 )  # fmt: skip
                 n_imp += 1
                 defl = 1
-                if HAS_STICK:
-                    dt_acc = chatter_remaining(x, s, pv, speed, chatter_time)
+                defl_stop = ev_stop
+                if HAS_STICK and STICKS[ev_stop]:
+                    dt_acc = chatter_remaining(x, s, pv, ev_stop, speed, chatter_time)
                     if dt_acc >= 0.0:  # complete chattering: on to the accumulation point, then sticking
                         s += dt_acc
                         if wrap and s >= T:  # (the Jacobian is not valid after sticking)
                             s -= T
                             k += 1
-                        enter_contact(x, s, pv)
+                        enter_contact(x, s, pv, ev_stop)
                         mode = 1
+                        stuck = ev_stop
                         defl = 0
                         jac_valid = False
                         if recording:
                             append_pair(sticks, n_stick, k * T + s, math.nan)
                             n_stick += 1
-            else:
-                # Release from sticking: the contact force changes sign.
-                mode = 0
-                defl = 3
-                if recording:
-                    close_sticking(sticks, n_stick, k * T + s)
         if isamp >= n_samples:
             break
 
     if track_min and mode == 0 and recording:
-        finish_guard(x, s, pv, k * T + s, slope_end, slope_first, min_info)
+        finish_guard(x, s, pv, watch, k * T + s, slope_end, slope_first, min_info)
     close_sticking(sticks, n_stick, k * T + s)
     lyap_span = k * T + s - lyap_t0 if (lyap and lyap_started) else 0.0
     Vout = np.zeros((n, ncol))
@@ -297,7 +308,7 @@ def integrate(start, pv, cfg):
         Vout,
         k,
         s,
-        mode,
+        0 if mode == 0 else 1 + stuck,
         nsteps,
         n_imp,
         samples[: max(0, min(n_keep, isamp - keep_from))].copy(),

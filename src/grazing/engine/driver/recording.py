@@ -79,8 +79,8 @@ def trajectory_points(T, wrap, traj_dt, X, k, s, h_acc, traj, n_traj, kt, st, xe
 
 
 @njit(cache=True, inline="always")
-def track_guard(O, X, x, t, h, h_acc, defl, event, gm, min_info, slope_end, slope_first, xe):
-    """The guard's minimum over ``[t, t + h_acc)`` and its closest approach; returns the slopes.
+def track_guard(O, row, X, x, t, h, h_acc, defl, event, gm, min_info, slope_end, slope_first, xe):
+    """Minimum of event row ``row`` (a guard) over ``[t, t + h_acc)``, closest approach; returns the slopes.
 
     ``min_info[:2 + n]`` holds the smallest value, its time and the state
     there; ``min_info[2 + n:]`` the same for the smallest local minimum in free
@@ -93,7 +93,7 @@ def track_guard(O, X, x, t, h, h_acc, defl, event, gm, min_info, slope_end, slop
     order = ORDER
     hk = 1.0
     for j in range(order + 1):
-        gm[j] = O[0, j] * hk
+        gm[j] = O[row, j] * hk
         hk *= h
     if gm[0] < min_info[0]:
         min_info[0] = gm[0]
@@ -132,10 +132,10 @@ def track_guard(O, X, x, t, h, h_acc, defl, event, gm, min_info, slope_end, slop
 
 
 @njit(cache=True)
-def finish_guard(x, s, pv, t, slope_end, slope_first, min_info):
+def finish_guard(x, s, pv, j, t, slope_end, slope_first, min_info):
     """At the end of the run: the final state, and a minimum where the orbit closes."""
     n = NX
-    g_end = guard(x, s, pv)
+    g_end = guard(x, s, pv, j)
     if g_end < min_info[0]:
         min_info[0] = g_end
         min_info[1] = t

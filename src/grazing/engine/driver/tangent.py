@@ -51,7 +51,7 @@ def lyapunov_step(x, V, ncol, recording, started, t0, t, scratch, logs):
 
 
 @njit(cache=True)
-def discontinuity_map(x, s, t, pv, a, e, window, use_var, ncol, V, gh, gv, record, imp, n_rec):
+def discontinuity_map(x, s, t, pv, j, a, e, window, use_var, ncol, V, gh, gv, record, imp, n_rec):
     """Nordmark's discontinuity map at leading order, at the grazing phase; returns ``(applied, n_rec)``.
 
     With ``v = L_f h`` and ``delta = v^2 / (2 a) - h`` (how far the local
@@ -62,16 +62,16 @@ def discontinuity_map(x, s, t, pv, a, e, window, use_var, ncol, V, gh, gv, recor
     as an impact (time, speed ``S``, state) when ``record``.
     """
     n = NX
-    hval = guard(x, s, pv)
-    vn = normal_rate(x, s, pv)
+    hval = guard(x, s, pv, j)
+    vn = normal_rate(x, s, pv, j)
     dz = vn * vn / (2.0 * a) - hval
     if not (dz > 0.0 and abs(vn) < window * a):
         return False, n_rec
     sp_ = math.sqrt(2.0 * a * dz)
     if use_var:
         # dD/dx = I - e (grad S)^T, grad S = a grad(delta) / S
-        guard_grad(x, s, pv, gh)
-        normal_rate_grad(x, s, pv, gv)
+        guard_grad(x, s, pv, gh, j)
+        normal_rate_grad(x, s, pv, gv, j)
         unpack_var(x, n, ncol, V)
         for c in range(ncol):
             gs = 0.0
@@ -83,6 +83,7 @@ def discontinuity_map(x, s, t, pv, a, e, window, use_var, ncol, V, gh, gv, recor
         pack_var(V, n, ncol, x)
     if record:
         append_record(imp, n_rec, t, sp_, x, n)
+        imp[0][n_rec, 2 + n] = j
         n_rec += 1
     for i in range(n):
         x[i] -= e[i] * sp_

@@ -1,0 +1,160 @@
+"""Every analysis command takes any model: --model (built-in or FILE.py:OBJECT), --set, --param, --stop-name.
+
+Smoke runs of every command on every built-in model with a second stop or more
+states, the JSON keys scripts rely on (``impacts_per_stop``, ``impact_stops``,
+``impacts_per_period_by_stop``, a grazing's ``stop`` and ``value``), and bad
+model input: one line on stderr, a non-zero exit.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import pytest
+
+from grazing.cli import main
+
+
+def run(argv, capsys):
+    code = main(argv)
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def run_json(argv, capsys):
+    code, out, err = run([*argv, "--json"], capsys)
+    assert code == 0, err
+    return json.loads(out)
+
+
+TWO = ["--model", "two-sided-oscillator"]
+
+
+def test_simulate_two_stops_json(capsys):
+    res = run_json(["simulate", *TWO, "--set", "omega=0.8", "--transient", "50", "--periods", "4"], capsys)
+    assert res["impacts_per_stop"] == {"right": 4, "left": 4}
+    assert res["impact_stops"] == ["right", "left"] * 4 or res["impact_stops"] == ["left", "right"] * 4
+    assert set(res["params"]) == {"zeta", "amp", "omega", "gap_left", "gap_right", "r"}
+
+
+def test_simulate_pendulum_json_lists_both_faces(capsys):
+    res = run_json(["simulate", "--transient", "100", "--periods", "5"], capsys)
+    assert res["impacts_per_stop"] == {"stop": 1, "back": 0}
+    assert res["params"]["case"] == "B" and "theta_hat_deg" in res["params"]
+
+
+@pytest.mark.parametrize(
+    "model, initial",
+    [
+        ("impact-oscillator", "0,0"),
+        ("bouncing-ball", "0.5,0"),
+        ("impact-damper", "0,0,0,0"),
+        ("two-sided-oscillator", "0,0"),
+    ],
+)
+def test_simulate_and_orbit_every_built_in_model(model, initial, capsys):
+    res = run_json(
+        ["simulate", "--model", model, "--initial", initial, "--transient", "50", "--periods", "3"], capsys
+    )
+    assert len(res["samples"]) == 3 and len(res["x_final"]) == len(initial.split(","))
+    code, out, err = run(["orbit", "--model", model, "--period", "1", "--transient", "300"], capsys)
+    assert code in (0, 1) and (out or err)  # an orbit, or one line saying why not (the ball may stick)
+    if code == 1:
+        assert err.startswith("grazing: error:") and err.count("\n") == 1
+
+
+def test_graze_sweep_continue_on_the_two_sided_oscillator(capsys):
+    base = [*TWO, "--set", "amp=0.5", "--set", "gap_left=1.5"]
+    res = run_json(["graze", *base, "--param", "omega", "--range", "0.5,0.9", "--stop-name", "left"], capsys)
+    (g,) = res["grazings"]
+    assert g["stop"] == "left" and 0.8 < g["value"] < 0.85 and "eta" not in g
+    res = run_json(["sweep", *TWO, "--param", "omega", "--start", "0.7", "--stop", "0.9", "--num", "3",
+                    "--transient", "50", "--periods", "8", "--workers", "1"], capsys)  # fmt: skip
+    by_stop = res["impacts_per_period_by_stop"]
+    assert set(by_stop) == {"right", "left"} and len(by_stop["right"]) == 3
+    assert by_stop["right"][1] == pytest.approx(1.0) and by_stop["left"][1] == pytest.approx(1.0)
+    res = run_json(["continue", *base, "--param", "omega", "--start", "0.5", "--stop", "0.9", "--stop-name",
+                    "right"], capsys)  # fmt: skip
+    kinds = [s["kind"] for s in res["special"]]
+    assert "grazing" in kinds
+    res = run_json(["map", *TWO, "--param1", "omega", "--start1", "0.7", "--stop1", "0.9", "--num1", "2",
+                    "--param2", "r", "--start2", "0.5", "--stop2", "0.8", "--num2", "2", "--transient", "30",
+                    "--periods", "8", "--workers", "1"], capsys)  # fmt: skip
+    assert len(res["period"]) == 2
+
+
+def test_normal_form_and_graze_curve_on_another_model(capsys):
+    base = [*TWO, "--set", "amp=0.5", "--set", "gap_left=1.5"]
+    res = run_json(
+        ["normal-form", *base, "--param", "omega", "--range", "0.5,0.9", "--stop-name", "right"], capsys
+    )
+    assert res["stop"] == "right" and res["value"] == pytest.approx(0.7107, abs=1e-3)
+    res = run_json(["graze-curve", *base, "--params", "omega,gap_right", "--range", "0.5,0.75",
+                    "--start-value", "1.0", "--stop-name", "right", "--max-step", "0.1"], capsys)  # fmt: skip
+    assert res["curve_params"] == ["omega", "gap_right"] and len(res["curve"]) > 2
+
+
+def test_pendulum_options_unchanged(capsys):
+    res = run_json(["graze", "--theta-hat", "40", "--eta-min", "0.4", "--eta-max", "0.6"], capsys)
+    assert [round(g["eta"], 4) for g in res["grazings"]] == [0.4451, 0.5473]
+    assert all(g["stop"] == "stop" and g["value"] == g["eta"] for g in res["grazings"])
+    res = run_json(["simulate", "--set", "theta_hat=30", "--transient", "10", "--periods", "2"], capsys)
+    assert res["params"]["theta_hat"] == pytest.approx(math.radians(30))
+
+
+def test_a_model_from_a_file(tmp_path, capsys):
+    path = tmp_path / "mine.py"
+    path.write_text(
+        "import sympy as sp\n"
+        "from grazing import HybridModel, Parameter, Stop\n"
+        "def build():\n"
+        "    x, v, t, w = sp.symbols('x v t w')\n"
+        "    return HybridModel('mine', [x, v], t, [Parameter('w', 1.3, lower=0, lower_open=True)],\n"
+        "        vector_field=[v, -0.1 * v - x + sp.cos(w * t)], period=2 * sp.pi / w,\n"
+        "        stops=[Stop('top', 1 - x, [x, -0.8 * v]), Stop('bottom', x + 1, [x, -0.8 * v])])\n"
+        "MODEL = build()\n"
+        "NOT_A_MODEL = 3\n"
+    )
+    res = run_json(["simulate", "--model", f"{path}:build", "--set", "w=1.1", "--periods", "3"], capsys)
+    assert set(res["impacts_per_stop"]) == {"top", "bottom"} and res["params"] == {"w": 1.1}
+    res = run_json(["simulate", "--model", f"{path}:MODEL", "--periods", "2"], capsys)
+    assert res["params"] == {"w": 1.3}
+    for bad, msg in [
+        (f"{path}:NOPE", "defines no 'NOPE'"),
+        (f"{path}:NOT_A_MODEL", "is not a grazing.HybridModel"),
+        (f"{tmp_path / 'missing.py'}:M", "no such file"),
+    ]:
+        code, _, err = run(["simulate", "--model", bad], capsys)
+        assert code != 0 and msg in err and err.count("\n") == 1
+
+
+@pytest.mark.parametrize(
+    "argv, msg",
+    [
+        (["simulate", "--model", "nope"], "unknown model 'nope'"),
+        (["simulate", *TWO, "--set", "zeta"], "expected NAME=VALUE"),
+        (["simulate", *TWO, "--set", "eta=1"], "unknown parameter 'eta'"),
+        (["simulate", *TWO, "--set", "r=2"], "r = 2 is outside [0, 1]"),
+        (["simulate", *TWO, "--set", "r=abc"], "is not a number"),
+        (
+            ["simulate", *TWO, "--initial", "1,2,3"],
+            "--initial must be X,V, got '1,2,3' (model two-sided-oscillator has 2 states)",
+        ),
+        (["simulate", *TWO, "--initial", "5,0"], "beyond stop 'right'"),
+        (["simulate", *TWO, "--eta", "0.5"], "--eta is not used with a model other than the pendulum"),
+        (
+            ["graze", *TWO, "--param", "omega", "--range", "0.5,0.9", "--stop-name", "middle"],
+            "unknown stop 'middle'",
+        ),
+        (["graze", *TWO, "--param", "nope", "--range", "0.5,0.9"], "unknown parameter 'nope'"),
+        (["graze", *TWO], "graze needs --param NAME and --range LO,HI"),
+        (
+            ["sweep", *TWO, "--param", "nope", "--start", "0", "--stop", "1", "--num", "2"],
+            "unknown parameter",
+        ),
+    ],
+)
+def test_bad_model_input_is_one_line(argv, msg, capsys):
+    code, _, err = run(argv, capsys)
+    assert code != 0 and msg in err and err.count("\n") == 1, err

@@ -1,0 +1,172 @@
+"""Models with several stops and more degrees of freedom (issue 13).
+
+Closed forms of the two-sided oscillator below grazing (amplitude, Floquet
+multipliers, grazing frequencies of each stop), the determinant of the
+monodromy of an orbit hitting both stops, agreement with scipy's event loop
+with one terminal event per stop, the pendulum's back face, and a property
+test: no trajectory of a model with one, two or three stops passes through a
+stop, and no impact adds energy.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import sympy as sp
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import grazing
+from grazing.models import impact_damper, impact_oscillator, pendulum, two_sided_oscillator
+from grazing.orbits import find_grazings, find_orbit
+from tests.engine.reference import assert_agrees
+
+
+def linear_amplitude(m: grazing.HybridModel) -> float:
+    p = m.params
+    w, z = p["omega"], p["zeta"]
+    return p["amp"] / math.hypot(1 - w * w, 2 * z * w)
+
+
+def test_two_sided_nonimpacting_orbit_matches_the_linear_response() -> None:
+    m = two_sided_oscillator(omega=0.5, amp=0.5)
+    orbit = find_orbit(m, period=1, tol=1e-13)
+    assert orbit.impacts == 0
+    x, v = orbit.state  # x = A cos(phi), v = A omega sin(phi) at t = 0
+    assert math.hypot(x, v / 0.5) == pytest.approx(linear_amplitude(m), abs=1e-10)
+    T, z = m.period, m.params["zeta"]
+    expected = np.exp(T * (-z + 1j * math.sqrt(1 - z * z) * np.array([1, -1])))
+    np.testing.assert_allclose(np.sort_complex(orbit.multipliers), np.sort_complex(expected), atol=1e-10)
+
+
+@pytest.mark.parametrize("stop, gap", [("right", 1.0), ("left", 1.5)])
+def test_grazing_frequency_of_each_stop_is_the_closed_form(stop: str, gap: float) -> None:
+    """The linear amplitude amp/|1 - w^2 + 2 i zeta w| reaches the stop's gap (below resonance)."""
+    m = two_sided_oscillator(amp=0.5, gap_right=1.0, gap_left=1.5)
+    points, _ = find_grazings(m, "omega", 0.5, 0.9, stop_name=stop)
+    assert len(points) == 1 and points[0].stop_name == stop
+    z, a = m.params["zeta"], m.params["amp"]
+    # (1 - u)^2 + 4 zeta^2 u = (a / gap)^2 with u = omega^2, the root below resonance
+    b = 2 - 4 * z * z
+    u = (b - math.sqrt(b * b - 4 * (1 - (a / gap) ** 2))) / 2
+    assert points[0].model.params["omega"] == pytest.approx(math.sqrt(u), abs=1e-8)
+
+
+def test_orbit_hitting_both_stops_monodromy() -> None:
+    """det(monodromy) = r^(2k) exp(-2 zeta T) for k impacts; the monodromy against finite differences."""
+    m = two_sided_oscillator()
+    orbit = find_orbit(m, period=1)
+    assert orbit.impacts == 2 and sorted(orbit.impact_stops.tolist()) == [0, 1]
+    r, z, T = m.params["r"], m.params["zeta"], m.period
+    assert np.linalg.det(orbit.monodromy) == pytest.approx(r**4 * math.exp(-2 * z * T), rel=1e-9)
+    fd = np.zeros((2, 2))
+    for j in range(2):
+        e = np.zeros(2)
+        e[j] = 1e-6
+        up = grazing.simulate(m, orbit.state + e, t0=orbit.t0, periods=1, phase=0.0).x_final
+        dn = grazing.simulate(m, orbit.state - e, t0=orbit.t0, periods=1, phase=0.0).x_final
+        fd[:, j] = (up - dn) / 2e-6
+    np.testing.assert_allclose(orbit.monodromy, fd, atol=1e-6)
+
+
+def test_two_stops_agree_with_scipy() -> None:
+    ref = assert_agrees(two_sided_oscillator(), [0.0, 0.0], periods=200)
+    assert set(ref.impacts_stop.tolist()) == {0, 1}
+
+
+def test_impact_damper_agrees_with_scipy_on_its_periodic_attractor() -> None:
+    m = impact_damper()
+    settled = grazing.simulate(m, [0.0, 0.0, 0.0, 0.0], transient=600, periods=1)
+    ref = assert_agrees(m, settled.x_final, t0=settled.t_final, periods=100)
+    assert set(ref.impacts_stop.tolist()) == {0, 1}
+
+
+def test_impact_damper_jacobian_orbit_and_grazing() -> None:
+    """4 states: the Jacobian across impacts, a periodic orbit with its multipliers, a grazing point."""
+    m = impact_damper()
+    x0 = grazing.simulate(m, [0.0, 0.0, 0.0, 0.0], transient=300, periods=1).x_final
+    sol = grazing.simulate(m, x0, periods=3, jacobian=True)
+    assert sol.n_impacts >= 4
+    fd = np.zeros((4, 4))
+    for j in range(4):
+        e = np.zeros(4)
+        e[j] = 1e-6
+        fd[:, j] = (
+            grazing.simulate(m, x0 + e, periods=3).x_final - grazing.simulate(m, x0 - e, periods=3).x_final
+        ) / 2e-6
+    np.testing.assert_allclose(sol.jacobian, fd, atol=1e-5 * max(1.0, np.abs(fd).max()))
+    orbit = find_orbit(m, x0, period=1)
+    assert orbit.impacts == 2 and orbit.stable
+    assert np.linalg.det(orbit.monodromy) != 0
+    # With a spring on the secondary mass the nonimpacting orbit is hyperbolic and grazes the walls.
+    tuned = impact_damper(omega2=0.8, amp=0.3, omega=0.6)
+    points, _ = find_grazings(tuned, "gap", 5.0, 0.05, stop_name="right")
+    assert points, "no grazing of the right wall found"
+    g = points[0]
+    assert abs(g.model.guard(g.contact, g.t_graze, "right")) < 1e-9 and g.stop_name == "right"
+
+
+def test_pendulum_rotating_over_the_top_hits_the_back_face() -> None:
+    m = pendulum("B", eta=0.446, theta_hat=math.radians(40))
+    sol = grazing.simulate(m, [0.0, -8.0], periods=3, impacts="all", trajectory=200)
+    per = sol.impacts.per_stop()
+    assert per["back"] >= 1
+    assert np.all(sol.trajectory[:, 0] >= m.params["theta_hat"] - 2 * math.pi - 1e-9)
+    assert_agrees(m, [0.0, -8.0], periods=2)  # (it chatters onto the front face in the third period)
+
+
+# -- nothing passes through a stop, no impact adds energy: one, two and three stops --------------
+
+
+def _three_stops() -> grazing.HybridModel:
+    """The impact damper with a third stop: a rigid wall for the primary mass at x1 = wall."""
+    x1, v1, x2, v2, t = sp.symbols("x1 v1 x2 v2 t")
+    zeta, amp, omega, mu, gap, r, wall = sp.symbols("zeta amp omega mu gap r wall")
+    dv = v2 - v1
+    rattle = [x1, v1 + mu * (1 + r) / (1 + mu) * dv, x2, v2 - (1 + r) / (1 + mu) * dv]
+    P = grazing.Parameter
+    return grazing.HybridModel(
+        "three-stops", [x1, v1, x2, v2], t,
+        [P("zeta", 0.05, lower=0), P("amp", 1.0), P("omega", 1.2, lower=0, lower_open=True),
+         P("mu", 0.1, lower=0, lower_open=True), P("gap", 2.0, lower=0, lower_open=True),
+         P("r", 0.6, lower=0, upper=1), P("wall", 1.5, lower=0, lower_open=True)],
+        vector_field=[v1, -2 * zeta * v1 - x1 + amp * sp.cos(omega * t), v2, 0],
+        period=2 * sp.pi / omega,
+        stops=[grazing.Stop("right", gap - (x2 - x1), rattle, [0, mu, 0, -1]),
+               grazing.Stop("left", gap + (x2 - x1), rattle, [0, mu, 0, -1]),
+               grazing.Stop("wall", wall - x1, [x1, -r * v1, x2, v2], [0, 1, 0, 0])],
+    )  # fmt: skip
+
+
+MODELS = {"one": impact_oscillator, "two": two_sided_oscillator, "three": _three_stops}
+
+
+def _energy(model: grazing.HybridModel, x: np.ndarray) -> float:
+    """Kinetic energy (the resets change velocities only)."""
+    if model.n_states == 2:
+        return 0.5 * x[1] ** 2
+    return 0.5 * (x[1] ** 2 + model.params["mu"] * x[3] ** 2)
+
+
+@settings(max_examples=12, deadline=None)
+@given(
+    which=st.sampled_from(sorted(MODELS)),
+    omega=st.floats(0.5, 2.0),
+    r=st.floats(0.3, 0.95),
+    start=st.floats(-0.9, 0.9),
+    speed=st.floats(-3.0, 3.0),
+)
+def test_nothing_passes_through_a_stop(which, omega, r, start, speed) -> None:
+    base = MODELS[which]()
+    m = base.with_params(omega=omega, r=r)
+    n = m.n_states
+    x0 = np.zeros(n)
+    x0[0], x0[1] = start * 0.09 if which == "one" else start, speed
+    sol = grazing.simulate(m, x0, periods=20, impacts="all", trajectory=40)
+    for j in range(m.n_stops):
+        h = np.array([m.guard(x, t, j) for x, t in zip(sol.trajectory, sol.trajectory_t)])
+        assert h.min() >= -1e-9, f"{m.name}: through stop {m.stop_names[j]} (h = {h.min():.3g})"
+    for x, t, j in zip(sol.impacts.state, sol.impacts.t, sol.impacts.stop):
+        assert _energy(m, m.reset(x, t, j)) <= _energy(m, x) * (1 + 1e-12) + 1e-15
