@@ -158,3 +158,44 @@ def test_a_model_from_a_file(tmp_path, capsys):
 def test_bad_model_input_is_one_line(argv, msg, capsys):
     code, _, err = run(argv, capsys)
     assert code != 0 and msg in err and err.count("\n") == 1, err
+
+
+# Every command on every built-in model (slow: each model compiles its tangent kernels).
+MODEL_ARGS = {
+    "two-sided-oscillator": (["--set", "amp=0.5"], "omega", "0.5,0.9", "r", "0.4,0.9"),
+    "impact-oscillator": (["--set", "sigma=0.5"], "omega", "1.5,2.5", "r", "0.5,0.9"),
+    "bouncing-ball": (["--set", "amplitude=1.3"], "omega", "0.9,1.1", "r", "0.3,0.6"),
+    "impact-damper": (
+        ["--set", "omega2=0.8", "--set", "amp=0.3", "--set", "omega=0.6"],
+        "gap",
+        "0.3,5",
+        "r",
+        "0.3,0.7",
+    ),
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("model", sorted(MODEL_ARGS))
+@pytest.mark.parametrize("command", ["sweep", "map", "continue", "graze", "normal-form", "graze-curve"])
+def test_every_command_on_every_model(model, command, capsys):
+    sets, p1, r1, p2, r2 = MODEL_ARGS[model]
+    lo1, hi1 = r1.split(",")
+    lo2, hi2 = r2.split(",")
+    base = [command, "--model", model, *sets]
+    argv = {
+        "sweep": [*base, "--param", p1, "--start", lo1, "--stop", hi1, "--num", "4", "--transient", "50",
+                  "--periods", "8", "--workers", "1"],
+        "map": [*base, "--param1", p1, "--start1", lo1, "--stop1", hi1, "--num1", "2", "--param2", p2,
+                "--start2", lo2, "--stop2", hi2, "--num2", "2", "--transient", "30", "--periods", "8",
+                "--workers", "1"],
+        "continue": [*base, "--param", p1, "--start", lo1, "--stop", hi1],
+        "graze": [*base, "--param", p1, "--range", r1],
+        "normal-form": [*base, "--param", p1, "--range", r1],
+        "graze-curve": [*base, "--params", f"{p1},{p2}", "--range", r1, "--start-value", lo2],
+    }[command]  # fmt: skip
+    code, out, err = run([*argv, "--json"], capsys)
+    # A result, or one line saying why there is none (no grazing in the range, the orbit sticks ...)
+    assert (code == 0 and json.loads(out)) or (
+        code == 1 and err.startswith("grazing: error:") and err.count("\n") == 1
+    ), err

@@ -170,3 +170,26 @@ def test_nothing_passes_through_a_stop(which, omega, r, start, speed) -> None:
         assert h.min() >= -1e-9, f"{m.name}: through stop {m.stop_names[j]} (h = {h.min():.3g})"
     for x, t, j in zip(sol.impacts.state, sol.impacts.t, sol.impacts.stop):
         assert _energy(m, m.reset(x, t, j)) <= _energy(m, x) * (1 + 1e-12) + 1e-15
+
+
+def test_sticks_on_either_stop_and_releases_where_the_force_vanishes() -> None:
+    """Slow strong forcing: the mass chatters onto one stop, sticks, is released, crosses to the other.
+
+    On the right stop (x = 1, v = 0) the contact force vanishes when amp cos(omega t) = 1, on
+    the left (x = -1) when amp cos(omega t) = -1: every sticking interval ends at one of those
+    phases, and the motion sticks on both stops.
+    """
+    amp, w = 3.0, 0.2
+    m = two_sided_oscillator(amp=amp, omega=w, r=0.3)
+    sol = grazing.simulate(m, [0.0, 0.0], transient=2, periods=3, impacts="sampled")
+    assert len(sol.sticking) >= 4
+    per = sol.impacts.per_stop()
+    assert per["right"] > 0 and per["left"] > 0
+    T = m.period
+    release = {"right": math.acos(1 / amp) / w, "left": (2 * math.pi - math.acos(-1 / amp)) / w}
+    for _, end in sol.sticking:
+        if abs(end - sol.t_final) < 1e-9:
+            continue  # still sticking when the run ends
+        phase = end % T
+        dist = min(min(abs(phase - r), T - abs(phase - r)) for r in release.values())
+        assert dist < 1e-9, f"a sticking interval ends at phase {phase}, not where the force vanishes"

@@ -147,6 +147,21 @@ def test_zarr_store_roundtrip_and_mismatch(tmp_path):
         ZarrStore(path, _spec(transient=300))
 
 
+def test_a_store_of_another_layout_is_refused_not_rewritten(tmp_path, monkeypatch):
+    """A store written before impacts were counted per stop is another sweep: one line, left as it is."""
+    from grazing.sweeps import run_sweep
+    from grazing.sweeps import spec as spec_module
+
+    monkeypatch.setattr(spec_module, "STORE_LAYOUT", 1)
+    path = tmp_path / "old.zarr"
+    run_sweep(_spec(), store=ZarrStore(path, _spec()), workers=1)
+    before = sorted((p.relative_to(path), p.stat().st_mtime_ns) for p in path.rglob("*"))
+    monkeypatch.setattr(spec_module, "STORE_LAYOUT", 2)
+    with pytest.raises(StoreMismatchError, match=r"store_layout \(1 in the store, 2 now\)"):
+        ZarrStore(path, _spec())
+    assert sorted((p.relative_to(path), p.stat().st_mtime_ns) for p in path.rglob("*")) == before
+
+
 def _sweep_cmd(out: Path) -> list[str]:
     # enough work per chunk (~0.1 s) that the kill lands mid-sweep
     args = "sweep --param eta --start 0.44 --stop 0.49 --num 60 --chunk-size 5 --workers 1"

@@ -142,13 +142,21 @@ class SweepSpec:
             "tol": self.tol,
             "shape": list(self.shape),
             "method": "map" if self.zdm is not None else "flow",
-            "zdm": None if self.zdm is None else [self.zdm.phase, self.zdm.accel, list(self.zdm.direction)],
+            "zdm": None
+            if self.zdm is None
+            else [self.zdm.phase, self.zdm.accel, list(self.zdm.direction), self.zdm.stop],
+            "stops": list(self.model.stop_names),
+            "store_layout": STORE_LAYOUT,
             "grazing_version": grazing.__version__,
         }
         return d
 
     def fingerprint(self) -> str:
         return hashlib.sha256(json.dumps(self.description(), sort_keys=True).encode()).hexdigest()[:16]
+
+
+STORE_LAYOUT = 2
+"""The version of what a store holds (2: impacts on each stop); a store of another layout is another sweep."""
 
 
 @dataclass
