@@ -156,6 +156,7 @@ class Results:
     process_others: float = math.nan
     one_off: dict[str, float] = field(default_factory=dict)
     grazing_periods: list[int] = field(default_factory=list)
+    peer: dict[str, Any] = field(default_factory=dict)  # the equal-work comparison with heyoka's batch mode
 
 
 def detect_period(samples: np.ndarray, tol: float = PERIOD_TOL, max_period: int = MAX_PERIOD) -> int:
@@ -396,6 +397,66 @@ def time_process(res: Results, n: int, quiet: float) -> None:
     )
 
 
+# ----------------------------------------------------------------------------- the expert peer
+
+PEER = Path(__file__).with_name("heyoka_batch_sweep.py")
+"""heyoka.py batch mode, as an expert writes a sweep (issue 15): one SIMD lane per η value."""
+
+EQUAL_WORK = ["--fresh", "--no-lyapunov", "--no-adaptive", "--tol", str(SWEEP_TOL)]
+"""grazing's options for the peer's work: every point from rest, full transients, no Lyapunov exponents."""
+
+
+def peer_commands(n: int, processes: int) -> tuple[list[str], list[str]]:
+    """The two whole-process commands of the equal-work comparison (ours, heyoka batch)."""
+    ours = [*cli_command(n), *EQUAL_WORK, "--workers", str(processes)]
+    theirs = [sys.executable, str(PEER), "--start", str(ETA_START), "--stop", str(ETA_STOP), "--num", str(n),
+              "--transient", str(TRANSIENT), "--periods", str(PERIODS), "--tol", str(SWEEP_TOL),
+              "--processes", str(processes), "--json"]  # fmt: skip
+    return ours, theirs
+
+
+def time_peer(res: Results, n: int, quiet: float) -> None:
+    """Equal work, whole processes, side by side: grazing's sweep and heyoka's batch-mode program."""
+    import json as json_
+
+    processes = os.cpu_count() or 1
+    ours_cmd, peer_cmd = peer_commands(n, processes)
+    log(f"equal work vs heyoka batch mode: {n} points, {processes} processes, best of {PROCESS_REPEATS} ...")
+    out = {}
+    for key, cmd in (("grazing", ours_cmd), ("heyoka-batch", peer_cmd)):
+        text = subprocess.run(
+            cmd, check=True, capture_output=True, text=True
+        ).stdout  # warm-up, and the periods
+        out[key] = json_.loads(text)["period"]
+    t_ours, o_ours = best_command(ours_cmd, PROCESS_REPEATS, quiet, stdout=subprocess.DEVNULL)
+    t_peer, o_peer = best_command(peer_cmd, PROCESS_REPEATS, quiet, stdout=subprocess.DEVNULL)
+    agree = sum(a == b for a, b in zip(out["grazing"], out["heyoka-batch"]))
+    import heyoka as hy_
+
+    res.peer = {
+        "points": n, "processes": processes, "lanes": hy_.recommended_simd_size(),
+        "grazing_s": t_ours, "grazing_others": o_ours, "heyoka_batch_s": t_peer,
+        "heyoka_batch_others": o_peer, "speedup": t_peer / t_ours, "periods_agree": agree,
+        "grazing_command": " ".join(ours_cmd[1:]), "heyoka_command": " ".join([PEER.name, *peer_cmd[2:]]),
+    }  # fmt: skip
+
+
+def peer_lines(res: Results) -> list[str]:
+    p = res.peer
+    if not p:
+        return []
+    return [
+        f"Equal work (every point from rest, {TRANSIENT} + {PERIODS} periods, tol {SWEEP_TOL:g}, "
+        "no Lyapunov), "
+        f"{p['points']} points, {p['processes']} processes, whole process (best of {PROCESS_REPEATS}):",
+        f"  grazing sweep {' '.join(EQUAL_WORK)}: {p['grazing_s']:.2f} s",
+        f"  heyoka.py batch mode ({p['lanes']} SIMD lanes per process, benchmarks/{PEER.name}): "
+        f"{p['heyoka_batch_s']:.2f} s",
+        f"  grazing is {p['speedup']:.2f}x as fast (issue 15's target: >= 1.5x); periods agree at "
+        f"{p['periods_agree']} of {p['points']} points",
+    ]
+
+
 # ----------------------------------------------------------------------------- agreement
 
 
@@ -495,6 +556,8 @@ def print_table(res: Results) -> None:
     per = np.array(res.grazing_periods)
     vals, counts = np.unique(per, return_counts=True)
     print("\nPeriods in the default sweep: " + ", ".join(f"{v}: {c}" for v, c in zip(vals, counts)))
+    for line in peer_lines(res):
+        print(line)
     for key in ("grazing-plain", "heyoka-t", "heyoka-t-1e-10", "heyoka-3d", "scipy"):
         d = disagreements(res, key)
         at_chunk = sum(j % CHUNK == 0 for j, _, _ in d)
@@ -552,6 +615,7 @@ def markdown(res: Results) -> str:
         + f". Whole process: best of {PROCESS_REPEATS}, imports and kernel load included. Before each "
         f"run, up to {res.settings['quiet_wait_s']:g} s of waiting for other processes to go quiet. "
         "Other load: cores kept busy by other processes during the (best) run, from /proc/stat.",
+        *(f"- {line.strip()}" for line in peer_lines(res)),
         "- Targets (issue 4, not asserted):",
         *(f"  - {line}" for line in targets(res)),
         f"- Machine: {versions_line(res.machine)}.",
@@ -590,6 +654,7 @@ def to_json(res: Results) -> dict[str, Any]:
         "process_seconds": res.process_seconds,
         "process_others": res.process_others,
         "one_off_seconds": res.one_off,
+        "heyoka_batch_peer": res.peer,
         "targets": targets(res),
     }
 
@@ -605,6 +670,7 @@ def main(argv: list[str] | None = None) -> int:
     time_heyoka(res, etas, args.quiet_wait)
     time_scipy(res, etas, x_final, args.quiet_wait)
     time_process(res, n, args.quiet_wait)
+    time_peer(res, n, args.quiet_wait)
     fill_agreement(res)
     res.machine["loadavg_end"] = loadavg()
     emit(args, lambda: print_table(res), lambda: markdown(res), lambda: to_json(res))
