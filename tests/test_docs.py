@@ -1,4 +1,8 @@
-"""Every Python example in the README and docs/ runs."""
+"""Every Python example in the README and docs/ runs.
+
+An example preceded by the line ``<!-- slow -->`` (it compiles kernels no other test needs)
+runs in the slow suite (``make test-all``).
+"""
 
 from __future__ import annotations
 
@@ -9,13 +13,14 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 DOCS = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
-BLOCK = re.compile(r"```python\n(.*?)```", re.S)
+BLOCK = re.compile(r"(<!-- slow -->\n)?```python\n(.*?)```", re.S)
 
 
 def _blocks():
     for path in DOCS:
-        for i, code in enumerate(BLOCK.findall(path.read_text())):
-            yield pytest.param(code, id=f"{path.name}-{i}")
+        for i, (slow, code) in enumerate(BLOCK.findall(path.read_text())):
+            marks = [pytest.mark.slow] if slow else []
+            yield pytest.param(code, id=f"{path.name}-{i}", marks=marks)
 
 
 @pytest.mark.parametrize("code", list(_blocks()))

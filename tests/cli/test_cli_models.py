@@ -47,10 +47,10 @@ def test_simulate_pendulum_json_lists_both_faces(capsys):
 @pytest.mark.parametrize(
     "model, initial",
     [
-        ("impact-oscillator", "0,0"),
-        ("bouncing-ball", "0.5,0"),
-        ("impact-damper", "0,0,0,0"),
         ("two-sided-oscillator", "0,0"),
+        pytest.param("impact-oscillator", "0,0", marks=pytest.mark.slow),
+        pytest.param("bouncing-ball", "0.5,0", marks=pytest.mark.slow),
+        pytest.param("impact-damper", "0,0,0,0", marks=pytest.mark.slow),
     ],
 )
 def test_simulate_and_orbit_every_built_in_model(model, initial, capsys):

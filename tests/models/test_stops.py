@@ -83,6 +83,7 @@ def test_impact_damper_agrees_with_scipy_on_its_periodic_attractor() -> None:
     assert set(ref.impacts_stop.tolist()) == {0, 1}
 
 
+@pytest.mark.slow
 def test_impact_damper_jacobian_orbit_and_grazing() -> None:
     """4 states: the Jacobian across impacts, a periodic orbit with its multipliers, a grazing point."""
     m = impact_damper()
