@@ -24,13 +24,17 @@ check-report: $(STAMP)
 	test -f report/index.html || $(MAKE) reproduce
 	$(BIN)/python -m grazing.report.browser report/index.html
 
+# The tests run on every core (pytest-xdist), each test file on one worker: kernel compilation,
+# most of a cold run, then proceeds in parallel.
+PYTEST_PARALLEL = -n auto --dist loadfile
+
 test: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks
-	$(BIN)/python -m pytest -m "not slow"
+	$(BIN)/python -m pytest -m "not slow" $(PYTEST_PARALLEL)
 
 test-all: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks
-	$(BIN)/python -m pytest
+	$(BIN)/python -m pytest $(PYTEST_PARALLEL)
 
 bench: $(STAMP)
 	$(BIN)/python -m pip install --quiet -e ".[test,bench]"
