@@ -236,9 +236,11 @@ def model_params_json(model: grazing.HybridModel, case: str) -> dict[str, Any]:
     return p
 
 
-def parse_state(text: str, model: grazing.HybridModel) -> np.ndarray:
-    """``--initial``: one comma-separated number per state of the model."""
+def parse_state(text: str | None, model: grazing.HybridModel) -> np.ndarray:
+    """``--initial``: one number per state, comma-separated (default: zero), inside every stop."""
     n = model.n_states
+    if text is None:
+        return np.zeros(n)
     form = "THETA,THETADOT in radians" if model.name == "pendulum" else ",".join(model.state_names).upper()
     try:
         values = np.array([float(t) for t in text.split(",")])
@@ -250,7 +252,43 @@ def parse_state(text: str, model: grazing.HybridModel) -> np.ndarray:
         ) from None
     if not np.all(np.isfinite(values)):
         raise InputError(f"--initial must be finite numbers, got {text!r}")
+    if model.name == "pendulum" and values[0] > model.params["theta_hat"]:
+        th = model.params["theta_hat"]
+        raise InputError(
+            f"initial angle {values[0]:g} rad is beyond the stop at theta-hat = {math.degrees(th):g} deg "
+            f"({th:.6g} rad)"
+        )
+    try:
+        model.check_state(values)
+    except grazing.InvalidStateError as exc:
+        raise InputError(f"--initial: {exc}") from None
     return values
+
+
+def search_range(
+    model: grazing.HybridModel, command: str, gparam: str | None, prange: str | None, eta_min: float,
+    eta_max: float,
+) -> tuple[grazing.Parameter, float, float, bool]:  # fmt: skip
+    """The parameter and interval a grazing search runs over: ``(parameter, lo, hi, pendulum_default)``.
+
+    ``--param NAME --range LO,HI`` (display units), or for the pendulum by default eta in
+    ``[--eta-min, --eta-max]`` (``pendulum_default`` then True).
+    """
+    if gparam is None and prange is None and model.name == "pendulum":
+        refuse_unused(["eta"], True, f"by {command}: it searches eta in [--eta-min, --eta-max]")
+        check_eta_range(eta_min, eta_max)
+        return model.parameter("eta"), eta_min, eta_max, True
+    refuse_unused(["eta_min", "eta_max"], True, "with --param/--range (use --range LO,HI)")
+    if gparam is None or prange is None:
+        raise InputError(f"{command} needs --param NAME and --range LO,HI (for this model)")
+    par = model_parameter(model, gparam)
+    refuse_unused([par.name], True, f"by {command}: it searches --param over --range")
+    lo, hi = (par.from_display(v) for v in parse_pair(prange, "--range", "LO,HI"))
+    if not lo < hi:
+        raise InputError(f"--range: LO must be below HI, got {prange}")
+    for v in (lo, hi):
+        model.with_params(**{par.name: v})  # both ends inside the parameter's interval
+    return par, lo, hi, False
 
 
 def parse_pair(

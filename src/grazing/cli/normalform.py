@@ -10,18 +10,16 @@ import numpy as np
 import grazing
 from grazing.cli.common import (
     PENDULUM_UNFOLDING,
-    check_eta_range,
     complex_list,
     emit_json,
     json_option,
     model_options,
-    model_parameter,
     model_params_json,
-    parse_pair,
+    search_range,
     stop_name_option,
     stop_option_index,
 )
-from grazing.cli.validate import POSITIVE, InputError, refuse_unused
+from grazing.cli.validate import POSITIVE
 
 
 @click.command("normal-form")
@@ -59,22 +57,7 @@ def normal_form_cmd(
     from grazing.normalform import find_grazing_point, normal_form_at, observe, predict
 
     stop = stop_option_index(model, stop_name)
-    pendulum = gparam is None and prange is None and model.name == "pendulum"
-    if pendulum:
-        refuse_unused(["eta"], True, "by normal-form: it searches eta in [--eta-min, --eta-max]")
-        check_eta_range(eta_min, eta_max)
-        par, lo, hi = model.parameter("eta"), eta_min, eta_max
-    else:
-        refuse_unused(["eta_min", "eta_max"], True, "with --param/--range (use --range LO,HI)")
-        if gparam is None or prange is None:
-            raise InputError("normal-form needs --param NAME and --range LO,HI (for this model)")
-        par = model_parameter(model, gparam)
-        refuse_unused([par.name], True, "by normal-form: it searches --param over --range")
-        lo, hi = (par.from_display(v) for v in parse_pair(prange, "--range", "LO,HI"))
-        if not lo < hi:
-            raise InputError(f"--range: LO must be below HI, got {prange}")
-        for v in (lo, hi):
-            model.with_params(**{par.name: v})
+    par, lo, hi, pendulum = search_range(model, "normal-form", gparam, prange, eta_min, eta_max)
     point = find_grazing_point(model, par.name, lo, hi, which, stop_name=stop)
     nf = normal_form_at(point, PENDULUM_UNFOLDING if pendulum else (par.name,))
     pred = predict(nf, par.name)

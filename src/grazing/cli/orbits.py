@@ -25,6 +25,7 @@ from grazing.cli.common import (
     parse_pair,
     parse_state,
     save_dataset,
+    search_range,
     stop_name_option,
     stop_option_index,
 )
@@ -52,21 +53,6 @@ def _orbit_json(orbit: Any) -> dict[str, Any]:
     return out
 
 
-def _initial_state(model: grazing.HybridModel, initial: str) -> np.ndarray:
-    """``--initial`` for a model: one number per state, inside every stop."""
-    x0 = parse_state(initial, model)
-    if model.name == "pendulum" and x0[0] > model.params["theta_hat"]:
-        raise InputError(
-            f"initial angle {x0[0]:g} rad is beyond the stop at theta-hat = "
-            f"{math.degrees(model.params['theta_hat']):g} deg"
-        )
-    try:
-        model.check_state(x0)
-    except grazing.InvalidStateError as exc:
-        raise InputError(f"--initial: {exc}") from None
-    return x0
-
-
 @click.command()
 @model_options(any_model=True)
 @click.option("--period", type=ORBIT_PERIOD, help="Period in forcing periods (default: detected).")
@@ -90,7 +76,7 @@ def orbit(
     from grazing.orbits import find_orbit
 
     refuse_unused(["transient"], initial is not None, "with --initial (it runs the simulation that guesses)")
-    x0 = _initial_state(model, initial) if initial is not None else None
+    x0 = parse_state(initial, model) if initial is not None else None
     orb = find_orbit(model, x0, period=period, transient=transient)
     res = {"params": model_params_json(model, case), **_orbit_json(orb)}
     if as_json:
@@ -160,21 +146,7 @@ def graze(
     from grazing.orbits import find_grazings
 
     stop = stop_option_index(model, stop_name)
-    if gparam is None and prange is None and model.name == "pendulum":
-        refuse_unused(["eta"], True, "by graze: it searches eta in [--eta-min, --eta-max]")
-        check_eta_range(eta_min, eta_max)
-        par, lo, hi = model.parameter("eta"), eta_min, eta_max
-    else:
-        refuse_unused(["eta_min", "eta_max"], True, "with --param/--range (use --range LO,HI)")
-        if gparam is None or prange is None:
-            raise InputError("graze needs --param NAME and --range LO,HI (for this model)")
-        par = model_parameter(model, gparam)
-        refuse_unused([par.name], True, "by graze: it searches --param over --range")
-        lo, hi = (par.from_display(v) for v in parse_pair(prange, "--range", "LO,HI"))
-        if not lo < hi:
-            raise InputError(f"--range: LO must be below HI, got {prange}")
-        for v in (lo, hi):
-            model.with_params(**{par.name: v})  # both ends inside the parameter's interval
+    par, lo, hi, _ = search_range(model, "graze", gparam, prange, eta_min, eta_max)
     bar = Progress("continuing", enabled=not as_json)
     try:
         points, branch = find_grazings(
@@ -360,7 +332,7 @@ def continue_(
             if not ANGLE_DEG.accepts(v):
                 raise InputError(f"{opt} for theta-hat must be {ANGLE_DEG.describe()}, got {v:g}")
     check_out(out, ".nc")
-    x0 = _initial_state(model.with_params(**{name: par.from_display(start)}), initial) if initial else None
+    x0 = parse_state(initial, model.with_params(**{name: par.from_display(start)})) if initial else None
     a, b = par.from_display(start), par.from_display(stop)
     for v in (a, b):  # both ends within the parameter's bounds, before any work ("r = 2 is outside [0, 1]")
         model.with_params(**{name: v})

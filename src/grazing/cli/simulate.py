@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import functools
-import math
 import time
 from pathlib import Path
 from typing import Any
@@ -13,7 +12,6 @@ import numpy as np
 
 import grazing
 from grazing.cli.common import (
-    InputError,
     Progress,
     check_out,
     emit_json,
@@ -55,16 +53,7 @@ def simulate(
 ) -> None:
     """Simulate a model (the pendulum by default); print stroboscopic samples, impacts, period."""
     refuse_unused(["points_per_period"], trajectory is None, "without --trajectory")
-    x0 = parse_state(initial, model) if initial is not None else np.zeros(model.n_states)
-    if model.name == "pendulum" and x0[0] > model.params["theta_hat"]:
-        raise InputError(
-            f"initial angle {x0[0]:g} rad is beyond the stop at theta-hat = "
-            f"{math.degrees(model.params['theta_hat']):g} deg ({model.params['theta_hat']:.6g} rad)"
-        )
-    try:
-        model.check_state(x0)
-    except grazing.InvalidStateError as exc:
-        raise InputError(f"--initial: {exc}") from None
+    x0 = parse_state(initial, model)
     check_out(trajectory, ".csv", "--trajectory")
     points = periods * points_per_period + 1 if trajectory is not None else 0
     check_memory(

@@ -160,16 +160,6 @@ def _run_sweep_spec(
     return _SweepRun(ds, period)
 
 
-def _initial(model: grazing.HybridModel, initial: str | None) -> np.ndarray:
-    """``--initial`` of a sweep: one number per state (default zero), inside every stop."""
-    x0 = parse_state(initial, model) if initial is not None else np.zeros(model.n_states)
-    try:
-        model.check_state(x0)
-    except grazing.InvalidStateError as exc:
-        raise InputError(f"--initial: {exc}") from None
-    return x0
-
-
 def _sweep_json(ds: Any, param: str, values: np.ndarray) -> dict[str, Any]:
     return {
         "param": param,
@@ -233,7 +223,7 @@ def sweep_cmd(
     shown = np.linspace(start, stop, num)
     vals = np.array([par.from_display(v) for v in shown])
     order = np.sort(vals) if direction == "up" else np.sort(vals)[::-1]
-    x0 = _initial(model, initial)
+    x0 = parse_state(initial, model)
     for v in (order[0], order[-1]):
         model.with_params(**{name: v})
     zdm, graze_info = None, None
@@ -326,7 +316,7 @@ def map_cmd(
     v1, v2 = np.sort(v1), np.sort(v2)
     for a, b in ((v1[0], v2[0]), (v1[-1], v2[-1])):
         model.with_params(**{n1: a, n2: b})
-    x0 = _initial(model, initial)
+    x0 = parse_state(initial, model)
     settings = SweepSettings(
         transient=transient, periods=periods, fresh=fresh, chunk_size=chunk_size, adaptive=not no_adaptive,
         lyapunov=not no_lyapunov, tol=tol,
