@@ -218,3 +218,19 @@ def test_neimark_sacker_is_located_for_the_forced_van_der_pol_oscillator():
     above = grazing.simulate(vdp.with_params(F=f_ns + 0.05), [0, 0], transient=1500, periods=100)
     below = grazing.simulate(vdp.with_params(F=f_ns - 0.05), [0, 0], transient=1500, periods=100)
     assert above.period() == 1 and below.period() == 0  # entrained vs quasi-periodic
+
+
+def test_an_impact_at_zero_speed_gives_no_jacobian_and_one_clear_error():
+    """The ball on a table moving 1.3 (ω = 0.9) meets the table at exactly zero speed: the saltation
+    matrix is unbounded there, so the Jacobian is marked invalid (it used to raise ZeroDivisionError
+    inside the compiled driver) and Newton's method says why it stops."""
+    from grazing.errors import ConvergenceError
+    from grazing.models import bouncing_ball
+    from grazing.orbits.shooting import initial_guess
+
+    m = bouncing_ball(amplitude=1.3, omega=0.9)
+    x, _ = initial_guess(m)
+    sol = grazing.simulate(m, x, periods=1, jacobian=True)
+    assert not sol.jacobian_valid
+    with pytest.raises(ConvergenceError, match="sticks to the stop"):
+        find_orbit(m, period=1)

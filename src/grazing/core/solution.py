@@ -123,7 +123,8 @@ class Solution:
         parameters, as extra columns), if requested.
     jacobian_valid
         False when the run stuck to the stop (the Jacobian across sticking is
-        not computed).
+        not computed) or met it at exactly zero normal speed (where the
+        saltation matrix is unbounded).
     lyapunov
         Lyapunov exponents per unit time over the sampled span, if requested.
     guard_min

@@ -310,9 +310,9 @@ def find_orbit(
             ) from None
         if not fm.solution.jacobian_valid:
             raise ConvergenceError(
-                f"the motion sticks to the stop during the period-{n} map (iterate {it}); the Jacobian "
-                "across sticking is not computed, so Newton's method and Floquet multipliers are not "
-                "available for it: simulate it instead"
+                f"the motion sticks to the stop (or meets it at zero speed) during the period-{n} map "
+                f"(iterate {it}); the Jacobian across sticking is not computed, so Newton's method and "
+                "Floquet multipliers are not available for it: simulate it instead"
             )
         F = fm.image - x
         res = float(np.max(np.abs(F)))

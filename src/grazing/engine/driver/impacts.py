@@ -18,7 +18,11 @@ from grazing.engine.stepping import append_record, append_row, pack_var, unpack_
 
 @njit(cache=True)
 def saltation(xm, xp, s, pv, j, V, ncol):
-    """Apply the saltation matrix of stop ``j`` (paper eq. 14, with time and parameter terms) to V."""
+    """Apply the saltation matrix of stop ``j`` (paper eq. 14, with time and parameter terms) to V.
+
+    Returns False, leaving V alone, for an impact at zero normal speed (``L_f h = 0``): there the
+    saltation matrix is unbounded and the flow's Jacobian does not exist.
+    """
     n = NX
     fm = np.empty(n)
     fp = np.empty(n)
@@ -35,6 +39,8 @@ def saltation(xm, xp, s, pv, j, V, ncol):
     den = ht
     for i in range(n):
         den += hx[i] * fm[i]
+    if den == 0.0:
+        return False
     w = np.empty(n)
     for i in range(n):
         acc = fp[i] - Gt[i]
@@ -62,6 +68,7 @@ def saltation(xm, xp, s, pv, j, V, ncol):
     for i in range(n):
         for c in range(ncol):
             V[i, c] = Vn[i, c]
+    return True
 
 
 @njit(cache=True)
@@ -98,8 +105,9 @@ def enter_contact(x, s, pv, j):
 def apply_impact(x, xp, s, t, pv, j, use_var, ncol, nrows, V, record, imp, n_rec, traj_on, traj, n_traj):
     """Reset the state on stop ``j`` (``x`` holds it) and its variational matrix; returns the speed.
 
-    Returns ``(speed, n_rec, n_traj)``: the approach speed ``-L_f h``, and
-    the impact and trajectory counters (the impact is recorded as
+    Returns ``(speed, n_rec, n_traj, jac_ok)``: the approach speed ``-L_f h``,
+    the impact and trajectory counters, and False when the variational matrix
+    could not be carried across (an impact at zero normal speed; the impact is recorded as
     ``[t, speed, state before, j]`` when ``record``; both states go into the
     trajectory when ``traj_on``).  Afterwards ``x`` holds the state after the
     reset.
@@ -109,8 +117,10 @@ def apply_impact(x, xp, s, t, pv, j, use_var, ncol, nrows, V, record, imp, n_rec
     reset(x, s, pv, xp, j)
     if use_var:
         unpack_var(x, n, ncol, V)
-        saltation(x, xp, s, pv, j, V, ncol)
+        jac_ok = saltation(x, xp, s, pv, j, V, ncol)
         pack_var(V, n, ncol, xp)
+    else:
+        jac_ok = True
     if record:
         append_record(imp, n_rec, t, -vn, x, n)
         imp[0][n_rec, 2 + n] = j
@@ -121,7 +131,7 @@ def apply_impact(x, xp, s, t, pv, j, use_var, ncol, nrows, V, record, imp, n_rec
         n_traj += 2
     for i in range(nrows):
         x[i] = xp[i]
-    return -vn, n_rec, n_traj
+    return -vn, n_rec, n_traj, jac_ok
 
 
 @njit(cache=True)

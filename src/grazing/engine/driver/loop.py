@@ -270,10 +270,11 @@ def integrate(start, pv, cfg):
                 # Impact: x holds the state on stop ev_stop, just before its reset.
                 record = record_impacts == 2 or (record_impacts == 1 and recording)
                 traj_on = recording and traj_dt > 0.0
-                speed, n_imp_rec, n_traj = apply_impact(
+                speed, n_imp_rec, n_traj, salt_ok = apply_impact(
                     x, xp, s, k * T + s, pv, ev_stop, use_var, ncol, nrows, V, record, imp, n_imp_rec,
                     traj_on, traj, n_traj,
                 )  # fmt: skip
+                jac_valid = jac_valid and salt_ok  # (an impact at zero normal speed has no Jacobian)
                 n_imp += 1
                 defl = 1
                 defl_stop = ev_stop
