@@ -21,3 +21,7 @@ class SimulationError(GrazingError, RuntimeError):
 
 class ConvergenceError(GrazingError, RuntimeError):
     """A Newton iteration did not converge."""
+
+
+class GrazingWarning(UserWarning):
+    """A result that was computed as asked but is not a motion of the system (the CLI prints it as a note)."""

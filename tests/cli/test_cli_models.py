@@ -69,6 +69,7 @@ def test_graze_sweep_continue_on_the_two_sided_oscillator(capsys):
     res = run_json(["graze", *base, "--param", "omega", "--range", "0.5,0.9", "--stop-name", "left"], capsys)
     (g,) = res["grazings"]
     assert g["stop"] == "left" and 0.8 < g["value"] < 0.85 and "eta" not in g
+    assert g["crossed"] == ["right"]  # that orbit passes through the right stop (gap 1 < 1.5)
     res = run_json(["sweep", *TWO, "--param", "omega", "--start", "0.7", "--stop", "0.9", "--num", "3",
                     "--transient", "50", "--periods", "8", "--workers", "1"], capsys)  # fmt: skip
     by_stop = res["impacts_per_period_by_stop"]
@@ -76,8 +77,7 @@ def test_graze_sweep_continue_on_the_two_sided_oscillator(capsys):
     assert by_stop["right"][1] == pytest.approx(1.0) and by_stop["left"][1] == pytest.approx(1.0)
     res = run_json(["continue", *base, "--param", "omega", "--start", "0.5", "--stop", "0.9", "--stop-name",
                     "right"], capsys)  # fmt: skip
-    kinds = [s["kind"] for s in res["special"]]
-    assert "grazing" in kinds
+    assert [(s["kind"], s["stop"]) for s in res["special"]] == [("grazing", "right"), ("grazing", "left")]
     res = run_json(["map", *TWO, "--param1", "omega", "--start1", "0.7", "--stop1", "0.9", "--num1", "2",
                     "--param2", "r", "--start2", "0.5", "--stop2", "0.8", "--num2", "2", "--transient", "30",
                     "--periods", "8", "--workers", "1"], capsys)  # fmt: skip

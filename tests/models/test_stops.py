@@ -44,9 +44,16 @@ def test_two_sided_nonimpacting_orbit_matches_the_linear_response() -> None:
 @pytest.mark.parametrize("stop, gap", [("right", 1.0), ("left", 1.5)])
 def test_grazing_frequency_of_each_stop_is_the_closed_form(stop: str, gap: float) -> None:
     """The linear amplitude amp/|1 - w^2 + 2 i zeta w| reaches the stop's gap (below resonance)."""
+    import warnings
+
     m = two_sided_oscillator(amp=0.5, gap_right=1.0, gap_left=1.5)
-    points, _ = find_grazings(m, "omega", 0.5, 0.9, stop_name=stop)
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        points, _ = find_grazings(m, "omega", 0.5, 0.9, stop_name=stop)
     assert len(points) == 1 and points[0].stop_name == stop
+    # the left grazing (amplitude 1.5) lies beyond the right one (1.0): that orbit passes through it
+    assert points[0].crossed == (() if stop == "right" else ("right",))
+    assert len(said) == (0 if stop == "right" else 1)
     z, a = m.params["zeta"], m.params["amp"]
     # (1 - u)^2 + 4 zeta^2 u = (a / gap)^2 with u = omega^2, the root below resonance
     b = 2 - 4 * z * z
@@ -194,3 +201,46 @@ def test_sticks_on_either_stop_and_releases_where_the_force_vanishes() -> None:
         phase = end % T
         dist = min(min(abs(phase - r), T - abs(phase - r)) for r in release.values())
         assert dist < 1e-9, f"a sticking interval ends at phase {phase}, not where the force vanishes"
+
+
+def test_nonimpacting_branch_reports_every_stops_grazing_and_what_it_passes_through() -> None:
+    """Right gap 1, left gap 1.5: the linear orbit touches the right stop first, then the left one.
+
+    The left grazing of the virtual (stops ignored) orbit lies beyond the right one, so that orbit
+    passes through the right stop: it is not a motion of the system, and find_grazings says so.
+    """
+    from grazing.errors import GrazingWarning
+    from grazing.orbits import continue_orbit
+
+    m = two_sided_oscillator(amp=0.5, gap_right=1.0, gap_left=1.5, omega=0.5)
+    branch = continue_orbit(m, "omega", 0.5, 0.9, period=1, virtual=True, detect=("grazing",))
+    found = [(m.stop_names[sp_.stop], sp_.grazing.stop_name, sp_.grazing.crossed) for sp_ in branch.special]
+    assert found == [("right", "right", ()), ("left", "left", ("right",))]
+    with pytest.warns(GrazingWarning, match="passes through stop.*'right'"):
+        points, _ = find_grazings(m, "omega", 0.5, 0.9, stop_name="left")
+    assert [p.stop_name for p in points] == ["left"]
+
+
+def test_impacting_branch_ends_where_it_gains_an_impact_on_another_stop() -> None:
+    """A period-1 orbit impacting only the right stop, continued in omega until it touches the left one.
+
+    The branch ends at a grazing with the left stop, located by the grazing equations; an independent
+    simulation of the orbit there comes within 1e-9 of the left stop with zero speed.
+    """
+    from grazing.orbits import continue_orbit
+
+    m = two_sided_oscillator(amp=0.5, gap_right=1.0, gap_left=1.5, omega=1.1)
+    orbit = find_orbit(m, period=1, t0=None)
+    assert orbit.impacts == 1 and orbit.impact_stops.tolist() == [0]
+    branch = continue_orbit(m, "omega", 1.1, 1.35, orbit=orbit)
+    end = branch.special[-1]
+    assert end.kind == "grazing" and end.grazing is not None and end.grazing.stop_name == "left"
+    assert "with stop 'left'" in branch.status and "gains an impact" in branch.status
+    assert branch.values[-1] < end.param < 1.35
+    at = m.with_params(omega=end.param)
+    there = find_orbit(at, end.orbit.state, period=1, t0=end.orbit.t0)
+    phase = 2 * math.pi * (there.t0 / at.period % 1.0)
+    sol = grazing.simulate(at, there.state, t0=there.t0, periods=1, phase=phase, guard_min=True)
+    h_left, _, x_left = sol.guard_min_by_stop[1]
+    assert abs(h_left) < 1e-9 and abs(x_left[1]) < 1e-6
+    assert sol.impacts.per_stop() == {"right": 1, "left": 0}

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -30,6 +31,7 @@ from grazing.cli.common import (
     stop_option_index,
 )
 from grazing.cli.validate import ANGLE_DEG, FINITE, ORBIT_PERIOD, POSITIVE, count, refuse_unused
+from grazing.errors import GrazingWarning
 from grazing.models.pendulum import max_angle
 
 
@@ -107,6 +109,7 @@ def _grazing_json(g: Any, param: str | None = None) -> dict[str, Any]:
             "abs_lambda": g.abs_lambda,
             "t_graze": g.phase,
             "accel": g.accel,
+            "crossed": list(g.crossed),
         }
     )
     return out
@@ -149,14 +152,12 @@ def graze(
     par, lo, hi, _ = search_range(model, "graze", gparam, prange, eta_min, eta_max)
     bar = Progress("continuing", enabled=not as_json)
     try:
-        points, branch = find_grazings(
-            model,
-            par.name,
-            lo,
-            hi,
-            stop_name=stop,
-            progress=lambda n, v: bar(int(1000 * (v - lo) / (hi - lo)), 1000),
-        )
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", GrazingWarning)  # (said below, with each grazing)
+            points, branch = find_grazings(
+                model, par.name, lo, hi, stop_name=stop,
+                progress=lambda n, v: bar(int(1000 * (v - lo) / (hi - lo)), 1000),
+            )  # fmt: skip
     finally:
         bar.close()
     res = {
@@ -181,6 +182,9 @@ def graze(
         where = "" if g["stop"] == "stop" else f" (stop {g['stop']})"
         click.echo(f"{par.name} = {g['value']:.6f}{unit}{where}: multipliers {mu}, "
                    f"|lambda| = {g['abs_lambda']:.4f}, t_graze = {g['t_graze']:.4f}")  # fmt: skip
+        if g["crossed"]:
+            click.echo(f"  note: this orbit passes through stop {', '.join(g['crossed'])}, which the system "
+                       "hits first: not a motion of the system")  # fmt: skip
 
 
 @click.command("graze-curve")
@@ -365,6 +369,7 @@ def continue_(
             {
                 "kind": sp_.kind,
                 "value": back(sp_.param),
+                **({"stop": model.stop_names[sp_.stop]} if sp_.kind == "grazing" else {}),
                 "index": sp_.index,
                 "multipliers": complex_list(sp_.multipliers),
                 "state": sp_.orbit.state,
@@ -385,6 +390,7 @@ def continue_(
     click.echo(f"{len(branch)} points of the period-{branch.period} orbit{more}, {kind}; {branch.status}")
     for sp_ in res["special"]:
         mu = ", ".join(f"{x:+.4f}{y:+.4f}i" for x, y in sp_["multipliers"])
-        click.echo(f"  {sp_['kind']:16s} {cparam} = {sp_['value']:.8g}   multipliers {mu}")
+        on = f" (stop {sp_['stop']})" if "stop" in sp_ and model.n_stops > 1 else ""
+        click.echo(f"  {sp_['kind']:16s} {cparam} = {sp_['value']:.8g}   multipliers {mu}{on}")
     if out is not None:
         click.echo(f"branch saved to {out}")

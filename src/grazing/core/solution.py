@@ -134,7 +134,12 @@ class Solution:
         ``(h, t, x)``: the closest approach to the stop in free flight (the
         smallest local minimum of the guard, away from impacts and sticking),
         if requested and there is one.  For an impacting orbit it says how
-        near the orbit is to gaining an impact.
+        near the orbit is to gaining an impact.  Both refer to the stop named
+        by ``stop_name`` (the first by default).
+    guard_min_by_stop, approach_by_stop
+        The same for every stop of the model, in the order of
+        :attr:`~grazing.HybridModel.stop_names` (``approach_by_stop[j]`` is
+        None when stop ``j`` has no closest approach in free flight).
     n_steps
         Number of Taylor steps taken.
     """
@@ -155,6 +160,8 @@ class Solution:
     lyapunov: np.ndarray | None = None
     guard_min: tuple[float, float, np.ndarray] | None = None
     approach_min: tuple[float, float, np.ndarray] | None = None
+    guard_min_by_stop: tuple[tuple[float, float, np.ndarray], ...] | None = None
+    approach_by_stop: tuple[tuple[float, float, np.ndarray] | None, ...] | None = None
     info: dict[str, Any] = field(default_factory=dict)
 
     def period(self, tol: float = DEFAULT_PERIOD_TOL, max_period: int = DEFAULT_MAX_PERIOD) -> int:

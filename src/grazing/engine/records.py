@@ -84,5 +84,5 @@ class Result(NamedTuple):
     trajectory: np.ndarray  # rows [t, state...]
     log_sums: np.ndarray  # Lyapunov sums
     lyap_span: float
-    guard_min: np.ndarray  # [h, t, state..., h_approach, t_approach, state...]
+    guard_min: np.ndarray  # per stop (rows): [h, t, state..., h_approach, t_approach, state...]
     jacobian_valid: bool

@@ -69,8 +69,8 @@ class Segment:
     trajectory: np.ndarray  # rows [t, state...]
     log_sums: np.ndarray
     lyap_span: float
-    guard_min: np.ndarray  # [h_min, t, state...]
-    approach_min: np.ndarray  # [h, t, state...] at the closest approach away from contacts
+    guard_min: np.ndarray  # rows per stop: [h_min, t, state...]
+    approach_min: np.ndarray  # rows per stop: [h, t, state...] at the closest approach away from contacts
     jacobian_valid: bool
     steps: int
 
@@ -271,7 +271,7 @@ class Runner:
         gm = out.guard_min
         return Segment(
             out.samples, out.impacts, out.n_impacts, out.sticking, out.trajectory, out.log_sums,
-            out.lyap_span, gm[: 2 + n], gm[2 + n :], out.jacobian_valid, out.steps,
+            out.lyap_span, gm[:, : 2 + n], gm[:, 2 + n :], out.jacobian_valid, out.steps,
         )  # fmt: skip
 
 

@@ -184,10 +184,9 @@ def simulate(
             parts[key].append(arr)
         log_sum += seg.log_sums
         lyap_span += seg.lyap_span
-        if guard_min and keep and (gmin is None or seg.guard_min[0] < gmin[0]):
-            gmin = seg.guard_min
-        if guard_min and keep and (amin is None or seg.approach_min[0] < amin[0]):
-            amin = seg.approach_min
+        if guard_min and keep:  # the smallest over the chunks, for each stop
+            gmin = _smaller_rows(gmin, seg.guard_min)
+            amin = _smaller_rows(amin, seg.approach_min)
         done += chunk
         if progress is not None:
             progress(done, total)
@@ -222,8 +221,12 @@ def simulate(
         jacobian=jac,
         jacobian_valid=jac_ok,
         lyapunov=log_sum / lyap_span if lyapunov else None,
-        guard_min=(float(gmin[0]), float(gmin[1]), gmin[2:].copy()) if gmin is not None else None,
-        approach_min=(float(amin[0]), float(amin[1]), amin[2:].copy()) if _found(amin) else None,
+        guard_min=_min_tuple(gmin[stop_index]) if gmin is not None else None,
+        approach_min=_min_tuple(amin[stop_index]) if amin is not None and _found(amin[stop_index]) else None,
+        guard_min_by_stop=tuple(_min_tuple(r) for r in gmin) if gmin is not None else None,
+        approach_by_stop=(
+            tuple(_min_tuple(r) if _found(r) else None for r in amin) if amin is not None else None
+        ),
         info={
             "order": run.order,
             "tol": tol,
@@ -265,6 +268,20 @@ def _sample_time_terms(
 
 def _found(info: np.ndarray | None) -> bool:
     return info is not None and bool(np.isfinite(info[0]))
+
+
+def _smaller_rows(best: np.ndarray | None, new: np.ndarray) -> np.ndarray:
+    """Row by row (one row per stop), the row with the smaller first entry."""
+    if best is None:
+        return new.copy()
+    out = best.copy()
+    better = new[:, 0] < best[:, 0]
+    out[better] = new[better]
+    return out
+
+
+def _min_tuple(row: np.ndarray) -> tuple[float, float, np.ndarray]:
+    return float(row[0]), float(row[1]), row[2:].copy()
 
 
 def _concat(arrays: list[np.ndarray], width: int) -> np.ndarray:

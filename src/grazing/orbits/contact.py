@@ -20,7 +20,7 @@ from grazing.core.model import HybridModel
 from grazing.errors import ConvergenceError
 from grazing.maps import flow_map
 from grazing.orbits.palc import PalcSettings, newton
-from grazing.orbits.shooting import sorted_multipliers
+from grazing.orbits.shooting import CROSSING_TOL, sorted_multipliers
 
 
 @dataclass(frozen=True)
@@ -49,6 +49,10 @@ class GrazingPoint:
         The orbit's other impacts per period (0 for a nonimpacting orbit that grazes).
     stop
         Index of the stop it grazes (:attr:`stop_name` its name).
+    crossed
+        Names of the other stops that the orbit passes through, computed with
+        the stops ignored (a nonimpacting orbit).  Where there are any, the
+        grazing is not a motion of the system: it hits those stops first.
     """
 
     model: HybridModel
@@ -60,6 +64,7 @@ class GrazingPoint:
     period: int = 1
     impacts: int = 0
     stop: int = 0
+    crossed: tuple[str, ...] = ()
 
     @property
     def stop_name(self) -> str:
@@ -129,10 +134,20 @@ def contact_system(
             period=period,
             impacts=fm.impacts,
             stop=stop,
+            crossed=() if events else _crossed(m, fm.solution.guard_min_by_stop, stop),
         )
         return F, DF, point
 
     return evaluate
+
+
+def _crossed(model: HybridModel, guard_mins, stop: int) -> tuple[str, ...]:
+    """The stops other than ``stop`` whose guard goes negative along a flow that ignores the stops."""
+    return tuple(
+        name
+        for j, (name, g) in enumerate(zip(model.stop_names, guard_mins or ()))
+        if j != stop and g[0] < -CROSSING_TOL
+    )
 
 
 def refine_grazing(

@@ -105,6 +105,8 @@ class SpecialPoint:
         equations (contact state and time, monodromy on the section through
         the contact with the grazing contact not an impact); None if those
         did not converge, in which case ``param`` is the end of the bracket.
+    stop
+        For a grazing: the index of the stop grazed.
     """
 
     kind: str
@@ -112,6 +114,7 @@ class SpecialPoint:
     param: float
     orbit: PeriodicOrbit
     grazing: GrazingPoint | None = None
+    stop: int = 0
 
     @property
     def multipliers(self) -> np.ndarray:
@@ -267,6 +270,15 @@ def _test_function(kind: str, orbit: PeriodicOrbit) -> float:
     raise ValueError(f"unknown special point kind {kind!r}")
 
 
+def _stop_guard_min(orbit: PeriodicOrbit, stop: int) -> float:
+    """The smallest value of stop ``stop``'s guard along a virtual orbit: zero where it grazes that stop."""
+    if not orbit.virtual:
+        return math.nan
+    if orbit.guard_min_by_stop:
+        return orbit.guard_min_by_stop[stop][0]
+    return orbit.guard_min if stop == orbit.stop else math.nan
+
+
 def _verified(kind: str, orbit: PeriodicOrbit) -> bool:
     """Does a located point satisfy the defining condition of its kind?"""
     mu = orbit.multipliers
@@ -287,6 +299,27 @@ def _detect(evaluate, kind: str, a: PalcPoint, b: PalcPoint, s: PalcSettings) ->
     return loc if loc is not None and _verified(kind, loc.payload) else None
 
 
+def _detect_grazing(
+    evaluate, stop: int, a: PalcPoint, b: PalcPoint, param: str, n: int, s: PalcSettings
+) -> SpecialPoint | None:
+    """The grazing of stop ``stop`` between two points of a virtual branch, located and refined."""
+    test = lambda p: _stop_guard_min(p.payload, stop)  # noqa: E731
+    if not sign_changed(test(a), test(b)):
+        return None
+    loc = locate(evaluate, a, b, test, s)
+    if loc is None:
+        return None
+    lo: PeriodicOrbit = loc.payload
+    _, t, x = lo.guard_min_by_stop[stop] if lo.guard_min_by_stop else (0.0, lo.t_guard_min, lo.x_guard_min)
+    point = None
+    try:
+        point = refine_grazing(lo.model, x, t, param, period=n, stop_name=stop)
+    except GrazingError:
+        point = None
+    value = float(loc.u[-1]) if point is None else point.model.params[param]
+    return SpecialPoint("grazing", -1, value, lo, point, stop)
+
+
 def grazing_margin(orbit: PeriodicOrbit) -> tuple[float, np.ndarray | None, float, str, int]:
     """How far ``orbit`` is from grazing, and where: ``(delta, contact guess, time, what, stop)``.
 
@@ -295,12 +328,16 @@ def grazing_margin(orbit: PeriodicOrbit) -> tuple[float, np.ndarray | None, floa
     ``v^2 / (2 a)`` (how deep the local parabola of a low-velocity impact
     reaches, ``v`` the impact speed and ``a = L_f^2 h``).  Both tend to zero
     linearly in the parameter as the orbit approaches a grazing from its side.
-    ``stop`` is the index of the stop concerned: the closest approach is to
-    the orbit's own :attr:`~PeriodicOrbit.stop`, the impacts are on any stop.
+    ``stop`` is the index of the stop concerned (closest approaches and
+    impacts on every stop are considered).
     """
     best: tuple[float, np.ndarray | None, float, str, int] = (math.inf, None, math.nan, "", orbit.stop)
-    if orbit.approach is not None:
-        best = (orbit.approach[0], orbit.approach[2], orbit.approach[1], "gains an impact", orbit.stop)
+    approaches = orbit.approach_by_stop or tuple(
+        orbit.approach if j == orbit.stop else None for j in range(orbit.model.n_stops)
+    )
+    for j, ap in enumerate(approaches):  # a new impact on any stop
+        if ap is not None and ap[0] < best[0]:
+            best = (ap[0], ap[2], ap[1], "gains an impact", j)
     if orbit.impact_states is not None:
         stops = orbit.impact_stops if orbit.impact_stops.size == orbit.impact_times.size else None
         for i, (t, v, x) in enumerate(zip(orbit.impact_times, orbit.impact_speeds, orbit.impact_states)):
@@ -403,9 +440,9 @@ def continue_orbit(
     stop_name
         For models with several stops: the stop (name or index; default the
         starting orbit's, else the first) whose grazing a nonimpacting branch
-        looks for.  An impacting branch ends where it loses an impact on any
-        stop, or gains one on this stop; it also ends (without a located
-        grazing) where it gains an impact on another.
+        looks for first.  A nonimpacting branch reports the grazings of every
+        stop; an impacting branch ends where it loses or gains an impact on
+        any stop, at that stop's grazing.
     switch
         At a grazing where the impact sequence changes, continue onto the orbit
         with the new sequence (a new segment of the branch) instead of ending.
@@ -509,22 +546,17 @@ def continue_orbit(
                 continue
             if prev is not None and branch.segments and branch.segments[-1] == segment:
                 for kind in detect:
+                    if kind == "grazing":  # (virtual branches) the grazing of any stop
+                        for j in range(model.n_stops):
+                            found = _detect_grazing(evaluate, j, prev, pt, param, n, s)
+                            if found is not None:
+                                branch.special.append(dataclasses.replace(found, index=len(branch) - 1))
+                        continue
                     loc = _detect(evaluate, kind, prev, pt, s)
                     if loc is None:
                         continue
-                    point = None
-                    if kind == "grazing":
-                        lo = loc.payload
-                        gm = lo.x_guard_min
-                        assert gm is not None
-                        try:
-                            point = refine_grazing(
-                                lo.model, gm, lo.t_guard_min, param, period=n, stop_name=lo.stop
-                            )
-                        except GrazingError:
-                            point = None
-                    value = float(loc.u[-1]) if point is None else point.model.params[param]
-                    branch.special.append(SpecialPoint(kind, len(branch) - 1, value, loc.payload, point))
+                    value = float(loc.u[-1])
+                    branch.special.append(SpecialPoint(kind, len(branch) - 1, value, loc.payload, None))
                 branch.arclength.append(branch.arclength[-1] + float(np.linalg.norm(pt.u - prev.u)))
             else:
                 branch.arclength.append(branch.arclength[-1] if branch.arclength else 0.0)
@@ -552,8 +584,11 @@ def continue_orbit(
         if point is None and not palc.boundary.reached:
             break  # steps beyond jumped to another orbit, and no grazing is just ahead: say so
         value = point.model.params[param] if point is not None else float(prev.u[-1])
-        branch.special.append(SpecialPoint("grazing", len(branch) - 1, value, last, point))
+        where_stop = grazing_margin(last)[4] if point is None else point.stop
+        branch.special.append(SpecialPoint("grazing", len(branch) - 1, value, last, point, where_stop))
         where = f"{param} = {value:.10g}"
+        if model.n_stops > 1:
+            where = f"{where} with stop {model.stop_names[where_stop]!r}"
         if point is None:
             where += (
                 f" (bracketed only: the grazing equations did not converge; last orbit at {prev.u[-1]:.10g})"

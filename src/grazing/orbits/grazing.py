@@ -19,6 +19,7 @@ A periodic orbit grazes when it touches the stop with zero normal velocity:
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -27,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from grazing.core.model import HybridModel
-from grazing.errors import ConvergenceError, InvalidParameterError
+from grazing.errors import ConvergenceError, GrazingWarning, InvalidParameterError
 from grazing.orbits.contact import GrazingPoint, contact_system
 from grazing.orbits.continuation import Branch, continue_orbit
 from grazing.orbits.palc import Palc, PalcPoint, PalcSettings, locate, sign_changed
@@ -49,7 +50,10 @@ def find_grazings(
     The orbit is followed with the stop ignored, through folds, and every zero
     of its minimum guard value is located and refined.  ``stop_name``: for
     models with several stops, the stop whose grazings are sought (name or
-    index; the first by default).
+    index; the first by default; the branch's special points hold every
+    stop's).  A grazing orbit that passes through another stop
+    (:attr:`GrazingPoint.crossed`) is not a motion of the system: it is
+    returned, with a :class:`~grazing.errors.GrazingWarning`.
 
     Returns
     -------
@@ -76,13 +80,24 @@ def find_grazings(
         progress=progress,
         stop_name=stop_name,
     )
+    watch = model.stop_index(stop_name)
     points = []
     for sp_ in branch.special:
         if sp_.kind != "grazing":
             continue
+        if sp_.stop != watch:
+            continue
         if sp_.grazing is None:
             raise ConvergenceError(
                 f"the grazing near {param} = {sp_.param:.8g} was bracketed but its equations did not converge"
+            )
+        if sp_.grazing.crossed:
+            warnings.warn(
+                f"the nonimpacting orbit grazing stop {sp_.grazing.stop_name!r} at {param} = "
+                f"{sp_.param:.10g} passes through stop(s) {', '.join(map(repr, sp_.grazing.crossed))}: "
+                "the system hits those first, so this grazing is not a motion of the system",
+                GrazingWarning,
+                stacklevel=2,
             )
         points.append(sp_.grazing)
     return points, branch

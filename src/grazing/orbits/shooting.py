@@ -30,6 +30,9 @@ SECTION_MARGIN = 0.05
 """When an impact of the starting orbit lies within this fraction of a period of the
 stroboscopic section, an automatic section (``t0=None``) moves to a quiet phase."""
 
+CROSSING_TOL = 1e-9
+"""A virtual orbit whose guard goes below ``-CROSSING_TOL`` passes through that stop."""
+
 
 @dataclass(frozen=True)
 class PeriodicOrbit:
@@ -68,6 +71,10 @@ class PeriodicOrbit:
     stop
         Index of the stop that ``guard_min`` and ``approach`` refer to (models
         with several stops); ``impact_stops`` gives the stop of each impact.
+    guard_min_by_stop, approach_by_stop
+        ``(h, t, x)`` of the smallest guard value and of the closest approach
+        for every stop, in the order of the model's ``stop_names`` (see
+        :attr:`guard_mins` and :attr:`crossed_stops`).
     """
 
     model: HybridModel
@@ -89,6 +96,18 @@ class PeriodicOrbit:
     approach: tuple[float, float, np.ndarray] | None = None
     stop: int = 0
     impact_stops: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+    guard_min_by_stop: tuple[tuple[float, float, np.ndarray], ...] = ()
+    approach_by_stop: tuple[tuple[float, float, np.ndarray] | None, ...] = ()
+
+    @property
+    def guard_mins(self) -> np.ndarray:
+        """The smallest value of every stop's guard along the orbit."""
+        return np.array([g[0] for g in self.guard_min_by_stop])
+
+    @property
+    def crossed_stops(self) -> tuple[str, ...]:
+        """The stops a virtual orbit passes through (where any are, it is not a physical motion)."""
+        return tuple(name for name, g in zip(self.model.stop_names, self.guard_mins) if g < -CROSSING_TOL)
 
     @property
     def signature(self) -> tuple[int, ...]:
@@ -162,6 +181,8 @@ def _orbit_from(model: HybridModel, x: np.ndarray, t0: float, n: int, fm: FlowMa
         approach=sol.approach_min,
         stop=stop,
         impact_stops=sol.impacts.stop.copy(),
+        guard_min_by_stop=sol.guard_min_by_stop or (),
+        approach_by_stop=sol.approach_by_stop or (),
     )
 
 

@@ -14,12 +14,14 @@ from __future__ import annotations
 
 import math
 import time
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from grazing.errors import GrazingWarning
 from grazing.models import two_sided_oscillator
 from grazing.orbits import find_grazings, find_orbit
 from grazing.plotting import plot_bifurcation
@@ -86,7 +88,9 @@ def compute(s: Settings, progress: Progress | None = None) -> Run:
         model, "omega", np.linspace(lo, hi, num), transient=s.transient, periods=s.periods, workers=s.workers
     )
     say("two stops: grazings of the nonimpacting orbit with each stop")
-    grazings = {name: find_grazings(model, "omega", lo, hi, stop_name=name)[0] for name in STOPS}
+    with warnings.catch_warnings():  # (a grazing that passes through the other stop is drawn as such)
+        warnings.simplefilter("ignore", GrazingWarning)
+        grazings = {name: find_grazings(model, "omega", lo, hi, stop_name=name)[0] for name in STOPS}
     return Run(model, ds, grazings, time.perf_counter() - start)
 
 
@@ -94,14 +98,15 @@ def draw(run: Run, path: Path) -> None:
     fig, axes = new_figure(2, 1, (8.0, 6.4))
     ax1, ax2 = np.ravel(axes)
     plot_bifurcation(ax1, run.ds, windows=False, nonimpacting=False)
-    ax1.set_title("stroboscopic x against ω; dashed: grazings of the nonimpacting orbit")
+    ax1.set_title("stroboscopic x against ω; dashed: grazings of the nonimpacting orbit\n(dotted: it passes "
+                  "through the other stop)")  # fmt: skip
     omega = run.ds["value"].values
     for name in STOPS:
         ipp = run.ds.impacts_per_period_by_stop.sel(stop=name).values
         ax2.plot(omega, ipp, ".", ms=3, color=COLORS[name], label=f"stop {name}")
         for g in run.grazings[name]:
-            for ax in (ax1, ax2):
-                ax.axvline(g.model.params["omega"], color=COLORS[name], ls="--", lw=0.8)
+            for ax in (ax1, ax2):  # dotted: that orbit passes through the other stop (not a motion)
+                ax.axvline(g.model.params["omega"], color=COLORS[name], ls=":" if g.crossed else "--", lw=0.8)
     gaps = {"right": run.model.params["gap_right"], "left": -run.model.params["gap_left"]}
     for name, level in gaps.items():
         ax1.axhline(level, color=COLORS[name], lw=0.8)
@@ -158,9 +163,16 @@ def comparisons(run: Run) -> tuple[Comparison, ...]:
     )
     for name, gap in (("right", m.params["gap_right"]), ("left", m.params["gap_left"])):
         exact_w = [w for w in grazing_frequencies(m, gap) if run.ds["value"].values.min() <= w]
-        found = sorted(g.model.params["omega"] for g in run.grazings[name])
+        found = sorted(run.grazings[name], key=lambda g: g.model.params["omega"])
         for i, w in enumerate(exact_w):
-            near = min(found, key=lambda f: abs(f - w)) if found else math.nan
+            g = min(found, key=lambda g: abs(g.model.params["omega"] - w)) if found else None
+            near = g.model.params["omega"] if g is not None else math.nan
+            crossed = (
+                f"; that orbit passes through stop {', '.join(g.crossed)} (hit first), so this grazing "
+                "of the linear response is not a motion of the system (dotted in the figure)"
+                if g is not None and g.crossed
+                else ""
+            )
             rows.append(
                 numeric_row(
                     FIGURE_ID,
@@ -173,7 +185,7 @@ def comparisons(run: Run) -> tuple[Comparison, ...]:
                     why_tolerance="1e-8",
                     paper_text=f"{w:.10f}",
                     note="closed form: the linear amplitude equals the gap; ours: continuation of the "
-                    "nonimpacting orbit watching that stop, then Newton on the grazing equations",
+                    "nonimpacting orbit watching that stop, then Newton on the grazing equations" + crossed,
                 )
             )
     both = m.with_params(amp=1.0, omega=0.8, gap_left=1.0)
@@ -239,7 +251,9 @@ def build(out_dir: Path, progress: Progress | None = None, settings: Settings | 
         "sampled periods. Top: the samples "
         "(the stops as horizontal lines); bottom: impacts on each stop per period of the detected orbit (per "
         "forcing period where none is detected). Dashed: the "
-        "grazings of the nonimpacting orbit with each stop, from continuation.",
+        "grazings of the nonimpacting orbit with each stop, from continuation; dotted where that orbit "
+        "already passes through the other stop (the system hits that stop first: not a motion of the "
+        "system).",
         "Bifurcation diagram of the two-sided oscillator in omega with impacts per stop",
     )
     return FigureResult(

@@ -104,9 +104,9 @@ def integrate(start, pv, cfg):
     traj = new_table(64 if traj_dt > 0.0 else 1, 1 + n)
     logs = np.zeros(n)
     scratch = np.zeros(n)
-    min_info = np.full(2 * (2 + n), math.inf)
-    slope_end = math.nan  # d guard / dt at the end of the previous free-flight step
-    slope_first = math.nan  # ... at the start of the first recorded one
+    min_info = np.full((NSTOPS, 2 * (2 + n)), math.inf)  # per stop (see track_guard)
+    slope_end = np.full(NSTOPS, math.nan)  # d guard / dt at the end of the previous free-flight step
+    slope_first = np.full(NSTOPS, math.nan)  # ... at the start of the first recorded one
     fbuf = np.empty(n)
     shift_sens = use_var and NSENS > 0 and wrap
     zdm_gh = np.zeros(n)
@@ -208,10 +208,11 @@ def integrate(start, pv, cfg):
         if recording and traj_dt > 0.0:
             n_traj, kt, st = trajectory_points(T, wrap, traj_dt, X, k, s, h_acc, traj, n_traj, kt, st, xe)
         if recording and track_min and mode == 0 and h_acc > 0.0:
-            slope_end, slope_first = track_guard(
-                O, watch, X, x, k * T + s, h, h_acc, defl if defl_stop == watch else 0, event, gm, min_info,
-                slope_end, slope_first, xe,
-            )  # fmt: skip
+            for j in range(NSTOPS):  # every stop's closest approach
+                slope_end[j], slope_first[j] = track_guard(
+                    O, j, X, x, k * T + s, h, h_acc, defl if defl_stop == j else 0, event, gm, min_info[j],
+                    slope_end[j], slope_first[j], xe,
+                )  # fmt: skip
 
         # Advance to the end of the accepted part of the step.
         eval_rows(X, nrows, order, h_acc, xe)
@@ -297,7 +298,8 @@ def integrate(start, pv, cfg):
             break
 
     if track_min and mode == 0 and recording:
-        finish_guard(x, s, pv, watch, k * T + s, slope_end, slope_first, min_info)
+        for j in range(NSTOPS):
+            finish_guard(x, s, pv, j, k * T + s, slope_end[j], slope_first[j], min_info[j])
     close_sticking(sticks, n_stick, k * T + s)
     lyap_span = k * T + s - lyap_t0 if (lyap and lyap_started) else 0.0
     Vout = np.zeros((n, ncol))
