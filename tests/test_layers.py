@@ -218,6 +218,23 @@ def _import_alone(module: str) -> tuple[str, int, str]:
     )
 
 
+HEAVY = ("numba", "llvmlite", "xarray", "zarr", "dask", "matplotlib", "sympy", "scipy", "h5netcdf", "click")
+
+
+def test_import_grazing_loads_no_heavy_dependency():
+    """``import grazing`` is numpy and the package only: the engine (numba) loads on first use."""
+    code = (
+        "import sys, math, grazing\n"
+        f"print(','.join(m for m in {HEAVY!r} if m in sys.modules))\n"
+        "m = grazing.models.pendulum('B', eta=0.446, theta_hat=math.radians(40))\n"
+        "print(grazing.simulate(m, [0.0, 0.0], transient=1, periods=1).samples.shape)\n"
+        "print('numba' in sys.modules)\n"
+    )
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.splitlines() == ["", "(1, 2)", "True"]
+
+
 @pytest.mark.parametrize("batch", [0, 1])
 def test_every_module_imports_on_its_own_in_a_fresh_interpreter(batch):
     """Half of the modules per test (the two halves run as two tests), two interpreters at a time."""

@@ -7,11 +7,15 @@
 (10, 2)
 """
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
 from grazing import models
 from grazing.core import HybridModel, Impacts, Parameter, Solution, Stop
+from grazing.core.model import set_kernel_loader
 from grazing.core.options import SaveAt, Solver, SweepSettings, Tangent
 from grazing.core.period import detect_period
-from grazing.engine.simulate import simulate
 from grazing.errors import (
     ConvergenceError,
     GrazingError,
@@ -20,8 +24,27 @@ from grazing.errors import (
     SimulationError,
 )
 
+if TYPE_CHECKING:
+    from grazing.engine.simulate import simulate
 
-def __getattr__(name: str) -> str:
+
+def _load_engine(*args: Any) -> Any:
+    # The engine (numba, about 0.2 s to import) is imported when a model first needs its
+    # kernels or grazing.simulate is first used, not by ``import grazing``; importing it
+    # registers its own kernel loader in place of this one.
+    from grazing.engine import codegen
+
+    return codegen.load_model_kernels(*args)
+
+
+set_kernel_loader(_load_engine)
+
+
+def __getattr__(name: str) -> Any:
+    if name == "simulate":
+        from grazing.engine.simulate import simulate
+
+        return simulate
     # The version is looked up on first use: importlib.metadata costs ~50 ms at import.
     if name == "__version__":
         from importlib.metadata import PackageNotFoundError, version
