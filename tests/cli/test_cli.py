@@ -122,3 +122,34 @@ def test_help_and_version(capsys):
     assert run(["--help"], capsys)[0] == 0
     code, out, _ = run(["--version"], capsys)
     assert code == 0 and "grazing" in out
+
+
+def test_sweep_without_a_store_builds_no_dataset(tmp_path):
+    """A sweep printed or emitted as JSON keeps its arrays: xarray (and the dask it imports) stay unloaded;
+    asking for a NetCDF file builds the dataset, with the same periods."""
+    code = (
+        "import json, sys\n"
+        "from grazing.cli import main\n"
+        "sys.argv = ['grazing', 'sweep', '--param', 'eta', '--start', '0.44', '--stop', '0.45',\n"
+        "            '--num', '4', '--transient', '20', '--periods', '8', '--workers', '1'] + sys.argv[1:]\n"
+        "try:\n"
+        "    main()\n"
+        "except SystemExit as exc:\n"
+        "    assert not exc.code, exc.code\n"
+        "print(json.dumps(['xarray' in sys.modules, 'dask' in sys.modules]))\n"
+    )
+    quiet = subprocess.run(
+        [sys.executable, "-c", code, "--json"], capture_output=True, text=True, timeout=600
+    )
+    assert quiet.returncode == 0, quiet.stderr
+    first, flags = quiet.stdout.strip().splitlines()
+    assert json.loads(flags) == [False, False]
+    nc = tmp_path / "s.nc"
+    saved = subprocess.run([sys.executable, "-c", code, "--out", str(nc)], capture_output=True, text=True,
+                           timeout=600)  # fmt: skip
+    assert saved.returncode == 0, saved.stderr
+    assert json.loads(saved.stdout.strip().splitlines()[-1])[0] is True
+    import xarray as xr
+
+    with xr.open_dataset(nc) as ds:
+        assert ds.sortby("value").period.values.tolist() == json.loads(first)["period"]

@@ -103,26 +103,32 @@ def _check_sweep_options(
 
 
 class _SweepRun:
-    """What a sweep run returns to its command: the dataset, or (streamed to a store) the periods only."""
+    """What a sweep run returns to its command: the dataset, or (streamed to a store) the periods only,
+    or (``arrays``: results kept in memory and no dataset asked for) the per-point arrays."""
 
-    def __init__(self, ds: Any, period: np.ndarray | None):
+    def __init__(self, ds: Any, period: np.ndarray | None, arrays: dict[str, np.ndarray] | None = None):
         self.ds = ds
         self.period = period
+        self.arrays = arrays
 
 
 def _run_sweep_spec(
     spec: Any, out: Path | None, scheduler: str | None, workers: int | None, as_json: bool,
-    wait: bool = False, timeout: float | None = None,
+    wait: bool = False, timeout: float | None = None, arrays: bool = False,
 ) -> _SweepRun:  # fmt: skip
     """Run a sweep spec with the CLI's storage, cluster and progress options.
 
     With a Zarr store and no ``--json``, the results stream to the store and
-    only the detected periods are read back (for the summary).
+    only the detected periods are read back (for the summary).  With
+    ``arrays`` and no Zarr store, the results stay in memory as per-point
+    arrays and no xarray dataset is built unless a NetCDF file is asked for
+    (importing xarray, and the dask it imports, costs about a second).
     """
     from grazing.sweeps.api import run_sweep
 
     zarr_out = out is not None and out.suffix.lower() == ".zarr"
     streamed = zarr_out and not as_json
+    memory = arrays and not zarr_out
     client = None
     if scheduler is not None:
         try:
@@ -144,39 +150,55 @@ def _run_sweep_spec(
                     + (f" (PID {pid})" if pid is not None else "") + "; waiting", err=True
                 ),
             )  # fmt: skip
+        elif memory:
+            from grazing.sweeps.store import MemoryStore
+
+            store = MemoryStore(spec)
         ds = run_sweep(
             spec, store=store, workers=workers, client=client, progress=bar, timeout=timeout,
-            notice=lambda msg: click.echo(f"grazing: {msg}", err=True), load=not streamed,
+            notice=lambda msg: click.echo(f"grazing: {msg}", err=True), load=not (streamed or memory),
         )  # fmt: skip
         period = store.read("period") if streamed else None
     finally:
         bar.close()
-        if store is not None:
+        if store is not None and not memory:
             store.close()
         if client is not None:
             client.close()
+    if memory:
+        if out is not None:
+            save_dataset(store.dataset(), out)
+        return _SweepRun(None, None, store.arrays)
     if out is not None and out.suffix.lower() == ".nc":
         save_dataset(ds, out)
     return _SweepRun(ds, period)
 
 
-def _sweep_json(ds: Any, param: str, values: np.ndarray) -> dict[str, Any]:
+def _sweep_json(spec: Any, run: _SweepRun, param: str, shown: np.ndarray) -> dict[str, Any]:
+    """The sweep's ``--json`` keys, points sorted by value, from its arrays or its dataset."""
+    from grazing.sweeps.store import impacts_per_period
+
+    if run.arrays is not None:
+        a = run.arrays
+    else:
+        a = {k: run.ds[k].values for k in ("samples", "period", "impacts", "lyapunov", "transient_used",
+                                             "impacts_by_stop")}  # fmt: skip
+    by_value = np.argsort(np.asarray(spec.points, dtype=float)[:, 0], kind="stable")
+    ipp, ipp_stop = impacts_per_period(spec, a)
+
+    def finite(v: np.ndarray) -> list[float | None]:
+        return [None if not math.isfinite(x) else float(x) for x in v]
+
     return {
         "param": param,
-        "values": values,
-        "period": ds.period.values,
-        "impacts_per_period": np.where(
-            np.isfinite(ds.impacts_per_period.values), ds.impacts_per_period.values, None
-        ),
-        "lyapunov": [None if not math.isfinite(v) else float(v) for v in ds.lyapunov.values],
-        "samples": ds.samples.values[..., 0],
-        "transient_used": ds.transient_used.values,
+        "values": np.sort(shown),
+        "period": a["period"][by_value],
+        "impacts_per_period": finite(ipp[by_value]),
+        "lyapunov": finite(a["lyapunov"][by_value]),
+        "samples": a["samples"][by_value][..., 0],
+        "transient_used": a["transient_used"][by_value],
         "impacts_per_period_by_stop": {
-            str(name): [
-                None if not math.isfinite(v) else float(v)
-                for v in ds.impacts_per_period_by_stop.sel(stop=name).values
-            ]
-            for name in ds.stop.values
+            str(name): finite(ipp_stop[by_value, j]) for j, name in enumerate(spec.model.stop_names)
         },
     }
 
@@ -235,17 +257,18 @@ def sweep_cmd(
     )  # fmt: skip
     spec = sweep_spec(model, name, vals, x0=x0, direction=direction, settings=settings, zdm=zdm)
     t0 = time.perf_counter()
-    run = _run_sweep_spec(spec, out, scheduler, workers, as_json, wait, timeout)
+    run = _run_sweep_spec(spec, out, scheduler, workers, as_json, wait, timeout, arrays=True)
     elapsed = time.perf_counter() - t0
     if as_json:
-        ds = run.ds.sortby("value")
-        res = {"params": model_params_json(model, case), **_sweep_json(ds, sparam, np.sort(shown))}
+        res = {"params": model_params_json(model, case), **_sweep_json(spec, run, sparam, shown)}
         res.update({"direction": direction, "fresh": fresh, "transient": transient, "periods": periods,
                     "chunk_size": spec.size, "elapsed_s": elapsed, "out": str(out) if out else None,
                     "method": method, "grazing": graze_info})  # fmt: skip
         emit_json(res)
         return
-    if run.ds is not None:
+    if run.arrays is not None:
+        per = run.arrays["period"][np.argsort(order, kind="stable")]
+    elif run.ds is not None:
         per = run.ds.sortby("value").period.values
     else:  # streamed to the store: the periods in visiting order, sorted like the values
         per = run.period[np.argsort(order, kind="stable")]

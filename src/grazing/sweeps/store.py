@@ -40,6 +40,7 @@ __all__ = [
     "StoreMismatchError",
     "ZarrStore",
     "build_dataset",
+    "impacts_per_period",
     "open_store",
 ]
 
@@ -79,6 +80,19 @@ def _stop_levels(spec: SweepSpec) -> np.ndarray:
     return out
 
 
+def impacts_per_period(spec: SweepSpec, arrays: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """Impacts per period of each point's detected orbit (per forcing period where none), in all and per stop.
+
+    Computed from a sweep's flat per-point arrays (nan where a point failed);
+    the dataset's ``impacts_per_period`` and ``impacts_per_period_by_stop``.
+    """
+    period, impacts, by_stop = arrays["period"], arrays["impacts"], arrays["impacts_by_stop"]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ipp = np.where(impacts >= 0, impacts / spec.periods * np.maximum(period, 1), np.nan)
+        ipp_stop = np.where(by_stop >= 0, by_stop / spec.periods * np.maximum(period, 1)[:, None], np.nan)
+    return ipp, ipp_stop
+
+
 def build_dataset(spec: SweepSpec, arrays: dict[str, np.ndarray], attrs: dict[str, Any] | None = None) -> Any:
     """The xarray Dataset of a sweep from its flat per-point arrays."""
     import xarray as xr
@@ -87,9 +101,7 @@ def build_dataset(spec: SweepSpec, arrays: dict[str, np.ndarray], attrs: dict[st
     period = arrays["period"]
     impacts = arrays["impacts"]
     by_stop = arrays["impacts_by_stop"]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        ipp = np.where(impacts >= 0, impacts / spec.periods * np.maximum(period, 1), np.nan)
-        ipp_stop = np.where(by_stop >= 0, by_stop / spec.periods * np.maximum(period, 1)[:, None], np.nan)
+    ipp, ipp_stop = impacts_per_period(spec, arrays)
     data = {
         "samples": (("point", "sample", "component"), arrays["samples"]),
         "period": ("point", period),
