@@ -29,9 +29,9 @@ consecutive points and located by regula falsi along the secant:
 * period-doubling: ``det(P_x + I)`` (a multiplier passes through -1);
 * Neimark-Sacker: ``det(P_x) - 1`` with a complex pair (2-D maps; the
   bialternate-product test in general);
-* grazing: the minimum of the guard along a nonimpacting (virtual) orbit
-  reaches zero (then refined by the grazing equations), or the end of an
-  impacting branch described above.
+* grazing: the minimum of a stop's guard along a nonimpacting (virtual)
+  orbit reaches zero, for every stop (then refined by the grazing
+  equations), or the end of an impacting branch described above.
 
 The stroboscopic map is not smooth where an impact falls on its section, so
 the section is chosen away from impacts (``t0=None``, the default) and moved
@@ -265,18 +265,15 @@ def _test_function(kind: str, orbit: PeriodicOrbit) -> float:
     if kind == "neimark-sacker":
         complex_pair = bool(np.any(np.abs(orbit.multipliers.imag) > 1e-12))
         return float(np.linalg.det(J) - 1.0) if complex_pair else math.nan
-    if kind == "grazing":  # (a physical branch ends at its grazings instead)
-        return orbit.guard_min if orbit.virtual else math.nan
     raise ValueError(f"unknown special point kind {kind!r}")
 
 
 def _stop_guard_min(orbit: PeriodicOrbit, stop: int) -> float:
-    """The smallest value of stop ``stop``'s guard along a virtual orbit: zero where it grazes that stop."""
-    if not orbit.virtual:
-        return math.nan
-    if orbit.guard_min_by_stop:
-        return orbit.guard_min_by_stop[stop][0]
-    return orbit.guard_min if stop == orbit.stop else math.nan
+    """The smallest value of stop ``stop``'s guard along a virtual orbit: zero where it grazes that stop.
+
+    (A physical branch ends at its grazings instead: nan.)
+    """
+    return orbit.guard_min_by_stop[stop][0] if orbit.virtual else math.nan
 
 
 def _verified(kind: str, orbit: PeriodicOrbit) -> bool:
@@ -310,7 +307,7 @@ def _detect_grazing(
     if loc is None:
         return None
     lo: PeriodicOrbit = loc.payload
-    _, t, x = lo.guard_min_by_stop[stop] if lo.guard_min_by_stop else (0.0, lo.t_guard_min, lo.x_guard_min)
+    _, t, x = lo.guard_min_by_stop[stop]
     point = None
     try:
         point = refine_grazing(lo.model, x, t, param, period=n, stop_name=stop)
@@ -332,10 +329,7 @@ def grazing_margin(orbit: PeriodicOrbit) -> tuple[float, np.ndarray | None, floa
     impacts on every stop are considered).
     """
     best: tuple[float, np.ndarray | None, float, str, int] = (math.inf, None, math.nan, "", orbit.stop)
-    approaches = orbit.approach_by_stop or tuple(
-        orbit.approach if j == orbit.stop else None for j in range(orbit.model.n_stops)
-    )
-    for j, ap in enumerate(approaches):  # a new impact on any stop
+    for j, ap in enumerate(orbit.approach_by_stop):  # a new impact on any stop
         if ap is not None and ap[0] < best[0]:
             best = (ap[0], ap[2], ap[1], "gains an impact", j)
     if orbit.impact_states is not None:
