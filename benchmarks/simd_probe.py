@@ -47,19 +47,20 @@ import numpy as np
 from numba import njit
 
 import grazing
+from grazing.engine.abi import call_model
 from grazing.engine.codegen import generate_source
 
 ORDER = 20
 
 
 def kernel_body(model: grazing.HybridModel) -> tuple[str, list[str]]:
-    """The generated ``tc_free`` of ``model``: its full source, and its body's statements."""
-    src = generate_source(model._def.system, 0, ORDER)
+    """The generated ``tc_free`` of ``model``: its source, and its body's statements."""
+    src = generate_source(model._def.system, 0, ORDER).text
     start = src.index("def tc_free")
-    end = src.index("@njit", start)
+    end = src.index("\ndef ", start + 1)
     text = src[start:end]
     body = [s.strip() for s in text.splitlines()[1:] if s.strip() and s.strip() != "return"]
-    return src, body
+    return text, body
 
 
 def numba_lanes(body: list[str], L: int, fastmath: bool):
@@ -203,8 +204,11 @@ def time_numba_lanes(body, L, fastmath, x0, s0, pv, ref, reps) -> tuple[float, f
 
 def probe(L: int) -> None:
     model = grazing.models.pendulum("B", eta=0.446, theta_hat=math.radians(40))
-    _, body = kernel_body(model)
-    tc = model.kernels(0, ORDER).tc_free  # the engine's compiled kernel of the same source
+    text, body = kernel_body(model)
+    ns: dict = {"math": math}
+    exec(text, ns)  # our own generated code
+    tc = njit(ns["tc_free"])  # numba compiling the kernel's text (the engine's kernels before issue 15)
+    engine_addr = model.kernels(0, ORDER).library.address("tc_free")  # the engine's kernel (llvmlite)
     n, n_guards, k1 = model.n_states, model.n_stops, ORDER + 1
     rng = np.random.default_rng(1)
     pv = model.param_vector.copy()
@@ -225,10 +229,25 @@ def probe(L: int) -> None:
                     xl[i] = x0[i, lane]
                 tc(xl, s0[lane], pv, Xs, Os)
 
+    @njit
+    def run_engine(reps, addr, x0, s0, pv, Xs, Os):
+        xl = np.empty(x0.shape[0])
+        for _ in range(reps):
+            for lane in range(x0.shape[1]):
+                for i in range(x0.shape[0]):
+                    xl[i] = x0[i, lane]
+                call_model(addr, xl, s0[lane], pv, Xs, Os, None, 0)
+
     reps = 200_000 // L
     run_scalar(1, x0, s0, pv, Xs, Os)
     t_scalar = best_of(lambda: run_scalar(reps, x0, s0, pv, Xs, Os))
     print(f"L = {L}: numba scalar kernel, once per lane: {t_scalar / (reps * L) * 1e9:6.1f} ns per lane")
+    Xe, Oe = np.zeros_like(Xs), np.zeros_like(Os)
+    run_engine(1, engine_addr, x0[:, -1:].copy(), s0[-1:], pv, Xe, Oe)
+    same = np.array_equal(Xe, ref[-1][0]) and np.array_equal(Oe, ref[-1][1])
+    t_engine = best_of(lambda: run_engine(reps, engine_addr, x0, s0, pv, Xs, Os))
+    print(f"       engine's scalar kernel (llvmlite): {t_engine / (reps * L) * 1e9:6.1f} ns per lane, "
+          f"{t_scalar / t_engine:.2f}x; bit-identical {same}")  # fmt: skip
 
     for fastmath in (False, True):
         t_l, compile_s, same, asm = time_numba_lanes(body, L, fastmath, x0, s0, pv, ref, reps)

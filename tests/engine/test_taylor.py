@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from grazing.engine.codegen import load_source
+from grazing.engine.llvmgen import compile_library
 from grazing.engine.taylor import UnsupportedExpressionError, taylor_kernel
 
 x, y, t = sp.symbols("x y t")
@@ -57,8 +57,8 @@ def _symbolic_coefficients(rhs, outputs, x0, t0, params, order):
 
 def _compiled(order):
     k = taylor_kernel("tc", (x, y), t, (w, c), RHS, OUTPUTS, order=order)
-    mod = load_source("import math\nfrom numba import njit\n\n@njit(cache=True)\n" + k.source)
-    return k, mod.tc
+    lib = compile_library(k.source, f"test_taylor_{order}", columns={"tc": {"X": order + 1, "O": order + 1}})
+    return k, lib.function("tc")
 
 
 @pytest.fixture(scope="module")

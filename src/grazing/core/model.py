@@ -22,7 +22,7 @@ import hashlib
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from types import MappingProxyType, ModuleType
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
@@ -30,7 +30,7 @@ import numpy as np
 from grazing.core.symbolic import Stop, SymbolicSystem
 from grazing.errors import InvalidParameterError, InvalidStateError
 
-KernelLoader = Callable[["_Definition", int, "int | None"], ModuleType]
+KernelLoader = Callable[["_Definition", int, "int | None"], Any]
 """``loader(definition, directions, order) -> module``: builds (or loads from the cache) the
 compiled kernels of a model definition; ``order=None`` is the engine's default order."""
 
@@ -199,7 +199,7 @@ class _Definition:
         self._symbolic = symbolic
         self._builder = builder
         self._system: SymbolicSystem | None = None
-        self._kernels: dict[tuple[int, int], ModuleType] = {}
+        self._kernels: dict[tuple[int, int], Any] = {}
         self._numeric: dict[tuple[str, int], Callable[..., Any]] = {}
         if symbolic is not None:
             self.system  # noqa: B018 - validate user models at construction
@@ -295,7 +295,7 @@ class _Definition:
         period = _srepr(self.period_expr)
         return repr((self.name, [p.name for p in self.parameters], period, self.periodic, source))
 
-    def kernels(self, directions: int = 0, order: int | None = None) -> ModuleType:
+    def kernels(self, directions: int = 0, order: int | None = None) -> Any:
         if (directions, order) not in self._kernels:
             if _kernel_loader is None:  # pragma: no cover - import grazing registers the engine's
                 raise RuntimeError("no kernel loader registered: import grazing (or grazing.engine) first")
@@ -744,7 +744,7 @@ class HybridModel:
         return f"<HybridModel {self.name}: {vals}>"
 
     # -- numerics -------------------------------------------------------------
-    def kernels(self, directions: int = 0, order: int | None = None) -> ModuleType:
+    def kernels(self, directions: int = 0, order: int | None = None) -> Any:
         """The compiled kernel module (generated and cached on first use).
 
         One module per number of sensitivity ``directions`` (columns of the

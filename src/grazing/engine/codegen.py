@@ -1,12 +1,16 @@
-"""Code generation: the compiled kernels of a hybrid model, assembled, cached and loaded.
+"""Code generation: the compiled functions of a hybrid model, assembled, cached and loaded.
 
-For each model (and each set of parameters to differentiate with respect to)
-one Python module is generated: Taylor-coefficient kernels for free flight,
-free flight with variational equations, and sticking; scalar functions for the
-vector field, guard, reset and their Jacobians; and the integration driver
-(:mod:`grazing.engine.driver`).  The module is written to a cache directory named
-by a hash of its source and imported; numba then caches the machine code next
-to it, so a model is compiled once per machine, not once per process.
+For each model (and each number of parameter-sensitivity directions and
+Taylor order) the model's functions are generated as straight-line Python:
+Taylor-coefficient kernels for free flight, free flight with variational
+equations, and sticking; the vector field, guards, resets and their
+Jacobians, one per stop, and dispatchers over the stops.
+:mod:`grazing.engine.llvmgen` translates them to LLVM IR and compiles them to
+an object file (under a second), which is cached on disk by a hash of the
+model and of the generator; loading it takes milliseconds.  The integration
+driver (:mod:`grazing.engine.driver`) is model-independent: numba compiles it
+once per machine and it calls the model's functions through their addresses
+(:mod:`grazing.engine.abi`).
 
 The cache directory is ``$GRAZING_CACHE_DIR`` if set, else
 ``$XDG_CACHE_HOME/grazing`` (``~/.cache/grazing``).
@@ -16,27 +20,30 @@ from __future__ import annotations
 
 import hashlib
 import importlib.util
+import json
 import math
 import os
 import sys
 import tempfile
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from grazing.core.model import set_kernel_loader
 from grazing.core.options import MACHINE_EPSILON
-from grazing.core.solution import Status
 from grazing.core.symbolic import SymbolicSystem
 from grazing.engine import driver
-from grazing.engine.polyroots import work_shape
+from grazing.engine.abi import SLOTS
 
 if TYPE_CHECKING:  # pragma: no cover
     import sympy as sp
 
 # Bump when the generated code changes meaning without its text changing.
-_CODEGEN_VERSION = "3"
+_CODEGEN_VERSION = "4"
 
 
 def taylor_order(tol: float) -> int:
@@ -61,7 +68,7 @@ def _scalar_function(
     returns: sp.Expr | None = None,
     extra_args: str = "",
 ) -> str:
-    """Numba source of ``name(x, s, pv{extra_args})`` with CSE'd assignments."""
+    """Source of ``name(x, s, pv{extra_args})`` with CSE'd assignments (for :mod:`.llvmgen`)."""
     import sympy as sp
 
     from grazing.engine.taylor import ScalarPrinter
@@ -74,7 +81,7 @@ def _scalar_function(
     for sym, _ in repl:
         names[sym] = str(sym)
     pr = ScalarPrinter(names)
-    lines = ["@njit(cache=True)", f"def {name}(x, s, pv{extra_args}):"]
+    lines = [f"def {name}(x, s, pv{extra_args}):"]
     for sym, e in repl:
         lines.append(f"    {sym} = {pr.doprint(e)}")
     for (target, _), e in zip(assigns, reduced):
@@ -83,19 +90,6 @@ def _scalar_function(
         lines.append(f"    return {pr.doprint(reduced[-1])}")
     elif not assigns:
         lines.append("    return 0.0")
-    return "\n".join(lines) + "\n"
-
-
-def _dispatch(name: str, args: str, stops: Sequence[int]) -> str:
-    """Numba source of ``name(args, j=0)``: the function ``name_s{j}`` of stop ``j``.
-
-    ``stops`` lists the stops that have the function; any other ``j`` calls
-    the last of them (the driver never asks for it).
-    """
-    lines = ["@njit(cache=True)", f"def {name}({args}, j=0):"]
-    for j in stops[:-1]:
-        lines += [f"    if j == {j}:", f"        return {name}_s{j}({args})"]
-    lines.append(f"    return {name}_s{stops[-1]}({args})")
     return "\n".join(lines) + "\n"
 
 
@@ -163,12 +157,36 @@ def _stop_functions(
     ]
 
 
-def generate_source(system: SymbolicSystem, directions: int = 0, order: int = DEFAULT_ORDER) -> str:
-    """Full source of the kernel module for ``system`` with Taylor polynomials of degree ``order``.
+@dataclass(frozen=True)
+class ModelSource:
+    """The generated functions of a model, and what their compilation and the driver need to know.
+
+    Attributes
+    ----------
+    text
+        Python definitions of every function (straight-line code).
+    columns
+        For each function, the number of columns of its 2-D array arguments.
+    dispatch
+        For each per-stop function of :data:`grazing.engine.abi.SLOTS`, the
+        definitions it picks from by the stop index.
+    sizes
+        ``nx``, ``nsens``, ``nparams``, ``nstops``, ``order`` and ``sticks``
+        (per stop: it has a sticking mode).
+    """
+
+    text: str
+    columns: dict[str, dict[str, int]]
+    dispatch: dict[str, list[str]]
+    sizes: dict[str, Any]
+
+
+def generate_source(system: SymbolicSystem, directions: int = 0, order: int = DEFAULT_ORDER) -> ModelSource:
+    """The functions of ``system`` with Taylor polynomials of degree ``order``.
 
     ``directions`` extra columns of the variational matrix hold derivatives
     along directions ``D[c]`` in parameter space, read at run time after the
-    parameter values: the kernels' parameter vector is ``(p, D.ravel())``.
+    parameter values: the functions' parameter vector is ``(p, D.ravel())``.
     """
     import dataclasses
 
@@ -189,23 +207,6 @@ def generate_source(system: SymbolicSystem, directions: int = 0, order: int = DE
 
     ncol = n + directions
     f = sys_.vector_field
-    parts = [
-        "# Generated by grazing.engine.codegen; do not edit.",
-        "import math",
-        "import numpy as np",
-        "from numba import njit",
-        "from grazing.engine.polyroots import horner, isolate_first_root, quadratic_bound",
-        "from grazing.engine.stepping import (append_pair, append_record, append_row,"
-        " divide_double_root_at_one, eval_rows, new_table, orthonormalize, pack_var, poly_derivative,"
-        " set_row, set_slice, step_factor, step_size, table_rows, unpack_var)",
-        f"NX = {n}",
-        f"NSENS = {directions}",
-        f"NPARAMS = {m}",
-        f"NSTOPS = {nstops}",
-        f"ORDER = {order}",
-        *(f"STATUS_{status.name} = {int(status)}" for status in Status),
-        f"ROOT_WORK_ROWS, ROOT_WORK_MIN_COLS = {work_shape(0)}",
-    ]
     guards = [stop.guard for stop in sys_.stops]  # the event rows of free flight, one per stop
     free = taylor_kernel("tc_free", sys_.states, sys_.time, sys_.params, f, guards, order)
     # Variational equations: V' = f_x V (+ f_p D[c] on the direction columns).
@@ -240,24 +241,23 @@ def generate_source(system: SymbolicSystem, directions: int = 0, order: int = DE
         kernels.append(
             taylor_kernel("tc_stick_s0", sys_.states, sys_.time, sys_.params, f, [sp.Integer(1)], order)
         )
-    parts.append(f"HAS_STICK = {bool(sticky)}")
-    parts.append(f"STICKS = {tuple(j in sticky for j in range(nstops))!r}")
-    for k in kernels:
-        parts.append("@njit(cache=True)\n" + k.source)
-    parts.append(_dispatch("tc_stick", "x0, s0, pv, X, O", sticky or [0]))
-
+    parts = [k.source for k in kernels]
+    columns: dict[str, dict[str, int]] = {k.name: {"X": order + 1, "O": order + 1} for k in kernels}
     parts.append(
         _scalar_function("rhs", sys_, [(f"out[{i}]", e) for i, e in enumerate(f)], extra_args=", out")
     )
     every = list(range(nstops))
     for j in every:
         parts.extend(_stop_functions(sys_.at_stop(j), sysd.at_stop(j), j, along, directions))
-    for name, args in (
-        ("guard", "x, s, pv"), ("guard_grad", "x, s, pv, gx"), ("guard_pgrad", "x, s, pv, hp"),
-        ("reset", "x, s, pv, out"), ("reset_jac", "x, s, pv, Gx, Gt, Gp"), ("normal_rate", "x, s, pv"),
-        ("normal_accel", "x, s, pv"), ("normal_rate_grad", "x, s, pv, gr"), ("contact_dir", "x, s, pv, e"),
-    ):  # fmt: skip
-        parts.append(_dispatch(name, args, every))
+        columns[f"reset_jac_s{j}"] = {"Gx": n, "Gp": max(directions, 1)}
+    dispatch = {
+        name: [f"{name}_s{j}" for j in every]
+        for name in (
+            "guard", "guard_grad", "guard_pgrad", "reset", "reset_jac", "normal_rate", "normal_accel",
+            "normal_rate_grad", "contact_dir",
+        )
+    }  # fmt: skip
+    dispatch["tc_stick"] = [f"tc_stick_s{j}" for j in (sticky or [0])]
     # dT/dp for every parameter: a sample "one period later" moves when the period does.
     period = sp.Integer(0) if sys_.period is None else sys_.period
     parts.append(
@@ -266,8 +266,11 @@ def generate_source(system: SymbolicSystem, directions: int = 0, order: int = DE
             extra_args=", tp",
         )
     )  # fmt: skip
-    parts.append(driver.template_text())
-    return "\n\n".join(parts)
+    sizes = {
+        "nx": n, "nsens": directions, "nparams": m, "nstops": nstops, "order": order,
+        "sticks": [j in sticky for j in every],
+    }  # fmt: skip
+    return ModelSource("\n\n".join(parts), columns, dispatch, sizes)
 
 
 def cache_dir() -> Path:
@@ -279,21 +282,32 @@ def cache_dir() -> Path:
     return Path(base) / "grazing"
 
 
+def _key(*parts: Any) -> str:
+    return hashlib.sha256(repr(parts).encode()).hexdigest()[:20]
+
+
 def kernel_key(identity: str, directions: int, order: int = DEFAULT_ORDER) -> str:
-    """Cache key of a kernel module: the model's identity and everything the code depends on.
+    """Cache key of a model's compiled functions: the model's identity and everything the code depends on."""
+    import llvmlite
+
+    here = Path(__file__).parent
+    deps = "".join((here / f).read_text() for f in ("taylor.py", "codegen.py", "llvmgen.py", "abi.py"))
+    versions = (_CODEGEN_VERSION, llvmlite.__version__, sys.version)
+    return _key(identity, int(directions), order, versions, deps)
+
+
+def driver_key() -> str:
+    """Cache key of the compiled driver: its sources and those of everything it inlines.
 
     numba's on-disk cache does not notice changes in functions imported from
-    other modules, so the sources of the driver, the root finder and the code
-    generator are part of the key.
+    other modules, so the sources of the helpers are part of the key.
     """
     import numba
 
     here = Path(__file__).parent
-    files = [here / f for f in ("polyroots.py", "stepping.py", "taylor.py", "codegen.py", "records.py")]
+    files = [here / f for f in ("polyroots.py", "stepping.py", "records.py", "abi.py")]
     deps = "".join(path.read_text() for path in [*files, *driver.template_files()])
-    versions = (_CODEGEN_VERSION, numba.__version__, sys.version)
-    text = repr((identity, int(directions), order, versions, deps))
-    return hashlib.sha256(text.encode()).hexdigest()[:20]
+    return _key(_CODEGEN_VERSION, numba.__version__, sys.version, deps)
 
 
 def _init_numba_without_blas_probe() -> None:
@@ -321,9 +335,9 @@ def _init_numba_without_blas_probe() -> None:
 def _write_bytecode(path: Path) -> None:
     """Byte-compile a generated module once, even under ``PYTHONDONTWRITEBYTECODE``.
 
-    A kernel module is thousands of lines; compiling its source on every import
-    costs ~80 ms per process.  The ``.pyc`` is checked against the source as
-    usual, so it is never stale.
+    Compiling the driver's source on every import would cost time in every
+    process.  The ``.pyc`` is checked against the source as usual, so it is
+    never stale.
     """
     import py_compile
 
@@ -336,28 +350,30 @@ def _write_bytecode(path: Path) -> None:
         pass
 
 
+def _cached_file(name: str, make: Callable[[], bytes]) -> Path:
+    """The cache file ``name``, written (atomically) with ``make()`` if it is not there yet."""
+    for d in (cache_dir(), Path(tempfile.gettempdir()) / "grazing-cache"):
+        try:
+            d.mkdir(parents=True, exist_ok=True)
+            path = d / name
+            if not path.exists():
+                fd, tmp = tempfile.mkstemp(dir=d, suffix=".tmp")
+                with os.fdopen(fd, "wb") as fh:
+                    fh.write(make())
+                os.replace(tmp, path)
+            return path
+        except OSError:
+            continue
+    raise OSError("no writable cache directory for compiled kernels")  # pragma: no cover
+
+
 def load_kernels(key: str, source: Callable[[], str]) -> ModuleType:
-    """Import the kernel module ``key``, generating it with ``source()`` if not cached."""
+    """Import the generated numba module ``key``, writing it with ``source()`` if not cached."""
     modname = f"grazing_kernels_{key}"
     if modname in sys.modules:
         return sys.modules[modname]
     _init_numba_without_blas_probe()
-    path: Path | None = None
-    for d in (cache_dir(), Path(tempfile.gettempdir()) / "grazing-cache"):
-        try:
-            d.mkdir(parents=True, exist_ok=True)
-            candidate = d / f"{modname}.py"
-            if not candidate.exists():
-                fd, tmp = tempfile.mkstemp(dir=d, suffix=".tmp")
-                with os.fdopen(fd, "w") as fh:
-                    fh.write(source())
-                os.replace(tmp, candidate)
-            path = candidate
-            break
-        except OSError:
-            continue
-    if path is None:  # pragma: no cover - no writable directory at all
-        raise OSError("no writable cache directory for compiled kernels")
+    path = _cached_file(f"{modname}.py", lambda: source().encode())
     _write_bytecode(path)
     spec = importlib.util.spec_from_file_location(modname, path)
     assert spec is not None and spec.loader is not None
@@ -367,21 +383,78 @@ def load_kernels(key: str, source: Callable[[], str]) -> ModuleType:
     return module
 
 
-def load_source(source: str) -> ModuleType:
-    """Import generated ``source`` as a cached kernel module (keyed by its text)."""
-    return load_kernels(kernel_key(source, 0), lambda: source)
+def load_driver() -> ModuleType:
+    """The compiled driver (numba compiles it once per machine and caches it)."""
+    return load_kernels(
+        driver_key(), lambda: "# Generated by grazing.engine.codegen; do not edit.\n" + driver.template_text()
+    )
 
 
-def load_model_kernels(definition: Any, directions: int, order: int | None) -> ModuleType:
-    """The kernel module of a model definition (:class:`grazing.core.model` calls this).
+class ModelKernels:
+    """A model's compiled functions, loaded: callable from Python and, through their addresses, the driver.
+
+    Attributes ``NX``, ``NSENS``, ``NPARAMS``, ``NSTOPS``, ``ORDER``,
+    ``STICKS`` give the sizes; every name of :data:`grazing.engine.abi.SLOTS`
+    is a Python caller (``model.kernels().guard(x, t, pv, j)``); arrays must
+    be C-contiguous float64, outputs are written in place.  ``table`` is the
+    :class:`~grazing.engine.records.Kernels` record the driver takes.
+    """
+
+    def __init__(self, library: Any, sizes: dict[str, Any]) -> None:
+        self.library = library
+        self.NX = int(sizes["nx"])
+        self.NSENS = int(sizes["nsens"])
+        self.NPARAMS = int(sizes["nparams"])
+        self.NSTOPS = int(sizes["nstops"])
+        self.ORDER = int(sizes["order"])
+        self.STICKS = tuple(bool(s) for s in sizes["sticks"])
+        self.HAS_STICK = any(self.STICKS)
+        fns = np.array([library.address(name) for name in SLOTS], dtype=np.int64)
+        if not fns.all():  # pragma: no cover - a damaged cache file
+            raise OSError("compiled model functions are missing from the kernel cache")
+        self.table = (fns, self.NX, self.NSENS, self.NSTOPS, self.ORDER, np.array(self.STICKS, dtype=bool))
+        for name in SLOTS:
+            setattr(self, name, library.function(name))
+
+    def integrate(self, start: tuple[Any, ...], pv: np.ndarray, cfg: tuple[Any, ...]) -> Any:
+        """Run the driver on this model (see :mod:`grazing.engine.driver.loop`)."""
+        return load_driver().integrate(start, pv, cfg, self.table)
+
+
+_loaded: dict[str, ModelKernels] = {}
+
+
+def compile_model(source: ModelSource, key: str) -> bytes:
+    """The cache file of a model: a JSON line of its sizes, then the object file of its functions."""
+    from grazing.engine import llvmgen
+
+    prefix = f"grazing_{key}"
+    module = llvmgen.translate(source.text, prefix, columns=source.columns, dispatch=source.dispatch)
+    return json.dumps(source.sizes).encode() + b"\n" + llvmgen.compile_object(module)
+
+
+def load_compiled(key: str, source: Callable[[], ModelSource]) -> ModelKernels:
+    """The model functions ``key``, compiled with ``source()`` if not cached, loaded once per process."""
+    kernels = _loaded.get(key)
+    if kernels is None:
+        from grazing.engine import llvmgen
+
+        path = _cached_file(f"grazing_model_{key}.bin", lambda: compile_model(source(), key))
+        header, obj = path.read_bytes().split(b"\n", 1)
+        kernels = _loaded[key] = ModelKernels(llvmgen.Library(obj, f"grazing_{key}"), json.loads(header))
+    return kernels
+
+
+def load_model_kernels(definition: Any, directions: int, order: int | None) -> ModelKernels:
+    """The compiled functions of a model definition (:class:`grazing.core.model` calls this).
 
     Keyed by the model's identity, the number of sensitivity directions, the
-    order and the sources of the engine, so a cached module is found without
+    order and the sources of the generator, so a cached model is found without
     building the model's symbolic form (no sympy import on a cache hit).
     """
     order = DEFAULT_ORDER if order is None else order
     key = kernel_key(definition.identity(), directions, order)
-    return load_kernels(key, lambda: generate_source(definition.system, directions, order))
+    return load_compiled(key, lambda: generate_source(definition.system, directions, order))
 
 
 set_kernel_loader(load_model_kernels)

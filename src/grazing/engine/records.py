@@ -1,9 +1,11 @@
-"""The records the compiled driver takes and returns: :class:`Start`, :class:`Config`, :class:`Result`.
+"""The records the compiled driver takes and returns: :class:`Start`, :class:`Config`, :class:`Kernels`,
+:class:`Result`.
 
 Named tuples, which numba compiles as structs: the driver,
-``integrate(start, pv, config) -> result``, reads its settings by name (no
+``integrate(start, pv, config, kernels) -> result``, reads its settings by name (no
 positional argument lists) and returns one record that the runner reads by
-name.  Built by :class:`grazing.engine.runner.Runner`.
+name.  Built by :class:`grazing.engine.runner.Runner` (the kernels by
+:mod:`grazing.engine.codegen`).
 """
 
 from __future__ import annotations
@@ -65,6 +67,17 @@ class Config(NamedTuple):
 
 STATIC = Config._fields[Config._fields.index("T") :]
 """The fields of :class:`Config` that stay the same for every call on one trajectory."""
+
+
+class Kernels(NamedTuple):
+    """A model's compiled functions as the driver sees them: their addresses and the model's sizes."""
+
+    fns: np.ndarray  # int64 addresses, in the order of grazing.engine.abi.SLOTS
+    nx: int  # states
+    nsens: int  # sensitivity directions (columns of V after the first nx)
+    nstops: int
+    order: int  # of the Taylor polynomials
+    sticks: np.ndarray  # bool per stop: the stop has a sticking mode
 
 
 class Result(NamedTuple):

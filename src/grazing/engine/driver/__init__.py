@@ -1,17 +1,22 @@
-"""The compiled integration driver, in small pieces appended to every generated kernel module.
+"""The compiled integration driver, in small pieces, compiled once per machine for every model.
 
-The pieces call the model's own compiled functions (``tc_free``, ``tc_var``,
-``tc_stick``, ``rhs``, ``guard``, ``reset``, ``reset_jac`` ...) and constants
-(``NX``, ``NSENS``, ``ORDER``, ``HAS_STICK``, the ``STATUS_*`` codes of
-:class:`grazing.core.solution.Status`), which :mod:`grazing.engine.codegen`
-defines in each model's module; keeping them in that module lets numba resolve
-them as globals and cache the compiled result on disk.  Each file here is
-valid Python that imports on its own (the model's names are only looked up
-when a piece is compiled).  What does not depend on the model is in
-:mod:`grazing.engine.stepping` and :mod:`grazing.engine.polyroots`, compiled
-once per machine.
+The driver reaches a model through a :class:`~grazing.engine.records.Kernels`
+record: the addresses of the model's compiled functions (``tc_free``,
+``tc_var``, ``tc_stick``, ``rhs``, ``guard``, ``reset``, ``reset_jac`` ...;
+machine code from :mod:`grazing.engine.llvmgen`) and its sizes, given at run
+time.  So the driver does not depend on the model and numba compiles it once
+per machine, not once per model, sensitivity set and Taylor order.
+
+Each file here is valid Python that imports on its own.  For numba they are
+concatenated into one generated module (:func:`template_text`, imports
+between the pieces dropped), keyed by a hash of their sources and of the
+helpers they call (:mod:`grazing.engine.stepping`,
+:mod:`grazing.engine.polyroots`): numba's own cache would not notice a change
+in a piece that another one inlines.
 
 The pieces, in the order a step uses them:
+
+* :mod:`.calls` -- the model's functions through the address table;
 
 * :mod:`.events` -- the step (Taylor coefficients and step size) and event
   location (the guard's polynomial over the step, known roots divided out,
@@ -30,7 +35,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-PIECES = ("events.py", "recording.py", "tangent.py", "impacts.py", "loop.py")
+PIECES = ("calls.py", "events.py", "recording.py", "tangent.py", "impacts.py", "loop.py")
 """The template files, in the order they are appended."""
 
 
@@ -40,6 +45,19 @@ def template_files() -> list[Path]:
     return [here / name for name in PIECES]
 
 
+def _without_driver_imports(text: str) -> str:
+    """``text`` without its ``from grazing.engine.driver... import`` statements."""
+    import ast
+
+    lines = text.splitlines()
+    for node in ast.parse(text).body:
+        if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("grazing.engine.driver"):
+            assert node.end_lineno is not None
+            for i in range(node.lineno - 1, node.end_lineno):
+                lines[i] = ""
+    return "\n".join(lines) + "\n"
+
+
 def template_text() -> str:
-    """The driver's source, as appended to a generated kernel module."""
-    return "\n\n".join(path.read_text() for path in template_files())
+    """The driver's source: the pieces in order, as one module."""
+    return "\n\n".join(_without_driver_imports(path.read_text()) for path in template_files())

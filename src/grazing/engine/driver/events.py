@@ -1,4 +1,4 @@
-"""Driver piece: the location of events on a step (appended to each kernel module).
+"""Driver piece: the location of events on a step.
 
 On every step every stop's guard ``h`` (or, for the stop it sticks to, the
 contact force) is expanded as a Taylor polynomial alongside the state; written
@@ -20,7 +20,7 @@ from grazing.engine.stepping import divide_double_root_at_one
 
 
 @njit(cache=True, inline="always")
-def event_polynomial(O, row, h, mode, defl, end_contact, a):
+def event_polynomial(O, row, h, mode, defl, end_contact, a, order):
     """Event row ``row`` over the step as ``a[0] + a[1] u + ...``; returns ``(degree, tail)``.
 
     ``defl`` roots at ``u = 0`` are known (1 after an impact, 2 at a grazing
@@ -30,7 +30,6 @@ def event_polynomial(O, row, h, mode, defl, end_contact, a):
     ``sum |a_j|`` for ``j >= 3``, which :func:`event_certificate` needs
     (summed while the coefficients are written, on the common path).
     """
-    order = ORDER
     hk = 1.0
     for j in range(min(3, order + 1)):
         a[j] = O[row, j] * hk
@@ -80,7 +79,7 @@ def event_certificate(a, tail):
 
 
 @njit(cache=True, inline="always")
-def first_event(O, h, mode, stuck, events, skip, defl, defl_stop, end_contact, end_stop, a, work):
+def first_event(m, O, h, mode, stuck, events, skip, defl, defl_stop, end_contact, end_stop, a, work):
     """The first event on the step over every stop: ``(u, stop)``, ``u < 0`` when there is none.
 
     ``mode`` 1 is sticking to stop ``stuck`` (its row is the contact force);
@@ -91,13 +90,13 @@ def first_event(O, h, mode, stuck, events, skip, defl, defl_stop, end_contact, e
     """
     u = -1.0
     stop = 0
-    for r in range(NSTOPS):
+    for r in range(m.nstops):
         force = mode == 1 and r == stuck
         if not (events or force) or r == skip:
             continue
-        deg, tail = event_polynomial(
-            O, r, h, 1 if force else 0, defl if r == defl_stop else 0, end_contact and r == end_stop, a
-        )
+        defl_r = defl if r == defl_stop else 0
+        end_r = end_contact and r == end_stop
+        deg, tail = event_polynomial(O, r, h, 1 if force else 0, defl_r, end_r, a, m.order)
         ur = event_certificate(a, tail)
         if ur > 0.0:  # rarely: the certificate cannot exclude a root on the step
             ur = isolate_first_root(a, deg, work)

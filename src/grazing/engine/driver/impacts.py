@@ -1,4 +1,4 @@
-"""Driver piece: impacts, chattering and sticking (appended to each kernel module).
+"""Driver piece: impacts, chattering and sticking.
 
 At an impact the state on the stop is reset, ``x <- g(x)``, and the
 variational matrix multiplied by the saltation matrix (paper eq. 14).  If the
@@ -13,29 +13,42 @@ import math
 import numpy as np
 from numba import njit
 
+from grazing.engine.driver.calls import (
+    contact_dir,
+    guard,
+    guard_grad,
+    guard_pgrad,
+    normal_accel,
+    normal_rate,
+    normal_rate_grad,
+    reset,
+    reset_jac,
+    rhs,
+)
 from grazing.engine.stepping import append_record, append_row, pack_var, unpack_var
 
 
 @njit(cache=True)
-def saltation(xm, xp, s, pv, j, V, ncol):
+def saltation(m, xm, xp, s, pv, j, V, ncol):
     """Apply the saltation matrix of stop ``j`` (paper eq. 14, with time and parameter terms) to V.
 
     Returns False, leaving V alone, for an impact at zero normal speed (``L_f h = 0``): there the
     saltation matrix is unbounded and the flow's Jacobian does not exist.
     """
-    n = NX
+    n = m.nx
+    nsens = m.nsens
     fm = np.empty(n)
     fp = np.empty(n)
-    rhs(xm, s, pv, fm)
-    rhs(xp, s, pv, fp)
+    rhs(m, xm, s, pv, fm)
+    rhs(m, xp, s, pv, fp)
     Gx = np.zeros((n, n))
     Gt = np.zeros(n)
-    Gp = np.zeros((n, max(NSENS, 1)))
-    reset_jac(xm, s, pv, Gx, Gt, Gp, j)
+    Gp = np.zeros((n, max(nsens, 1)))
+    reset_jac(m, xm, s, pv, Gx, Gt, Gp, j)
     hx = np.zeros(n)
-    hp = np.zeros(max(NSENS, 1))
-    ht = guard_grad(xm, s, pv, hx, j)
-    guard_pgrad(xm, s, pv, hp, j)
+    hp = np.zeros(max(nsens, 1))
+    ht = guard_grad(m, xm, s, pv, hx, j)
+    guard_pgrad(m, xm, s, pv, hp, j)
     den = ht
     for i in range(n):
         den += hx[i] * fm[i]
@@ -72,13 +85,13 @@ def saltation(xm, xp, s, pv, j, V, ncol):
 
 
 @njit(cache=True)
-def enter_contact(x, s, pv, j):
+def enter_contact(m, x, s, pv, j):
     """Project x onto the contact manifold {h = 0, L_f h = 0} of stop ``j``."""
-    n = NX
+    n = m.nx
     gx = np.zeros(n)
     for _ in range(3):
-        hval = guard(x, s, pv, j)
-        guard_grad(x, s, pv, gx, j)
+        hval = guard(m, x, s, pv, j)
+        guard_grad(m, x, s, pv, gx, j)
         nn = 0.0
         for i in range(n):
             nn += gx[i] * gx[i]
@@ -87,11 +100,11 @@ def enter_contact(x, s, pv, j):
         for i in range(n):
             x[i] -= hval * gx[i] / nn
     e = np.zeros(n)
-    contact_dir(x, s, pv, e, j)
+    contact_dir(m, x, s, pv, e, j)
     gr = np.zeros(n)
     for _ in range(3):
-        vn = normal_rate(x, s, pv, j)
-        normal_rate_grad(x, s, pv, gr, j)
+        vn = normal_rate(m, x, s, pv, j)
+        normal_rate_grad(m, x, s, pv, gr, j)
         d = 0.0
         for i in range(n):
             d += gr[i] * e[i]
@@ -102,7 +115,7 @@ def enter_contact(x, s, pv, j):
 
 
 @njit(cache=True)
-def apply_impact(x, xp, s, t, pv, j, use_var, ncol, nrows, V, record, imp, n_rec, traj_on, traj, n_traj):
+def apply_impact(m, x, xp, s, t, pv, j, use_var, ncol, nrows, V, record, imp, n_rec, traj_on, traj, n_traj):
     """Reset the state on stop ``j`` (``x`` holds it) and its variational matrix; returns the speed.
 
     Returns ``(speed, n_rec, n_traj, jac_ok)``: the approach speed ``-L_f h``,
@@ -112,12 +125,12 @@ def apply_impact(x, xp, s, t, pv, j, use_var, ncol, nrows, V, record, imp, n_rec
     trajectory when ``traj_on``).  Afterwards ``x`` holds the state after the
     reset.
     """
-    n = NX
-    vn = normal_rate(x, s, pv, j)
-    reset(x, s, pv, xp, j)
+    n = m.nx
+    vn = normal_rate(m, x, s, pv, j)
+    reset(m, x, s, pv, xp, j)
     if use_var:
         unpack_var(x, n, ncol, V)
-        jac_ok = saltation(x, xp, s, pv, j, V, ncol)
+        jac_ok = saltation(m, x, xp, s, pv, j, V, ncol)
         pack_var(V, n, ncol, xp)
     else:
         jac_ok = True
@@ -135,7 +148,7 @@ def apply_impact(x, xp, s, t, pv, j, use_var, ncol, nrows, V, record, imp, n_rec
 
 
 @njit(cache=True)
-def chatter_remaining(x, s, pv, j, speed, chatter_time):
+def chatter_remaining(m, x, s, pv, j, speed, chatter_time):
     """The time to the accumulation point of a chattering sequence on stop ``j`` starting now, or -1.
 
     After the reset the body leaves the stop with speed ``w`` while the stop
@@ -144,8 +157,8 @@ def chatter_remaining(x, s, pv, j, speed, chatter_time):
     Returns that time when it is below ``chatter_time`` (or 0 when the body
     does not leave the stop at all), else -1: no sticking.
     """
-    w = normal_rate(x, s, pv, j)
-    acc = normal_accel(x, s, pv, j)
+    w = normal_rate(m, x, s, pv, j)
+    acc = normal_accel(m, x, s, pv, j)
     if not acc < 0.0:
         return -1.0
     if speed <= 0.0 or w <= 0.0:

@@ -1,8 +1,9 @@
-"""Driver piece: the integration loop (appended to each kernel module).
+"""Driver piece: the integration loop.
 
-``integrate(start, pv, cfg)`` takes a :class:`~grazing.engine.records.Start`,
-the parameter vector (values, then the sensitivity directions) and a
-:class:`~grazing.engine.records.Config`, and returns a
+``integrate(start, pv, cfg, m)`` takes a :class:`~grazing.engine.records.Start`,
+the parameter vector (values, then the sensitivity directions), a
+:class:`~grazing.engine.records.Config` and the model's compiled functions
+(:class:`~grazing.engine.records.Kernels`), and returns a
 :class:`~grazing.engine.records.Result`.  Each step: the Taylor coefficients
 and the step size (:mod:`.events`), the step cut at the last sample or at the
 discontinuity map's phase, the first event on it, what the step records
@@ -31,7 +32,14 @@ import math
 import numpy as np
 from numba import njit
 
-from grazing.engine.records import Config, Result, Start
+from grazing.core.solution import Status
+from grazing.engine.driver.calls import tc_free, tc_stick, tc_var
+from grazing.engine.driver.events import first_event
+from grazing.engine.driver.impacts import apply_impact, chatter_remaining, close_sticking, enter_contact
+from grazing.engine.driver.recording import finish_guard, take_samples, track_guard, trajectory_points
+from grazing.engine.driver.tangent import discontinuity_map, lyapunov_step, shift_period
+from grazing.engine.polyroots import work_shape
+from grazing.engine.records import Config, Kernels, Result, Start
 from grazing.engine.stepping import (
     append_pair,
     append_row,
@@ -43,20 +51,28 @@ from grazing.engine.stepping import (
     unpack_var,
 )
 
+STATUS_OK = int(Status.OK)
+STATUS_STEP_LIMIT = int(Status.STEP_LIMIT)
+STATUS_NONFINITE = int(Status.NONFINITE)
+STATUS_ZENO = int(Status.ZENO)
+ROOT_WORK_ROWS, ROOT_WORK_MIN_COLS = work_shape(0)
+
 
 @njit(cache=True)
-def integrate(start, pv, cfg):
+def integrate(start, pv, cfg, m):
     """Integrate from ``start`` until the ``cfg.n_samples``-th stroboscopic sample (see the module).
 
-    ``start`` and ``cfg`` arrive as plain tuples in the field order of their
+    ``start``, ``cfg`` and ``m`` arrive as plain tuples in the field order of their
     records (numba types a plain tuple in C, a named tuple field by field in
     Python: 3x faster per call) and are named again here.  Every setting used
     in the loop is read from the record once, into a local.
     """
     start = Start(*start)
     cfg = Config(*cfg)
-    n = NX
-    order = ORDER
+    m = Kernels(*m)
+    n = m.nx
+    order = m.order
+    nstops = m.nstops
     # The settings read on every step, as locals (no record access in the loop).
     T = cfg.T
     wrap = cfg.wrap
@@ -79,7 +95,7 @@ def integrate(start, pv, cfg):
     zdm_window = cfg.zdm_window
     watch = cfg.stop
     factor = step_factor(cfg.safety, order)
-    ncol = n + NSENS
+    ncol = n + m.nsens
     nv = n * ncol if use_var else 0
     ntot = n + nv
     x = np.empty(ntot)
@@ -90,7 +106,7 @@ def integrate(start, pv, cfg):
             for c in range(ncol):
                 x[n + i * ncol + c] = start.V[i, c]
     X = np.zeros((ntot, order + 1))
-    O = np.zeros((NSTOPS, order + 1))
+    O = np.zeros((nstops, order + 1))
     work = np.zeros((ROOT_WORK_ROWS, max(order + 1, ROOT_WORK_MIN_COLS)))
     a = np.zeros(order + 1)
     gm = np.zeros(order + 1)
@@ -104,11 +120,11 @@ def integrate(start, pv, cfg):
     traj = new_table(64 if traj_dt > 0.0 else 1, 1 + n)
     logs = np.zeros(n)
     scratch = np.zeros(n)
-    min_info = np.full((NSTOPS, 2 * (2 + n)), math.inf)  # per stop (see track_guard)
-    slope_end = np.full(NSTOPS, math.nan)  # d guard / dt at the end of the previous free-flight step
-    slope_first = np.full(NSTOPS, math.nan)  # ... at the start of the first recorded one
+    min_info = np.full((nstops, 2 * (2 + n)), math.inf)  # per stop (see track_guard)
+    slope_end = np.full(nstops, math.nan)  # d guard / dt at the end of the previous free-flight step
+    slope_first = np.full(nstops, math.nan)  # ... at the start of the first recorded one
     fbuf = np.empty(n)
-    shift_sens = use_var and NSENS > 0 and wrap
+    shift_sens = use_var and m.nsens > 0 and wrap
     zdm_gh = np.zeros(n)
     zdm_gv = np.zeros(n)
 
@@ -161,13 +177,13 @@ def integrate(start, pv, cfg):
         # The step: Taylor coefficients of the solution (and of the event function), and the step size.
         if mode == 0:
             if use_var:
-                tc_var(x, s, pv, X, O)
+                tc_var(m, x, s, pv, X, O)
             else:
-                tc_free(x, s, pv, X, O)
-            h = step_size(X, ntot, O, NSTOPS, 0, order, max_step, factor)
+                tc_free(m, x, s, pv, X, O)
+            h = step_size(X, ntot, O, nstops, 0, order, max_step, factor)
         else:
-            tc_stick(x, s, pv, X, O, stuck)  # the first n rows only
-            h = step_size(X, n, O, NSTOPS, stuck, order, max_step, factor)
+            tc_stick(m, x, s, pv, X, O, stuck)  # the first n rows only
+            h = step_size(X, n, O, nstops, stuck, order, max_step, factor)
         rem = (ks - k) * T + (ss - s)
         is_last = False
         if isamp == n_samples - 1 and h >= rem:
@@ -183,7 +199,7 @@ def integrate(start, pv, cfg):
 
         # The first event on the step (each guard's polynomial in u in [0, 1]).
         u, ev_stop = first_event(
-            O, h, mode, stuck, events, watch if zdm_on else -1, defl, defl_stop,
+            m, O, h, mode, stuck, events, watch if zdm_on else -1, defl, defl_stop,
             touch_end and is_last and mode == 0, watch, a, work,
         )  # fmt: skip
         event = u >= 0.0 and h > 0.0
@@ -202,15 +218,15 @@ def integrate(start, pv, cfg):
         # What the step records within (0, h_acc].
         if (ks - k) * T + (ss - s) <= h_acc:  # a sample is due on this step (about once a period)
             isamp, ks, ss, recording, n_stick, n_traj, kt, st = take_samples(
-                T, wrap, n_samples, n_keep, traj_dt, X, k, s, h_acc, event, is_last, mode, isamp, ks, ss,
+                m, T, wrap, n_samples, n_keep, traj_dt, X, k, s, h_acc, event, is_last, mode, isamp, ks, ss,
                 keep_from, recording, samples, sticks, n_stick, traj, n_traj, kt, st, xe,
             )  # fmt: skip
         if recording and traj_dt > 0.0:
-            n_traj, kt, st = trajectory_points(T, wrap, traj_dt, X, k, s, h_acc, traj, n_traj, kt, st, xe)
+            n_traj, kt, st = trajectory_points(m, T, wrap, traj_dt, X, k, s, h_acc, traj, n_traj, kt, st, xe)
         if recording and track_min and mode == 0 and h_acc > 0.0:
-            for j in range(NSTOPS):  # every stop's closest approach
+            for j in range(nstops):  # every stop's closest approach
                 slope_end[j], slope_first[j] = track_guard(
-                    O, j, X, x, k * T + s, h, h_acc, defl if defl_stop == j else 0, event, gm, min_info[j],
+                    m, O, j, X, x, k * T + s, h, h_acc, defl if defl_stop == j else 0, event, gm, min_info[j],
                     slope_end[j], slope_first[j], xe,
                 )  # fmt: skip
 
@@ -221,20 +237,21 @@ def integrate(start, pv, cfg):
         s += h_acc
         if wrap and s >= T:
             if shift_sens and mode == 0:
-                shift_period(x, s, pv, Tp, ncol, fbuf)
+                shift_period(m, x, s, pv, Tp, ncol, fbuf)
             s -= T
             k += 1
         nsteps += 1
         defl = 0
         if lyap and use_var and mode == 0:
             lyap_started, lyap_t0 = lyapunov_step(
-                x, V, ncol, recording, lyap_started, lyap_t0, k * T + s, scratch, logs
+                m, x, V, ncol, recording, lyap_started, lyap_t0, k * T + s, scratch, logs
             )
 
         if zdm_hit:
             kz += 1
             record = record_impacts == 2 or (record_impacts == 1 and recording)
             applied, n_imp_rec = discontinuity_map(
+                m,
                 x,
                 s,
                 k * T + s,
@@ -272,21 +289,21 @@ def integrate(start, pv, cfg):
                 record = record_impacts == 2 or (record_impacts == 1 and recording)
                 traj_on = recording and traj_dt > 0.0
                 speed, n_imp_rec, n_traj, salt_ok = apply_impact(
-                    x, xp, s, k * T + s, pv, ev_stop, use_var, ncol, nrows, V, record, imp, n_imp_rec,
+                    m, x, xp, s, k * T + s, pv, ev_stop, use_var, ncol, nrows, V, record, imp, n_imp_rec,
                     traj_on, traj, n_traj,
                 )  # fmt: skip
                 jac_valid = jac_valid and salt_ok  # (an impact at zero normal speed has no Jacobian)
                 n_imp += 1
                 defl = 1
                 defl_stop = ev_stop
-                if HAS_STICK and STICKS[ev_stop]:
-                    dt_acc = chatter_remaining(x, s, pv, ev_stop, speed, chatter_time)
+                if m.sticks[ev_stop]:
+                    dt_acc = chatter_remaining(m, x, s, pv, ev_stop, speed, chatter_time)
                     if dt_acc >= 0.0:  # complete chattering: on to the accumulation point, then sticking
                         s += dt_acc
                         if wrap and s >= T:  # (the Jacobian is not valid after sticking)
                             s -= T
                             k += 1
-                        enter_contact(x, s, pv, ev_stop)
+                        enter_contact(m, x, s, pv, ev_stop)
                         mode = 1
                         stuck = ev_stop
                         defl = 0
@@ -298,8 +315,8 @@ def integrate(start, pv, cfg):
             break
 
     if track_min and mode == 0 and recording:
-        for j in range(NSTOPS):
-            finish_guard(x, s, pv, j, k * T + s, slope_end[j], slope_first[j], min_info[j])
+        for j in range(nstops):
+            finish_guard(m, x, s, pv, j, k * T + s, slope_end[j], slope_first[j], min_info[j])
     close_sticking(sticks, n_stick, k * T + s)
     lyap_span = k * T + s - lyap_t0 if (lyap and lyap_started) else 0.0
     Vout = np.zeros((n, ncol))

@@ -1,4 +1,4 @@
-"""Driver piece: what a step records (appended to each kernel module).
+"""Driver piece: what a step records.
 
 Stroboscopic samples and trajectory points are evaluated from the step's
 Taylor polynomials (dense output) at their exact times; the recorded span
@@ -12,13 +12,14 @@ import math
 import numpy as np  # noqa: F401 - the names the pieces share in the generated module
 from numba import njit
 
+from grazing.engine.driver.calls import guard
 from grazing.engine.polyroots import horner
 from grazing.engine.stepping import append_pair, append_row, eval_rows, poly_derivative, set_row, set_slice
 
 
 @njit(cache=True, inline="always")
 def take_samples(
-    T, wrap, n_samples, n_keep, traj_dt, X, k, s, h_acc, event, is_last, mode, isamp, ks, ss, keep_from,
+    m, T, wrap, n_samples, n_keep, traj_dt, X, k, s, h_acc, event, is_last, mode, isamp, ks, ss, keep_from,
     recording, samples, sticks, n_stick, traj, n_traj, kt, st, xe,
 ):  # fmt: skip
     """The samples within ``(0, h_acc]`` of the step; returns the updated sampling state.
@@ -28,7 +29,8 @@ def take_samples(
     the sticking-interval and trajectory counters (the span may start while
     sticking, and starts the trajectory).
     """
-    n = NX
+    n = m.nx
+    order = m.order
     while isamp < n_samples:
         dt = (ks - k) * T + (ss - s)
         if dt > h_acc or (event and dt == h_acc and not is_last):
@@ -36,7 +38,7 @@ def take_samples(
         if is_last and isamp == n_samples - 1:
             dt = h_acc
         if isamp >= keep_from:
-            eval_rows(X, n, ORDER, dt, xe)
+            eval_rows(X, n, order, dt, xe)
             set_row(samples, isamp - keep_from, 0, xe, n)
         isamp += 1
         if wrap:
@@ -49,7 +51,7 @@ def take_samples(
                 append_pair(sticks, n_stick, k * T + s + dt, math.nan)
                 n_stick += 1
             if traj_dt > 0.0:
-                eval_rows(X, n, ORDER, dt, xe)
+                eval_rows(X, n, order, dt, xe)
                 append_row(traj, n_traj, k * T + s + dt, xe, n)
                 n_traj += 1
                 kt = k
@@ -61,14 +63,14 @@ def take_samples(
 
 
 @njit(cache=True, inline="always")
-def trajectory_points(T, wrap, traj_dt, X, k, s, h_acc, traj, n_traj, kt, st, xe):
+def trajectory_points(m, T, wrap, traj_dt, X, k, s, h_acc, traj, n_traj, kt, st, xe):
     """Trajectory points within the step, every ``traj_dt``; returns ``(n_traj, kt, st)``."""
-    n = NX
+    n = m.nx
     while True:
         dt = (kt - k) * T + (st - s)
         if dt > h_acc:
             break
-        eval_rows(X, n, ORDER, dt, xe)
+        eval_rows(X, n, m.order, dt, xe)
         append_row(traj, n_traj, k * T + s + dt, xe, n)
         n_traj += 1
         st += traj_dt
@@ -79,7 +81,7 @@ def trajectory_points(T, wrap, traj_dt, X, k, s, h_acc, traj, n_traj, kt, st, xe
 
 
 @njit(cache=True, inline="always")
-def track_guard(O, row, X, x, t, h, h_acc, defl, event, gm, min_info, slope_end, slope_first, xe):
+def track_guard(m, O, row, X, x, t, h, h_acc, defl, event, gm, min_info, slope_end, slope_first, xe):
     """Minimum of event row ``row`` (a guard) over ``[t, t + h_acc)``, closest approach; returns the slopes.
 
     ``min_info[:2 + n]`` holds the smallest value, its time and the state
@@ -89,8 +91,8 @@ def track_guard(O, row, X, x, t, h, h_acc, defl, event, gm, min_info, slope_end,
     at the end of this step (nan when an event follows) and at the start of
     the first recorded step.
     """
-    n = NX
-    order = ORDER
+    n = m.nx
+    order = m.order
     hk = 1.0
     for j in range(order + 1):
         gm[j] = O[row, j] * hk
@@ -132,10 +134,10 @@ def track_guard(O, row, X, x, t, h, h_acc, defl, event, gm, min_info, slope_end,
 
 
 @njit(cache=True)
-def finish_guard(x, s, pv, j, t, slope_end, slope_first, min_info):
+def finish_guard(m, x, s, pv, j, t, slope_end, slope_first, min_info):
     """At the end of the run: the final state, and a minimum where the orbit closes."""
-    n = NX
-    g_end = guard(x, s, pv, j)
+    n = m.nx
+    g_end = guard(m, x, s, pv, j)
     if g_end < min_info[0]:
         min_info[0] = g_end
         min_info[1] = t

@@ -1,20 +1,20 @@
-"""Driver piece: the tangent dynamics and the discontinuity map (appended to each kernel module).
+"""Driver piece: the tangent dynamics and the discontinuity map.
 
 The variational matrix ``V`` is integrated with the state (its rows follow
 the state in ``x``): columns ``0 .. n-1`` are ``d x / d x0``, the next
-``NSENS`` the derivatives along the sensitivity directions in parameter space.
+``m.nsens`` the derivatives along the sensitivity directions in parameter space.
 """
 
 import math
 
-import numpy as np  # noqa: F401 - the names the pieces share in the generated module
 from numba import njit
 
+from grazing.engine.driver.calls import guard, guard_grad, normal_rate, normal_rate_grad, rhs
 from grazing.engine.stepping import append_record, orthonormalize, pack_var, unpack_var
 
 
 @njit(cache=True)
-def shift_period(x, s, pv, Tp, ncol, f):
+def shift_period(m, x, s, pv, Tp, ncol, f):
     """Parameter columns of V at a period boundary: ``V_p += f(x, s) dT/dp``.
 
     Time is kept as ``k T + s``; the variational equations give derivatives at
@@ -23,20 +23,21 @@ def shift_period(x, s, pv, Tp, ncol, f):
     parameter the two labels are different instants, ``dT/dp`` apart per
     period, and the state moves by ``f dT/dp`` between them.
     """
-    rhs(x, s, pv, f)
-    for i in range(NX):
-        for c in range(NSENS):
-            x[NX + i * ncol + NX + c] += f[i] * Tp[c]
+    rhs(m, x, s, pv, f)
+    n = m.nx
+    for i in range(n):
+        for c in range(m.nsens):
+            x[n + i * ncol + n + c] += f[i] * Tp[c]
 
 
 @njit(cache=True, inline="always")
-def lyapunov_step(x, V, ncol, recording, started, t0, t, scratch, logs):
+def lyapunov_step(m, x, V, ncol, recording, started, t0, t, scratch, logs):
     """Gram-Schmidt on the tangent vectors after a step; returns ``(started, t0)``.
 
     Before the recorded span the vectors are only aligned (their growth is
     discarded); from its start the log norms are summed into ``logs``.
     """
-    n = NX
+    n = m.nx
     unpack_var(x, n, ncol, V)
     if recording and not started:
         started = True
@@ -51,7 +52,7 @@ def lyapunov_step(x, V, ncol, recording, started, t0, t, scratch, logs):
 
 
 @njit(cache=True)
-def discontinuity_map(x, s, t, pv, j, a, e, window, use_var, ncol, V, gh, gv, record, imp, n_rec):
+def discontinuity_map(m, x, s, t, pv, j, a, e, window, use_var, ncol, V, gh, gv, record, imp, n_rec):
     """Nordmark's discontinuity map at leading order, at the grazing phase; returns ``(applied, n_rec)``.
 
     With ``v = L_f h`` and ``delta = v^2 / (2 a) - h`` (how far the local
@@ -61,17 +62,17 @@ def discontinuity_map(x, s, t, pv, j, a, e, window, use_var, ncol, V, gh, gv, re
     variational matrix by ``dD/dx = I - e (grad S)^T``.  The kick is recorded
     as an impact (time, speed ``S``, state) when ``record``.
     """
-    n = NX
-    hval = guard(x, s, pv, j)
-    vn = normal_rate(x, s, pv, j)
+    n = m.nx
+    hval = guard(m, x, s, pv, j)
+    vn = normal_rate(m, x, s, pv, j)
     dz = vn * vn / (2.0 * a) - hval
     if not (dz > 0.0 and abs(vn) < window * a):
         return False, n_rec
     sp_ = math.sqrt(2.0 * a * dz)
     if use_var:
         # dD/dx = I - e (grad S)^T, grad S = a grad(delta) / S
-        guard_grad(x, s, pv, gh, j)
-        normal_rate_grad(x, s, pv, gv, j)
+        guard_grad(m, x, s, pv, gh, j)
+        normal_rate_grad(m, x, s, pv, gv, j)
         unpack_var(x, n, ncol, V)
         for c in range(ncol):
             gs = 0.0
