@@ -18,6 +18,7 @@ The cache directory is ``$GRAZING_CACHE_DIR`` if set, else
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import importlib.util
 import json
@@ -296,6 +297,7 @@ def kernel_key(identity: str, directions: int, order: int = DEFAULT_ORDER) -> st
     return _key(identity, int(directions), order, versions, deps)
 
 
+@functools.cache
 def driver_key() -> str:
     """Cache key of the compiled driver: its sources and those of everything it inlines.
 
@@ -415,10 +417,13 @@ class ModelKernels:
         self.table = (fns, self.NX, self.NSENS, self.NSTOPS, self.ORDER, np.array(self.STICKS, dtype=bool))
         for name in SLOTS:
             setattr(self, name, library.function(name))
+        self._integrate: Callable[..., Any] | None = None
 
     def integrate(self, start: tuple[Any, ...], pv: np.ndarray, cfg: tuple[Any, ...]) -> Any:
         """Run the driver on this model (see :mod:`grazing.engine.driver.loop`)."""
-        return load_driver().integrate(start, pv, cfg, self.table)
+        if self._integrate is None:
+            self._integrate = load_driver().integrate
+        return self._integrate(start, pv, cfg, self.table)
 
 
 _loaded: dict[str, ModelKernels] = {}
