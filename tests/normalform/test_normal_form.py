@@ -100,6 +100,22 @@ def test_map_without_impact_is_the_linearised_stroboscopic_map(nf40):
     np.testing.assert_allclose(np.array(cols).T, nf40.monodromy, atol=2e-3)
 
 
+def test_batched_iteration_follows_the_normal_form_map(nf40):
+    """Iterating many mu at once gives each mu's iteration of ``normal_form``'s map."""
+    from grazing.normalform.prediction import iterate_normal_form
+
+    step = nf40.normal_form("eta")
+    mus = np.array([1e-5, -3e-4, 6e-4, 2.5e-3])
+    states, speeds = iterate_normal_form(nf40, "eta", mus, n=60, keep=60)
+    for i, mu in enumerate(mus):
+        u = np.zeros(2)
+        for k in range(60):
+            u, s = step(u, mu)
+            np.testing.assert_allclose(states[k, i], u, rtol=1e-12, atol=1e-18)
+            assert speeds[k, i] == pytest.approx(s, rel=1e-12, abs=1e-18)
+    assert np.array_equal(iterate_normal_form(nf40, "eta", mus[2], n=60, keep=60)[0], states[:, 2])
+
+
 def test_normal_form_map_and_flow_agree_near_grazing(nf40):
     """Small mu: the linear 2-D normal form, the nonlinear-flow map and the exact impacting
     flow settle on orbits of the same period (windows of the period-adding cascade)."""
