@@ -5,7 +5,10 @@ script takes the pendulum's generated free-flight kernel (``tc_free``: the
 Taylor coefficients of the solution and of the guards, straight-line code)
 and times three ways of computing it for ``L`` states at once, per lane:
 
-1. ``numba scalar``: today's kernel called once per lane (the reference);
+1. ``numba scalar``: the kernel's text compiled by numba (the engine's kernels before
+   issue 15) called once per lane (the reference); and the engine's own scalar kernel
+   (compiled from the same text through LLVM IR by :mod:`grazing.engine.llvmgen`), called
+   from numba through its address;
 2. ``numba lanes``: the same straight-line body inside ``for l in range(L)``
    with lane-contiguous arrays (``X[i, k, l]``) -- what an attempt in numba
    looks like.  The assembly shows whether LLVM vectorised it (packed
@@ -22,7 +25,8 @@ Run::
 
     python benchmarks/simd_probe.py          # L = 4 and 8
 
-Findings on the 2-core AVX-512 machine of benchmarks/README.md (order 20):
+Findings on the 2-core AVX-512 machine of benchmarks/README.md (order 20): the engine's
+scalar kernel is bit-identical to numba's and 1.1-1.25x faster;
 numba does not vectorise the lane loop -- no packed multiply for L = 4 or 8,
 0.43-1.1x per lane (the earlier attempt's 0.6-0.9x), 1.2x with ``fastmath``
 only by contracting to scalar FMAs, which changes the results.  The llvmlite

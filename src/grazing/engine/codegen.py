@@ -444,9 +444,20 @@ def load_compiled(key: str, source: Callable[[], ModelSource]) -> ModelKernels:
     if kernels is None:
         from grazing.engine import llvmgen
 
-        path = _cached_file(f"grazing_model_{key}.bin", lambda: compile_model(source(), key))
-        header, obj = path.read_bytes().split(b"\n", 1)
-        kernels = _loaded[key] = ModelKernels(llvmgen.Library(obj, f"grazing_{key}"), json.loads(header))
+        name = f"grazing_model_{key}.bin"
+
+        def read(path: Path) -> ModelKernels:
+            header, obj = path.read_bytes().split(b"\n", 1)
+            sizes = json.loads(header)
+            return ModelKernels(llvmgen.Library(obj, f"grazing_{key}"), sizes)
+
+        path = _cached_file(name, lambda: compile_model(source(), key))
+        try:
+            kernels = read(path)
+        except (ValueError, RuntimeError, OSError):  # a damaged cache file (ours): compile it again
+            path.unlink(missing_ok=True)
+            kernels = read(_cached_file(name, lambda: compile_model(source(), key)))
+        _loaded[key] = kernels
     return kernels
 
 
