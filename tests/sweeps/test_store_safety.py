@@ -411,7 +411,7 @@ def test_ctrl_c_stops_at_once_and_keeps_the_finished_chunks(tmp_path):
     finally:
         if proc.poll() is None:
             proc.kill()
-    assert proc.returncode == 130
+    assert proc.returncode == 130, (proc.returncode, err, _chunks_done(out), workers)
     assert err.strip() == "grazing: interrupted"
     assert all_gone(workers)
     assert 1 <= _chunks_done(out) < 400  # what was finished is kept (and resumed by the same command)
