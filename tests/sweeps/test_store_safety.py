@@ -399,10 +399,16 @@ def test_a_worker_killed_by_the_system_is_one_line_and_takes_the_others_along(tm
     assert _chunks_done(out) >= 1
 
 
+def _default_sigint() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def test_ctrl_c_stops_at_once_and_keeps_the_finished_chunks(tmp_path):
     out = tmp_path / "c.zarr"
+    # As from a terminal: Ctrl-C's default disposition (a test runner's worker may ignore SIGINT,
+    # and a child started from it would inherit that and run to the end).
     proc = subprocess.Popen(_slow_cli(out), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            start_new_session=True)  # fmt: skip
+                            start_new_session=True, preexec_fn=_default_sigint)  # fmt: skip
     try:
         assert wait_until(lambda: _chunks_done(out) >= 1)
         workers = descendants(proc.pid)
