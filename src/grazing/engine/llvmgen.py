@@ -315,17 +315,16 @@ class Library:
             if not addr:
                 raise AttributeError(f"no compiled function {name!r}")
             cfunc = _CFUNC(addr)
-            library = self  # the code lives as long as its callers
 
             def caller(x: np.ndarray, s: float, pv: np.ndarray, *rest: Any) -> float:
                 ptrs = [_pointer(x), float(s), _pointer(pv)]
                 arrays = [r for r in rest if isinstance(r, np.ndarray)]
                 j = [r for r in rest if not isinstance(r, np.ndarray)]
                 ptrs += [_pointer(a) for a in arrays] + [None] * (ARITY - len(arrays))
-                assert library._engine is not None
                 return cfunc(*ptrs, int(j[0]) if j else 0)
 
             caller.__name__ = name
+            caller.library = self  # type: ignore[attr-defined]  # the code lives as long as its callers
             self._callers[name] = caller
         return caller
 
