@@ -31,10 +31,18 @@ SLOTS = (
 )  # fmt: skip
 """The model functions, in the order of the address table the driver receives."""
 
+LANE_SLOTS = ("tc_free_lanes", "tc_var_lanes")
+"""The lane (SIMD) versions of the Taylor kernels, after :data:`SLOTS` in the table (address 0 if absent).
+
+A lane function computes its kernel for ``L`` points at once: every array
+element holds ``L`` lanes (lane ``l`` of element ``e`` at ``e * L + l``),
+the lanes' times come in ``c`` (``L`` doubles) and ``s`` is unused.
+"""
+
 (
     TC_FREE, TC_VAR, TC_STICK, RHS, GUARD, GUARD_GRAD, GUARD_PGRAD, RESET, RESET_JAC, NORMAL_RATE,
-    NORMAL_ACCEL, NORMAL_RATE_GRAD, CONTACT_DIR, PERIOD_GRAD,
-) = range(len(SLOTS))  # fmt: skip
+    NORMAL_ACCEL, NORMAL_RATE_GRAD, CONTACT_DIR, PERIOD_GRAD, TC_FREE_LANES, TC_VAR_LANES,
+) = range(len(SLOTS) + len(LANE_SLOTS))  # fmt: skip
 
 
 def _call_model_intrinsic():  # pragma: no cover - compiled

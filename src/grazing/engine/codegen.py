@@ -38,7 +38,7 @@ from grazing.core.model import set_kernel_loader
 from grazing.core.options import MACHINE_EPSILON
 from grazing.core.symbolic import SymbolicSystem
 from grazing.engine import driver
-from grazing.engine.abi import SLOTS
+from grazing.engine.abi import LANE_SLOTS, SLOTS
 
 if TYPE_CHECKING:  # pragma: no cover
     import sympy as sp
@@ -411,10 +411,12 @@ class ModelKernels:
         self.ORDER = int(sizes["order"])
         self.STICKS = tuple(bool(s) for s in sizes["sticks"])
         self.HAS_STICK = any(self.STICKS)
-        fns = np.array([library.address(name) for name in SLOTS], dtype=np.int64)
-        if not fns.all():  # pragma: no cover - a damaged cache file
-            raise OSError("compiled model functions are missing from the kernel cache")
-        self.table = (fns, self.NX, self.NSENS, self.NSTOPS, self.ORDER, np.array(self.STICKS, dtype=bool))
+        self.LANES = int(sizes.get("lanes", 0))
+        fns = np.array([library.address(name) for name in SLOTS + LANE_SLOTS], dtype=np.int64)
+        if not fns[: len(SLOTS)].all() or (self.LANES and not fns[len(SLOTS) :].all()):  # pragma: no cover
+            raise OSError("compiled model functions are missing from the kernel cache")  # a damaged file
+        sticks = np.array(self.STICKS, dtype=bool)
+        self.table = (fns, self.NX, self.NSENS, self.NSTOPS, self.ORDER, sticks, self.LANES)
         for name in SLOTS:
             setattr(self, name, library.function(name))
         self._integrate: Callable[..., Any] | None = None
@@ -434,8 +436,14 @@ def compile_model(source: ModelSource, key: str) -> bytes:
     from grazing.engine import llvmgen
 
     prefix = f"grazing_{key}"
-    module = llvmgen.translate(source.text, prefix, columns=source.columns, dispatch=source.dispatch)
-    return json.dumps(source.sizes).encode() + b"\n" + llvmgen.compile_object(module)
+    # Lane (SIMD) versions of the Taylor kernels for sweeps, which use no sensitivity directions.
+    lanes = llvmgen.lane_width() if source.sizes["nsens"] == 0 else 0
+    module = llvmgen.translate(
+        source.text, prefix, columns=source.columns, dispatch=source.dispatch, lanes=lanes,
+        lane_functions=("tc_free", "tc_var"),
+    )  # fmt: skip
+    sizes = {**source.sizes, "lanes": lanes}
+    return json.dumps(sizes).encode() + b"\n" + llvmgen.compile_object(module)
 
 
 def load_compiled(key: str, source: Callable[[], ModelSource]) -> ModelKernels:

@@ -75,14 +75,31 @@ class _Function:
     builder: ir.IRBuilder
     args: dict[str, tuple[str, Any]]  # Python name -> ("ptr", value, columns) or ("val", value)
     columns: Mapping[str, int]
+    lanes: int = 0  # 0: scalars; L: every value a vector of L lanes (see translate)
     env: dict[str, ir.Value] = field(default_factory=dict)
 
     def _declare(self, name: str, nargs: int, intrinsic: bool) -> ir.Function:
-        full = f"llvm.{name}.f64" if intrinsic else name
+        ty = ir.VectorType(_DOUBLE, self.lanes) if self.lanes and intrinsic else _DOUBLE
+        full = (f"llvm.{name}.v{self.lanes}f64" if self.lanes else f"llvm.{name}.f64") if intrinsic else name
         existing = self.module.globals.get(full)
         if existing is not None:
             return existing
-        return ir.Function(self.module, ir.FunctionType(_DOUBLE, [_DOUBLE] * nargs), name=full)
+        return ir.Function(self.module, ir.FunctionType(ty, [ty] * nargs), name=full)
+
+    def _constant(self, ty: ir.Type, v: Any) -> ir.Constant:
+        """A constant, as a vector of equal lanes in lane functions."""
+        if self.lanes:
+            return ir.Constant(ir.VectorType(ty, self.lanes), [v] * self.lanes)
+        return ir.Constant(ty, v)
+
+    def _scalarised(self, callee: ir.Function, args: list[ir.Value]) -> ir.Value:
+        """``callee`` (a C function of doubles) applied lane by lane."""
+        b = self.builder
+        out = self._constant(_DOUBLE, 0.0)
+        for lane in range(self.lanes):
+            i = ir.Constant(ir.IntType(32), lane)
+            out = b.insert_element(out, b.call(callee, [b.extract_element(a, i) for a in args]), i)
+        return out
 
     def _element(self, node: ast.Subscript) -> ir.Value:
         """Pointer to ``arr[i]`` or ``arr[i, k]`` (C order; the columns of 2-D arrays are known)."""
@@ -98,6 +115,9 @@ class _Function:
             offset = i * self.columns[name] + k
         else:
             offset = _int(idx)
+        if self.lanes:  # lane l of element e is at e * L + l
+            vec = ir.VectorType(_DOUBLE, self.lanes).as_pointer()
+            return self.builder.bitcast(self.builder.gep(ptr, [ir.Constant(_I64, offset * self.lanes)]), vec)
         return self.builder.gep(ptr, [ir.Constant(_I64, offset)])
 
     def value(self, node: ast.expr) -> ir.Value:
@@ -105,9 +125,9 @@ class _Function:
         b = self.builder
         if isinstance(node, ast.Constant):
             if isinstance(node.value, bool):
-                return ir.Constant(_I1, int(node.value))
+                return self._constant(_I1, int(node.value))
             if isinstance(node.value, int | float):
-                return ir.Constant(_DOUBLE, float(node.value))
+                return self._constant(_DOUBLE, float(node.value))
         elif isinstance(node, ast.Name):
             if node.id in self.env:
                 return self.env[node.id]
@@ -115,9 +135,9 @@ class _Function:
                 return self.args[node.id][1]
         elif isinstance(node, ast.Attribute):
             if isinstance(node.value, ast.Name) and node.value.id == "math" and node.attr in _CONSTANTS:
-                return ir.Constant(_DOUBLE, _CONSTANTS[node.attr])
+                return self._constant(_DOUBLE, _CONSTANTS[node.attr])
         elif isinstance(node, ast.Subscript):
-            return b.load(self._element(node))
+            return b.load(self._element(node), align=8)
         elif isinstance(node, ast.UnaryOp):
             v = self.value(node.operand)
             if isinstance(node.op, ast.USub):
@@ -169,7 +189,8 @@ class _Function:
             if name in _INTRINSICS:
                 return b.call(self._declare(name, len(args), True), args)
             if name in _EXTERNS:
-                return b.call(self._declare(_EXTERNS[name], len(args), False), args)
+                callee = self._declare(_EXTERNS[name], len(args), False)
+                return self._scalarised(callee, args) if self.lanes else b.call(callee, args)
         raise UntranslatableCodeError(f"cannot translate the call {ast.unparse(node)!r} to LLVM IR")
 
     def statement(self, stmt: ast.stmt) -> bool:
@@ -182,9 +203,11 @@ class _Function:
                 self.env[target.id] = v
                 return False
             if isinstance(target, ast.Subscript):
-                b.store(v, self._element(target))
+                b.store(v, self._element(target), align=8)
                 return False
         elif isinstance(stmt, ast.Return):
+            if self.lanes and stmt.value is not None:
+                raise UntranslatableCodeError("a lane function returns nothing")
             b.ret(ir.Constant(_DOUBLE, 0.0) if stmt.value is None else self.value(stmt.value))
             return True
         elif isinstance(stmt, ast.Expr) and isinstance(stmt.value, ast.Constant):  # a docstring
@@ -198,16 +221,24 @@ def _int(node: ast.expr) -> int:
     raise UntranslatableCodeError(f"array index {ast.unparse(node)!r} is not a constant")
 
 
-def _define(module: ir.Module, fdef: ast.FunctionDef, symbol: str, columns: Mapping[str, int]) -> None:
+def _define(
+    module: ir.Module, fdef: ast.FunctionDef, symbol: str, columns: Mapping[str, int], lanes: int = 0
+) -> None:
     """Define ``symbol`` in ``module`` from the Python function ``fdef`` (see :func:`translate`)."""
     fn = ir.Function(module, _FNTY, name=symbol)
     params = [a.arg for a in fdef.args.args]
-    if not 3 <= len(params) <= 6:
+    if not 3 <= len(params) <= (5 if lanes else 6):
         raise UntranslatableCodeError(f"{fdef.name} has {len(params)} arguments (3 to 6 expected)")
     x, s, pv, a, bb, c, _j = fn.args
-    slots = [("ptr", x), ("val", s), ("ptr", pv), ("ptr", a), ("ptr", bb), ("ptr", c)]
     builder = ir.IRBuilder(fn.append_basic_block("entry"))
-    f = _Function(module, fn, builder, dict(zip(params, slots)), columns)
+    if lanes:  # the lanes' times come in c, as L doubles
+        for arg in (x, pv, a, bb, c):
+            arg.add_attribute("noalias")
+        svec = builder.load(builder.bitcast(c, ir.VectorType(_DOUBLE, lanes).as_pointer()), align=8)
+        slots = [("ptr", x), ("val", svec), ("ptr", pv), ("ptr", a), ("ptr", bb)]
+    else:
+        slots = [("ptr", x), ("val", s), ("ptr", pv), ("ptr", a), ("ptr", bb), ("ptr", c)]
+    f = _Function(module, fn, builder, dict(zip(params, slots)), columns, lanes)
     for stmt in fdef.body:
         if f.statement(stmt):
             return
@@ -215,7 +246,8 @@ def _define(module: ir.Module, fdef: ast.FunctionDef, symbol: str, columns: Mapp
 
 
 def translate(source: str, prefix: str, columns: Mapping[str, Mapping[str, int]] | None = None,
-              dispatch: Mapping[str, list[str]] | None = None) -> ir.Module:  # fmt: skip
+              dispatch: Mapping[str, list[str]] | None = None, lanes: int = 0,
+              lane_functions: tuple[str, ...] = ()) -> ir.Module:  # fmt: skip
     """The LLVM module of every ``def`` in ``source``, each named ``{prefix}_{name}``.
 
     A function ``def f(x, s, pv[, a[, b[, c]]])`` becomes ``double
@@ -225,6 +257,15 @@ def translate(source: str, prefix: str, columns: Mapping[str, Mapping[str, int]]
     argument of ``f``.  ``dispatch[name]`` lists functions (one per stop)
     that ``{prefix}_{name}`` calls according to its last argument ``j``
     (any other ``j``: the last of them).
+
+    With ``lanes = L``, each function ``f`` named in ``lane_functions`` (a
+    function of ``x, s, pv`` and at most two output arrays) also becomes
+    ``{prefix}_{f}_lanes``, which computes ``f`` for ``L`` points at once on
+    vectors of ``L`` doubles (SIMD): every array element holds ``L`` lanes
+    (lane ``l`` of element ``e`` at ``e * L + l``), and the lanes' times come
+    in the argument ``c`` (``L`` doubles; ``s`` is unused).  Each lane's
+    result is the same operations on the same values as ``f``'s: the same
+    numbers, bit for bit.
     """
     module = ir.Module(name=prefix)
     module.triple = llvm.get_process_triple()
@@ -233,6 +274,8 @@ def translate(source: str, prefix: str, columns: Mapping[str, Mapping[str, int]]
     for node in tree.body:
         if isinstance(node, ast.FunctionDef):
             _define(module, node, f"{prefix}_{node.name}", columns.get(node.name, {}))
+            if lanes and node.name in lane_functions:
+                _define(module, node, f"{prefix}_{node.name}_lanes", columns.get(node.name, {}), lanes)
     for name, targets in (dispatch or {}).items():
         fn = ir.Function(module, _FNTY, name=f"{prefix}_{name}")
         b = ir.IRBuilder(fn.append_basic_block("entry"))
@@ -267,6 +310,23 @@ def _target_machine() -> Any:
     return target.create_target_machine(
         cpu=llvm.get_host_cpu_name(), features=features, opt=3, reloc="pic", codemodel="default"
     )
+
+
+def lane_width() -> int:
+    """Doubles in this CPU's widest vector registers: 8 with AVX-512, 4 with AVX, else 2.
+
+    Examples
+    --------
+    >>> lane_width() in (2, 4, 8)
+    True
+    """
+    _target_machine()  # (initialises LLVM)
+    features = llvm.get_host_cpu_features()
+    if features.get("avx512f"):
+        return 8
+    if features.get("avx"):
+        return 4
+    return 2
 
 
 def compile_object(module: ir.Module) -> bytes:

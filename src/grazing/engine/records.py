@@ -72,12 +72,13 @@ STATIC = Config._fields[Config._fields.index("T") :]
 class Kernels(NamedTuple):
     """A model's compiled functions as the driver sees them: their addresses and the model's sizes."""
 
-    fns: np.ndarray  # int64 addresses, in the order of grazing.engine.abi.SLOTS
+    fns: np.ndarray  # int64 addresses, in the order of grazing.engine.abi.SLOTS then LANE_SLOTS
     nx: int  # states
     nsens: int  # sensitivity directions (columns of V after the first nx)
     nstops: int
     order: int  # of the Taylor polynomials
     sticks: np.ndarray  # bool per stop: the stop has a sticking mode
+    lanes: int  # lanes of the lane functions (0: none)
 
 
 class Result(NamedTuple):

@@ -5,10 +5,15 @@ process pool of the package: workers die with their parent, at most a few
 chunks are queued ahead, Ctrl-C cancels what is queued and stops the workers
 at once).  A Dask cluster gets the same bounded window of chunks; without any
 worker for a while the caller is told, and given up on after a timeout.
+
+Chunks travel in groups (:func:`chunk_groups`) that a worker computes
+together on the SIMD lanes of :func:`grazing.sweeps.run.run_chunks`: a
+continuation sweep needs one chunk per lane to fill them.
 """
 
 from __future__ import annotations
 
+import math
 import os
 import time
 from collections.abc import Callable, Iterator, Sequence
@@ -16,7 +21,7 @@ from typing import Any
 
 from grazing.errors import GrazingError
 from grazing.parallel import in_flight, map_unordered
-from grazing.sweeps.run import run_chunk
+from grazing.sweeps.run import run_chunks
 from grazing.sweeps.spec import ChunkResult, SweepSpec
 
 
@@ -42,9 +47,33 @@ def _init_pool_worker(parent_pid: int, spec: SweepSpec) -> None:
     _WORKER_SPEC = spec
 
 
-def _run_chunk_in_worker(index: int) -> ChunkResult:
+def _run_group_in_worker(group: list[int]) -> list[ChunkResult]:
     assert _WORKER_SPEC is not None
-    return run_chunk(_WORKER_SPEC, index)
+    return run_chunks(_WORKER_SPEC, group)
+
+
+def chunk_groups(spec: SweepSpec, todo: Sequence[int], workers: int) -> list[list[int]]:
+    """``todo`` split into groups of consecutive chunks, each computed together on SIMD lanes.
+
+    A continuation sweep fills the lanes with one chunk each, a fresh one
+    with points (about four per lane); no group is bigger than an even share
+    of the chunks among the workers.
+
+    Examples
+    --------
+    >>> import grazing
+    >>> from grazing.sweeps.spec import sweep_spec
+    >>> spec = sweep_spec(grazing.models.pendulum("B"), "eta", [0.4 + 0.001 * i for i in range(100)])
+    >>> [len(g) for g in chunk_groups(spec, range(spec.n_chunks), workers=2)]
+    [1, 1]
+    """
+    from grazing.engine.llvmgen import lane_width
+
+    lanes = lane_width()
+    per = math.ceil(4 * lanes / spec.size) if spec.fresh else lanes
+    per = max(1, min(per, math.ceil(len(todo) / max(1, workers))))
+    todo = list(todo)
+    return [todo[i : i + per] for i in range(0, len(todo), per)]
 
 
 def _local_results(
@@ -53,14 +82,16 @@ def _local_results(
     """Chunk results from local worker processes (:func:`grazing.parallel.map_unordered`).
 
     Each worker receives the spec once, when it starts; ``run`` replaces
-    ``run_chunk`` (tests).
+    the computation of one chunk (tests).
     """
     if run is not None:
         yield from map_unordered(run, list(todo), workers)
         return
-    yield from map_unordered(
-        _run_chunk_in_worker, list(todo), workers, initializer=_init_pool_worker, initargs=(spec,)
-    )
+    for results in map_unordered(
+        _run_group_in_worker, chunk_groups(spec, todo, workers), workers, initializer=_init_pool_worker,
+        initargs=(spec,),
+    ):  # fmt: skip
+        yield from results
 
 
 def _dask_workers(client: Any) -> int:
@@ -85,15 +116,15 @@ def _dask_results(
     from distributed import wait
 
     address = getattr(getattr(client, "scheduler", None), "address", "the scheduler")
-    queue = iter(todo)
+    queue = iter(chunk_groups(spec, todo, max(1, _dask_workers(client))))
     pending: set[Any] = set()
     idle_since: float | None = None
     noticed = False
     try:
         while True:
             window = max(64, in_flight(_dask_workers(client)))  # one look at the cluster per round
-            for i in queue:
-                pending.add(client.submit(run_chunk, spec, i, pure=False))
+            for group in queue:
+                pending.add(client.submit(run_chunks, spec, group, pure=False))
                 if len(pending) >= window:
                     break
             if not pending:
@@ -106,7 +137,7 @@ def _dask_results(
             if finished:
                 idle_since = None
                 for fut in finished:
-                    yield _dask_result(fut)
+                    yield from _dask_result(fut)
                 continue
             if _dask_workers(client):
                 idle_since = None
@@ -128,8 +159,8 @@ def _dask_results(
         raise
 
 
-def _dask_result(fut: Any) -> ChunkResult:
-    """A finished chunk's result; a failure of the cluster (a worker killed too often...) as one line."""
+def _dask_result(fut: Any) -> list[ChunkResult]:
+    """A finished group's chunk results; a failure of the cluster (a worker killed...) as one line."""
     try:
         return fut.result()
     except GrazingError:
@@ -153,7 +184,7 @@ def chunk_results(
         return
     workers = workers or os.cpu_count() or 1
     if workers <= 1 or len(todo) <= 1:
-        for i in todo:
-            yield run_chunk(spec, i)
+        for group in chunk_groups(spec, todo, 1):
+            yield from run_chunks(spec, group)
         return
     yield from _local_results(spec, todo, workers)

@@ -1,4 +1,4 @@
-"""Computing a chunk of a sweep: pure functions of the spec (what a worker runs).
+"""Computing chunks of a sweep: pure functions of the spec (what a worker runs).
 
 At each point the model is run for a transient, then ``periods`` forcing
 periods are sampled at the stroboscopic phase; the samples, their period, the
@@ -14,117 +14,127 @@ congruent to the full transient modulo p).  The samples, and in a continuation
 sweep the next point's starting state, are then those of the full transient to
 about 1e-9.  (In a continuation sweep through chaos with coexisting attractors,
 such a 1e-9 difference can, like any rounding difference, lead the next points
-to another attractor; fresh sweeps are unaffected.)
+to another attractor; fresh sweeps are unaffected.)  With Lyapunov exponents,
+the last 16 periods of the transient align the tangent vectors, and the
+exponent is taken over the sampled periods.
+
+The points are computed by the compiled driver on SIMD lanes
+(:mod:`grazing.engine.driver.lanes`): several points at once, each lane its
+own point with its own steps and events; in a continuation sweep a lane
+follows one chunk, in a fresh sweep it takes any point.  The results do not
+depend on the lanes (each lane does the scalar path's arithmetic).
 """
 
 from __future__ import annotations
 
 import math
 import time
-from typing import Any
+from collections.abc import Sequence
 
 import numpy as np
 
-from grazing.core.model import HybridModel
+from grazing.core.options import CHATTER_TOL
 from grazing.core.period import DEFAULT_MAX_PERIOD, DEFAULT_PERIOD_TOL, detect_period
-from grazing.engine.runner import Runner
-from grazing.errors import SimulationError
+from grazing.engine.codegen import load_driver, taylor_order
+from grazing.engine.runner import step_safety
 from grazing.sweeps.spec import ChunkResult, SweepSpec
 
-ADAPTIVE_BLOCK = 32
-"""Periods of the transient run between two looks at the samples (adaptive transients)."""
 
-ADAPTIVE_MAX_PERIOD = 16
-"""The largest period an adaptive transient recognises."""
+def run_chunks(spec: SweepSpec, indices: Sequence[int]) -> list[ChunkResult]:
+    """Compute the chunks ``indices`` of ``spec`` together (on SIMD lanes); their results in that order.
 
-ADAPTIVE_TOL = 1e-9
-"""Samples repeating to this tolerance end an adaptive transient."""
-
-LYAPUNOV_ALIGN = 16
-"""Periods of the transient during which the tangent vectors are aligned (not counted)."""
-
-
-def run_point(spec: SweepSpec, model: HybridModel, x: np.ndarray, t0: float) -> tuple[Any, ...]:
-    """Transient then sampled periods at one point; returns the point's results."""
-    run = Runner(model, x, t0=t0, phase=spec.phase, tol=spec.tol, zdm=spec.zdm)
-    align = min(LYAPUNOV_ALIGN, spec.transient) if spec.lyapunov else 0
-    budget = spec.transient - align
-    used = 0
-    # The transient always runs in the same blocks (so the trajectory does not
-    # depend on ``adaptive``); adaptive only decides whether to stop early.
-    while used < budget:
-        block = min(ADAPTIVE_BLOCK, budget - used)
-        seg = run.advance(block, block if spec.adaptive else 0)
-        used += block
-        if spec.adaptive and block == ADAPTIVE_BLOCK:
-            p = detect_period(seg.samples, tol=ADAPTIVE_TOL, max_period=ADAPTIVE_MAX_PERIOD)
-            if p > 0:
-                # Stop at the point of the cycle where the full transient would end,
-                # so that the samples (and the next point's start) are the same.
-                extra = (budget - used) % p
-                if extra:
-                    run.advance(extra, 0)
-                    used += extra
-                break
-    if spec.lyapunov:
-        var = Runner(model, run.x, t0=run.t, phase=spec.phase, tol=spec.tol, variational=True, zdm=spec.zdm)
-        var.mode = run.mode
-        seg = var.advance(align + spec.periods, spec.periods, lyapunov=True, impacts="sampled")
-        lyap = (
-            float(np.max(seg.log_sums / seg.lyap_span)) if seg.jacobian_valid and seg.lyap_span else math.nan
+    Each chunk's result is a pure function of the spec and its index: the
+    same whichever chunks are computed with it.
+    """
+    start = time.perf_counter()
+    model = spec.model
+    n, m, nstops = model.n_states, spec.periods, model.n_stops
+    slices = [spec.chunk(i) for i in indices]
+    pts = [pt for sl in slices for pt in spec.points[sl]]
+    npts = len(pts)
+    models = [spec.model_at(pt) for pt in pts]
+    order = taylor_order(spec.tol)
+    kern = model.kernels(0, order)
+    pvs = np.array([mm.param_vector for mm in models], dtype=float).reshape(npts, -1)
+    Ts = np.array([float(mm.period) for mm in models])
+    phase = (spec.phase % (2 * math.pi)) / (2 * math.pi)
+    sphase = phase * Ts
+    tcarry = (spec.phase / (2 * math.pi)) % 1.0 * Ts
+    z = spec.zdm
+    zdms = np.array([float(z.phase) % T for T in Ts]) if z is not None else np.zeros(npts)
+    # Jobs: runs of points in which each continues from the previous (a chunk; every point when fresh).
+    jobs, first = [], 0
+    for sl in slices:
+        size = sl.stop - sl.start
+        jobs += [(first + j, first + j + 1) for j in range(size)] if spec.fresh else [(first, first + size)]
+        first += size
+    samples = np.full((npts, m, n), np.nan)
+    by_stop = np.zeros((npts, nstops), dtype=np.int64)
+    lyap = np.full(npts, np.nan)
+    used = np.zeros(npts, dtype=np.int64)
+    x_final = np.full((npts, n), np.nan)
+    t_final = np.zeros(npts)
+    ok = np.zeros(npts, dtype=np.int64)
+    load_driver().sweep_lanes(
+        kern.table,
+        max(kern.LANES, 1),
+        np.array(jobs, dtype=np.int64).reshape(-1, 2),
+        bool(spec.fresh),
+        bool(model.periodic),
+        np.asarray(spec.x0, dtype=float),
+        pvs,
+        Ts,
+        sphase,
+        tcarry,
+        zdms,
+        int(spec.transient),
+        int(m),
+        bool(spec.adaptive),
+        bool(spec.lyapunov),
+        float(step_safety(spec.tol, order)),
+        float(CHATTER_TOL),
+        z is not None,
+        float(z.accel) if z is not None else 1.0,
+        np.asarray(z.direction if z is not None else np.zeros(n), dtype=float),
+        float(z.window) if z is not None else 0.0,
+        int(z.stop) if z is not None else 0,
+        samples,
+        by_stop,
+        lyap,
+        used,
+        x_final,
+        t_final,
+        ok,
+    )
+    results, first = [], 0
+    for index, sl in zip(indices, slices):
+        size = sl.stop - sl.start
+        part = slice(first, first + size)
+        first += size
+        good = ok[part] == 1
+        res = ChunkResult(
+            index=index,
+            samples=np.where(good[:, None, None], samples[part], np.nan),
+            period=np.array(
+                [
+                    detect_period(s, DEFAULT_PERIOD_TOL, DEFAULT_MAX_PERIOD) if g else -1
+                    for s, g in zip(samples[part], good)
+                ],
+                dtype=np.int32,
+            ),
+            impacts=np.where(good, by_stop[part].sum(axis=1), 0).astype(np.int32),
+            lyapunov=np.where(good, lyap[part], np.nan),
+            transient_used=np.where(good, used[part], 0).astype(np.int32),
+            x_final=np.where(good[:, None], x_final[part], np.nan),
+            impacts_by_stop=np.where(good[:, None], by_stop[part], -1).astype(np.int32),
         )
-        final = var
-    else:
-        seg = run.advance(spec.periods, spec.periods, impacts="sampled")
-        lyap = math.nan
-        final = run
-    n = model.n_states
-    by_stop = np.bincount(seg.impacts[:, 2 + n].astype(np.int64), minlength=model.n_stops)
-    return seg.samples, by_stop, lyap, used + align, final.x, final.t
+        results.append(res)
+    seconds = time.perf_counter() - start
+    for res in results:  # (the chunks ran together: each is charged its share)
+        res.seconds = seconds / len(results)
+    return results
 
 
 def run_chunk(spec: SweepSpec, index: int) -> ChunkResult:
     """Compute chunk ``index`` of ``spec`` (a pure function of its arguments)."""
-    start = time.perf_counter()
-    sl = spec.chunk(index)
-    pts = spec.points[sl]
-    n, m = spec.model.n_states, spec.periods
-    res = ChunkResult(
-        index=index,
-        samples=np.full((len(pts), m, n), np.nan),
-        period=np.zeros(len(pts), dtype=np.int32),
-        impacts=np.zeros(len(pts), dtype=np.int32),
-        lyapunov=np.full(len(pts), np.nan),
-        transient_used=np.zeros(len(pts), dtype=np.int32),
-        x_final=np.full((len(pts), n), np.nan),
-        impacts_by_stop=np.zeros((len(pts), spec.model.n_stops), dtype=np.int32),
-    )
-    x0 = np.asarray(spec.x0, dtype=float)
-    x = x0.copy()
-    t0 = 0.0
-    carried = False
-    for j, pt in enumerate(pts):
-        model = spec.model_at(pt)
-        if carried and model.periodic:
-            # The state carried over is the last sample, at forcing phase ``spec.phase``:
-            # start the next point at that phase of its own period (which may differ).
-            t0 = (spec.phase / (2 * math.pi)) % 1.0 * model.period
-        start_x, start_t = (x0, 0.0) if spec.fresh or not carried else (x, t0)
-        try:
-            samples, by_stop, lyap, used, x, t0 = run_point(spec, model, start_x, start_t)
-        except SimulationError:
-            # Recorded as missing (NaN samples, period -1); the next point restarts from x0.
-            res.period[j] = -1
-            res.impacts_by_stop[j] = -1
-            carried = False
-            continue
-        res.samples[j] = samples
-        res.period[j] = detect_period(samples, DEFAULT_PERIOD_TOL, DEFAULT_MAX_PERIOD)
-        res.impacts[j] = int(by_stop.sum())
-        res.impacts_by_stop[j] = by_stop
-        res.lyapunov[j] = lyap
-        res.transient_used[j] = used
-        res.x_final[j] = x
-        carried = True
-    res.seconds = time.perf_counter() - start
-    return res
+    return run_chunks(spec, [index])[0]

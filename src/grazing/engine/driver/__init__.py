@@ -28,14 +28,16 @@ The pieces, in the order a step uses them:
 * :mod:`.impacts` -- reset and saltation matrix, chattering summed to sticking,
   release;
 * :mod:`.loop` -- ``integrate(start, config) -> result`` over the records of
-  :mod:`grazing.engine.records`.
+  :mod:`grazing.engine.records`;
+* :mod:`.lanes` -- the points of a sweep on SIMD lanes, the loop's step per
+  lane around the model's lane functions.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
-PIECES = ("calls.py", "events.py", "recording.py", "tangent.py", "impacts.py", "loop.py")
+PIECES = ("calls.py", "events.py", "recording.py", "tangent.py", "impacts.py", "loop.py", "lanes.py")
 """The template files, in the order they are appended."""
 
 

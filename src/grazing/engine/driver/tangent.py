@@ -76,8 +76,8 @@ def discontinuity_map(m, x, s, t, pv, j, a, e, window, use_var, ncol, V, gh, gv,
         unpack_var(x, n, ncol, V)
         for c in range(ncol):
             gs = 0.0
-            for j in range(n):
-                gs += (vn * gv[j] - a * gh[j]) * V[j, c]
+            for q in range(n):  # (not j: the stop is recorded below)
+                gs += (vn * gv[q] - a * gh[q]) * V[q, c]
             gs /= sp_
             for i in range(n):
                 V[i, c] -= e[i] * gs

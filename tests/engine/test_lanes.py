@@ -1,0 +1,308 @@
+"""SIMD lanes: the lane functions and the sweep driver on lanes give the scalar path's numbers, bit for bit.
+
+1. Each lane of a model's lane function (``tc_free_lanes``, ``tc_var_lanes``,
+   :mod:`grazing.engine.llvmgen`) equals the scalar kernel at that lane's
+   state, time and parameters, for the built-in models and random ones.
+2. The sweep driver on lanes (:mod:`grazing.engine.driver.lanes`) equals an
+   independent oracle written here over :class:`grazing.engine.runner.Runner`
+   (the scalar driver called period block by period block, the protocol of a
+   sweep point as :mod:`grazing.sweeps.run` describes it), and does not
+   depend on the number of lanes or on how chunks are grouped: continuation
+   and fresh sweeps, adaptive transients, Lyapunov exponents, chattering and
+   sticking, the discontinuity map, and a point that fails.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import grazing
+from grazing.core.options import SweepSettings
+from grazing.core.period import DEFAULT_MAX_PERIOD, DEFAULT_PERIOD_TOL, detect_period
+from grazing.engine import llvmgen
+from grazing.engine.abi import TC_FREE_LANES, TC_VAR_LANES
+from grazing.engine.codegen import taylor_order
+from grazing.engine.runner import Runner
+from grazing.errors import SimulationError
+from grazing.models import bouncing_ball, impact_oscillator, pendulum, two_sided_oscillator
+from grazing.sweeps.run import run_chunks
+from grazing.sweeps.spec import SweepSpec, sweep_spec
+from tests.random_models import ModelSpec, model_specs
+
+CFUNC = llvmgen._CFUNC
+
+
+# ----------------------------------------------------------------------------- lane functions
+
+
+def check_lane_functions(model: grazing.HybridModel, rng: np.random.Generator, trials: int = 5) -> None:
+    kern = model.kernels()
+    L, n, K, nstops = kern.LANES, kern.NX, kern.ORDER + 1, kern.NSTOPS
+    assert L == llvmgen.lane_width()
+    fns = kern.table[0]
+    p0 = model.param_vector
+    for slot, scalar, rows in ((TC_FREE_LANES, kern.tc_free, n), (TC_VAR_LANES, kern.tc_var, n + n * n)):
+        lanes = CFUNC(int(fns[slot]))
+        for _ in range(trials):
+            x = np.ascontiguousarray(rng.normal(size=(rows, L)))
+            s = rng.uniform(0.0, 2 * model.period, L)
+            pv = np.ascontiguousarray(p0[:, None] * rng.uniform(0.8, 1.2, (len(p0), L)))
+            XL, OL = np.full((rows, K, L), np.nan), np.full((nstops, K, L), np.nan)
+            lanes(x.ctypes.data, 0.0, pv.ctypes.data, XL.ctypes.data, OL.ctypes.data, s.ctypes.data, 0)
+            for lane in range(L):
+                X, O = np.zeros((rows, K)), np.zeros((nstops, K))
+                scalar(x[:, lane].copy(), s[lane], pv[:, lane].copy(), X, O)
+                assert np.array_equal(X, XL[:, :, lane], equal_nan=True), (model.name, slot, lane)
+                assert np.array_equal(O, OL[:, :, lane], equal_nan=True), (model.name, slot, lane)
+
+
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda: pendulum("B", theta_hat=math.radians(40)),
+        lambda: bouncing_ball(amplitude=1.2),
+        lambda: impact_oscillator(sigma=0.1, omega=2.0),
+        lambda: two_sided_oscillator(),
+    ],
+    ids=["pendulum", "bouncing-ball", "impact-oscillator", "two-sided"],
+)
+def test_lane_functions_equal_the_scalar_kernel(make) -> None:
+    check_lane_functions(make(), np.random.default_rng(7))
+
+
+@settings(max_examples=2)
+@given(spec=model_specs())
+def test_lane_functions_of_random_models(spec: ModelSpec) -> None:
+    check_lane_functions(spec.model(), np.random.default_rng(3), trials=2)
+
+
+def test_models_with_sensitivity_directions_have_no_lane_functions() -> None:
+    kern = pendulum("B").kernels(1)
+    assert kern.LANES == 0 and not kern.table[0][TC_FREE_LANES]
+
+
+def test_lane_ir_is_vector_code() -> None:
+    src = (
+        "def tc(x, s, pv, X, O):\n"
+        "    X[0, 0] = math.sin(s) * pv[0] + x[0] ** 2\n"
+        "    O[0, 0] = math.tan(x[0])\n"
+    )
+    columns = {"tc": {"X": 1, "O": 1}}
+    ir_text = str(llvmgen.translate(src, "v", columns=columns, lanes=4, lane_functions=("tc",)))
+    assert "<4 x double>" in ir_text and "llvm.sin.v4f64" in ir_text
+    # no vector tan: the scalar function's call, then one per lane
+    assert ir_text.count('call double @"tan"') == 1 + 4
+
+
+# ----------------------------------------------------------------------------- the sweep driver
+
+BLOCK, MAX_P, TOL, ALIGN = 32, 16, 1e-9, 16
+
+
+def oracle_point(spec: SweepSpec, model, x, t0):
+    """A sweep point over Runner, period block by period block (the protocol of grazing.sweeps.run)."""
+    run = Runner(model, x, t0=t0, phase=spec.phase, tol=spec.tol, zdm=spec.zdm)
+    align = min(ALIGN, spec.transient) if spec.lyapunov else 0
+    budget, used = spec.transient - align, 0
+    while used < budget:
+        block = min(BLOCK, budget - used)
+        seg = run.advance(block, block if spec.adaptive else 0)
+        used += block
+        if spec.adaptive and block == BLOCK:
+            p = detect_period(seg.samples, tol=TOL, max_period=MAX_P)
+            if p > 0:
+                extra = (budget - used) % p
+                if extra:
+                    run.advance(extra, 0)
+                    used += extra
+                break
+    if spec.lyapunov:
+        final = Runner(model, run.x, t0=run.t, phase=spec.phase, tol=spec.tol, variational=True, zdm=spec.zdm)
+        final.mode = run.mode
+        seg = final.advance(align + spec.periods, spec.periods, lyapunov=True, impacts="sampled")
+        lyap = (
+            float(np.max(seg.log_sums / seg.lyap_span)) if seg.jacobian_valid and seg.lyap_span else math.nan
+        )
+    else:
+        final = run
+        seg = run.advance(spec.periods, spec.periods, impacts="sampled")
+        lyap = math.nan
+    n = model.n_states
+    by_stop = np.bincount(seg.impacts[:, 2 + n].astype(np.int64), minlength=model.n_stops)
+    return seg.samples, by_stop, lyap, used + align, final.x, final.t
+
+
+def oracle_chunk(spec: SweepSpec, index: int) -> dict[str, np.ndarray]:
+    pts = spec.points[spec.chunk(index)]
+    out: dict[str, list] = {k: [] for k in ("samples", "period", "by_stop", "lyapunov", "used", "x_final")}
+    x0 = np.asarray(spec.x0, dtype=float)
+    x, t0, carried = x0.copy(), 0.0, False
+    for pt in pts:
+        model = spec.model_at(pt)
+        if carried and model.periodic:
+            t0 = (spec.phase / (2 * math.pi)) % 1.0 * model.period
+        start_x, start_t = (x0, 0.0) if spec.fresh or not carried else (x, t0)
+        try:
+            samples, by_stop, lyap, used, x, t0 = oracle_point(spec, model, start_x, start_t)
+        except SimulationError:
+            n = model.n_states
+            samples, by_stop, lyap, used = (
+                np.full((spec.periods, n), np.nan),
+                [-1] * model.n_stops,
+                math.nan,
+                0,
+            )
+            out["x_final"].append(np.full(n, np.nan))
+            out["period"].append(-1)
+            carried = False
+        else:
+            out["x_final"].append(x)
+            out["period"].append(detect_period(samples, DEFAULT_PERIOD_TOL, DEFAULT_MAX_PERIOD))
+            carried = True
+        out["samples"].append(samples)
+        out["by_stop"].append(by_stop)
+        out["lyapunov"].append(lyap)
+        out["used"].append(used)
+    return {k: np.asarray(v) for k, v in out.items()}
+
+
+def assert_chunks_equal(spec: SweepSpec, results, lanes: str) -> None:
+    for res in results:
+        ref = oracle_chunk(spec, res.index)
+        got = {
+            "samples": res.samples,
+            "period": res.period,
+            "by_stop": res.impacts_by_stop,
+            "lyapunov": res.lyapunov,
+            "used": res.transient_used,
+            "x_final": res.x_final,
+        }
+        for key, value in ref.items():
+            assert np.array_equal(np.asarray(got[key], dtype=float), value.astype(float), equal_nan=True), (
+                f"{lanes}: chunk {res.index}, {key} differs from the Runner oracle"
+            )
+
+
+SWEEPS = {
+    "pendulum continuation, adaptive, Lyapunov": (
+        lambda: pendulum("B", theta_hat=math.radians(40)),
+        "eta",
+        np.linspace(0.44, 0.47, 12),
+        SweepSettings(transient=200, periods=30, chunk_size=3),
+    ),
+    "pendulum fresh, no Lyapunov, fixed transient": (
+        lambda: pendulum("B", theta_hat=math.radians(40)),
+        "eta",
+        np.linspace(0.44, 0.47, 10),
+        SweepSettings(transient=100, periods=20, chunk_size=4, fresh=True, adaptive=False, lyapunov=False),
+    ),
+    "bouncing ball: chattering and sticking": (
+        lambda: bouncing_ball(amplitude=1.2),
+        "amplitude",
+        np.linspace(1.0, 1.6, 8),
+        SweepSettings(transient=20, periods=12, chunk_size=2),
+    ),
+    "two-sided oscillator, phase": (
+        lambda: two_sided_oscillator(),
+        "omega",
+        np.linspace(0.7, 0.9, 8),
+        SweepSettings(transient=60, periods=16, chunk_size=3, phase=1.3),
+    ),
+}
+
+
+@pytest.mark.parametrize("name", list(SWEEPS))
+def test_sweep_on_lanes_equals_the_runner_oracle(name: str) -> None:
+    make, param, values, settings_ = SWEEPS[name]
+    spec = sweep_spec(make(), param, values, settings=settings_)
+    kern = spec.model.kernels(0, taylor_order(spec.tol))
+    saved = kern.LANES
+    try:
+        for lanes in sorted({saved, 1}):  # (1: every Taylor kernel called lane by lane, scalar)
+            kern.LANES = lanes
+            assert_chunks_equal(spec, run_chunks(spec, list(range(spec.n_chunks))), f"{lanes} lanes")
+    finally:
+        kern.LANES = saved
+    # grouped differently: one chunk at a time
+    assert_chunks_equal(spec, [run_chunks(spec, [i])[0] for i in range(spec.n_chunks)], "one chunk")
+
+
+def test_sweep_with_the_discontinuity_map_equals_the_oracle() -> None:
+    from grazing.normalform import find_grazing_point, normal_form_at
+
+    point = find_grazing_point(pendulum("B", theta_hat=math.radians(40)), "eta", 0.2, 1.0, "first")
+    zdm = normal_form_at(point, ("eta", "theta_hat")).discontinuity_map()
+    spec = sweep_spec(
+        point.model,
+        "eta",
+        np.linspace(0.4452, 0.4462, 6),
+        settings=SweepSettings(transient=100, periods=20, chunk_size=3),
+        zdm=zdm,
+    )
+    assert_chunks_equal(spec, run_chunks(spec, list(range(spec.n_chunks))), "map method")
+
+
+def runaway_model() -> grazing.HybridModel:
+    """``x'' = k x + cos t`` with a stop at ``x = -1``: for ``k > 0`` the state runs away to infinity."""
+    import sympy as sp
+
+    x, v, t, k, c = sp.symbols("x v t k c")
+    return grazing.HybridModel(
+        "runaway",
+        [x, v],
+        t,
+        [grazing.Parameter("k", -1.0), grazing.Parameter("c", 0.1, lower=0.0)],
+        vector_field=[v, k * x - c * v + sp.cos(t)],
+        guard=x + 1,
+        reset=[x, -0.8 * v],
+        period=2 * sp.pi,
+        contact_direction=[0, 1],
+    )
+
+
+def test_failing_points_and_the_next_ones() -> None:
+    # From x0, k = 25 overflows (a point that fails: NaN samples, period -1); the next point of
+    # the chunk starts again from x0, and fails again or, with k < 0, succeeds.
+    spec = sweep_spec(
+        runaway_model(),
+        "k",
+        [30.0, 25.0, -1.0, -1.5, -2.0, -3.0],
+        x0=(0.5, 0.0),
+        direction="down",
+        settings=SweepSettings(transient=40, periods=10, chunk_size=3),
+    )
+    results = run_chunks(spec, [0, 1])
+    periods = np.concatenate([r.period for r in results])
+    assert list(periods < 0) == [True, True, False, False, False, False]
+    for res in results:
+        bad = res.period < 0
+        assert np.isnan(res.samples[bad]).all() and (res.impacts_by_stop[bad] == -1).all()
+    assert_chunks_equal(spec, results, "failing")
+
+
+@pytest.mark.slow
+@settings(max_examples=6)
+@given(spec=model_specs(), fresh=st.booleans(), lyapunov=st.booleans())
+def test_random_model_sweeps_on_lanes_equal_the_oracle(spec: ModelSpec, fresh: bool, lyapunov: bool) -> None:
+    model = spec.model()
+    w = [p.name for p in model.parameters][3]  # the frequency: it sets the period
+    values = model.params[w] * np.linspace(0.9, 1.1, 9)
+    sw = sweep_spec(
+        model,
+        w,
+        values,
+        x0=spec.initial_state(),
+        settings=SweepSettings(
+            transient=40,
+            periods=10,
+            chunk_size=3,
+            fresh=fresh,
+            lyapunov=lyapunov,
+        ),
+    )
+    assert_chunks_equal(sw, run_chunks(sw, list(range(sw.n_chunks))), "random model")
