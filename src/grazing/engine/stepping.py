@@ -58,6 +58,12 @@ def step_size(X, n, O, nout, orow, order, max_step, factor):
         nx = max(nx, abs(X[i, 0]))
         n1 = max(n1, abs(X[i, order - 1]))
         n2 = max(n2, abs(X[i, order]))
+    return step_from_norms(nx, n1, n2, order, max_step, factor)
+
+
+@njit(cache=True, inline="always")
+def step_from_norms(nx, n1, n2, order, max_step, factor):
+    """The step of :func:`step_size` from its norms: the values' ``nx`` and the last two coefficients'."""
     sc = max(1.0, nx)
     # log rho = min(log(sc/n1)/(order-1), log(sc/n2)/order): two logs and one exp
     log_rho = math.inf

@@ -34,9 +34,9 @@ from grazing.engine.driver.events import first_event
 from grazing.engine.driver.impacts import apply_impact, chatter_remaining, enter_contact
 from grazing.engine.driver.recording import take_samples
 from grazing.engine.driver.tangent import discontinuity_map, lyapunov_step
-from grazing.engine.polyroots import work_shape
+from grazing.engine.polyroots import quadratic_bound, work_shape
 from grazing.engine.records import Kernels
-from grazing.engine.stepping import eval_rows, new_table, step_factor, step_size
+from grazing.engine.stepping import new_table, step_factor, step_from_norms, step_size
 
 LANE_ROOT_ROWS, LANE_ROOT_MIN_COLS = work_shape(0)
 ADAPTIVE_BLOCK = 32  # (grazing.sweeps.run.ADAPTIVE_BLOCK)
@@ -125,7 +125,7 @@ def to_lane(X, O, rows, nstops, K, XT, OT, lane):
 
 
 @njit(cache=True)
-def begin_request(m, li, lf, xs, lane, periods, keep, use_var, T, zdm_s):
+def begin_request(li, lf, lane, periods, keep, use_var, T, zdm_s):
     """Start lane ``lane`` on ``periods`` samples keeping the last ``keep`` (``Runner.advance``)."""
     li[lane, L_NSAMP] = periods
     li[lane, L_NKEEP] = keep
@@ -202,14 +202,14 @@ def sweep_lanes(
 
     li = np.zeros((L, L_NLI), dtype=np.int64)
     lf = np.zeros((L, F_NLF))
-    xs = np.zeros((L, ntot))
+    XS = np.zeros((ntot, L))  # the lanes' states (and variational matrices), lane by lane
     Xs = np.zeros((ntot, K))  # one lane's coefficients from a scalar function
     Os = np.zeros((nstops, K))
+    xl = np.zeros(ntot)  # one lane's state, for the scalar functions
     pl = np.zeros((L, npv))
     logs = np.zeros((L, n))
     buf = np.zeros((L, keep_max, n))
     counts = np.zeros((L, nstops), dtype=np.int64)
-    XI = np.zeros((ntot, L))
     SI = np.zeros(L)
     PT = np.zeros((npv, L))
     XT = np.zeros((ntot, K, L))
@@ -226,6 +226,23 @@ def sweep_lanes(
     sticks = new_table(1, 2)
     traj = new_table(1, 1 + n)
     kinds = np.zeros(L, dtype=np.int64)  # 0 sticking or idle, 1 free flight, 2 with the variational equations
+    # What a step decides for each lane (pass A), for the advance (vectors) and the rest (pass B).
+    hs = np.zeros(L)  # step
+    dts = np.zeros(L)  # accepted part of it
+    us = np.zeros(L)  # first event at u in [0, 1] (< 0: none)
+    evs = np.zeros(L, dtype=np.int64)  # its stop
+    flags = np.zeros(L, dtype=np.int64)  # bit 1 event, 2 last, 4 discontinuity map, 8 failed
+    todo = np.zeros(L, dtype=np.int64)  # 1: the lane steps this round
+    nx_ = np.zeros(L)  # step-size norms
+    n1_ = np.zeros(L)
+    n2_ = np.zeros(L)
+    a0 = np.zeros(L)  # low coefficients and tail of an event polynomial
+    a1 = np.zeros(L)
+    a2 = np.zeros(L)
+    tl = np.zeros(L)
+    hk = np.zeros(L)
+    plain = np.zeros(L, dtype=np.int64)  # 1: no event on the step is certain so far
+    acc = np.zeros(L)
 
     next_job = 0
     active = 0
@@ -248,7 +265,7 @@ def sweep_lanes(
                 T = Ts[p]
                 if fresh or not carried:
                     for i in range(n):
-                        xs[lane, i] = x0[i]
+                        XS[i, lane] = x0[i]
                     t0 = 0.0
                 else:
                     t0 = tcarry[p] if periodic else out_t[p - 1]
@@ -272,11 +289,11 @@ def sweep_lanes(
                     blk = min(ADAPTIVE_BLOCK, budget)
                     li[lane, L_BLOCK] = blk
                     li[lane, L_STAGE] = TRANSIENT
-                    begin_request(m, li, lf, xs, lane, blk, blk if adaptive else 0, False, T, zdms[p])
+                    begin_request(li, lf, lane, blk, blk if adaptive else 0, False, T, zdms[p])
                 else:
                     li[lane, L_STAGE] = FINAL
                     final_request(
-                        m, li, lf, xs, lane, align, periods, lyapunov, T, sphase[p], periodic, zdms[p]
+                        li, lf, XS, n, lane, align, periods, lyapunov, T, sphase[p], periodic, zdms[p]
                     )
                 active += 1
         if active == 0:
@@ -294,146 +311,244 @@ def sweep_lanes(
                 else:
                     kinds[lane] = 1
                     nfree += 1
+        for lane in range(L):
+            SI[lane] = lf[lane, F_S]
         for kind in (1, 2):
             count = nfree if kind == 1 else nvar
             rows = n if kind == 1 else ntot
             if count == 0:
                 continue
             if use_lanes and count >= VECTOR_MIN_LANES:
-                for lane in range(L):
-                    SI[lane] = lf[lane, F_S]
-                    for i in range(rows):
-                        XI[i, lane] = xs[lane, i]
-                call_model(m.fns[TC_FREE_LANES if kind == 1 else TC_VAR_LANES], XI, 0.0, PT, XT, OT, SI, 0)
+                call_model(m.fns[TC_FREE_LANES if kind == 1 else TC_VAR_LANES], XS, 0.0, PT, XT, OT, SI, 0)
             else:  # lane by lane, into the lanes' columns
                 for lane in range(L):
                     if kinds[lane] == kind:
+                        for i in range(rows):
+                            xl[i] = XS[i, lane]
                         if kind == 1:
-                            tc_free(m, xs[lane], lf[lane, F_S], pl[lane], Xs, Os)
+                            tc_free(m, xl, SI[lane], pl[lane], Xs, Os)
                         else:
-                            tc_var(m, xs[lane], lf[lane, F_S], pl[lane], Xs, Os)
+                            tc_var(m, xl, SI[lane], pl[lane], Xs, Os)
                         to_lane(Xs, Os, rows, nstops, K, XT, OT, lane)
 
-        # One step of every lane (the step of the loop's integrate, for a sweep's settings).
+        # The step sizes of the lanes in free flight: their norms on vectors (as step_size, row by row).
         for lane in range(L):
+            nx_[lane] = abs(OT[0, 0, lane])
+            n1_[lane] = 0.0
+            n2_[lane] = 0.0
+        for r in range(nstops):
+            for lane in range(L):
+                n1_[lane] = max(n1_[lane], abs(OT[r, order - 1, lane]))
+                n2_[lane] = max(n2_[lane], abs(OT[r, order, lane]))
+        for i in range(ntot if nvar > 0 else n):
+            for lane in range(L):
+                if i < n or kinds[lane] == 2:
+                    nx_[lane] = max(nx_[lane], abs(XT[i, 0, lane]))
+                    n1_[lane] = max(n1_[lane], abs(XT[i, order - 1, lane]))
+                    n2_[lane] = max(n2_[lane], abs(XT[i, order, lane]))
+
+        # Pass A, lane by lane: the step, its events and its samples.
+        for lane in range(L):
+            todo[lane] = 0
+            flags[lane] = 0
+            plain[lane] = 0
             if li[lane, L_STAGE] == IDLE:
                 continue
             p = li[lane, L_POINT]
             T = Ts[p]
-            x = xs[lane]
-            X = XT[:, :, lane]
-            O = OT[:, :, lane]
-            pv = pl[lane]
             k = li[lane, L_K]
             s = lf[lane, F_S]
             mode = li[lane, L_MODE]
-            stuck = li[lane, L_STUCK]
-            use_var = li[lane, L_VAR] == 1
-            n_samples = li[lane, L_NSAMP]
-            n_keep = li[lane, L_NKEEP]
-            keep_from = n_samples - n_keep
-            isamp = li[lane, L_ISAMP]
-            ks = li[lane, L_KS]
-            ss = lf[lane, F_SS]
-            recording = li[lane, L_REC] == 1
-            defl = li[lane, L_DEFL]
-            defl_stop = li[lane, L_DEFL_STOP]
-            nrows = ntot if (mode == 0 and use_var) else n
             status = 0
             if li[lane, L_STEPS] >= li[lane, L_MAXSTEPS]:
                 status = 1
             for i in range(n):
-                if not math.isfinite(x[i]):
+                if not math.isfinite(XS[i, lane]):
                     status = 2
-            if status == 0:
-                if mode == 1:
-                    tc_stick(m, x, s, pv, Xs, Os, stuck)
-                    to_lane(Xs, Os, n, nstops, K, XT, OT, lane)
-                    h = step_size(X, n, O, nstops, stuck, order, T, factor)
-                else:
-                    h = step_size(X, nrows, O, nstops, 0, order, T, factor)
-                rem = (ks - k) * T + (ss - s)
-                is_last = False
-                if isamp == n_samples - 1 and h >= rem:
-                    h = rem
-                    is_last = True
-                zdm_hit = False
-                kz = li[lane, L_KZ]
-                sz = zdms[p]
-                if zdm_on:
-                    rem_z = (kz - k) * T + (sz - s)
-                    if rem_z <= h:
-                        h = rem_z
-                        zdm_hit = True
-                        is_last = is_last and rem_z >= rem
+            if status != 0:
+                flags[lane] = 8
+                li[lane, L_STATUS] = status
+                continue
+            if mode == 1:
+                stuck = li[lane, L_STUCK]
+                for i in range(n):
+                    xl[i] = XS[i, lane]
+                tc_stick(m, xl, s, pl[lane], Xs, Os, stuck)
+                to_lane(Xs, Os, n, nstops, K, XT, OT, lane)
+                h = step_size(Xs, n, Os, nstops, stuck, order, T, factor)
+            else:
+                h = step_from_norms(nx_[lane], n1_[lane], n2_[lane], order, T, factor)
+            isamp = li[lane, L_ISAMP]
+            rem = (li[lane, L_KS] - k) * T + (lf[lane, F_SS] - s)
+            is_last = False
+            if isamp == li[lane, L_NSAMP] - 1 and h >= rem:
+                h = rem
+                is_last = True
+            if zdm_on:
+                rem_z = (li[lane, L_KZ] - k) * T + (zdms[p] - s)
+                if rem_z <= h:
+                    h = rem_z
+                    flags[lane] |= 4
+                    is_last = is_last and rem_z >= rem
+            if is_last:
+                flags[lane] |= 2
+            hs[lane] = h
+            todo[lane] = 1
+            plain[lane] = 1 if mode == 0 and li[lane, L_DEFL] == 0 else 0
+
+        # No event on the step where every guard's polynomial is certainly positive (event_certificate
+        # on vectors: the same coefficients as event_polynomial); the other lanes search lane by lane.
+        for r in range(nstops):
+            if zdm_on and r == watch:
+                continue
+            for lane in range(L):
+                hk[lane] = 1.0
+                tl[lane] = 0.0
+                a0[lane] = OT[r, 0, lane] * hk[lane]
+                hk[lane] *= hs[lane]
+                a1[lane] = OT[r, 1, lane] * hk[lane]
+                hk[lane] *= hs[lane]
+                a2[lane] = OT[r, 2, lane] * hk[lane]
+                hk[lane] *= hs[lane]
+            for j in range(3, K):
+                for lane in range(L):
+                    tl[lane] += abs(OT[r, j, lane] * hk[lane])
+                    hk[lane] *= hs[lane]
+            for lane in range(L):
+                if plain[lane] == 1 and not (
+                    a0[lane] > 0.0 and quadratic_bound(a0[lane], a1[lane], a2[lane], tl[lane]) > 0.0
+                ):
+                    plain[lane] = 0
+        for lane in range(L):
+            if todo[lane] == 0:
+                continue
+            h = hs[lane]
+            if plain[lane] == 1:
+                u = -1.0
+                ev_stop = 0
+            else:
+                mode = li[lane, L_MODE]
                 u, ev_stop = first_event(
                     m,
-                    O,
+                    OT[:, :, lane],
                     h,
                     mode,
-                    stuck,
+                    li[lane, L_STUCK],
                     True,
                     watch if zdm_on else -1,
-                    defl,
-                    defl_stop,
+                    li[lane, L_DEFL],
+                    li[lane, L_DEFL_STOP],
                     False,
                     watch,
                     a,
                     work,
                 )
-                event = u >= 0.0 and h > 0.0
-                if event and u == 0.0:
-                    li[lane, L_ZERO] += 1
-                    if li[lane, L_ZERO] > 3:
-                        status = 3
-                else:
-                    li[lane, L_ZERO] = 0
-            if status == 0:
-                h_acc = u * h if event else h
-                if event and is_last and u >= 1.0:
-                    event = False
-                if (ks - k) * T + (ss - s) <= h_acc:
-                    isamp, ks, ss, recording, _, _, _, _ = take_samples(
-                        m,
-                        T,
-                        periodic,
-                        n_samples,
-                        n_keep,
-                        0.0,
-                        X,
-                        k,
-                        s,
-                        h_acc,
-                        event,
-                        is_last,
-                        mode,
-                        isamp,
-                        ks,
-                        ss,
-                        keep_from,
-                        recording,
-                        buf[lane],
-                        sticks,
-                        0,
-                        traj,
-                        0,
-                        k,
-                        s,
-                        xe,
-                    )
-                eval_rows(X, nrows, order, h_acc, xe)
-                for i in range(nrows):
-                    x[i] = xe[i]
-                s += h_acc
-                if periodic and s >= T:
-                    s -= T
-                    k += 1
-                li[lane, L_STEPS] += 1
-                defl = 0
-                if lyapunov and use_var and mode == 0:
+            event = u >= 0.0 and h > 0.0
+            if event and u == 0.0:
+                li[lane, L_ZERO] += 1
+                if li[lane, L_ZERO] > 3:
+                    flags[lane] = 8
+                    li[lane, L_STATUS] = 3
+                    todo[lane] = 0
+                    continue
+            else:
+                li[lane, L_ZERO] = 0
+            is_last = (flags[lane] & 2) != 0
+            h_acc = u * h if event else h
+            if event and is_last and u >= 1.0:
+                event = False
+            if event:
+                flags[lane] |= 1
+            us[lane] = u
+            evs[lane] = ev_stop
+            dts[lane] = h_acc
+            p = li[lane, L_POINT]
+            T = Ts[p]
+            k = li[lane, L_K]
+            s = lf[lane, F_S]
+            if (li[lane, L_KS] - k) * T + (lf[lane, F_SS] - s) <= h_acc:
+                recording = li[lane, L_REC] == 1
+                isamp, ks, ss, recording, _, _, _, _ = take_samples(
+                    m,
+                    T,
+                    periodic,
+                    li[lane, L_NSAMP],
+                    li[lane, L_NKEEP],
+                    0.0,
+                    XT[:, :, lane],
+                    k,
+                    s,
+                    h_acc,
+                    event,
+                    is_last,
+                    li[lane, L_MODE],
+                    li[lane, L_ISAMP],
+                    li[lane, L_KS],
+                    lf[lane, F_SS],
+                    li[lane, L_NSAMP] - li[lane, L_NKEEP],
+                    recording,
+                    buf[lane],
+                    sticks,
+                    0,
+                    traj,
+                    0,
+                    k,
+                    s,
+                    xe,
+                )
+                li[lane, L_ISAMP] = isamp
+                li[lane, L_KS] = ks
+                lf[lane, F_SS] = ss
+                li[lane, L_REC] = 1 if recording else 0
+
+        # The advance of every stepping lane to the end of its accepted part (eval_rows on vectors):
+        # the state in all, the variational equations in free flight.
+        for lane in range(L):
+            if todo[lane] == 0:
+                dts[lane] = 0.0
+        for i in range(ntot if nvar > 0 else n):
+            for lane in range(L):
+                acc[lane] = XT[i, order, lane]
+            for j in range(order - 1, -1, -1):
+                for lane in range(L):
+                    acc[lane] = acc[lane] * dts[lane] + XT[i, j, lane]
+            for lane in range(L):
+                if todo[lane] == 1 and (i < n or (kinds[lane] == 2 and li[lane, L_MODE] == 0)):
+                    XS[i, lane] = acc[lane]
+
+        # Pass B, lane by lane: time, Lyapunov vectors, discontinuity map, impacts, the request's end.
+        for lane in range(L):
+            if flags[lane] == 8:  # the point failed: the next point starts afresh
+                out_ok[li[lane, L_POINT]] = 0
+                li[lane, L_STAGE] = IDLE
+                active -= 1
+                continue
+            if todo[lane] == 0:
+                continue
+            p = li[lane, L_POINT]
+            T = Ts[p]
+            k = li[lane, L_K]
+            s = lf[lane, F_S] + dts[lane]
+            if periodic and s >= T:
+                s -= T
+                k += 1
+            li[lane, L_STEPS] += 1
+            li[lane, L_DEFL] = 0
+            mode = li[lane, L_MODE]
+            use_var = li[lane, L_VAR] == 1
+            nrows = ntot if (mode == 0 and use_var) else n
+            event = (flags[lane] & 1) != 0
+            zdm_hit = (flags[lane] & 4) != 0
+            lyap_now = lyapunov and use_var and mode == 0
+            if lyap_now or zdm_hit or event:
+                for i in range(ntot):
+                    xl[i] = XS[i, lane]
+                recording = li[lane, L_REC] == 1
+                pv = pl[lane]
+                if lyap_now:
                     started, lt0 = lyapunov_step(
                         m,
-                        x,
+                        xl,
                         V,
                         ncol,
                         recording,
@@ -446,10 +561,10 @@ def sweep_lanes(
                     li[lane, L_LSTART] = 1 if started else 0
                     lf[lane, F_LT0] = lt0
                 if zdm_hit:
-                    li[lane, L_KZ] = kz + 1
+                    li[lane, L_KZ] += 1
                     applied, _ = discontinuity_map(
                         m,
-                        x,
+                        xl,
                         s,
                         k * T + s,
                         pv,
@@ -469,15 +584,17 @@ def sweep_lanes(
                     if applied and recording and li[lane, L_STAGE] == FINAL:
                         counts[lane, watch] += 1
                 if event:
+                    ev_stop = evs[lane]
+                    stuck = li[lane, L_STUCK]
                     if mode == 1 and ev_stop == stuck:
-                        mode = 0
-                        defl = 3
-                        defl_stop = stuck
+                        li[lane, L_MODE] = 0
+                        li[lane, L_DEFL] = 3
+                        li[lane, L_DEFL_STOP] = stuck
                     else:
-                        mode = 0
+                        li[lane, L_MODE] = 0
                         speed, _, _, salt_ok = apply_impact(
                             m,
-                            x,
+                            xl,
                             xp,
                             s,
                             k * T + s,
@@ -498,37 +615,26 @@ def sweep_lanes(
                             li[lane, L_JAC] = 0
                         if recording and li[lane, L_STAGE] == FINAL:
                             counts[lane, ev_stop] += 1
-                        defl = 1
-                        defl_stop = ev_stop
+                        li[lane, L_DEFL] = 1
+                        li[lane, L_DEFL_STOP] = ev_stop
                         if m.sticks[ev_stop]:
-                            dt_acc = chatter_remaining(m, x, s, pv, ev_stop, speed, chatter_tol * T)
+                            dt_acc = chatter_remaining(m, xl, s, pv, ev_stop, speed, chatter_tol * T)
                             if dt_acc >= 0.0:
                                 s += dt_acc
                                 if periodic and s >= T:
                                     s -= T
                                     k += 1
-                                enter_contact(m, x, s, pv, ev_stop)
-                                mode = 1
-                                stuck = ev_stop
-                                defl = 0
+                                enter_contact(m, xl, s, pv, ev_stop)
+                                li[lane, L_MODE] = 1
+                                li[lane, L_STUCK] = ev_stop
+                                li[lane, L_DEFL] = 0
                                 li[lane, L_JAC] = 0
+                for i in range(ntot):
+                    XS[i, lane] = xl[i]
             li[lane, L_K] = k
             lf[lane, F_S] = s
-            li[lane, L_MODE] = mode
-            li[lane, L_STUCK] = stuck
-            li[lane, L_ISAMP] = isamp
-            li[lane, L_KS] = ks
-            lf[lane, F_SS] = ss
-            li[lane, L_REC] = 1 if recording else 0
-            li[lane, L_DEFL] = defl
-            li[lane, L_DEFL_STOP] = defl_stop
-            if status != 0:  # the point failed: the next point starts afresh
-                out_ok[p] = 0
-                li[lane, L_STATUS] = status
-                li[lane, L_STAGE] = IDLE
-                active -= 1
-                continue
-            if isamp < n_samples:
+            n_samples = li[lane, L_NSAMP]
+            if li[lane, L_ISAMP] < n_samples:
                 continue
             # The request is done (Runner.advance returns): on to the next stage of the point.
             if periodic:
@@ -548,20 +654,20 @@ def sweep_lanes(
                         if extra:
                             li[lane, L_USED] += extra
                             li[lane, L_STAGE] = EXTRA
-                            begin_request(m, li, lf, xs, lane, extra, 0, False, T, zdms[p])
+                            begin_request(li, lf, lane, extra, 0, False, T, zdms[p])
                             continue
                         nxt = 0
                 if nxt < 0 and used < budget:
                     blk = min(ADAPTIVE_BLOCK, budget - used)
                     li[lane, L_BLOCK] = blk
-                    begin_request(m, li, lf, xs, lane, blk, blk if adaptive else 0, False, T, zdms[p])
+                    begin_request(li, lf, lane, blk, blk if adaptive else 0, False, T, zdms[p])
                     continue
                 li[lane, L_STAGE] = FINAL
-                final_request(m, li, lf, xs, lane, align, periods, lyapunov, T, sphase[p], periodic, zdms[p])
+                final_request(li, lf, XS, n, lane, align, periods, lyapunov, T, sphase[p], periodic, zdms[p])
                 continue
             if stage == EXTRA:
                 li[lane, L_STAGE] = FINAL
-                final_request(m, li, lf, xs, lane, align, periods, lyapunov, T, sphase[p], periodic, zdms[p])
+                final_request(li, lf, XS, n, lane, align, periods, lyapunov, T, sphase[p], periodic, zdms[p])
                 continue
             # FINAL: the point's results.
             for r in range(periods):
@@ -583,7 +689,7 @@ def sweep_lanes(
             out_lyap[p] = lyap
             out_used[p] = li[lane, L_USED] + align
             for i in range(n):
-                out_x[p, i] = x[i]
+                out_x[p, i] = XS[i, lane]
             out_t[p] = k * T + s
             out_ok[p] = 1
             li[lane, L_STAGE] = IDLE
@@ -591,10 +697,9 @@ def sweep_lanes(
 
 
 @njit(cache=True)
-def final_request(m, li, lf, xs, lane, align, periods, lyapunov, T, s_phase, periodic, zdm_s):
+def final_request(li, lf, XS, n, lane, align, periods, lyapunov, T, s_phase, periodic, zdm_s):
     """The recorded stage of a point: with the variational equations (from the identity) for Lyapunov."""
     if lyapunov:  # a new Runner at the current time (as run_point's ``var``)
-        n = m.nx
         t0 = li[lane, L_K] * T + lf[lane, F_S]
         k0, s0, ks0, ss0 = start_times(t0, T, s_phase, periodic)
         li[lane, L_K] = k0
@@ -603,7 +708,7 @@ def final_request(m, li, lf, xs, lane, align, periods, lyapunov, T, s_phase, per
         lf[lane, F_RSS] = ss0
         for i in range(n):
             for c in range(n):
-                xs[lane, n + i * n + c] = 1.0 if i == c else 0.0
-        begin_request(m, li, lf, xs, lane, align + periods, periods, True, T, zdm_s)
+                XS[n + i * n + c, lane] = 1.0 if i == c else 0.0
+        begin_request(li, lf, lane, align + periods, periods, True, T, zdm_s)
     else:
-        begin_request(m, li, lf, xs, lane, periods, periods, False, T, zdm_s)
+        begin_request(li, lf, lane, periods, periods, False, T, zdm_s)
