@@ -83,4 +83,10 @@ def _call_model_intrinsic():  # pragma: no cover - compiled
     return call_model
 
 
-call_model = _call_model_intrinsic()
+def __getattr__(name: str) -> object:
+    # ``call_model`` is made on first use (the compiled driver imports it): numba, about 0.25 s
+    # to import, is not needed by a process that only hands work to others (a sweep's parent).
+    if name == "call_model":
+        globals()["call_model"] = fn = _call_model_intrinsic()
+        return fn
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -55,7 +55,8 @@ def _run_group_in_worker(group: list[int]) -> list[ChunkResult]:
 def chunk_groups(spec: SweepSpec, todo: Sequence[int], workers: int) -> list[list[int]]:
     """``todo`` split into groups of consecutive chunks, each computed together on SIMD lanes.
 
-    A continuation sweep fills the lanes with one chunk each, a fresh one
+    A continuation sweep fills the lanes with one chunk each (up to two
+    chunks per lane: a lane whose chunk is done takes the next), a fresh one
     with points (about four per lane); no group is bigger than an even share
     of the chunks among the workers.
 
@@ -70,7 +71,7 @@ def chunk_groups(spec: SweepSpec, todo: Sequence[int], workers: int) -> list[lis
     from grazing.engine.llvmgen import lane_width
 
     lanes = lane_width()
-    per = math.ceil(4 * lanes / spec.size) if spec.fresh else lanes
+    per = math.ceil(4 * lanes / spec.size) if spec.fresh else 2 * lanes
     per = max(1, min(per, math.ceil(len(todo) / max(1, workers))))
     todo = list(todo)
     return [todo[i : i + per] for i in range(0, len(todo), per)]
