@@ -77,7 +77,7 @@ def run_chunks(spec: SweepSpec, indices: Sequence[int]) -> list[ChunkResult]:
     ok = np.zeros(npts, dtype=np.int64)
     load_driver().sweep_lanes(
         kern.table,
-        max(kern.LANES, 1),
+        1 if len(jobs) == 1 else max(1, kern.LANES),  # (the lane functions' width, or one lane)
         np.array(jobs, dtype=np.int64).reshape(-1, 2),
         bool(spec.fresh),
         bool(model.periodic),

@@ -198,7 +198,7 @@ def sweep_lanes(
     align = min(LYAPUNOV_ALIGN, transient) if lyapunov else 0
     budget = transient - align
     keep_max = max(periods, ADAPTIVE_BLOCK)
-    use_lanes = L > 1 and m.fns[TC_FREE_LANES] != 0
+    use_lanes = L > 1 and L == m.lanes and m.fns[TC_FREE_LANES] != 0  # (the lane functions' width)
 
     li = np.zeros((L, L_NLI), dtype=np.int64)
     lf = np.zeros((L, F_NLF))
@@ -320,6 +320,11 @@ def sweep_lanes(
                 continue
             if use_lanes and count >= VECTOR_MIN_LANES:
                 call_model(m.fns[TC_FREE_LANES if kind == 1 else TC_VAR_LANES], XS, 0.0, PT, XT, OT, SI, 0)
+            elif L == 1:  # one lane: the lane arrays are the scalar function's arrays
+                if kind == 1:
+                    tc_free(m, XS, SI[0], pl[0], XT, OT)
+                else:
+                    tc_var(m, XS, SI[0], pl[0], XT, OT)
             else:  # lane by lane, into the lanes' columns
                 for lane in range(L):
                     if kinds[lane] == kind:
@@ -397,8 +402,11 @@ def sweep_lanes(
             plain[lane] = 1 if mode == 0 and li[lane, L_DEFL] == 0 else 0
 
         # No event on the step where every guard's polynomial is certainly positive (event_certificate
-        # on vectors: the same coefficients as event_polynomial); the other lanes search lane by lane.
-        for r in range(nstops):
+        # on vectors: the same coefficients as event_polynomial); the other lanes search lane by lane
+        # (and a single lane at once).
+        for lane in range(L if L == 1 else 0):
+            plain[lane] = 0
+        for r in range(nstops if L > 1 else 0):
             if zdm_on and r == watch:
                 continue
             for lane in range(L):
