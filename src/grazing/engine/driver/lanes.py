@@ -72,11 +72,10 @@ IDLE, TRANSIENT, EXTRA, FINAL = 0, 1, 2, 3
     L_POINT,
     L_JOBEND,
     L_USED,
-    L_BUDGET,
     L_BLOCK,
     L_RKS,
     L_NLI,
-) = range(26)
+) = range(25)
 # Float state of a lane (columns of ``lf``).
 F_S, F_SS, F_LT0, F_RSS, F_NLF = range(5)
 
@@ -229,7 +228,6 @@ def sweep_lanes(
     # What a step decides for each lane (pass A), for the advance (vectors) and the rest (pass B).
     hs = np.zeros(L)  # step
     dts = np.zeros(L)  # accepted part of it
-    us = np.zeros(L)  # first event at u in [0, 1] (< 0: none)
     evs = np.zeros(L, dtype=np.int64)  # its stop
     flags = np.zeros(L, dtype=np.int64)  # bit 1 event, 2 last, 4 discontinuity map, 8 failed
     todo = np.zeros(L, dtype=np.int64)  # 1: the lane steps this round
@@ -467,7 +465,6 @@ def sweep_lanes(
                 event = False
             if event:
                 flags[lane] |= 1
-            us[lane] = u
             evs[lane] = ev_stop
             dts[lane] = h_acc
             p = li[lane, L_POINT]
