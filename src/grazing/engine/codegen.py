@@ -304,12 +304,12 @@ def driver_key() -> str:
     numba's on-disk cache does not notice changes in functions imported from
     other modules, so the sources of the helpers are part of the key.
     """
-    import numba
+    from importlib.metadata import version
 
     here = Path(__file__).parent
     files = [here / f for f in ("polyroots.py", "stepping.py", "records.py", "abi.py")]
     deps = "".join(path.read_text() for path in [*files, *driver.template_files()])
-    return _key(_CODEGEN_VERSION, numba.__version__, sys.version, deps)
+    return _key(_CODEGEN_VERSION, version("numba"), sys.version, deps)  # (numba's version, not imported)
 
 
 def _init_numba_without_blas_probe() -> None:

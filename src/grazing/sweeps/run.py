@@ -35,7 +35,8 @@ import numpy as np
 
 from grazing.core.options import CHATTER_TOL
 from grazing.core.period import DEFAULT_MAX_PERIOD, DEFAULT_PERIOD_TOL, detect_period
-from grazing.engine.codegen import load_driver, taylor_order
+from grazing.engine.codegen import taylor_order
+from grazing.engine.native import load_sweep_lanes
 from grazing.engine.runner import step_safety
 from grazing.sweeps.spec import ChunkResult, SweepSpec
 
@@ -75,7 +76,7 @@ def run_chunks(spec: SweepSpec, indices: Sequence[int]) -> list[ChunkResult]:
     x_final = np.full((npts, n), np.nan)
     t_final = np.zeros(npts)
     ok = np.zeros(npts, dtype=np.int64)
-    load_driver().sweep_lanes(
+    load_sweep_lanes()(
         kern.table,
         1 if len(jobs) == 1 else max(1, kern.LANES),  # (the lane functions' width, or one lane)
         np.array(jobs, dtype=np.int64).reshape(-1, 2),

@@ -1,0 +1,134 @@
+"""The sweep driver's machine code loaded without numba (:mod:`grazing.engine.native`).
+
+The sweeps of tests/engine/test_lanes.py run through it and equal an oracle
+over numba's ``integrate``; here: it is numba's ``sweep_lanes`` bit for bit,
+a sweep in a new process does not import numba, wrong arrays are refused
+before any machine code runs, an error inside the code becomes an exception,
+and a damaged cache file is built again.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from grazing.core.options import SweepSettings
+from grazing.engine import native
+from grazing.engine.codegen import load_driver, taylor_order
+from grazing.models import bouncing_ball, pendulum
+from grazing.sweeps import run
+from grazing.sweeps.spec import sweep_spec
+
+FIELDS = ("samples", "period", "impacts", "lyapunov", "transient_used", "x_final", "impacts_by_stop")
+
+
+@pytest.mark.parametrize(
+    ("make", "param", "values", "fresh"),
+    [
+        (lambda: pendulum("B", theta_hat=math.radians(40)), "eta", np.linspace(0.44, 0.47, 24), False),
+        (lambda: bouncing_ball(amplitude=1.2), "amplitude", np.linspace(1.0, 1.6, 12), True),
+    ],
+    ids=["pendulum-continuation", "bouncing-ball-fresh"],
+)
+def test_native_entry_equals_numbas_function(make, param, values, fresh, monkeypatch) -> None:
+    settings = SweepSettings(transient=60, periods=12, chunk_size=3, fresh=fresh)
+    spec = sweep_spec(make(), param, values, settings=settings)
+    chunks = list(range(spec.n_chunks))
+    ours = run.run_chunks(spec, chunks)
+    monkeypatch.setattr(run, "load_sweep_lanes", lambda: load_driver().sweep_lanes)
+    numbas = run.run_chunks(spec, chunks)
+    for a, b in zip(ours, numbas, strict=True):
+        for field in FIELDS:
+            assert np.array_equal(getattr(a, field), getattr(b, field), equal_nan=True), field
+    assert np.isfinite(np.concatenate([r.samples for r in ours])).all()
+
+
+def test_a_sweep_in_a_new_process_does_not_import_numba() -> None:
+    native.load_sweep_lanes()  # (the cache file exists)
+    code = (
+        "import sys, numpy as np, grazing\n"
+        "from grazing.sweeps.spec import sweep_spec\n"
+        "from grazing.core.options import SweepSettings\n"
+        "from grazing.sweeps.run import run_chunks\n"
+        "spec = sweep_spec(grazing.models.pendulum('B'), 'eta', np.linspace(0.44, 0.45, 4),\n"
+        "                  settings=SweepSettings(transient=20, periods=4, chunk_size=2))\n"
+        "res = run_chunks(spec, [0, 1])\n"
+        "assert np.isfinite(res[0].samples).all()\n"
+        "print('numba' in sys.modules)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "False"
+
+
+def sweep_arguments() -> tuple[list, int]:
+    """The arguments of ``sweep_lanes`` for one bouncing-ball point, and the index of ``out_samples``."""
+    model = bouncing_ball()
+    kern = model.kernels(0, taylor_order(1e-10))
+    n, periods = model.n_states, 3
+    args = [
+        kern.table, 1, np.array([[0, 1]], dtype=np.int64), False, bool(model.periodic), np.array([0.5, 0.0]),
+        model.param_vector.reshape(1, -1).copy(), np.array([float(model.period)]), np.zeros(1), np.zeros(1),
+        np.zeros(1), 4, periods, False, False, 1.5, 1e-9, False, 1.0, np.zeros(n), 0.0, 0,
+        np.full((1, periods, n), np.nan), np.zeros((1, model.n_stops), dtype=np.int64), np.zeros(1),
+        np.zeros(1, dtype=np.int64), np.zeros((1, n)), np.zeros(1), np.zeros(1, dtype=np.int64),
+    ]  # fmt: skip
+    return args, 22
+
+
+def test_the_entry_point_computes_and_refuses_wrong_arrays() -> None:
+    sweep = native.load_sweep_lanes()
+    args, out = sweep_arguments()
+    sweep(*args)
+    assert np.isfinite(args[out]).all() and args[-1][0] == 1
+    wrong_arrays = (
+        (out, np.zeros((1, 2, 2))),  # shape
+        (out, np.zeros((1, 3, 2), dtype=np.float32)),  # dtype
+        (out, np.zeros((1, 3, 4))[:, :, ::2]),  # not contiguous
+        (5, np.zeros(3)),  # x0 of the wrong size
+    )
+    for index, bad in wrong_arrays:
+        wrong = list(args)
+        wrong[index] = bad
+        with pytest.raises(TypeError, match="must be a C-contiguous"):
+            sweep(*wrong)
+
+
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")  # (numba's wrapper prints it)
+def test_an_exception_in_the_machine_code_is_reported() -> None:
+    from numba import cfunc, types
+
+    compiled = cfunc(types.int64(types.int64))(lambda n: 10 // n)
+    loaded = native.load_object(native.object_file(compiled, "toy"), "toy")
+    assert loaded is not None
+    toy = ctypes.CFUNCTYPE(ctypes.c_int64, ctypes.c_int64)(loaded[0])
+    assert toy(3) == 3
+    assert toy(0) != native._DONE  # ZeroDivisionError: numba's wrapper returns 0 and prints it
+
+
+def test_a_damaged_cache_file_is_built_again(tmp_path, monkeypatch) -> None:
+    monkeypatch.setenv("GRAZING_CACHE_DIR", str(tmp_path))
+    path = tmp_path / f"grazing_native_{native.cache_key()}.bin"
+    path.write_bytes(b"not a header\n\x00\x01")
+    native.load_sweep_lanes.cache_clear()
+    try:
+        sweep = native.load_sweep_lanes()
+        args, out = sweep_arguments()
+        sweep(*args)
+        assert np.isfinite(args[out]).all()
+        assert path.read_bytes().startswith(b'{"symbols"')
+    finally:
+        native.load_sweep_lanes.cache_clear()
+
+
+def test_the_entry_point_takes_the_drivers_arguments() -> None:
+    import inspect
+
+    assert tuple(inspect.signature(load_driver().sweep_lanes.py_func).parameters) == native.DRIVER_ARGUMENTS
+    with pytest.raises(TypeError, match="29 arguments expected"):
+        native.load_sweep_lanes()(1, 2)
