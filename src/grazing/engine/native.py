@@ -109,15 +109,26 @@ def object_file(compiled: Any, name: str) -> bytes:
     """
     import llvmlite.binding as llvm
 
-    from grazing.engine.llvmgen import _target_machine
-
     module = llvm.parse_assembly(compiled.inspect_llvm())
     module.get_function(compiled.native_name).name = f"{_PREFIX}_{name}"
     needs = sorted(
         {f.name for f in module.functions if f.is_declaration and not f.name.startswith("llvm.")}
         | {g.name for g in module.global_variables if g.is_declaration}
     )
-    return json.dumps({"symbols": needs}).encode() + b"\n" + _target_machine().emit_object(module)
+    return json.dumps({"symbols": needs}).encode() + b"\n" + _jit_target_machine().emit_object(module)
+
+
+def _jit_target_machine() -> Any:
+    """A target machine with the options numba's JIT uses (static relocations, the JIT's code model)."""
+    import llvmlite.binding as llvm
+
+    from grazing.engine.llvmgen import _target_machine
+
+    _target_machine()  # (initialises LLVM's native target)
+    return llvm.Target.from_default_triple().create_target_machine(
+        cpu=llvm.get_host_cpu_name(), features=llvm.get_host_cpu_features().flatten(), opt=3,
+        reloc="static", codemodel="jitdefault", jit=True,
+    )  # fmt: skip
 
 
 def build() -> bytes:
@@ -130,7 +141,7 @@ def build() -> bytes:
 
 
 def cache_key() -> str:
-    """Key of the entry point's cache file: the driver's key, llvmlite's version and this CPU."""
+    """Key of the entry point's cache file: the driver's key, this module, llvmlite's version and this CPU."""
     import llvmlite
     import llvmlite.binding as llvm
 
@@ -139,7 +150,7 @@ def cache_key() -> str:
 
     _target_machine()  # (initialises LLVM's native target)
     cpu = (llvm.get_host_cpu_name(), llvm.get_host_cpu_features().flatten())
-    return _key(driver_key(), llvmlite.__version__, cpu)
+    return _key(driver_key(), Path(__file__).read_text(), llvmlite.__version__, cpu)
 
 
 def _numba_extension(name: str) -> ModuleType:
