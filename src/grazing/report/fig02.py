@@ -14,6 +14,7 @@ the model itself (no recording) is compared with what fig 3 shows was measured.
 from __future__ import annotations
 
 import math
+import os
 import tempfile
 import time
 from collections.abc import Callable, Sequence
@@ -23,6 +24,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 import grazing
+from grazing.parallel import map_unordered
 from grazing.report import paper
 from grazing.report.base import (
     DPI,
@@ -105,9 +107,8 @@ def figure_2_synthetic(
     >>> res["40"]["period"], res["40"]["model_period"]
     ([1, 5], [1, 5])
     """
-    from grazing.experiment.diagram import load_diagram, model_sweep, plot_diagram
+    from grazing.experiment.diagram import model_sweep, plot_diagram
     from grazing.experiment.fit import grazing_eta
-    from grazing.experiment.synthetic import synthetic_sweep
     from grazing.models.pendulum import CASES
 
     say = progress or (lambda _m: None)
@@ -122,14 +123,19 @@ def figure_2_synthetic(
     out: dict[str, Any] = {"synthetic": True}
     with tempfile.TemporaryDirectory() as tmp:
         base = Path(workdir) if workdir is not None else Path(tmp)
-        for ax, th in zip(axes, theta_hats):
+        grazes, jobs = [], []
+        for th in theta_hats:
             eg = grazing_eta(th, CASES["B"]["beta"], alpha=CASES["B"]["alpha"])
             centre = eg if eg is not None else 0.45
             etas = np.linspace(centre + span[0], centre + span[1], num)
-            folder = base / f"theta{th:g}"
+            grazes.append(eg)
+            jobs.append((base / f"theta{th:g}", float(th), etas, periods, transient, sample_rate))
             say(f"synthetic recordings at theta_hat = {th:g} deg ({num} frequencies)")
-            synthetic_sweep(folder, th, etas, periods=periods, transient=transient, sample_rate=sample_rate)
-            diag = load_diagram(folder)
+        # Written and analysed one stop angle per process (CSV formatting and parsing are most of the time).
+        diagrams = dict(map_unordered(_recorded_diagram, jobs, workers or os.cpu_count() or 1))
+        for ax, th, eg, job in zip(axes, theta_hats, grazes, jobs):
+            etas = job[2]
+            diag = diagrams[float(th)]
             model = model_sweep(
                 th, np.linspace(etas[0], etas[-1], model_num), periods=periods, workers=workers
             )
@@ -150,6 +156,16 @@ def figure_2_synthetic(
             }
     out["image"] = finish_figure(fig if own else None, path, dpi)
     return out
+
+
+def _recorded_diagram(job: tuple[Path, float, np.ndarray, int, int, float]) -> tuple[float, Any]:
+    """Write the synthetic recordings of one stop angle and analyse them: ``(theta_hat_deg, diagram)``."""
+    from grazing.experiment.diagram import load_diagram
+    from grazing.experiment.synthetic import synthetic_sweep
+
+    folder, th, etas, periods, transient, sample_rate = job
+    synthetic_sweep(folder, th, etas, periods=periods, transient=transient, sample_rate=sample_rate)
+    return th, load_diagram(folder)
 
 
 # ----------------------------------------------------------------------------
