@@ -1,10 +1,11 @@
 """The sweep driver's machine code loaded without numba (:mod:`grazing.engine.native`).
 
 The sweeps of tests/engine/test_lanes.py run through it and equal an oracle
-over numba's ``integrate``; here: it is numba's ``sweep_lanes`` bit for bit,
-a sweep in a new process does not import numba, wrong arrays are refused
-before any machine code runs, an error inside the code becomes an exception,
-and a damaged cache file is built again.
+over numba's ``integrate``; here: it is numba's ``sweep_lanes`` bit for bit
+(slow: numba compiles that function anew, it is not in numba's cache), a
+sweep in a new process does not import numba, wrong arrays are refused
+before any machine code runs, an error inside the code is reported, and a
+damaged cache file is built again.
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ import numpy as np
 import pytest
 
 from grazing.core.options import SweepSettings
-from grazing.engine import native
+from grazing.engine import codegen, native
 from grazing.engine.codegen import load_driver, taylor_order
 from grazing.models import bouncing_ball, pendulum
 from grazing.sweeps import run
@@ -27,6 +28,7 @@ from grazing.sweeps.spec import sweep_spec
 FIELDS = ("samples", "period", "impacts", "lyapunov", "transient_used", "x_final", "impacts_by_stop")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("make", "param", "values", "fresh"),
     [
@@ -99,29 +101,39 @@ def test_the_entry_point_computes_and_refuses_wrong_arrays() -> None:
             sweep(*wrong)
 
 
-@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")  # (numba's wrapper prints it)
 def test_an_exception_in_the_machine_code_is_reported() -> None:
-    from numba import cfunc, types
+    from numba import njit, types
 
-    compiled = cfunc(types.int64(types.int64))(lambda n: 10 // n)
-    loaded = native.load_object(native.object_file(compiled, "toy"), "toy")
+    loaded = native.load_object(native.object_file(njit(lambda n: 10 // n), (types.int64,), "toy"), "toy")
     assert loaded is not None
-    toy = ctypes.CFUNCTYPE(ctypes.c_int64, ctypes.c_int64)(loaded[0])
-    assert toy(3) == 3
-    assert toy(0) != native._DONE  # ZeroDivisionError: numba's wrapper returns 0 and prints it
+    address, params, _library = loaded
+    assert params == ["i64"]
+    entry = ctypes.CFUNCTYPE(ctypes.c_int64, ctypes.c_void_p)(address)
+    assert entry(np.array([3], dtype=np.int64).ctypes.data) in native._RETURNED
+    assert entry(np.array([0], dtype=np.int64).ctypes.data) not in native._RETURNED  # ZeroDivisionError
 
 
 def test_a_damaged_cache_file_is_built_again(tmp_path, monkeypatch) -> None:
+    native.load_sweep_lanes()  # (the cache file exists)
+    key = native.cache_key()
+    source = (codegen.cache_dir() / f"grazing_native_{key}.bin").read_bytes()
+    built = []
+
+    def build() -> bytes:
+        built.append(1)
+        return source
+
+    monkeypatch.setattr(native, "build", build)
     monkeypatch.setenv("GRAZING_CACHE_DIR", str(tmp_path))
-    path = tmp_path / f"grazing_native_{native.cache_key()}.bin"
+    path = tmp_path / f"grazing_native_{key}.bin"
     path.write_bytes(b"not a header\n\x00\x01")
     native.load_sweep_lanes.cache_clear()
     try:
         sweep = native.load_sweep_lanes()
         args, out = sweep_arguments()
         sweep(*args)
-        assert np.isfinite(args[out]).all()
-        assert path.read_bytes().startswith(b'{"symbols"')
+        assert np.isfinite(args[out]).all() and built == [1]
+        assert path.read_bytes() == source
     finally:
         native.load_sweep_lanes.cache_clear()
 

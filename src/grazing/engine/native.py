@@ -4,18 +4,20 @@ numba compiles the driver (:mod:`grazing.engine.driver`) once per machine and
 caches it, but a process that uses it pays about half a second to import
 numba and have it load that cache -- in every worker of every sweep, more
 than the work of a small sweep.  So the sweep's entry point,
-:func:`~grazing.engine.driver.lanes.sweep_lanes`, is also compiled once per
-machine as a plain C function over pointers (a ``numba.cfunc``), and its
-LLVM IR (the function and everything it calls) is turned into an object file
-in the kernel cache.  A sweep loads that file with llvmlite, as it loads a
-model's functions (:mod:`grazing.engine.llvmgen`), and calls it through
-ctypes: the same machine code as numba's, the same numbers bit for bit.
+:func:`~grazing.engine.driver.lanes.sweep_lanes`, is compiled by numba once
+per machine and its LLVM IR (the function and everything it calls, as numba
+optimised it) becomes an object file in the kernel cache, with a small entry
+function added that takes the function's arguments from an array of 64-bit
+slots.  A sweep loads that file with llvmlite, as it loads a model's
+functions (:mod:`grazing.engine.llvmgen`), and calls it through ctypes: the
+machine code numba would run, the same numbers bit for bit.
 
 numba's code calls a few C functions of numba's own: its memory allocator
 (NRT, for the driver's work arrays) and, on the error path only, its
 exception helpers.  They come from numba's extension modules, loaded by path
 without importing the numba package (or from numba, if it is imported
-already).
+already).  Should the code report an error, the call is repeated with numba's
+own compiled function, which raises the error as a Python exception.
 
 Examples
 --------
@@ -39,83 +41,107 @@ from typing import Any
 
 import numpy as np
 
-# The entry point's C arguments, in order: (name, kind).  Arrays are passed as pointers and
-# their shapes as the integer arguments around them; ``m`` (the Kernels record) is spread out.
-ARGUMENTS = (
-    ("fns", "i64*"), ("nfns", "i64"), ("nx", "i64"), ("nsens", "i64"), ("nstops", "i64"),
-    ("order", "i64"), ("sticks", "bool*"), ("mlanes", "i64"),
-    ("lanes", "i64"), ("jobs", "i64*"), ("njobs", "i64"), ("fresh", "u8"), ("periodic", "u8"),
-    ("x0", "f64*"), ("npts", "i64"), ("npv", "i64"), ("pvs", "f64*"), ("Ts", "f64*"),
-    ("sphase", "f64*"), ("tcarry", "f64*"), ("zdms", "f64*"), ("transient", "i64"),
-    ("periods", "i64"), ("adaptive", "u8"), ("lyapunov", "u8"), ("safety", "f64"),
-    ("chatter_tol", "f64"), ("zdm_on", "u8"), ("zdm_a", "f64"), ("zdm_e", "f64*"),
-    ("zdm_window", "f64"), ("watch", "i64"), ("out_samples", "f64*"), ("out_by_stop", "i64*"),
-    ("out_lyap", "f64*"), ("out_used", "i64*"), ("out_x", "f64*"), ("out_t", "f64*"),
-    ("out_ok", "i64*"),
-)  # fmt: skip
 DRIVER_ARGUMENTS = (
     "m", "lanes", "jobs", "fresh", "periodic", "x0", "pvs", "Ts", "sphase", "tcarry", "zdms", "transient",
     "periods", "adaptive", "lyapunov", "safety", "chatter_tol", "zdm_on", "zdm_a", "zdm_e", "zdm_window",
     "watch", "out_samples", "out_by_stop", "out_lyap", "out_used", "out_x", "out_t", "out_ok",
 )  # fmt: skip
 """The arguments of :func:`grazing.engine.driver.lanes.sweep_lanes`; the loaded entry point takes them too."""
-_CTYPES = {"i64": ctypes.c_int64, "u8": ctypes.c_uint8, "f64": ctypes.c_double}
-_DTYPES = {"i64*": np.dtype(np.int64), "f64*": np.dtype(np.float64), "bool*": np.dtype(np.bool_)}
+_KERNELS = ("fns", "nx", "nsens", "nstops", "order", "sticks", "mlanes")
+"""The fields of ``m`` (:class:`grazing.engine.records.Kernels`)."""
+_ARRAYS = {
+    "fns": ("i8", 1), "sticks": ("?", 1), "jobs": ("i8", 2), "x0": ("f8", 1), "pvs": ("f8", 2),
+    "Ts": ("f8", 1), "sphase": ("f8", 1), "tcarry": ("f8", 1), "zdms": ("f8", 1), "zdm_e": ("f8", 1),
+    "out_samples": ("f8", 3), "out_by_stop": ("i8", 2), "out_lyap": ("f8", 1), "out_used": ("i8", 1),
+    "out_x": ("f8", 2), "out_t": ("f8", 1), "out_ok": ("i8", 1),
+}  # fmt: skip
+"""dtype and dimensions of the array arguments (C-contiguous)."""
+_BOOLS = ("fresh", "periodic", "adaptive", "lyapunov", "zdm_on")
+_FLOATS = ("safety", "chatter_tol", "zdm_a", "zdm_window")
 _PREFIX = "grazing_native"
 _ENTRY = "sweep_lanes"
-_DONE = 1
-"""What the entry point returns when the sweep ran (numba's wrapper returns 0 after an exception)."""
+_RETURNED = (0, -2)
+"""numba's status codes of a function that returned (OK, None); the others report an exception."""
 
 
-def _entry_function(sweep: Callable[..., None]) -> Callable[..., int]:
-    """The C entry point's Python source, for ``numba.cfunc``: pointers to arrays, then ``sweep``."""
-    from numba import carray
-
-    def entry(
-        fns, nfns, nx, nsens, nstops, order, sticks, mlanes, lanes, jobs, njobs, fresh, periodic, x0,
-        npts, npv, pvs, Ts, sphase, tcarry, zdms, transient, periods, adaptive, lyapunov, safety,
-        chatter_tol, zdm_on, zdm_a, zdm_e, zdm_window, watch, out_samples, out_by_stop, out_lyap,
-        out_used, out_x, out_t, out_ok,
-    ):  # fmt: skip
-        m = (carray(fns, (nfns,)), nx, nsens, nstops, order, carray(sticks, (nstops,)), mlanes)
-        sweep(
-            m, lanes, carray(jobs, (njobs, 2)), fresh != 0, periodic != 0, carray(x0, (nx,)),
-            carray(pvs, (npts, npv)), carray(Ts, (npts,)), carray(sphase, (npts,)), carray(tcarry, (npts,)),
-            carray(zdms, (npts,)), transient, periods, adaptive != 0, lyapunov != 0, safety, chatter_tol,
-            zdm_on != 0, zdm_a, carray(zdm_e, (nx,)), zdm_window, watch,
-            carray(out_samples, (npts, periods, nx)), carray(out_by_stop, (npts, nstops)),
-            carray(out_lyap, (npts,)), carray(out_used, (npts,)), carray(out_x, (npts, nx)),
-            carray(out_t, (npts,)), carray(out_ok, (npts,)),
-        )  # fmt: skip
-        return _DONE
-
-    return entry
-
-
-def _numba_signature() -> Any:
+def _signature() -> Any:
+    """The numba signature of ``sweep_lanes`` for the arrays :data:`_ARRAYS` describes."""
     from numba import types
 
-    kinds = {
-        "i64": types.int64, "u8": types.uint8, "f64": types.float64, "i64*": types.CPointer(types.int64),
-        "f64*": types.CPointer(types.float64), "bool*": types.CPointer(types.boolean),
-    }  # fmt: skip
-    return types.int64(*(kinds[kind] for _, kind in ARGUMENTS))
+    scalar = {"i8": types.int64, "f8": types.float64, "?": types.boolean}
+
+    def of(name: str) -> Any:
+        if name in _ARRAYS:
+            dtype, ndim = _ARRAYS[name]
+            return types.Array(scalar[dtype], ndim, "C")
+        if name in _BOOLS:
+            return types.boolean
+        return types.float64 if name in _FLOATS else types.int64
+
+    kernels = types.Tuple([of(name) for name in _KERNELS])
+    return tuple(kernels if name == "m" else of(name) for name in DRIVER_ARGUMENTS)
 
 
-def object_file(compiled: Any, name: str) -> bytes:
-    """The cache file of the ``numba.cfunc`` ``compiled``: a JSON line (the C symbols it needs), its object.
+def _slot_loads(types_: list[str]) -> tuple[list[str], list[str]]:
+    """LLVM IR lines loading one argument of each type in ``types_`` from ``%slots``; and the arguments."""
+    lines, args = [], []
+    for i, ty in enumerate(types_):
+        lines.append(f"  %p{i} = getelementptr inbounds i64, ptr %slots, i64 {i}")
+        lines.append(f"  %s{i} = load i64, ptr %p{i}, align 8")
+        if ty == "i64":
+            args.append(f"i64 %s{i}")
+            continue
+        cast = {"ptr": "inttoptr", "double": "bitcast", "i8": "trunc", "i32": "trunc", "i1": "trunc"}.get(ty)
+        if cast is None:
+            raise TypeError(f"an argument of type {ty} cannot come from a 64-bit slot")
+        lines.append(f"  %a{i} = {cast} i64 %s{i} to {ty}")
+        args.append(f"{ty} %a{i}")
+    return lines, args
 
-    The entry point is named ``{_PREFIX}_{name}`` in the object file.
+
+def object_file(dispatcher: Any, signature: tuple[Any, ...], name: str) -> bytes:
+    """The cache file of a numba function compiled for ``signature``: a JSON line, then an object file.
+
+    The object file holds numba's LLVM IR of the function (and of everything it
+    calls, as numba optimised it, not optimised again) and an entry function
+    ``{_PREFIX}_{name}(int64 *slots) -> int64``: numba's status code, the
+    function's flattened arguments read from ``slots``.  ``dispatcher`` must
+    not come from numba's on-disk cache (whose IR numba does not keep).  The
+    JSON line lists the C symbols the code needs and the arguments' LLVM types.
     """
     import llvmlite.binding as llvm
 
-    module = llvm.parse_assembly(compiled.inspect_llvm())
-    module.get_function(compiled.native_name).name = f"{_PREFIX}_{name}"
+    dispatcher.compile(signature)
+    text = dispatcher.inspect_llvm(signature)
+    module = llvm.parse_assembly(text)
+    target = module.get_function(dispatcher.overloads[signature].fndesc.llvm_func_name)
+    params = [str(a.type) for a in target.arguments][2:]  # (after the return slot and the exception info)
+    lines, args = _slot_loads(params)
+    entry = "\n".join(
+        [
+            f"define i64 @{_PREFIX}_{name}(ptr %slots) {{",
+            "entry:",
+            "  %ret = alloca [8 x i64], align 8",
+            "  %exc = alloca ptr, align 8",
+            "  store ptr null, ptr %exc, align 8",
+            *lines,
+            f'  %status = call i32 @"{target.name}"(ptr %ret, ptr %exc, {", ".join(args)})',
+            "  %code = sext i32 %status to i64",
+            "  ret i64 %code",
+            "}",
+        ]
+    )
+    wrapper = llvm.parse_assembly(
+        f'target triple = "{module.triple}"\ntarget datalayout = "{module.data_layout}"\n'
+        f'declare i32 @"{target.name}"(ptr, ptr, {", ".join(params)})\n{entry}\n'
+    )
+    module.link_in(wrapper)
     needs = sorted(
         {f.name for f in module.functions if f.is_declaration and not f.name.startswith("llvm.")}
         | {g.name for g in module.global_variables if g.is_declaration}
     )
-    return json.dumps({"symbols": needs}).encode() + b"\n" + _jit_target_machine().emit_object(module)
+    header = json.dumps({"symbols": needs, "params": params}).encode()
+    return header + b"\n" + _jit_target_machine().emit_object(module)
 
 
 def _jit_target_machine() -> Any:
@@ -132,12 +158,10 @@ def _jit_target_machine() -> Any:
 
 
 def build() -> bytes:
-    """The cache file of the sweep driver's entry point (numba compiles the driver or loads its cache)."""
-    from numba import cfunc
-
+    """The cache file of the sweep driver (numba compiles ``sweep_lanes``, which it does not cache)."""
     from grazing.engine.codegen import load_driver
 
-    return object_file(cfunc(_numba_signature())(_entry_function(load_driver().sweep_lanes)), _ENTRY)
+    return object_file(load_driver().sweep_lanes, _signature(), _ENTRY)
 
 
 def cache_key() -> str:
@@ -216,45 +240,71 @@ def _resolvable(name: str, math_helpers: dict[str, int]) -> bool:
     return True
 
 
-def _caller(address: int, keep: Any) -> Callable[..., None]:
-    """A Python function with the arguments of ``driver.lanes.sweep_lanes``, calling the entry point."""
-    cfunc = ctypes.CFUNCTYPE(ctypes.c_int64, *(_CTYPES.get(kind, ctypes.c_void_p) for _, kind in ARGUMENTS))(
-        address
-    )
+def _shapes(values: dict[str, Any]) -> dict[str, tuple[int, ...]]:
+    """The shape each array argument must have, from the sizes the others give."""
+    nx, nstops, npts = values["nx"], values["nstops"], values["pvs"].shape[0]
+    names = ("Ts", "sphase", "tcarry", "zdms", "out_lyap", "out_used", "out_t", "out_ok")
+    per_point = {name: (npts,) for name in names}
+    return {
+        **per_point, "fns": values["fns"].shape, "sticks": (nstops,), "jobs": (values["jobs"].shape[0], 2),
+        "x0": (nx,), "pvs": values["pvs"].shape, "zdm_e": (nx,), "out_samples": (npts, values["periods"], nx),
+        "out_by_stop": (npts, nstops), "out_x": (npts, nx),
+    }  # fmt: skip
+
+
+def flatten(arguments: tuple[Any, ...]) -> tuple[np.ndarray, list[str]]:
+    """``sweep_lanes``'s arguments as numba passes them: 64-bit slots and their LLVM types.
+
+    An array is its memory manager (none), parent (none), size, item size,
+    data pointer, shape and strides; ``m`` is its fields; a boolean a byte.
+    Arrays of another dtype, dimension, shape or layout than the driver takes
+    are refused (``TypeError``).
+    """
+    if len(arguments) != len(DRIVER_ARGUMENTS):
+        raise TypeError(f"sweep driver: {len(DRIVER_ARGUMENTS)} arguments expected, got {len(arguments)}")
+    values = dict(zip(DRIVER_ARGUMENTS, arguments, strict=True))
+    values.update(zip(_KERNELS, values.pop("m"), strict=True))
+    shapes = _shapes(values)
+    slots: list[int] = []
+    kinds: list[str] = []
+    for name in (*_KERNELS, *DRIVER_ARGUMENTS[1:]):
+        value = values[name]
+        if name in _ARRAYS:
+            dtype, ndim = _ARRAYS[name]
+            a = value
+            ok = isinstance(a, np.ndarray) and a.dtype == np.dtype(dtype) and a.ndim == ndim
+            if not (ok and a.flags.c_contiguous and a.shape == shapes[name]):
+                want = f"a C-contiguous {np.dtype(dtype)} array of shape {shapes[name]}"
+                raise TypeError(f"sweep driver: {name} must be {want}")
+            if name.startswith("out_") and not a.flags.writeable:
+                raise TypeError(f"sweep driver: {name} must be writeable")
+            slots += [0, 0, a.size, a.itemsize, a.ctypes.data, *a.shape, *a.strides]
+            kinds += ["ptr", "ptr", "i64", "i64", "ptr", *["i64"] * (2 * ndim)]
+        elif name in _BOOLS:
+            slots.append(1 if value else 0)
+            kinds.append("i8")
+        elif name in _FLOATS:
+            slots.append(int(np.float64(value).view(np.int64)))
+            kinds.append("double")
+        else:
+            slots.append(int(value))
+            kinds.append("i64")
+    return np.array(slots, dtype=np.int64), kinds
+
+
+def _caller(address: int, params: list[str], keep: Any) -> Callable[..., None]:
+    """A Python function with the arguments of ``driver.lanes.sweep_lanes``, calling its machine code."""
+    entry = ctypes.CFUNCTYPE(ctypes.c_int64, ctypes.c_void_p)(address)
 
     def sweep_lanes(*arguments: Any) -> None:
-        if len(arguments) != len(DRIVER_ARGUMENTS):
-            raise TypeError(f"sweep driver: {len(DRIVER_ARGUMENTS)} arguments expected, got {len(arguments)}")
-        values = dict(zip(DRIVER_ARGUMENTS, arguments, strict=True))
-        fns, nx, nsens, nstops, order, sticks, mlanes = values.pop("m")
-        npts, npv = values["pvs"].shape
-        periods = values["periods"]
-        values.update(
-            fns=fns, nfns=fns.shape[0], nx=nx, nsens=nsens, nstops=nstops, order=order, sticks=sticks,
-            mlanes=mlanes, njobs=values["jobs"].shape[0], npts=npts, npv=npv,
-        )  # fmt: skip
-        shapes = {
-            "fns": (values["nfns"],), "sticks": (nstops,), "jobs": (values["njobs"], 2), "x0": (nx,),
-            "pvs": (npts, npv), "Ts": (npts,), "sphase": (npts,), "tcarry": (npts,), "zdms": (npts,),
-            "zdm_e": (nx,), "out_samples": (npts, periods, nx), "out_by_stop": (npts, nstops),
-            "out_lyap": (npts,), "out_used": (npts,), "out_x": (npts, nx), "out_t": (npts,),
-            "out_ok": (npts,),
-        }  # fmt: skip
-        args = []
-        for name, kind in ARGUMENTS:
-            value = values[name]
-            if kind in _DTYPES:
-                a = value
-                if a.dtype != _DTYPES[kind] or not a.flags.c_contiguous or a.shape != shapes[name]:
-                    want = f"a C-contiguous {_DTYPES[kind]} array of shape {shapes[name]}"
-                    raise TypeError(f"sweep driver: {name} must be {want}")
-                if name.startswith("out_") and not a.flags.writeable:
-                    raise TypeError(f"sweep driver: {name} must be writeable")
-                args.append(a.ctypes.data)
-            else:
-                args.append(value)
-        if cfunc(*args) != _DONE:
-            raise RuntimeError("the compiled sweep driver raised an error (its message is above)")
+        slots, kinds = flatten(arguments)
+        if kinds != params:  # pragma: no cover - a driver whose arguments changed without its cache key
+            raise TypeError("sweep driver: the compiled code takes other arguments; clear the kernel cache")
+        if entry(slots.ctypes.data) not in _RETURNED:  # pragma: no cover - the driver raised
+            from grazing.engine.codegen import load_driver
+
+            load_driver().sweep_lanes(*arguments)  # (numba's function raises the error; outputs rewritten)
+            raise RuntimeError("the compiled sweep driver failed where numba's function did not")
 
     sweep_lanes.library = keep  # type: ignore[attr-defined]  # (the machine code lives as long as this)
     return sweep_lanes
@@ -272,7 +322,6 @@ def load_sweep_lanes() -> Callable[..., None]:
     from grazing.engine.codegen import _cached_file, load_driver
 
     name = f"grazing_native_{cache_key()}.bin"
-
     path = _cached_file(name, build)
     try:
         loaded = load_object(path.read_bytes(), _ENTRY)
@@ -284,15 +333,16 @@ def load_sweep_lanes() -> Callable[..., None]:
     return _caller(*loaded)
 
 
-def load_object(data: bytes, name: str) -> tuple[int, Any] | None:
-    """Load a cache file of :func:`object_file`: the address of its entry point ``name`` and the code's owner.
+def load_object(data: bytes, name: str) -> tuple[int, list[str], Any] | None:
+    """Load a cache file of :func:`object_file`: its entry point's address, argument types and owner.
 
     ``None`` if a C function the code calls cannot be found.
     """
     from grazing.engine.llvmgen import Library
 
     header, obj = data.split(b"\n", 1)
-    symbols = list(json.loads(header)["symbols"])
+    meta = json.loads(header)
+    symbols, params = list(meta["symbols"]), list(meta["params"])
     _register_numba_runtime()
     math_helpers = dict(_numba_extension("numba._helperlib").c_helpers)
     if not all(_resolvable(s, math_helpers) for s in symbols):
@@ -301,4 +351,4 @@ def load_object(data: bytes, name: str) -> tuple[int, Any] | None:
     address = library.address(name)
     if not address:
         raise OSError(f"no function {name} in the object file")
-    return address, library
+    return address, params, library

@@ -145,7 +145,7 @@ def begin_request(li, lf, lane, periods, keep, use_var, T, zdm_s):
     li[lane, L_KZ] = k if s < zdm_s - 1e-9 * T else k + 1
 
 
-@njit(cache=True)
+@njit(cache=False)  # (compiled once per machine into its own object file, grazing.engine.native)
 def sweep_lanes(
     m,
     lanes,
