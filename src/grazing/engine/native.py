@@ -226,11 +226,10 @@ def _register_numba_runtime() -> None:
             llvm.add_symbol("PyExc_" + obj.__name__, id(obj))
 
 
-def _resolvable(name: str, math_helpers: dict[str, int]) -> bool:
+def _resolvable(name: str) -> bool:
+    """Whether machine code loaded now finds the C symbol ``name``."""
     import llvmlite.binding as llvm
 
-    if name in math_helpers:  # (bound to the C library's function, as numba binds them)
-        llvm.add_symbol(name, math_helpers[name])
     if llvm.address_of_symbol(name):
         return True
     try:
@@ -338,14 +337,19 @@ def load_object(data: bytes, name: str) -> tuple[int, list[str], Any] | None:
 
     ``None`` if a C function the code calls cannot be found.
     """
+    import llvmlite.binding as llvm
+
     from grazing.engine.llvmgen import Library
 
     header, obj = data.split(b"\n", 1)
     meta = json.loads(header)
     symbols, params = list(meta["symbols"]), list(meta["params"])
     _register_numba_runtime()
-    math_helpers = dict(_numba_extension("numba._helperlib").c_helpers)
-    if not all(_resolvable(s, math_helpers) for s in symbols):
+    helpers = _numba_extension("numba._helperlib").c_helpers
+    for symbol in symbols:
+        if symbol in helpers:  # a C math function: bound to the C library's, as numba binds it
+            llvm.add_symbol(symbol, helpers[symbol])
+    if not all(_resolvable(symbol) for symbol in symbols):
         return None
     library = Library(obj, _PREFIX)
     address = library.address(name)
