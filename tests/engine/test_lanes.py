@@ -30,7 +30,7 @@ from grazing.engine.codegen import taylor_order
 from grazing.engine.runner import Runner
 from grazing.errors import SimulationError
 from grazing.models import bouncing_ball, impact_oscillator, pendulum, two_sided_oscillator
-from grazing.sweeps.run import run_chunks
+from grazing.sweeps.run import LaneBatch, run_chunks, stream_chunks
 from grazing.sweeps.spec import SweepSpec, sweep_spec
 from tests.random_models import ModelSpec, model_specs
 
@@ -230,6 +230,43 @@ def test_sweep_on_lanes_equals_the_runner_oracle(name: str) -> None:
         kern.LANES = saved
     # grouped differently: one chunk at a time
     assert_chunks_equal(spec, [run_chunks(spec, [i])[0] for i in range(spec.n_chunks)], "one chunk")
+    # the jobs shared by three threads (the chunks reported as they finish)
+    streamed = list(stream_chunks([(spec, i) for i in range(spec.n_chunks)], 3))
+    assert sorted(k for k, _ in streamed) == list(range(spec.n_chunks))
+    assert_chunks_equal(spec, [res for _, res in streamed], "three threads")
+
+
+def test_chunks_of_several_sweeps_in_one_batch_equal_each_sweep_alone() -> None:
+    # Specs that differ in their points, start state, phase and continuation share one driver call.
+    model = pendulum("B", theta_hat=math.radians(40))
+    base = dict(transient=120, periods=20, chunk_size=3)
+    specs = [
+        sweep_spec(model, "eta", np.linspace(0.44, 0.45, 6), settings=SweepSettings(**base)),
+        sweep_spec(
+            model,
+            "eta",
+            np.linspace(0.46, 0.47, 4),
+            x0=(0.1, -0.2),
+            direction="down",
+            settings=SweepSettings(**base, phase=0.7),
+        ),
+        sweep_spec(
+            model.with_params(theta_hat=math.radians(30)),
+            "eta",
+            np.linspace(0.45, 0.46, 5),
+            x0=(0.05, 0.0),
+            settings=SweepSettings(**base, fresh=True),
+        ),
+    ]
+    parts = [(spec, i) for spec in specs for i in range(spec.n_chunks)]
+    batch = LaneBatch(parts)
+    batch.run()
+    assert batch.finished() == list(range(len(parts)))
+    for spec in specs:
+        assert_chunks_equal(spec, [batch.result(k) for k, (s, _) in enumerate(parts) if s is spec], "batch")
+    other = sweep_spec(model, "eta", [0.44, 0.45], settings=SweepSettings(**{**base, "periods": 10}))
+    with pytest.raises(ValueError, match="share the model and the sweep settings"):
+        LaneBatch([(specs[0], 0), (other, 0)])
 
 
 def test_sweep_with_the_discontinuity_map_equals_the_oracle() -> None:

@@ -73,14 +73,19 @@ def sweep_arguments() -> tuple[list, int]:
     model = bouncing_ball()
     kern = model.kernels(0, taylor_order(1e-10))
     n, periods = model.n_states, 3
-    args = [
-        kern.table, 1, np.array([[0, 1]], dtype=np.int64), False, bool(model.periodic), np.array([0.5, 0.0]),
-        model.param_vector.reshape(1, -1).copy(), np.array([float(model.period)]), np.zeros(1), np.zeros(1),
-        np.zeros(1), 4, periods, False, False, 1.5, 1e-9, False, 1.0, np.zeros(n), 0.0, 0,
-        np.full((1, periods, n), np.nan), np.zeros((1, model.n_stops), dtype=np.int64), np.zeros(1),
-        np.zeros(1, dtype=np.int64), np.zeros((1, n)), np.zeros(1), np.zeros(1, dtype=np.int64),
-    ]  # fmt: skip
-    return args, 22
+    values = dict(
+        m=kern.table, lanes=1, jobs=np.array([[0, 1]], dtype=np.int64), control=np.zeros(2, dtype=np.int64),
+        fresh=False, periodic=bool(model.periodic), x0=np.array([[0.5, 0.0]]),
+        pvs=model.param_vector.reshape(1, -1).copy(), Ts=np.array([float(model.period)]), sphase=np.zeros(1),
+        tcarry=np.zeros(1), zdms=np.zeros(1), transient=4, periods=periods, adaptive=False, lyapunov=False,
+        safety=1.5, chatter_tol=1e-9, zdm_on=False, zdm_a=1.0, zdm_e=np.zeros(n), zdm_window=0.0, watch=0,
+        out_samples=np.full((1, periods, n), np.nan),
+        out_by_stop=np.zeros((1, model.n_stops), dtype=np.int64), out_lyap=np.zeros(1),
+        out_used=np.zeros(1, dtype=np.int64), out_x=np.zeros((1, n)), out_t=np.zeros(1),
+        out_ok=np.full(1, -1, dtype=np.int64),
+    )  # fmt: skip
+    assert tuple(values) == native.DRIVER_ARGUMENTS
+    return list(values.values()), native.DRIVER_ARGUMENTS.index("out_samples")
 
 
 def test_the_entry_point_computes_and_refuses_wrong_arrays() -> None:
@@ -88,11 +93,13 @@ def test_the_entry_point_computes_and_refuses_wrong_arrays() -> None:
     args, out = sweep_arguments()
     sweep(*args)
     assert np.isfinite(args[out]).all() and args[-1][0] == 1
+    x0 = native.DRIVER_ARGUMENTS.index("x0")
     wrong_arrays = (
         (out, np.zeros((1, 2, 2))),  # shape
         (out, np.zeros((1, 3, 2), dtype=np.float32)),  # dtype
         (out, np.zeros((1, 3, 4))[:, :, ::2]),  # not contiguous
-        (5, np.zeros(3)),  # x0 of the wrong size
+        (x0, np.zeros((1, 3))),  # x0 of the wrong size
+        (x0, np.zeros((2, 2))),  # x0 not one per job
     )
     for index, bad in wrong_arrays:
         wrong = list(args)
@@ -142,5 +149,5 @@ def test_the_entry_point_takes_the_drivers_arguments() -> None:
     import inspect
 
     assert tuple(inspect.signature(load_driver().sweep_lanes.py_func).parameters) == native.DRIVER_ARGUMENTS
-    with pytest.raises(TypeError, match="29 arguments expected"):
+    with pytest.raises(TypeError, match=f"{len(native.DRIVER_ARGUMENTS)} arguments expected"):
         native.load_sweep_lanes()(1, 2)

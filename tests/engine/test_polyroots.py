@@ -57,8 +57,9 @@ def test_matches_smallest_simple_root(roots, extra):
     if np.min(np.diff(roots), initial=1.0) < 1e-3:
         return
     a = P.polyfromroots(roots)
-    for e in extra:  # roots outside [0, 1] or complex pairs: do not add roots inside
-        a = P.polymul(a, [1.0 + abs(e), 0.0, 1.0]) if e > 0 else P.polymul(a, [1.0 + abs(e), -1.0])
+    for e in extra:  # complex pairs, or real roots outside [0, 1] (a cluster at 1 would make those
+        # inside ill-conditioned, as for any root finder: 1.1 keeps them apart)
+        a = P.polymul(a, [1.0 + abs(e), 0.0, 1.0]) if e > 0 else P.polymul(a, [1.1 + abs(e), -1.0])
     if a[0] < 0:
         a = -a
     u = _first_root(a)

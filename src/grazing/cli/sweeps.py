@@ -45,7 +45,7 @@ def _sweep_options(func: Callable[..., Any]) -> Callable[..., Any]:
         click.option("--fresh", is_flag=True, help="Start every point from --initial."),
         click.option("--chunk-size", type=count(0), default=None,
                      help="Points per chunk: the unit of parallel work and of saving (0: one chunk)."),
-        click.option("--workers", type=WORKERS, help="Local processes (default: all cores)."),
+        click.option("--workers", type=WORKERS, help="Local threads (default: all cores)."),
         click.option("--scheduler", metavar="tcp://HOST:PORT", help="Run the chunks on a Dask cluster."),
         click.option("--timeout", type=POSITIVE, metavar="SECONDS",
                      help="With --scheduler: give up after this long without any Dask worker "

@@ -39,7 +39,7 @@ monodromy matrix of a damped orbit underflows (its determinant is
 """
 
 MAX_WORKERS = 1024
-"""Most local worker processes."""
+"""Most local workers (threads of a sweep, processes elsewhere)."""
 
 MAX_SAMPLE_RATE = 1e6
 """Highest sample rate (Hz) of a written recording: times are written to the microsecond."""

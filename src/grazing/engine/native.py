@@ -42,16 +42,17 @@ from typing import Any
 import numpy as np
 
 DRIVER_ARGUMENTS = (
-    "m", "lanes", "jobs", "fresh", "periodic", "x0", "pvs", "Ts", "sphase", "tcarry", "zdms", "transient",
-    "periods", "adaptive", "lyapunov", "safety", "chatter_tol", "zdm_on", "zdm_a", "zdm_e", "zdm_window",
-    "watch", "out_samples", "out_by_stop", "out_lyap", "out_used", "out_x", "out_t", "out_ok",
+    "m", "lanes", "jobs", "control", "fresh", "periodic", "x0", "pvs", "Ts", "sphase", "tcarry", "zdms",
+    "transient", "periods", "adaptive", "lyapunov", "safety", "chatter_tol", "zdm_on", "zdm_a", "zdm_e",
+    "zdm_window", "watch", "out_samples", "out_by_stop", "out_lyap", "out_used", "out_x", "out_t", "out_ok",
 )  # fmt: skip
 """The arguments of :func:`grazing.engine.driver.lanes.sweep_lanes`; the loaded entry point takes them too."""
 _KERNELS = ("fns", "nx", "nsens", "nstops", "order", "sticks", "mlanes")
 """The fields of ``m`` (:class:`grazing.engine.records.Kernels`)."""
 _ARRAYS = {
-    "fns": ("i8", 1), "sticks": ("?", 1), "jobs": ("i8", 2), "x0": ("f8", 1), "pvs": ("f8", 2),
-    "Ts": ("f8", 1), "sphase": ("f8", 1), "tcarry": ("f8", 1), "zdms": ("f8", 1), "zdm_e": ("f8", 1),
+    "fns": ("i8", 1), "sticks": ("?", 1), "jobs": ("i8", 2), "control": ("i8", 1), "x0": ("f8", 2),
+    "pvs": ("f8", 2), "Ts": ("f8", 1), "sphase": ("f8", 1), "tcarry": ("f8", 1), "zdms": ("f8", 1),
+    "zdm_e": ("f8", 1),
     "out_samples": ("f8", 3), "out_by_stop": ("i8", 2), "out_lyap": ("f8", 1), "out_used": ("i8", 1),
     "out_x": ("f8", 2), "out_t": ("f8", 1), "out_ok": ("i8", 1),
 }  # fmt: skip
@@ -244,9 +245,11 @@ def _shapes(values: dict[str, Any]) -> dict[str, tuple[int, ...]]:
     nx, nstops, npts = values["nx"], values["nstops"], values["pvs"].shape[0]
     names = ("Ts", "sphase", "tcarry", "zdms", "out_lyap", "out_used", "out_t", "out_ok")
     per_point = {name: (npts,) for name in names}
+    njobs = values["jobs"].shape[0]
     return {
-        **per_point, "fns": values["fns"].shape, "sticks": (nstops,), "jobs": (values["jobs"].shape[0], 2),
-        "x0": (nx,), "pvs": values["pvs"].shape, "zdm_e": (nx,), "out_samples": (npts, values["periods"], nx),
+        **per_point, "fns": values["fns"].shape, "sticks": (nstops,), "jobs": (njobs, 2), "control": (2,),
+        "x0": (njobs, nx), "pvs": values["pvs"].shape, "zdm_e": (nx,),
+        "out_samples": (npts, values["periods"], nx),
         "out_by_stop": (npts, nstops), "out_x": (npts, nx),
     }  # fmt: skip
 
@@ -302,7 +305,10 @@ def _caller(address: int, params: list[str], keep: Any) -> Callable[..., None]:
         if entry(slots.ctypes.data) not in _RETURNED:  # pragma: no cover - the driver raised
             from grazing.engine.codegen import load_driver
 
-            load_driver().sweep_lanes(*arguments)  # (numba's function raises the error; outputs rewritten)
+            values = dict(zip(DRIVER_ARGUMENTS, arguments, strict=True))
+            values["control"][1] = 1  # (the other threads of the call stop)
+            values["control"] = np.zeros(2, dtype=np.int64)  # every job again, in this thread:
+            load_driver().sweep_lanes(*values.values())  # numba's function raises the error
             raise RuntimeError("the compiled sweep driver failed where numba's function did not")
 
     sweep_lanes.library = keep  # type: ignore[attr-defined]  # (the machine code lives as long as this)

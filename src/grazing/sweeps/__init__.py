@@ -2,14 +2,14 @@
 
 :func:`sweep` and :func:`parameter_map` (in :mod:`~grazing.sweeps.api`) build a
 :class:`~grazing.sweeps.spec.SweepSpec`, whose chunks :mod:`~grazing.sweeps.run`
-computes, :mod:`~grazing.sweeps.executor` distributes (local processes or a Dask
+computes, :mod:`~grazing.sweeps.executor` distributes (local threads or a Dask
 cluster) and :mod:`~grazing.sweeps.store` keeps (in memory, or in a resumable
 Zarr store that grazing owns and locks).  :mod:`~grazing.sweeps.windows` finds
 the periodic windows of a one-parameter diagram.
 """
 
 from grazing.core.period import detect_period
-from grazing.sweeps.api import parameter_map, run_sweep, sweep
+from grazing.sweeps.api import parameter_map, run_sweep, run_sweeps, sweep
 from grazing.sweeps.run import run_chunk
 from grazing.sweeps.spec import SweepSpec, map_spec, sweep_spec
 
@@ -20,6 +20,7 @@ __all__ = [
     "parameter_map",
     "run_chunk",
     "run_sweep",
+    "run_sweeps",
     "sweep",
     "sweep_spec",
 ]

@@ -1,14 +1,18 @@
-"""Where the chunks of a sweep run: in this process, on local worker processes, or on a Dask cluster.
+"""Where the chunks of a sweep run: on the local cores (threads of this process) or on a Dask cluster.
 
-Local processes come from :func:`grazing.parallel.map_unordered` (the one
-process pool of the package: workers die with their parent, at most a few
-chunks are queued ahead, Ctrl-C cancels what is queued and stops the workers
-at once).  A Dask cluster gets the same bounded window of chunks; without any
-worker for a while the caller is told, and given up on after a timeout.
+Locally, the chunks (of one sweep, or of several: :func:`local_results`)
+are computed in batches (:func:`local_batches`) by one
+thread per core sharing each batch's jobs
+(:func:`grazing.sweeps.run.stream_chunks`: the compiled driver runs without
+the GIL), and handed to the caller as each one finishes.  No worker process
+is started, so there is none to leave behind, and a small sweep costs little
+more than its work; Ctrl-C (or an error while storing a result) stops the
+threads at their next step.
 
-Chunks travel in groups (:func:`chunk_groups`) that a worker computes
-together on the SIMD lanes of :func:`grazing.sweeps.run.run_chunks`: a
-continuation sweep needs one chunk per lane to fill them.
+A Dask cluster gets groups of chunks (:func:`chunk_groups`), each computed
+together on the SIMD lanes of :func:`grazing.sweeps.run.run_chunks`, a
+bounded window of them at a time; without any worker for a while the caller
+is told, and given up on after a timeout.
 """
 
 from __future__ import annotations
@@ -20,8 +24,8 @@ from collections.abc import Callable, Iterator, Sequence
 from typing import Any
 
 from grazing.errors import GrazingError
-from grazing.parallel import in_flight, map_unordered
-from grazing.sweeps.run import run_chunks
+from grazing.parallel import in_flight
+from grazing.sweeps.run import batch_key, run_chunks, stream_chunks
 from grazing.sweeps.spec import ChunkResult, SweepSpec
 
 
@@ -35,21 +39,8 @@ DASK_NOTICE_AFTER = 5.0
 POLL_INTERVAL = 0.5
 """Seconds between two looks at a Dask cluster while no chunk finishes."""
 
-_WORKER_SPEC: SweepSpec | None = None
-"""The sweep of this pool worker (set once by its initializer, not sent with every chunk)."""
-
-
-def _init_pool_worker(parent_pid: int, spec: SweepSpec) -> None:
-    global _WORKER_SPEC
-    from grazing.parallel import init_worker
-
-    init_worker(parent_pid)
-    _WORKER_SPEC = spec
-
-
-def _run_group_in_worker(group: list[int]) -> list[ChunkResult]:
-    assert _WORKER_SPEC is not None
-    return run_chunks(_WORKER_SPEC, group)
+BATCH_VALUES = 1 << 21
+"""Most sample values (points x periods x states) of a local batch, beyond what filling the lanes takes."""
 
 
 def chunk_groups(spec: SweepSpec, todo: Sequence[int], workers: int) -> list[list[int]]:
@@ -77,22 +68,58 @@ def chunk_groups(spec: SweepSpec, todo: Sequence[int], workers: int) -> list[lis
     return [todo[i : i + per] for i in range(0, len(todo), per)]
 
 
-def _local_results(
-    spec: SweepSpec, todo: Sequence[int], workers: int, run: Callable[[int], Any] | None = None
-) -> Iterator[Any]:
-    """Chunk results from local worker processes (:func:`grazing.parallel.map_unordered`).
+Part = tuple[SweepSpec, int]
+"""A chunk of a sweep: the spec and the chunk's index."""
 
-    Each worker receives the spec once, when it starts; ``run`` replaces
-    the computation of one chunk (tests).
+
+def local_batches(parts: Sequence[Part], threads: int) -> list[list[Part]]:
+    """``parts`` split into the batches that ``threads`` threads compute in turn (one driver call each).
+
+    The chunks of a batch share the model and the sweep settings
+    (:func:`grazing.sweeps.run.batch_key`).  A batch fills every thread's
+    lanes twice over (two chains of a continuation sweep per lane, four
+    points per lane) and holds at least :data:`BATCH_VALUES` sample values
+    (points x periods x states) when there are that many: a batch's chunks
+    reach the caller as they finish, but its lanes run idle at its end.
+
+    Examples
+    --------
+    >>> import grazing
+    >>> from grazing.sweeps.spec import sweep_spec
+    >>> spec = sweep_spec(grazing.models.pendulum("B"), "eta", [0.4 + 0.001 * i for i in range(1000)])
+    >>> [len(b) for b in local_batches([(spec, i) for i in range(spec.n_chunks)], threads=2)]
+    [20]
     """
-    if run is not None:
-        yield from map_unordered(run, list(todo), workers)
-        return
-    for results in map_unordered(
-        _run_group_in_worker, chunk_groups(spec, todo, workers), workers, initializer=_init_pool_worker,
-        initargs=(spec,),
-    ):  # fmt: skip
-        yield from results
+    from grazing.engine.llvmgen import lane_width
+
+    lanes = max(1, lane_width()) * max(1, threads)
+    groups: dict[tuple[Any, ...], list[Part]] = {}
+    for part in parts:
+        groups.setdefault(batch_key(part[0]), []).append(part)
+    out: list[list[Part]] = []
+    for group in groups.values():
+        batch: list[Part] = []
+        jobs = points = values = 0
+        for spec, i in group:
+            sl = spec.chunk(i)
+            size = sl.stop - sl.start
+            batch.append((spec, i))
+            jobs += size if spec.fresh else 1
+            points += size
+            values += size * spec.periods * spec.model.n_states
+            if jobs >= 2 * lanes and points >= 4 * lanes and values >= BATCH_VALUES:
+                out.append(batch)
+                batch, jobs, points, values = [], 0, 0, 0
+        if batch:
+            out.append(batch)
+    return out
+
+
+def local_results(parts: Sequence[Part], threads: int) -> Iterator[tuple[Part, ChunkResult]]:
+    """Each chunk of ``parts`` with its result as it finishes, computed by ``threads`` threads here."""
+    for batch in local_batches(parts, threads):
+        for k, result in stream_chunks(batch, threads):
+            yield batch[k], result
 
 
 def _dask_workers(client: Any) -> int:
@@ -183,9 +210,5 @@ def chunk_results(
     if client is not None:
         yield from _dask_results(spec, todo, client, timeout, notice)
         return
-    workers = workers or os.cpu_count() or 1
-    if workers <= 1 or len(todo) <= 1:
-        for group in chunk_groups(spec, todo, 1):
-            yield from run_chunks(spec, group)
-        return
-    yield from _local_results(spec, todo, workers)
+    for _, result in local_results([(spec, i) for i in todo], max(1, workers or os.cpu_count() or 1)):
+        yield result

@@ -21,15 +21,21 @@ exponent is taken over the sampled periods.
 The points are computed by the compiled driver on SIMD lanes
 (:mod:`grazing.engine.driver.lanes`): several points at once, each lane its
 own point with its own steps and events; in a continuation sweep a lane
-follows one chunk, in a fresh sweep it takes any point.  The results do not
-depend on the lanes (each lane does the scalar path's arithmetic).
+follows one chunk, in a fresh sweep it takes any point.  Several threads can
+share one call's jobs (:func:`stream_chunks`): each takes the next job when
+one of its lanes is free, so the cores stay busy until the last chains, and
+the chunks are handed out as soon as they are finished.  The results do not
+depend on the lanes or the threads (each lane does the scalar path's
+arithmetic; a chain of points stays on one lane).
 """
 
 from __future__ import annotations
 
 import math
+import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -40,100 +46,225 @@ from grazing.engine.native import load_sweep_lanes
 from grazing.engine.runner import step_safety
 from grazing.sweeps.spec import ChunkResult, SweepSpec
 
+POLL_INTERVAL = 0.05
+"""Seconds between two looks of :func:`stream_chunks` at the finished points."""
+
+
+def batch_key(spec: SweepSpec) -> tuple[Any, ...]:
+    """What the chunks of one driver call share (everything that is not per point or per job)."""
+    z = spec.zdm
+    zdm = None
+    if z is not None:
+        zdm = (float(z.accel), tuple(np.asarray(z.direction, dtype=float)), float(z.window), int(z.stop))
+    return (
+        id(spec.model._def), spec.model.periodic, taylor_order(spec.tol), spec.tol, spec.transient,
+        spec.periods, spec.adaptive, spec.lyapunov, zdm,
+    )  # fmt: skip
+
+
+class LaneBatch:
+    """Chunks of sweeps computed by one call of the compiled driver, on one thread or several.
+
+    ``parts`` are ``(spec, chunk index)`` pairs; their specs may differ in
+    their points, start state, phase and in being fresh or not, but not in
+    the model, tolerance, transient, periods, adaptive transients, Lyapunov
+    exponents or discontinuity map (``ValueError``).
+
+    Examples
+    --------
+    >>> import grazing
+    >>> from grazing.sweeps.spec import sweep_spec
+    >>> spec = sweep_spec(grazing.models.pendulum("B"), "eta", [0.44, 0.45, 0.46])
+    >>> batch = LaneBatch([(spec, 0)])
+    >>> batch.run()
+    >>> batch.result(0).period.tolist() == batch.result(0).period.tolist()
+    True
+    """
+
+    def __init__(self, parts: Sequence[tuple[SweepSpec, int]]) -> None:
+        if not parts:
+            raise ValueError("a batch needs at least one chunk")
+        key = batch_key(parts[0][0])
+        if any(batch_key(spec) != key for spec, _ in parts[1:]):
+            raise ValueError("the chunks of a batch must share the model and the sweep settings")
+        self.parts = list(parts)
+        spec0 = parts[0][0]
+        model = spec0.model
+        n, m, nstops = model.n_states, spec0.periods, model.n_stops
+        slices = [spec.chunk(i) for spec, i in parts]
+        models, phases, tcarry, zdms, jobs, x0s, bounds = [], [], [], [], [], [], []
+        first = 0
+        for (spec, _), sl in zip(parts, slices):
+            size = sl.stop - sl.start
+            here = [spec.model_at(pt) for pt in spec.points[sl]]
+            Ts = [float(mm.period) for mm in here]
+            models += here
+            phases += [(spec.phase % (2 * math.pi)) / (2 * math.pi) * T for T in Ts]
+            tcarry += [(spec.phase / (2 * math.pi)) % 1.0 * T for T in Ts]
+            zdms += [float(spec.zdm.phase) % T if spec.zdm is not None else 0.0 for T in Ts]
+            # Jobs: runs of points, each continuing from the previous (a chunk; every point when fresh).
+            runs = [(j, j + 1) for j in range(first, first + size)] if spec.fresh else [(first, first + size)]
+            jobs += runs
+            x0s += [spec.x0] * len(runs)
+            bounds.append((first, first + size))
+            first += size
+        npts = first
+        self._bounds = bounds
+        order = taylor_order(spec0.tol)
+        self._kern = model.kernels(0, order)
+        self._order = order
+        self._spec0 = spec0
+        self.jobs = np.array(jobs, dtype=np.int64).reshape(-1, 2)
+        self.x0 = np.array(x0s, dtype=float).reshape(-1, n)
+        self.pvs = np.array([mm.param_vector for mm in models], dtype=float).reshape(npts, -1)
+        self.Ts = np.array([float(mm.period) for mm in models])
+        self.sphase = np.array(phases, dtype=float)
+        self.tcarry = np.array(tcarry, dtype=float)
+        self.zdms = np.array(zdms, dtype=float)
+        self.fresh = all(spec.fresh for spec, _ in parts)  # (a fresh spec's jobs are single points anyway)
+        self.control = np.zeros(2, dtype=np.int64)  # [next job, stop]
+        self.samples = np.full((npts, m, n), np.nan)
+        self.by_stop = np.zeros((npts, nstops), dtype=np.int64)
+        self.lyap = np.full(npts, np.nan)
+        self.used = np.zeros(npts, dtype=np.int64)
+        self.x_final = np.full((npts, n), np.nan)
+        self.t_final = np.zeros(npts)
+        self.ok = np.full(npts, -1, dtype=np.int64)  # -1 not finished, 0 failed, 1 done
+        self._starts = np.array([a for a, _ in bounds], dtype=np.int64)
+        self._taken = np.zeros(len(parts), dtype=bool)
+
+    def run(self) -> None:
+        """Compute the batch's points (or, with other threads running it too, its share of them)."""
+        spec, kern, z = self._spec0, self._kern, self._spec0.zdm
+        n = spec.model.n_states
+        load_sweep_lanes()(
+            kern.table,
+            1 if len(self.jobs) == 1 else max(1, kern.LANES),  # (the lane functions' width, or one lane)
+            self.jobs,
+            self.control,
+            self.fresh,
+            bool(spec.model.periodic),
+            self.x0,
+            self.pvs,
+            self.Ts,
+            self.sphase,
+            self.tcarry,
+            self.zdms,
+            int(spec.transient),
+            int(spec.periods),
+            bool(spec.adaptive),
+            bool(spec.lyapunov),
+            float(step_safety(spec.tol, self._order)),
+            float(CHATTER_TOL),
+            z is not None,
+            float(z.accel) if z is not None else 1.0,
+            np.asarray(z.direction if z is not None else np.zeros(n), dtype=float),
+            float(z.window) if z is not None else 0.0,
+            int(z.stop) if z is not None else 0,
+            self.samples,
+            self.by_stop,
+            self.lyap,
+            self.used,
+            self.x_final,
+            self.t_final,
+            self.ok,
+        )
+
+    def stop(self) -> None:
+        """Have the threads running the batch return at their next step (unfinished points stay so)."""
+        self.control[1] = 1
+
+    def finished(self) -> list[int]:
+        """Positions in ``parts`` of the chunks finished since the last call (every point done or failed)."""
+        complete = np.logical_and.reduceat(self.ok >= 0, self._starts)
+        done = [int(k) for k in np.flatnonzero(complete & ~self._taken)]
+        self._taken[done] = True
+        return done
+
+    def result(self, k: int) -> ChunkResult:
+        """The result of chunk ``parts[k]`` (once finished)."""
+        a, b = self._bounds[k]
+        part = slice(a, b)
+        good = self.ok[part] == 1
+        samples = self.samples[part]
+        return ChunkResult(
+            index=self.parts[k][1],
+            samples=np.where(good[:, None, None], samples, np.nan),
+            period=np.array(
+                [
+                    detect_period(s, DEFAULT_PERIOD_TOL, DEFAULT_MAX_PERIOD) if g else -1
+                    for s, g in zip(samples, good)
+                ],
+                dtype=np.int32,
+            ),
+            impacts=np.where(good, self.by_stop[part].sum(axis=1), 0).astype(np.int32),
+            lyapunov=np.where(good, self.lyap[part], np.nan),
+            transient_used=np.where(good, self.used[part], 0).astype(np.int32),
+            x_final=np.where(good[:, None], self.x_final[part], np.nan),
+            impacts_by_stop=np.where(good[:, None], self.by_stop[part], -1).astype(np.int32),
+        )
+
 
 def run_chunks(spec: SweepSpec, indices: Sequence[int]) -> list[ChunkResult]:
-    """Compute the chunks ``indices`` of ``spec`` together (on SIMD lanes); their results in that order.
+    """Compute the chunks ``indices`` of ``spec`` together (on SIMD lanes, in this thread); in that order.
 
     Each chunk's result is a pure function of the spec and its index: the
     same whichever chunks are computed with it.
     """
     start = time.perf_counter()
-    model = spec.model
-    n, m, nstops = model.n_states, spec.periods, model.n_stops
-    slices = [spec.chunk(i) for i in indices]
-    pts = [pt for sl in slices for pt in spec.points[sl]]
-    npts = len(pts)
-    models = [spec.model_at(pt) for pt in pts]
-    order = taylor_order(spec.tol)
-    kern = model.kernels(0, order)
-    pvs = np.array([mm.param_vector for mm in models], dtype=float).reshape(npts, -1)
-    Ts = np.array([float(mm.period) for mm in models])
-    phase = (spec.phase % (2 * math.pi)) / (2 * math.pi)
-    sphase = phase * Ts
-    tcarry = (spec.phase / (2 * math.pi)) % 1.0 * Ts
-    z = spec.zdm
-    zdms = np.array([float(z.phase) % T for T in Ts]) if z is not None else np.zeros(npts)
-    # Jobs: runs of points in which each continues from the previous (a chunk; every point when fresh).
-    jobs, first = [], 0
-    for sl in slices:
-        size = sl.stop - sl.start
-        jobs += [(first + j, first + j + 1) for j in range(size)] if spec.fresh else [(first, first + size)]
-        first += size
-    samples = np.full((npts, m, n), np.nan)
-    by_stop = np.zeros((npts, nstops), dtype=np.int64)
-    lyap = np.full(npts, np.nan)
-    used = np.zeros(npts, dtype=np.int64)
-    x_final = np.full((npts, n), np.nan)
-    t_final = np.zeros(npts)
-    ok = np.zeros(npts, dtype=np.int64)
-    load_sweep_lanes()(
-        kern.table,
-        1 if len(jobs) == 1 else max(1, kern.LANES),  # (the lane functions' width, or one lane)
-        np.array(jobs, dtype=np.int64).reshape(-1, 2),
-        bool(spec.fresh),
-        bool(model.periodic),
-        np.asarray(spec.x0, dtype=float),
-        pvs,
-        Ts,
-        sphase,
-        tcarry,
-        zdms,
-        int(spec.transient),
-        int(m),
-        bool(spec.adaptive),
-        bool(spec.lyapunov),
-        float(step_safety(spec.tol, order)),
-        float(CHATTER_TOL),
-        z is not None,
-        float(z.accel) if z is not None else 1.0,
-        np.asarray(z.direction if z is not None else np.zeros(n), dtype=float),
-        float(z.window) if z is not None else 0.0,
-        int(z.stop) if z is not None else 0,
-        samples,
-        by_stop,
-        lyap,
-        used,
-        x_final,
-        t_final,
-        ok,
-    )
-    results, first = [], 0
-    for index, sl in zip(indices, slices):
-        size = sl.stop - sl.start
-        part = slice(first, first + size)
-        first += size
-        good = ok[part] == 1
-        res = ChunkResult(
-            index=index,
-            samples=np.where(good[:, None, None], samples[part], np.nan),
-            period=np.array(
-                [
-                    detect_period(s, DEFAULT_PERIOD_TOL, DEFAULT_MAX_PERIOD) if g else -1
-                    for s, g in zip(samples[part], good)
-                ],
-                dtype=np.int32,
-            ),
-            impacts=np.where(good, by_stop[part].sum(axis=1), 0).astype(np.int32),
-            lyapunov=np.where(good, lyap[part], np.nan),
-            transient_used=np.where(good, used[part], 0).astype(np.int32),
-            x_final=np.where(good[:, None], x_final[part], np.nan),
-            impacts_by_stop=np.where(good[:, None], by_stop[part], -1).astype(np.int32),
-        )
-        results.append(res)
+    batch = LaneBatch([(spec, i) for i in indices])
+    batch.run()
+    results = [batch.result(k) for k in range(len(indices))]
     seconds = time.perf_counter() - start
     for res in results:  # (the chunks ran together: each is charged its share)
         res.seconds = seconds / len(results)
     return results
+
+
+def stream_chunks(parts: Sequence[tuple[SweepSpec, int]], threads: int) -> Iterator[tuple[int, ChunkResult]]:
+    """``(position in parts, result)`` of each chunk of ``parts`` as soon as it is finished.
+
+    The chunks are computed as one :class:`LaneBatch` by ``threads`` threads
+    sharing its jobs (the compiled driver runs without the GIL).  When the
+    consumer stops early (Ctrl-C, an error, ``close()``) the threads are
+    told to stop and have returned, at their next step, before this returns.
+    """
+    batch = LaneBatch(parts)
+    errors: list[BaseException] = []
+    finished = threading.Semaphore(0)
+
+    def work() -> None:
+        try:
+            batch.run()
+        except BaseException as exc:  # (reported by the consumer's thread)
+            errors.append(exc)
+            batch.stop()
+        finally:
+            finished.release()
+
+    workers = [threading.Thread(target=work, name=f"grazing-sweep-{i}", daemon=True) for i in range(threads)]
+    for w in workers:
+        w.start()
+    running, last = len(workers), time.perf_counter()
+    try:
+        while running:
+            if finished.acquire(timeout=POLL_INTERVAL):
+                running -= 1
+            if errors:
+                raise errors[0]
+            done = batch.finished()
+            now = time.perf_counter()
+            for k in done:
+                res = batch.result(k)
+                res.seconds = (now - last) * threads / len(done)
+                yield k, res
+            last = now if done else last
+        for k in batch.finished():
+            yield k, batch.result(k)
+    finally:
+        batch.stop()
+        for w in workers:
+            w.join()
 
 
 def run_chunk(spec: SweepSpec, index: int) -> ChunkResult:

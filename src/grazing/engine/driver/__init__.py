@@ -37,7 +37,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-PIECES = ("calls.py", "events.py", "recording.py", "tangent.py", "impacts.py", "loop.py", "lanes.py")
+PIECES = (
+    "atomics.py", "calls.py", "events.py", "recording.py", "tangent.py", "impacts.py", "loop.py", "lanes.py",
+)  # fmt: skip
 """The template files, in the order they are appended."""
 
 

@@ -29,6 +29,7 @@ import numpy as np
 from numba import njit
 
 from grazing.engine.abi import TC_FREE_LANES, TC_VAR_LANES, call_model
+from grazing.engine.driver.atomics import fetch_add, load_acquire, store_release
 from grazing.engine.driver.calls import tc_free, tc_stick, tc_var
 from grazing.engine.driver.events import first_event
 from grazing.engine.driver.impacts import apply_impact, chatter_remaining, enter_contact
@@ -74,8 +75,9 @@ IDLE, TRANSIENT, EXTRA, FINAL = 0, 1, 2, 3
     L_USED,
     L_BLOCK,
     L_RKS,
+    L_JOB,
     L_NLI,
-) = range(25)
+) = range(26)
 # Float state of a lane (columns of ``lf``).
 F_S, F_SS, F_LT0, F_RSS, F_NLF = range(5)
 
@@ -145,11 +147,12 @@ def begin_request(li, lf, lane, periods, keep, use_var, T, zdm_s):
     li[lane, L_KZ] = k if s < zdm_s - 1e-9 * T else k + 1
 
 
-@njit(cache=False)  # (compiled once per machine into its own object file, grazing.engine.native)
+@njit(cache=False, nogil=True)  # (compiled once per machine into its own object file, grazing.engine.native)
 def sweep_lanes(
     m,
     lanes,
     jobs,
+    control,
     fresh,
     periodic,
     x0,
@@ -179,10 +182,17 @@ def sweep_lanes(
 ):
     """Compute the sweep points of ``jobs`` on ``lanes`` lanes (see the module); results into ``out_*``.
 
-    Per point ``p``: parameter vector ``pvs[p]``, period ``Ts[p]``, sampling
-    phase ``sphase[p]`` (local time), start time of a point continued from
-    the previous one ``tcarry[p]`` (periodic models), local time of the
-    discontinuity map ``zdms[p]``.  ``out_ok[p]`` is 0 where the point failed.
+    Job ``j`` starts from state ``x0[j]``.  Per point ``p``: parameter
+    vector ``pvs[p]``, period ``Ts[p]``, sampling phase ``sphase[p]`` (local
+    time), start time of a point continued from the previous one
+    ``tcarry[p]`` (periodic models), local time of the discontinuity map
+    ``zdms[p]``.  ``out_ok[p]`` becomes 1 once the point's results are
+    written, 0 if it failed (the caller sets it to -1 before).
+
+    Several threads may run the same call (the same arrays): they take the
+    jobs in turn from the counter ``control[0]`` (0 at the start), and stop
+    at the next step once the caller sets ``control[1]`` to 1, leaving the
+    points they had not finished at -1.
     """
     m = Kernels(*m)
     n = m.nx
@@ -242,28 +252,31 @@ def sweep_lanes(
     plain = np.zeros(L, dtype=np.int64)  # 1: no event on the step is certain so far
     acc = np.zeros(L)
 
-    next_job = 0
     active = 0
     for lane in range(L):
         li[lane, L_STAGE] = IDLE
     while True:
+        if load_acquire(control, 1) != 0:  # the caller stops the sweep: unfinished points stay at -1
+            return
         # Idle lanes take the next point: their job's next one, else the next job's first.
         for lane in range(L):
-            while li[lane, L_STAGE] == IDLE:
+            while li[lane, L_STAGE] == IDLE and li[lane, L_JOBEND] >= 0:
                 p = li[lane, L_POINT] + 1
                 carried = li[lane, L_STATUS] == 0 and li[lane, L_JOBEND] > 0
                 if li[lane, L_JOBEND] == 0 or p >= li[lane, L_JOBEND]:
-                    if next_job >= jobs.shape[0]:
+                    job = fetch_add(control, 0, 1)
+                    if job >= jobs.shape[0]:
+                        li[lane, L_JOBEND] = -1  # (no more jobs for this lane)
                         break
-                    p = jobs[next_job, 0]
-                    li[lane, L_JOBEND] = jobs[next_job, 1]
-                    next_job += 1
+                    p = jobs[job, 0]
+                    li[lane, L_JOBEND] = jobs[job, 1]
+                    li[lane, L_JOB] = job
                     carried = False
                 li[lane, L_POINT] = p
                 T = Ts[p]
                 if fresh or not carried:
                     for i in range(n):
-                        XS[i, lane] = x0[i]
+                        XS[i, lane] = x0[li[lane, L_JOB], i]
                     t0 = 0.0
                 else:
                     t0 = tcarry[p] if periodic else out_t[p - 1]
@@ -524,7 +537,7 @@ def sweep_lanes(
         # Pass B, lane by lane: time, Lyapunov vectors, discontinuity map, impacts, the request's end.
         for lane in range(L):
             if flags[lane] == 8:  # the point failed: the next point starts afresh
-                out_ok[li[lane, L_POINT]] = 0
+                store_release(out_ok, li[lane, L_POINT], 0)
                 li[lane, L_STAGE] = IDLE
                 active -= 1
                 continue
@@ -696,7 +709,7 @@ def sweep_lanes(
             for i in range(n):
                 out_x[p, i] = XS[i, lane]
             out_t[p] = k * T + s
-            out_ok[p] = 1
+            store_release(out_ok, p, 1)  # (after its results: another thread may read them now)
             li[lane, L_STAGE] = IDLE
             active -= 1
 
