@@ -74,7 +74,7 @@ def sweep_arguments() -> tuple[list, int]:
     kern = model.kernels(0, taylor_order(1e-10))
     n, periods = model.n_states, 3
     values = dict(
-        m=kern.table, lanes=1, jobs=np.array([[0, 1]], dtype=np.int64), control=np.zeros(2, dtype=np.int64),
+        m=kern.table, lanes=1, jobs=np.array([[0, 1]], dtype=np.int64), control=np.zeros(3, dtype=np.int64),
         fresh=False, periodic=bool(model.periodic), x0=np.array([[0.5, 0.0]]),
         pvs=model.param_vector.reshape(1, -1).copy(), Ts=np.array([float(model.period)]), sphase=np.zeros(1),
         tcarry=np.zeros(1), zdms=np.zeros(1), transient=4, periods=periods, adaptive=False, lyapunov=False,

@@ -247,7 +247,7 @@ def _shapes(values: dict[str, Any]) -> dict[str, tuple[int, ...]]:
     per_point = {name: (npts,) for name in names}
     njobs = values["jobs"].shape[0]
     return {
-        **per_point, "fns": values["fns"].shape, "sticks": (nstops,), "jobs": (njobs, 2), "control": (2,),
+        **per_point, "fns": values["fns"].shape, "sticks": (nstops,), "jobs": (njobs, 2), "control": (3,),
         "x0": (njobs, nx), "pvs": values["pvs"].shape, "zdm_e": (nx,),
         "out_samples": (npts, values["periods"], nx),
         "out_by_stop": (npts, nstops), "out_x": (npts, nx),
@@ -307,7 +307,7 @@ def _caller(address: int, params: list[str], keep: Any) -> Callable[..., None]:
 
             values = dict(zip(DRIVER_ARGUMENTS, arguments, strict=True))
             values["control"][1] = 1  # (the other threads of the call stop)
-            values["control"] = np.zeros(2, dtype=np.int64)  # every job again, in this thread:
+            values["control"] = np.zeros(3, dtype=np.int64)  # every job again, in this thread:
             load_driver().sweep_lanes(*values.values())  # numba's function raises the error
             raise RuntimeError("the compiled sweep driver failed where numba's function did not")
 

@@ -122,7 +122,7 @@ class LaneBatch:
         self.tcarry = np.array(tcarry, dtype=float)
         self.zdms = np.array(zdms, dtype=float)
         self.fresh = all(spec.fresh for spec, _ in parts)  # (a fresh spec's jobs are single points anyway)
-        self.control = np.zeros(2, dtype=np.int64)  # [next job, stop]
+        self.control = np.zeros(3, dtype=np.int64)  # [next job, stop, most jobs at a time per thread]
         self.samples = np.full((npts, m, n), np.nan)
         self.by_stop = np.zeros((npts, nstops), dtype=np.int64)
         self.lyap = np.full(npts, np.nan)
@@ -230,6 +230,7 @@ def stream_chunks(parts: Sequence[tuple[SweepSpec, int]], threads: int) -> Itera
     told to stop and have returned, at their next step, before this returns.
     """
     batch = LaneBatch(parts)
+    batch.control[2] = math.ceil(len(batch.jobs) / threads)  # (a few chains: as many on each thread)
     errors: list[BaseException] = []
     finished = threading.Semaphore(0)
 

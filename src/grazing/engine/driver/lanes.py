@@ -190,9 +190,11 @@ def sweep_lanes(
     written, 0 if it failed (the caller sets it to -1 before).
 
     Several threads may run the same call (the same arrays): they take the
-    jobs in turn from the counter ``control[0]`` (0 at the start), and stop
-    at the next step once the caller sets ``control[1]`` to 1, leaving the
-    points they had not finished at -1.
+    jobs in turn from the counter ``control[0]`` (0 at the start), each
+    running at most ``control[2]`` jobs at a time (0: one per lane; so that
+    a few jobs are shared out evenly), and stop at the next step once the
+    caller sets ``control[1]`` to 1, leaving the points they had not
+    finished at -1.
     """
     m = Kernels(*m)
     n = m.nx
@@ -264,6 +266,8 @@ def sweep_lanes(
                 p = li[lane, L_POINT] + 1
                 carried = li[lane, L_STATUS] == 0 and li[lane, L_JOBEND] > 0
                 if li[lane, L_JOBEND] == 0 or p >= li[lane, L_JOBEND]:
+                    if control[2] > 0 and active >= control[2]:
+                        break  # (this thread has its share of the jobs running)
                     job = fetch_add(control, 0, 1)
                     if job >= jobs.shape[0]:
                         li[lane, L_JOBEND] = -1  # (no more jobs for this lane)
