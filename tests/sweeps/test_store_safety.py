@@ -407,8 +407,8 @@ def test_closing_a_local_sweep_stops_its_threads_at_once():
     # (the 400 points would take minutes), the unfinished chunks are not reported.
     spec = _spec(points=tuple((float(v),) for v in np.linspace(0.44, 0.49, 400)), chunk_size=1,
                  transient=60000, periods=10, adaptive=False)  # fmt: skip
-    results = executor._local_results(spec, list(range(spec.n_chunks)), 2)
-    first = next(results)
+    results = executor.local_results([(spec, i) for i in range(spec.n_chunks)], 2)
+    _, first = next(results)
     assert first.period.shape == (1,) and first.period[0] >= 1
     start = time.monotonic()
     results.close()
