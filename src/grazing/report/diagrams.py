@@ -383,6 +383,22 @@ def run_parallel(
     return results
 
 
+def run_calls(calls: Sequence[tuple[Callable[..., Any], tuple[Any, ...], dict[str, Any]]]) -> list[Any]:
+    """``[fn(*args, **kwargs) for fn, args, kwargs in calls]`` on a process per core; the results in order.
+
+    A figure's images and data files are drawn and written at once (each
+    call in its own process: matplotlib and the netCDF writer hold the GIL).
+    """
+    workers = min(os.cpu_count() or 1, max(len(calls), 1))
+    tagged = run_parallel(_call, list(enumerate(calls)), workers)
+    return [res for _, res in sorted(tagged, key=lambda t: t[0])]
+
+
+def _call(item: tuple[int, tuple[Callable[..., Any], tuple[Any, ...], dict[str, Any]]]) -> tuple[int, Any]:
+    i, (fn, args, kwargs) = item
+    return i, fn(*args, **kwargs)
+
+
 def run_panels(
     case: str,
     panels: Sequence[Panel],

@@ -91,10 +91,11 @@ def build(out_dir: Path, progress: Progress | None = None, settings: Settings | 
     runs = diagrams.run_panels(CASE, PANELS, s, progress=say, tag="fig 7: ")
     say("fig 7: drawing")
     names = ("fig07_bifurcation.png", "fig07_magnified.png", "fig07_overview.png")
-    diagrams.draw_panels(runs.main, out_dir / names[0], case_label=CASE_LABEL)
-    diagrams.draw_panels(runs.zoom, out_dir / names[1], case_label=CASE_LABEL)
-    diagrams.draw_panels(runs.overview, out_dir / names[2], case_label=CASE_LABEL)
-    nc, csv = diagrams.write_data(runs, out_dir, "fig07_sweeps", CASE)
+    views = (runs.main, runs.zoom, runs.overview)
+    *_, (nc, csv) = diagrams.run_calls(
+        [(diagrams.draw_panels, (r, out_dir / n), {"case_label": CASE_LABEL}) for r, n in zip(views, names)]
+        + [(diagrams.write_data, (runs, out_dir, "fig07_sweeps", CASE), {})]
+    )
     images = (
         Image(
             names[0],

@@ -126,9 +126,21 @@ def build(out_dir: Path, progress: Progress | None = None, settings: Settings | 
     )
     say("fig 10: drawing")
     name, zname = "fig10_map_bifurcation.png", "fig10_map_magnified.png"
-    diagrams.draw_panels(mapped.main, out_dir / name, case_label=CASE_LABEL, reference=flow.main)
-    diagrams.draw_panels(mapped.zoom, out_dir / zname, case_label=CASE_LABEL, reference=flow.zoom)
-    nc, csv = diagrams.write_data(mapped, out_dir, "fig10_map_sweeps", fig07.CASE)
+    *_, (nc, csv) = diagrams.run_calls(
+        [
+            (
+                diagrams.draw_panels,
+                (mapped.main, out_dir / name),
+                {"case_label": CASE_LABEL, "reference": flow.main},
+            ),
+            (
+                diagrams.draw_panels,
+                (mapped.zoom, out_dir / zname),
+                {"case_label": CASE_LABEL, "reference": flow.zoom},
+            ),
+            (diagrams.write_data, (mapped, out_dir, "fig10_map_sweeps", fig07.CASE), {}),
+        ]
+    )
 
     rows: list[Comparison] = []
     match_rows = []
