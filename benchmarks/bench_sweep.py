@@ -448,8 +448,8 @@ def peer_lines(res: Results) -> list[str]:
     return [
         f"Equal work (every point from rest, {TRANSIENT} + {PERIODS} periods, tol {SWEEP_TOL:g}, "
         "no Lyapunov), "
-        f"{p['points']} points, {p['processes']} processes, whole process (best of {PROCESS_REPEATS}):",
-        f"  grazing sweep {' '.join(EQUAL_WORK)}: {p['grazing_s']:.2f} s",
+        f"{p['points']} points, {p['processes']} cores, whole process (best of {PROCESS_REPEATS}):",
+        f"  grazing sweep {' '.join(EQUAL_WORK)} (a thread per core): {p['grazing_s']:.2f} s",
         f"  heyoka.py batch mode ({p['lanes']} SIMD lanes per process, benchmarks/{PEER.name}): "
         f"{p['heyoka_batch_s']:.2f} s",
         f"  grazing is {p['speedup']:.2f}x as fast (issue 15's target: >= 1.5x); periods agree at "
