@@ -22,23 +22,28 @@ from numba.core import cgutils
 from numba.extending import intrinsic
 
 
-def _item_pointer(context, builder, array_type, array, index):
-    """The address of ``array[index]`` (no bounds check: the driver's indices are its own)."""
-    ary = context.make_array(array_type)(context, builder, array)
+def _int64_vector(array):
+    """Whether numba type ``array`` is a one-dimensional int64 array (else the intrinsic does not apply)."""
+    return isinstance(array, types.Array) and array.dtype == types.int64 and array.ndim == 1
+
+
+def _item_pointer(context, builder, signature, args):
+    """The address of ``array[index]``, ``args = (array, index, ...)`` (no bounds check: the driver's)."""
+    array_type = signature.args[0]
+    index = context.cast(builder, args[1], signature.args[1], types.intp)
+    ary = context.make_array(array_type)(context, builder, args[0])
     return cgutils.get_item_pointer(context, builder, array_type, ary, [index], wraparound=False)
 
 
 @intrinsic
 def fetch_add(typingctx, array, index, value):
     """``array[index] += value`` at once for every thread; the value before the addition."""
-    if not (isinstance(array, types.Array) and array.dtype == types.int64 and array.ndim == 1):
+    if not _int64_vector(array):
         return None
 
     def codegen(context, builder, signature, args):
-        i = context.cast(builder, args[1], signature.args[1], types.intp)
         v = context.cast(builder, args[2], signature.args[2], types.int64)
-        ptr = _item_pointer(context, builder, signature.args[0], args[0], i)
-        return builder.atomic_rmw("add", ptr, v, "seq_cst")
+        return builder.atomic_rmw("add", _item_pointer(context, builder, signature, args), v, "seq_cst")
 
     return types.int64(array, index, value), codegen
 
@@ -46,13 +51,11 @@ def fetch_add(typingctx, array, index, value):
 @intrinsic
 def load_acquire(typingctx, array, index):
     """``array[index]``, seeing every write another thread made before its :func:`store_release`."""
-    if not (isinstance(array, types.Array) and array.dtype == types.int64 and array.ndim == 1):
+    if not _int64_vector(array):
         return None
 
     def codegen(context, builder, signature, args):
-        i = context.cast(builder, args[1], signature.args[1], types.intp)
-        ptr = _item_pointer(context, builder, signature.args[0], args[0], i)
-        return builder.load_atomic(ptr, "acquire", 8)
+        return builder.load_atomic(_item_pointer(context, builder, signature, args), "acquire", 8)
 
     return types.int64(array, index), codegen
 
@@ -60,14 +63,12 @@ def load_acquire(typingctx, array, index):
 @intrinsic
 def store_release(typingctx, array, index, value):
     """``array[index] = value`` after every write this thread made before it (see :func:`load_acquire`)."""
-    if not (isinstance(array, types.Array) and array.dtype == types.int64 and array.ndim == 1):
+    if not _int64_vector(array):
         return None
 
     def codegen(context, builder, signature, args):
-        i = context.cast(builder, args[1], signature.args[1], types.intp)
         v = context.cast(builder, args[2], signature.args[2], types.int64)
-        ptr = _item_pointer(context, builder, signature.args[0], args[0], i)
-        builder.store_atomic(v, ptr, "release", 8)
+        builder.store_atomic(v, _item_pointer(context, builder, signature, args), "release", 8)
         return context.get_dummy_value()
 
     return types.void(array, index, value), codegen
