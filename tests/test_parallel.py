@@ -1,4 +1,4 @@
-"""Worker processes die with their parent: the report's pool, and the initializer itself."""
+"""Worker processes die with their parent: the report's pool, the initializer, and a pool stopped early."""
 
 from __future__ import annotations
 
@@ -62,3 +62,26 @@ def test_init_worker_kills_the_worker_with_its_parent(tmp_path):
     os.kill(parent.pid, signal.SIGKILL)
     parent.join()
     assert all_gone([worker])
+
+
+def _fast_or_stuck(i: int) -> int:
+    if i == 0:
+        return i
+    marks = Path(os.environ["GRAZING_TEST_MARKS"])
+    (marks / f"started-{i}").write_text(str(os.getpid()))
+    time.sleep(600)  # a job in flight: it never finishes unless waited for
+    (marks / f"finished-{i}").touch()
+    return i
+
+
+def test_stopping_the_pool_cancels_queued_jobs_and_kills_those_in_flight(tmp_path, monkeypatch):
+    from grazing.parallel import map_unordered
+
+    monkeypatch.setenv("GRAZING_TEST_MARKS", str(tmp_path))
+    results = map_unordered(_fast_or_stuck, list(range(6)), 2)
+    assert next(results) == 0
+    assert wait_until(lambda: len(list(tmp_path.glob("started-*"))) == 2)  # both workers busy
+    workers = [int(p.read_text()) for p in tmp_path.glob("started-*")]
+    results.close()  # what Ctrl-C, or an error while using a result, does
+    assert all_gone(workers)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["started-1", "started-2"]  # nothing else ran
