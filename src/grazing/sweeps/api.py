@@ -111,14 +111,12 @@ def run_sweeps(specs: Sequence[SweepSpec], *, workers: int | None = None) -> lis
     >>> [ds.period.values.tolist() for ds in run_sweeps(specs, workers=1)]
     [[1, 1, 1], [1, 1, 1]]
     """
-    import os
-
     from grazing.sweeps.store import MemoryStore
 
     unique = {id(spec): spec for spec in specs}  # (a spec given twice is computed once)
     sinks = {key: MemoryStore(spec) for key, spec in unique.items()}
     parts = [(spec, i) for spec in unique.values() for i in range(spec.n_chunks)]
-    for (spec, _), res in local_results(parts, max(1, workers or os.cpu_count() or 1)):
+    for (spec, _), res in local_results(parts, workers):
         sinks[id(spec)].write(res)
     return [sinks[id(spec)].dataset() for spec in specs]
 

@@ -115,8 +115,9 @@ def local_batches(parts: Sequence[Part], threads: int) -> list[list[Part]]:
     return out
 
 
-def local_results(parts: Sequence[Part], threads: int) -> Iterator[tuple[Part, ChunkResult]]:
-    """Each chunk of ``parts`` with its result as it finishes, computed by ``threads`` threads here."""
+def local_results(parts: Sequence[Part], threads: int | None) -> Iterator[tuple[Part, ChunkResult]]:
+    """Each chunk of ``parts`` with its result as it finishes, by ``threads`` threads (None: one per core)."""
+    threads = max(1, threads or os.cpu_count() or 1)
     for batch in local_batches(parts, threads):
         for k, result in stream_chunks(batch, threads):
             yield batch[k], result
@@ -210,5 +211,5 @@ def chunk_results(
     if client is not None:
         yield from _dask_results(spec, todo, client, timeout, notice)
         return
-    for _, result in local_results([(spec, i) for i in todo], max(1, workers or os.cpu_count() or 1)):
+    for _, result in local_results([(spec, i) for i in todo], workers):
         yield result
