@@ -85,3 +85,26 @@ def test_stopping_the_pool_cancels_queued_jobs_and_kills_those_in_flight(tmp_pat
     results.close()  # what Ctrl-C, or an error while using a result, does
     assert all_gone(workers)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["started-1", "started-2"]  # nothing else ran
+
+
+def _stage(job: tuple[str, int]) -> tuple[str, int, int]:
+    """A first job marks itself done after a while; a later job counts the marks it finds on starting."""
+    kind, i = job
+    marks = Path(os.environ["GRAZING_TEST_MARKS"])
+    if kind == "first":
+        time.sleep(0.2 * (i + 1))
+        (marks / f"first-{i}").touch()
+        return kind, i, os.getpid()
+    return kind, len(list(marks.glob("first-*"))), os.getpid()
+
+
+def test_first_jobs_finish_before_the_others_start_on_the_same_workers(tmp_path, monkeypatch):
+    from grazing.parallel import map_unordered
+
+    monkeypatch.setenv("GRAZING_TEST_MARKS", str(tmp_path))
+    first = [("first", i) for i in range(3)]
+    results = list(map_unordered(_stage, [("job", i) for i in range(5)], 2, first=first))
+    assert [r[0] for r in results] == ["first"] * 3 + ["job"] * 5  # the first ones are yielded first
+    assert [r[1] for r in results[3:]] == [3] * 5  # every job started after all the first ones ended
+    assert len({r[2] for r in results}) == 2 and os.getpid() not in {r[2] for r in results}
+    assert {r[2] for r in results[3:]} <= {r[2] for r in results[:3]}  # the same worker processes

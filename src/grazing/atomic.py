@@ -1,7 +1,10 @@
 """Files written all at once: a temporary next to the target, moved into place on success.
 
 A failed or interrupted write leaves nothing behind (the CLI's promise: bad
-input or an error writes no half-file).
+input or an error writes no half-file).  A process killed in the middle of a
+write (a worker stopped on Ctrl-C) cannot remove its temporary file; inside
+:func:`scratch_folder` the temporaries of the files under a folder are made
+in a hidden folder of it instead, removed as a whole at the end.
 
 >>> import tempfile, pathlib
 >>> p = pathlib.Path(tempfile.mkdtemp()) / "x.csv"
@@ -16,6 +19,7 @@ import ctypes
 import ctypes.util
 import errno
 import os
+import shutil
 import sys
 import tempfile
 from collections.abc import Callable, Iterator
@@ -30,15 +34,62 @@ def _umask() -> int:
     return mask
 
 
+_SCRATCH: dict[Path, Path] = {}
+"""Folders being written by this process (and the workers it forks): their scratch folders."""
+
+
+@contextmanager
+def scratch_folder(root: str | Path) -> Iterator[Path]:
+    """Within the block, temporary files of :func:`atomic_path` for files under ``root`` go to one folder.
+
+    The folder (hidden, in ``root``, made by this call) is removed with all it
+    holds when the block ends, however it ends: what workers forked inside the
+    block and killed while writing left is removed too, never a file of
+    ``root`` itself.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> root = pathlib.Path(tempfile.mkdtemp())
+    >>> with scratch_folder(root) as scratch:
+    ...     write_text_atomic(root / "a.txt", lambda fh: fh.write("a"))
+    ...     scratch.parent == root
+    True
+    >>> sorted(p.name for p in root.iterdir())
+    ['a.txt']
+    """
+    key = Path(root).resolve()
+    folder = Path(tempfile.mkdtemp(dir=key, prefix=".grazing-partial-"))
+    _SCRATCH[key] = folder
+    try:
+        yield folder
+    finally:
+        if _SCRATCH.get(key) == folder:
+            del _SCRATCH[key]
+        shutil.rmtree(folder, ignore_errors=True)
+
+
+def _temporary_folder(path: Path) -> Path:
+    """The folder of ``path``'s temporary file: the scratch folder of an enclosing root, else its own."""
+    folder = path.parent if str(path.parent) else Path(".")
+    if _SCRATCH:
+        here = folder.resolve()
+        for root, scratch in _SCRATCH.items():
+            if here == root or root in here.parents:
+                return scratch
+    return folder
+
+
 @contextmanager
 def atomic_path(path: str | Path, suffix: str = ".tmp") -> Iterator[str]:
     """Yield a temporary file name next to ``path``; move it to ``path`` if the block succeeds.
 
     The file gets the usual permissions (``0666 & ~umask``; ``mkstemp`` alone
     would leave 0600).  On any exception the temporary file is removed.
+    Inside :func:`scratch_folder` the temporary file is in its folder.
     """
     path = Path(path)
-    folder = path.parent if str(path.parent) else Path(".")
+    folder = _temporary_folder(path)
     fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{path.name}.", suffix=suffix)
     os.close(fd)
     try:
@@ -51,8 +102,8 @@ def atomic_path(path: str | Path, suffix: str = ".tmp") -> Iterator[str]:
 
 
 def write_text_atomic(path: str | Path, write: Callable[[Any], Any]) -> None:
-    """Write a text file through ``write(file_handle)``, all at once."""
-    with atomic_path(path) as tmp, open(tmp, "w", newline="") as fh:
+    """Write a UTF-8 text file through ``write(file_handle)``, all at once."""
+    with atomic_path(path) as tmp, open(tmp, "w", newline="", encoding="utf-8") as fh:
         write(fh)
 
 

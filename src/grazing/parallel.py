@@ -112,10 +112,14 @@ def map_unordered(
     initargs: tuple[Any, ...] = (),
     start_method: str = "fork",
     ignore_sigint: bool = True,
+    first: Sequence[Any] = (),
 ) -> Iterator[Any]:
     """``fn(job)`` for every job on up to ``workers`` processes, yielded as each finishes.
 
-    With one worker (or one job) everything runs in this process.  Each worker
+    ``first`` are jobs run to the end before any of ``jobs`` starts, on the
+    same workers (compiling or loading what the jobs need, say, once); their
+    results are yielded first.  With one worker (or one job) everything runs
+    in this process.  Each worker
     runs ``initializer(parent_pid, *initargs)`` if given (it must call
     :func:`init_worker`), else :func:`init_worker`.  ``start_method`` is
     ``"fork"`` (falls back to spawn where fork does not exist) or ``"spawn"``
@@ -128,9 +132,13 @@ def map_unordered(
     --------
     >>> sorted(map_unordered(abs, [-1, 2, -3], workers=1))
     [1, 2, 3]
+    >>> list(map_unordered(abs, [-2], workers=1, first=[-1]))
+    [1, 2]
     """
-    if workers <= 1 or len(jobs) <= 1:
-        for job in jobs:
+    stages = [list(first), list(jobs)] if len(first) else [list(jobs)]
+    n = min(workers, max(len(stage) for stage in stages))
+    if n <= 1:
+        for job in (job for stage in stages for job in stage):
             yield fn(job)
         return
     import multiprocessing as mp
@@ -139,25 +147,25 @@ def map_unordered(
 
     method = start_method if start_method in mp.get_all_start_methods() else "spawn"
     ctx = mp.get_context(method)
-    n = min(workers, len(jobs))
     if initializer is None:
         initializer, initargs = init_worker, (os.getpid(), ignore_sigint)
     else:
         initargs = (os.getpid(), *initargs)
     ex = ProcessPoolExecutor(max_workers=n, mp_context=ctx, initializer=initializer, initargs=initargs)
-    queue = iter(jobs)
     pending: set[Any] = set()
     try:
-        while True:
-            for job in queue:
-                pending.add(ex.submit(fn, job))
-                if len(pending) >= in_flight(n):
+        for stage in stages:
+            queue = iter(stage)
+            while True:
+                for job in queue:
+                    pending.add(ex.submit(fn, job))
+                    if len(pending) >= in_flight(n):
+                        break
+                if not pending:
                     break
-            if not pending:
-                break
-            finished, pending = wait(pending, return_when=FIRST_COMPLETED)
-            for fut in finished:
-                yield fut.result()
+                finished, pending = wait(pending, return_when=FIRST_COMPLETED)
+                for fut in finished:
+                    yield fut.result()
     except BaseException as exc:
         stop_pool_processes(ex)  # first: shutdown() forgets the processes
         ex.shutdown(wait=False, cancel_futures=True)

@@ -25,17 +25,16 @@ True
 from __future__ import annotations
 
 import json
-import os
 import shutil
 import time
 from collections.abc import Sequence
-from dataclasses import replace
 from datetime import datetime
 from pathlib import Path
 from types import ModuleType
 from typing import Any
 
 import grazing
+from grazing.atomic import scratch_folder, write_text_atomic
 from grazing.report import (
     errata,
     fig02,
@@ -50,9 +49,10 @@ from grazing.report import (
     figmap,
     figstops,
 )
-from grazing.report.base import Comparison, DataFile, Dynamics, FigureResult, Image, Progress, number_rows
+from grazing.report.base import Comparison, DataFile, Dynamics, FigureResult, Image, Progress
 from grazing.report.html import RULES_TEXT, ReportMeta, render, scoreboard
 from grazing.report.provenance import collect, source_root
+from grazing.report.schedule import RESULTS, build_figures
 
 __all__ = [
     "FIGURES",
@@ -88,7 +88,6 @@ PAPER_FIGURES = ("4", "6", "7", "8", "9", "10", "11", "12")
 
 INDEX = "index.html"
 COMPARISONS = "comparisons.json"
-RESULTS = "results"
 DOCS = (("the grazing normal form", "normal-form.md"), ("the experiment tools", "experiment.md"))
 """The documents linked from the top of the page (copied from the repository's ``docs/``)."""
 
@@ -112,51 +111,6 @@ def select(names: Sequence[str]) -> list[ModuleType]:
             raise ValueError(f"no figure {name!r} in the report (known: {known})")
         wanted.add(key)
     return [m for m in FIGURES if m.FIGURE_ID in wanted]
-
-
-def _compile_job(job: tuple[str, Any]) -> None:
-    """Compile (or load) one kernel module: ``("flow", tol)`` or ``("tangent", sensitivities)``."""
-    import numpy as np
-
-    from grazing.engine.runner import Runner
-
-    kind, arg = job
-    model = grazing.models.pendulum("B", eta=0.4, theta_hat=0.5)
-    if kind == "flow":
-        grazing.simulate(model, [0.0, 0.0], periods=1, tol=arg)
-    else:
-        Runner(model, np.zeros(model.n_states), variational=True, sensitivities=arg).advance(1, 1)
-
-
-def _precompile(workers: int | None = None) -> None:
-    """Compile (or load) every kernel module the figures use, in parallel processes (seconds when cached).
-
-    The sweeps integrate at :data:`grazing.core.options.SWEEP_TOL`, whose Taylor order
-    differs from the default one: its kernels are a module of their own.
-    """
-    import multiprocessing as mp
-
-    from grazing.core.options import SWEEP_TOL as DEFAULT_SWEEP_TOL
-
-    jobs = [
-        ("flow", DEFAULT_SWEEP_TOL),
-        ("tangent", ()),
-        ("tangent", ("eta",)),
-        ("tangent", ("eta", "theta_hat")),
-    ]
-    n = min(workers or os.cpu_count() or 1, len(jobs))
-    if n <= 1:
-        for job in jobs:
-            _compile_job(job)
-        return
-    with mp.get_context("spawn").Pool(n) as pool:  # fresh interpreters: no half-initialised numba state
-        pool.map(_compile_job, jobs)
-
-
-def _write_atomic(path: Path, text: str) -> None:
-    tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_text(text, encoding="utf-8")
-    os.replace(tmp, path)
 
 
 def _copy_docs(out: Path) -> tuple[tuple[str, str], ...]:
@@ -234,20 +188,8 @@ def build_report(
     (out / RESULTS).mkdir(parents=True, exist_ok=True)
     prov = collect()
     say("compiling the model's kernels (once per machine; loading them when cached)")
-    t0 = time.perf_counter()
-    _precompile()
-    compile_seconds = time.perf_counter() - t0
-    say(f"kernels ready in {compile_seconds:.1f} s")
-    for module in modules:
-        res = module.build(out, say)
-        res = replace(
-            res,
-            comparisons=number_rows(res.figure_id, res.comparisons),
-            built=datetime.now().astimezone().isoformat(timespec="seconds"),
-            commit=prov.commit,
-        )
-        _write_atomic(out / RESULTS / f"{res.figure_id}.json", json.dumps(res.to_json(), ensure_ascii=False))
-        say(f"figure {module.FIGURE_ID} done in {res.seconds:.1f} s")
+    with scratch_folder(out):  # (a worker stopped while writing leaves nothing in out)
+        compile_seconds = build_figures(modules, out, say, prov.commit)
     results = load_results(out)
     done = {r.figure_id for r in results}
     meta = ReportMeta(
@@ -263,9 +205,9 @@ def build_report(
         docs=_copy_docs(out),
         pending=tuple(f for f in PAPER_FIGURES if f not in done),
     )
-    _write_atomic(
-        out / COMPARISONS, json.dumps(comparisons_json(results, meta), ensure_ascii=False, indent=1)
-    )
+    text = json.dumps(comparisons_json(results, meta), ensure_ascii=False, indent=1)
+    write_text_atomic(out / COMPARISONS, lambda fh: fh.write(text))
     index = out / INDEX
-    _write_atomic(index, render(results, meta))
+    page = render(results, meta)
+    write_text_atomic(index, lambda fh: fh.write(page))
     return index

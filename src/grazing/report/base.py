@@ -393,8 +393,11 @@ def signed(value: float, digits: int) -> str:
 
 
 def save_png(fig: Figure, path: Path) -> Path:
-    """Save a matplotlib figure as a PNG of :data:`DPI` dots per inch and return the path."""
-    fig.savefig(path, dpi=DPI, format="png", metadata={"Software": None})
+    """Save a matplotlib figure as a PNG of :data:`DPI` dots per inch (all at once) and return the path."""
+    from grazing.atomic import atomic_path
+
+    with atomic_path(path, suffix=".png") as tmp:
+        fig.savefig(tmp, dpi=DPI, format="png", metadata={"Software": None})
     return path
 
 
@@ -409,8 +412,15 @@ def new_figure(nrows: int, ncols: int, size: tuple[float, float]) -> tuple[Figur
 
 
 def finish_figure(fig: Figure | None, path: str | Path | None, dpi: int = DPI) -> str | None:
-    """Save ``fig`` at ``path`` (if both are given); the path written, or None."""
+    """Save ``fig`` at ``path`` (if both are given, all at once); the path written, or None."""
+    from grazing.atomic import atomic_path
+
     if fig is None or path is None:
         return None
-    fig.savefig(path, dpi=dpi)
+    suffix = Path(path).suffix
+    if not suffix:  # (matplotlib adds its default format's extension to the name)
+        fig.savefig(path, dpi=dpi)
+        return str(path)
+    with atomic_path(path, suffix=suffix) as tmp:
+        fig.savefig(tmp, dpi=dpi, format=suffix[1:])
     return str(path)

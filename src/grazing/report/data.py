@@ -24,6 +24,8 @@ from typing import Any
 
 import numpy as np
 
+from grazing.atomic import atomic_path, write_text_atomic
+
 ENGINE = "h5netcdf"
 COMPRESSION = {"zlib": True, "complevel": 4}
 
@@ -65,26 +67,29 @@ def slim_sweep(ds: Any, **attrs: Any) -> Any:
 
 
 def write_groups(path: Path, groups: Mapping[str, Any]) -> Path:
-    """Write datasets as the groups of one NetCDF file (replacing the file)."""
-    path.unlink(missing_ok=True)
-    for i, (group, ds) in enumerate(groups.items()):
-        enc = {v: dict(COMPRESSION) for v in ds.data_vars if ds[v].ndim >= 1 and ds[v].dtype.kind == "f"}
-        ds.to_netcdf(path, mode="w" if i == 0 else "a", group=group, engine=ENGINE, encoding=enc)
+    """Write datasets as the groups of one NetCDF file (replacing the file, all at once)."""
+    with atomic_path(path, suffix=".nc") as tmp:
+        for i, (group, ds) in enumerate(groups.items()):
+            enc = {v: dict(COMPRESSION) for v in ds.data_vars if ds[v].ndim >= 1 and ds[v].dtype.kind == "f"}
+            ds.to_netcdf(tmp, mode="w" if i == 0 else "a", group=group, engine=ENGINE, encoding=enc)
     return path
 
 
 def write_dataset(path: Path, ds: Any) -> Path:
-    """Write one dataset to NetCDF (replacing the file), float variables compressed."""
-    path.unlink(missing_ok=True)
+    """Write one dataset to NetCDF (replacing the file, all at once), float variables compressed."""
     enc = {v: dict(COMPRESSION) for v in ds.data_vars if ds[v].ndim >= 1 and ds[v].dtype.kind == "f"}
-    ds.to_netcdf(path, engine=ENGINE, encoding=enc)
+    with atomic_path(path, suffix=".nc") as tmp:
+        ds.to_netcdf(tmp, engine=ENGINE, encoding=enc)
     return path
 
 
 def write_csv(path: Path, header: Sequence[str], rows: Iterable[Sequence[Any]]) -> None:
-    """Write a small table as CSV (numbers with full precision)."""
-    with path.open("w", newline="", encoding="utf-8") as fh:
+    """Write a small table as CSV (numbers with full precision), all at once."""
+
+    def write(fh: Any) -> None:
         w = csv.writer(fh, lineterminator="\n")
         w.writerow(header)
         for row in rows:
             w.writerow([repr(float(x)) if isinstance(x, (float, np.floating)) else x for x in row])
+
+    write_text_atomic(path, write)

@@ -234,8 +234,39 @@ def zoom_of(run: PanelRun, zoomed: Sequence[PanelRun]) -> PanelRun | None:
     return next((z for z in zoomed if z.panel == run.panel), None)
 
 
-def _grazings(model: grazing.HybridModel) -> list[Grazing]:
-    points, _ = find_grazings(model, "eta", 0.2, 1.0)
+_GRAZING_POINTS: dict[tuple[str, float, float | None], list[Any]] = {}
+"""The grazings of each panel's model found in this process (all views and figs 7 and 10 share them)."""
+
+
+def panel_model(case: str, theta_hat_deg: float, alpha: float | None = None) -> grazing.HybridModel:
+    """The pendulum of a panel: ``case`` at the stop angle ``theta_hat_deg`` (and ``alpha`` if given)."""
+    extra = {} if alpha is None else {"alpha": alpha}
+    return grazing.models.pendulum(case, theta_hat=math.radians(theta_hat_deg), **extra)
+
+
+def grazing_points(case: str, theta_hat_deg: float, alpha: float | None = None) -> list[Any]:
+    """The grazings of the nonimpacting period-1 orbit for η in [0.2, 1] (computed once per process).
+
+    The :class:`~grazing.orbits.contact.GrazingPoint` objects of
+    :func:`grazing.orbits.find_grazings`, in its order.
+    """
+    key = (case, float(theta_hat_deg), alpha)
+    if key not in _GRAZING_POINTS:
+        _GRAZING_POINTS[key] = find_grazings(panel_model(*key), "eta", 0.2, 1.0)[0]
+    return _GRAZING_POINTS[key]
+
+
+def first_grazing(model: grazing.HybridModel, points: Sequence[Any]) -> Any:
+    """The grazing of lowest η among ``points`` (:func:`grazing_points` of ``model``), as
+    :func:`grazing.normalform.find_grazing_point` picks it; its one-line error if there is none."""
+    from grazing.normalform import find_grazing_point
+
+    if not points:
+        return find_grazing_point(model, "eta", 0.2, 1.0)
+    return min(points, key=lambda g: g.model.params["eta"])
+
+
+def _grazings(points: Sequence[Any]) -> list[Grazing]:
     return [
         Grazing(float(p.model.params["eta"]), tuple(complex(z) for z in p.multipliers), p.abs_lambda)
         for p in points
@@ -300,13 +331,15 @@ def run_panel(
     view: str = "main",
     alpha: float | None = None,
     method: str = "flow",
+    points: Sequence[Any] | None = None,
 ) -> PanelRun:
     """Compute one view of a panel: the grazings, the sweep and (overview) the impacting branch.
 
     With ``method="map"`` the sweep iterates the discontinuity-map Poincare map
     built at the panel's first grazing (fig 10) instead of the impacting flow.
     The impacting period-1 branch is continued on the overview (on the main
-    view of a panel without one).
+    view of a panel without one).  ``points`` are the panel's grazings
+    (:func:`grazing_points`, computed here if not given).
 
     Examples
     --------
@@ -317,17 +350,16 @@ def run_panel(
     if view not in VIEWS:
         raise ValueError(f"view must be one of {VIEWS}, got {view!r}")
     start, cpu = time.perf_counter(), time.process_time()
-    extra = {} if alpha is None else {"alpha": alpha}
-    model = grazing.models.pendulum(case, theta_hat=math.radians(panel.theta_hat_deg), **extra)
-    grazings = _grazings(model)
+    model = panel_model(case, panel.theta_hat_deg, alpha)
+    if points is None:
+        points = grazing_points(case, panel.theta_hat_deg, alpha)
+    grazings = _grazings(points)
     lo, hi, n = _view_range(panel, view, grazings, settings)
     zdm = None
     if method == "map":
-        from grazing.normalform import find_grazing_point, normal_form_at
+        from grazing.normalform import normal_form_at
 
-        zdm = normal_form_at(
-            find_grazing_point(model, "eta", 0.2, 1.0), ("eta", "theta_hat")
-        ).discontinuity_map()
+        zdm = normal_form_at(first_grazing(model, points), ("eta", "theta_hat")).discontinuity_map()
     ds = sweep(
         model,
         "eta",
@@ -362,8 +394,13 @@ _RUNS: dict[tuple[Any, ...], PanelRun] = {}
 """Panels computed in this process (figs 7 and 10 share the direct-simulation panels)."""
 
 
-def _job(args: tuple[str, Panel, Settings, str, float | None, str]) -> PanelRun:
-    return run_panel(*args)
+def _job(args: tuple[str, Panel, Settings, str, float | None, str, Sequence[Any]]) -> PanelRun:
+    *view, points = args
+    return run_panel(*view, points=points)
+
+
+def _grazing_job(key: tuple[str, float, float | None]) -> tuple[tuple[str, float, float | None], list[Any]]:
+    return key, grazing_points(*key)
 
 
 def run_parallel(
@@ -410,13 +447,20 @@ def run_panels(
     progress: Callable[[str], None] | None = None,
     tag: str = "",
 ) -> Runs:
-    """Compute the views of all panels in parallel (those computed before in this process are reused)."""
+    """Compute the views of all panels in parallel (those computed before in this process are reused).
+
+    The grazings of the panels are found first (a panel at a time, in
+    parallel) and given to each of its views.
+    """
     say = progress or (lambda _msg: None)
     wanted = [(case, p, settings, v, alpha, method) for v in VIEWS if v in views for p in panels if p.has(v)]
     jobs = [j for j in wanted if j not in _RUNS]
     workers = min(settings.workers or os.cpu_count() or 1, max(len(jobs), 1))
     if jobs:
         warm_up(case)
+    keys = list(dict.fromkeys((case, float(j[1].theta_hat_deg), alpha) for j in jobs))
+    missing = [k for k in keys if k not in _GRAZING_POINTS]
+    _GRAZING_POINTS.update(run_parallel(_grazing_job, missing, min(workers, max(len(missing), 1))))
 
     def report(run: PanelRun) -> None:
         lo, hi = run.eta_range
@@ -425,7 +469,8 @@ def run_panels(
             f"η values in [{lo:.6g}, {hi:.6g}] in {run.seconds:.1f} s (CPU {run.cpu_seconds:.1f} s)"
         )
 
-    for run in run_parallel(_job, jobs, workers, report):  # completion order: match by panel and view
+    tasks = [(*j, _GRAZING_POINTS[(case, float(j[1].theta_hat_deg), alpha)]) for j in jobs]
+    for run in run_parallel(_job, tasks, workers, report):  # completion order: match by panel and view
         _RUNS[next(j for j in jobs if j[1] == run.panel and j[3] == run.view)] = run
     out = Runs(main=[])
     for v in VIEWS:

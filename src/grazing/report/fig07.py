@@ -300,14 +300,12 @@ def panel_rows(runs: Runs, p: Panel, heads: dict[str, str]) -> list[Comparison]:
 
 def _prediction_text(run: PanelRun) -> str:
     """The normal-form prediction past the panel's first grazing (docs/normal-form.md)."""
-    from grazing.models import pendulum
-    from grazing.normalform import find_grazing_point, normal_form_at
+    from grazing.normalform import normal_form_at
     from grazing.normalform.prediction import predict
 
+    th = run.panel.theta_hat_deg
     try:
-        point = find_grazing_point(
-            pendulum(CASE, theta_hat=math.radians(run.panel.theta_hat_deg)), "eta", 0.2, 1.0
-        )
+        point = diagrams.first_grazing(diagrams.panel_model(CASE, th), diagrams.grazing_points(CASE, th))
         return predict(normal_form_at(point, ("eta", "theta_hat")), "eta").scenario
     except Exception as exc:  # pragma: no cover - reported, not fatal
         return f"(not computed: {exc})"

@@ -23,6 +23,8 @@ from grazing.report.diagrams import Panel, PanelRun, Runs, Settings, Window
 from grazing.report.rules import WindowMatch, criterion_row, majority, match_windows, minus
 
 FIGURE_ID = "10"
+BUILT_AFTER = "7"
+"""Built in the process of fig 7 when both are built: the flow panels are fig 7's sweeps, reused."""
 CASE_LABEL = "case B, discontinuity map"
 MAJORITY = 0.5
 """A panel agrees when more than this fraction of the simulation's windows are matched."""
