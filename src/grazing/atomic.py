@@ -34,6 +34,9 @@ def _umask() -> int:
     return mask
 
 
+SCRATCH_PREFIX = ".grazing-partial-"
+"""Scratch folders are named ``<prefix><pid>-<random>`` (the PID of the process that made them)."""
+
 _SCRATCH: dict[Path, Path] = {}
 """Folders being written by this process (and the workers it forks): their scratch folders."""
 
@@ -59,7 +62,8 @@ def scratch_folder(root: str | Path) -> Iterator[Path]:
     ['a.txt']
     """
     key = Path(root).resolve()
-    folder = Path(tempfile.mkdtemp(dir=key, prefix=".grazing-partial-"))
+    remove_stale_scratch(key)
+    folder = Path(tempfile.mkdtemp(dir=key, prefix=f"{SCRATCH_PREFIX}{os.getpid()}-"))
     _SCRATCH[key] = folder
     try:
         yield folder
@@ -67,6 +71,30 @@ def scratch_folder(root: str | Path) -> Iterator[Path]:
         if _SCRATCH.get(key) == folder:
             del _SCRATCH[key]
         shutil.rmtree(folder, ignore_errors=True)
+
+
+def remove_stale_scratch(root: str | Path) -> list[Path]:
+    """Remove the scratch folders of ``root`` left by processes that no longer exist (killed).
+
+    Only folders named like :func:`scratch_folder`'s, whose process is gone and
+    that hold nothing but hidden files (temporaries) are removed.  Returns them.
+    """
+    from grazing.parallel import pid_alive
+
+    removed = []
+    try:
+        found = [p for p in Path(root).iterdir() if p.name.startswith(SCRATCH_PREFIX) and p.is_dir()]
+    except OSError:
+        return removed
+    for folder in found:
+        pid = folder.name[len(SCRATCH_PREFIX) :].split("-", 1)[0]
+        if not pid.isdigit() or pid_alive(int(pid)):
+            continue
+        if any(not (p.is_file() and p.name.startswith(".")) for p in folder.iterdir()):
+            continue
+        shutil.rmtree(folder, ignore_errors=True)
+        removed.append(folder)
+    return removed
 
 
 def _temporary_folder(path: Path) -> Path:

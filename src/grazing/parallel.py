@@ -39,6 +39,23 @@ WATCH_INTERVAL = 0.5
 """Seconds between two looks at the parent's PID."""
 
 
+def pid_alive(pid: int) -> bool:
+    """Whether a process with this PID exists on this machine.
+
+    >>> pid_alive(os.getpid())
+    True
+    """
+    if pid <= 0:
+        return False
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
 def set_parent_death_signal(sig: int = signal.SIGKILL) -> bool:
     """Have the kernel send ``sig`` to this process when its parent dies (Linux only).
 

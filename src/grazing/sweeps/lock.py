@@ -23,6 +23,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from grazing.errors import GrazingError
+from grazing.parallel import pid_alive
 
 _HELD: set[int] = set()
 """File descriptors of the locks this process holds (closed in forked children)."""
@@ -42,23 +43,6 @@ os.register_at_fork(after_in_child=_close_inherited)
 
 class StoreBusyError(GrazingError):
     """Another process is writing the store."""
-
-
-def pid_alive(pid: int) -> bool:
-    """Whether a process with this PID exists on this machine.
-
-    >>> pid_alive(os.getpid())
-    True
-    """
-    if pid <= 0:
-        return False
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    return True
 
 
 def read_pid(path: str | Path) -> int | None:

@@ -26,7 +26,8 @@ from typing import Any
 
 from grazing.atomic import rename_noreplace
 from grazing.errors import GrazingError, InvalidParameterError
-from grazing.sweeps.lock import StoreLock, pid_alive
+from grazing.parallel import pid_alive
+from grazing.sweeps.lock import StoreLock
 
 MARKER_GROUP = "grazing"
 """Sub-group holding the marker (its attributes) and the lock file."""
