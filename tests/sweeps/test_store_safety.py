@@ -425,7 +425,7 @@ def test_a_cluster_without_workers_says_so_and_times_out(tmp_path, monkeypatch, 
 
     monkeypatch.chdir(tmp_path)
     monkeypatch.setattr(executor, "DASK_NOTICE_AFTER", 0.0)
-    with LocalCluster(n_workers=0, processes=False, dashboard_address=None) as cluster:
+    with LocalCluster(n_workers=0, processes=False, dashboard_address=":0") as cluster:
         addr = cluster.scheduler_address
         code = main([*SWEEP[:-2], "--scheduler", addr, "--timeout", "1", "--out", "s.nc"])
     out, err = capsys.readouterr()

@@ -236,7 +236,7 @@ def test_dask_cluster_gives_identical_results():
     spec = _spec()
     local = run_sweep(spec, workers=2)
     with LocalCluster(n_workers=2, threads_per_worker=1, host="127.0.0.1", processes=True,
-                      dashboard_address=None) as cluster, Client(cluster) as client:  # fmt: skip
+                      dashboard_address=":0") as cluster, Client(cluster) as client:  # fmt: skip
         remote = run_sweep(spec, client=client)
         args = "sweep --param eta --start 0.44 --stop 0.46 --num 12 --chunk-size 4 --transient 200"
         args += f" --periods 30 --scheduler {cluster.scheduler_address} --json"
