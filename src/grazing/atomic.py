@@ -73,28 +73,39 @@ def scratch_folder(root: str | Path) -> Iterator[Path]:
         shutil.rmtree(folder, ignore_errors=True)
 
 
+def remove_dead_folders(parent: str | Path, prefix: str, removable: Callable[[Path], bool]) -> list[Path]:
+    """Remove the folders ``<prefix><pid>-...`` of ``parent`` whose process is gone, if ``removable``.
+
+    The folders grazing makes beside or inside a user's files carry the PID of
+    the process that made them; one whose process no longer exists (killed
+    outright) is removed if ``removable(folder)`` says it holds only what
+    grazing puts there.  Returns the removed folders.
+    """
+    from grazing.parallel import pid_alive
+
+    removed: list[Path] = []
+    try:
+        found = [p for p in Path(parent).iterdir() if p.name.startswith(prefix) and p.is_dir()]
+    except OSError:
+        return removed
+    for folder in found:
+        pid = folder.name[len(prefix) :].split("-", 1)[0]
+        if not pid.isdigit() or pid_alive(int(pid)) or not removable(folder):
+            continue
+        shutil.rmtree(folder, ignore_errors=True)
+        removed.append(folder)
+    return removed
+
+
 def remove_stale_scratch(root: str | Path) -> list[Path]:
     """Remove the scratch folders of ``root`` left by processes that no longer exist (killed).
 
     Only folders named like :func:`scratch_folder`'s, whose process is gone and
     that hold nothing but hidden files (temporaries) are removed.  Returns them.
     """
-    from grazing.parallel import pid_alive
-
-    removed = []
-    try:
-        found = [p for p in Path(root).iterdir() if p.name.startswith(SCRATCH_PREFIX) and p.is_dir()]
-    except OSError:
-        return removed
-    for folder in found:
-        pid = folder.name[len(SCRATCH_PREFIX) :].split("-", 1)[0]
-        if not pid.isdigit() or pid_alive(int(pid)):
-            continue
-        if any(not (p.is_file() and p.name.startswith(".")) for p in folder.iterdir()):
-            continue
-        shutil.rmtree(folder, ignore_errors=True)
-        removed.append(folder)
-    return removed
+    return remove_dead_folders(
+        root, SCRATCH_PREFIX, lambda f: all(p.is_file() and p.name.startswith(".") for p in f.iterdir())
+    )
 
 
 def _temporary_folder(path: Path) -> Path:

@@ -24,9 +24,8 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from grazing.atomic import rename_noreplace
+from grazing.atomic import remove_dead_folders, rename_noreplace
 from grazing.errors import GrazingError, InvalidParameterError
-from grazing.parallel import pid_alive
 from grazing.sweeps.lock import StoreLock
 
 MARKER_GROUP = "grazing"
@@ -104,21 +103,9 @@ def remove_stale_builds(path: str | Path) -> list[Path]:
     """
     path = Path(path)
     parent = path.parent if str(path.parent) else Path(".")
-    removed = []
-    prefix = _build_prefix(path)
-    try:
-        candidates = [p for p in parent.iterdir() if p.name.startswith(prefix) and p.is_dir()]
-    except OSError:
-        return removed
-    for cand in candidates:
-        pid_text = cand.name[len(prefix) :].split("-", 1)[0]
-        if not pid_text.isdigit() or pid_alive(int(pid_text)):
-            continue
-        if any(cand.iterdir()) and not marker_path(cand).is_file():
-            continue
-        shutil.rmtree(cand, ignore_errors=True)
-        removed.append(cand)
-    return removed
+    return remove_dead_folders(
+        parent, _build_prefix(path), lambda f: not any(f.iterdir()) or marker_path(f).is_file()
+    )
 
 
 def create_store(path: str | Path, build: Callable[[Path], None], marker: dict[str, Any]) -> StoreLock | None:
