@@ -28,6 +28,8 @@ class Status(IntEnum):
     NONFINITE = 2
     ZENO = 3
     """Impacts accumulate and the model has no sticking rule (or a zero-time event loop)."""
+    INTERRUPTED = 4
+    """Ctrl-C (SIGINT) during the run: the caller raises :class:`KeyboardInterrupt`."""
 
     def message(self, t: float, max_steps: int) -> str:
         """The user-facing sentence for this status at time ``t``."""
@@ -40,6 +42,8 @@ class Status(IntEnum):
                 f"impacts accumulate at t = {t:.6g} and cannot be continued "
                 "(the model defines no contact_direction for sticking)"
             )
+        if self is Status.INTERRUPTED:
+            return f"interrupted at t = {t:.6g}"
         return "ok"
 
 

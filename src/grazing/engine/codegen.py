@@ -37,8 +37,9 @@ import numpy as np
 from grazing.core.model import set_kernel_loader
 from grazing.core.options import MACHINE_EPSILON
 from grazing.core.symbolic import SymbolicSystem
-from grazing.engine import driver
+from grazing.engine import driver, interrupts
 from grazing.engine.abi import LANE_SLOTS, SLOTS
+from grazing.engine.records import Result
 
 if TYPE_CHECKING:  # pragma: no cover
     import sympy as sp
@@ -421,11 +422,20 @@ class ModelKernels:
             setattr(self, name, library.function(name))
         self._integrate: Callable[..., Any] | None = None
 
-    def integrate(self, start: tuple[Any, ...], pv: np.ndarray, cfg: tuple[Any, ...]) -> Any:
-        """Run the driver on this model (see :mod:`grazing.engine.driver.loop`)."""
+    def integrate(self, start: tuple[Any, ...], pv: np.ndarray, cfg: tuple[Any, ...]) -> Result:
+        """Run the driver on this model (see :mod:`grazing.engine.driver.loop`).
+
+        ``cfg`` holds the fields of :class:`~grazing.engine.records.Config` but
+        the last ones (:data:`~grazing.engine.records.INTERRUPT`), added here: a
+        Ctrl-C during the run stops the driver at its next step and raises
+        :class:`KeyboardInterrupt` (:mod:`grazing.engine.interrupts`).
+        """
         if self._integrate is None:
             self._integrate = load_driver().integrate
-        return self._integrate(start, pv, cfg, self.table)
+        with interrupts.counting_sigint() as seen:
+            out = self._integrate(start, pv, (*cfg, interrupts.SIGINTS, seen), self.table)
+        interrupts.raise_if_interrupted(seen)
+        return Result(*out)
 
 
 _loaded: dict[str, ModelKernels] = {}

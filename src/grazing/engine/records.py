@@ -63,10 +63,16 @@ class Config(NamedTuple):
     zdm_window: float  # largest |L_f h| / a for which it is applied
     Tp: np.ndarray  # dT/dp along each sensitivity direction
     stop: int  # the stop a grazing analysis looks at (tracked guard, grazing contacts, discontinuity map)
+    # -- Ctrl-C (appended by grazing.engine.codegen.ModelKernels.integrate, see grazing.engine.interrupts)
+    sigints: np.ndarray  # int64 (1,): SIGINTs counted by the machine-code handler
+    sigints_seen: int  # the count when the call started: the driver stops when it changes
 
 
-STATIC = Config._fields[Config._fields.index("T") :]
+STATIC = Config._fields[Config._fields.index("T") : Config._fields.index("stop") + 1]
 """The fields of :class:`Config` that stay the same for every call on one trajectory."""
+
+INTERRUPT = Config._fields[Config._fields.index("sigints") :]
+"""The fields of :class:`Config` about Ctrl-C, added to every call's record last."""
 
 
 class Kernels(NamedTuple):

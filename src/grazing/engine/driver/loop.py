@@ -3,7 +3,7 @@
 ``integrate(start, pv, cfg, m)`` takes a :class:`~grazing.engine.records.Start`,
 the parameter vector (values, then the sensitivity directions), a
 :class:`~grazing.engine.records.Config` and the model's compiled functions
-(:class:`~grazing.engine.records.Kernels`), and returns a
+(:class:`~grazing.engine.records.Kernels`), and returns the fields of a
 :class:`~grazing.engine.records.Result`.  Each step: the Taylor coefficients
 and the step size (:mod:`.events`), the step cut at the last sample or at the
 discontinuity map's phase, the first event on it, what the step records
@@ -33,13 +33,14 @@ import numpy as np
 from numba import njit
 
 from grazing.core.solution import Status
+from grazing.engine.driver.atomics import load_acquire
 from grazing.engine.driver.calls import tc_free, tc_stick, tc_var
 from grazing.engine.driver.events import first_event
 from grazing.engine.driver.impacts import apply_impact, chatter_remaining, close_sticking, enter_contact
 from grazing.engine.driver.recording import finish_guard, take_samples, track_guard, trajectory_points
 from grazing.engine.driver.tangent import discontinuity_map, lyapunov_step, shift_period
 from grazing.engine.polyroots import work_shape
-from grazing.engine.records import Config, Kernels, Result, Start
+from grazing.engine.records import Config, Kernels, Start
 from grazing.engine.stepping import (
     append_pair,
     append_row,
@@ -55,12 +56,15 @@ STATUS_OK = int(Status.OK)
 STATUS_STEP_LIMIT = int(Status.STEP_LIMIT)
 STATUS_NONFINITE = int(Status.NONFINITE)
 STATUS_ZENO = int(Status.ZENO)
+STATUS_INTERRUPTED = int(Status.INTERRUPTED)
 ROOT_WORK_ROWS, ROOT_WORK_MIN_COLS = work_shape(0)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def integrate(start, pv, cfg, m):
     """Integrate from ``start`` until the ``cfg.n_samples``-th stroboscopic sample (see the module).
+
+    The GIL is released while it runs: other Python threads go on meanwhile.
 
     ``start``, ``cfg`` and ``m`` arrive as plain tuples in the field order of their
     records (numba types a plain tuple in C, a named tuple field by field in
@@ -94,6 +98,8 @@ def integrate(start, pv, cfg, m):
     zdm_e = cfg.zdm_e
     zdm_window = cfg.zdm_window
     watch = cfg.stop
+    sigints = cfg.sigints
+    sigints_seen = cfg.sigints_seen
     factor = step_factor(cfg.safety, order)
     ncol = n + m.nsens
     nv = n * ncol if use_var else 0
@@ -167,6 +173,9 @@ def integrate(start, pv, cfg, m):
     while True:
         if nsteps >= max_steps:
             status = STATUS_STEP_LIMIT
+            break
+        if load_acquire(sigints, 0) != sigints_seen:  # Ctrl-C (grazing.engine.interrupts)
+            status = STATUS_INTERRUPTED
             break
         for i in range(n):
             if not math.isfinite(x[i]):
@@ -322,7 +331,9 @@ def integrate(start, pv, cfg, m):
     Vout = np.zeros((n, ncol))
     if use_var:
         unpack_var(x, n, ncol, Vout)
-    return Result(
+    # A plain tuple (the caller makes the Result): numba's boxing of a named tuple runs Python code
+    # (unpickling the class) without checking it for an error, a crash if a Ctrl-C is pending.
+    return (
         status,
         x[:n].copy(),
         Vout,

@@ -1,0 +1,28 @@
+"""The ``grazing`` command's entry point, a module of its own outside the package.
+
+Importing ``grazing.cli`` takes a few tenths of a second (numpy, click, the
+commands); a Ctrl-C meanwhile would print Python's traceback.  This module
+imports nothing before it can catch that, so a Ctrl-C at any moment ends the
+command with one line and exit status 130 (:func:`grazing.cli.main` handles
+the rest).
+"""
+
+from __future__ import annotations
+
+import sys
+
+EXIT_INTERRUPTED = 130  # grazing.cli.common.EXIT_INTERRUPTED (not imported: that is the point)
+
+
+def main() -> int:
+    """Import the command line and run it; a Ctrl-C while importing is one line."""
+    try:
+        from grazing.cli import main as run
+    except KeyboardInterrupt:
+        print("grazing: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    return run()
+
+
+if __name__ == "__main__":  # pragma: no cover - the console script calls main()
+    sys.exit(main())

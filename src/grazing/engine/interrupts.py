@@ -1,0 +1,130 @@
+"""Ctrl-C inside the compiled driver: a SIGINT counter that the driver reads on every step.
+
+While the driver runs, Python cannot run its own SIGINT handler (which only
+sets a flag that the interpreter looks at between bytecodes), so a long run
+would ignore Ctrl-C until it ends.  Around each driver call made in the main
+thread, :func:`counting_sigint` installs instead a handler in machine code
+(compiled here with llvmlite, a few instructions, async-signal-safe) that
+adds one to :data:`SIGINTS`; the driver compares :data:`SIGINTS` with the
+count at its start once per step and returns
+:attr:`~grazing.core.solution.Status.INTERRUPTED`; the previous handler is
+restored when the call returns, and the caller raises
+:class:`KeyboardInterrupt` (:func:`raise_if_interrupted`).
+
+The handler is installed only where Python's default handler is in place
+(:func:`signal.default_int_handler`, which raises ``KeyboardInterrupt``), in
+the main thread, on POSIX systems: a program with a SIGINT handler of its
+own keeps it, and its handler runs when the driver call returns, as before.
+
+Examples
+--------
+>>> import signal
+>>> previous = signal.signal(signal.SIGINT, signal.default_int_handler)  # as in a new Python
+>>> with counting_sigint() as seen:
+...     signal.raise_signal(signal.SIGINT)  # as a Ctrl-C while the driver runs
+...     int(SIGINTS[0]) - seen
+1
+>>> signal.getsignal(signal.SIGINT) is signal.default_int_handler  # restored
+True
+>>> _ = signal.signal(signal.SIGINT, previous)
+"""
+
+from __future__ import annotations
+
+import ctypes
+import os
+import signal
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
+from typing import Any
+
+import numpy as np
+
+SIGINTS = np.zeros(1, dtype=np.int64)
+"""How many SIGINTs the machine-code handler has seen in this process (only ever increased)."""
+
+_SIGACTION_BYTES = 512
+"""Room for a ``struct sigaction`` on every POSIX system (152 bytes on Linux x86-64)."""
+
+_state: dict[str, Any] = {}
+
+
+def _handler_address() -> int:
+    """The address of ``void handler(int)`` adding one to :data:`SIGINTS` (compiled once per process)."""
+    if "address" not in _state:
+        import llvmlite.binding as llvm
+        from llvmlite import ir
+
+        from grazing.engine.llvmgen import _target_machine
+
+        module = ir.Module(name="grazing_interrupts")
+        i64 = ir.IntType(64)
+        fn = ir.Function(module, ir.FunctionType(ir.VoidType(), [ir.IntType(32)]), "grazing_count_sigint")
+        builder = ir.IRBuilder(fn.append_basic_block())
+        counter = builder.inttoptr(ir.Constant(i64, SIGINTS.ctypes.data), i64.as_pointer())
+        builder.atomic_rmw("add", counter, ir.Constant(i64, 1), "seq_cst")
+        builder.ret_void()
+        parsed = llvm.parse_assembly(str(module))
+        parsed.verify()
+        engine = llvm.create_mcjit_compiler(parsed, _target_machine())
+        engine.finalize_object()
+        _state["engine"] = engine  # the code lives as long as the process
+        _state["address"] = int(engine.get_function_address("grazing_count_sigint"))
+    return int(_state["address"])
+
+
+def _sigaction() -> Any:
+    """libc's ``sigaction``, or None where there is none (Windows)."""
+    if "sigaction" not in _state:
+        fn = None
+        if os.name == "posix":
+            try:
+                fn = ctypes.CDLL(None, use_errno=True).sigaction
+                fn.argtypes = [ctypes.c_int, ctypes.c_void_p, ctypes.c_void_p]
+                fn.restype = ctypes.c_int
+            except (OSError, AttributeError):  # pragma: no cover - a libc without sigaction
+                fn = None
+        _state["sigaction"] = fn
+    return _state["sigaction"]
+
+
+def _counting_applies() -> bool:
+    return (
+        threading.current_thread() is threading.main_thread()
+        and signal.getsignal(signal.SIGINT) is signal.default_int_handler
+        and _sigaction() is not None
+    )
+
+
+@contextmanager
+def counting_sigint() -> Iterator[int]:
+    """Within the block, SIGINT adds one to :data:`SIGINTS` instead of running Python's handler.
+
+    Yields the count at the start (what the driver compares with).  Where the
+    counting handler does not apply (another thread, a handler of the
+    program's own, no ``sigaction``) nothing is changed: the count then never
+    moves and a SIGINT is handled by Python when the block ends.
+    """
+    seen = int(SIGINTS[0])
+    if not _counting_applies():
+        yield seen
+        return
+    sigaction = _sigaction()
+    old = ctypes.create_string_buffer(_SIGACTION_BYTES)
+    if sigaction(signal.SIGINT, None, old) != 0:  # pragma: no cover - cannot fail for SIGINT
+        yield seen
+        return
+    new = ctypes.create_string_buffer(old.raw, _SIGACTION_BYTES)  # same mask and flags
+    ctypes.c_void_p.from_buffer(new).value = _handler_address()  # the handler is the first member
+    sigaction(signal.SIGINT, new, None)
+    try:
+        yield seen
+    finally:
+        sigaction(signal.SIGINT, old, None)
+
+
+def raise_if_interrupted(seen: int) -> None:
+    """Raise :class:`KeyboardInterrupt` if a SIGINT was counted since the count was ``seen``."""
+    if int(SIGINTS[0]) != seen:
+        raise KeyboardInterrupt

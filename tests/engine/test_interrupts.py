@@ -1,0 +1,101 @@
+"""Ctrl-C inside the compiled driver: the run stops at its next step and raises KeyboardInterrupt."""
+
+from __future__ import annotations
+
+import math
+import os
+import signal
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import grazing
+from grazing.engine import interrupts
+from grazing.engine.runner import Runner
+
+pytestmark = pytest.mark.skipif(os.name != "posix", reason="the counting handler needs sigaction")
+
+LONG = 10**8
+"""Forcing periods of one driver call that would take several minutes (a bound the tests never reach)."""
+
+
+@pytest.fixture
+def default_sigint():
+    """Python's own SIGINT handler, as in a new interpreter (a test runner's worker may have another)."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, previous)
+
+
+def _sigint_after(seconds: float) -> threading.Timer:
+    """Send this process a SIGINT from another thread after ``seconds`` (as a Ctrl-C at the terminal)."""
+    timer = threading.Timer(seconds, os.kill, (os.getpid(), signal.SIGINT))
+    timer.start()
+    return timer
+
+
+MODELS = [
+    ("pendulum", lambda: grazing.models.pendulum("B", eta=0.446, theta_hat=math.radians(40)), (0.0, 0.0)),
+    ("bouncing ball", lambda: grazing.models.bouncing_ball(), None),  # sticks to the table
+    ("impact oscillator", lambda: grazing.models.impact_oscillator(), None),
+]
+
+
+@pytest.mark.parametrize(("name", "make", "x0"), MODELS, ids=[m[0] for m in MODELS])
+def test_ctrl_c_stops_a_long_run_inside_the_driver(name, make, x0, default_sigint):
+    model = make()
+    x0 = np.zeros(model.n_states) if x0 is None else np.array(x0)
+    runner = Runner(model, x0)  # compiled and loaded before the clock starts
+    timer = _sigint_after(0.5)
+    start = time.monotonic()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            runner.advance(LONG, 1)  # one call of the driver
+    finally:
+        timer.cancel()
+    assert time.monotonic() - start < 60.0  # the call takes minutes: the driver stopped
+    # Python's handler is back, and the next run is as if nothing had happened.
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    again = grazing.simulate(model, x0, transient=20, periods=3)
+    fresh = grazing.simulate(make(), x0, transient=20, periods=3)
+    np.testing.assert_array_equal(again.samples, fresh.samples)
+
+
+def test_a_handler_of_the_program_is_kept_and_runs_after_the_call(default_sigint):
+    # A program with a SIGINT handler of its own: the run is not cut short, the handler runs once.
+    model = grazing.models.pendulum("B", eta=0.446, theta_hat=math.radians(40))
+    grazing.simulate(model, [0.0, 0.0], transient=2, periods=1)
+    calls = []
+    signal.signal(signal.SIGINT, lambda signum, frame: calls.append(signum))
+    expected = grazing.simulate(model, [0.0, 0.0], transient=30000, periods=2)
+    timer = _sigint_after(0.05)
+    try:
+        sol = grazing.simulate(model, [0.0, 0.0], transient=30000, periods=2)
+    finally:
+        timer.join()
+    assert calls == [signal.SIGINT]
+    np.testing.assert_array_equal(sol.samples, expected.samples)
+
+
+def test_the_counting_handler_is_installed_only_in_the_main_thread(default_sigint):
+    seen: list[bool] = []
+
+    def look() -> None:
+        with interrupts.counting_sigint():
+            seen.append(signal.getsignal(signal.SIGINT) is signal.default_int_handler)
+
+    thread = threading.Thread(target=look)
+    thread.start()
+    thread.join()
+    assert seen == [True]
+    before = int(interrupts.SIGINTS[0])
+    with interrupts.counting_sigint() as count:
+        assert count == before
+        signal.raise_signal(signal.SIGINT)  # counted, not raised
+        with pytest.raises(KeyboardInterrupt):
+            interrupts.raise_if_interrupted(count)
+    assert int(interrupts.SIGINTS[0]) == before + 1
+    with pytest.raises(KeyboardInterrupt):  # outside the block, Python's handler again
+        signal.raise_signal(signal.SIGINT)
