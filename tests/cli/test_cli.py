@@ -153,3 +153,44 @@ def test_sweep_without_a_store_builds_no_dataset(tmp_path):
 
     with xr.open_dataset(nc) as ds:
         assert ds.sortby("value").period.values.tolist() == json.loads(first)["period"]
+
+
+def test_bare_grazing_prints_the_help(capsys):
+    code, out, err = run([], capsys)
+    assert code == 0 and err == ""
+    assert out.startswith("Usage: grazing [OPTIONS] COMMAND [ARGS]...\n")
+    assert "\nCommands:\n" in out and "  simulate " in out
+
+
+def test_the_simulate_summary_has_no_cut_or_dangling_lines(capsys):
+    # A model with many parameters: its header is one line, whatever the terminal's width, and no
+    # line ends with a separator (a line cut at the width once left "sticking intervals: 0; ").
+    argv = ["simulate", "--model", "two-sided-oscillator", "--set", "omega=0.8", "--transient", "20"]
+    code, out, err = run([*argv, "--periods", "4"], capsys)
+    assert code == 0, err
+    lines = out.splitlines()
+    assert lines[0].startswith("two-sided-oscillator ") and lines[0].rstrip().endswith("r=0.8")
+    assert "sticking intervals: 0" in out
+    assert not [line for line in lines if line.rstrip().endswith((";", ","))]
+
+
+def test_damping_refuses_more_peaks_than_its_free_decay_has(capsys):
+    from grazing.experiment.damping import MIN_SWING, free_decay
+    from grazing.models.pendulum import case_values
+
+    # Case B released 0.5 rad below the stop: each peak is smaller by the factor
+    # exp(-2 pi beta / sqrt(1 - 4 beta^2)) r (small-amplitude decay, impact at zero angle), so the
+    # swing falls below MIN_SWING after floor(ln(0.5 / MIN_SWING) / per-peak) peaks.
+    b = case_values("B")
+    per_peak = 2 * math.pi * b["beta"] / math.sqrt(1 - 4 * b["beta"] ** 2) - math.log(b["r"])
+    most = math.floor(math.log(0.5 / MIN_SWING) / per_peak)
+    code, out, err = run(["damping", "--peaks", str(most), "--json"], capsys)
+    assert code == 0, err
+    assert len(json.loads(out)["amplitudes"]) == most + 1  # the release and every peak asked for
+    assert free_decay(b["r"], b["beta"], peaks=most).amplitudes[-1] > MIN_SWING
+    code, out, err = run(["damping", "--peaks", str(most + 1)], capsys)
+    assert code == 2 and out == ""
+    assert err == (
+        f"grazing: error: --peaks {most + 1}: the free decay at r = 0.7675, beta = 0.048 falls below "
+        f"1e-10 rad after {most} peaks; ask for at most {most} --peaks\n"
+    )

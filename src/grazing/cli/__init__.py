@@ -35,7 +35,14 @@ for _command in (
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the CLI; every error becomes one line on stderr and an exit status."""
+    """Run the CLI; every error becomes one line on stderr and an exit status.
+
+    Without arguments it prints the help, as ``grazing --help`` does.
+    """
+    import sys
+
+    if not (sys.argv[1:] if argv is None else argv):
+        argv = ["--help"]
     try:
         cli.main(args=argv, prog_name="grazing", standalone_mode=False)
     except click.exceptions.Exit as exc:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
@@ -74,6 +75,24 @@ def _check_decay_memory(r: float, beta: float, amplitude_rad: float, peaks: int)
         f"a free decay of {count_text(n)} peaks",
         "ask for fewer --peaks",
     )
+
+
+def _check_peaks(points: Iterable[tuple[float, float]], amplitude_rad: float, peaks: int) -> None:
+    """Refuse ``--peaks`` beyond what a free decay at every ``(r, beta)`` of ``points`` has.
+
+    A free decay is followed until its swing falls below
+    :data:`~grazing.experiment.damping.MIN_SWING` (``decay_peaks``); asking
+    for more peaks than that would silently use fewer.
+    """
+    from grazing.experiment import damping as dmp
+
+    fewest = min(((dmp.decay_peaks(r, b, amplitude_rad, peaks), r, b) for r, b in points), default=None)
+    if fewest is not None and fewest[0] < peaks:
+        n, r, b = fewest
+        raise InputError(
+            f"--peaks {peaks}: the free decay at r = {r:g}, beta = {b:g} falls below "
+            f"{dmp.MIN_SWING:g} rad after {n} peaks; ask for at most {n} --peaks"
+        )
 
 
 _case_option = click.option(
@@ -162,6 +181,7 @@ def damping_cmd(
     dmp._check_r_beta(rv, bv)
     if max(ks) > peaks:
         raise InputError(f"--k-hat {max(ks)} needs at least as many --peaks (got {peaks})")
+    _check_peaks([(rv, bv)], amp, peaks)
     _check_decay_memory(rv, bv, amp, peaks)
     dec = dmp.free_decay(rv, bv, amplitude=amp, peaks=peaks)
     est = dmp.log_decrement(dec.amplitudes, ks, normalisation=normalisation)  # type: ignore[arg-type]
@@ -227,12 +247,15 @@ def iso_damping_cmd(
     check_memory(curve_bytes(num), f"a curve of {count_text(num)} points", "ask for fewer --num")
     for pr, pb in dmp.PAPER_POINTS.values():
         _check_decay_memory(pr, pb, amp, peaks)
+    _check_peaks(dmp.PAPER_POINTS.values(), amp, peaks)
     protocol: dict[str, Any] = {}
     if relation == "model":
         protocol = {"amplitude": amp, "peaks": peaks, "normalisation": normalisation}
     elif relation == "protocol":
         protocol = {"amplitude": amp, "peaks": peaks}
     curve = dmp.iso_damping(damping, num=num, relation=relation, **protocol)  # type: ignore[arg-type]
+    if protocol:  # every point of the curve measured with --peaks peaks
+        _check_peaks(zip(curve.r, curve.beta), amp, peaks)
     points = {}
     for name, (pr, pb) in dmp.PAPER_POINTS.items():
         points[name] = {

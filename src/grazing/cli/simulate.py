@@ -121,7 +121,7 @@ def _print_simulation(
     from rich.console import Console
     from rich.table import Table
 
-    con = Console()
+    con = Console(soft_wrap=True)  # a line is never cut at the terminal's width (the table keeps its own)
     values = "  ".join(
         f"{p.name}={p.to_display(model.params[p.name]):g}{' deg' if p.angle else ''}"
         for p in model.parameters
@@ -132,8 +132,9 @@ def _print_simulation(
     con.print(f"{n} sampled periods after {sol.info['transient']} transient: [bold]{kind}[/bold]")
     con.print(
         f"impacts: {sol.n_impacts} in the whole run, {len(sol.impacts)} in the sampled span; "
-        f"sticking intervals: {len(sol.sticking)}; {sol.n_steps} steps in {elapsed:.3f} s"
+        f"sticking intervals: {len(sol.sticking)}"
     )
+    con.print(f"{sol.n_steps} steps in {elapsed:.3f} s")
     if model.n_stops > 1:
         con.print(
             "impacts per stop in the sampled span: "
