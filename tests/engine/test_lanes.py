@@ -155,7 +155,7 @@ def oracle_chunk(spec: SweepSpec, index: int) -> dict[str, np.ndarray]:
                 np.full((spec.periods, n), np.nan),
                 [-1] * model.n_stops,
                 math.nan,
-                0,
+                -1,
             )
             out["x_final"].append(np.full(n, np.nan))
             out["period"].append(-1)
