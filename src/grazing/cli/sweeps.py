@@ -31,7 +31,6 @@ from grazing.cli.limits import POINT_OVERHEAD, check_memory, count_text, sweep_b
 from grazing.cli.validate import FINITE, POSITIVE, TOLERANCE, WORKERS, count, path_type, refuse_unused
 from grazing.core.options import CHUNK_SIZE, SweepSettings
 from grazing.core.solution import Status
-from grazing.sweeps.status import failure_text, failures, reasons
 
 ONE_VALUE = "with {num} 1 (its one value is {start}: give the same value to both, or {num} 2 or more)"
 """Why the last value is refused with one value: ``--stop is not used with --num 1 (...)``."""
@@ -189,6 +188,7 @@ def _run_sweep_spec(
 
 def _sweep_json(spec: Any, run: _SweepRun, param: str, shown: np.ndarray) -> dict[str, Any]:
     """The sweep's ``--json`` keys, points sorted by value, from its arrays or its dataset."""
+    from grazing.sweeps.status import reasons
     from grazing.sweeps.store import impacts_per_period
 
     if run.arrays is not None:
@@ -215,6 +215,8 @@ def _sweep_json(spec: Any, run: _SweepRun, param: str, shown: np.ndarray) -> dic
 
 def _outcomes(period: np.ndarray, status: np.ndarray) -> tuple[int, int, str]:
     """Points with a period, points computed without one (<= 64), and the failed ones with their reasons."""
+    from grazing.sweeps.status import failure_text
+
     ok = status == Status.OK
     return int((ok & (period > 0)).sum()), int((ok & (period == 0)).sum()), failure_text(status)
 
@@ -249,6 +251,7 @@ def sweep_cmd(
     """Brute-force bifurcation diagram: stroboscopic samples, periods, impacts and
     Lyapunov exponents along a parameter range."""
     from grazing.sweeps.spec import sweep_spec
+    from grazing.sweeps.status import failures, reasons
 
     par = model_parameter(model, sparam)
     name = par.name
@@ -343,6 +346,7 @@ def map_cmd(
 ) -> None:  # fmt: skip
     """Two-parameter map of periods, impacts and Lyapunov exponents."""
     from grazing.sweeps.spec import map_spec
+    from grazing.sweeps.status import failures, reasons
 
     par1, par2 = model_parameter(model, param1, "--param1"), model_parameter(model, param2, "--param2")
     n1, n2 = par1.name, par2.name
