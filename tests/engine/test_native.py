@@ -25,7 +25,9 @@ from grazing.models import bouncing_ball, pendulum
 from grazing.sweeps import run
 from grazing.sweeps.spec import sweep_spec
 
-FIELDS = ("samples", "period", "impacts", "lyapunov", "transient_used", "x_final", "impacts_by_stop")
+FIELDS = (
+    "samples", "period", "impacts", "lyapunov", "transient_used", "x_final", "impacts_by_stop", "status",
+)  # fmt: skip
 
 
 @pytest.mark.slow
