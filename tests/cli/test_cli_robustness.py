@@ -4,11 +4,13 @@ silently ignored, memory is checked before work, and a property test over random
 from __future__ import annotations
 
 import contextlib
+import json
 import os
 import shutil
 import tempfile
 from pathlib import Path
 
+import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -170,6 +172,10 @@ IGNORED_OPTIONS = [
     # issue 26: messages (a free decay has fewer peaks than asked: it was silently shortened)
     (["damping", "--peaks", "1000000"], "--peaks 1000000: the free decay at r = 0.7675, beta = 0.048"),
     (["iso-damping", "--peaks", "30"], "falls below 1e-10 rad after"),
+    # issue 26: failed points
+    ([*SWEEP[:8], "1"], "--stop is not used with --num 1 (its one value is --start"),
+    ([*MAP[:8], "1", *MAP[9:]], "--stop1 is not used with --num1 1 (its one value is --start1"),
+    ([*MAP[:16], "1", *MAP[17:]], "--stop2 is not used with --num2 1 (its one value is --start2"),
 ]
 
 MEMORY = [
@@ -246,6 +252,74 @@ def test_check_memory_bound(monkeypatch):
 def test_click_messages_are_one_line(capsys, inputs):
     err = _one_line_error(["sweep", "--start", "0.4"], capsys, inputs)
     assert "Missing option '--param'" in err
+
+
+# --------------------------------------------------------------------------
+# issue 26: failed points are counted with their reasons, and --json is strict JSON
+
+CLOCK_MODEL = """
+import sympy as sp
+from grazing import HybridModel, Parameter
+
+q, p, t, w, c = sp.symbols("q p t w c")
+model = HybridModel(
+    "clock-stop", states=[q, p], time=t,
+    parameters=[Parameter("w", 1.0, lower=0, lower_open=True), Parameter("c", 1.5)],
+    vector_field=[p, -q], guard=c + sp.cos(w * t), reset=[q, -p], period=2 * sp.pi / w,
+)
+"""
+"""A stop whose guard depends on time only: for |c| < 1 it is reached and the reset does not move it."""
+
+QUICK = ["--transient", "3", "--periods", "3", "--workers", "1"]
+FAILED_POINTS = [
+    # issue 26: failed points (the commands of the issue; each point's reason follows from its values)
+    (
+        ["sweep", "--param", "alpha", "--start", "0", "--stop", "1e300", "--num", "5", *QUICK],
+        {"ok": 1, "non-finite state": 4},
+    ),
+    (
+        ["sweep", "--param", "eta", "--start", "1e-300", "--stop", "0.5", "--num", "3", *QUICK],
+        {"non-finite state": 1, "ok": 2},
+    ),
+    (
+        ["sweep", "--param", "eta", "--start", "0.44", "--stop", "0.44", "--num", "1", "--tol", "1e-300",
+         "--transient", "0", "--periods", "1"],
+        {"step limit": 1},
+    ),
+    (
+        ["sweep", "--model", "clock.py:model", "--param", "c", "--start", "-0.5", "--stop", "2", "--num", "6",
+         *QUICK],
+        {"accumulating impacts": 4, "ok": 2},
+    ),
+    (
+        ["map", "--param1", "eta", "--start1", "0.4", "--stop1", "0.41", "--num1", "2", "--param2", "alpha",
+         "--start2", "0.2254", "--stop2", "1e300", "--num2", "2", *QUICK],
+        {"ok": 2, "non-finite state": 2},
+    ),
+]  # fmt: skip
+
+
+def _strict_json(text: str) -> dict:
+    def refuse(constant: str) -> None:
+        raise ValueError(f"not strict JSON: {constant}")
+
+    return json.loads(text, parse_constant=refuse)
+
+
+@pytest.mark.parametrize(("argv", "outcomes"), FAILED_POINTS)
+def test_failed_points_are_counted_and_the_json_is_strict(argv, outcomes, capsys, inputs):
+    with _workspace(inputs) as work:
+        (work / "clock.py").write_text(CLOCK_MODEL)
+        assert main([*argv, "--json"]) == 0
+        res = _strict_json(capsys.readouterr().out)
+        status = np.ravel(res["status"])
+        assert {why: int((status == why).sum()) for why in set(status)} == outcomes
+        assert all((per == -1) == (why != "ok") for per, why in zip(np.ravel(res["period"]), status))
+        assert main(argv) == 0
+        out = capsys.readouterr().out
+    failed = {why: n for why, n in outcomes.items() if why != "ok"}
+    detail = ", ".join(f"{why}: {n}" for why, n in sorted(failed.items(), key=lambda item: -item[1]))
+    assert f"failed: {sum(failed.values())} ({detail})" in out
 
 
 # --------------------------------------------------------------------------
@@ -487,6 +561,13 @@ def _given(argv: list[str]) -> dict[str, str | None]:
     return out
 
 
+def _number(text: str | None) -> float | None:
+    try:
+        return float(text) if text is not None else None
+    except ValueError:
+        return None
+
+
 def ignored(argv: list[str]) -> list[str]:
     """The options that the rest of ``argv`` makes meaningless (what must be refused)."""
     cmd, g = argv[0], _given(argv)
@@ -515,6 +596,11 @@ def ignored(argv: list[str]) -> list[str]:
             bad.append("--timeout")
         if "--workers" in g and "--scheduler" in g:
             bad.append("--workers")
+        # issue 26: failed points (with one value, the last must equal the first)
+        for num, start, stop in (("--num", "--start", "--stop"), ("--num1", "--start1", "--stop1"),
+                                 ("--num2", "--start2", "--stop2")):  # fmt: skip
+            if g.get(num) == "1" and stop in g and _number(g.get(stop)) != _number(g.get(start)):
+                bad.append(stop)
     if cmd == "damping":
         model_only = ["--case", "--r", "--beta", "--amplitude", "--peaks"]
         bad += [o for o in model_only if o in g] if "--recording" in g else []
@@ -540,6 +626,8 @@ def _check_run(argv: list[str], capsys, template: Path) -> None:
         out, err = capsys.readouterr()
         if code == 0 or code is None:  # passed every check: nothing it was given may be ignored
             assert not ignored(argv), (argv, ignored(argv))
+            if code == 0 and "--json" in argv and out:  # issue 26: strict JSON (no NaN, no Infinity)
+                _strict_json(out)
             return
         assert err.startswith("grazing: error: ") and err.count("\n") == 1, (argv, err)
         assert out == "", (argv, out)

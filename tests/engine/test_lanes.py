@@ -24,6 +24,7 @@ from hypothesis import strategies as st
 import grazing
 from grazing.core.options import SweepSettings
 from grazing.core.period import DEFAULT_MAX_PERIOD, DEFAULT_PERIOD_TOL, detect_period
+from grazing.core.solution import Status
 from grazing.engine import llvmgen
 from grazing.engine.abi import TC_FREE_LANES, TC_VAR_LANES
 from grazing.engine.codegen import taylor_order
@@ -155,7 +156,7 @@ def oracle_chunk(spec: SweepSpec, index: int) -> dict[str, np.ndarray]:
                 np.full((spec.periods, n), np.nan),
                 [-1] * model.n_stops,
                 math.nan,
-                0,
+                -1,
             )
             out["x_final"].append(np.full(n, np.nan))
             out["period"].append(-1)
@@ -316,6 +317,8 @@ def test_failing_points_and_the_next_ones() -> None:
     results = run_chunks(spec, [0, 1])
     periods = np.concatenate([r.period for r in results])
     assert list(periods < 0) == [True, True, False, False, False, False]
+    status = np.concatenate([r.status for r in results])
+    assert [Status(s) for s in status] == [Status.NONFINITE] * 2 + [Status.OK] * 4
     for res in results:
         bad = res.period < 0
         assert np.isnan(res.samples[bad]).all() and (res.impacts_by_stop[bad] == -1).all()

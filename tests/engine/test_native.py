@@ -25,7 +25,9 @@ from grazing.models import bouncing_ball, pendulum
 from grazing.sweeps import run
 from grazing.sweeps.spec import sweep_spec
 
-FIELDS = ("samples", "period", "impacts", "lyapunov", "transient_used", "x_final", "impacts_by_stop")
+FIELDS = (
+    "samples", "period", "impacts", "lyapunov", "transient_used", "x_final", "impacts_by_stop", "status",
+)  # fmt: skip
 
 
 @pytest.mark.slow
@@ -82,7 +84,7 @@ def sweep_arguments() -> tuple[list, int]:
         out_samples=np.full((1, periods, n), np.nan),
         out_by_stop=np.zeros((1, model.n_stops), dtype=np.int64), out_lyap=np.zeros(1),
         out_used=np.zeros(1, dtype=np.int64), out_x=np.zeros((1, n)), out_t=np.zeros(1),
-        out_ok=np.full(1, -1, dtype=np.int64),
+        out_status=np.full(1, -1, dtype=np.int64),
     )  # fmt: skip
     assert tuple(values) == native.DRIVER_ARGUMENTS
     return list(values.values()), native.DRIVER_ARGUMENTS.index("out_samples")
@@ -92,7 +94,7 @@ def test_the_entry_point_computes_and_refuses_wrong_arrays() -> None:
     sweep = native.load_sweep_lanes()
     args, out = sweep_arguments()
     sweep(*args)
-    assert np.isfinite(args[out]).all() and args[-1][0] == 1
+    assert np.isfinite(args[out]).all() and args[-1][0] == 0
     x0 = native.DRIVER_ARGUMENTS.index("x0")
     wrong_arrays = (
         (out, np.zeros((1, 2, 2))),  # shape

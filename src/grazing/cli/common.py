@@ -363,15 +363,46 @@ def write_atomic(path: Path, write: Callable[[Any], None]) -> None:
 
 
 def emit_json(obj: dict[str, Any]) -> None:
-    click.echo(json.dumps(obj, allow_nan=False, default=json_default))
+    """Print ``obj`` as strict JSON on one line (every command's ``--json``): see :func:`json_text`."""
+    click.echo(json_text(obj))
+
+
+def json_text(obj: Any) -> str:
+    """``obj`` as strict JSON: NaN and infinities become ``null``, numpy arrays and scalars plain values.
+
+    Examples
+    --------
+    >>> json_text({"a": [1.5, float("nan")], "b": np.array([[0.0, np.inf]]), "c": np.float32(2)})
+    '{"a": [1.5, null], "b": [[0.0, null]], "c": 2.0}'
+    """
+    try:
+        return json.dumps(obj, allow_nan=False, default=json_default)
+    except ValueError:  # a non-finite float outside an array (arrays are converted by json_default)
+        return json.dumps(_finite_or_null(obj), allow_nan=False, default=json_default)
 
 
 def json_default(o: Any) -> Any:
+    """The JSON value of a numpy array or scalar (non-finite floats as None), for ``json.dumps``."""
     if isinstance(o, np.ndarray):
+        if o.dtype.kind == "f" and not np.isfinite(o).all():
+            return np.where(np.isfinite(o), o, None).tolist()
         return o.tolist()
     if isinstance(o, np.generic):
-        return o.item()
+        return _finite_or_null(o.item())
     raise TypeError(f"not JSON serialisable: {type(o).__name__}")
+
+
+def _finite_or_null(o: Any) -> Any:
+    """``o`` with every non-finite float in its dicts, lists and tuples replaced by None."""
+    if isinstance(o, float):
+        return o if math.isfinite(o) else None
+    if isinstance(o, dict):
+        return {k: _finite_or_null(v) for k, v in o.items()}
+    if isinstance(o, (list, tuple)):
+        return [_finite_or_null(v) for v in o]
+    if isinstance(o, (np.ndarray, np.generic)):  # (an array of objects, a numpy scalar)
+        return _finite_or_null(json_default(o))
+    return o
 
 
 def check_eta_range(eta_min: float, eta_max: float) -> None:

@@ -30,6 +30,10 @@ from grazing.cli.common import (
 from grazing.cli.limits import POINT_OVERHEAD, check_memory, count_text, sweep_bytes
 from grazing.cli.validate import FINITE, POSITIVE, TOLERANCE, WORKERS, count, path_type, refuse_unused
 from grazing.core.options import CHUNK_SIZE, SweepSettings
+from grazing.core.solution import Status
+
+ONE_VALUE = "with {num} 1 (its one value is {start}: give the same value to both, or {num} 2 or more)"
+"""Why the last value is refused with one value: ``--stop is not used with --num 1 (...)``."""
 
 
 def _sweep_options(func: Callable[..., Any]) -> Callable[..., Any]:
@@ -103,12 +107,18 @@ def _check_sweep_options(
 
 
 class _SweepRun:
-    """What a sweep run returns to its command: the dataset, or (streamed to a store) the periods only,
-    or (``arrays``: results kept in memory and no dataset asked for) the per-point arrays."""
+    """What a sweep run returns to its command: the dataset, or (streamed to a store) the periods and
+    statuses only, or (``arrays``: results kept in memory and no dataset asked for) the per-point arrays.
 
-    def __init__(self, ds: Any, period: np.ndarray | None, arrays: dict[str, np.ndarray] | None = None):
+    ``period`` and ``status`` are flat along the spec's points (in visiting order) in every case.
+    """
+
+    def __init__(
+        self, ds: Any, period: np.ndarray, status: np.ndarray, arrays: dict[str, np.ndarray] | None = None
+    ):
         self.ds = ds
         self.period = period
+        self.status = status
         self.arrays = arrays
 
 
@@ -158,7 +168,7 @@ def _run_sweep_spec(
             spec, store=store, workers=workers, client=client, progress=bar, timeout=timeout,
             notice=lambda msg: click.echo(f"grazing: {msg}", err=True), load=not (streamed or memory),
         )  # fmt: skip
-        period = store.read("period") if streamed else None
+        flat = {name: store.read(name) for name in ("period", "status")} if streamed else None
     finally:
         bar.close()
         if store is not None and not memory:
@@ -168,39 +178,47 @@ def _run_sweep_spec(
     if memory:
         if out is not None:
             save_dataset(store.dataset(), out)
-        return _SweepRun(None, None, store.arrays)
+        return _SweepRun(None, store.arrays["period"], store.arrays["status"], store.arrays)
     if out is not None and out.suffix.lower() == ".nc":
         save_dataset(ds, out)
-    return _SweepRun(ds, period)
+    if flat is None:  # (the dataset's points, flattened: in visiting order, as the spec lists them)
+        flat = {name: ds[name].values.ravel() for name in ("period", "status")}
+    return _SweepRun(ds, flat["period"], flat["status"])
 
 
 def _sweep_json(spec: Any, run: _SweepRun, param: str, shown: np.ndarray) -> dict[str, Any]:
     """The sweep's ``--json`` keys, points sorted by value, from its arrays or its dataset."""
+    from grazing.sweeps.status import reasons
     from grazing.sweeps.store import impacts_per_period
 
     if run.arrays is not None:
         a = run.arrays
     else:
         a = {k: run.ds[k].values for k in ("samples", "period", "impacts", "lyapunov", "transient_used",
-                                             "impacts_by_stop")}  # fmt: skip
+                                             "impacts_by_stop", "status")}  # fmt: skip
     by_value = np.argsort(np.asarray(spec.points, dtype=float)[:, 0], kind="stable")
     ipp, ipp_stop = impacts_per_period(spec, a)
-
-    def finite(v: np.ndarray) -> list[float | None]:
-        return [None if not math.isfinite(x) else float(x) for x in v]
-
     return {
         "param": param,
         "values": np.sort(shown),
         "period": a["period"][by_value],
-        "impacts_per_period": finite(ipp[by_value]),
-        "lyapunov": finite(a["lyapunov"][by_value]),
+        "impacts_per_period": ipp[by_value],
+        "lyapunov": a["lyapunov"][by_value],
         "samples": a["samples"][by_value][..., 0],
         "transient_used": a["transient_used"][by_value],
         "impacts_per_period_by_stop": {
-            str(name): finite(ipp_stop[by_value, j]) for j, name in enumerate(spec.model.stop_names)
+            str(name): ipp_stop[by_value, j] for j, name in enumerate(spec.model.stop_names)
         },
+        "status": reasons(a["status"][by_value]),
     }
+
+
+def _outcomes(period: np.ndarray, status: np.ndarray) -> tuple[int, int, str]:
+    """Points with a period, points computed without one (<= 64), and the failed ones with their reasons."""
+    from grazing.sweeps.status import failure_text
+
+    ok = status == Status.OK
+    return int((ok & (period > 0)).sum()), int((ok & (period == 0)).sum()), failure_text(status)
 
 
 @click.command("sweep")
@@ -233,10 +251,12 @@ def sweep_cmd(
     """Brute-force bifurcation diagram: stroboscopic samples, periods, impacts and
     Lyapunov exponents along a parameter range."""
     from grazing.sweeps.spec import sweep_spec
+    from grazing.sweeps.status import failures, reasons
 
     par = model_parameter(model, sparam)
     name = par.name
     refuse_unused([name], True, f"with --param {sparam}: the swept values replace it")
+    refuse_unused(["stop"], num == 1 and stop != start, ONE_VALUE.format(num="--num", start="--start"))
     refuse_unused(["which"], method != "map", "without --method map")
     chunk_size = CHUNK_SIZE if chunk_size is None else chunk_size
     _check_sweep_options(
@@ -266,17 +286,19 @@ def sweep_cmd(
                     "method": method, "grazing": graze_info})  # fmt: skip
         emit_json(res)
         return
-    if run.arrays is not None:
-        per = run.arrays["period"][np.argsort(order, kind="stable")]
-    elif run.ds is not None:
-        per = run.ds.sortby("value").period.values
-    else:  # streamed to the store: the periods in visiting order, sorted like the values
-        per = run.period[np.argsort(order, kind="stable")]
+    by_value = np.argsort(order, kind="stable")  # (the points in visiting order, sorted like the values)
+    per, status = run.period[by_value], run.status[by_value]
+    periodic, aperiodic, failed = _outcomes(per, status)
     click.echo(f"{num} values of {sparam} in {elapsed:.1f} s ({num / elapsed:.0f} points/s)")
-    click.echo(f"periodic points: {(per > 0).sum()}, no period <= 64: {(per == 0).sum()}")
-    for p in sorted(set(per[per > 0].tolist()))[:12]:
-        sel = np.sort(shown)[per == p]
+    click.echo(f"periodic points: {periodic}, no period <= 64: {aperiodic}, {failed}")
+    ok = status == Status.OK
+    for p in sorted(set(per[ok & (per > 0)].tolist()))[:12]:
+        sel = np.sort(shown)[ok & (per == p)]
         click.echo(f"  period {p:2d}: {sel.size} points, {sparam} in [{sel.min():.6g}, {sel.max():.6g}]")
+    words = np.array(reasons(status))
+    for why in failures(status):
+        sel = np.sort(shown)[words == why]
+        click.echo(f"  failed, {why}: {sel.size} points, {sparam} in [{sel.min():.6g}, {sel.max():.6g}]")
     if out is not None:
         click.echo(f"saved to {out}")
 
@@ -324,12 +346,15 @@ def map_cmd(
 ) -> None:  # fmt: skip
     """Two-parameter map of periods, impacts and Lyapunov exponents."""
     from grazing.sweeps.spec import map_spec
+    from grazing.sweeps.status import failures, reasons
 
     par1, par2 = model_parameter(model, param1, "--param1"), model_parameter(model, param2, "--param2")
     n1, n2 = par1.name, par2.name
     if n1 == n2:
         raise InputError("--param1 and --param2 must differ")
     refuse_unused([n1, n2], True, f"with --param1 {param1} --param2 {param2}: the mapped values replace it")
+    refuse_unused(["stop1"], num1 == 1 and stop1 != start1, ONE_VALUE.format(num="--num1", start="--start1"))
+    refuse_unused(["stop2"], num2 == 1 and stop2 != start2, ONE_VALUE.format(num="--num2", start="--start2"))
     chunk_size = num1 if chunk_size is None else chunk_size
     _check_sweep_options(out, scheduler, chunk_size, num1 * num2, periods, model.n_states, workers, as_json,
                          "a map")  # fmt: skip
@@ -355,16 +380,21 @@ def map_cmd(
             "param1": param1, "values1": np.sort(s1), "param2": param2, "values2": np.sort(s2),
             "period": ds.period.values, "impacts_per_period": ds.impacts_per_period.values,
             "lyapunov": ds.lyapunov.values, "elapsed_s": elapsed, "out": str(out) if out else None,
+            "status": reasons(ds.status.values),
         }  # fmt: skip
-        res["impacts_per_period"] = [
-            [None if not math.isfinite(x) else x for x in row] for row in res["impacts_per_period"]
-        ]
-        res["lyapunov"] = [[None if not math.isfinite(x) else x for x in row] for row in res["lyapunov"]]
         emit_json(res)
         return
-    per = run.ds.period.values if run.ds is not None else run.period
+    periodic, aperiodic, failed = _outcomes(run.period, run.status)
     click.echo(
-        f"{num1} x {num2} map in {elapsed:.1f} s; periodic cells {(per > 0).sum()}, none {(per == 0).sum()}"
+        f"{num1} x {num2} map in {elapsed:.1f} s; periodic cells {periodic}, none {aperiodic}, {failed}"
     )
+    words = np.array(reasons(run.status))
+    for why in failures(run.status):
+        cells = np.flatnonzero(words == why)  # (row by row: param2's index, then param1's)
+        a, b = np.sort(s1)[cells % num1], np.sort(s2)[cells // num1]
+        click.echo(
+            f"  failed, {why}: {cells.size} cells, {param1} in [{a.min():.6g}, {a.max():.6g}], "
+            f"{param2} in [{b.min():.6g}, {b.max():.6g}]"
+        )
     if out is not None:
         click.echo(f"saved to {out}")

@@ -46,6 +46,42 @@ class Status(IntEnum):
             return f"interrupted at t = {t:.6g}"
         return "ok"
 
+    @property
+    def reason(self) -> str:
+        """A few words for the outcome, as sweeps report each point's: ``'ok'``, ``'step limit'`` ...
+
+        Examples
+        --------
+        >>> [s.reason for s in Status]
+        ['ok', 'step limit', 'non-finite state', 'accumulating impacts', 'interrupted']
+        """
+        return _REASONS[self][0]
+
+    @property
+    def explanation(self) -> str:
+        """What the outcome means and what to do about it (one sentence, for documentation)."""
+        return _REASONS[self][1]
+
+
+_REASONS = {
+    Status.OK: ("ok", "computed"),
+    Status.STEP_LIMIT: (
+        "step limit",
+        "the integrator reached its step limit (20000 steps per forcing period): the forcing period "
+        "is very long for the motion, the motion very fast, or the tolerance very small",
+    ),
+    Status.NONFINITE: (
+        "non-finite state",
+        "the state overflowed to infinity or NaN: a parameter too large, or a motion that escapes",
+    ),
+    Status.ZENO: (
+        "accumulating impacts",
+        "impacts accumulate (complete chattering) on a stop without a contact_direction for sticking, "
+        "or events repeat at one instant (a guard the reset does not move away from)",
+    ),
+    Status.INTERRUPTED: ("interrupted", "Ctrl-C stopped the run (raised as KeyboardInterrupt)"),
+}
+
 
 @dataclass(frozen=True)
 class Impacts:

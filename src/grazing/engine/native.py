@@ -23,7 +23,7 @@ Examples
 --------
 >>> sweep = load_sweep_lanes()  # the driver's arguments; it writes the out_* arrays
 >>> DRIVER_ARGUMENTS[:3], DRIVER_ARGUMENTS[-1]
-(('m', 'lanes', 'jobs'), 'out_ok')
+(('m', 'lanes', 'jobs'), 'out_status')
 """
 
 from __future__ import annotations
@@ -44,7 +44,8 @@ import numpy as np
 DRIVER_ARGUMENTS = (
     "m", "lanes", "jobs", "control", "fresh", "periodic", "x0", "pvs", "Ts", "sphase", "tcarry", "zdms",
     "transient", "periods", "adaptive", "lyapunov", "safety", "chatter_tol", "zdm_on", "zdm_a", "zdm_e",
-    "zdm_window", "watch", "out_samples", "out_by_stop", "out_lyap", "out_used", "out_x", "out_t", "out_ok",
+    "zdm_window", "watch", "out_samples", "out_by_stop", "out_lyap", "out_used", "out_x", "out_t",
+    "out_status",
 )  # fmt: skip
 """The arguments of :func:`grazing.engine.driver.lanes.sweep_lanes`; the loaded entry point takes them too."""
 _KERNELS = ("fns", "nx", "nsens", "nstops", "order", "sticks", "mlanes")
@@ -54,7 +55,7 @@ _ARRAYS = {
     "pvs": ("f8", 2), "Ts": ("f8", 1), "sphase": ("f8", 1), "tcarry": ("f8", 1), "zdms": ("f8", 1),
     "zdm_e": ("f8", 1),
     "out_samples": ("f8", 3), "out_by_stop": ("i8", 2), "out_lyap": ("f8", 1), "out_used": ("i8", 1),
-    "out_x": ("f8", 2), "out_t": ("f8", 1), "out_ok": ("i8", 1),
+    "out_x": ("f8", 2), "out_t": ("f8", 1), "out_status": ("i8", 1),
 }  # fmt: skip
 """dtype and dimensions of the array arguments (C-contiguous)."""
 _BOOLS = ("fresh", "periodic", "adaptive", "lyapunov", "zdm_on")
@@ -243,7 +244,7 @@ def _resolvable(name: str) -> bool:
 def _shapes(values: dict[str, Any]) -> dict[str, tuple[int, ...]]:
     """The shape each array argument must have, from the sizes the others give."""
     nx, nstops, npts = values["nx"], values["nstops"], values["pvs"].shape[0]
-    names = ("Ts", "sphase", "tcarry", "zdms", "out_lyap", "out_used", "out_t", "out_ok")
+    names = ("Ts", "sphase", "tcarry", "zdms", "out_lyap", "out_used", "out_t", "out_status")
     per_point = {name: (npts,) for name in names}
     njobs = values["jobs"].shape[0]
     return {

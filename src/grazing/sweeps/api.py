@@ -158,16 +158,27 @@ def sweep(
 
     Returns an :class:`xarray.Dataset` with, per point (in increasing parameter
     order whatever the direction): ``samples`` (periods x states), ``period``
-    (0: none <= 64), ``impacts_per_period``, ``lyapunov`` (largest exponent
-    per unit time), ``transient_used``.
+    (0: none <= 64; -1: the point failed), ``impacts_per_period``, ``lyapunov``
+    (largest exponent per unit time), ``transient_used``, and ``status``: 0
+    (ok) or why the point failed, a :class:`~grazing.core.solution.Status`
+    code (1 step limit, 2 non-finite state, 3 accumulating impacts; its
+    attributes ``flag_values`` and ``flag_meanings`` say so too).  A failed
+    point has NaN samples and Lyapunov exponent and -1 impacts; the sweep
+    goes on, its next point starting afresh from ``x0``.
 
     Examples
     --------
     >>> import math, numpy as np, grazing
     >>> m = grazing.models.pendulum("B", theta_hat=math.radians(40))
     >>> ds = sweep(m, "eta", np.linspace(0.40, 0.42, 3), periods=20, workers=1)
-    >>> ds.period.values.tolist()
-    [1, 1, 1]
+    >>> ds.period.values.tolist(), ds.status.values.tolist()
+    ([1, 1, 1], [0, 0, 0])
+    >>> ds = sweep(m.with_params(eta=0.4), "alpha", [0.2254, 1e300], periods=20, workers=1)
+    >>> ds.period.values.tolist(), ds.status.values.tolist()  # forcing of 1e300 overflows the state
+    ([1, -1], [0, 2])
+    >>> from grazing.sweeps.status import failure_text
+    >>> failure_text(ds.status.values)
+    'failed: 1 (non-finite state: 1)'
     """
     used: set[str] = set()
     settings = with_shorthands(settings, SweepSettings, shorthands, used)
@@ -197,7 +208,8 @@ def parameter_map(
     Each row (fixed ``param2``) is swept in increasing ``param1``; with the
     default ``chunk_size = 0`` one row is one chunk.  ``settings`` and the
     keyword shorthands as for :func:`sweep`.  Returns a dataset with
-    dimensions ``(param2, param1)``.
+    dimensions ``(param2, param1)`` and the variables of :func:`sweep`
+    (``status``: ok, or why each point failed).
     """
     used: set[str] = set()
     settings = with_shorthands(settings or SweepSettings(chunk_size=0), SweepSettings, shorthands, used)

@@ -41,10 +41,12 @@ import numpy as np
 
 from grazing.core.options import CHATTER_TOL
 from grazing.core.period import DEFAULT_MAX_PERIOD, DEFAULT_PERIOD_TOL, detect_period
+from grazing.core.solution import Status
 from grazing.engine.codegen import taylor_order
 from grazing.engine.native import load_sweep_lanes
 from grazing.engine.runner import step_safety
 from grazing.sweeps.spec import ChunkResult, SweepSpec
+from grazing.sweeps.status import NOT_COMPUTED, STATUS_DTYPE
 
 POLL_INTERVAL = 0.05
 """Seconds between two looks of :func:`stream_chunks` at the finished points."""
@@ -129,7 +131,7 @@ class LaneBatch:
         self.used = np.zeros(npts, dtype=np.int64)
         self.x_final = np.full((npts, n), np.nan)
         self.t_final = np.zeros(npts)
-        self.ok = np.full(npts, -1, dtype=np.int64)  # -1 not finished, 0 failed, 1 done
+        self.status = np.full(npts, NOT_COMPUTED, dtype=np.int64)  # then each point's Status code
         self._starts = np.array([a for a, _ in bounds], dtype=np.int64)
         self._taken = np.zeros(len(parts), dtype=bool)
 
@@ -167,7 +169,7 @@ class LaneBatch:
             self.used,
             self.x_final,
             self.t_final,
-            self.ok,
+            self.status,
         )
 
     def stop(self) -> None:
@@ -176,7 +178,7 @@ class LaneBatch:
 
     def finished(self) -> list[int]:
         """Positions in ``parts`` of the chunks finished since the last call (every point done or failed)."""
-        complete = np.logical_and.reduceat(self.ok >= 0, self._starts)
+        complete = np.logical_and.reduceat(self.status != NOT_COMPUTED, self._starts)
         done = [int(k) for k in np.flatnonzero(complete & ~self._taken)]
         self._taken[done] = True
         return done
@@ -185,7 +187,8 @@ class LaneBatch:
         """The result of chunk ``parts[k]`` (once finished)."""
         a, b = self._bounds[k]
         part = slice(a, b)
-        good = self.ok[part] == 1
+        status = self.status[part]
+        good = status == Status.OK
         samples = self.samples[part]
         return ChunkResult(
             index=self.parts[k][1],
@@ -197,11 +200,12 @@ class LaneBatch:
                 ],
                 dtype=np.int32,
             ),
-            impacts=np.where(good, self.by_stop[part].sum(axis=1), 0).astype(np.int32),
+            impacts=np.where(good, self.by_stop[part].sum(axis=1), -1).astype(np.int32),
             lyapunov=np.where(good, self.lyap[part], np.nan),
-            transient_used=np.where(good, self.used[part], 0).astype(np.int32),
+            transient_used=np.where(good, self.used[part], -1).astype(np.int32),
             x_final=np.where(good[:, None], self.x_final[part], np.nan),
             impacts_by_stop=np.where(good[:, None], self.by_stop[part], -1).astype(np.int32),
+            status=status.astype(STATUS_DTYPE),
         )
 
 

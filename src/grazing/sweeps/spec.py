@@ -155,8 +155,9 @@ class SweepSpec:
         return hashlib.sha256(json.dumps(self.description(), sort_keys=True).encode()).hexdigest()[:16]
 
 
-STORE_LAYOUT = 2
-"""The version of what a store holds (2: impacts on each stop); a store of another layout is another sweep."""
+STORE_LAYOUT = 3
+"""The version of what a store holds (2: impacts on each stop, 3: each point's status); a store of
+another layout is another sweep."""
 
 
 @dataclass
@@ -170,6 +171,7 @@ class ChunkResult:
     lyapunov: np.ndarray  # (points,) largest exponent per unit time (nan if sticking)
     transient_used: np.ndarray  # (points,) transient periods actually run
     x_final: np.ndarray  # (points, n_states)
+    status: np.ndarray  # (points,) each point's Status code (grazing.sweeps.status): 0 ok, else why it failed
     impacts_by_stop: np.ndarray | None = None  # (points, n_stops) impacts on each stop in the sampled span
     seconds: float = 0.0
 

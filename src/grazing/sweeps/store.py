@@ -16,6 +16,7 @@ from __future__ import annotations
 import json
 import os
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -31,6 +32,7 @@ from grazing.sweeps.ownership import (
     lock_for,
 )
 from grazing.sweeps.spec import ChunkResult, SweepSpec, spec_summary
+from grazing.sweeps.status import NOT_COMPUTED, STATUS_DTYPE, status_attrs
 
 __all__ = [
     "ForeignStoreError",
@@ -49,21 +51,48 @@ class StoreMismatchError(GrazingError, ValueError):
     """An existing result store was made by a different sweep."""
 
 
-_VARIABLES = ("samples", "period", "impacts", "lyapunov", "transient_used", "x_final", "impacts_by_stop")
-"""The per-point variables of a sweep."""
+@dataclass(frozen=True)
+class _Variable:
+    """A per-point variable as a store holds it: its dimensions, dtype and value before it is computed."""
+
+    dims: tuple[str, ...]
+    dtype: Any
+    fill: float | int
+
+
+_STORED = {
+    "samples": _Variable(("point", "sample", "component"), np.float64, np.nan),
+    "period": _Variable(("point",), np.int32, -1),
+    "impacts": _Variable(("point",), np.int32, -1),
+    "lyapunov": _Variable(("point",), np.float64, np.nan),
+    "transient_used": _Variable(("point",), np.int32, -1),
+    "x_final": _Variable(("point", "component"), np.float64, np.nan),
+    "impacts_by_stop": _Variable(("point", "stop"), np.int32, -1),
+    "status": _Variable(("point",), STATUS_DTYPE, NOT_COMPUTED),
+}
+"""The per-point variables of a sweep, as the stores hold them (flat along ``point``)."""
+_VARIABLES = tuple(_STORED)
+
+
+def _shapes(spec: SweepSpec) -> dict[str, tuple[int, ...]]:
+    """The shape of each stored variable."""
+    size = {"point": spec.n_points, "sample": spec.periods, "component": spec.model.n_states,
+            "stop": spec.model.n_stops}  # fmt: skip
+    return {name: tuple(size[d] for d in var.dims) for name, var in _STORED.items()}
 
 
 def _empty_arrays(spec: SweepSpec) -> dict[str, np.ndarray]:
-    n, m, p = spec.model.n_states, spec.periods, spec.n_points
     return {
-        "samples": np.full((p, m, n), np.nan),
-        "period": np.full(p, -1, dtype=np.int32),
-        "impacts": np.full(p, -1, dtype=np.int32),
-        "lyapunov": np.full(p, np.nan),
-        "transient_used": np.full(p, -1, dtype=np.int32),
-        "x_final": np.full((p, n), np.nan),
-        "impacts_by_stop": np.full((p, spec.model.n_stops), -1, dtype=np.int32),
+        name: np.full(shape, _STORED[name].fill, dtype=_STORED[name].dtype)
+        for name, shape in _shapes(spec).items()
     }
+
+
+def _flat(arrays: dict[str, np.ndarray]) -> Any:
+    """The stored variables (``arrays``, or a chunk's part of them) as a Dataset along ``point``."""
+    import xarray as xr
+
+    return xr.Dataset({name: (_STORED[name].dims, arrays[name]) for name in _VARIABLES})
 
 
 def _stop_levels(spec: SweepSpec) -> np.ndarray:
@@ -112,6 +141,7 @@ def build_dataset(spec: SweepSpec, arrays: dict[str, np.ndarray], attrs: dict[st
         "x_final": (("point", "component"), arrays["x_final"]),
         "impacts_by_stop": (("point", "stop"), by_stop),
         "impacts_per_period_by_stop": (("point", "stop"), ipp_stop),
+        "status": ("point", arrays["status"]),
     }
     coords: dict[str, Any] = {
         "component": list(spec.model.state_names),
@@ -141,6 +171,7 @@ def build_dataset(spec: SweepSpec, arrays: dict[str, np.ndarray], attrs: dict[st
     ds["lyapunov"].attrs["description"] = (
         "largest Lyapunov exponent per unit time (nan: not computed / sticking)"
     )
+    ds["status"].attrs.update(status_attrs())
     summary = spec_summary(spec)
     ds.attrs.update(
         {
@@ -328,25 +359,19 @@ class ZarrStore:
         import dask.array as da
         import xarray as xr
 
-        n, m, p, c = self.spec.model.n_states, self.spec.periods, self.spec.n_points, self.spec.size
-        k = self.spec.model.n_stops
-        fill = {"samples": np.nan, "period": -1, "impacts": -1, "lyapunov": np.nan, "transient_used": -1,
-                "x_final": np.nan, "impacts_by_stop": -1}  # fmt: skip
-        shapes = {"samples": (p, m, n), "period": (p,), "impacts": (p,), "lyapunov": (p,),
-                  "transient_used": (p,), "x_final": (p, n), "impacts_by_stop": (p, k)}  # fmt: skip
-        dims = {"samples": ("point", "sample", "component"), "x_final": ("point", "component"),
-                "impacts_by_stop": ("point", "stop")}  # fmt: skip
+        c = self.spec.size
         data: dict[str, Any] = {}
         encoding: dict[str, Any] = {}
-        for name, shape in shapes.items():
-            dtype = np.float64 if isinstance(fill[name], float) else np.int32
+        for name, shape in _shapes(self.spec).items():
+            var = _STORED[name]
             chunks = (c, *shape[1:])
-            data[name] = (dims.get(name, ("point",)), da.full(shape, fill[name], dtype=dtype, chunks=chunks))
-            encoding[name] = {"chunks": chunks, "fill_value": fill[name]}
+            data[name] = (var.dims, da.full(shape, var.fill, dtype=var.dtype, chunks=chunks))
+            encoding[name] = {"chunks": chunks, "fill_value": var.fill}
         nc = self.spec.n_chunks
         data["chunk_done"] = ("chunk", da.zeros(nc, dtype=np.int8, chunks=min(nc, 1 << 20)))
         encoding["chunk_done"] = {"chunks": (1,), "fill_value": 0}
         ds = xr.Dataset(data)
+        ds["status"].attrs.update(status_attrs())
         summary = spec_summary(self.spec)
         ds.attrs.update({"spec": json.dumps(summary, sort_keys=True), "fingerprint": summary["fingerprint"]})
         ds.attrs.update(self.attrs)
@@ -366,17 +391,7 @@ class ZarrStore:
         import xarray as xr
 
         sl = self.spec.chunk(res.index)
-        part = xr.Dataset(
-            {
-                "samples": (("point", "sample", "component"), res.samples),
-                "period": ("point", res.period),
-                "impacts": ("point", res.impacts),
-                "lyapunov": ("point", res.lyapunov),
-                "transient_used": ("point", res.transient_used),
-                "x_final": (("point", "component"), res.x_final),
-                "impacts_by_stop": (("point", "stop"), res.impacts_by_stop),
-            }
-        )
+        part = _flat({name: getattr(res, name) for name in _VARIABLES})
         part.to_zarr(str(self.path), region={"point": sl}, consolidated=False)
         flag = xr.Dataset({"chunk_done": ("chunk", np.ones(1, dtype=np.int8))})
         flag.to_zarr(str(self.path), region={"chunk": slice(res.index, res.index + 1)}, consolidated=False)
@@ -410,19 +425,7 @@ def build_dataset_flat(spec: SweepSpec, arrays: dict[str, np.ndarray], attrs: di
     No string coordinates are stored (component names come from the spec on
     loading), so the store uses only Zarr v3's numeric types.
     """
-    import xarray as xr
-
-    ds = xr.Dataset(
-        {
-            "samples": (("point", "sample", "component"), arrays["samples"]),
-            "period": ("point", arrays["period"]),
-            "impacts": ("point", arrays["impacts"]),
-            "lyapunov": ("point", arrays["lyapunov"]),
-            "transient_used": ("point", arrays["transient_used"]),
-            "x_final": (("point", "component"), arrays["x_final"]),
-            "impacts_by_stop": (("point", "stop"), arrays["impacts_by_stop"]),
-        }
-    )
+    ds = _flat(arrays)
     summary = spec_summary(spec)
     ds.attrs.update({"spec": json.dumps(summary, sort_keys=True), "fingerprint": summary["fingerprint"]})
     ds.attrs.update(attrs)

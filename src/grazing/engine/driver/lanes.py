@@ -33,6 +33,7 @@ from grazing.engine.driver.atomics import fetch_add, load_acquire, store_release
 from grazing.engine.driver.calls import tc_free, tc_stick, tc_var
 from grazing.engine.driver.events import first_event
 from grazing.engine.driver.impacts import apply_impact, chatter_remaining, enter_contact
+from grazing.engine.driver.loop import STATUS_NONFINITE, STATUS_OK, STATUS_STEP_LIMIT, STATUS_ZENO
 from grazing.engine.driver.recording import take_samples
 from grazing.engine.driver.tangent import discontinuity_map, lyapunov_step
 from grazing.engine.polyroots import quadratic_bound, work_shape
@@ -178,7 +179,7 @@ def sweep_lanes(
     out_used,
     out_x,
     out_t,
-    out_ok,
+    out_status,
 ):
     """Compute the sweep points of ``jobs`` on ``lanes`` lanes (see the module); results into ``out_*``.
 
@@ -186,8 +187,10 @@ def sweep_lanes(
     vector ``pvs[p]``, period ``Ts[p]``, sampling phase ``sphase[p]`` (local
     time), start time of a point continued from the previous one
     ``tcarry[p]`` (periodic models), local time of the discontinuity map
-    ``zdms[p]``.  ``out_ok[p]`` becomes 1 once the point's results are
-    written, 0 if it failed (the caller sets it to -1 before).
+    ``zdms[p]``.  ``out_status[p]`` becomes the point's
+    :class:`~grazing.core.solution.Status` code once it is finished: 0 once
+    its results are written, else why it failed (1 step limit, 2 non-finite
+    state, 3 accumulating impacts); the caller sets it to -1 before.
 
     Several threads may run the same call (the same arrays): they take the
     jobs in turn from the counter ``control[0]`` (0 at the start), each
@@ -264,7 +267,7 @@ def sweep_lanes(
         for lane in range(L):
             while li[lane, L_STAGE] == IDLE and li[lane, L_JOBEND] >= 0:
                 p = li[lane, L_POINT] + 1
-                carried = li[lane, L_STATUS] == 0 and li[lane, L_JOBEND] > 0
+                carried = li[lane, L_STATUS] == STATUS_OK and li[lane, L_JOBEND] > 0
                 if li[lane, L_JOBEND] == 0 or p >= li[lane, L_JOBEND]:
                     if control[2] > 0 and active >= control[2]:
                         break  # (this thread has its share of the jobs running)
@@ -291,7 +294,7 @@ def sweep_lanes(
                 lf[lane, F_RSS] = ss0
                 li[lane, L_MODE] = 0
                 li[lane, L_STUCK] = 0
-                li[lane, L_STATUS] = 0
+                li[lane, L_STATUS] = STATUS_OK
                 li[lane, L_USED] = 0
                 for j in range(npv):
                     pl[lane, j] = pvs[p, j]
@@ -379,13 +382,13 @@ def sweep_lanes(
             k = li[lane, L_K]
             s = lf[lane, F_S]
             mode = li[lane, L_MODE]
-            status = 0
+            status = STATUS_OK
             if li[lane, L_STEPS] >= li[lane, L_MAXSTEPS]:
-                status = 1
+                status = STATUS_STEP_LIMIT
             for i in range(n):
                 if not math.isfinite(XS[i, lane]):
-                    status = 2
-            if status != 0:
+                    status = STATUS_NONFINITE
+            if status != STATUS_OK:
                 flags[lane] = 8
                 li[lane, L_STATUS] = status
                 continue
@@ -471,7 +474,7 @@ def sweep_lanes(
                 li[lane, L_ZERO] += 1
                 if li[lane, L_ZERO] > 3:
                     flags[lane] = 8
-                    li[lane, L_STATUS] = 3
+                    li[lane, L_STATUS] = STATUS_ZENO
                     todo[lane] = 0
                     continue
             else:
@@ -540,8 +543,8 @@ def sweep_lanes(
 
         # Pass B, lane by lane: time, Lyapunov vectors, discontinuity map, impacts, the request's end.
         for lane in range(L):
-            if flags[lane] == 8:  # the point failed: the next point starts afresh
-                store_release(out_ok, li[lane, L_POINT], 0)
+            if flags[lane] == 8:  # the point failed (L_STATUS says why): the next point starts afresh
+                store_release(out_status, li[lane, L_POINT], li[lane, L_STATUS])
                 li[lane, L_STAGE] = IDLE
                 active -= 1
                 continue
@@ -691,7 +694,19 @@ def sweep_lanes(
                 li[lane, L_STAGE] = FINAL
                 final_request(li, lf, XS, n, lane, align, periods, lyapunov, T, sphase[p], periodic, zdms[p])
                 continue
-            # FINAL: the point's results.
+            # FINAL: the point's results (a state that became non-finite on the last step fails the point).
+            finite = True
+            for i in range(n):
+                finite = finite and math.isfinite(XS[i, lane])
+            for r in range(periods):
+                for c in range(n):
+                    finite = finite and math.isfinite(buf[lane, r, c])
+            if not finite:
+                li[lane, L_STATUS] = STATUS_NONFINITE
+                store_release(out_status, p, STATUS_NONFINITE)
+                li[lane, L_STAGE] = IDLE
+                active -= 1
+                continue
             for r in range(periods):
                 for c in range(n):
                     out_samples[p, r, c] = buf[lane, r, c]
@@ -713,7 +728,7 @@ def sweep_lanes(
             for i in range(n):
                 out_x[p, i] = XS[i, lane]
             out_t[p] = k * T + s
-            store_release(out_ok, p, 1)  # (after its results: another thread may read them now)
+            store_release(out_status, p, STATUS_OK)  # (after its results: another thread may read them now)
             li[lane, L_STAGE] = IDLE
             active -= 1
 
