@@ -27,6 +27,7 @@ from grazing.cli.validate import (
     ANGLE_DEG,
     InputError,
     path_type,
+    refuse_set,
     refuse_unused,
 )
 from grazing.models.pendulum import CASES, DEFAULT_CASE, case_values
@@ -276,6 +277,7 @@ def search_range(
     """
     if gparam is None and prange is None and model.name == "pendulum":
         refuse_unused(["eta"], True, f"by {command}: it searches eta in [--eta-min, --eta-max]")
+        refuse_set(["eta"], f"by {command}: it searches eta in [--eta-min, --eta-max]")
         check_eta_range(eta_min, eta_max)
         return model.parameter("eta"), eta_min, eta_max, True
     refuse_unused(["eta_min", "eta_max"], True, "with --param/--range (use --range LO,HI)")
@@ -283,6 +285,7 @@ def search_range(
         raise InputError(f"{command} needs --param NAME and --range LO,HI (for this model)")
     par = model_parameter(model, gparam)
     refuse_unused([par.name], True, f"by {command}: it searches --param over --range")
+    refuse_set([par.name], f"by {command}: it searches --param over --range")
     lo, hi = (par.from_display(v) for v in parse_pair(prange, "--range", "LO,HI"))
     if not lo < hi:
         raise InputError(f"--range: LO must be below HI, got {prange}")

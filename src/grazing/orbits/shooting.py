@@ -19,6 +19,7 @@ import numpy as np
 from grazing.core.model import HybridModel
 from grazing.core.options import NEWTON_MAX_ITER, NEWTON_TOL
 from grazing.core.period import detect_period
+from grazing.core.solution import Solution
 from grazing.engine.simulate import simulate
 from grazing.errors import ConvergenceError, InvalidParameterError, InvalidStateError, SimulationError
 from grazing.maps import FlowMap, flow_map
@@ -218,24 +219,94 @@ def move_section(orbit: PeriodicOrbit, t_new: float, *, tol: float = DEFAULT_TOL
     )
 
 
+GUESS = "an initial guess x0 (--initial)"
+"""What to give when the default guess, simulated from rest, cannot start Newton's method."""
+
+
+@dataclass(frozen=True)
+class InitialGuess:
+    """A point near an attractor, from simulation starting at rest (:func:`initial_guess`).
+
+    Attributes
+    ----------
+    state
+        The last stroboscopic sample.
+    period
+        The period detected over the sampled periods (0 if none).
+    transient
+        Forcing periods simulated before sampling.
+    sticking
+        How the motion sticks to a stop over the sampled periods: ``""`` (it
+        does not), or a phrase such as ``"ends riding on the stop"`` (see
+        :func:`sticking_phrase`).
+    """
+
+    state: np.ndarray
+    period: int
+    transient: int
+    sticking: str = ""
+
+
+def _stop_phrase(model: HybridModel, x: np.ndarray, t: float) -> str:
+    """The stop nearest to ``x`` (the smallest guard value), as messages name it."""
+    name = model.stop_names[int(np.argmin(np.abs(model.guards(x, t))))] if model.n_stops > 1 else "stop"
+    return "the stop" if name == "stop" else f"stop {name!r}"
+
+
+def sticking_phrase(sol: Solution, periods: int) -> str:
+    """How the run ``sol``, sampled over ``periods`` forcing periods, sticks to a stop, in words.
+
+    ``""`` without sticking; ``"ends riding on the stop"`` when one interval
+    lasts to the end of the run; else ``"sticks to the stop 3 times in 2
+    forcing periods"`` (the stop named when the model has only one or the run
+    ends on it).
+    """
+    sticking, t_final, model = sol.sticking, sol.t_final, sol.model
+    if not len(sticking):
+        return ""
+    riding = sticking[-1, 1] >= t_final - 1e-9 * max(1.0, abs(t_final))
+    where = _stop_phrase(model, sol.x_final, t_final) if riding or model.n_stops == 1 else "a stop"
+    if riding and len(sticking) == 1:
+        return f"ends riding on {where}"
+    k = len(sticking)
+    return f"sticks to {where} {k} time{'s' * (k > 1)} in {periods} forcing period{'s' * (periods > 1)}"
+
+
 def initial_guess(
     model: HybridModel, *, t0: float = 0.0, transient: int = 500, samples: int = 128, virtual: bool = False
-) -> tuple[np.ndarray, int]:
+) -> InitialGuess:
     """A point near an attractor and its period, from simulation starting at rest.
 
-    Returns the last stroboscopic sample and the detected period (0 if none).
+    Raises
+    ------
+    SimulationError
+        When the simulation fails (it diverges from an unstable orbit, say),
+        saying what to do: give an initial guess.
     """
-    sol = simulate(
-        model,
-        np.zeros(model.n_states),
-        t0=t0,
+    try:
+        sol = simulate(
+            model,
+            np.zeros(model.n_states),
+            t0=t0,
+            transient=transient,
+            periods=samples,
+            phase=2 * math.pi * (t0 / model.period % 1.0),
+            impacts="none",
+            events=not virtual,
+        )
+    except SimulationError as exc:
+        flow = " with the stops ignored" if virtual else ""
+        raise SimulationError(
+            f"cannot guess the orbit by simulating from rest{flow}: {exc} (an unstable orbit is never "
+            f"reached by simulation); give {GUESS} near the orbit: Newton's method finds it from there, "
+            "stable or not"
+        ) from None
+    return InitialGuess(
+        state=sol.samples[-1].copy(),
+        period=detect_period(sol.samples, tol=1e-6),
         transient=transient,
-        periods=samples,
-        phase=2 * math.pi * (t0 / model.period % 1.0),
-        impacts="none",
-        events=not virtual,
+        sticking=sticking_phrase(sol, samples),
     )
-    return sol.samples[-1].copy(), detect_period(sol.samples, tol=1e-6)
 
 
 def find_orbit(
@@ -303,14 +374,16 @@ def find_orbit(
         return move_section(orbit, quiet_section(orbit), tol=tol)
     advice = "try another initial guess, another period, or a longer transient"
     stop = model.stop_index(stop_name)
+    guess: InitialGuess | None = None
     if x0 is None:
-        x, detected = initial_guess(model, t0=t0, transient=transient, virtual=virtual)
+        guess = initial_guess(model, t0=t0, transient=transient, virtual=virtual)
+        x, detected = guess.state, guess.period
         n = int(period or detected or 1)
         if not (period or detected):
             advice = (
                 f"simulation from rest showed no period <= 64 after {transient} periods (chaos, or a "
-                f"transient not yet settled), so a period-1 orbit was tried; give the period or an "
-                "initial guess, or a longer transient"
+                "transient not yet settled), so a period-1 orbit was tried; give the period (--period) or "
+                "an initial guess x0 (--initial), or a longer transient (--transient)"
             )
     else:
         x = model.check_state(x0, t0, allowed=not virtual)
@@ -330,11 +403,7 @@ def find_orbit(
                 f"beyond the stop); {advice}"
             ) from None
         if not fm.solution.jacobian_valid:
-            raise ConvergenceError(
-                f"the motion sticks to the stop (or meets it at zero speed) during the period-{n} map "
-                f"(iterate {it}); the Jacobian across sticking is not computed, so Newton's method and "
-                "Floquet multipliers are not available for it: simulate it instead"
-            )
+            raise ConvergenceError(_sticking_message(model, n, it, fm, guess))
         F = fm.image - x
         res = float(np.max(np.abs(F)))
         residuals.append(res)
@@ -362,3 +431,22 @@ def find_orbit(
         f"Newton did not converge to a period-{n} orbit: residual {residuals[-1]:.3g} after "
         f"{len(residuals) - 1} iterations{why}; {advice}"
     )
+
+
+def _sticking_message(model: HybridModel, n: int, it: int, fm: FlowMap, guess: InitialGuess | None) -> str:
+    """Why Newton's method stops where the period-``n`` map has no Jacobian (sticking), and what to do."""
+    how = sticking_phrase(fm.solution, n)
+    what = (
+        f"the motion {how}" if how else "the motion sticks to the stop (or meets it at zero speed)"
+    ) + f" during the period-{n} map (iterate {it})"
+    no_jacobian = (
+        "the Jacobian across sticking is not computed, so Newton's method and Floquet multipliers are "
+        "not available for it"
+    )
+    if guess is not None and guess.sticking and it == 0:
+        return (
+            f"the default initial guess sticks: simulated from rest for {guess.transient} forcing periods, "
+            f"the motion {guess.sticking}, and {no_jacobian}; give {GUESS} near an orbit that does not "
+            "stick, or simulate this motion instead"
+        )
+    return f"{what}; {no_jacobian}: give {GUESS} near an orbit that does not stick, or simulate this motion"
