@@ -247,29 +247,45 @@ class InitialGuess:
     sticking: str = ""
 
 
-def _stop_phrase(model: HybridModel, x: np.ndarray, t: float) -> str:
-    """The stop nearest to ``x`` (the smallest guard value), as messages name it."""
-    name = model.stop_names[int(np.argmin(np.abs(model.guards(x, t))))] if model.n_stops > 1 else "stop"
+def _stop_phrase(name: str) -> str:
+    """A stop as messages name it: ``the stop`` (a model's only, unnamed stop) or ``stop 'left'``."""
     return "the stop" if name == "stop" else f"stop {name!r}"
 
 
+def _sticking_stops(sol: Solution, riding: bool) -> list[str]:
+    """The stop of each sticking interval of ``sol``: that of the last recorded impact before it (the
+    chattering that ends in it), else the stop the run ends on (last interval), else ``""``."""
+    model = sol.model
+    if model.n_stops == 1:
+        return [model.stop_names[0]] * len(sol.sticking)
+    names = []
+    for start in sol.sticking[:, 0]:
+        before = np.flatnonzero(sol.impacts.t <= start + 1e-9 * max(1.0, abs(start)))
+        names.append(sol.impacts.stop_name(int(before[-1])) if before.size else "")
+    if riding and not names[-1]:
+        names[-1] = model.stop_names[int(np.argmin(np.abs(model.guards(sol.x_final, sol.t_final))))]
+    return names
+
+
 def sticking_phrase(sol: Solution, periods: int) -> str:
-    """How the run ``sol``, sampled over ``periods`` forcing periods, sticks to a stop, in words.
+    """How the run ``sol``, sampled over ``periods`` forcing periods, sticks to its stops, in words.
 
     ``""`` without sticking; ``"ends riding on the stop"`` when one interval
-    lasts to the end of the run; else ``"sticks to the stop 3 times in 2
-    forcing periods"`` (the stop named when the model has only one or the run
-    ends on it).
+    lasts to the end of the run; else ``"sticks to stop 'right' 3 times and
+    to stop 'left' 2 times in 2 forcing periods"`` (each interval's stop as
+    :func:`_sticking_stops` finds it; intervals whose stop it does not find
+    are left out unless it finds none).
     """
-    sticking, t_final, model = sol.sticking, sol.t_final, sol.model
-    if not len(sticking):
+    if not len(sol.sticking):
         return ""
-    riding = sticking[-1, 1] >= t_final - 1e-9 * max(1.0, abs(t_final))
-    where = _stop_phrase(model, sol.x_final, t_final) if riding or model.n_stops == 1 else "a stop"
-    if riding and len(sticking) == 1:
-        return f"ends riding on {where}"
-    k = len(sticking)
-    return f"sticks to {where} {k} time{'s' * (k > 1)} in {periods} forcing period{'s' * (periods > 1)}"
+    riding = sol.sticking[-1, 1] >= sol.t_final - 1e-9 * max(1.0, abs(sol.t_final))
+    names = _sticking_stops(sol, riding)
+    if riding and len(names) == 1:
+        return f"ends riding on {_stop_phrase(names[0]) if names[0] else 'a stop'}"
+    known = [n for n in names if n] or names  # (one begun before the sampled span has no impact before it)
+    counts = {name: known.count(name) for name in dict.fromkeys(known)}
+    parts = [f"{_stop_phrase(n) if n else 'a stop'} {k} time{'s' * (k > 1)}" for n, k in counts.items()]
+    return f"sticks to {' and to '.join(parts)} in {periods} forcing period{'s' * (periods > 1)}"
 
 
 def initial_guess(
@@ -279,9 +295,9 @@ def initial_guess(
 
     Raises
     ------
-    SimulationError
-        When the simulation fails (it diverges from an unstable orbit, say),
-        saying what to do: give an initial guess.
+    SimulationError, InvalidStateError
+        When the simulation fails (it diverges from an unstable orbit, say) or
+        rest is beyond a stop, saying what to do: give an initial guess.
     """
     try:
         sol = simulate(
@@ -291,15 +307,15 @@ def initial_guess(
             transient=transient,
             periods=samples,
             phase=2 * math.pi * (t0 / model.period % 1.0),
-            impacts="none",
+            impacts="sampled",  # (they name the stop of each sticking interval)
             events=not virtual,
         )
-    except SimulationError as exc:
+    except (SimulationError, InvalidStateError) as exc:
         flow = " with the stops ignored" if virtual else ""
-        raise SimulationError(
-            f"cannot guess the orbit by simulating from rest{flow}: {exc} (an unstable orbit is never "
-            f"reached by simulation); give {GUESS} near the orbit: Newton's method finds it from there, "
-            "stable or not"
+        raise type(exc)(
+            f"cannot guess the orbit by simulating from rest{flow}: {exc}; give {GUESS} near the orbit, "
+            "from which Newton's method finds it without simulating it (unstable orbits too, which a "
+            "simulation never settles on)"
         ) from None
     return InitialGuess(
         state=sol.samples[-1].copy(),
@@ -330,7 +346,9 @@ def find_orbit(
     x0
         Initial guess at time ``t0``.  Default: the state after ``transient``
         forcing periods from rest (and its detected period, if ``period`` is
-        not given).
+        not given).  A simulation settles only on a stable orbit: where the
+        motion from rest diverges (an unstable orbit), sticks to a stop or
+        settles on another orbit, give ``x0`` (the error says which happened).
     period
         Period in forcing periods (default: detected by simulation, else 1).
     t0
@@ -352,7 +370,11 @@ def find_orbit(
     Raises
     ------
     ConvergenceError
-        With the residual, the iteration count and what to try.
+        With the residual, the iteration count and what to try; also where
+        the motion sticks to a stop (no Jacobian across sticking).
+    SimulationError, InvalidStateError
+        Without ``x0``, when the simulation from rest fails or rest is beyond
+        a stop (see :func:`initial_guess`).
 
     Examples
     --------
