@@ -116,6 +116,9 @@ def test_the_unstable_orbit_s_grazings_from_initial(capsys):
 
     cf = ClosedForm()
     first, second = cf.grazing_frequencies(UPPER)
+    orbit = run_json(["orbit", *NEG, "--set", "w=0.7", "--initial", "0,0", "--period", "1"], capsys)
+    assert orbit["state"] == pytest.approx(list(cf.state(0.7)), abs=1e-12)
+    assert orbit["impacts"] == 0 and orbit["stable"] is False
     search = ["--param", "w", "--range", "0.5,1.5", "--initial", "0,0"]
     res = run_json(["graze", *NEG, *search], capsys)
     assert [g["value"] for g in res["grazings"]] == pytest.approx([first, second], rel=1e-10)

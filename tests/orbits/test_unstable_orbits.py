@@ -43,6 +43,20 @@ def test_the_free_orbit_is_unstable_and_newton_finds_it_from_a_guess():
     assert not orbit.stable and orbit.abs_lambda == pytest.approx(math.exp(-ZETA * 2 * math.pi / 0.7))
 
 
+def test_a_physical_search_finds_the_unstable_orbit_where_it_touches_no_stop():
+    """From a guess whose flow hits a stop, Newton's method on the physical map fails; on the flow
+    through the stops it converges, and an orbit clear of every stop is a physical orbit.  At w = 0.9
+    the free orbit (amplitude 2.46) passes through the ceiling (2): no such orbit, and the error stays."""
+    for w in (0.5, 0.7):
+        orbit = find_orbit(negative_damping(w=w), [0.0, 0.0], period=1)
+        assert not orbit.virtual and orbit.impacts == 0 and not orbit.stable
+        np.testing.assert_allclose(orbit.state, CF.state(w), rtol=0, atol=1e-12)
+        assert min(orbit.guard_mins) == pytest.approx(UPPER - CF.amplitude(w), abs=1e-9)
+    assert CF.amplitude(0.9) > UPPER
+    with pytest.raises(grazing.ConvergenceError, match=r"try another initial guess or another period$"):
+        find_orbit(negative_damping(w=0.9), [0.0, 0.0], period=1)
+
+
 @pytest.mark.parametrize(
     "call",
     [

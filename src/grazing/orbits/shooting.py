@@ -21,7 +21,13 @@ from grazing.core.options import NEWTON_MAX_ITER, NEWTON_TOL
 from grazing.core.period import detect_period
 from grazing.core.solution import Solution
 from grazing.engine.simulate import simulate
-from grazing.errors import ConvergenceError, InvalidParameterError, InvalidStateError, SimulationError
+from grazing.errors import (
+    ConvergenceError,
+    GrazingError,
+    InvalidParameterError,
+    InvalidStateError,
+    SimulationError,
+)
 from grazing.maps import FlowMap, flow_map
 
 DEFAULT_TOL = NEWTON_TOL
@@ -359,6 +365,10 @@ def find_orbit(
         where an impact falls on the section).
     virtual
         Ignore the stop (for nonimpacting orbits continued past grazing).
+        Without it, where Newton's method on the physical map fails, it is
+        run from the same guess on the flow through the stops too: an orbit
+        found there that keeps clear of every stop is a physical orbit (an
+        unstable orbit whose neighbours hit a stop, say) and is returned.
     tol
         Convergence when ``max |P^n(x) - x| <= tol``.
     max_iter
@@ -394,10 +404,10 @@ def find_orbit(
         if orbit.section_clearance() >= SECTION_MARGIN:
             return orbit
         return move_section(orbit, quiet_section(orbit), tol=tol)
-    advice = "try another initial guess, another period, or a longer transient"
     stop = model.stop_index(stop_name)
     guess: InitialGuess | None = None
     if x0 is None:
+        advice = "try another period (--period), an initial guess x0 (--initial) or a longer transient"
         guess = initial_guess(model, t0=t0, transient=transient, virtual=virtual)
         x, detected = guess.state, guess.period
         n = int(period or detected or 1)
@@ -408,51 +418,97 @@ def find_orbit(
                 "an initial guess x0 (--initial), or a longer transient (--transient)"
             )
     else:
+        advice = "try another initial guess or another period"
         x = model.check_state(x0, t0, allowed=not virtual)
         n = int(period or 1)
-    residuals: list[float] = []
-    why = ""
-    for it in range(max_iter + 1):
-        try:
-            fm = flow_map(model, x, t0=t0, periods=n, virtual=virtual, stop_name=stop)
-        except SimulationError as exc:
-            raise ConvergenceError(
-                f"Newton's method for a period-{n} orbit failed at iterate {it} ({exc}); {advice}"
-            ) from None
-        except InvalidStateError:
-            raise ConvergenceError(
-                f"Newton's method for a period-{n} orbit left the allowed region (iterate {it} is "
-                f"beyond the stop); {advice}"
-            ) from None
-        if not fm.solution.jacobian_valid:
-            raise ConvergenceError(_sticking_message(model, n, it, fm, guess))
-        F = fm.image - x
-        res = float(np.max(np.abs(F)))
-        residuals.append(res)
-        if not np.isfinite(res):
-            break
-        if res <= tol:
-            return _orbit_from(model, x, t0, n, fm, virtual, residuals, stop)
-        if it == max_iter:
-            break
-        A = fm.jacobian - np.eye(model.n_states)
-        try:
-            dx = np.linalg.solve(A, -F)
-        except np.linalg.LinAlgError:
-            why = " (the Jacobian P_x - I is singular: a fold or a multiplier 1?)"
-            break
-        # Backtrack so that the iterate stays in the allowed region.
-        lam = 1.0
-        for _ in range(30):
-            trial = x + lam * dx
-            if virtual or np.min(model.guards(trial, t0)) >= 0:
+    newton = _Newton(model, t0, n, stop, tol, max_iter)
+    try:
+        return newton.solve(x, virtual, advice, guess)
+    except ConvergenceError:
+        inside = None if virtual else newton.nonimpacting(x)
+        if inside is None:
+            raise
+        return inside
+
+
+@dataclass(frozen=True)
+class _Newton:
+    """Newton's method on the period-``n`` stroboscopic map from the section through ``t0``."""
+
+    model: HybridModel
+    t0: float
+    n: int
+    stop: int
+    tol: float
+    max_iter: int
+
+    def solve(self, x: np.ndarray, virtual: bool, advice: str, guess: InitialGuess | None) -> PeriodicOrbit:
+        """The orbit from ``x``, or :class:`ConvergenceError` saying why not and ``advice``."""
+        model, t0, n, stop, tol = self.model, self.t0, self.n, self.stop, self.tol
+        residuals: list[float] = []
+        why = ""
+        for it in range(self.max_iter + 1):
+            try:
+                fm = flow_map(model, x, t0=t0, periods=n, virtual=virtual, stop_name=stop)
+            except SimulationError as exc:
+                raise ConvergenceError(
+                    f"Newton's method for a period-{n} orbit failed at iterate {it} ({exc}); {advice}"
+                ) from None
+            except InvalidStateError:
+                raise ConvergenceError(
+                    f"Newton's method for a period-{n} orbit left the allowed region (iterate {it} is "
+                    f"beyond the stop); {advice}"
+                ) from None
+            if not fm.solution.jacobian_valid:
+                raise ConvergenceError(_sticking_message(model, n, it, fm, guess))
+            F = fm.image - x
+            res = float(np.max(np.abs(F)))
+            residuals.append(res)
+            if not np.isfinite(res):
                 break
-            lam *= 0.5
-        x = trial
-    raise ConvergenceError(
-        f"Newton did not converge to a period-{n} orbit: residual {residuals[-1]:.3g} after "
-        f"{len(residuals) - 1} iterations{why}; {advice}"
-    )
+            if res <= tol:
+                return _orbit_from(model, x, t0, n, fm, virtual, residuals, stop)
+            if it == self.max_iter:
+                break
+            A = fm.jacobian - np.eye(model.n_states)
+            try:
+                dx = np.linalg.solve(A, -F)
+            except np.linalg.LinAlgError:
+                why = " (the Jacobian P_x - I is singular: a fold or a multiplier 1?)"
+                break
+            # Backtrack so that the iterate stays in the allowed region.
+            lam = 1.0
+            for _ in range(30):
+                trial = x + lam * dx
+                if virtual or np.min(model.guards(trial, t0)) >= 0:
+                    break
+                lam *= 0.5
+            x = trial
+        raise ConvergenceError(
+            f"Newton did not converge to a period-{n} orbit: residual {residuals[-1]:.3g} after "
+            f"{len(residuals) - 1} iterations{why}; {advice}"
+        )
+
+    def nonimpacting(self, x: np.ndarray) -> PeriodicOrbit | None:
+        """A physical orbit that touches no stop, found from ``x`` on the flow through the stops, or None.
+
+        Newton's method on the physical map fails from a guess whose flow hits a stop although the
+        orbit itself does not (an unstable orbit, from a guess off it, say); on the flow through the
+        stops it converges, and an orbit that keeps clear of every stop is also a physical orbit
+        (checked on the physical map).
+        """
+        try:
+            free = self.solve(x, True, "", None)
+        except GrazingError:
+            return None
+        if np.min(free.guard_mins) <= CROSSING_TOL:
+            return None
+        fm = flow_map(self.model, free.state, t0=self.t0, periods=self.n, stop_name=self.stop)
+        res = float(np.max(np.abs(fm.image - free.state)))
+        if fm.impacts or not fm.solution.jacobian_valid or not res <= self.tol:
+            return None
+        residuals = [*free.residuals, res]
+        return _orbit_from(self.model, free.state, self.t0, self.n, fm, False, residuals, self.stop)
 
 
 def _sticking_message(model: HybridModel, n: int, it: int, fm: FlowMap, guess: InitialGuess | None) -> str:
