@@ -315,17 +315,19 @@ def graze_curve(
 @click.option("--param", "cparam", required=True, metavar="NAME",
               help="Parameter to vary: any of the model's (the pendulum's eta, theta-hat, alpha, beta, r); "
               "angles in degrees.")  # fmt: skip
-@click.option("--start", type=FINITE, required=True, help="Start value of the parameter.")
-@click.option("--stop", type=FINITE, required=True, help="End value of the parameter.")
+@click.option("--start", type=FINITE, required=True, help="Start value of the parameter (display unit).")
+@click.option("--stop", type=FINITE, required=True, help="End value of the parameter (display unit).")
 @click.option("--period", type=ORBIT_PERIOD, help="Period of the orbit (default: detected).")
 @click.option("--initial", metavar="X1,X2,...", help="Initial guess at time 0, one number per state.")
 @stop_name_option
 @click.option("--virtual/--physical", default=None,
-              help="Ignore the stop (default: yes for a nonimpacting starting orbit).")  # fmt: skip
+              help="Ignore the stops (default: for a nonimpacting starting orbit, without "
+              "--switch).")  # fmt: skip
 @click.option("--max-step", type=POSITIVE, default=0.04, show_default=True, help="Largest continuation step.")
 @click.option("--switch", is_flag=True,
               help="At a grazing where the impact sequence changes, continue on the orbit with the new "
-              "sequence (a new branch segment) instead of ending there.")  # fmt: skip
+              "sequence (a new branch segment) instead of ending there (a physical branch only: not "
+              "with --virtual).")  # fmt: skip
 @netcdf_out_option
 @json_option
 def continue_(
