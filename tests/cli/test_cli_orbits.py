@@ -199,3 +199,25 @@ def test_switch_from_a_nonimpacting_orbit_follows_it_physically(argv, capsys):
     first = next(s["value"] for s in plain["special"] if s["kind"] == "grazing")
     assert switched["special"][-1]["value"] == pytest.approx(first, abs=1e-9)
     assert "switch" in switched["status"] and "can be followed with switch" not in switched["status"]
+
+
+def test_a_parameter_named_like_an_option_leaves_the_option_alone(capsys, tmp_path, monkeypatch):
+    """A model's parameters called ``out`` and ``period``: continuing in them still takes --out and
+    --period (only the pendulum's options set parameters); --set of them is refused."""
+    (tmp_path / "named.py").write_text(
+        "import sympy as sp\n"
+        "from grazing import HybridModel, Parameter\n"
+        "x, v, t, out, period, wall = sp.symbols('x v t out period wall')\n"
+        "MODEL = HybridModel('named', [x, v], t, [Parameter('out', 0.05, lower=0),\n"
+        "    Parameter('period', 2.8, lower=0, lower_open=True), Parameter('wall', 1.0)],\n"
+        "    vector_field=[v, -2 * out * v - x + sp.cos(period * t)], guard=wall - x, reset=[x, -0.8 * v],\n"
+        "    period=2 * sp.pi / period, contact_direction=[0, 1])\n"
+    )
+    monkeypatch.chdir(tmp_path)
+    model = ["continue", "--model", "named.py:MODEL"]
+    res = run_json([*model, "--param", "out", "--start", "0.05", "--stop", "0.1", "--out", "b.nc"], capsys)
+    assert res["out"] == "b.nc" and (tmp_path / "b.nc").exists()
+    res = run_json([*model, "--param", "period", "--start", "2.8", "--stop", "3.2", "--period", "1"], capsys)
+    assert res["period"] == 1 and res["values"][-1] == pytest.approx(3.2)
+    code = main([*model, "--param", "period", "--start", "2.8", "--stop", "3.2", "--set", "period=3"])
+    assert code == 2 and "--set period=3 is not used with --param period" in capsys.readouterr().err

@@ -25,12 +25,13 @@ from grazing.cli.common import (
     netcdf_out_option,
     parse_pair,
     parse_state,
+    refuse_varied,
     save_dataset,
     search_range,
     stop_name_option,
     stop_option_index,
 )
-from grazing.cli.validate import ANGLE_DEG, FINITE, ORBIT_PERIOD, POSITIVE, count, refuse_set, refuse_unused
+from grazing.cli.validate import ANGLE_DEG, FINITE, ORBIT_PERIOD, POSITIVE, count, refuse_unused
 from grazing.errors import GrazingWarning
 from grazing.models.pendulum import max_angle
 
@@ -245,10 +246,8 @@ def graze_curve(
     stop = stop_option_index(model, stop_name)
     generic = gparams is not None or prange is not None or start_value is not None or model.name != "pendulum"
     if not generic:
-        refuse_unused(["eta"], True, "by graze-curve: it searches eta in [--eta-min, --eta-max]")
-        refuse_unused(["theta_hat"], True, "by graze-curve: the curve starts at --start-deg")
-        refuse_set(["eta"], "by graze-curve: it searches eta in [--eta-min, --eta-max]")
-        refuse_set(["theta_hat"], "by graze-curve: the curve starts at --start-deg")
+        refuse_varied(["eta"], "by graze-curve: it searches eta in [--eta-min, --eta-max]")
+        refuse_varied(["theta_hat"], "by graze-curve: the curve starts at --start-deg")
         check_eta_range(eta_min, eta_max)
         p1, p2 = model.parameter("eta"), model.parameter("theta_hat")
         lo, hi, start = eta_min, eta_max, math.radians(start_deg)
@@ -264,8 +263,7 @@ def graze_curve(
         p1, p2 = (model_parameter(model, t, "--params") for t in names)
         if p1.name == p2.name:
             raise InputError("--params: the two parameters must differ")
-        refuse_unused([p1.name, p2.name], True, "by graze-curve: it moves both --params")
-        refuse_set([p1.name, p2.name], "by graze-curve: it moves both --params")
+        refuse_varied([p1.name, p2.name], "by graze-curve: it moves both --params")
         lo, hi = (p1.from_display(v) for v in parse_pair(prange, "--range", "LO,HI"))
         if not lo < hi:
             raise InputError(f"--range: LO must be below HI, got {prange}")
@@ -352,8 +350,7 @@ def continue_(
 
     par = model_parameter(model, cparam)
     name = par.name
-    refuse_unused([name], True, f"with --param {cparam}: the branch starts at --start")
-    refuse_set([name], f"with --param {cparam}: the branch starts at --start")
+    refuse_varied([name], f"with --param {cparam}: the branch starts at --start")
     refuse_unused(
         ["switch"], virtual is True, "with --virtual: a virtual branch ignores the stops, so its impact "
         "sequence never changes (it is followed through its grazings)",
