@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import pytest
 
@@ -89,3 +90,134 @@ def test_newton_failure_is_reported(capsys):
     assert err.startswith("grazing: error: Newton did not converge to a period-2 orbit: residual")
     assert "after 30 iterations; try another initial guess" in err
     assert len(err.strip().splitlines()) == 1
+
+
+# --------------------------------------------------------------------------
+# issue 26: an unstable orbit from --initial; parameters in their display unit; --switch
+
+
+NEG = [
+    "--model",
+    f"{Path(__file__).resolve().parents[1] / 'orbits' / 'negative_damping.py'}:negative_damping",
+]
+
+
+def run_text(argv, capsys):
+    code = main(argv)
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    return out
+
+
+def test_the_unstable_orbit_s_grazings_from_initial(capsys):
+    """Every grazing command finds the unstable nonimpacting orbit from --initial (Newton's method on
+    the flow through the stops) and its grazings where the closed form has them."""
+    from tests.orbits.negative_damping import UPPER, ClosedForm
+
+    cf = ClosedForm()
+    first, second = cf.grazing_frequencies(UPPER)
+    orbit = run_json(["orbit", *NEG, "--set", "w=0.7", "--initial", "0,0", "--period", "1"], capsys)
+    assert orbit["state"] == pytest.approx(list(cf.state(0.7)), abs=1e-12)
+    assert orbit["impacts"] == 0 and orbit["stable"] is False
+    search = ["--param", "w", "--range", "0.5,1.5", "--initial", "0,0"]
+    res = run_json(["graze", *NEG, *search], capsys)
+    assert [g["value"] for g in res["grazings"]] == pytest.approx([first, second], rel=1e-10)
+    assert all(g["abs_lambda"] > 1 and g["stop"] == "ceiling" for g in res["grazings"])
+    res = run_json(["normal-form", *NEG, *search, "--which", "second"], capsys)
+    assert res["value"] == pytest.approx(second, rel=1e-10) and res["abs_lambda"] > 1
+    assert res["coefficients"]["accel"] == pytest.approx(UPPER * second**2, rel=1e-9)
+    res = run_json(["continue", *NEG, "--param", "w", "--start", "0.5", "--stop", "1.5", "--virtual",
+                    "--initial", "0,0"], capsys)  # fmt: skip
+    graze = [(s["stop"], s["value"]) for s in res["special"] if s["kind"] == "grazing"]
+    assert graze[0] == ("ceiling", pytest.approx(first, rel=1e-10))
+    assert graze[-1] == ("ceiling", pytest.approx(second, rel=1e-10))
+    assert not any(res["stable"])
+    res = run_json(["graze-curve", *NEG, "--params", "w,upper", "--range", "0.5,1.5", "--start-value", "2",
+                    "--initial", "0,0"], capsys)  # fmt: skip
+    fold_w, fold_a = cf.fold()
+    assert res["fold"] == {"w": pytest.approx(fold_w, rel=1e-8), "upper": pytest.approx(fold_a, rel=1e-12)}
+
+
+def test_the_pendulum_s_unstable_orbit_from_initial(capsys):
+    """α = 0.6, η = 0.4148: a saddle nonimpacting orbit between two stable ones.  Its grazing in θ̂
+    (degrees) is where the stop meets its largest angle, which `orbit` reports from shooting alone;
+    without --initial the search finds a stable orbit's grazing instead."""
+    base = ["--alpha", "0.6", "--eta", "0.4148"]
+    orbit = run_json(
+        ["orbit", *base, "--theta-hat", "170", "--period", "1", "--initial", "-1.39,0.73"], capsys
+    )
+    assert orbit["impacts"] == 0 and not orbit["stable"]
+    search = ["--param", "theta_hat", "--range", "60,120", *base]
+    (g,) = run_json(["graze", *search, "--initial", "-1.39,0.73"], capsys)["grazings"]
+    assert g["value"] == pytest.approx(orbit["max_theta_deg"], abs=1e-8)
+    assert g["abs_lambda"] == pytest.approx(max(orbit["abs_multipliers"]), rel=1e-7)
+    (stable,) = run_json(["graze", *search], capsys)["grazings"]
+    assert stable["abs_lambda"] < 1 and abs(stable["value"] - g["value"]) > 10
+    res = run_json(["normal-form", *search, "--initial", "-1.39,0.73"], capsys)
+    assert res["value"] == pytest.approx(g["value"], abs=1e-8)
+
+
+def test_continue_shows_the_parameter_in_its_display_unit_on_every_line(capsys):
+    """θ̂ in degrees on the status line and on the special points' lines (it was radians on the
+    first), the same number as the JSON, which keeps degrees; a parameter with a unit shows it."""
+    argv = ["continue", "--param", "theta-hat", "--start", "30", "--stop", "50", "--eta", "0.44"]
+    res = run_json(argv, capsys)
+    (graze,) = [s for s in res["special"] if s["kind"] == "grazing"]
+    # The period-2 orbit loses its impact where the period-1 nonimpacting orbit grazes (graze, JSON).
+    (g,) = run_json(["graze", "--param", "theta_hat", "--range", "30,50", "--set", "eta=0.44"], capsys)[
+        "grazings"
+    ]
+    assert graze["value"] == pytest.approx(g["value"], abs=1e-8) and 36 < g["value"] < 37
+    assert res["values"][0] == pytest.approx(30.0)
+    out = run_text(argv, capsys)
+    assert f"ended at a grazing at theta_hat = {graze['value']:.10g} deg" in out
+    assert f"  grazing          theta_hat = {graze['value']:.8g} deg   multipliers" in out
+    assert "(stop stop)" not in out and "= 0.6" not in out
+    out = run_text(
+        ["continue", "--param", "theta_hat", "--start", "30", "--stop", "50", "--eta", "0.3"], capsys
+    )
+    assert "reached the bound theta_hat = 50 deg" in out
+    out = run_text(["continue", *NEG, "--set", "w=0.7", "--param", "upper", "--start", "1", "--stop", "3",
+                    "--virtual", "--initial", "0,0"], capsys)  # fmt: skip
+    assert "reached the bound upper = 3 m" in out and "  grazing          upper = 1.7187815 m" in out
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["continue", "--param", "eta", "--start", "0.40", "--stop", "0.47"],
+        ["continue", "--model", "impact-oscillator", "--param", "omega", "--start", "4", "--stop", "3"],
+    ],
+    ids=["pendulum", "impact-oscillator"],
+)
+def test_switch_from_a_nonimpacting_orbit_follows_it_physically(argv, capsys):
+    """--switch is used: the nonimpacting orbit is followed with the stops (physical) up to its grazing,
+    where the branch switches or says why not; without it the branch ignores the stops."""
+    plain = run_json(argv, capsys)
+    switched = run_json([*argv, "--switch"], capsys)
+    assert plain["virtual"] is True and switched["virtual"] is False and switched["switch"] is True
+    first = next(s["value"] for s in plain["special"] if s["kind"] == "grazing")
+    assert switched["special"][-1]["value"] == pytest.approx(first, abs=1e-9)
+    assert "switch" in switched["status"] and "can be followed with switch" not in switched["status"]
+
+
+def test_a_parameter_named_like_an_option_leaves_the_option_alone(capsys, tmp_path, monkeypatch):
+    """A model's parameters called ``out`` and ``period``: continuing in them still takes --out and
+    --period (only the pendulum's options set parameters); --set of them is refused."""
+    (tmp_path / "named.py").write_text(
+        "import sympy as sp\n"
+        "from grazing import HybridModel, Parameter\n"
+        "x, v, t, out, period, wall = sp.symbols('x v t out period wall')\n"
+        "MODEL = HybridModel('named', [x, v], t, [Parameter('out', 0.05, lower=0),\n"
+        "    Parameter('period', 2.8, lower=0, lower_open=True), Parameter('wall', 1.0)],\n"
+        "    vector_field=[v, -2 * out * v - x + sp.cos(period * t)], guard=wall - x, reset=[x, -0.8 * v],\n"
+        "    period=2 * sp.pi / period, contact_direction=[0, 1])\n"
+    )
+    monkeypatch.chdir(tmp_path)
+    model = ["continue", "--model", "named.py:MODEL"]
+    res = run_json([*model, "--param", "out", "--start", "0.05", "--stop", "0.1", "--out", "b.nc"], capsys)
+    assert res["out"] == "b.nc" and (tmp_path / "b.nc").exists()
+    res = run_json([*model, "--param", "period", "--start", "2.8", "--stop", "3.2", "--period", "1"], capsys)
+    assert res["period"] == 1 and res["values"][-1] == pytest.approx(3.2)
+    code = main([*model, "--param", "period", "--start", "2.8", "--stop", "3.2", "--set", "period=3"])
+    assert code == 2 and "--set period=3 is not used with --param period" in capsys.readouterr().err

@@ -6,6 +6,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import re
 import shutil
 import tempfile
 from pathlib import Path
@@ -176,6 +177,35 @@ IGNORED_OPTIONS = [
     ([*SWEEP[:8], "1"], "--stop is not used with --num 1 (its one value is --start"),
     ([*MAP[:8], "1", *MAP[9:]], "--stop1 is not used with --num1 1 (its one value is --start1"),
     ([*MAP[:16], "1", *MAP[17:]], "--stop2 is not used with --num2 1 (its one value is --start2"),
+    # issue 26: orbits
+    (
+        "continue --param eta --start 0.4 --stop 0.5 --switch --virtual".split(),
+        "--switch is not used with --virtual: a virtual branch ignores the stops",
+    ),
+    (
+        "continue --model impact-oscillator --param omega --start 3 --stop 4 --virtual --switch".split(),
+        "--switch is not used with --virtual",
+    ),
+    (
+        "continue --param eta --start 0.4 --stop 0.5 --set eta=0.3".split(),
+        "--set eta=0.3 is not used with --param eta: the branch starts at --start",
+    ),
+    (
+        "continue --model two-sided-oscillator --param omega --start 0.5 --stop 0.9 --set omega=0.7".split(),
+        "--set omega=0.7 is not used with --param omega",
+    ),
+    (["graze", "--set", "eta=0.4"], "--set eta=0.4 is not used by graze: it searches eta in"),
+    (
+        "graze --model impact-oscillator --param omega --range 2.5,4 --set omega=3".split(),
+        "--set omega=3 is not used by graze: it searches --param over --range",
+    ),
+    (["normal-form", "--set", "eta=0.4"], "--set eta=0.4 is not used by normal-form"),
+    (["graze-curve", "--set", "theta_hat=30"], "--set theta_hat=30 is not used by graze-curve"),
+    (
+        "graze-curve --model two-sided-oscillator --params omega,gap_right --range 0.5,0.75 --start-value 1 "
+        "--set gap_right=2".split(),
+        "--set gap_right=2 is not used by graze-curve: it moves both --params",
+    ),
 ]
 
 MEMORY = [
@@ -214,6 +244,70 @@ MEMORY = [
 @pytest.mark.parametrize(("argv", "message"), FORMER_TRACEBACKS + ACCEPTED_BUT_WRONG + IGNORED_OPTIONS)
 def test_one_line_and_nothing_written(argv, message, capsys, inputs):
     assert message in _one_line_error(argv, capsys, inputs)
+
+
+# issue 26: orbits.  Where the default guess (a simulation from rest) cannot start Newton's method,
+# the error says what happened and to give --initial; parameters are in their display unit.
+NEG = f"{Path(__file__).resolve().parents[1] / 'orbits' / 'negative_damping.py'}:negative_damping"
+DIVERGED = (
+    r"cannot guess the orbit by simulating from rest with the stops ignored: the state became non-finite"
+)
+GUESS = r"give an initial guess x0 \(--initial\) near the orbit, from which Newton's method finds it"
+STICKS = r"the default initial guess sticks: simulated from rest for 500 forcing periods, the motion "
+NOT_STICKING = r"give an initial guess x0 \(--initial\) near an orbit that does not stick"
+ORBIT_MESSAGES = [
+    (["orbit", "--model", "bouncing-ball"], f"{STICKS}ends riding on the stop, .*{NOT_STICKING}"),
+    (
+        ["orbit", "--r", "0", "--theta-hat", "10"],
+        f"{STICKS}sticks to the stop 128 times in 128 .*{NOT_STICKING}",
+    ),
+    (
+        ["orbit", "--model", "two-sided-oscillator", "--set", "r=0", "--set", "amp=3"],
+        f"{STICKS}sticks to stop '(right|left)' 12. times and to stop '(left|right)' 12. times .*"
+        f"{NOT_STICKING}",
+    ),
+    (["graze", "--model", NEG, "--param", "w", "--range", "0.5,1.5"], f"{DIVERGED}.*{GUESS}"),
+    (["normal-form", "--model", NEG, "--param", "w", "--range", "0.5,1.5"], f"{DIVERGED}.*{GUESS}"),
+    (
+        ["graze-curve", "--model", NEG, "--params", "w,upper", "--range", "0.5,1.5", "--start-value", "2"],
+        f"{DIVERGED}.*{GUESS}",
+    ),
+    (
+        ["continue", "--model", NEG, "--param", "w", "--start", "0.5", "--stop", "1.5", "--virtual"],
+        f"{DIVERGED}.*{GUESS}",
+    ),
+    (
+        ["orbit", "--theta-hat", "-10"],
+        rf"simulating from rest: initial state \[0.0, 0.0\] is beyond the stop .*{GUESS}",
+    ),
+    (
+        ["orbit", "--model", "impact-oscillator", "--set", "sigma=-0.1"],
+        rf"simulating from rest: initial state \[0.0, 0.0\] is beyond the stop .*{GUESS}",
+    ),
+    (
+        ["normal-form", "--param", "theta_hat", "--range", "30,50", "--eta", "0.44", "--which", "second"],
+        r"no second grazing of the period-1 orbit for theta_hat in \[30, 50\] deg \(found 1\)",
+    ),
+    (
+        [
+            "normal-form",
+            "--model",
+            NEG,
+            *"--param upper --range 1,3 --set w=0.7 --initial 0,0 --which second".split(),
+        ],
+        r"no second grazing of the period-1 orbit for upper in \[1, 3\] m \(found 1\)",
+    ),
+    (
+        ["graze-curve", "--params", "theta_hat,eta", "--range", "10,50", "--start-value", "0.3"],
+        r"no grazing of the period-1 orbit for theta_hat in \[10, 50\] deg at eta = 0.3$",
+    ),
+]
+
+
+@pytest.mark.parametrize(("argv", "pattern"), ORBIT_MESSAGES)
+def test_orbit_messages_say_what_happened_and_what_to_do(argv, pattern, capsys, inputs):
+    err = _one_line_error(argv, capsys, inputs, code_expected=1)
+    assert re.search(pattern, err.removeprefix("grazing: error: ")), err
 
 
 @pytest.mark.parametrize(("argv", "message"), MEMORY)
@@ -517,6 +611,11 @@ COMMANDS: dict[str, dict[str, list[str] | None]] = {
     },
     "report": {"--out": ["rep", ""]},
 }
+# issue 26: orbits
+for _cmd in ("graze", "normal-form", "graze-curve"):
+    COMMANDS[_cmd]["--initial"] = ["0,0", "-0.5,0.1", "0;0"]
+COMMANDS["continue"]["--switch"] = None
+
 REQUIRED = ["--param", "--start", "--stop", "--num", "--param1", "--start1", "--stop1", "--num1", "--param2",
             "--start2", "--stop2", "--num2", "PATH"]  # fmt: skip
 REAL_WORK = ("simulate", "sweep", "map", "damping", "synthesize", "analyze")
@@ -613,7 +712,15 @@ def ignored(argv: list[str]) -> list[str]:
         folder = g.get("PATH") in ("folder", "forty")
         bad += [o for o in ("--forcing-hz", "--cutoff-hz", "--noise") if folder and o in g]
         bad += [o for o in ("--theta-hat", "--with-model") if not folder and o in g]
+    # issue 26: orbits
+    if cmd == "continue" and "--switch" in g and _last_flag(argv, ("--virtual", "--physical")) == "--virtual":
+        bad.append("--switch")
     return bad
+
+
+def _last_flag(argv: list[str], flags: tuple[str, ...]) -> str | None:
+    """The last of ``flags`` in ``argv`` (a flag pair such as --virtual/--physical: the last one wins)."""
+    return next((a for a in reversed(argv) if a in flags), None)
 
 
 def _check_run(argv: list[str], capsys, template: Path) -> None:

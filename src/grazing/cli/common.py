@@ -27,6 +27,7 @@ from grazing.cli.validate import (
     ANGLE_DEG,
     InputError,
     path_type,
+    refuse_set,
     refuse_unused,
 )
 from grazing.models.pendulum import CASES, DEFAULT_CASE, case_values
@@ -265,6 +266,14 @@ def parse_state(text: str | None, model: grazing.HybridModel) -> np.ndarray:
     return values
 
 
+def refuse_varied(names: list[str], why: str) -> None:
+    """Refuse what would set a parameter that the command varies itself: ``--set NAME=...`` and the
+    pendulum's own option (``--eta``...).  Only the pendulum's options are parameters: a model's
+    parameter called ``out`` or ``period`` leaves ``--out`` and ``--period`` alone."""
+    refuse_unused([n for n in names if n in PENDULUM_OPTIONS], True, why)
+    refuse_set(names, why)
+
+
 def search_range(
     model: grazing.HybridModel, command: str, gparam: str | None, prange: str | None, eta_min: float,
     eta_max: float,
@@ -275,14 +284,14 @@ def search_range(
     ``[--eta-min, --eta-max]`` (``pendulum_default`` then True).
     """
     if gparam is None and prange is None and model.name == "pendulum":
-        refuse_unused(["eta"], True, f"by {command}: it searches eta in [--eta-min, --eta-max]")
+        refuse_varied(["eta"], f"by {command}: it searches eta in [--eta-min, --eta-max]")
         check_eta_range(eta_min, eta_max)
         return model.parameter("eta"), eta_min, eta_max, True
     refuse_unused(["eta_min", "eta_max"], True, "with --param/--range (use --range LO,HI)")
     if gparam is None or prange is None:
         raise InputError(f"{command} needs --param NAME and --range LO,HI (for this model)")
     par = model_parameter(model, gparam)
-    refuse_unused([par.name], True, f"by {command}: it searches --param over --range")
+    refuse_varied([par.name], f"by {command}: it searches --param over --range")
     lo, hi = (par.from_display(v) for v in parse_pair(prange, "--range", "LO,HI"))
     if not lo < hi:
         raise InputError(f"--range: LO must be below HI, got {prange}")

@@ -19,6 +19,7 @@ from grazing.cli.common import (
     stop_name_option,
     stop_option_index,
 )
+from grazing.cli.orbits import initial_option, range_start_state
 from grazing.cli.validate import POSITIVE
 
 
@@ -29,7 +30,7 @@ from grazing.cli.validate import POSITIVE
     type=click.Choice(["first", "second"]),
     default="first",
     show_default=True,
-    help="First or second grazing in eta at this theta-hat.",
+    help="First or second grazing in increasing --param (the pendulum: in eta at this theta-hat).",
 )
 @click.option("--eta-min", type=POSITIVE, default=0.2, show_default=True, help="Lower end of the eta search.")
 @click.option("--eta-max", type=POSITIVE, default=1.0, show_default=True, help="Upper end of the eta search.")
@@ -44,13 +45,14 @@ from grazing.cli.validate import POSITIVE
     "--range", "prange", default=None, metavar="LO,HI", help="The interval of --param (display unit)."
 )
 @stop_name_option
+@initial_option
 @click.option(
     "--check", is_flag=True, help="Also simulate just past grazing and compare with the prediction."
 )
 @json_option
 def normal_form_cmd(
     model: grazing.HybridModel, case: str, which: str, eta_min: float, eta_max: float, gparam: str | None,
-    prange: str | None, stop_name: str | None, check: bool, as_json: bool,
+    prange: str | None, stop_name: str | None, initial: str | None, check: bool, as_json: bool,
 ) -> None:  # fmt: skip
     """Grazing normal form at a grazing of the period-1 orbit: multipliers, the
     discontinuity map's coefficients and the predicted scenario past grazing."""
@@ -58,7 +60,8 @@ def normal_form_cmd(
 
     stop = stop_option_index(model, stop_name)
     par, lo, hi, pendulum = search_range(model, "normal-form", gparam, prange, eta_min, eta_max)
-    point = find_grazing_point(model, par.name, lo, hi, which, stop_name=stop)
+    x0 = range_start_state(initial, model, {par.name: lo})
+    point = find_grazing_point(model, par.name, lo, hi, which, stop_name=stop, x0=x0)
     nf = normal_form_at(point, PENDULUM_UNFOLDING if pendulum else (par.name,))
     pred = predict(nf, par.name)
     res: dict[str, Any] = {
@@ -94,7 +97,8 @@ def normal_form_cmd(
         return
     mu = ", ".join(f"{z.real:+.4f}{z.imag:+.4f}i" for z in point.multipliers)
     where = "" if point.stop_name == "stop" else f" (stop {point.stop_name})"
-    click.echo(f"{which} grazing at {par.name} = {res['value']:.6f}{where}, t_graze = {point.phase:.4f}")
+    click.echo(f"{which} grazing at {par.show(point.model.params[par.name], '.6f')}{where}, "
+               f"t_graze = {point.phase:.4f}")  # fmt: skip
     click.echo(f"  multipliers {mu}, |lambda| = {point.abs_lambda:.4f}, kappa (M12) = {nf.kappa:+.4f}")
     click.echo(f"  discontinuity map: a = {nf.accel:.6f}, e = {np.round(nf.direction, 6).tolist()}")
     click.echo(f"  prediction: {pred.scenario} ({pred.rule})")

@@ -25,6 +25,7 @@ from grazing.cli.common import (
     netcdf_out_option,
     parse_pair,
     parse_state,
+    refuse_varied,
     save_dataset,
     search_range,
     stop_name_option,
@@ -55,13 +56,30 @@ def _orbit_json(orbit: Any) -> dict[str, Any]:
     return out
 
 
+initial_option = click.option(
+    "--initial",
+    metavar="X1,X2,...",
+    help="Guess of the nonimpacting orbit at time 0 (one number per state), with the parameters at the "
+    "start of the search (default: simulated from rest with the stops ignored, which reaches only a "
+    "stable orbit: give one where that orbit is unstable).",
+)
+
+
+def range_start_state(
+    initial: str | None, model: grazing.HybridModel, start: dict[str, float]
+) -> np.ndarray | None:
+    """``--initial`` of a grazing search: a state of ``model`` with the parameters ``start`` (or None)."""
+    return None if initial is None else parse_state(initial, model.with_params(**start))
+
+
 @click.command()
 @model_options(any_model=True)
 @click.option("--period", type=ORBIT_PERIOD, help="Period in forcing periods (default: detected).")
 @click.option(
     "--initial",
     metavar="X1,X2,...",
-    help="Initial guess at time 0, one per state (default: from simulation).",
+    help="Initial guess at time 0, one per state (default: simulated from rest; give one where that "
+    "motion sticks, diverges or settles on another orbit).",
 )
 @click.option("--transient", type=count(0), default=500, show_default=True,
               help="Forcing periods simulated for the initial guess (without --initial).")  # fmt: skip
@@ -134,6 +152,7 @@ def _grazing_json(g: Any, param: str | None = None) -> dict[str, Any]:
     help="The interval of --param to search (in its display unit: degrees for angles).",
 )
 @stop_name_option
+@initial_option
 @json_option
 def graze(
     model: grazing.HybridModel,
@@ -143,6 +162,7 @@ def graze(
     gparam: str | None,
     prange: str | None,
     stop_name: str | None,
+    initial: str | None,
     as_json: bool,
 ) -> None:
     """Every grazing of the period-1 nonimpacting orbit with a stop, for a parameter in a range."""
@@ -150,12 +170,13 @@ def graze(
 
     stop = stop_option_index(model, stop_name)
     par, lo, hi, _ = search_range(model, "graze", gparam, prange, eta_min, eta_max)
+    x0 = range_start_state(initial, model, {par.name: lo})
     bar = Progress("continuing", enabled=not as_json)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", GrazingWarning)  # (said below, with each grazing)
             points, branch = find_grazings(
-                model, par.name, lo, hi, stop_name=stop,
+                model, par.name, lo, hi, x0=x0, stop_name=stop,
                 progress=lambda n, v: bar(int(1000 * (v - lo) / (hi - lo)), 1000),
             )  # fmt: skip
     finally:
@@ -173,14 +194,12 @@ def graze(
     if as_json:
         emit_json(res)
         return
-    unit = f" {par.display_unit}" if par.angle else ""
     if not points:
-        click.echo(f"no grazing with stop {model.stop_names[stop]} for {par.name} in "
-                   f"[{par.to_display(lo):g}, {par.to_display(hi):g}]{unit}")  # fmt: skip
-    for g in res["grazings"]:
+        click.echo(f"no grazing with stop {model.stop_names[stop]!r} for {par.show_range(lo, hi)}")
+    for point, g in zip(points, res["grazings"]):
         mu = ", ".join(f"{a:+.4f}{b:+.4f}i" for a, b in g["multipliers"])
         where = "" if g["stop"] == "stop" else f" (stop {g['stop']})"
-        click.echo(f"{par.name} = {g['value']:.6f}{unit}{where}: multipliers {mu}, "
+        click.echo(f"{par.show(point.model.params[par.name], '.6f')}{where}: multipliers {mu}, "
                    f"|lambda| = {g['abs_lambda']:.4f}, t_graze = {g['t_graze']:.4f}")  # fmt: skip
         if g["crossed"]:
             click.echo(f"  note: this orbit passes through stop {', '.join(g['crossed'])}, which the system "
@@ -203,6 +222,7 @@ def graze(
 @click.option("--eta-min", type=POSITIVE, default=0.2, show_default=True, help="Lower end of the eta range.")
 @click.option("--eta-max", type=POSITIVE, default=1.0, show_default=True, help="Upper end of the eta range.")
 @click.option("--max-step", type=POSITIVE, default=0.05, show_default=True, help="Largest continuation step.")
+@initial_option
 @netcdf_out_option
 @json_option
 def graze_curve(
@@ -216,6 +236,7 @@ def graze_curve(
     prange: str | None,
     start_value: float | None,
     stop_name: str | None,
+    initial: str | None,
     out: Path | None,
     as_json: bool,
 ) -> None:
@@ -225,8 +246,8 @@ def graze_curve(
     stop = stop_option_index(model, stop_name)
     generic = gparams is not None or prange is not None or start_value is not None or model.name != "pendulum"
     if not generic:
-        refuse_unused(["eta"], True, "by graze-curve: it searches eta in [--eta-min, --eta-max]")
-        refuse_unused(["theta_hat"], True, "by graze-curve: the curve starts at --start-deg")
+        refuse_varied(["eta"], "by graze-curve: it searches eta in [--eta-min, --eta-max]")
+        refuse_varied(["theta_hat"], "by graze-curve: the curve starts at --start-deg")
         check_eta_range(eta_min, eta_max)
         p1, p2 = model.parameter("eta"), model.parameter("theta_hat")
         lo, hi, start = eta_min, eta_max, math.radians(start_deg)
@@ -242,16 +263,17 @@ def graze_curve(
         p1, p2 = (model_parameter(model, t, "--params") for t in names)
         if p1.name == p2.name:
             raise InputError("--params: the two parameters must differ")
-        refuse_unused([p1.name, p2.name], True, "by graze-curve: it moves both --params")
+        refuse_varied([p1.name, p2.name], "by graze-curve: it moves both --params")
         lo, hi = (p1.from_display(v) for v in parse_pair(prange, "--range", "LO,HI"))
         if not lo < hi:
             raise InputError(f"--range: LO must be below HI, got {prange}")
         start = p2.from_display(start_value)
         model.with_params(**{p2.name: start})
+    x0 = range_start_state(initial, model, {p1.name: lo, p2.name: start})
     check_out(out, ".nc")
     settings = PalcSettings(ds=min(0.02, max_step), ds_max=max_step)
     curve = grazing_curve(
-        model, (p1.name, p2.name), start, search=(lo, hi), settings=settings, stop_name=stop
+        model, (p1.name, p2.name), start, search=(lo, hi), x0=x0, settings=settings, stop_name=stop
     )
     if out is not None:
         save_dataset(curve.to_dataset(), out)
@@ -280,10 +302,9 @@ def graze_curve(
             tmax, eta_at = res["theta_max_deg"], res["eta_at_theta_max"]
             click.echo(f"theta-hat_max = {tmax:.4f} deg at eta = {eta_at:.6f}: no grazing above it")
         return
-    first = f"{p2.name} = {p2.to_display(start):g}{' deg' if p2.angle else ''}"
-    click.echo(f"{len(curve.points)} grazing orbits from {first} ({curve.status})")
+    click.echo(f"{len(curve.points)} grazing orbits from {p2.show(start, 'g')} ({curve.status})")
     if fold:
-        where = ", ".join(f"{k} = {v:.6g}" for k, v in res["fold"].items())
+        where = ", ".join(p.show(fold.model.params[p.name], ".6g") for p in (p1, p2))
         click.echo(f"fold of the grazing curve (largest {p2.name}) at {where}: no grazing beyond it")
 
 
@@ -292,17 +313,19 @@ def graze_curve(
 @click.option("--param", "cparam", required=True, metavar="NAME",
               help="Parameter to vary: any of the model's (the pendulum's eta, theta-hat, alpha, beta, r); "
               "angles in degrees.")  # fmt: skip
-@click.option("--start", type=FINITE, required=True, help="Start value of the parameter.")
-@click.option("--stop", type=FINITE, required=True, help="End value of the parameter.")
+@click.option("--start", type=FINITE, required=True, help="Start value of the parameter (display unit).")
+@click.option("--stop", type=FINITE, required=True, help="End value of the parameter (display unit).")
 @click.option("--period", type=ORBIT_PERIOD, help="Period of the orbit (default: detected).")
 @click.option("--initial", metavar="X1,X2,...", help="Initial guess at time 0, one number per state.")
 @stop_name_option
 @click.option("--virtual/--physical", default=None,
-              help="Ignore the stop (default: yes for a nonimpacting starting orbit).")  # fmt: skip
+              help="Ignore the stops (default: for a nonimpacting starting orbit, without "
+              "--switch).")  # fmt: skip
 @click.option("--max-step", type=POSITIVE, default=0.04, show_default=True, help="Largest continuation step.")
 @click.option("--switch", is_flag=True,
               help="At a grazing where the impact sequence changes, continue on the orbit with the new "
-              "sequence (a new branch segment) instead of ending there.")  # fmt: skip
+              "sequence (a new branch segment) instead of ending there (a physical branch only: not "
+              "with --virtual).")  # fmt: skip
 @netcdf_out_option
 @json_option
 def continue_(
@@ -327,7 +350,11 @@ def continue_(
 
     par = model_parameter(model, cparam)
     name = par.name
-    refuse_unused([name], True, f"with --param {cparam}: the branch starts at --start")
+    refuse_varied([name], f"with --param {cparam}: the branch starts at --start")
+    refuse_unused(
+        ["switch"], virtual is True, "with --virtual: a virtual branch ignores the stops, so its impact "
+        "sequence never changes (it is followed through its grazings)",
+    )  # fmt: skip
     watch = stop_option_index(model, stop_name)
     if start == stop:
         raise InputError(f"--start and --stop must be finite and differ, got {start:g} and {stop:g}")
@@ -388,9 +415,9 @@ def continue_(
     segs = max(branch.segments) + 1 if branch.segments else 1
     more = f" in {segs} segments (impact sequence switched at grazings)" if segs > 1 else ""
     click.echo(f"{len(branch)} points of the period-{branch.period} orbit{more}, {kind}; {branch.status}")
-    for sp_ in res["special"]:
+    for point, sp_ in zip(branch.special, res["special"]):
         mu = ", ".join(f"{x:+.4f}{y:+.4f}i" for x, y in sp_["multipliers"])
-        on = f" (stop {sp_['stop']})" if "stop" in sp_ and model.n_stops > 1 else ""
-        click.echo(f"  {sp_['kind']:16s} {cparam} = {sp_['value']:.8g}   multipliers {mu}{on}")
+        on = f" (stop {sp_['stop']})" if sp_.get("stop", "stop") != "stop" else ""  # as graze prints it
+        click.echo(f"  {sp_['kind']:16s} {par.show(point.param, '.8g')}   multipliers {mu}{on}")
     if out is not None:
         click.echo(f"branch saved to {out}")

@@ -220,3 +220,16 @@ def refuse_unused(names: Iterable[str], unused: bool, why: str, ctx: click.Conte
     for name in names:
         if given(ctx, name):
             raise InputError(f"{option_label(_param(ctx, name))} is not used {why}")
+
+
+def refuse_set(names: Iterable[str], why: str, ctx: click.Context | None = None) -> None:
+    """Refuse ``--set NAME=VALUE`` for any model parameter in ``names`` (the command sets them itself).
+
+    ``why`` completes the message: ``--set eta=0.4 is not used {why}``.  The
+    command's ``--set`` values are read from the click context.
+    """
+    ctx = ctx or click.get_current_context()
+    wanted = set(names)
+    for item in ctx.params.get("sets") or ():
+        if item.partition("=")[0].strip().replace("-", "_") in wanted:
+            raise InputError(f"--set {item} is not used {why}")

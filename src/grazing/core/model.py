@@ -113,6 +113,28 @@ class Parameter:
         """A value given in the display unit, in the model's unit (radians for angles)."""
         return math.radians(value) if self.angle else float(value)
 
+    def show(self, value: float, spec: str = ".10g") -> str:
+        """``name = value unit`` with a model value in the display unit, as messages print it.
+
+        Examples
+        --------
+        >>> Parameter("theta_hat", 0.7, unit="rad", angle=True).show(0.7, ".4g")
+        'theta_hat = 40.11 deg'
+        >>> Parameter("eta", 0.4).show(0.4451211835)
+        'eta = 0.4451211835'
+        """
+        unit = f" {self.display_unit}" if self.display_unit else ""
+        return f"{self.name} = {self.to_display(value):{spec}}{unit}"
+
+    def show_range(self, lo: float, hi: float, spec: str = "g") -> str:
+        """``name in [lo, hi] unit`` with model values in the display unit, as messages print it.
+
+        >>> Parameter("theta_hat", 0.7, unit="rad", angle=True).show_range(0.5235987756, 0.6108652382)
+        'theta_hat in [30, 35] deg'
+        """
+        unit = f" {self.display_unit}" if self.display_unit else ""
+        return f"{self.name} in [{self.to_display(lo):{spec}}, {self.to_display(hi):{spec}}]{unit}"
+
     def interval(self) -> str:
         def fmt(v: float) -> str:
             return f"{v:g}"

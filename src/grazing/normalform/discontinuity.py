@@ -35,6 +35,7 @@ vector of the parameter ``p = p* + mu``, and ``D_mu`` using the linearised
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -191,10 +192,15 @@ def find_grazing_point(
     hi: float,
     which: str = "first",
     stop_name: int | str | None = None,
+    *,
+    x0: Sequence[float] | np.ndarray | None = None,
 ) -> GrazingPoint:
     """The first or second grazing of the period-1 nonimpacting orbit for ``param`` in ``[lo, hi]``.
 
     ``stop_name``: the stop grazed (name or index; the first by default).
+    ``x0``: a guess of the nonimpacting orbit at time 0 with ``param = lo``,
+    needed where that orbit is unstable (see
+    :func:`~grazing.orbits.grazing.find_grazings`).
 
     Raises :class:`~grazing.errors.ConvergenceError` (one clear line) if there is none.
     """
@@ -203,12 +209,12 @@ def find_grazing_point(
 
     if which not in ("first", "second"):
         raise InvalidParameterError(f"which must be 'first' or 'second', got {which!r}")
-    points, _ = find_grazings(model, param, lo, hi, stop_name=stop_name)
+    points, _ = find_grazings(model, param, lo, hi, x0=x0, stop_name=stop_name)
     points.sort(key=lambda g: g.model.params[param])
     k = 0 if which == "first" else 1
     if len(points) <= k:
         raise ConvergenceError(
-            f"no {which} grazing of the period-1 orbit for {param} in [{lo:g}, {hi:g}] "
+            f"no {which} grazing of the period-1 orbit for {model.parameter(param).show_range(lo, hi)} "
             f"(found {len(points)}); the discontinuity map needs a grazing orbit"
         )
     return points[k]

@@ -174,6 +174,7 @@ def refine_grazing(
     pt = newton(evaluate, u0, PalcSettings(tol=tol, max_newton=12))  # n + 2 equations, n + 2 unknowns
     if pt is None:
         raise ConvergenceError(
-            f"Newton's method for the grazing orbit did not converge near {free} = {model.params[free]:.8g}"
+            "Newton's method for the grazing orbit did not converge near "
+            f"{model.parameter(free).show(model.params[free], '.8g')}"
         )
     return pt.payload

@@ -426,7 +426,8 @@ def continue_orbit(
     virtual
         Ignore the stop (default: True when the starting orbit has no
         impacts, so nonimpacting orbits are followed through grazing, which is
-        located and reported).
+        located and reported; False with ``switch``, which only a physical
+        branch uses).
     settings
         Step control (:class:`~grazing.orbits.palc.PalcSettings`).
     detect
@@ -440,6 +441,9 @@ def continue_orbit(
     switch
         At a grazing where the impact sequence changes, continue onto the orbit
         with the new sequence (a new segment of the branch) instead of ending.
+        A virtual branch has no such grazing: ``switch`` with ``virtual=True``
+        (or a virtual starting ``orbit``) raises
+        :class:`~grazing.errors.InvalidParameterError`.
     progress
         Called as ``progress(points, param_value)`` after each point.
 
@@ -470,6 +474,15 @@ def continue_orbit(
         raise InvalidParameterError("start and stop must differ")
     m0 = model.with_params(**{param: start})
     model.with_params(**{param: stop})  # the end of the range must be a valid value too
+    par = model.parameter(param)
+    if switch and (virtual or (virtual is None and orbit is not None and orbit.virtual)):
+        raise InvalidParameterError(
+            "switch has no effect on a virtual branch: it ignores the stops, so its impact sequence never "
+            "changes (it is followed through its grazings, which are located); continue the physical "
+            "orbit (virtual=False) to switch at a grazing"
+        )
+    if switch and virtual is None:
+        virtual = False  # a nonimpacting orbit too: followed up to its grazing, then switched
     watch = model.stop_index(
         stop_name if stop_name is not None else (orbit.stop if orbit is not None else None)
     )
@@ -531,7 +544,7 @@ def continue_orbit(
         palc = Palc(
             evaluate, PalcPoint(u0, F, DF, orb), index=nx, sign=sign, bounds=bounds,
             settings=dataclasses.replace(s, max_points=max(2, s.max_points - len(branch) + 1)),
-            names={nx: param}, check=check, margin=None if virtual else margin,
+            names={nx: param}, shows={nx: par.show}, check=check, margin=None if virtual else margin,
         )  # fmt: skip
         restarted = prev is not None and segment == branch.segments[-1]  # the section moved
         for k, pt in enumerate(palc):
@@ -580,12 +593,13 @@ def continue_orbit(
         value = point.model.params[param] if point is not None else float(prev.u[-1])
         where_stop = grazing_margin(last)[4] if point is None else point.stop
         branch.special.append(SpecialPoint("grazing", len(branch) - 1, value, last, point, where_stop))
-        where = f"{param} = {value:.10g}"
+        where = par.show(value)
         if model.n_stops > 1:
             where = f"{where} with stop {model.stop_names[where_stop]!r}"
         if point is None:
             where += (
-                f" (bracketed only: the grazing equations did not converge; last orbit at {prev.u[-1]:.10g})"
+                f" (bracketed only: the grazing equations did not converge; last orbit at "
+                f"{par.show(prev.u[-1])})"
             )
         reason = palc.boundary.reason
         if not palc.boundary.reached:

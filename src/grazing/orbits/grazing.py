@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -40,6 +40,7 @@ def find_grazings(
     start: float,
     stop: float,
     *,
+    x0: Sequence[float] | np.ndarray | None = None,
     period: int = 1,
     settings: PalcSettings | None = None,
     progress: Callable[[int, float], None] | None = None,
@@ -48,7 +49,11 @@ def find_grazings(
     """Every grazing of the period-n nonimpacting orbit for ``param`` in ``[start, stop]``.
 
     The orbit is followed with the stop ignored, through folds, and every zero
-    of its minimum guard value is located and refined.  ``stop_name``: for
+    of its minimum guard value is located and refined.  ``x0``: a guess of the
+    orbit's state at time 0 with ``param = start``; Newton's method on the
+    flow through the stops finds the orbit from it, stable or unstable
+    (default: the state after a simulation from rest with the stops ignored,
+    which reaches only a stable orbit).  ``stop_name``: for
     models with several stops, the stop whose grazings are sought (name or
     index; the first by default; the branch's special points hold every
     stop's).  A grazing orbit that passes through another stop
@@ -73,6 +78,7 @@ def find_grazings(
         param,
         start,
         stop,
+        x0=None if x0 is None else np.asarray(x0, dtype=float),
         period=period,
         virtual=True,
         settings=settings,
@@ -81,6 +87,7 @@ def find_grazings(
         stop_name=stop_name,
     )
     watch = model.stop_index(stop_name)
+    par = model.parameter(param)
     points = []
     for sp_ in branch.special:
         if sp_.kind != "grazing":
@@ -89,12 +96,13 @@ def find_grazings(
             continue
         if sp_.grazing is None:
             raise ConvergenceError(
-                f"the grazing near {param} = {sp_.param:.8g} was bracketed but its equations did not converge"
+                f"the grazing near {par.show(sp_.param, '.8g')} was bracketed but its equations did not "
+                "converge"
             )
         if sp_.grazing.crossed:
             warnings.warn(
-                f"the nonimpacting orbit grazing stop {sp_.grazing.stop_name!r} at {param} = "
-                f"{sp_.param:.10g} passes through stop(s) {', '.join(map(repr, sp_.grazing.crossed))}: "
+                f"the nonimpacting orbit grazing stop {sp_.grazing.stop_name!r} at {par.show(sp_.param)} "
+                f"passes through stop(s) {', '.join(map(repr, sp_.grazing.crossed))}: "
                 "the system hits those first, so this grazing is not a motion of the system",
                 GrazingWarning,
                 stacklevel=2,
@@ -162,6 +170,7 @@ def grazing_curve(
     start: float,
     *,
     search: tuple[float, float],
+    x0: Sequence[float] | np.ndarray | None = None,
     period: int = 1,
     settings: PalcSettings | None = None,
     progress: Callable[[int, float], None] | None = None,
@@ -173,6 +182,8 @@ def grazing_curve(
     ``search``) at ``params[1] = start``, moves with ``params[1]`` increasing,
     turns at the fold (located), and ends when ``params[1]`` is back at
     ``start`` on the other branch or ``params[0]`` leaves ``search``.
+    ``x0``: a guess of the nonimpacting orbit at time 0 with ``params[0] =
+    search[0]`` and ``params[1] = start`` (see :func:`find_grazings`).
 
     Examples
     --------
@@ -188,10 +199,11 @@ def grazing_curve(
             raise InvalidParameterError(f"unknown parameter {p!r}")
     s = settings or PalcSettings(ds=0.02, ds_max=0.05)
     base = model.with_params(**{p2: start})
-    first, _ = find_grazings(base, p1, search[0], search[1], period=period, stop_name=stop_name)
+    first, _ = find_grazings(base, p1, search[0], search[1], x0=x0, period=period, stop_name=stop_name)
     if not first:
         raise ConvergenceError(
-            f"no grazing of the period-{period} orbit for {p1} in {search} at {p2} = {start:g}"
+            f"no grazing of the period-{period} orbit for {model.parameter(p1).show_range(*search)} at "
+            f"{model.parameter(p2).show(start, 'g')}"
         )
     g0 = first[0]
     n = model.n_states
@@ -206,6 +218,7 @@ def grazing_curve(
         bounds={n + 1: search, n + 2: (start, math.inf)},
         settings=s,
         names={n: "t_graze", n + 1: p1, n + 2: p2},
+        shows={n + 1: model.parameter(p1).show, n + 2: model.parameter(p2).show},
     )
     curve = GrazingCurve(params=params)
     prev: PalcPoint | None = None

@@ -166,7 +166,10 @@ class Palc:
     The curve starts in the direction where ``u[index]`` moves with ``sign``.
     ``bounds`` maps component indices to ``(lo, hi)``: when a prediction
     leaves one of them, the last point is placed exactly on that bound and the
-    iteration ends.  ``names`` gives the components' names for messages.
+    iteration ends.  ``names`` gives the components' names for messages, and
+    ``shows`` how to print a component's value in them (``index -> value ->
+    "name = value unit"``, e.g. :meth:`~grazing.Parameter.show`: a parameter
+    in its display unit); by default ``name = value``.
     ``check`` and ``margin`` are the caller's acceptance test and boundary
     margin (see the module docstring).  After iteration, :attr:`status` says
     why it stopped and :attr:`boundary` is set if it stopped at a boundary.
@@ -182,6 +185,7 @@ class Palc:
         bounds: dict[int, tuple[float, float]],
         settings: PalcSettings | None = None,
         names: dict[int, str] | None = None,
+        shows: dict[int, Callable[[float], str]] | None = None,
         check: Check | None = None,
         margin: Callable[[PalcPoint], float] | None = None,
     ):
@@ -191,6 +195,7 @@ class Palc:
         self.bounds = bounds
         self.s = settings or PalcSettings()
         self.names = names or {}
+        self.shows = shows or {}
         self.check = check
         self.margin = margin
         t = tangent(first.DF)
@@ -203,8 +208,13 @@ class Palc:
     def _name(self, i: int) -> str:
         return self.names.get(i, f"u[{i}]")
 
+    def _show(self, i: int, value: float) -> str:
+        """Component ``i`` at ``value``, as messages print it."""
+        show = self.shows.get(i)
+        return show(float(value)) if show is not None else f"{self._name(i)} = {value:.10g}"
+
     def _where(self, pt: PalcPoint) -> str:
-        return f"{self._name(self.index)} = {pt.u[self.index]:.10g}"
+        return self._show(self.index, pt.u[self.index])
 
     def _outside(self, u: np.ndarray) -> tuple[int, float] | None:
         """The first violated bound along the step, as (index, bound value)."""
@@ -381,7 +391,7 @@ class Palc:
                 margins.append((float(cur.u[self.index]), self.margin(cur)))
                 del margins[:-2]
             if out is not None:
-                self.status = f"reached the bound {self._name(out[0])} = {out[1]:.10g}"
+                self.status = f"reached the bound {self._show(out[0], out[1])}"
                 return
             if verdict == STOP:
                 self.status = reason

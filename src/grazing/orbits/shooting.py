@@ -19,8 +19,15 @@ import numpy as np
 from grazing.core.model import HybridModel
 from grazing.core.options import NEWTON_MAX_ITER, NEWTON_TOL
 from grazing.core.period import detect_period
+from grazing.core.solution import Solution
 from grazing.engine.simulate import simulate
-from grazing.errors import ConvergenceError, InvalidParameterError, InvalidStateError, SimulationError
+from grazing.errors import (
+    ConvergenceError,
+    GrazingError,
+    InvalidParameterError,
+    InvalidStateError,
+    SimulationError,
+)
 from grazing.maps import FlowMap, flow_map
 
 DEFAULT_TOL = NEWTON_TOL
@@ -218,24 +225,110 @@ def move_section(orbit: PeriodicOrbit, t_new: float, *, tol: float = DEFAULT_TOL
     )
 
 
+GUESS = "an initial guess x0 (--initial)"
+"""What to give when the default guess, simulated from rest, cannot start Newton's method."""
+
+
+@dataclass(frozen=True)
+class InitialGuess:
+    """A point near an attractor, from simulation starting at rest (:func:`initial_guess`).
+
+    Attributes
+    ----------
+    state
+        The last stroboscopic sample.
+    period
+        The period detected over the sampled periods (0 if none).
+    transient
+        Forcing periods simulated before sampling.
+    sticking
+        How the motion sticks to a stop over the sampled periods: ``""`` (it
+        does not), or a phrase such as ``"ends riding on the stop"`` (see
+        :func:`sticking_phrase`).
+    """
+
+    state: np.ndarray
+    period: int
+    transient: int
+    sticking: str = ""
+
+
+def _stop_phrase(name: str) -> str:
+    """A stop as messages name it: ``the stop`` (a model's only, unnamed stop) or ``stop 'left'``."""
+    return "the stop" if name == "stop" else f"stop {name!r}"
+
+
+def _sticking_stops(sol: Solution, riding: bool) -> list[str]:
+    """The stop of each sticking interval of ``sol``: that of the last recorded impact before it (the
+    chattering that ends in it), else the stop the run ends on (last interval), else ``""``."""
+    model = sol.model
+    if model.n_stops == 1:
+        return [model.stop_names[0]] * len(sol.sticking)
+    names = []
+    for start in sol.sticking[:, 0]:
+        before = np.flatnonzero(sol.impacts.t <= start + 1e-9 * max(1.0, abs(start)))
+        names.append(sol.impacts.stop_name(int(before[-1])) if before.size else "")
+    if riding and not names[-1]:
+        names[-1] = model.stop_names[int(np.argmin(np.abs(model.guards(sol.x_final, sol.t_final))))]
+    return names
+
+
+def sticking_phrase(sol: Solution, periods: int) -> str:
+    """How the run ``sol``, sampled over ``periods`` forcing periods, sticks to its stops, in words.
+
+    ``""`` without sticking; ``"ends riding on the stop"`` when one interval
+    lasts to the end of the run; else ``"sticks to stop 'right' 3 times and
+    to stop 'left' 2 times in 2 forcing periods"`` (each interval's stop as
+    :func:`_sticking_stops` finds it; intervals whose stop it does not find
+    are left out unless it finds none).
+    """
+    if not len(sol.sticking):
+        return ""
+    riding = sol.sticking[-1, 1] >= sol.t_final - 1e-9 * max(1.0, abs(sol.t_final))
+    names = _sticking_stops(sol, riding)
+    if riding and len(names) == 1:
+        return f"ends riding on {_stop_phrase(names[0]) if names[0] else 'a stop'}"
+    known = [n for n in names if n] or names  # (one begun before the sampled span has no impact before it)
+    counts = {name: known.count(name) for name in dict.fromkeys(known)}
+    parts = [f"{_stop_phrase(n) if n else 'a stop'} {k} time{'s' * (k > 1)}" for n, k in counts.items()]
+    return f"sticks to {' and to '.join(parts)} in {periods} forcing period{'s' * (periods > 1)}"
+
+
 def initial_guess(
     model: HybridModel, *, t0: float = 0.0, transient: int = 500, samples: int = 128, virtual: bool = False
-) -> tuple[np.ndarray, int]:
+) -> InitialGuess:
     """A point near an attractor and its period, from simulation starting at rest.
 
-    Returns the last stroboscopic sample and the detected period (0 if none).
+    Raises
+    ------
+    SimulationError, InvalidStateError
+        When the simulation fails (it diverges from an unstable orbit, say) or
+        rest is beyond a stop, saying what to do: give an initial guess.
     """
-    sol = simulate(
-        model,
-        np.zeros(model.n_states),
-        t0=t0,
+    try:
+        sol = simulate(
+            model,
+            np.zeros(model.n_states),
+            t0=t0,
+            transient=transient,
+            periods=samples,
+            phase=2 * math.pi * (t0 / model.period % 1.0),
+            impacts="sampled",  # (they name the stop of each sticking interval)
+            events=not virtual,
+        )
+    except (SimulationError, InvalidStateError) as exc:
+        flow = " with the stops ignored" if virtual else ""
+        raise type(exc)(
+            f"cannot guess the orbit by simulating from rest{flow}: {exc}; give {GUESS} near the orbit, "
+            "from which Newton's method finds it without simulating it (unstable orbits too, which a "
+            "simulation never settles on)"
+        ) from None
+    return InitialGuess(
+        state=sol.samples[-1].copy(),
+        period=detect_period(sol.samples, tol=1e-6),
         transient=transient,
-        periods=samples,
-        phase=2 * math.pi * (t0 / model.period % 1.0),
-        impacts="none",
-        events=not virtual,
+        sticking=sticking_phrase(sol, samples),
     )
-    return sol.samples[-1].copy(), detect_period(sol.samples, tol=1e-6)
 
 
 def find_orbit(
@@ -259,7 +352,9 @@ def find_orbit(
     x0
         Initial guess at time ``t0``.  Default: the state after ``transient``
         forcing periods from rest (and its detected period, if ``period`` is
-        not given).
+        not given).  A simulation settles only on a stable orbit: where the
+        motion from rest diverges (an unstable orbit), sticks to a stop or
+        settles on another orbit, give ``x0`` (the error says which happened).
     period
         Period in forcing periods (default: detected by simulation, else 1).
     t0
@@ -270,6 +365,10 @@ def find_orbit(
         where an impact falls on the section).
     virtual
         Ignore the stop (for nonimpacting orbits continued past grazing).
+        Without it, where Newton's method on the physical map fails, it is
+        run from the same guess on the flow through the stops too: an orbit
+        found there that keeps clear of every stop is a physical orbit (an
+        unstable orbit whose neighbours hit a stop, say) and is returned.
     tol
         Convergence when ``max |P^n(x) - x| <= tol``.
     max_iter
@@ -281,7 +380,11 @@ def find_orbit(
     Raises
     ------
     ConvergenceError
-        With the residual, the iteration count and what to try.
+        With the residual, the iteration count and what to try; also where
+        the motion sticks to a stop (no Jacobian across sticking).
+    SimulationError, InvalidStateError
+        Without ``x0``, when the simulation from rest fails or rest is beyond
+        a stop (see :func:`initial_guess`).
 
     Examples
     --------
@@ -301,64 +404,127 @@ def find_orbit(
         if orbit.section_clearance() >= SECTION_MARGIN:
             return orbit
         return move_section(orbit, quiet_section(orbit), tol=tol)
-    advice = "try another initial guess, another period, or a longer transient"
     stop = model.stop_index(stop_name)
+    guess: InitialGuess | None = None
     if x0 is None:
-        x, detected = initial_guess(model, t0=t0, transient=transient, virtual=virtual)
+        advice = "try another period (--period), an initial guess x0 (--initial) or a longer transient"
+        guess = initial_guess(model, t0=t0, transient=transient, virtual=virtual)
+        x, detected = guess.state, guess.period
         n = int(period or detected or 1)
         if not (period or detected):
             advice = (
                 f"simulation from rest showed no period <= 64 after {transient} periods (chaos, or a "
-                f"transient not yet settled), so a period-1 orbit was tried; give the period or an "
-                "initial guess, or a longer transient"
+                "transient not yet settled), so a period-1 orbit was tried; give the period (--period) or "
+                "an initial guess x0 (--initial), or a longer transient (--transient)"
             )
     else:
+        advice = "try another initial guess or another period"
         x = model.check_state(x0, t0, allowed=not virtual)
         n = int(period or 1)
-    residuals: list[float] = []
-    why = ""
-    for it in range(max_iter + 1):
-        try:
-            fm = flow_map(model, x, t0=t0, periods=n, virtual=virtual, stop_name=stop)
-        except SimulationError as exc:
-            raise ConvergenceError(
-                f"Newton's method for a period-{n} orbit failed at iterate {it} ({exc}); {advice}"
-            ) from None
-        except InvalidStateError:
-            raise ConvergenceError(
-                f"Newton's method for a period-{n} orbit left the allowed region (iterate {it} is "
-                f"beyond the stop); {advice}"
-            ) from None
-        if not fm.solution.jacobian_valid:
-            raise ConvergenceError(
-                f"the motion sticks to the stop (or meets it at zero speed) during the period-{n} map "
-                f"(iterate {it}); the Jacobian across sticking is not computed, so Newton's method and "
-                "Floquet multipliers are not available for it: simulate it instead"
-            )
-        F = fm.image - x
-        res = float(np.max(np.abs(F)))
-        residuals.append(res)
-        if not np.isfinite(res):
-            break
-        if res <= tol:
-            return _orbit_from(model, x, t0, n, fm, virtual, residuals, stop)
-        if it == max_iter:
-            break
-        A = fm.jacobian - np.eye(model.n_states)
-        try:
-            dx = np.linalg.solve(A, -F)
-        except np.linalg.LinAlgError:
-            why = " (the Jacobian P_x - I is singular: a fold or a multiplier 1?)"
-            break
-        # Backtrack so that the iterate stays in the allowed region.
-        lam = 1.0
-        for _ in range(30):
-            trial = x + lam * dx
-            if virtual or np.min(model.guards(trial, t0)) >= 0:
+    newton = _Newton(model, t0, n, stop, tol, max_iter)
+    try:
+        return newton.solve(x, virtual, advice, guess)
+    except ConvergenceError:
+        inside = None if virtual else newton.nonimpacting(x)
+        if inside is None:
+            raise
+        return inside
+
+
+@dataclass(frozen=True)
+class _Newton:
+    """Newton's method on the period-``n`` stroboscopic map from the section through ``t0``."""
+
+    model: HybridModel
+    t0: float
+    n: int
+    stop: int
+    tol: float
+    max_iter: int
+
+    def solve(self, x: np.ndarray, virtual: bool, advice: str, guess: InitialGuess | None) -> PeriodicOrbit:
+        """The orbit from ``x``, or :class:`ConvergenceError` saying why not and ``advice``."""
+        model, t0, n, stop, tol = self.model, self.t0, self.n, self.stop, self.tol
+        residuals: list[float] = []
+        why = ""
+        for it in range(self.max_iter + 1):
+            try:
+                fm = flow_map(model, x, t0=t0, periods=n, virtual=virtual, stop_name=stop)
+            except SimulationError as exc:
+                raise ConvergenceError(
+                    f"Newton's method for a period-{n} orbit failed at iterate {it} ({exc}); {advice}"
+                ) from None
+            except InvalidStateError:
+                raise ConvergenceError(
+                    f"Newton's method for a period-{n} orbit left the allowed region (iterate {it} is "
+                    f"beyond the stop); {advice}"
+                ) from None
+            if not fm.solution.jacobian_valid:
+                raise ConvergenceError(_sticking_message(model, n, it, fm, guess))
+            F = fm.image - x
+            res = float(np.max(np.abs(F)))
+            residuals.append(res)
+            if not np.isfinite(res):
                 break
-            lam *= 0.5
-        x = trial
-    raise ConvergenceError(
-        f"Newton did not converge to a period-{n} orbit: residual {residuals[-1]:.3g} after "
-        f"{len(residuals) - 1} iterations{why}; {advice}"
+            if res <= tol:
+                return _orbit_from(model, x, t0, n, fm, virtual, residuals, stop)
+            if it == self.max_iter:
+                break
+            A = fm.jacobian - np.eye(model.n_states)
+            try:
+                dx = np.linalg.solve(A, -F)
+            except np.linalg.LinAlgError:
+                why = " (the Jacobian P_x - I is singular: a fold or a multiplier 1?)"
+                break
+            # Backtrack so that the iterate stays in the allowed region.
+            lam = 1.0
+            for _ in range(30):
+                trial = x + lam * dx
+                if virtual or np.min(model.guards(trial, t0)) >= 0:
+                    break
+                lam *= 0.5
+            x = trial
+        raise ConvergenceError(
+            f"Newton did not converge to a period-{n} orbit: residual {residuals[-1]:.3g} after "
+            f"{len(residuals) - 1} iterations{why}; {advice}"
+        )
+
+    def nonimpacting(self, x: np.ndarray) -> PeriodicOrbit | None:
+        """A physical orbit that touches no stop, found from ``x`` on the flow through the stops, or None.
+
+        Newton's method on the physical map fails from a guess whose flow hits a stop although the
+        orbit itself does not (an unstable orbit, from a guess off it, say); on the flow through the
+        stops it converges, and an orbit that keeps clear of every stop is also a physical orbit
+        (checked on the physical map).
+        """
+        try:
+            free = self.solve(x, True, "", None)
+        except GrazingError:
+            return None
+        if np.min(free.guard_mins) <= CROSSING_TOL:
+            return None
+        fm = flow_map(self.model, free.state, t0=self.t0, periods=self.n, stop_name=self.stop)
+        res = float(np.max(np.abs(fm.image - free.state)))
+        if fm.impacts or not fm.solution.jacobian_valid or not res <= self.tol:
+            return None
+        residuals = [*free.residuals, res]
+        return _orbit_from(self.model, free.state, self.t0, self.n, fm, False, residuals, self.stop)
+
+
+def _sticking_message(model: HybridModel, n: int, it: int, fm: FlowMap, guess: InitialGuess | None) -> str:
+    """Why Newton's method stops where the period-``n`` map has no Jacobian (sticking), and what to do."""
+    how = sticking_phrase(fm.solution, n)
+    what = (
+        f"the motion {how}" if how else "the motion sticks to the stop (or meets it at zero speed)"
+    ) + f" during the period-{n} map (iterate {it})"
+    no_jacobian = (
+        "the Jacobian across sticking is not computed, so Newton's method and Floquet multipliers are "
+        "not available for it"
     )
+    if guess is not None and guess.sticking and it == 0:
+        return (
+            f"the default initial guess sticks: simulated from rest for {guess.transient} forcing periods, "
+            f"the motion {guess.sticking}, and {no_jacobian}; give {GUESS} near an orbit that does not "
+            "stick, or simulate this motion instead"
+        )
+    return f"{what}; {no_jacobian}: give {GUESS} near an orbit that does not stick, or simulate this motion"
