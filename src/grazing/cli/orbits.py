@@ -217,6 +217,7 @@ def graze_curve(
     start_value: float | None,
     stop_name: str | None,
     out: Path | None,
+    overwrite: bool,
     as_json: bool,
 ) -> None:
     """Two-parameter continuation of grazing (the pendulum: in (eta, theta-hat), with theta-hat_max)."""
@@ -248,13 +249,13 @@ def graze_curve(
             raise InputError(f"--range: LO must be below HI, got {prange}")
         start = p2.from_display(start_value)
         model.with_params(**{p2.name: start})
-    check_out(out, ".nc")
+    check_out(out, ".nc", overwrite=overwrite)
     settings = PalcSettings(ds=min(0.02, max_step), ds_max=max_step)
     curve = grazing_curve(
         model, (p1.name, p2.name), start, search=(lo, hi), settings=settings, stop_name=stop
     )
     if out is not None:
-        save_dataset(curve.to_dataset(), out)
+        save_dataset(curve.to_dataset(), out, overwrite)
     fold = curve.fold
     res: dict[str, Any] = {
         "params": model_params_json(model, case),
@@ -318,6 +319,7 @@ def continue_(
     max_step: float,
     switch: bool,
     out: Path | None,
+    overwrite: bool,
     as_json: bool,
 ) -> None:
     """Pseudo-arclength continuation of a periodic orbit, with folds, period-doublings,
@@ -335,7 +337,7 @@ def continue_(
         for opt, v in (("--start", start), ("--stop", stop)):
             if not ANGLE_DEG.accepts(v):
                 raise InputError(f"{opt} for theta-hat must be {ANGLE_DEG.describe()}, got {v:g}")
-    check_out(out, ".nc")
+    check_out(out, ".nc", overwrite=overwrite)
     x0 = parse_state(initial, model.with_params(**{name: par.from_display(start)})) if initial else None
     a, b = par.from_display(start), par.from_display(stop)
     for v in (a, b):  # both ends within the parameter's bounds, before any work ("r = 2 is outside [0, 1]")
@@ -350,7 +352,7 @@ def continue_(
     finally:
         bar.close()
     if out is not None:
-        save_dataset(branch.to_dataset(), out)
+        save_dataset(branch.to_dataset(), out, overwrite)
     back = par.to_display
     res = {
         "params": model_params_json(model, case),
