@@ -140,7 +140,9 @@ def resolved(path: str | Path) -> Path:
 
 def _write_error(path: Path, exc: OSError) -> WriteError:
     reason = exc.strerror or str(exc) or type(exc).__name__
-    return WriteError(f"cannot write {path}: {reason}; nothing was written")
+    err = WriteError(f"cannot write {path}: {reason}; nothing was written")
+    err.strerror = reason  # (the reason alone, for a caller that names the file otherwise)
+    return err
 
 
 @contextmanager

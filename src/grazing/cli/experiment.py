@@ -612,6 +612,7 @@ def _synthesize_folder(out: Path, theta_hat: float, etas: tuple[float, ...], **k
     import tempfile
 
     from grazing.atomic import rename_noreplace, resolved, write_bytes_atomic
+    from grazing.errors import WriteError
     from grazing.experiment.synthetic import synthetic_sweep
 
     parent = out.parent if str(out.parent) else Path(".")
@@ -631,8 +632,12 @@ def _synthesize_folder(out: Path, theta_hat: float, etas: tuple[float, ...], **k
             os.umask(mask)
             os.chmod(tmp, 0o777 & ~mask)
             rename_noreplace(tmp, out)
-    except BaseException:
+    except BaseException as exc:
         shutil.rmtree(tmp, ignore_errors=True)
+        if isinstance(exc, WriteError):  # (named by the hidden folder's path, which is gone)
+            raise WriteError(
+                f"cannot write the recordings into {out}: {exc.strerror}; nothing was written"
+            ) from None
         raise
     return [out / p.name for p in written]
 
