@@ -310,6 +310,8 @@ def _png_chunks(data: bytes) -> list[tuple[bytes, bytes]]:
         i += 12 + length
         if kind == b"IEND":
             break
+    if i != len(data) or not chunks or chunks[-1][0] != b"IEND":
+        raise ValueError("not a whole PNG file (bytes after its end, or no end)")
     return chunks
 
 

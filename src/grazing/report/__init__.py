@@ -163,7 +163,7 @@ def build_report(
     out_dir
         Folder for the report: a report folder of grazing's (files of the same
         names are replaced, other files are left alone), an empty folder, or a
-        new folder in an existing one (see :mod:`grazing.report.folder`).
+        new folder (made with its parents; see :mod:`grazing.report.folder`).
     progress
         Called with one-line messages as the build proceeds.
     only

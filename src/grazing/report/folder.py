@@ -1,12 +1,13 @@
 """The report's folder: grazing's as a whole, marked by a file in it.
 
 A folder is a report folder of grazing's when it holds :data:`MARKER` (a small
-JSON file with grazing's mark), which a build writes first.  A build goes into
-such a folder, into a new folder (made in an existing one: missing parents are
-not made, as no command makes them), or into an empty folder; any other folder
+hidden JSON file with grazing's mark), which a build writes first.  A build goes
+into such a folder, into a new folder, or into an empty folder; any other folder
 (a report of a grazing without the marker, a folder of yours) is refused in one
 line and left untouched, unless ``overwrite`` is given, which lets the build
-replace the files of the report's names in it.
+replace the files of the report's names in it.  (``grazing report`` makes a new
+folder only in an existing one, as every command refuses a missing folder; in
+Python, :func:`claim_report_folder` makes the missing parents too.)
 
 Examples
 --------
@@ -28,7 +29,7 @@ import os
 from pathlib import Path
 
 from grazing.atomic import resolved
-from grazing.errors import ForeignFileError, InvalidParameterError
+from grazing.errors import ForeignFileError
 from grazing.outputs import PYTHON_HINT, write_json
 
 MARKER = ".grazing-report"
@@ -45,8 +46,6 @@ def check_report_folder(path: str | Path, *, overwrite: bool = False, hint: str 
 
     Raises
     ------
-    InvalidParameterError
-        If the folder ``path`` would go in does not exist.
     ForeignFileError
         If ``path`` is a file, or a folder that is neither empty nor a report
         folder of grazing's (and ``overwrite`` is not given).
@@ -54,9 +53,6 @@ def check_report_folder(path: str | Path, *, overwrite: bool = False, hint: str 
     shown = Path(path)
     target = resolved(shown)
     if not os.path.lexists(target):
-        parent = target.parent if str(target.parent) else Path(".")
-        if not parent.is_dir():
-            raise InvalidParameterError(f"folder {str(parent)!r} does not exist")
         return
     if not target.is_dir():
         raise ForeignFileError(f"{shown} exists and is not a folder; it was left untouched: name a folder")
@@ -69,8 +65,8 @@ def check_report_folder(path: str | Path, *, overwrite: bool = False, hint: str 
 
 
 def claim_report_folder(path: str | Path) -> None:
-    """Make the folder ``path`` if missing (not its parents) and mark it as grazing's (after the check)."""
+    """Make the folder ``path`` if missing and mark it as grazing's (after :func:`check_report_folder`)."""
     target = resolved(path)
-    target.mkdir(exist_ok=True)
+    target.mkdir(parents=True, exist_ok=True)
     if not (target / MARKER).is_file():
         write_json(target / MARKER, {"grazing_report": 1}, overwrite=True)
