@@ -106,6 +106,10 @@ def _digest_of_mark(text: Any) -> str | None:
     return m.group(2) if m else None
 
 
+# ----------------------------------------------------------------------------
+# Ownership
+
+
 _OWNED: list[Path] = []
 """Folders that are grazing's as a whole while this process (and the workers it forks) writes them."""
 
@@ -131,17 +135,16 @@ def _in_owned_folder(path: Path) -> bool:
     return any(here == root or root in here.parents for root in _OWNED)
 
 
-# ----------------------------------------------------------------------------
-# Ownership
-
-
 def written_by_grazing(path: str | Path) -> bool:
     """Whether the file at ``path`` carries grazing's mark and is unchanged since grazing wrote it.
 
-    Anything that cannot be read or parsed is not grazing's.
+    Anything that cannot be read or parsed, or is no regular file, is not grazing's.
     """
     try:
-        with open(resolved(path), "rb") as fh:
+        target = resolved(path)
+        if not stat.S_ISREG(os.stat(target).st_mode):  # (a pipe would block the read)
+            return False
+        with open(target, "rb") as fh:
             head = fh.read(8)
             if head == HDF5_SIGNATURE:
                 fh.seek(0)
