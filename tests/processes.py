@@ -55,3 +55,41 @@ def all_gone(pids: Iterable[int], limit: float = 60.0) -> bool:
     """Whether every process of ``pids`` is gone (zombies count as gone) within ``limit`` seconds."""
     pids = list(pids)
     return wait_until(lambda: not any(alive(p) for p in pids), limit)
+
+
+def limit_file_size(limit: int) -> None:
+    """In this process: no file may grow past ``limit`` bytes, and a write past it fails with EFBIG
+    (SIGXFSZ ignored) -- a full disk, as a test without root can make one."""
+    import resource
+    import signal
+
+    signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+    resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+
+
+def _limited_child(limit: int, fn: Callable[..., object], args: tuple, results: object) -> None:
+    limit_file_size(limit)
+    try:
+        fn(*args)
+    except BaseException as exc:  # reported to the parent: the test judges it
+        results.put((type(exc).__name__, str(exc)))  # type: ignore[attr-defined]
+    else:
+        results.put(None)  # type: ignore[attr-defined]
+
+
+def with_full_disk(fn: Callable[..., object], *args: object, limit: int = 4096) -> tuple[str, str] | None:
+    """Run ``fn(*args)`` in a forked child whose files cannot grow past ``limit`` bytes.
+
+    Returns None if it returned, else ``(exception class name, message)``; the
+    child's exit code must be 0 (it did not crash).
+    """
+    import multiprocessing as mp
+
+    ctx = mp.get_context("fork")
+    results = ctx.Queue()
+    child = ctx.Process(target=_limited_child, args=(limit, fn, args, results))
+    child.start()
+    got = results.get(timeout=300)
+    child.join(60)
+    assert child.exitcode == 0, child.exitcode
+    return got  # type: ignore[no-any-return]

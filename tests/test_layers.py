@@ -22,6 +22,7 @@ PACKAGE = SRC / "grazing"
 LAYERS = {
     "grazing.errors": 0,
     "grazing.atomic": 0,
+    "grazing.outputs": 0,
     "grazing.parallel": 0,
     "grazing.core": 1,
     "grazing.models": 2,

@@ -1,7 +1,11 @@
 """Files written all at once: a temporary next to the target, moved into place on success.
 
 A failed or interrupted write leaves nothing behind (the CLI's promise: bad
-input or an error writes no half-file).  A process killed in the middle of a
+input or an error writes no half-file): the temporary is removed and a write
+that the system refuses (a full disk, a file-size limit, a read-only folder)
+is a :class:`~grazing.errors.WriteError` naming the file, one line.  A
+symbolic link is followed: the file it points to is replaced, never the link.
+A process killed in the middle of a
 write (a worker stopped on Ctrl-C) cannot remove its temporary file; inside
 :func:`scratch_folder` the temporaries of the files under a folder are made
 in a hidden folder of it instead, removed as a whole at the end.
@@ -23,9 +27,11 @@ import shutil
 import sys
 import tempfile
 from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from pathlib import Path
 from typing import Any
+
+from grazing.errors import GrazingError, WriteError
 
 
 def _umask() -> int:
@@ -119,24 +125,54 @@ def _temporary_folder(path: Path) -> Path:
     return folder
 
 
+def resolved(path: str | Path) -> Path:
+    """``path`` with its symbolic links followed: the file a write to ``path`` replaces.
+
+    >>> import tempfile, pathlib
+    >>> d = pathlib.Path(tempfile.mkdtemp())
+    >>> (d / "link.csv").symlink_to(d / "data.csv")
+    >>> resolved(d / "link.csv") == (d / "data.csv").resolve()
+    True
+    """
+    path = Path(path)
+    return Path(os.path.realpath(path)) if os.path.islink(path) else path
+
+
+def _write_error(path: Path, exc: OSError) -> WriteError:
+    reason = exc.strerror or str(exc) or type(exc).__name__
+    err = WriteError(f"cannot write {path}: {reason}; nothing was written")
+    err.strerror = reason  # (the reason alone, for a caller that names the file otherwise)
+    return err
+
+
 @contextmanager
 def atomic_path(path: str | Path, suffix: str = ".tmp") -> Iterator[str]:
     """Yield a temporary file name next to ``path``; move it to ``path`` if the block succeeds.
 
     The file gets the usual permissions (``0666 & ~umask``; ``mkstemp`` alone
-    would leave 0600).  On any exception the temporary file is removed.
-    Inside :func:`scratch_folder` the temporary file is in its folder.
+    would leave 0600).  On any exception the temporary file is removed; an
+    :class:`OSError` (a full disk...) becomes a :class:`~grazing.errors.WriteError`
+    naming ``path``.  A symbolic link at ``path`` is followed (:func:`resolved`):
+    its target is replaced.  Inside :func:`scratch_folder` the temporary file is
+    in its folder.
     """
-    path = Path(path)
+    shown = Path(path)
+    path = resolved(shown)
     folder = _temporary_folder(path)
-    fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{path.name}.", suffix=suffix)
+    try:
+        fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{path.name}.", suffix=suffix)
+    except OSError as exc:
+        raise _write_error(shown, exc) from None
     os.close(fd)
     try:
         yield tmp
         os.chmod(tmp, 0o666 & ~_umask())
         os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
+    except BaseException as exc:
+        with suppress(OSError):
+            Path(tmp).unlink(missing_ok=True)
+        if isinstance(exc, OSError) and not isinstance(exc, GrazingError):
+            raise _write_error(shown, exc) from None
         raise
 
 
@@ -144,6 +180,12 @@ def write_text_atomic(path: str | Path, write: Callable[[Any], Any]) -> None:
     """Write a UTF-8 text file through ``write(file_handle)``, all at once."""
     with atomic_path(path) as tmp, open(tmp, "w", newline="", encoding="utf-8") as fh:
         write(fh)
+
+
+def write_bytes_atomic(path: str | Path, data: bytes | memoryview) -> None:
+    """Write ``data`` to ``path`` all at once (plain file I/O: a full disk is a :class:`WriteError`)."""
+    with atomic_path(path) as tmp, open(tmp, "wb") as fh:
+        fh.write(data)
 
 
 _AT_FDCWD = -100

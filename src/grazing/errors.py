@@ -23,5 +23,13 @@ class ConvergenceError(GrazingError, RuntimeError):
     """A Newton iteration did not converge."""
 
 
+class ForeignFileError(InvalidParameterError):
+    """An output's path holds a file grazing did not write (or one changed since): it is left as it is."""
+
+
+class WriteError(GrazingError, OSError):
+    """A file could not be written (a full disk, a read-only folder...); nothing was written."""
+
+
 class GrazingWarning(UserWarning):
     """A result that was computed as asked but is not a motion of the system (the CLI prints it as a note)."""

@@ -58,6 +58,7 @@ def test_trajectory_csv(tmp_path, capsys):
     code, _, _ = run([*argv, "--points-per-period", "20", "--json"], capsys)
     assert code == 0
     rows = list(csv.reader(path.open()))
+    assert rows.pop()[0].startswith("# written by grazing ")  # the mark: a comment line at the end
     assert rows[0] == ["tau", "theta", "dtheta"]
     taus = [float(r[0]) for r in rows[1:]]
     assert taus[0] == pytest.approx(10 * 2 * math.pi)

@@ -22,8 +22,13 @@ from grazing.cli.limits import MEMORY_ENV, MemoryLimitError, check_memory, parse
 from grazing.experiment.synthetic import synthetic_sweep
 
 
-def _files(root: Path) -> dict[str, bytes | None]:
-    return {str(p.relative_to(root)): (p.read_bytes() if p.is_file() else None) for p in root.rglob("*")}
+def _files(root: Path) -> dict[str, bytes | str | None]:
+    """Every file's bytes (a symbolic link: where it points) and every folder under ``root``."""
+
+    def content(p: Path) -> bytes | str | None:
+        return os.readlink(p) if p.is_symlink() else p.read_bytes() if p.is_file() else None
+
+    return {str(p.relative_to(root)): content(p) for p in root.rglob("*")}
 
 
 def _big_field_csv(path: Path, in_header: bool = False) -> None:
@@ -47,6 +52,14 @@ def inputs(tmp_path_factory):
     shutil.copytree(root / "folder", bad)
     for side in bad.glob("*.json"):
         side.write_text(side.read_text().replace('"theta_hat_deg": 40.0', '"theta_hat_deg": "forty"'))
+    # issue 26: files -- a user's files where outputs go
+    (root / "notes.csv").write_text("my,notes\n1,2\n")
+    (root / "mine.nc").write_bytes(b"my data")
+    (root / "mine.png").write_bytes(b"my picture")
+    (root / "keep.json").write_text('{"mine": 1}\n')
+    (root / "myreport").mkdir()
+    (root / "myreport" / "index.html").write_text("<p>my page</p>\n")
+    (root / "link.nc").symlink_to("mine.nc")
     return root
 
 
@@ -56,7 +69,7 @@ def _workspace(template: Path):
     old = Path.cwd()
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp) / "w"
-        shutil.copytree(template, work)
+        shutil.copytree(template, work, symlinks=True)
         os.chdir(work)
         try:
             yield work
@@ -133,6 +146,24 @@ ACCEPTED_BUT_WRONG = [
     (["report", "--out", ""], "--out must name a file or folder, got an empty string"),
     ([*SWEEP, "--out", ""], "--out must name a file or folder, got an empty string"),
     (["analyze", ""], "FILE.csv|DIR must name a file or folder, got an empty string"),
+    # issue 26: files
+    (["iso-damping", "--out", "notes.csv"], "notes.csv exists and was not written by grazing"),
+    (["simulate", "--trajectory", "notes.csv"], "notes.csv exists and was not written by grazing"),
+    (["synthesize", "--eta", "0.446", "--out", "notes.csv"], "notes.csv exists and was not written"),
+    (["synthesize", "--eta", "0.446", "--out", "keep.csv"], "keep.json exists and was not written"),
+    ([*SWEEP, "--out", "mine.nc"], "mine.nc exists and was not written by grazing"),
+    ([*MAP, "--out", "mine.nc"], "mine.nc exists and was not written by grazing"),
+    (
+        ["continue", "--param", "eta", "--start", "0.446", "--stop", "0.44", "--out", "mine.nc"],
+        "mine.nc exists and was not written by grazing",
+    ),
+    (["graze-curve", "--out", "mine.nc"], "mine.nc exists and was not written by grazing"),
+    (["analyze", "rec.csv", "--plot", "mine.png"], "mine.png exists and was not written by grazing"),
+    ([*SWEEP, "--out", "link.nc"], "link.nc (a link to "),
+    (["report", "--out", "myreport"], "myreport exists and is not a report folder of grazing"),
+    (["report", "--out", "a/b/c"], "folder 'a/b' does not exist"),
+    (["synthesize", "--eta", "0.446", "--out", "s8.txt"], "'s8.txt' is neither a .csv file nor a folder"),
+    (["synthesize", "--eta", "0.446", "--eta", "0.45", "--out", "new/fold"], "folder 'new' does not exist"),
 ]
 
 IGNORED_OPTIONS = [
@@ -206,6 +237,17 @@ IGNORED_OPTIONS = [
         "--set gap_right=2".split(),
         "--set gap_right=2 is not used by graze-curve: it moves both --params",
     ),
+    # issue 26: files
+    (["simulate", "--overwrite"], "--overwrite is not used without --trajectory"),
+    (["iso-damping", "--overwrite"], "--overwrite is not used without --out"),
+    (["analyze", "rec.csv", "--overwrite"], "--overwrite is not used without --plot"),
+    (["graze-curve", "--overwrite"], "--overwrite is not used without --out"),
+    (
+        ["continue", "--param", "eta", "--start", "0.446", "--stop", "0.44", "--overwrite"],
+        "--overwrite is not used without --out",
+    ),
+    ([*SWEEP, "--overwrite"], "--overwrite is not used without --out"),
+    ([*MAP, "--overwrite", "--out", "m.zarr"], "--overwrite is not used with a Zarr store"),
 ]
 
 MEMORY = [
@@ -616,6 +658,16 @@ for _cmd in ("graze", "normal-form", "graze-curve"):
     COMMANDS[_cmd]["--initial"] = ["0,0", "-0.5,0.1", "0;0"]
 COMMANDS["continue"]["--switch"] = None
 
+# issue 26: files -- --overwrite wherever a command writes a file, and the user's files of `inputs` as outputs
+OUTPUT_OPTION = {"simulate": "--trajectory", "analyze": "--plot"}
+"""The option naming the file a command writes (``--out`` unless listed)."""
+FOREIGN = {".nc": ["mine.nc", "link.nc"], ".csv": ["notes.csv", "keep.csv"], ".png": ["mine.png"]}
+for _cmd, _suffix in (("simulate", ".csv"), ("graze-curve", ".nc"), ("continue", ".nc"), ("sweep", ".nc"),
+                      ("map", ".nc"), ("iso-damping", ".csv"), ("analyze", ".png"), ("synthesize", ".csv"),
+                      ("report", "")):  # fmt: skip
+    _option = OUTPUT_OPTION.get(_cmd, "--out")
+    COMMANDS[_cmd] = {**COMMANDS[_cmd], "--overwrite": None}
+    COMMANDS[_cmd][_option] = [*COMMANDS[_cmd][_option], *FOREIGN.get(_suffix, ["myreport", "a/b/c"])]
 REQUIRED = ["--param", "--start", "--stop", "--num", "--param1", "--start1", "--stop1", "--num1", "--param2",
             "--start2", "--stop2", "--num2", "PATH"]  # fmt: skip
 REAL_WORK = ("simulate", "sweep", "map", "damping", "synthesize", "analyze")
@@ -715,6 +767,11 @@ def ignored(argv: list[str]) -> list[str]:
     # issue 26: orbits
     if cmd == "continue" and "--switch" in g and _last_flag(argv, ("--virtual", "--physical")) == "--virtual":
         bad.append("--switch")
+    # issue 26: files
+    if "--overwrite" in g and cmd != "report" and OUTPUT_OPTION.get(cmd, "--out") not in g:
+        bad.append("--overwrite")
+    if cmd in ("sweep", "map") and "--overwrite" in g and str(g.get("--out", "")).endswith(".zarr"):
+        bad.append("--overwrite")
     return bad
 
 

@@ -3,8 +3,11 @@
 Bad input is an :class:`InputError` (one line, exit 2); the work's own errors
 are :class:`~grazing.errors.GrazingError` (one line, exit 1); :func:`main`
 turns both into ``grazing: error: ...`` on stderr.  Every file a command
-writes is written all at once (:func:`write_atomic`, :func:`save_dataset`),
-so a failed run leaves nothing half-written.
+writes is written all at once with grazing's mark (:func:`write_table`,
+:func:`save_dataset`, :mod:`grazing.outputs`), so a failed run leaves nothing
+half-written; an output path is checked before any work (:func:`check_out`):
+a file there that grazing did not write is refused unless ``--overwrite`` is
+given.
 """
 
 from __future__ import annotations
@@ -22,7 +25,7 @@ import click
 import numpy as np
 
 import grazing
-from grazing.atomic import atomic_path, write_text_atomic
+from grazing.atomic import resolved
 from grazing.cli.validate import (
     ANGLE_DEG,
     InputError,
@@ -49,9 +52,19 @@ InputError = InputError
 
 
 json_option = click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
-netcdf_out_option = click.option(
-    "--out", type=path_type(dir_okay=False), metavar="FILE.nc", help="Save as NetCDF."
+overwrite_option = click.option(
+    "--overwrite",
+    is_flag=True,
+    help="Replace an output file that grazing did not write (a file grazing wrote is always replaced).",
 )
+OVERWRITE_HINT = "use another name, or --overwrite to replace it"
+"""How a refusal to replace a file ends on the command line."""
+
+
+def netcdf_out_option(func: Callable[..., Any]) -> Callable[..., Any]:
+    """``--out FILE.nc`` and ``--overwrite``."""
+    out = click.option("--out", type=path_type(dir_okay=False), metavar="FILE.nc", help="Save as NetCDF.")
+    return out(overwrite_option(func))
 
 
 PENDULUM_OPTIONS = ("case", "alpha", "beta", "r", "eta", "theta_hat")
@@ -362,13 +375,11 @@ class Progress:
             self._bar.stop()
 
 
-def write_atomic(path: Path, write: Callable[[Any], None]) -> None:
-    """Write a text file all at once (see :mod:`grazing.atomic`), into an existing folder."""
-    path = Path(path)
-    folder = path.parent if str(path.parent) else Path(".")
-    if not folder.is_dir():
-        raise InputError(f"folder {str(folder)!r} does not exist")
-    write_text_atomic(path, write)
+def write_table(path: Path, write: Callable[[Any], None], overwrite: bool = False) -> None:
+    """Write a CSV table all at once with grazing's mark (:func:`grazing.outputs.write_csv`)."""
+    from grazing.outputs import write_csv
+
+    write_csv(path, write, overwrite=overwrite, hint=OVERWRITE_HINT)
 
 
 def emit_json(obj: dict[str, Any]) -> None:
@@ -424,21 +435,36 @@ def complex_list(mu: np.ndarray) -> list[list[float]]:
     return [[float(z.real), float(z.imag)] for z in np.asarray(mu, dtype=complex)]
 
 
-def check_out(out: Path | None, suffix: str, option: str = "--out") -> None:
-    """An output path must have ``suffix`` and an existing folder (checked before any work)."""
+def check_out(out: Path | None, suffix: str, option: str = "--out", overwrite: bool = False) -> None:
+    """Check an output path before any work: its suffix, its folder, and what is there already.
+
+    The folder must exist; a file there is replaced only if grazing wrote it
+    or ``--overwrite`` is given (:func:`grazing.outputs.check_replaceable`; a
+    symbolic link is followed).  ``--overwrite`` without the output is refused.
+    """
     if out is None:
+        refuse_unused(["overwrite"], True, f"without {option}")
         return
     if out.suffix.lower() != suffix:
         raise InputError(f"{option} must name a {suffix} file, got {str(out)!r}")
-    folder = out.parent if str(out.parent) else Path(".")
+    check_folder(out)
+    from grazing.outputs import check_replaceable
+
+    check_replaceable(out, overwrite=overwrite, hint=OVERWRITE_HINT)
+
+
+def check_folder(out: Path) -> None:
+    """The folder an output goes into must exist (no command makes missing folders)."""
+    folder = resolved(out).parent  # (of the file a symbolic link points to)
     if not folder.is_dir():
         raise InputError(f"folder {str(folder)!r} does not exist")
 
 
-def save_dataset(ds: Any, out: Path) -> None:
-    """Write a dataset to NetCDF all at once, so a failure leaves nothing."""
-    with atomic_path(out, suffix=".nc") as tmp:
-        ds.to_netcdf(tmp, engine="h5netcdf")
+def save_dataset(ds: Any, out: Path, overwrite: bool = False) -> None:
+    """Write a dataset to NetCDF all at once with grazing's mark (:func:`grazing.outputs.write_netcdf`)."""
+    from grazing.outputs import write_netcdf
+
+    write_netcdf(out, ds, overwrite=overwrite, hint=OVERWRITE_HINT)
 
 
 def error_line(message: str) -> None:

@@ -17,8 +17,17 @@ from typing import Any
 import click
 import numpy as np
 
-from grazing.atomic import atomic_path
-from grazing.cli.common import InputError, Progress, check_out, emit_json, json_option, write_atomic
+from grazing.cli.common import (
+    OVERWRITE_HINT,
+    InputError,
+    Progress,
+    check_folder,
+    check_out,
+    emit_json,
+    json_option,
+    overwrite_option,
+    write_table,
+)
 from grazing.cli.limits import (
     check_memory,
     count_text,
@@ -49,10 +58,11 @@ def _none_if_nan(v: float) -> float | None:
     return None if not math.isfinite(v) else float(v)
 
 
-def _save_png(fig: Any, path: Path) -> None:
-    """Save a figure all at once (never half-written)."""
-    with atomic_path(path, suffix=".png") as tmp:
-        fig.savefig(tmp, dpi=150)
+def _save_png(fig: Any, path: Path, overwrite: bool) -> None:
+    """Save a figure all at once (never half-written), with grazing's mark."""
+    from grazing.outputs import save_png
+
+    save_png(fig, path, dpi=150, overwrite=overwrite, hint=OVERWRITE_HINT)
 
 
 def _r_beta(case: str, r: float | None, beta: float | None) -> tuple[float, float]:
@@ -233,17 +243,18 @@ def _write_curve_csv(r: np.ndarray, beta: np.ndarray, fh: Any) -> None:
 @_norm_option
 @click.option("--out", type=path_type(dir_okay=False), metavar="FILE.csv",
               help="Write the curve (r,beta) to a CSV file.")  # fmt: skip
+@overwrite_option
 @json_option
 def iso_damping_cmd(
     damping: float, num: int, relation: str, amplitude: float, peaks: int, normalisation: str,
-    out: Path | None, as_json: bool,
+    out: Path | None, overwrite: bool, as_json: bool,
 ) -> None:  # fmt: skip
     """The curve of (r, beta) along which the measured damping is D (fig 4b)."""
     from grazing.experiment import damping as dmp
 
     refuse_unused(["normalisation"], relation != "model", f"with --relation {relation}")
     amp = _amplitude_rad(amplitude)
-    check_out(out, ".csv")
+    check_out(out, ".csv", overwrite=overwrite)
     check_memory(curve_bytes(num), f"a curve of {count_text(num)} points", "ask for fewer --num")
     for pr, pb in dmp.PAPER_POINTS.values():
         _check_decay_memory(pr, pb, amp, peaks)
@@ -266,7 +277,7 @@ def iso_damping_cmd(
             "D_protocol": dmp.paper_protocol_damping(pr, pb, amplitude=amp, peaks=peaks).damping,
         }
     if out is not None:
-        write_atomic(out, lambda fh: _write_curve_csv(curve.r, curve.beta, fh))
+        write_table(out, lambda fh: _write_curve_csv(curve.r, curve.beta, fh), overwrite)
     res = {
         "damping": curve.damping,
         "relation": relation,
@@ -367,7 +378,7 @@ def _analysis_json(a: Any, rec: Any) -> dict[str, Any]:
     }
 
 
-def _plot_recording(a: Any, path: Path) -> None:
+def _plot_recording(a: Any, path: Path, overwrite: bool) -> None:
     from matplotlib.figure import Figure
 
     fig = Figure(figsize=(9.0, 3.2), layout="constrained")
@@ -386,7 +397,7 @@ def _plot_recording(a: Any, path: Path) -> None:
     ax2.plot(np.degrees(emb[:, 0]), np.degrees(emb[:, 1]), lw=0.5)
     ax2.set_xlabel("θ(t − T/4) (deg)")
     ax2.set_ylabel("θ(t) (deg)")
-    _save_png(fig, path)
+    _save_png(fig, path, overwrite)
 
 
 @click.command("analyze")
@@ -411,17 +422,18 @@ def _plot_recording(a: Any, path: Path) -> None:
               help="Model sweep points (with --with-model).")  # fmt: skip
 @click.option("--plot", type=path_type(dir_okay=False), metavar="FILE.png",
               help="Draw the time series and embedding (file) or the diagram (folder).")  # fmt: skip
+@overwrite_option
 @json_option
 def analyze_cmd(
     path: Path, forcing_hz: float | None, phase: float, degrees: bool, cutoff_hz: float | None,
     cutoff_multiple: float, max_period: int, noise: float | None, theta_hat: float | None, with_model: bool,
-    case: str, model_points: int, plot: Path | None, as_json: bool,
+    case: str, model_points: int, plot: Path | None, overwrite: bool, as_json: bool,
 ) -> None:  # fmt: skip
     """Analyse a recording (period, stroboscopic samples, noise) or a folder of them (fig 2-style diagram)."""
     from grazing.experiment.recording import load_recording
     from grazing.experiment.signal import analyze_recording
 
-    check_out(plot, ".png", "--plot")
+    check_out(plot, ".png", "--plot", overwrite)
     case_values(case)
     refuse_unused(["case", "model_points"], not with_model, "without --with-model")
     refuse_unused(["cutoff_multiple"], cutoff_hz is not None, "with --cutoff-hz")
@@ -436,7 +448,7 @@ def analyze_cmd(
                 "ask for fewer --model-points",
             )
         _analyze_folder(path, phase, degrees, cutoff_multiple, max_period, theta_hat, with_model, case,
-                        model_points, plot, as_json)  # fmt: skip
+                        model_points, plot, overwrite, as_json)  # fmt: skip
         return
     if with_model:
         raise InputError("--with-model applies to a folder of recordings")
@@ -447,7 +459,7 @@ def analyze_cmd(
         max_period=max_period, noise=noise,
     )  # fmt: skip
     if plot is not None:
-        _plot_recording(a, plot)
+        _plot_recording(a, plot, overwrite)
     res = _analysis_json(a, rec)
     res["plot"] = str(plot) if plot else None
     if as_json:
@@ -473,7 +485,7 @@ def analyze_cmd(
 
 def _analyze_folder(
     path: Path, phase: float, degrees: bool, cutoff_multiple: float, max_period: int, theta_hat: float | None,
-    with_model: bool, case: str, model_points: int, plot: Path | None, as_json: bool,
+    with_model: bool, case: str, model_points: int, plot: Path | None, overwrite: bool, as_json: bool,
 ) -> None:  # fmt: skip
     from grazing.experiment.diagram import load_diagram, model_sweep, plot_diagram
 
@@ -503,7 +515,7 @@ def _analyze_folder(
         fig = Figure(figsize=(7.0, 4.0), layout="constrained")
         label = "synthetic recordings" if diag.synthetic else "recordings"
         plot_diagram(fig.add_subplot(), diag, model, label=label)
-        _save_png(fig, plot)
+        _save_png(fig, plot, overwrite)
     res: dict[str, Any] = {
         "folder": str(path),
         "theta_hat_deg": diag.theta_hat_deg,
@@ -554,16 +566,19 @@ def _analyze_folder(
 @click.option("--noise", type=NON_NEGATIVE, default=1e-3, show_default=True, help="Sensor noise, rad.")
 @click.option("--seed", type=SEED, default=0, show_default=True, help="Seed of the noise (>= 0).")
 @click.option("--out", type=path_type(), required=True, metavar="FILE.csv|DIR",
-              help="A .csv file (one --eta) or a folder (several).")  # fmt: skip
+              help="A .csv file (one --eta; with a sidecar .json) or a folder (several; an existing folder, "
+              "or a new one named without a suffix).")  # fmt: skip
+@overwrite_option
 @json_option
 def synthesize_cmd(
     etas: tuple[float, ...], theta_hat: float, case: str, periods: int, transient: int, sample_rate: float,
-    noise: float, seed: int, out: Path, as_json: bool,
+    noise: float, seed: int, out: Path, overwrite: bool, as_json: bool,
 ) -> None:  # fmt: skip
     """Write SYNTHETIC rig-like recordings simulated from the model (1 kHz, noise, drift, trigger)."""
     from grazing.experiment.apparatus import PAPER_RIG
     from grazing.experiment.recording import MIN_SAMPLES
-    from grazing.experiment.synthetic import synthetic_recording, write_recording
+    from grazing.experiment.synthetic import recording_name, synthetic_recording, write_recording
+    from grazing.outputs import check_replaceable
 
     case_values(case)
     one_file = out.suffix.lower() == ".csv"
@@ -571,8 +586,15 @@ def synthesize_cmd(
         raise InputError("several --eta values need a folder as --out, not a .csv file")
     if not one_file and out.exists() and not out.is_dir():
         raise InputError(f"--out {str(out)!r} exists and is not a folder")
-    if not (out.parent if str(out.parent) else Path(".")).is_dir():
-        raise InputError(f"folder {str(out.parent)!r} does not exist")
+    if not one_file and not out.is_dir() and out.suffix:
+        raise InputError(
+            f"--out {str(out)!r} is neither a .csv file nor a folder: name a .csv file (one --eta), "
+            "or a folder (a new one without a suffix)"
+        )
+    check_folder(out)
+    csvs = [out] if one_file else [out / recording_name(theta_hat, e) for e in etas]
+    for target in (p for c in csvs for p in (c, c.with_suffix(".json"))):
+        check_replaceable(target, overwrite=overwrite, hint=OVERWRITE_HINT)
     samples = {e: periods / PAPER_RIG.forcing_hz(e) * sample_rate for e in etas}
     fewest = min(samples, key=samples.__getitem__)
     if samples[fewest] < MIN_SAMPLES:
@@ -589,7 +611,7 @@ def synthesize_cmd(
     kw = {"case": case, "sample_rate": sample_rate, "noise": noise}
     if one_file:
         rec = synthetic_recording(etas[0], theta_hat, periods=periods, transient=transient, seed=seed, **kw)
-        paths = [write_recording(rec, out)]
+        paths = [write_recording(rec, out, overwrite=overwrite, hint=OVERWRITE_HINT)]
     else:
         kw.update(periods=periods, transient=transient, seed=seed)
         paths = _synthesize_folder(out, theta_hat, etas, **kw)
@@ -605,12 +627,15 @@ def _synthesize_folder(out: Path, theta_hat: float, etas: tuple[float, ...], **k
 
     They are written into a hidden folder beside ``out``, then moved into
     ``out`` (or the hidden folder renamed to ``out`` if it did not exist), so a
-    failure part-way leaves nothing behind.
+    failure part-way leaves nothing behind.  The files they replace in ``out``
+    were checked before (grazing's, or ``--overwrite``); a symbolic link there
+    is followed.
     """
     import shutil
     import tempfile
 
-    from grazing.atomic import rename_noreplace
+    from grazing.atomic import rename_noreplace, resolved, write_bytes_atomic
+    from grazing.errors import WriteError
     from grazing.experiment.synthetic import synthetic_sweep
 
     parent = out.parent if str(out.parent) else Path(".")
@@ -619,15 +644,23 @@ def _synthesize_folder(out: Path, theta_hat: float, etas: tuple[float, ...], **k
         written = synthetic_sweep(tmp, theta_hat, etas, **kwargs)
         if out.is_dir():
             for f in sorted(tmp.iterdir()):
-                os.replace(f, out / f.name)
-            tmp.rmdir()
+                dest = resolved(out / f.name)
+                try:
+                    os.replace(f, dest)
+                except OSError:  # (a link to another file system)
+                    write_bytes_atomic(dest, f.read_bytes())
+            shutil.rmtree(tmp)
         else:
             mask = os.umask(0)
             os.umask(mask)
             os.chmod(tmp, 0o777 & ~mask)
             rename_noreplace(tmp, out)
-    except BaseException:
+    except BaseException as exc:
         shutil.rmtree(tmp, ignore_errors=True)
+        if isinstance(exc, WriteError):  # (named by the hidden folder's path, which is gone)
+            raise WriteError(
+                f"cannot write the recordings into {out}: {exc.strerror}; nothing was written"
+            ) from None
         raise
     return [out / p.name for p in written]
 

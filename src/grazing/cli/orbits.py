@@ -238,6 +238,7 @@ def graze_curve(
     stop_name: str | None,
     initial: str | None,
     out: Path | None,
+    overwrite: bool,
     as_json: bool,
 ) -> None:
     """Two-parameter continuation of grazing (the pendulum: in (eta, theta-hat), with theta-hat_max)."""
@@ -270,13 +271,13 @@ def graze_curve(
         start = p2.from_display(start_value)
         model.with_params(**{p2.name: start})
     x0 = range_start_state(initial, model, {p1.name: lo, p2.name: start})
-    check_out(out, ".nc")
+    check_out(out, ".nc", overwrite=overwrite)
     settings = PalcSettings(ds=min(0.02, max_step), ds_max=max_step)
     curve = grazing_curve(
         model, (p1.name, p2.name), start, search=(lo, hi), x0=x0, settings=settings, stop_name=stop
     )
     if out is not None:
-        save_dataset(curve.to_dataset(), out)
+        save_dataset(curve.to_dataset(), out, overwrite)
     fold = curve.fold
     res: dict[str, Any] = {
         "params": model_params_json(model, case),
@@ -341,6 +342,7 @@ def continue_(
     max_step: float,
     switch: bool,
     out: Path | None,
+    overwrite: bool,
     as_json: bool,
 ) -> None:
     """Pseudo-arclength continuation of a periodic orbit, with folds, period-doublings,
@@ -362,7 +364,7 @@ def continue_(
         for opt, v in (("--start", start), ("--stop", stop)):
             if not ANGLE_DEG.accepts(v):
                 raise InputError(f"{opt} for theta-hat must be {ANGLE_DEG.describe()}, got {v:g}")
-    check_out(out, ".nc")
+    check_out(out, ".nc", overwrite=overwrite)
     x0 = parse_state(initial, model.with_params(**{name: par.from_display(start)})) if initial else None
     a, b = par.from_display(start), par.from_display(stop)
     for v in (a, b):  # both ends within the parameter's bounds, before any work ("r = 2 is outside [0, 1]")
@@ -377,7 +379,7 @@ def continue_(
     finally:
         bar.close()
     if out is not None:
-        save_dataset(branch.to_dataset(), out)
+        save_dataset(branch.to_dataset(), out, overwrite)
     back = par.to_display
     res = {
         "params": model_params_json(model, case),

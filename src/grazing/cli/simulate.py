@@ -18,8 +18,9 @@ from grazing.cli.common import (
     json_option,
     model_options,
     model_params_json,
+    overwrite_option,
     parse_state,
-    write_atomic,
+    write_table,
 )
 from grazing.cli.limits import check_memory, count_text, simulate_bytes
 from grazing.cli.validate import FINITE, count, path_type, refuse_unused
@@ -39,6 +40,7 @@ from grazing.cli.validate import FINITE, count, path_type, refuse_unused
               help="Write the dense trajectory of the sampled span to a CSV file.")  # fmt: skip
 @click.option("--points-per-period", type=count(4), default=100, show_default=True,
               help="Trajectory resolution (with --trajectory).")  # fmt: skip
+@overwrite_option
 @json_option
 def simulate(
     model: grazing.HybridModel,
@@ -49,12 +51,13 @@ def simulate(
     phase: float,
     trajectory: Path | None,
     points_per_period: int,
+    overwrite: bool,
     as_json: bool,
 ) -> None:
     """Simulate a model (the pendulum by default); print stroboscopic samples, impacts, period."""
     refuse_unused(["points_per_period"], trajectory is None, "without --trajectory")
     x0 = parse_state(initial, model)
-    check_out(trajectory, ".csv", "--trajectory")
+    check_out(trajectory, ".csv", "--trajectory", overwrite)
     points = periods * points_per_period + 1 if trajectory is not None else 0
     check_memory(
         simulate_bytes(periods, model.n_states, points, as_json),
@@ -79,7 +82,7 @@ def simulate(
         bar.close()
     elapsed = time.perf_counter() - t0
     if trajectory is not None:
-        write_atomic(trajectory, functools.partial(_write_trajectory_csv, sol))
+        write_table(trajectory, functools.partial(_write_trajectory_csv, sol), overwrite)
     period = sol.period()
     result = {
         "params": model_params_json(model, case),

@@ -18,12 +18,15 @@ from grazing.cli.common import (
     PENDULUM_UNFOLDING,
     InputError,
     Progress,
+    check_folder,
+    check_out,
     complex_list,
     emit_json,
     json_option,
     model_options,
     model_parameter,
     model_params_json,
+    overwrite_option,
     parse_state,
     save_dataset,
 )
@@ -62,6 +65,7 @@ def _sweep_options(func: Callable[..., Any]) -> Callable[..., Any]:
                      help="Zarr store (resumable; one run at a time) or NetCDF file."),
         click.option("--wait", is_flag=True,
                      help="If another run is writing the --out store, wait for it instead of stopping."),
+        overwrite_option,
         json_option,
     ]  # fmt: skip
     for opt in reversed(options):
@@ -71,16 +75,18 @@ def _sweep_options(func: Callable[..., Any]) -> Callable[..., Any]:
 
 def _check_sweep_options(
     out: Path | None, scheduler: str | None, chunk_size: int | None, n_points: int, periods: int,
-    n_states: int, workers: int | None, as_json: bool, what: str,
+    n_states: int, workers: int | None, as_json: bool, what: str, overwrite: bool = False,
 ) -> None:  # fmt: skip
     """The checks shared by ``sweep`` and ``map``, before any work: output, options used together, memory."""
     if out is not None and out.suffix.lower() not in (".zarr", ".nc"):
         raise InputError(f"--out must end in .zarr or .nc, got {str(out)!r}")
-    if out is not None:
-        folder = out.parent if str(out.parent) else Path(".")
-        if not folder.is_dir():
-            raise InputError(f"folder {str(folder)!r} does not exist")
     zarr_out = out is not None and out.suffix.lower() == ".zarr"
+    if out is not None and not zarr_out:
+        check_out(out, ".nc", overwrite=overwrite)
+    elif out is not None:
+        check_folder(out)
+    refuse_unused(["overwrite"], out is None, "without --out")
+    refuse_unused(["overwrite"], zarr_out, "with a Zarr store (a store is never replaced)")
     refuse_unused(["wait"], not zarr_out, "without a Zarr store (--out FILE.zarr)")
     refuse_unused(["timeout"], scheduler is None, "without --scheduler")
     refuse_unused(
@@ -124,7 +130,7 @@ class _SweepRun:
 
 def _run_sweep_spec(
     spec: Any, out: Path | None, scheduler: str | None, workers: int | None, as_json: bool,
-    wait: bool = False, timeout: float | None = None, arrays: bool = False,
+    wait: bool = False, timeout: float | None = None, arrays: bool = False, overwrite: bool = False,
 ) -> _SweepRun:  # fmt: skip
     """Run a sweep spec with the CLI's storage, cluster and progress options.
 
@@ -177,10 +183,10 @@ def _run_sweep_spec(
             client.close()
     if memory:
         if out is not None:
-            save_dataset(store.dataset(), out)
+            save_dataset(store.dataset(), out, overwrite)
         return _SweepRun(None, store.arrays["period"], store.arrays["status"], store.arrays)
     if out is not None and out.suffix.lower() == ".nc":
-        save_dataset(ds, out)
+        save_dataset(ds, out, overwrite)
     if flat is None:  # (the dataset's points, flattened: in visiting order, as the spec lists them)
         flat = {name: ds[name].values.ravel() for name in ("period", "status")}
     return _SweepRun(ds, flat["period"], flat["status"])
@@ -246,7 +252,7 @@ def sweep_cmd(
     sparam: str, start: float, stop: float, num: int, direction: str, method: str, which: str,
     transient: int, periods: int, initial: str, fresh: bool, chunk_size: int | None, workers: int | None,
     scheduler: str | None, timeout: float | None, no_lyapunov: bool, no_adaptive: bool, tol: float,
-    out: Path | None, wait: bool, as_json: bool,
+    out: Path | None, wait: bool, overwrite: bool, as_json: bool,
 ) -> None:  # fmt: skip
     """Brute-force bifurcation diagram: stroboscopic samples, periods, impacts and
     Lyapunov exponents along a parameter range."""
@@ -260,7 +266,7 @@ def sweep_cmd(
     refuse_unused(["which"], method != "map", "without --method map")
     chunk_size = CHUNK_SIZE if chunk_size is None else chunk_size
     _check_sweep_options(
-        out, scheduler, chunk_size, num, periods, model.n_states, workers, as_json, "a sweep"
+        out, scheduler, chunk_size, num, periods, model.n_states, workers, as_json, "a sweep", overwrite
     )
     shown = np.linspace(start, stop, num)
     vals = np.array([par.from_display(v) for v in shown])
@@ -277,7 +283,9 @@ def sweep_cmd(
     )  # fmt: skip
     spec = sweep_spec(model, name, vals, x0=x0, direction=direction, settings=settings, zdm=zdm)
     t0 = time.perf_counter()
-    run = _run_sweep_spec(spec, out, scheduler, workers, as_json, wait, timeout, arrays=True)
+    run = _run_sweep_spec(
+        spec, out, scheduler, workers, as_json, wait, timeout, arrays=True, overwrite=overwrite
+    )
     elapsed = time.perf_counter() - t0
     if as_json:
         res = {"params": model_params_json(model, case), **_sweep_json(spec, run, sparam, shown)}
@@ -342,7 +350,7 @@ def map_cmd(
     param1: str, start1: float, stop1: float, num1: int, param2: str, start2: float, stop2: float, num2: int,
     transient: int, periods: int, initial: str, fresh: bool, chunk_size: int | None, workers: int | None,
     scheduler: str | None, timeout: float | None, no_lyapunov: bool, no_adaptive: bool, tol: float,
-    out: Path | None, wait: bool, as_json: bool,
+    out: Path | None, wait: bool, overwrite: bool, as_json: bool,
 ) -> None:  # fmt: skip
     """Two-parameter map of periods, impacts and Lyapunov exponents."""
     from grazing.sweeps.spec import map_spec
@@ -357,7 +365,7 @@ def map_cmd(
     refuse_unused(["stop2"], num2 == 1 and stop2 != start2, ONE_VALUE.format(num="--num2", start="--start2"))
     chunk_size = num1 if chunk_size is None else chunk_size
     _check_sweep_options(out, scheduler, chunk_size, num1 * num2, periods, model.n_states, workers, as_json,
-                         "a map")  # fmt: skip
+                         "a map", overwrite)  # fmt: skip
     s1, s2 = np.linspace(start1, stop1, num1), np.linspace(start2, stop2, num2)
     v1 = np.array([par1.from_display(v) for v in s1])
     v2 = np.array([par2.from_display(v) for v in s2])
@@ -371,7 +379,7 @@ def map_cmd(
     )  # fmt: skip
     spec = map_spec(model, n1, v1, n2, v2, x0=x0, settings=settings)
     t0 = time.perf_counter()
-    run = _run_sweep_spec(spec, out, scheduler, workers, as_json, wait, timeout)
+    run = _run_sweep_spec(spec, out, scheduler, workers, as_json, wait, timeout, overwrite=overwrite)
     elapsed = time.perf_counter() - t0
     if as_json:
         ds = run.ds

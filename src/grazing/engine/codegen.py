@@ -13,7 +13,14 @@ once per machine and it calls the model's functions through their addresses
 (:mod:`grazing.engine.abi`).
 
 The cache directory is ``$GRAZING_CACHE_DIR`` if set, else
-``$XDG_CACHE_HOME/grazing`` (``~/.cache/grazing``).
+``$XDG_CACHE_HOME/grazing`` (``~/.cache/grazing``); it is made if missing.  A
+``GRAZING_CACHE_DIR`` that cannot be used (not a folder, not writable) is an
+error of one line: you chose it.  Where the default folder cannot be used (a
+read-only home), the kernels are cached in a private folder of the system's
+temporary folder instead, and one line on stderr says so.  Cache files are
+written all at once, after the compilation succeeded: a failed compilation or
+a full disk leaves nothing in the cache (a full disk is one
+:class:`~grazing.errors.WriteError`).
 """
 
 from __future__ import annotations
@@ -34,12 +41,14 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from grazing.atomic import write_bytes_atomic
 from grazing.core.model import set_kernel_loader
 from grazing.core.options import MACHINE_EPSILON
 from grazing.core.symbolic import SymbolicSystem
 from grazing.engine import driver, interrupts
 from grazing.engine.abi import LANE_SLOTS, SLOTS
 from grazing.engine.records import Result
+from grazing.errors import WriteError
 
 if TYPE_CHECKING:  # pragma: no cover
     import sympy as sp
@@ -275,13 +284,73 @@ def generate_source(system: SymbolicSystem, directions: int = 0, order: int = DE
     return ModelSource("\n\n".join(parts), columns, dispatch, sizes)
 
 
+CACHE_ENV = "GRAZING_CACHE_DIR"
+"""Environment variable naming the folder of the compiled kernels."""
+
+
 def cache_dir() -> Path:
-    """Directory where generated kernel modules (and numba's caches) live."""
-    env = os.environ.get("GRAZING_CACHE_DIR")
+    """Directory where generated kernel modules (and numba's caches) live, as configured (see
+    :func:`usable_cache_dir` for the one used)."""
+    env = os.environ.get(CACHE_ENV)
     if env:
         return Path(env)
     base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
     return Path(base) / "grazing"
+
+
+def _unusable(folder: Path, private: bool = False) -> str | None:
+    """Why ``folder`` cannot hold the cache (made if missing), or None."""
+    try:
+        folder.mkdir(mode=0o700 if private else 0o777, parents=True, exist_ok=True)
+    except OSError as exc:
+        return exc.strerror or str(exc)
+    if not folder.is_dir():
+        return "not a folder"
+    if not os.access(folder, os.W_OK | os.X_OK):
+        return "not writable"
+    uid = getattr(os, "getuid", None)
+    if private and uid is not None and folder.stat().st_uid != uid():
+        return "owned by another user"
+    return None
+
+
+_NOTED: set[Path] = set()
+
+
+def usable_cache_dir() -> Path:
+    """The folder the compiled kernels are cached in: :func:`cache_dir`, made if missing.
+
+    Raises
+    ------
+    WriteError
+        If ``GRAZING_CACHE_DIR`` is set and cannot be used, or neither the
+        default folder nor the private fallback in the temporary folder can.
+    """
+    folder = cache_dir()
+    problem = _unusable(folder)
+    if problem is None:
+        return folder
+    if os.environ.get(CACHE_ENV):
+        raise WriteError(
+            f"{CACHE_ENV}={os.environ[CACHE_ENV]} cannot hold the compiled kernels ({problem}): set it to a "
+            "writable folder, or unset it"
+        )
+    uid = getattr(os, "getuid", lambda: "user")()
+    fallback = Path(tempfile.gettempdir()) / f"grazing-cache-{uid}"
+    second = _unusable(fallback, private=True)
+    if second is not None:
+        raise WriteError(
+            f"no folder can hold the compiled kernels: {folder} ({problem}), {fallback} ({second}); "
+            f"set {CACHE_ENV} to a writable folder"
+        )
+    if folder not in _NOTED:
+        _NOTED.add(folder)
+        print(
+            f"grazing: note: {folder} cannot hold the compiled kernels ({problem}); they are cached in "
+            f"{fallback} (set {CACHE_ENV} to choose)",
+            file=sys.stderr,
+        )
+    return fallback
 
 
 def _key(*parts: Any) -> str:
@@ -354,20 +423,17 @@ def _write_bytecode(path: Path) -> None:
 
 
 def _cached_file(name: str, make: Callable[[], bytes]) -> Path:
-    """The cache file ``name``, written (atomically) with ``make()`` if it is not there yet."""
-    for d in (cache_dir(), Path(tempfile.gettempdir()) / "grazing-cache"):
-        try:
-            d.mkdir(parents=True, exist_ok=True)
-            path = d / name
-            if not path.exists():
-                fd, tmp = tempfile.mkstemp(dir=d, suffix=".tmp")
-                with os.fdopen(fd, "wb") as fh:
-                    fh.write(make())
-                os.replace(tmp, path)
-            return path
-        except OSError:
-            continue
-    raise OSError("no writable cache directory for compiled kernels")  # pragma: no cover
+    """The cache file ``name``, written with ``make()`` if it is not there yet.
+
+    ``make()`` runs first and the file is written all at once after it, so a
+    failed compilation or a failed write (a full disk: a
+    :class:`~grazing.errors.WriteError`) leaves nothing in the cache.
+    """
+    path = usable_cache_dir() / name
+    if not path.exists():
+        data = make()
+        write_bytes_atomic(path, data)
+    return path
 
 
 def load_kernels(key: str, source: Callable[[], str]) -> ModuleType:

@@ -11,7 +11,9 @@ A recording is a CSV file with a header row and the columns
     1 on the sample where the forcing passes its reference phase (the sample
     nearest to that instant), 0 elsewhere.
 
-Other columns are ignored; column names are case-insensitive.  A sidecar
+Other columns are ignored; column names are case-insensitive.  Lines that
+start with ``#`` are comments, before the header or among the rows (grazing
+ends each CSV file it writes with one: :mod:`grazing.outputs`).  A sidecar
 ``NAME.json`` next to ``NAME.csv`` may give ``forcing_hz``, ``theta_hat_deg``
 and anything else (the synthetic recordings write one).
 
@@ -298,9 +300,12 @@ def load_recording(path: str | Path, *, degrees: bool = False) -> Recording:
     except IsADirectoryError:
         raise RecordingError(f"{path}: is a folder, not a CSV file") from None
     lines = text.splitlines()
-    if not lines or not lines[0].strip():
+    first = next((i for i, line in enumerate(lines) if not _is_comment(line)), len(lines))
+    if first == len(lines) or not lines[first].strip():
         raise RecordingError(f"{name}: empty file (expected a header row with time,angle)")
-    header = [h.strip().lower() for h in next(_csv_rows(lines[:1], name), (1, []))[1]]
+    header = [
+        h.strip().lower() for h in next(_csv_rows(lines[first : first + 1], name, first + 1), (1, []))[1]
+    ]
     missing = [c for c in ("time", "angle") if c not in header]
     if missing:
         found = ", ".join(h for h in header if h) or "nothing"
@@ -309,7 +314,7 @@ def load_recording(path: str | Path, *, degrees: bool = False) -> Recording:
             f"{name}: missing column{'s' if len(missing) > 1 else ''} {cols} (found: {found})"
         )
     cols = {c: header.index(c) for c in ("time", "angle", "trigger") if c in header}
-    data = _parse_rows(lines, header, cols, name)
+    data = _parse_rows(lines, header, cols, name, first)
     x = data["angle"]
     if degrees:
         x = np.radians(x)
@@ -332,11 +337,16 @@ def _csv_rows(lines: list[str], name: str, first: int = 1) -> Iterator[tuple[int
         yield first + reader.line_num - 1, row
 
 
+def _is_comment(line: str) -> bool:
+    return line.lstrip().startswith("#")
+
+
 def _parse_rows(
-    lines: list[str], header: list[str], cols: dict[str, int], name: str
+    lines: list[str], header: list[str], cols: dict[str, int], name: str, head: int = 0
 ) -> dict[str, np.ndarray]:
-    """Parse the numeric columns; fast path through numpy, exact error messages from a row loop."""
-    body = "\n".join(lines[1:])
+    """Parse the numeric columns (the header is ``lines[head]``); fast path through numpy (which skips
+    ``#`` comments), exact error messages from a row loop."""
+    body = "\n".join(lines[head + 1 :])
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # "input contained no data": reported below
@@ -347,8 +357,8 @@ def _parse_rows(
         pass
     out: dict[str, list[float]] = {c: [] for c in cols}
     width = len(header)
-    for lineno, row in _csv_rows(lines[1:], name, first=2):
-        if not row or all(not f.strip() for f in row):
+    for lineno, row in _csv_rows(lines[head + 1 :], name, first=head + 2):
+        if not row or all(not f.strip() for f in row) or _is_comment(row[0]):
             continue
         if len(row) < width:
             raise RecordingError(f"{name}: line {lineno}: expected {width} fields, got {len(row)}")

@@ -7,23 +7,26 @@ apparatus (``omega = eta omega_0``, ``omega_0 = 2 sqrt(g_e / L)``) and
 noise, quantisation (a 12-bit converter over one turn), a slow drift of the
 potentiometer's zero, and trigger pulses once per forcing cycle.  Every
 recording says ``"synthetic": true`` in its metadata and sidecar; they are
-test and demonstration data, never the paper's measurements.
+test and demonstration data, never the paper's measurements.  The files carry
+grazing's mark (:mod:`grazing.outputs`): a file of the same name that grazing
+did not write is never replaced, unless ``overwrite`` is given.
 """
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Sequence
+from contextlib import ExitStack
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from grazing.atomic import write_text_atomic
+from grazing.atomic import atomic_path
 from grazing.errors import InvalidParameterError
 from grazing.experiment.apparatus import PAPER_RIG, Apparatus
 from grazing.experiment.recording import Recording, from_arrays
+from grazing.outputs import PYTHON_HINT, check_replaceable, marked_json, write_marked_csv
 
 SAMPLE_RATE = 1000.0
 """The rig's sampling rate (Hz)."""
@@ -225,10 +228,21 @@ def synthetic_free_decay(
     return from_arrays(t, angle, source=f"synthetic free decay r={r:g} beta={beta:g}", metadata=meta)
 
 
-def write_recording(rec: Recording, path: str | Path, *, trigger: bool = True, sidecar: bool = True) -> Path:
+def write_recording(
+    rec: Recording,
+    path: str | Path,
+    *,
+    trigger: bool = True,
+    sidecar: bool = True,
+    overwrite: bool = False,
+    hint: str = PYTHON_HINT,
+) -> Path:
     """Write a recording as CSV (``time,angle[,trigger]``) and its metadata as a sidecar JSON.
 
-    Both files are written through temporaries and renamed, so a failure
+    Both files carry grazing's mark and are checked first: a file at either
+    path that grazing did not write is refused
+    (:class:`~grazing.errors.ForeignFileError`) unless ``overwrite``.  Both are
+    written through temporaries and renamed together at the end, so a failure
     leaves nothing half-written.
 
     Examples
@@ -242,6 +256,10 @@ def write_recording(rec: Recording, path: str | Path, *, trigger: bool = True, s
     (True, True)
     """
     path = Path(path)
+    side = path.with_suffix(".json") if sidecar and rec.metadata else None
+    for target in (path, side):
+        if target is not None:
+            check_replaceable(target, overwrite=overwrite, hint=hint)
     cols = [rec.time, rec.angle]
     head = "time,angle"
     if trigger and rec.trigger_times is not None:
@@ -256,11 +274,26 @@ def write_recording(rec: Recording, path: str | Path, *, trigger: bool = True, s
         if rec.time.size:
             fh.write("\n".join(map(row.__mod__, zip(*(c.tolist() for c in cols)))) + "\n")
 
-    write_text_atomic(path, write_csv)
-    if sidecar and rec.metadata:
-        meta = rec.metadata
-        write_text_atomic(path.with_suffix(".json"), lambda fh: fh.write(json.dumps(meta, indent=1) + "\n"))
+    with ExitStack() as stack:  # (both temporaries written before either is renamed)
+        if side is not None:
+            tmp_side = stack.enter_context(atomic_path(side))
+        tmp = stack.enter_context(atomic_path(path))
+        with open(tmp, "w", newline="", encoding="utf-8") as fh:
+            write_marked_csv(fh, write_csv)
+        if side is not None:
+            text = marked_json(rec.metadata)
+            with open(tmp_side, "w", newline="", encoding="utf-8") as fh:
+                fh.write(text)
     return path
+
+
+def recording_name(theta_hat_deg: float, eta: float, apparatus: Apparatus = PAPER_RIG) -> str:
+    """The file name of a recording of :func:`synthetic_sweep`: ``theta<deg>_<forcing_hz>Hz.csv``.
+
+    >>> recording_name(40.0, 0.446)
+    'theta40_0.459234Hz.csv'
+    """
+    return f"theta{theta_hat_deg:g}_{apparatus.forcing_hz(eta):.6f}Hz.csv"
 
 
 def synthetic_sweep(
@@ -271,6 +304,7 @@ def synthetic_sweep(
     periods: int = 60,
     transient: int = 300,
     seed: int = 0,
+    overwrite: bool = False,
     **kwargs: Any,
 ) -> list[Path]:
     """Synthetic recordings at several forcing frequencies, as an experimenter sweeps.
@@ -289,6 +323,9 @@ def synthetic_sweep(
         Stop angle (degrees) and frequency ratios.
     periods, transient, seed
         As in :func:`synthetic_recording` (the seed is varied per file).
+    overwrite
+        Replace files of the same names that grazing did not write (checked
+        for every file before any work; see :func:`write_recording`).
     **kwargs
         Further :func:`synthetic_recording` arguments.
 
@@ -300,15 +337,18 @@ def synthetic_sweep(
     ['theta40_0.453056Hz.csv', 'theta40_0.459234Hz.csv']
     """
     out = Path(folder)
-    out.mkdir(parents=True, exist_ok=True)
     x = tuple(kwargs.pop("x0", (0.0, 0.0)))
     rig = kwargs.get("apparatus", PAPER_RIG)
+    targets = [out / recording_name(theta_hat_deg, eta, rig) for eta in etas]
+    for target in targets:
+        for p in (target, target.with_suffix(".json")):
+            check_replaceable(p, overwrite=overwrite)
+    out.mkdir(parents=True, exist_ok=True)
     paths = []
-    for j, eta in enumerate(etas):
+    for j, (eta, target) in enumerate(zip(etas, targets)):
         rec = synthetic_recording(
             float(eta), theta_hat_deg, periods=periods, transient=transient, x0=x, seed=seed + j, **kwargs
         )
         x = tuple(rec.metadata["x_final"])
-        name = f"theta{theta_hat_deg:g}_{rig.forcing_hz(eta):.6f}Hz.csv"
-        paths.append(write_recording(rec, out / name))
+        paths.append(write_recording(rec, target, overwrite=overwrite))
     return paths

@@ -228,9 +228,12 @@ class Branch:
         ds.attrs.update(attrs)
         return ds
 
-    def to_netcdf(self, path: str | Path) -> None:
-        """Save :meth:`to_dataset` to a NetCDF file."""
-        self.to_dataset().to_netcdf(path, engine="h5netcdf")
+    def to_netcdf(self, path: str | Path, overwrite: bool = False) -> None:
+        """Save :meth:`to_dataset` to a NetCDF file (:func:`grazing.outputs.write_netcdf`: all at once,
+        with grazing's mark; a file there that grazing did not write is refused unless ``overwrite``)."""
+        from grazing.outputs import write_netcdf
+
+        write_netcdf(path, self.to_dataset(), overwrite=overwrite)
 
 
 # ----------------------------------------------------------------------------

@@ -237,6 +237,9 @@ def grazing_curve(
     return curve
 
 
-def save_dataset(ds: Any, path: str | Path) -> None:
-    """Write an xarray dataset to NetCDF (h5netcdf engine)."""
-    ds.to_netcdf(path, engine="h5netcdf")
+def save_dataset(ds: Any, path: str | Path, overwrite: bool = False) -> None:
+    """Write an xarray dataset to NetCDF (:func:`grazing.outputs.write_netcdf`: all at once, with
+    grazing's mark; a file there that grazing did not write is refused unless ``overwrite``)."""
+    from grazing.outputs import write_netcdf
+
+    write_netcdf(path, ds, overwrite=overwrite)

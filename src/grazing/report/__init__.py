@@ -25,7 +25,6 @@ True
 from __future__ import annotations
 
 import json
-import shutil
 import time
 from collections.abc import Sequence
 from datetime import datetime
@@ -34,7 +33,8 @@ from types import ModuleType
 from typing import Any
 
 import grazing
-from grazing.atomic import scratch_folder, write_text_atomic
+from grazing.atomic import scratch_folder, write_bytes_atomic, write_text_atomic
+from grazing.outputs import owned_folder
 from grazing.report import (
     errata,
     fig02,
@@ -50,6 +50,7 @@ from grazing.report import (
     figstops,
 )
 from grazing.report.base import Comparison, DataFile, Dynamics, FigureResult, Image, Progress
+from grazing.report.folder import check_report_folder, claim_report_folder
 from grazing.report.html import RULES_TEXT, ReportMeta, render, scoreboard
 from grazing.report.provenance import collect, source_root
 from grazing.report.schedule import RESULTS, build_figures
@@ -120,7 +121,7 @@ def _copy_docs(out: Path) -> tuple[tuple[str, str], ...]:
     for title, name in DOCS:
         if (src / name).is_file():
             (out / "docs").mkdir(exist_ok=True)
-            shutil.copyfile(src / name, out / "docs" / name)
+            write_bytes_atomic(out / "docs" / name, (src / name).read_bytes())
             links.append((title, f"docs/{name}"))
     return tuple(links)
 
@@ -150,20 +151,27 @@ def comparisons_json(results: Sequence[FigureResult], meta: ReportMeta) -> dict[
 
 
 def build_report(
-    out_dir: Path | str, progress: Progress | None = None, only: Sequence[str] | None = None
+    out_dir: Path | str,
+    progress: Progress | None = None,
+    only: Sequence[str] | None = None,
+    overwrite: bool = False,
 ) -> Path:
     """Compute the figures; write their PNGs, data, ``comparisons.json`` and ``index.html`` into ``out_dir``.
 
     Parameters
     ----------
     out_dir
-        Directory for the report (created if missing; files of the same name
-        are overwritten, other files are left alone).
+        Folder for the report: a report folder of grazing's (files of the same
+        names are replaced, other files are left alone), an empty folder, or a
+        new folder (made with its parents; see :mod:`grazing.report.folder`).
     progress
         Called with one-line messages as the build proceeds.
     only
         Figure names (``["fig07"]``): rebuild these only, and render the page
         from them and the results of the other figures kept from earlier builds.
+    overwrite
+        Build into a folder that is not a report folder of grazing's, replacing
+        the files of the report's names in it.
 
     Returns
     -------
@@ -185,10 +193,12 @@ def build_report(
     start = time.perf_counter()
     modules = list(FIGURES) if only is None else select(only)
     out = Path(out_dir)
-    (out / RESULTS).mkdir(parents=True, exist_ok=True)
+    check_report_folder(out, overwrite=overwrite)
+    claim_report_folder(out)
+    (out / RESULTS).mkdir(exist_ok=True)
     prov = collect()
     say("compiling the model's kernels (once per machine; loading them when cached)")
-    with scratch_folder(out):  # (a worker stopped while writing leaves nothing in out)
+    with owned_folder(out), scratch_folder(out):  # (a worker stopped while writing leaves nothing in out)
         compile_seconds = build_figures(modules, out, say, prov.commit)
     results = load_results(out)
     done = {r.figure_id for r in results}

@@ -393,12 +393,15 @@ def signed(value: float, digits: int) -> str:
 
 
 def save_png(fig: Figure, path: Path) -> Path:
-    """Save a matplotlib figure as a PNG of :data:`DPI` dots per inch (all at once) and return the path."""
-    from grazing.atomic import atomic_path
+    """Save a matplotlib figure as a PNG of :data:`DPI` dots per inch (all at once, marked); return the path.
 
-    with atomic_path(path, suffix=".png") as tmp:
-        fig.savefig(tmp, dpi=DPI, format="png", metadata={"Software": None})
-    return path
+    Like every output it replaces only a file of grazing's
+    (:func:`grazing.outputs.check_replaceable`); in the folder of a report being
+    built, any file (the folder as a whole is grazing's).
+    """
+    from grazing.outputs import save_png as save_marked_png
+
+    return save_marked_png(fig, path, dpi=DPI)
 
 
 def new_figure(nrows: int, ncols: int, size: tuple[float, float]) -> tuple[Figure, Any]:
@@ -412,15 +415,24 @@ def new_figure(nrows: int, ncols: int, size: tuple[float, float]) -> tuple[Figur
 
 
 def finish_figure(fig: Figure | None, path: str | Path | None, dpi: int = DPI) -> str | None:
-    """Save ``fig`` at ``path`` (if both are given, all at once); the path written, or None."""
-    from grazing.atomic import atomic_path
+    """Save ``fig`` at ``path`` (if both are given, all at once); the path written, or None.
+
+    A PNG (or a name without a suffix, which gets ``.png``) carries grazing's
+    mark and replaces only what :func:`save_png` replaces; other formats are
+    written as matplotlib makes them.
+    """
+    import io
+
+    from grazing.atomic import write_bytes_atomic
+    from grazing.outputs import save_png as save_marked_png
 
     if fig is None or path is None:
         return None
-    suffix = Path(path).suffix
-    if not suffix:  # (matplotlib adds its default format's extension to the name)
-        fig.savefig(path, dpi=dpi)
-        return str(path)
-    with atomic_path(path, suffix=suffix) as tmp:
-        fig.savefig(tmp, dpi=dpi, format=suffix[1:])
+    path = Path(path)
+    if path.suffix.lower() in ("", ".png"):
+        path = path if path.suffix else path.with_suffix(".png")
+        return str(save_marked_png(fig, path, dpi=dpi))
+    buf = io.BytesIO()
+    fig.savefig(buf, dpi=dpi, format=path.suffix[1:])
+    write_bytes_atomic(path, buf.getvalue())
     return str(path)

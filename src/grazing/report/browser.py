@@ -30,6 +30,9 @@ from pathlib import Path
 from typing import Any
 from urllib.parse import unquote, urlparse
 
+from grazing.errors import GrazingError
+from grazing.outputs import check_replaceable, write_png_bytes
+
 CANDIDATES = ("chromium", "chromium-browser", "google-chrome", "google-chrome-stable", "chrome")
 """Executable names tried by :func:`find_chromium`."""
 
@@ -208,6 +211,7 @@ def check_page(
     screenshot: Path | str | None = None,
     width: int = 1400,
     timeout: float = 60.0,
+    overwrite: bool = False,
 ) -> PageCheck:
     """Load ``index`` in headless Chromium and check its images and links.
 
@@ -218,7 +222,9 @@ def check_page(
     chromium
         The browser executable (default: :func:`find_chromium`).
     screenshot
-        If given, a PNG of the whole page is written there.
+        If given, a PNG of the whole page is written there (with grazing's
+        mark; a file there that grazing did not write is refused, before the
+        browser starts, unless ``overwrite``).
     width
         Width of the browser window in CSS pixels.
     timeout
@@ -228,7 +234,11 @@ def check_page(
     ------
     FileNotFoundError
         When no Chromium is found or ``index`` does not exist.
+    ForeignFileError
+        When ``screenshot`` names a file grazing did not write (without ``overwrite``).
     """
+    if screenshot is not None:
+        check_replaceable(screenshot, overwrite=overwrite, hint="use another name, or --overwrite")
     page = Path(index).resolve()
     if not page.is_file():
         raise FileNotFoundError(page)
@@ -267,7 +277,7 @@ def check_page(
                     },
                     session=session,
                 )
-                Path(screenshot).write_bytes(base64.b64decode(shot["data"]))
+                write_png_bytes(screenshot, base64.b64decode(shot["data"]), overwrite=True)  # (checked)
         finally:
             dt.close()
     out = PageCheck(
@@ -294,10 +304,13 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("index", type=Path, help="the report's index.html")
     ap.add_argument("--screenshot", type=Path, help="write a PNG of the whole page here")
     ap.add_argument("--chromium", help="the browser executable (default: chromium on PATH, or $CHROMIUM)")
+    ap.add_argument("--overwrite", action="store_true", help="replace a --screenshot grazing did not write")
     args = ap.parse_args(argv)
     try:
-        res = check_page(args.index, chromium=args.chromium, screenshot=args.screenshot)
-    except FileNotFoundError as exc:
+        res = check_page(
+            args.index, chromium=args.chromium, screenshot=args.screenshot, overwrite=args.overwrite
+        )
+    except (FileNotFoundError, GrazingError) as exc:
         print(f"check-report: {exc}", file=sys.stderr)
         return 2
     for line in res.problems():

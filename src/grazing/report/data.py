@@ -4,7 +4,9 @@ A sweep is written without the angular velocity and with its samples
 compressed (``theta`` in radians, one row per swept value, one column per
 stroboscopic sample), together with the detected period and the impacts per
 period.  Several sweeps of one figure go into one NetCDF file, one group per
-panel: ``xarray.open_dataset(path, group="d")``.
+panel: ``xarray.open_dataset(path, group="d")``.  The NetCDF files carry
+grazing's mark (:mod:`grazing.outputs`), the small CSV tables do not: the
+report's folder as a whole is grazing's (:mod:`grazing.report.folder`).
 
 Examples
 --------
@@ -24,10 +26,8 @@ from typing import Any
 
 import numpy as np
 
-from grazing.atomic import atomic_path, write_text_atomic
-
-ENGINE = "h5netcdf"
-COMPRESSION = {"zlib": True, "complevel": 4}
+from grazing.atomic import write_text_atomic
+from grazing.outputs import write_netcdf
 
 
 def slim_sweep(ds: Any, **attrs: Any) -> Any:
@@ -67,20 +67,13 @@ def slim_sweep(ds: Any, **attrs: Any) -> Any:
 
 
 def write_groups(path: Path, groups: Mapping[str, Any]) -> Path:
-    """Write datasets as the groups of one NetCDF file (replacing the file, all at once)."""
-    with atomic_path(path, suffix=".nc") as tmp:
-        for i, (group, ds) in enumerate(groups.items()):
-            enc = {v: dict(COMPRESSION) for v in ds.data_vars if ds[v].ndim >= 1 and ds[v].dtype.kind == "f"}
-            ds.to_netcdf(tmp, mode="w" if i == 0 else "a", group=group, engine=ENGINE, encoding=enc)
-    return path
+    """Write datasets as the groups of one NetCDF file (replacing it, all at once), floats compressed."""
+    return write_netcdf(path, dict(groups), compress=True)
 
 
 def write_dataset(path: Path, ds: Any) -> Path:
     """Write one dataset to NetCDF (replacing the file, all at once), float variables compressed."""
-    enc = {v: dict(COMPRESSION) for v in ds.data_vars if ds[v].ndim >= 1 and ds[v].dtype.kind == "f"}
-    with atomic_path(path, suffix=".nc") as tmp:
-        ds.to_netcdf(tmp, engine=ENGINE, encoding=enc)
-    return path
+    return write_netcdf(path, ds, compress=True)
 
 
 def write_csv(path: Path, header: Sequence[str], rows: Iterable[Sequence[Any]]) -> None:

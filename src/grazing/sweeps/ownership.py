@@ -25,7 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from grazing.atomic import remove_dead_folders, rename_noreplace
-from grazing.errors import GrazingError, InvalidParameterError
+from grazing.errors import ForeignFileError, GrazingError, WriteError
 from grazing.sweeps.lock import StoreLock
 
 MARKER_GROUP = "grazing"
@@ -39,7 +39,7 @@ MARKER = {MARKER_KEY: "sweep", "grazing_store_format": 1}
 """The attributes that make a Zarr group a grazing sweep store."""
 
 
-class ForeignStoreError(InvalidParameterError):
+class ForeignStoreError(ForeignFileError):
     """Something that grazing did not make is at a store's path (it is left untouched)."""
 
 
@@ -145,10 +145,14 @@ def create_store(path: str | Path, build: Callable[[Path], None], marker: dict[s
             lock.release()
             shutil.rmtree(tmp, ignore_errors=True)
             return None
-    except BaseException:
+    except BaseException as exc:
         if lock is not None:
             lock.release()
         shutil.rmtree(tmp, ignore_errors=True)
+        if isinstance(exc, OSError) and not isinstance(exc, GrazingError):  # a full disk
+            raise WriteError(
+                f"cannot create sweep store {path}: {exc.strerror or exc}; nothing was written"
+            ) from None
         raise
     lock.name = str(path)
     lock.path = path / MARKER_GROUP / LOCK_FILE

@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from grazing.errors import GrazingError
+from grazing.errors import GrazingError, WriteError
 from grazing.sweeps.lock import StoreBusyError, StoreLock
 from grazing.sweeps.ownership import (
     ForeignStoreError,
@@ -392,9 +392,17 @@ class ZarrStore:
 
         sl = self.spec.chunk(res.index)
         part = _flat({name: getattr(res, name) for name in _VARIABLES})
-        part.to_zarr(str(self.path), region={"point": sl}, consolidated=False)
         flag = xr.Dataset({"chunk_done": ("chunk", np.ones(1, dtype=np.int8))})
-        flag.to_zarr(str(self.path), region={"chunk": slice(res.index, res.index + 1)}, consolidated=False)
+        try:
+            part.to_zarr(str(self.path), region={"point": sl}, consolidated=False)
+            flag.to_zarr(
+                str(self.path), region={"chunk": slice(res.index, res.index + 1)}, consolidated=False
+            )
+        except OSError as exc:  # a full disk: the chunk stays unflagged and is computed again on resume
+            raise WriteError(
+                f"cannot write to sweep store {self.path}: {exc.strerror or exc}; the chunks finished "
+                "before are kept: make room and run the command again to resume"
+            ) from None
         self._done[res.index] = True
 
     def _check_complete(self) -> None:

@@ -1,0 +1,445 @@
+"""Files grazing writes: the mark each one carries, the check before one is replaced, and the writers.
+
+Every file grazing writes says so, together with a SHA-256 digest of what it holds:
+
+==========  ===========================================================================
+CSV         a last line ``# written by grazing 0.1.0 (sha256 of the lines above: …)``
+NetCDF      the global attribute ``written_by``: ``grazing 0.1.0 (sha256 of the data: …)``
+PNG         the text chunk ``Software``: ``grazing 0.1.0 (sha256 of the image: …)``
+JSON        the key ``written_by``: ``grazing 0.1.0 (sha256 of the other keys: …)``
+==========  ===========================================================================
+
+A file is grazing's (:func:`written_by_grazing`) when its mark is there and its
+digest matches what the file holds: a file changed after grazing wrote it
+(edited by hand, appended to, re-saved by a program that kept the attribute) is
+no longer grazing's.
+
+Before a file is written, :func:`check_replaceable` refuses to replace a file
+that is not grazing's, with a one-line :class:`~grazing.errors.ForeignFileError`,
+unless ``overwrite`` is given; a file grazing wrote is replaced, and so is any
+file in a folder that is grazing's as a whole (a report's folder, inside
+:func:`owned_folder`).  A symbolic link
+is followed: the file it points to is checked and replaced, never the link.  A
+folder, a device or a pipe is never replaced.  Every file is written all at once
+(:mod:`grazing.atomic`); a NetCDF file is serialised in memory first and written
+with plain file I/O, so that libhdf5 never sees a full disk: a failed write is
+one :class:`~grazing.errors.WriteError` and leaves nothing.
+
+The CSV mark is a comment line: numpy's ``loadtxt`` and ``genfromtxt`` skip it
+as they are, pandas with ``read_csv(path, comment="#")``, and grazing's
+recording reader skips comment lines.
+
+Examples
+--------
+>>> import tempfile, pathlib
+>>> p = pathlib.Path(tempfile.mkdtemp()) / "t.csv"
+>>> write_csv(p, lambda fh: fh.write("r,beta\\n0.5,0.01\\n"))
+>>> p.read_text().splitlines()[:2], written_by_grazing(p)
+(['r,beta', '0.5,0.01'], True)
+>>> _ = p.write_text(p.read_text().replace("0.01", "0.02"))  # changed by hand: no longer grazing's
+>>> written_by_grazing(p)
+False
+>>> write_csv(p, lambda fh: fh.write("r,beta\\n"))
+Traceback (most recent call last):
+...
+grazing.errors.ForeignFileError: ... exists and was not written by grazing (or was changed since); ...
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import io
+import json
+import os
+import re
+import stat
+import struct
+import zlib
+from collections.abc import Callable, Iterator, Mapping
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any
+
+from grazing.atomic import resolved, write_bytes_atomic, write_text_atomic
+from grazing.errors import ForeignFileError
+
+MARK_KEY = "written_by"
+"""The NetCDF global attribute and the JSON key that hold the mark."""
+
+PNG_MARK_KEY = "Software"
+"""The PNG text chunk that holds the mark (the standard keyword for the program that made the image)."""
+
+CSV_MARK_PREFIX = "# written by "
+"""The start of the last line of a CSV file grazing wrote."""
+
+PYTHON_HINT = "write elsewhere, or pass overwrite=True to replace it"
+"""How a refusal ends for a caller in Python (the CLI says ``--overwrite``)."""
+
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
+
+COMPRESSION = {"zlib": True, "complevel": 4}
+"""The encoding of compressed float variables (:func:`write_netcdf` with ``compress=True``)."""
+
+_MARK = re.compile(r"grazing (\S+) \(sha256 of [a-z ]+: ([0-9a-f]{64})\)")
+_MAX_SMALL_FILE = 256 * 2**20
+"""JSON and PNG files larger than this are not grazing's (it writes none so large)."""
+
+
+@functools.cache
+def _version() -> str:
+    import grazing
+
+    return str(grazing.__version__)
+
+
+def mark_text(what: str, digest: str) -> str:
+    """The mark: ``grazing VERSION (sha256 of WHAT: DIGEST)``."""
+    return f"grazing {_version()} (sha256 of {what}: {digest})"
+
+
+def _digest_of_mark(text: Any) -> str | None:
+    if isinstance(text, bytes):
+        text = text.decode("utf-8", "replace")
+    m = _MARK.fullmatch(str(text).strip())
+    return m.group(2) if m else None
+
+
+# ----------------------------------------------------------------------------
+# Ownership
+
+
+_OWNED: list[Path] = []
+"""Folders that are grazing's as a whole while this process (and the workers it forks) writes them."""
+
+
+@contextmanager
+def owned_folder(root: str | Path) -> Iterator[None]:
+    """Within the block, any file under ``root`` may be replaced: ``root`` is grazing's as a whole.
+
+    The caller has checked it (a report's folder).  Workers forked inside the block inherit it.
+    """
+    key = Path(root).resolve()
+    _OWNED.append(key)
+    try:
+        yield
+    finally:
+        _OWNED.remove(key)
+
+
+def _in_owned_folder(path: Path) -> bool:
+    if not _OWNED:
+        return False
+    here = path.resolve().parent
+    return any(here == root or root in here.parents for root in _OWNED)
+
+
+def written_by_grazing(path: str | Path) -> bool:
+    """Whether the file at ``path`` carries grazing's mark and is unchanged since grazing wrote it.
+
+    Anything that cannot be read or parsed, or is no regular file, is not grazing's.
+    """
+    try:
+        target = resolved(path)
+        if not stat.S_ISREG(os.stat(target).st_mode):  # (a pipe would block the read)
+            return False
+        with open(target, "rb") as fh:
+            head = fh.read(8)
+            if head == HDF5_SIGNATURE:
+                fh.seek(0)
+                return _netcdf_is_ours(fh)
+            size = os.fstat(fh.fileno()).st_size
+            if head == PNG_SIGNATURE:
+                return size <= _MAX_SMALL_FILE and _png_is_ours(head + fh.read())
+            if head.lstrip().startswith(b"{"):
+                return size <= _MAX_SMALL_FILE and _json_is_ours(head + fh.read())
+            return _csv_is_ours(fh, size)
+    except Exception:  # unreadable, or not the format its first bytes say: the mark cannot be confirmed
+        return False
+
+
+def check_replaceable(path: str | Path, *, overwrite: bool = False, hint: str = PYTHON_HINT) -> None:
+    """Raise :class:`~grazing.errors.ForeignFileError` unless a file may be written at ``path``.
+
+    A file may be written where nothing is, or where grazing's file is (or any
+    regular file, with ``overwrite``); a symbolic link is followed.  Never a
+    folder, a device or a pipe.  Nothing is modified.
+
+    Parameters
+    ----------
+    path
+        Where the file is to go.
+    overwrite
+        Replace a regular file that grazing did not write.
+    hint
+        How the message ends (what the caller can do instead).
+    """
+    shown = Path(path)
+    target = resolved(shown)
+    if not os.path.lexists(target):
+        return
+    if target != shown:
+        shown = Path(f"{shown} (a link to {target})")
+    try:
+        mode = os.stat(target).st_mode
+    except OSError as exc:
+        raise ForeignFileError(f"{shown} cannot be checked ({exc.strerror}); it was left untouched") from None
+    if stat.S_ISDIR(mode):
+        raise ForeignFileError(f"{shown} is a folder; it was left untouched: name a file")
+    if not stat.S_ISREG(mode):
+        raise ForeignFileError(f"{shown} is not a regular file; it was left untouched: name a file")
+    if overwrite or _in_owned_folder(target) or written_by_grazing(target):
+        return
+    raise ForeignFileError(
+        f"{shown} exists and was not written by grazing (or was changed since); it was left untouched: {hint}"
+    )
+
+
+# ----------------------------------------------------------------------------
+# CSV (and other text tables)
+
+
+class _HashingWriter:
+    """A text file handle that also hashes what is written (as the UTF-8 bytes that reach the file)."""
+
+    def __init__(self, fh: Any):
+        self.fh = fh
+        self.sha = hashlib.sha256()
+        self.last = "\n"
+
+    def write(self, text: str) -> int:
+        if text:
+            self.sha.update(text.encode("utf-8"))
+            self.last = text[-1]
+        return self.fh.write(text)
+
+
+def write_csv(
+    path: str | Path, write: Callable[[Any], Any], *, overwrite: bool = False, hint: str = PYTHON_HINT
+) -> None:
+    """Write a text table through ``write(file_handle)``, all at once, with grazing's mark as its last line.
+
+    ``path`` is checked first (:func:`check_replaceable`).
+    """
+    check_replaceable(path, overwrite=overwrite, hint=hint)
+    write_text_atomic(path, lambda fh: write_marked_csv(fh, write))
+
+
+def write_marked_csv(fh: Any, write: Callable[[Any], Any]) -> None:
+    """Write a text table into the open file ``fh`` through ``write(file_handle)``, then grazing's mark."""
+    out = _HashingWriter(fh)
+    write(out)
+    if out.last != "\n":
+        out.write("\n")
+    fh.write(f"{CSV_MARK_PREFIX}{mark_text('the lines above', out.sha.hexdigest())}\n")
+
+
+def _csv_is_ours(fh: Any, size: int) -> bool:
+    tail_start = max(0, size - 4096)
+    fh.seek(tail_start)
+    tail = fh.read()
+    if not tail.endswith(b"\n"):
+        return False
+    cut = tail.rfind(b"\n", 0, len(tail) - 1) + 1
+    if cut == 0 and tail_start > 0:
+        return False  # a last line over 4 kB: not the mark
+    last = tail[cut:-1].decode("utf-8", "replace")
+    if not last.startswith(CSV_MARK_PREFIX):
+        return False
+    digest = _digest_of_mark(last[len(CSV_MARK_PREFIX) :])
+    if digest is None:
+        return False
+    sha, left = hashlib.sha256(), tail_start + cut
+    fh.seek(0)
+    while left > 0:
+        block = fh.read(min(left, 2**20))
+        if not block:
+            return False
+        sha.update(block)
+        left -= len(block)
+    return sha.hexdigest() == digest
+
+
+# ----------------------------------------------------------------------------
+# JSON
+
+
+def _canonical_json(obj: Any) -> bytes:
+    return json.dumps(obj, sort_keys=True, separators=(",", ":"), ensure_ascii=True).encode()
+
+
+def write_json(
+    path: str | Path, obj: Mapping[str, Any], *, overwrite: bool = False, hint: str = PYTHON_HINT
+) -> None:
+    """Write a JSON object (indented), all at once, with grazing's mark as its last key."""
+    check_replaceable(path, overwrite=overwrite, hint=hint)
+    text = marked_json(obj)
+    write_text_atomic(path, lambda fh: fh.write(text))
+
+
+def marked_json(obj: Mapping[str, Any]) -> str:
+    """The text of a JSON object (indented) with grazing's mark as its last key (an earlier mark dropped)."""
+    body = {k: v for k, v in obj.items() if k != MARK_KEY}
+    digest = hashlib.sha256(_canonical_json(body)).hexdigest()
+    return json.dumps({**body, MARK_KEY: mark_text("the other keys", digest)}, indent=1) + "\n"
+
+
+def _json_is_ours(data: bytes) -> bool:
+    obj = json.loads(data.decode("utf-8"))
+    if not isinstance(obj, dict):
+        return False
+    digest = _digest_of_mark(obj.pop(MARK_KEY, ""))
+    return digest is not None and hashlib.sha256(_canonical_json(obj)).hexdigest() == digest
+
+
+# ----------------------------------------------------------------------------
+# PNG
+
+
+def _png_chunks(data: bytes) -> list[tuple[bytes, bytes]]:
+    """The ``(type, payload)`` of every chunk of a PNG file (ValueError if it is not one)."""
+    if not data.startswith(PNG_SIGNATURE):
+        raise ValueError("not a PNG file")
+    chunks, i = [], len(PNG_SIGNATURE)
+    while i < len(data):
+        if i + 12 > len(data):
+            raise ValueError("truncated PNG chunk")
+        (length,) = struct.unpack(">I", data[i : i + 4])
+        kind, payload = data[i + 4 : i + 8], data[i + 8 : i + 8 + length]
+        if len(payload) != length:
+            raise ValueError("truncated PNG chunk")
+        chunks.append((kind, payload))
+        i += 12 + length
+        if kind == b"IEND":
+            break
+    if i != len(data) or not chunks or chunks[-1][0] != b"IEND":
+        raise ValueError("not a whole PNG file (bytes after its end, or no end)")
+    return chunks
+
+
+def _is_png_mark(kind: bytes, payload: bytes) -> bool:
+    key, sep, text = payload.partition(b"\0")
+    ours = kind == b"tEXt" and sep == b"\0" and key == PNG_MARK_KEY.encode()
+    return ours and _digest_of_mark(text) is not None
+
+
+def _png_digest(chunks: list[tuple[bytes, bytes]]) -> str:
+    sha = hashlib.sha256()
+    for kind, payload in chunks:
+        if not _is_png_mark(kind, payload):
+            sha.update(kind + struct.pack(">I", len(payload)) + payload)
+    return sha.hexdigest()
+
+
+def _png_chunk(kind: bytes, payload: bytes) -> bytes:
+    return struct.pack(">I", len(payload)) + kind + payload + struct.pack(">I", zlib.crc32(kind + payload))
+
+
+def mark_png(data: bytes) -> bytes:
+    """A PNG file's bytes with grazing's mark (a ``Software`` text chunk right after the header)."""
+    chunks = [c for c in _png_chunks(data) if not _is_png_mark(*c)]
+    text = f"{PNG_MARK_KEY}\0{mark_text('the image', _png_digest(chunks))}".encode("latin-1")
+    out = [PNG_SIGNATURE]
+    for kind, payload in chunks:
+        out.append(_png_chunk(kind, payload))
+        if kind == b"IHDR":
+            out.append(_png_chunk(b"tEXt", text))
+    return b"".join(out)
+
+
+def _png_is_ours(data: bytes) -> bool:
+    chunks = _png_chunks(data)
+    marks = [_digest_of_mark(p.partition(b"\0")[2]) for k, p in chunks if _is_png_mark(k, p)]
+    return len(marks) == 1 and marks[0] == _png_digest(chunks)
+
+
+def save_png(
+    fig: Any, path: str | Path, *, dpi: float, overwrite: bool = False, hint: str = PYTHON_HINT
+) -> Path:
+    """Save a matplotlib figure as a PNG with grazing's mark, all at once; return the path."""
+    check_replaceable(path, overwrite=overwrite, hint=hint)
+    buf = io.BytesIO()
+    fig.savefig(buf, dpi=dpi, format="png", metadata={"Software": None})
+    write_bytes_atomic(path, mark_png(buf.getvalue()))
+    return Path(path)
+
+
+def write_png_bytes(
+    path: str | Path, data: bytes, *, overwrite: bool = False, hint: str = PYTHON_HINT
+) -> None:
+    """Write a PNG image given as bytes (a screenshot...) with grazing's mark, all at once."""
+    check_replaceable(path, overwrite=overwrite, hint=hint)
+    write_bytes_atomic(path, mark_png(data))
+
+
+# ----------------------------------------------------------------------------
+# NetCDF
+
+
+def _hdf5_digest(h5: Any) -> str:
+    """SHA-256 of every dataset of an open HDF5 file: its name, type, shape and values."""
+    import h5py
+    import numpy as np
+
+    names: list[str] = []
+    h5.visititems(lambda name, obj: names.append(name) if isinstance(obj, h5py.Dataset) else None)
+    sha = hashlib.sha256()
+    for name in sorted(names):
+        d = h5[name]
+        sha.update(f"{name}\0{d.dtype.str}\0{d.shape}\0".encode())
+        values = d[()]
+        if isinstance(values, h5py.Empty):
+            continue
+        values = np.asarray(values)
+        if values.dtype.kind == "O":
+            sha.update(b"\0".join(v if isinstance(v, bytes) else str(v).encode() for v in values.ravel()))
+        else:
+            sha.update(np.ascontiguousarray(values).tobytes())
+    return sha.hexdigest()
+
+
+def _netcdf_is_ours(fh: Any) -> bool:
+    import h5py
+
+    with h5py.File(fh, "r") as h5:  # (a file object: no HDF5 file locking, which some mounts lack)
+        digest = _digest_of_mark(h5.attrs.get(MARK_KEY, ""))
+        return digest is not None and _hdf5_digest(h5) == digest
+
+
+def netcdf_bytes(data: Any, *, compress: bool = False) -> memoryview:
+    """A dataset, or ``{group: dataset}``, as the bytes of a NetCDF-4 file with grazing's mark.
+
+    The file is built in memory (h5netcdf on a :class:`io.BytesIO`): libhdf5
+    writes nothing to disk.  With ``compress`` every float variable of one or
+    more dimensions is compressed (:data:`COMPRESSION`).
+    """
+    import h5py
+
+    groups = {None: data} if hasattr(data, "data_vars") else data  # (a Dataset is a Mapping too)
+    buf = io.BytesIO()
+    for i, (group, ds) in enumerate(groups.items()):
+        enc = {}
+        if compress:
+            enc = {v: dict(COMPRESSION) for v in ds.data_vars if ds[v].ndim >= 1 and ds[v].dtype.kind == "f"}
+        if MARK_KEY in ds.attrs:  # (a dataset read from a file of grazing's: its old mark is not this file's)
+            ds = ds.copy(deep=False)
+            del ds.attrs[MARK_KEY]
+        ds.to_netcdf(buf, mode="w" if i == 0 else "a", group=group, engine="h5netcdf", encoding=enc)
+    with h5py.File(buf, "r+") as h5:
+        h5.attrs[MARK_KEY] = mark_text("the data", _hdf5_digest(h5))
+    return buf.getbuffer()
+
+
+def write_netcdf(
+    path: str | Path, data: Any, *, compress: bool = False, overwrite: bool = False, hint: str = PYTHON_HINT
+) -> Path:
+    """Write a dataset, or ``{group: dataset}``, to a NetCDF file with grazing's mark, all at once.
+
+    ``path`` is checked first (:func:`check_replaceable`); the file is built in
+    memory (:func:`netcdf_bytes`) and written with plain file I/O, so a full
+    disk is a :class:`~grazing.errors.WriteError` and leaves nothing.
+    """
+    check_replaceable(path, overwrite=overwrite, hint=hint)
+    write_bytes_atomic(path, netcdf_bytes(data, compress=compress))
+    return Path(path)
