@@ -19,7 +19,7 @@ import pytest
 from hypothesis import assume, given, settings
 
 import grazing
-from tests.engine.reference import assert_agrees
+from tests.engine.reference import MAX_AMPLIFICATION, amplification, assert_agrees
 from tests.random_models import ModelSpec, model_specs
 
 PERIODS = 2
@@ -65,7 +65,9 @@ def check_model(spec: ModelSpec) -> None:
         fd[:, j] = (a.x_final - b.x_final) / (2 * h)
     np.testing.assert_allclose(J, fd, rtol=0, atol=2e-5 * max(1.0, float(np.max(np.abs(fd)))))
 
-    # 2b. The samples and impacts agree with scipy's event loop on the sympy expressions.
+    # 2b. The samples and impacts agree with scipy's event loop on the sympy expressions (where
+    # the comparison is well-conditioned: a random model may be chaotic even over two periods).
+    assume(amplification(model, x0, t0=t0, phase=phase, periods=PERIODS) <= MAX_AMPLIFICATION)
     assert_agrees(model, x0, t0=t0, phase=phase, periods=PERIODS)
 
     # 3. Parameter sensitivities, the period-setting frequency included.
