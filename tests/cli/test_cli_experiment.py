@@ -70,9 +70,17 @@ def test_fit_json(cli, capsys):
     )
     assert code == 0, err
     res = json.loads(out)
+    # the fit's two conditions, checked directly: case B's grazing at 40 deg is at the given eta, and
+    # the damping of (r, beta) by the model's free decay (the default relation) is the given D
+    from grazing.experiment import grazing_eta, model_damping
+
+    assert res["eta_graze"] == pytest.approx(0.445, abs=1e-7)
+    assert grazing_eta(40.0, res["beta"]) == pytest.approx(0.445, abs=1e-7)
+    assert model_damping(res["r"], res["beta"]).damping == pytest.approx(0.07, abs=1e-5)
+    # regression pins of the solution (close to the paper's case B, beta = 0.048, r = 0.7675, which
+    # it fitted with another relation: tests/experiment/test_fit.py)
     assert res["beta"] == pytest.approx(0.0478, abs=2e-4)
     assert res["r"] == pytest.approx(0.872, abs=2e-3)
-    assert res["eta_graze"] == pytest.approx(0.445, abs=1e-7)
 
 
 def test_analyze_file_json_and_plot(cli, capsys, tmp_path, period5_csv):

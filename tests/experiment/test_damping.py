@@ -127,6 +127,8 @@ def test_paper_points_relation_and_reconstruction():
         assert paper_relation(r, b) == pytest.approx(0.07, abs=0.0021), name
         assert paper_protocol_damping(r, b).damping == pytest.approx(0.07, abs=0.0011), name
     model = [model_damping(r, b).damping for r, b in PAPER_POINTS.values()]
+    # regression pins of the model's eq. 6 damping at A-D (its limits, impacts alone and linear
+    # damping alone, are checked in closed form by test_iso_damping_points_give_the_target)
     assert model == pytest.approx([0.1301, 0.0905, 0.0794, 0.0689], abs=2e-4)
     c = iso_damping(0.07, num=3, relation="paper")
     assert c.r_min == pytest.approx(math.exp(-4 * math.pi * 0.07)) and c.beta_max == pytest.approx(0.07)

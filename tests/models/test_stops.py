@@ -20,7 +20,8 @@ from hypothesis import strategies as st
 
 import grazing
 from grazing.models import impact_damper, impact_oscillator, pendulum, two_sided_oscillator
-from grazing.orbits import find_grazings, find_orbit
+from grazing.orbits import continue_orbit, find_grazings, find_orbit
+from grazing.sweeps import sweep
 from tests.engine.reference import assert_agrees
 
 
@@ -88,6 +89,78 @@ def test_impact_damper_agrees_with_scipy_on_its_periodic_attractor() -> None:
     settled = grazing.simulate(m, [0.0, 0.0, 0.0, 0.0], transient=600, periods=1)
     ref = assert_agrees(m, settled.x_final, t0=settled.t_final, periods=100)
     assert set(ref.impacts_stop.tolist()) == {0, 1}
+
+
+# -- the impact damper (4 states, two walls) in the default suite: orbit, grazing, sweep, continue -------
+
+TUNED = dict(omega2=0.8, amp=0.3, omega=0.6)
+"""A spring on the secondary mass: the nonimpacting motion is the linear response, which grazes the walls."""
+
+
+def damper_linear_response(m: grazing.HybridModel) -> tuple[complex, complex]:
+    """Complex amplitudes (X1, X2) of the nonimpacting motion x = Re(X e^(i omega t)), in closed form.
+
+    With s = i omega and k = 2 zeta2 omega2 s + omega2^2: (s^2 + 2 zeta s + 1 + mu k) X1 - mu k X2 = amp
+    and (s^2 + k) X2 = k X1.
+    """
+    p = m.params
+    s = 1j * p["omega"]
+    k = 2 * p["zeta2"] * p["omega2"] * s + p["omega2"] ** 2
+    x1 = p["amp"] / (s * s + 2 * p["zeta"] * s + 1 + p["mu"] * k - p["mu"] * k * k / (s * s + k))
+    return x1, k * x1 / (s * s + k)
+
+
+def test_impact_damper_orbit_hits_both_walls_with_the_closed_form_determinant() -> None:
+    """det(monodromy) = r^(2k) exp(-2 zeta T) (a free secondary mass: trace -2 zeta; each impact's
+    saltation matrix has determinant (-r) (-r): the reset's and the relative velocity's ratio)."""
+    m = impact_damper()
+    x0 = grazing.simulate(m, [0.0] * 4, transient=300, periods=1).x_final
+    orbit = find_orbit(m, x0, period=1)
+    assert orbit.impacts == 2 and sorted(orbit.impact_stops.tolist()) == [0, 1] and orbit.stable
+    p = m.params
+    assert np.linalg.det(orbit.monodromy) == pytest.approx(
+        p["r"] ** 4 * math.exp(-2 * p["zeta"] * m.period), rel=1e-9
+    )
+
+
+def test_impact_damper_grazing_gap_is_the_linear_amplitude() -> None:
+    """The right wall is grazed where the gap equals the amplitude |X2 - X1| of the relative motion."""
+    m = impact_damper(**TUNED)
+    x1, x2 = damper_linear_response(m)
+    points, _ = find_grazings(m, "gap", 5.0, 0.05, stop_name="right")
+    assert len(points) == 1 and points[0].stop_name == "right"
+    assert points[0].model.params["gap"] == pytest.approx(abs(x2 - x1), abs=1e-9)
+    g = points[0]
+    assert abs(g.model.guard(g.contact, g.t_graze, "right")) < 1e-9
+
+
+def test_impact_damper_sweep_in_the_gap() -> None:
+    """Rattling (two impacts per period) in a narrow cavity; the linear response in a wide one."""
+    m = impact_damper(**TUNED)
+    gaps = [0.3, 0.5, 1.0, 2.0]  # the walls are grazed at 0.675
+    ds = sweep(m, "gap", gaps, transient=200, periods=16, workers=1)
+    assert ds.period.values.tolist() == [1, 1, 1, 1]
+    assert ds.impacts_per_period.values.tolist() == [2.0, 2.0, 0.0, 0.0]
+    x1, x2 = damper_linear_response(m)
+    w = m.params["omega"]  # samples at t = k T: x = Re X, v = Re(i omega X)
+    free = [x1.real, -w * x1.imag, x2.real, -w * x2.imag]
+    np.testing.assert_allclose(ds.samples.values[2:], np.broadcast_to(free, (2, 16, 4)), atol=1e-9)
+    for gap, samples in zip(gaps[:2], ds.samples.values[:2]):
+        orbit = find_orbit(m.with_params(gap=gap), samples[-1], period=1)
+        assert orbit.stable and orbit.impacts == 2
+        np.testing.assert_allclose(samples[-1], orbit.state, atol=1e-8)
+
+
+def test_impact_damper_nonimpacting_branch_ends_at_the_grazing() -> None:
+    m = impact_damper(**TUNED)
+    x1, x2 = damper_linear_response(m)
+    free = find_orbit(m.with_params(gap=2.0), period=1)
+    assert free.impacts == 0 and free.stable
+    branch = continue_orbit(m, "gap", 2.0, 0.3, orbit=free)
+    assert [s.kind for s in branch.special] == ["grazing"]
+    # both walls at once: the relative motion is symmetric
+    assert branch.special[0].param == pytest.approx(abs(x2 - x1), abs=1e-9)
+    assert "grazing" in branch.status and all(o.impacts == 0 for o in branch.orbits)
 
 
 @pytest.mark.slow

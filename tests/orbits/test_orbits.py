@@ -71,7 +71,7 @@ def test_determinant_identity_for_periodic_orbits(eta, theta_hat):
 
 
 def test_no_orbit_of_that_period_is_a_clear_error():
-    m = pendulum("B", eta=0.4458, theta_hat=40 * DEG)  # chaotic just past grazing (fig 11)
+    m = pendulum("B", eta=0.4458, theta_hat=40 * DEG)  # fig 11's η: the period-5 window, no period-3 orbit
     with pytest.raises(ConvergenceError, match=r"Newton did not converge to a period-3 orbit: residual"):
         find_orbit(m, [0.1, 0.1], period=3, max_iter=8)
 
