@@ -24,7 +24,7 @@ from scipy.optimize import brentq, minimize_scalar, root
 
 import grazing
 from grazing.models import bouncing_ball, impact_oscillator
-from grazing.orbits import continue_orbit, find_grazings, find_orbit
+from grazing.orbits import continue_orbit, find_grazings, find_orbit, grazing_curve
 
 R, G, W = 0.5, 1.0, 1.0
 
@@ -99,6 +99,22 @@ def test_impact_oscillator_grazing_in_omega_and_in_sigma():
     w = 2.8
     points, _ = find_grazings(impact_oscillator(zeta=ZETA, omega=w, sigma=1.0, r=REST), "sigma", 1.0, 0.01)
     assert [p.model.params["sigma"] for p in points] == pytest.approx([oscillator_amplitude(w)], abs=1e-10)
+
+
+def test_a_grazing_curve_in_restitution_ends_exactly_at_r_equal_to_one():
+    # r does not change the nonimpacting orbit: the curve is omega = const (the closed-form grazing
+    # frequency) from r = 0.5 up to r's own upper bound, 1, where it ends (it stopped on a step size
+    # that fell below its minimum just short of 1).
+    sigma = 0.1
+    curve = grazing_curve(impact_oscillator(zeta=ZETA, sigma=sigma, r=REST), ("omega", "r"), 0.5,
+                          search=(2.5, 4.0))  # fmt: skip
+    expected = brentq(lambda w: oscillator_amplitude(w) - sigma, 2.5, 4.0, xtol=1e-15)
+    assert curve.status == "reached the bound r = 1"
+    r_values = [p.model.params["r"] for p in curve.points]
+    assert r_values[0] == 0.5 and r_values[-1] == 1.0
+    assert [p.model.params["omega"] for p in curve.points] == pytest.approx(
+        [expected] * len(r_values), abs=1e-9
+    )
 
 
 def _impacting_orbit_closed_form(sigma: float):

@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from grazing.core.model import HybridModel
+from grazing.core.model import HybridModel, Parameter
 from grazing.errors import ConvergenceError, GrazingWarning, InvalidParameterError
 from grazing.orbits.contact import GrazingPoint, contact_system
 from grazing.orbits.continuation import Branch, continue_orbit
@@ -215,7 +215,7 @@ def grazing_curve(
         PalcPoint(u0, F, DF, pay),
         index=n + 2,
         sign=1.0,
-        bounds={n + 1: search, n + 2: (start, math.inf)},
+        bounds={n + 1: search, n + 2: (start, _closed_upper(model.parameter(p2)))},
         settings=s,
         names={n: "t_graze", n + 1: p1, n + 2: p2},
         shows={n + 1: model.parameter(p1).show, n + 2: model.parameter(p2).show},
@@ -243,3 +243,8 @@ def save_dataset(ds: Any, path: str | Path, overwrite: bool = False) -> None:
     from grazing.outputs import write_netcdf
 
     write_netcdf(path, ds, overwrite=overwrite)
+
+
+def _closed_upper(par: Parameter) -> float:
+    """Where a curve moving up in ``par`` ends: its upper bound if the parameter may take it (r = 1)."""
+    return par.upper if not par.upper_open else math.inf
