@@ -80,12 +80,12 @@ def unsupported(expr: Any, where: str) -> str | None:
     for node in sp.preorder_traversal(expr):
         if isinstance(node, (sp.Symbol, sp.Add, sp.Mul, sp.Pow)):
             continue
-        if isinstance(node, (sp.Number, sp.NumberSymbol)):
+        if node is sp.I:
+            return f"the imaginary unit I in {where}: a model's expressions are real"
+        if node.is_Atom and node.is_number:  # numbers, pi, E, oo, nan, zoo
             if node.is_extended_real and node.is_finite:
                 continue
             return f"{_shown(node)} in {where} is not a finite real number"
-        if node is sp.I:
-            return f"the imaginary unit I in {where}: a model's expressions are real"
         if isinstance(node, AppliedUndef):
             return (
                 f"{_shown(node)} in {where} is an undefined function: write it out with supported "
