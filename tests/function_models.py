@@ -62,10 +62,12 @@ def smooth_oscillator(**values: float) -> grazing.HybridModel:
 
         x' = v
         v' = -k tanh(x) - c atan(v) + amp (2 + sin(w t))^p cos(w t) + (2 + x^2)^(v/4) / 10
-        a stop where x + x^2/20 = gap (a curved guard), v <- -r v
+        a stop where x + atan(x^2)/20 = gap, v <- -r v (1 + tanh(x)/10)
 
     The exponent ``p`` is a parameter (its sensitivity goes through ``log`` of the
-    base), and ``(2 + x^2)^(v/4)`` a power with both base and exponent variable.
+    base), and ``(2 + x^2)^(v/4)`` a power with both base and exponent variable.  The guard and
+    the reset use the new functions too (their derivatives, the saltation matrix and the sticking
+    field are generated from them).
     """
     x, v, t = sp.symbols("x v t")
     k, c, amp, w, p, gap, r = sp.symbols("k c amp w p gap r")
@@ -86,7 +88,7 @@ def smooth_oscillator(**values: float) -> grazing.HybridModel:
         + (2 + x**2) ** (v / 4) / 10
     )
     model = grazing.HybridModel(
-        "smooth-oscillator", [x, v], t, params, vector_field=[v, accel], guard=gap - x - x**2 / 20,
-        reset=[x, -r * v], period=2 * sp.pi / w, contact_direction=[0, 1],
+        "smooth-oscillator", [x, v], t, params, vector_field=[v, accel], guard=gap - x - sp.atan(x**2) / 20,
+        reset=[x, -r * v * (1 + sp.tanh(x) / 10)], period=2 * sp.pi / w, contact_direction=[0, 1],
     )  # fmt: skip
     return model.with_params(**values) if values else model

@@ -64,14 +64,14 @@ def test_jacobian_and_sensitivities_against_central_differences(model) -> None:
 
 
 def test_compiled_derivatives_against_central_differences(model) -> None:
-    """f_x (of the compiled vector field), the guard's gradient and the contact's normal rate."""
+    """f_x, g_x (of the compiled vector field and reset), the guard's gradient and its normal rate."""
     rng = np.random.default_rng(5)
     kern = model.kernels()
     pv = model.param_vector
     h = 1e-6
     for _ in range(5):
         x, t = rng.normal(size=2), float(rng.uniform(0, model.period))
-        fx, hx, _ = model.jacobians(x, t)  # (sympy's derivatives, lambdified)
+        fx, hx, gx_reset = model.jacobians(x, t)  # (sympy's derivatives, lambdified)
         gx = np.zeros(2)
         ht = kern.guard_grad(x, t, pv, gx, 0)
         for j in range(2):
@@ -79,6 +79,8 @@ def test_compiled_derivatives_against_central_differences(model) -> None:
             e[j] = h
             fd_f = (model.vector_field(x + e, t) - model.vector_field(x - e, t)) / (2 * h)
             np.testing.assert_allclose(fx[:, j], fd_f, rtol=1e-7, atol=1e-7)
+            fd_g = (model.reset(x + e, t) - model.reset(x - e, t)) / (2 * h)
+            np.testing.assert_allclose(gx_reset[:, j], fd_g, rtol=1e-7, atol=1e-7)
             fd_h = (model.guard(x + e, t) - model.guard(x - e, t)) / (2 * h)
             assert gx[j] == pytest.approx(fd_h, rel=1e-7, abs=1e-7) == hx[j]
         assert ht == 0.0
