@@ -6,7 +6,8 @@ kind of power, defined for every real ``q`` (arguments of ``asin``, ``acos``,
 non-integer powers positive); :func:`smooth_term` is ``f(q) - f(0)``, which
 :mod:`tests.random_models` adds to its drawn models.  :func:`smooth_oscillator`
 is a fixed model using several of them at once, with a parameter in an
-exponent and a power whose base and exponent are both states.
+exponent and a power whose base and exponent are both states, and
+:func:`smooth_expressions` draws expressions that nest them.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import sympy as sp
+from hypothesis import strategies as st
 
 import grazing
 
@@ -92,3 +94,18 @@ def smooth_oscillator(**values: float) -> grazing.HybridModel:
         reset=[x, -r * v * (1 + sp.tanh(x) / 10)], period=2 * sp.pi / w, contact_direction=[0, 1],
     )  # fmt: skip
     return model.with_params(**values) if values else model
+
+
+@st.composite
+def smooth_expressions(draw: st.DrawFn, leaves: tuple[sp.Expr, ...], depth: int = 2) -> sp.Expr:
+    """A random expression of ``leaves``: functions of :data:`SMOOTH_FUNCTIONS` nested in each
+    other, sums, products and quotients ``a / (2 + b^2)``, defined for every real value of the leaves."""
+    if depth == 0 or draw(st.integers(0, 3)) == 0:
+        scale = draw(st.sampled_from([sp.Integer(1), sp.Integer(2), sp.Rational(1, 2), sp.Rational(-3, 4)]))
+        return scale * draw(st.sampled_from(leaves))
+    kind = draw(st.sampled_from(["function", "function", "sum", "product", "quotient"]))
+    a = draw(smooth_expressions(leaves, depth - 1))
+    if kind == "function":
+        return SMOOTH_FUNCTIONS[draw(st.sampled_from(sorted(SMOOTH_FUNCTIONS)))](a)
+    b = draw(smooth_expressions(leaves, depth - 1))
+    return {"sum": a + b, "product": a * b, "quotient": a / (2 + b**2)}[kind]

@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 
 from grazing.engine.llvmgen import compile_library
 from grazing.engine.taylor import UnsupportedExpressionError, taylor_kernel
-from tests.function_models import SMOOTH_FUNCTIONS
+from tests.function_models import SMOOTH_FUNCTIONS, smooth_expressions
 
 x, y, t = sp.symbols("x y t")
 w, c = sp.symbols("w c")
@@ -221,3 +221,19 @@ def test_new_functions_in_a_system_match_symbolic_differentiation():
 def test_reciprocal_functions_are_expanded_as_quotients():
     k = taylor_kernel("tc", (x,), t, (), (sp.sec(x) + sp.coth(2 + x),), order=3)
     assert "math.cos(" in k.source and "math.tanh(" in k.source
+
+
+@settings(max_examples=10, deadline=None)
+@given(
+    expr=smooth_expressions((q, s, pa, pb)), q0=_grid(0.5), s0=_grid(1.0), a=_grid(0.5), b=_grid(1.0)
+)  # fmt: skip
+def test_random_nested_expressions_against_high_precision_series(expr, q0, s0, a, b):
+    """Functions nested in each other, with sums, products and quotients (drawn by hypothesis)."""
+    k = taylor_kernel("tc", (q,), s, (pa, pb), (sp.Integer(1),), (expr,), order=FUNCTION_ORDER)
+    columns = {"tc": {"X": FUNCTION_ORDER + 1, "O": FUNCTION_ORDER + 1}}
+    tc = compile_library(k.source, f"test_taylor_random_{abs(hash(expr))}", columns=columns).function("tc")
+    X = np.zeros((1, FUNCTION_ORDER + 1))
+    O = np.zeros((1, FUNCTION_ORDER + 1))
+    tc(np.array([q0]), s0, np.array([a, b]), X, O)
+    ref = _cauchy_coefficients(sp.lambdify((q, s, pa, pb), expr, modules="mpmath"), q0, s0, a, b)
+    assert _weighted_error(O[0], ref) < FUNCTION_TOL, expr
