@@ -6,7 +6,9 @@ the code generator or Python uses itself (``v0``/``v1`` for the variational
 matrix, ``t_0`` for common subexpressions, ``pi``, ``E``, ``I``, ``lambda``,
 numpy and math functions, the generated code's own locals...).  The forcing
 frequency sets the period, so every drawn model has a period-setting parameter.
-The first (minimal) example is the issue's case: states ``x1, v1``.
+The first (minimal) example is the issue's case: states ``x1, v1``.  A drawn
+model may add a term with one of the smooth functions beyond sin and cos
+(:mod:`tests.function_models`).
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ import sympy as sp
 from hypothesis import strategies as st
 
 from grazing import HybridModel, Parameter
+from tests.function_models import SMOOTH_FUNCTIONS, smooth_term
 
 NAMES = (
     "x1", "v1", "t_0", "v0", "pi", "T", "J", "t", "t_", "x2", "v2", "E", "I", "e", "S", "N", "lambda",
@@ -40,6 +43,10 @@ class ModelSpec:
     restitution: float
     coupling: float
     cubic: float
+    smooth: str = "none"
+    """A term ``-0.3 F(q / (1 + q^2))`` in the acceleration, ``F`` a
+    :func:`tests.function_models.smooth_term` (tanh, asin, a power with a variable exponent ...),
+    or ``"none"``."""
 
     @property
     def state_names(self) -> tuple[str, ...]:
@@ -68,6 +75,8 @@ class ModelSpec:
         q, p = states[0], states[1]
         force = a * sp.cos(w * t)
         accel = -c * p - k * q - self.cubic * q**3 + force
+        if self.smooth != "none":  # (of a bounded argument: a bounded force, no runaway)
+            accel -= sp.Rational(3, 10) * smooth_term(self.smooth, q / (1 + q**2))
         params = [
             Parameter(str(c), self.damping, lower=0.0),
             Parameter(str(k), self.stiffness, lower=0.0, lower_open=True),
@@ -113,4 +122,5 @@ def model_specs(draw: st.DrawFn) -> ModelSpec:
         restitution=draw(st.floats(0.5, 0.95)),
         coupling=draw(st.floats(0.1, 1.0)),
         cubic=draw(st.sampled_from([0.0, 0.2])),
+        smooth=draw(st.sampled_from(["none", *SMOOTH_FUNCTIONS])),
     )

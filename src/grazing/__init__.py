@@ -22,6 +22,7 @@ from grazing.errors import (
     InvalidParameterError,
     InvalidStateError,
     SimulationError,
+    UnsupportedExpressionError,
 )
 
 if TYPE_CHECKING:
@@ -71,6 +72,7 @@ __all__ = [
     "Stop",
     "SweepSettings",
     "Tangent",
+    "UnsupportedExpressionError",
     "__version__",
     "detect_period",
     "models",

@@ -15,6 +15,10 @@ class InvalidStateError(GrazingError, ValueError):
     """An initial state is not in the allowed region (for example beyond the stop)."""
 
 
+class UnsupportedExpressionError(GrazingError, ValueError):
+    """A model uses a function the Taylor kernels do not expand (a non-smooth or unknown one)."""
+
+
 class SimulationError(GrazingError, RuntimeError):
     """The integration could not be completed (step limit, non-finite state...)."""
 

@@ -60,7 +60,34 @@ def inputs(tmp_path_factory):
     (root / "myreport").mkdir()
     (root / "myreport" / "index.html").write_text("<p>my page</p>\n")
     (root / "link.nc").symlink_to("mine.nc")
+    _model_files(root)  # issue 26: models
     return root
+
+
+MODEL_FILE = """
+import sympy as sp
+import grazing
+
+x, v, t, w, r = sp.symbols("x v t w r")
+
+
+def model(term=sp.tanh(x) + sp.atan(v) / 10, r_default=0.8):
+    params = [grazing.Parameter("w", 1.2, lower=0, lower_open=True),
+              grazing.Parameter("r", r_default, lower=0, upper=1)]
+    field = [v, -0.1 * v - term + sp.cos(w * t)]
+    return grazing.HybridModel("user", [x, v], t, params, vector_field=field, guard=0.5 - x,
+                               reset=[x, -r * v], period=2 * sp.pi / w, contact_direction=[0, 1])
+"""
+"""A model file (issue 26: models): tanh and atan, or any term and default of r."""
+
+
+def _model_files(root: Path) -> None:
+    """Model files: smooth functions, a non-smooth one, a bad default, one that exits, one that prints."""
+    (root / "smooth.py").write_text(MODEL_FILE)
+    (root / "nonsmooth.py").write_text(MODEL_FILE + "\nabs_model = lambda: model(sp.Abs(x))\n")
+    (root / "baddefault.py").write_text(MODEL_FILE + "\nbad = model(r_default=1.5)\n")
+    (root / "exits.py").write_text('import sys\nprint("bye")\nsys.exit(0)\n')
+    (root / "prints.py").write_text('print("hello from a model file")\n' + MODEL_FILE)
 
 
 @contextlib.contextmanager
@@ -131,6 +158,12 @@ FORMER_TRACEBACKS = [
         "'--seed': -1 is not in the range x>=0",
     ),
     (["analyze", "forty"], 'theta_hat_deg must be a number of degrees in (-180, 180), got "forty"'),
+    # issue 26: models
+    (
+        ["simulate", "--model", "nonsmooth.py:abs_model"],
+        "--model: abs_model() in nonsmooth.py failed: Abs is not smooth (Abs(x) in the vector field (v')): "
+        "model it as a stop (a guard and a reset), see docs/user-models.md",
+    ),
 ]
 
 ACCEPTED_BUT_WRONG = [
@@ -164,6 +197,16 @@ ACCEPTED_BUT_WRONG = [
     (["report", "--out", "a/b/c"], "folder 'a/b' does not exist"),
     (["synthesize", "--eta", "0.446", "--out", "s8.txt"], "'s8.txt' is neither a .csv file nor a folder"),
     (["synthesize", "--eta", "0.446", "--eta", "0.45", "--out", "new/fold"], "folder 'new' does not exist"),
+    # issue 26: models
+    (
+        ["simulate", "--model", "baddefault.py:bad"],
+        "--model: baddefault.py failed to load: the default of parameter r is invalid: "
+        "r = 1.5 is outside [0, 1]",
+    ),
+    (
+        ["simulate", "--model", "exits.py:model"],
+        "--model: exits.py failed to load: it called sys.exit(0) (it printed: bye)",
+    ),
 ]
 
 IGNORED_OPTIONS = [
@@ -248,6 +291,38 @@ IGNORED_OPTIONS = [
     ),
     ([*SWEEP, "--overwrite"], "--overwrite is not used without --out"),
     ([*MAP, "--overwrite", "--out", "m.zarr"], "--overwrite is not used with a Zarr store"),
+    # issue 26: models
+    (
+        ["simulate", "--theta-hat", "30", "--set", "theta_hat=40"],
+        "--theta-hat is not used with --set theta_hat=40 (give one of them)",
+    ),
+    (["orbit", "--set", "r=0.5", "--r", "0.6"], "--r is not used with --set r=0.5 (give one of them)"),
+    (
+        ["simulate", "--case", "A", "--alpha", "0.2", "--set", "beta=0.1", "--set", "r=0.5"],
+        "--case is not used when alpha, beta and r are all given (by --alpha, --beta, --r or --set)",
+    ),
+    (
+        [*SWEEP, "--set", "eta=0.45"],
+        "--set eta=0.45 is not used with --param eta: the swept values replace it",
+    ),
+    (
+        [
+            "sweep",
+            "--model",
+            "impact-oscillator",
+            "--param",
+            "omega",
+            "--start",
+            "2",
+            "--stop",
+            "3",
+            "--num",
+            "2",
+            "--set",
+            "omega=2.5",
+        ],
+        "--set omega=2.5 is not used with --param omega: the swept values replace it",
+    ),
 ]
 
 MEMORY = [
@@ -506,6 +581,7 @@ MODEL = {
     "--r": ["0.7675", "1", "0"],
     "--eta": ["0.446", "0.5"],
     "--theta-hat": ["40", "-10"],
+    "--set": ["theta_hat=35", "eta=0.45", "r=0.5", "alpha=0.2", "beta=0.05"],  # issue 26: models
 }
 RUN = {"--transient": ["0", "3"], "--periods": ["1", "3"], "--initial": ["0,0", "-0.5,0.1", "0;0"]}
 SWEEPS = {
@@ -719,13 +795,22 @@ def _number(text: str | None) -> float | None:
         return None
 
 
+def _sets(argv: list[str]) -> set[str]:
+    """The parameters given by ``--set NAME=VALUE`` (every occurrence), as their options (``--theta-hat``)."""
+    values = [argv[i + 1] for i in range(1, len(argv) - 1) if argv[i] == "--set"]
+    return {"--" + v.partition("=")[0].strip().replace("_", "-") for v in values if "=" in v}
+
+
 def ignored(argv: list[str]) -> list[str]:
     """The options that the rest of ``argv`` makes meaningless (what must be refused)."""
     cmd, g = argv[0], _given(argv)
     bad = []
+    sets = _sets(argv)  # issue 26: models (a parameter given by --set counts as its option)
     if cmd in ("simulate", "orbit", "graze", "graze-curve", "continue", "sweep", "map", "normal-form"):
-        if all(o in g for o in ("--alpha", "--beta", "--r")) and "--case" in g:
+        if all(o in g or o in sets for o in ("--alpha", "--beta", "--r")) and "--case" in g:
             bad.append("--case")
+        bad += [o for o in sets if o in g]  # the option and --set of one parameter
+        g = {**{o: "" for o in sets}, **g}  # from here --set NAME counts as the option --NAME
     if cmd == "simulate" and "--points-per-period" in g and "--trajectory" not in g:
         bad.append("--points-per-period")
     if cmd == "orbit" and "--initial" in g and "--transient" in g:
@@ -835,3 +920,27 @@ def test_random_argument_lists_many(cmd, data, capsys, inputs, stubbed_work):
 def test_random_argument_lists_with_real_work(cmd, data, capsys, inputs):
     """The same with the work done (cheap commands; sizes only from the small values and the bad ones)."""
     _check_run(data.draw(argument_lists(cmd, st.sampled_from(BAD))), capsys, inputs)
+
+
+# --------------------------------------------------------------------------
+# issue 26: models
+
+
+def test_a_model_with_smooth_functions_runs_and_its_prints_leave_json_clean(capsys, inputs):
+    """tanh and atan (a traceback before); a file that prints: its text on stderr, stdout pure JSON."""
+    import json
+
+    argv = ["simulate", "--periods", "2", "--transient", "2", "--json", "--model"]
+    with _workspace(inputs):
+        assert main([*argv, "smooth.py:model"]) == 0
+        out, err = capsys.readouterr()
+        assert json.loads(out)["params"] == {"w": 1.2, "r": 0.8} and err == ""
+        assert main([*argv, "prints.py:model"]) == 0
+        out, err = capsys.readouterr()
+        assert json.loads(out)["periods"] == 2 and err == "hello from a model file\n"
+
+
+def test_a_memory_bound_beyond_floats_is_one_line(monkeypatch, capsys, inputs):
+    monkeypatch.setenv(MEMORY_ENV, "1e400")
+    err = _one_line_error(["simulate", "--periods", "10"], capsys, inputs)
+    assert err == "grazing: error: GRAZING_MAX_MEMORY='1e400' is not a size such as 8G or 512M"

@@ -147,3 +147,109 @@ def test_model_rejects_unknown_symbols():
     x, v, t, q = sp.symbols("x v t q")
     with pytest.raises(ValueError, match="unknown symbols"):
         HybridModel("bad", [x, v], t, [], [v, q], -x, [x, -v], 1)
+
+
+# ----------------------------------------------------------------------------
+# issue 26: functions the kernels cannot expand are refused when the model is built
+
+
+def _oscillator(*, field=None, guard=None, reset=None, contact=(0, 1), period=None, stops=None):
+    """A forced oscillator with one term of each piece replaceable (states x, v; parameters w, r)."""
+    x, v, t, w, r = sp.symbols("x v t w r")
+    kw: dict = {"period": 2 * sp.pi / w if period is None else period}
+    if stops is None:
+        kw.update(guard=1 - x if guard is None else guard, reset=[x, -r * v] if reset is None else reset,
+                  contact_direction=contact)  # fmt: skip
+    else:
+        kw["stops"] = stops
+    params = [Parameter("w", 1.2, lower=0, lower_open=True), Parameter("r", 0.8, lower=0, upper=1)]
+    return HybridModel(
+        "probe", [x, v], t, params,
+        vector_field=[v, -0.1 * v - x + sp.cos(w * t) + (0 if field is None else field)], **kw,
+    )  # fmt: skip
+
+
+X, V, T, W = sp.symbols("x v t w")
+NON_SMOOTH = [
+    sp.Abs(X), sp.sign(V), sp.Heaviside(X), sp.Max(X, 0), sp.Min(X, V), sp.floor(X), sp.ceiling(V),
+    sp.Piecewise((X, X > 0), (0, True)), sp.Mod(X, 1), sp.re(X), sp.frac(X), sp.DiracDelta(X),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize("term", NON_SMOOTH, ids=lambda e: type(e).__name__)
+def test_non_smooth_functions_are_refused_naming_the_function_and_a_stop(term):
+    name = type(term).__name__
+    with pytest.raises(grazing.UnsupportedExpressionError) as err:
+        _oscillator(field=term)
+    msg = str(err.value)
+    assert msg.startswith(f"{name} is not smooth (") and "in the vector field (v')" in msg
+    assert msg.endswith("model it as a stop (a guard and a reset), see docs/user-models.md")
+    assert "\n" not in msg
+    assert isinstance(err.value, grazing.GrazingError)  # (the CLI prints it as one line)
+
+
+@pytest.mark.parametrize(
+    "pieces, where",
+    [
+        (dict(guard=1 - sp.Abs(X)), "in the guard)"),
+        (dict(reset=[X, -sp.Symbol("r") * sp.Abs(V)]), "in the reset)"),
+        (dict(contact=(0, sp.sign(V))), "in the contact direction)"),
+        (dict(period=2 * sp.pi / sp.Abs(W)), "in the period)"),
+        (
+            dict(stops=[grazing.Stop("left", X + 1, [X, -V], [0, 1]),
+                        grazing.Stop("right", 1 - X, [X, -sp.Max(V, 0)], [0, 1])]),
+            "in the reset of stop 'right')",
+        ),
+    ],
+)  # fmt: skip
+def test_every_piece_of_a_model_is_checked(pieces, where):
+    with pytest.raises(grazing.UnsupportedExpressionError, match="is not smooth") as err:
+        _oscillator(**pieces)
+    assert where in str(err.value)
+
+
+@pytest.mark.parametrize(
+    "term, start",
+    [
+        (
+            sp.besselj(0, X),
+            "besselj is not supported by the Taylor kernels (besselj(0, x) in the vector field",
+        ),
+        (sp.gamma(X), "gamma is not supported by the Taylor kernels"),
+        (sp.atan2(V, X), "atan2 is not supported by the Taylor kernels"),
+        (sp.Function("f")(X), "f(x) in the vector field (v') is an undefined function"),
+        (sp.I * X, "the imaginary unit I in the vector field"),
+        (sp.oo * X, "oo in the vector field (v') is not a finite real number"),
+    ],
+)
+def test_unknown_functions_are_refused_naming_them(term, start):
+    with pytest.raises(grazing.UnsupportedExpressionError) as err:
+        _oscillator(field=term)
+    assert str(err.value).startswith(start)
+    assert "docs/user-models.md" in str(err.value) or "real" in str(err.value)
+
+
+def test_smooth_functions_are_accepted_without_compiling():
+    """Building a model compiles nothing; every supported function passes the check."""
+    from tests.function_models import SMOOTH_FUNCTIONS
+
+    for name, f in SMOOTH_FUNCTIONS.items():
+        model = _oscillator(field=f(X) / 10 + sp.acosh(2 + V**2) / 10)
+        assert model.symbolic.vector_field[1].has(sp.acosh), name
+    assert _oscillator(field=sp.E**X * sp.EulerGamma).n_states == 2
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        (dict(default=1.5, lower=0, upper=1), "default of parameter r is invalid: r = 1.5 is outside [0, 1]"),
+        (dict(default=0.0, lower=0.0, lower_open=True), "r = 0 is outside (0, inf)"),
+        (dict(default=math.nan), "the default of parameter r is invalid: r must be finite, got nan"),
+        (dict(default="x"), "r must be a number, got 'x'"),
+        (dict(default=0.5, lower=1.0, upper=0.0), "parameter r: lower=1, upper=0 is not an interval"),
+    ],
+)  # fmt: skip
+def test_parameter_defaults_are_checked_against_their_bounds(kwargs, message):
+    with pytest.raises(InvalidParameterError) as err:
+        Parameter("r", **kwargs)
+    assert message in str(err.value)

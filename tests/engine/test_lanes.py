@@ -33,6 +33,7 @@ from grazing.errors import SimulationError
 from grazing.models import bouncing_ball, impact_oscillator, pendulum, two_sided_oscillator
 from grazing.sweeps.run import LaneBatch, run_chunks, stream_chunks
 from grazing.sweeps.spec import SweepSpec, sweep_spec
+from tests.function_models import smooth_oscillator
 from tests.random_models import ModelSpec, model_specs
 
 CFUNC = llvmgen._CFUNC
@@ -213,6 +214,13 @@ SWEEPS = {
         "omega",
         np.linspace(0.7, 0.9, 8),
         SweepSettings(transient=60, periods=16, chunk_size=3, phase=1.3),
+    ),
+    # issue 26: models: tanh, atan, a power of a time function with the swept exponent p, x**(v/4)
+    "smooth functions, exponent swept": (
+        lambda: smooth_oscillator(),
+        "p",
+        np.linspace(0.5, 0.9, 8),
+        SweepSettings(transient=40, periods=12, chunk_size=3),
     ),
 }
 

@@ -317,3 +317,36 @@ def test_impacting_branch_ends_where_it_gains_an_impact_on_another_stop() -> Non
     h_left, _, x_left = sol.guard_min_by_stop[1]
     assert abs(h_left) < 1e-9 and abs(x_left[1]) < 1e-6
     assert sol.impacts.per_stop() == {"right": 1, "left": 0}
+
+
+# issue 26: models: "impacts accumulate" names the stop and the reason
+
+
+def _corner(contact: bool, r: float = 0.5) -> grazing.HybridModel:
+    """A mass pushed into the corner of a wall (x = 1) and a floor (y = 1), both with restitution r."""
+    x, vx, y, vy, t, w, rr = sp.symbols("x vx y vy t w r")
+    P = grazing.Parameter
+    return grazing.HybridModel(
+        "corner", [x, vx, y, vy], t, [P("w", 1.0, lower=0, lower_open=True), P("r", r, lower=0, upper=1)],
+        vector_field=[vx, 2 + sp.cos(w * t) / 2 - vx / 10, vy, 2 + sp.sin(w * t) / 3 - vy / 10],
+        period=2 * sp.pi / w,
+        stops=[grazing.Stop("wall", 1 - x, [x, -rr * vx, y, vy], [0, 1, 0, 0] if contact else None),
+               grazing.Stop("floor", 1 - y, [x, vx, y, -rr * vy], [0, 0, 0, 1] if contact else None)],
+    )  # fmt: skip
+
+
+def test_accumulation_in_a_corner_of_two_sticking_stops_says_so() -> None:
+    """Contact directions on both stops: the run ends where the mass is on both at once, and the
+    message says so (it used to say that the model defines no contact_direction)."""
+    with pytest.raises(grazing.SimulationError) as err:
+        grazing.simulate(_corner(contact=True), [0.0, 0.0, 0.0, 0.0], periods=5)
+    msg = str(err.value)
+    assert "in the corner where stops 'wall' and 'floor' meet (the state is on both)" in msg
+    assert "contact_direction" not in msg
+
+
+def test_accumulation_on_a_stop_without_contact_direction_names_it() -> None:
+    with pytest.raises(grazing.SimulationError) as err:
+        grazing.simulate(_corner(contact=False, r=0.0), [0.0, 0.0, 0.0, 0.0], periods=5)
+    expected = "on stop 'wall' and cannot be continued (stop 'wall' has no contact_direction for sticking)"
+    assert expected in str(err.value)

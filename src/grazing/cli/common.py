@@ -69,12 +69,48 @@ def netcdf_out_option(func: Callable[..., Any]) -> Callable[..., Any]:
 
 PENDULUM_OPTIONS = ("case", "alpha", "beta", "r", "eta", "theta_hat")
 
+PRINTED_SHOWN = 80
+"""Characters of what a failing model file printed that its error line shows."""
+
+
+def run_user_code(failed: str, call: Callable[[], Any]) -> Any:
+    """``call()``, the user's code (a model file, its model function), as one line if it fails.
+
+    What it prints to stdout goes to stderr (stdout stays clean for ``--json``);
+    any exception it raises, or a ``sys.exit``, becomes an :class:`InputError`
+    starting with ``failed`` (``"--model: m.py failed to load"``) that shows the
+    start of what it printed.  ``KeyboardInterrupt`` passes (Ctrl-C).
+    """
+    import contextlib
+    import io
+
+    printed = io.StringIO()
+    try:
+        with contextlib.redirect_stdout(printed):
+            result = call()
+    except SystemExit as exc:
+        reason = "it called sys.exit()" if exc.code is None else f"it called sys.exit({exc.code!r})"
+    except grazing.GrazingError as exc:
+        reason = str(exc)
+    except Exception as exc:  # the user's code: any error is theirs, reported in one line
+        reason = f"{type(exc).__name__}: {exc}"
+    else:
+        if printed.getvalue():
+            click.echo(printed.getvalue(), err=True, nl=False)
+        return result
+    text = " ".join(printed.getvalue().split())
+    if text:
+        shown = text if len(text) <= PRINTED_SHOWN else text[: PRINTED_SHOWN - 3] + "..."
+        reason += f" (it printed: {shown})"
+    raise InputError(f"{failed}: {reason}") from None
+
 
 def load_model(spec: str) -> grazing.HybridModel:
     """The model a ``--model`` value names: a built-in name, or ``path/to/file.py:OBJECT``.
 
     ``OBJECT`` is a :class:`~grazing.HybridModel` or a function returning one
-    (called without arguments).  Anything else is an :class:`InputError`.
+    (called without arguments).  Anything else is an :class:`InputError`, and
+    so is a file that raises or exits while it loads (see :func:`run_user_code`).
     """
     from grazing.models import BUILT_IN
 
@@ -92,23 +128,29 @@ def load_model(spec: str) -> grazing.HybridModel:
     if module_spec is None or module_spec.loader is None:
         raise InputError(f"--model: cannot load {path_text!r} as Python")
     module = importlib.util.module_from_spec(module_spec)
-    try:
-        module_spec.loader.exec_module(module)
-    except Exception as exc:  # the user's file: any error is theirs, reported in one line
-        raise InputError(f"--model: {path_text} failed to load: {type(exc).__name__}: {exc}") from None
+    loader = module_spec.loader
+    run_user_code(f"--model: {path_text} failed to load", lambda: loader.exec_module(module))
     obj = getattr(module, name, None)
     if obj is None:
         raise InputError(f"--model: {path_text} defines no {name!r}")
     if callable(obj) and not isinstance(obj, grazing.HybridModel):
-        try:
-            obj = obj()
-        except Exception as exc:
-            raise InputError(f"--model: {name}() failed: {type(exc).__name__}: {exc}") from None
+        obj = run_user_code(f"--model: {name}() in {path_text} failed", obj)
     if not isinstance(obj, grazing.HybridModel):
         raise InputError(
             f"--model: {name} in {path_text} is not a grazing.HybridModel (or a function returning one)"
         )
     return obj
+
+
+def set_parameters(sets: tuple[str, ...]) -> dict[str, str]:
+    """The parameter names ``--set NAME=VALUE`` gives, each with its (last) item.
+
+    Examples
+    --------
+    >>> set_parameters(("eta=0.4", " r = 0.5", "eta=0.41"))
+    {'eta': 'eta=0.41', 'r': ' r = 0.5'}
+    """
+    return {item.partition("=")[0].strip(): item for item in sets}
 
 
 def apply_sets(model: grazing.HybridModel, sets: tuple[str, ...]) -> grazing.HybridModel:
@@ -146,9 +188,18 @@ def model_options(func: Callable[..., Any] | None = None, *, any_model: bool = F
         *args: Any, model_spec: str, sets: tuple[str, ...], case: str, alpha: float | None,
         beta: float | None, r: float | None, eta: float, theta_hat: float, **kwargs: Any,
     ) -> Any:  # fmt: skip
+        named = set_parameters(sets)
         if model_spec == "pendulum":
+            for name, item in named.items():  # the option and --set of one parameter: which one?
+                if name in PENDULUM_OPTIONS[1:]:
+                    refuse_unused([name], True, f"with --set {item} (give one of them)")
+            options = {n for n, v in (("alpha", alpha), ("beta", beta), ("r", r)) if v is not None}
             refuse_unused(
-                ["case"], None not in (alpha, beta, r), "when --alpha, --beta and --r are all given"
+                ["case"],
+                {"alpha", "beta", "r"} <= options | set(named),
+                "when --alpha, --beta and --r are all given"
+                if len(options) == 3
+                else "when alpha, beta and r are all given (by --alpha, --beta, --r or --set)",
             )
             model = build_pendulum(case, alpha, beta, r, eta, theta_hat)
         else:

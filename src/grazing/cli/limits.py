@@ -15,6 +15,10 @@ the ~250 MB of the interpreter and the compiled kernels.
 ('2.4 TB', '537 MB')
 >>> parse_size("8G"), parse_size("512M"), parse_size("2.5e9")
 (8000000000, 512000000, 2500000000)
+>>> parse_size("1e400")
+Traceback (most recent call last):
+...
+grazing.errors.GrazingError: GRAZING_MAX_MEMORY='1e400' is not a size such as 8G or 512M
 """
 
 from __future__ import annotations
@@ -69,9 +73,10 @@ def parse_size(text: str) -> int:
         If ``text`` is not such a size.
     """
     m = _SIZE.match(text)
-    if not m:
+    size = float(m.group(1)) * _UNITS[m.group(2).lower()] if m else math.nan
+    if not math.isfinite(size):  # (1e400 is a float overflow)
         raise GrazingError(f"{MEMORY_ENV}={text!r} is not a size such as 8G or 512M")
-    return int(float(m.group(1)) * _UNITS[m.group(2).lower()])
+    return int(size)
 
 
 def physical_memory() -> int | None:

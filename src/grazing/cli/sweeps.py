@@ -28,6 +28,7 @@ from grazing.cli.common import (
     model_params_json,
     overwrite_option,
     parse_state,
+    refuse_varied,
     save_dataset,
 )
 from grazing.cli.limits import POINT_OVERHEAD, check_memory, count_text, sweep_bytes
@@ -261,7 +262,7 @@ def sweep_cmd(
 
     par = model_parameter(model, sparam)
     name = par.name
-    refuse_unused([name], True, f"with --param {sparam}: the swept values replace it")
+    refuse_varied([name], f"with --param {sparam}: the swept values replace it")
     refuse_unused(["stop"], num == 1 and stop != start, ONE_VALUE.format(num="--num", start="--start"))
     refuse_unused(["which"], method != "map", "without --method map")
     chunk_size = CHUNK_SIZE if chunk_size is None else chunk_size
@@ -360,7 +361,7 @@ def map_cmd(
     n1, n2 = par1.name, par2.name
     if n1 == n2:
         raise InputError("--param1 and --param2 must differ")
-    refuse_unused([n1, n2], True, f"with --param1 {param1} --param2 {param2}: the mapped values replace it")
+    refuse_varied([n1, n2], f"with --param1 {param1} --param2 {param2}: the mapped values replace it")
     refuse_unused(["stop1"], num1 == 1 and stop1 != start1, ONE_VALUE.format(num="--num1", start="--start1"))
     refuse_unused(["stop2"], num2 == 1 and stop2 != start2, ONE_VALUE.format(num="--num2", start="--start2"))
     chunk_size = num1 if chunk_size is None else chunk_size

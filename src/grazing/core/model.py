@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from grazing.core.expressions import check_expression
 from grazing.core.symbolic import Stop, SymbolicSystem
 from grazing.errors import InvalidParameterError, InvalidStateError
 
@@ -79,6 +80,10 @@ class Parameter:
     Traceback (most recent call last):
     ...
     grazing.errors.InvalidParameterError: r = 1.5 is outside [0, 1] (restitution)
+    >>> Parameter("r", 1.5, lower=0.0, upper=1.0)
+    Traceback (most recent call last):
+    ...
+    grazing.errors.InvalidParameterError: the default of parameter r is invalid: r = 1.5 is outside [0, 1]
     >>> stop = Parameter("theta_hat", 0.7, unit="rad", symbol="θ̂", angle=True)
     >>> round(stop.to_display(0.7), 3), stop.display_unit, stop.label
     (40.107, 'deg', 'θ̂')
@@ -142,6 +147,16 @@ class Parameter:
         lo = "(" if self.lower_open or math.isinf(self.lower) else "["
         hi = ")" if self.upper_open or math.isinf(self.upper) else "]"
         return f"{lo}{fmt(self.lower)}, {fmt(self.upper)}{hi}"
+
+    def __post_init__(self) -> None:
+        if not self.lower <= self.upper:
+            raise InvalidParameterError(
+                f"parameter {self.name}: lower={self.lower:g}, upper={self.upper:g} is not an interval"
+            )
+        try:
+            self.check(self.default)
+        except InvalidParameterError as exc:
+            raise InvalidParameterError(f"the default of parameter {self.name} is invalid: {exc}") from None
 
     def check(self, value: Any) -> float:
         """Return ``value`` as a float, or raise :class:`InvalidParameterError`."""
@@ -303,6 +318,8 @@ class _Definition:
                     raise ValueError(f"unknown symbols {sorted(map(str, extra))} in {e}")
             if system.period.free_symbols - set(psyms):
                 raise ValueError("the period may depend on parameters only")
+            for where, e in _expressions(system):
+                check_expression(e, where)
             self._system = system
         return self._system
 
@@ -357,6 +374,20 @@ class _Definition:
     def period(self, values: Sequence[float]) -> float:
         """The forcing period for the parameter values ``values``."""
         return float(self._period_fn(*values))
+
+
+def _expressions(system: SymbolicSystem) -> list[tuple[str, Any]]:
+    """Every expression of a model with where it is, for messages (``"the guard of stop 'left'"``)."""
+    out: list[tuple[str, Any]] = [
+        (f"the vector field ({x}')", e) for x, e in zip(system.states, system.vector_field)
+    ]
+    for st in system.stops:
+        of = "" if len(system.stops) == 1 and st.name == "stop" else f" of stop {st.name!r}"
+        out += [(f"the guard{of}", st.guard)]
+        out += [(f"the reset{of}", e) for e in st.reset]
+        out += [(f"the contact direction{of}", e) for e in st.contact_direction or ()]
+    out.append(("the period", system.period))
+    return out
 
 
 def _greek(name: str) -> str:

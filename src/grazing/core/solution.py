@@ -31,17 +31,19 @@ class Status(IntEnum):
     INTERRUPTED = 4
     """Ctrl-C (SIGINT) during the run: the caller raises :class:`KeyboardInterrupt`."""
 
-    def message(self, t: float, max_steps: int) -> str:
-        """The user-facing sentence for this status at time ``t``."""
+    def message(self, t: float, max_steps: int, model: HybridModel | None = None, x: Any = None) -> str:
+        """The user-facing sentence for this status at time ``t`` (the run ended in state ``x`` of ``model``).
+
+        For :attr:`ZENO` the model and the state say why: see :func:`accumulation_message`.
+        """
         if self is Status.STEP_LIMIT:
             return f"step limit of {max_steps} steps reached at t = {t:.6g}"
         if self is Status.NONFINITE:
             return f"the state became non-finite at t = {t:.6g}"
         if self is Status.ZENO:
-            return (
-                f"impacts accumulate at t = {t:.6g} and cannot be continued "
-                "(the model defines no contact_direction for sticking)"
-            )
+            if model is None or x is None:
+                return f"impacts accumulate at t = {t:.6g} and cannot be continued"
+            return accumulation_message(model, x, t)
         if self is Status.INTERRUPTED:
             return f"interrupted at t = {t:.6g}"
         return "ok"
@@ -77,10 +79,61 @@ _REASONS = {
     Status.ZENO: (
         "accumulating impacts",
         "impacts accumulate (complete chattering) on a stop without a contact_direction for sticking, "
-        "or events repeat at one instant (a guard the reset does not move away from)",
+        "in a corner where two stops are hit at once, or events repeat at one instant (a guard the reset "
+        "does not move away from)",
     ),
     Status.INTERRUPTED: ("interrupted", "Ctrl-C stopped the run (raised as KeyboardInterrupt)"),
 }
+
+
+def accumulation_message(model: HybridModel, x: Any, t: float) -> str:
+    """Why impacts accumulate at ``(x, t)`` and cannot be continued (the driver's :attr:`Status.ZENO`).
+
+    The driver stops after a few events in a row at zero time.  With the state
+    on one stop, that stop has no contact direction (complete chattering is
+    continued as sticking only with one); on two stops at once (a corner where
+    both are active: the reset of each leaves the state on the other) it is a
+    contact with two stops, which the engine does not continue.
+
+    Examples
+    --------
+    >>> import sympy as sp
+    >>> import grazing
+    >>> x, v, t = sp.symbols("x v t")
+    >>> m = grazing.HybridModel("ball", [x, v], t, [grazing.Parameter("r", 0.5, lower=0, upper=1)],
+    ...     vector_field=[v, -1], guard=x, reset=[x, -sp.Symbol("r") * v], period=1, periodic=False)
+    >>> print(accumulation_message(m, [0.0, -1e-9], 2.0))  # doctest: +NORMALIZE_WHITESPACE
+    impacts accumulate at t = 2 on the stop and cannot be continued
+    (the model defines no contact_direction for sticking)
+    """
+    from grazing.core.model import ON_STOP_TOL
+
+    state = np.asarray(x, dtype=float).reshape(-1)
+    tol = ON_STOP_TOL * max(1.0, float(np.max(np.abs(state), initial=0.0)))
+    on = [j for j, h in enumerate(model.guards(state, t)) if abs(h) <= tol]
+    names = [repr(model.stop_names[j]) for j in on]
+    sticks = model.kernels().STICKS
+    if len(on) >= 2:
+        return (
+            f"impacts accumulate at t = {t:.6g} in the corner where stops {', '.join(names[:-1])} and "
+            f"{names[-1]} meet (the state is on both): sticking is continued on one stop at a time, "
+            "not on two at once"
+        )
+    if len(on) == 1:
+        (j,) = on
+        where = "the stop" if model.stop_names == ("stop",) else f"stop {names[0]}"
+        if not sticks[j]:
+            why = (
+                "the model defines no contact_direction for sticking"
+                if model.n_stops == 1
+                else f"stop {names[0]} has no contact_direction for sticking"
+            )
+            return f"impacts accumulate at t = {t:.6g} on {where} and cannot be continued ({why})"
+        return (
+            f"impacts accumulate at t = {t:.6g} on {where} and cannot be continued as sticking "
+            "(events repeat at zero time: the contact neither holds nor releases)"
+        )
+    return f"events repeat at zero time at t = {t:.6g}: the run cannot be continued"
 
 
 @dataclass(frozen=True)

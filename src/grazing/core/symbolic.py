@@ -114,16 +114,20 @@ class SymbolicSystem:
         The code generator creates symbols of its own (the variational matrix,
         common subexpressions); working on the canonical system guarantees that
         no name a user chooses for a state, parameter or time (``v1``, ``t_0``,
-        ``pi``, ``sin`` ...) can be the same sympy object as one of those.
+        ``pi``, ``sin`` ...) can be the same sympy object as one of those.  The
+        reciprocal functions are written as ``1 / f``
+        (:func:`grazing.core.expressions.smooth_form`).
         """
         import sympy as sp
+
+        from grazing.core.expressions import smooth_form
 
         sub = {x: sp.Dummy(f"x{i}") for i, x in enumerate(self.states)}
         sub[self.time] = sp.Dummy("t")
         sub.update({p: sp.Dummy(f"p{i}") for i, p in enumerate(self.params)})
 
         def tr(e: sp.Expr) -> sp.Expr:
-            return sp.sympify(e).xreplace(sub)
+            return smooth_form(sp.sympify(e).xreplace(sub))
 
         def cd(d: Sequence[Any] | None) -> tuple[sp.Expr, ...] | None:
             return None if d is None else tuple(map(tr, d))

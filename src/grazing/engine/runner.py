@@ -260,7 +260,9 @@ class Runner:
         )  # fmt: skip
         out = self.kern.integrate(start, self.pv, cfg)
         if out.status != Status.OK:
-            raise SimulationError(Status(int(out.status)).message(out.k * T + out.s, max_steps))
+            raise SimulationError(
+                Status(int(out.status)).message(out.k * T + out.s, max_steps, self.model, out.x)
+            )
         self.x, self.V, self.k, self.s, self.mode = out.x, out.V, out.k, out.s, out.mode
         self.touch_start = False  # only the first call starts at the contact
         if self.model.periodic:

@@ -3,10 +3,15 @@
 Taylor's method advances ``x' = F(x, t)`` by computing the normalised Taylor
 coefficients ``x[k] = x^(k)(t0) / k!`` of the solution to a high order ``p``
 by automatic differentiation: the right-hand side is decomposed into
-elementary operations (sums, products, quotients, ``sin``/``cos`` pairs,
-``exp``, ``log``, powers), each with a recurrence that gives its ``k``-th
-coefficient from lower ones (Jorba & Zou 2005; Biscani & Izzo 2021, the
-heyoka paper).  This module turns a sympy vector field into the Python source
+elementary operations (sums, products, quotients, ``sin``/``cos`` and
+``sinh``/``cosh`` pairs, ``tan`` and ``tanh`` with their derivative's series
+``1 +- t^2``, ``exp``, ``log``, powers with any exponent, and the functions
+``F`` expanded through their derivative ``F'(u) u'``: ``asin``, ``acos``,
+``atan``, ``asinh``, ``acosh``, ``atanh``, ``erf``, ``erfc``), each with a
+recurrence that gives its ``k``-th coefficient from lower ones (Jorba & Zou
+2005; Biscani & Izzo 2021, the heyoka paper).  Which functions a model may
+use is decided in one place, :mod:`grazing.core.expressions`, when the model
+is built.  This module turns a sympy vector field into the Python source
 of one numba function that runs those recurrences; the engine compiles it
 once per model and order and caches it on disk.
 
@@ -38,9 +43,24 @@ from dataclasses import dataclass, field
 import sympy as sp
 from sympy.printing.pycode import PythonCodePrinter
 
+from grazing.core.expressions import RECIPROCALS, smooth_form, unsupported
+from grazing.errors import UnsupportedExpressionError
 
-class UnsupportedExpressionError(ValueError):
-    """A vector field uses a function the Taylor code generator cannot expand."""
+__all__ = ["ScalarPrinter", "TaylorKernel", "UnsupportedExpressionError", "taylor_kernel"]
+
+
+_INVERSES: dict[str, Callable[[sp.Expr], sp.Expr]] = {
+    "asin": lambda u: 1 / sp.sqrt((1 - u) * (1 + u)),
+    "acos": lambda u: -1 / sp.sqrt((1 - u) * (1 + u)),
+    "atan": lambda u: 1 / (1 + u**2),
+    "asinh": lambda u: 1 / sp.sqrt(1 + u**2),
+    "acosh": lambda u: 1 / sp.sqrt((u - 1) * (u + 1)),
+    "atanh": lambda u: 1 / ((1 - u) * (1 + u)),
+    "erf": lambda u: 2 / sp.sqrt(sp.pi) * sp.exp(-(u**2)),
+    "erfc": lambda u: -2 / sp.sqrt(sp.pi) * sp.exp(-(u**2)),
+}
+"""Functions ``F`` expanded through their derivative ``F'(u)``, a smooth expression of ``u``:
+``(F o u)' = F'(u) u'``.  (``1 - u^2`` is written ``(1 - u)(1 + u)``: accurate near ``|u| = 1``.)"""
 
 
 @dataclass(frozen=True)
@@ -126,6 +146,7 @@ class _Builder:
     # (name, code assigning coefficient k, names of the nodes it depends on)
     memo: dict[sp.Expr, _Ref] = field(default_factory=dict)
     trig: dict[sp.Expr, tuple[str, str]] = field(default_factory=dict)
+    hyperbolic: dict[sp.Expr, tuple[str, str]] = field(default_factory=dict)
     n_scalar: int = 0
     n_node: int = 0
 
@@ -221,15 +242,22 @@ class _Builder:
         elif isinstance(expr, (sp.sin, sp.cos)):
             s, c = self._sincos(expr.args[0])
             ref = _General(s if isinstance(expr, sp.sin) else c)
+        elif isinstance(expr, (sp.sinh, sp.cosh)):
+            s, c = self._sinhcosh(expr.args[0])
+            ref = _General(s if isinstance(expr, sp.sinh) else c)
+        elif isinstance(expr, (sp.tan, sp.tanh)):
+            ref = self._tan(expr.args[0], hyperbolic=isinstance(expr, sp.tanh))
         elif isinstance(expr, sp.exp):
             ref = self._exp(self.visit(expr.args[0]))
         elif isinstance(expr, sp.log):
             ref = self._log(self.visit(expr.args[0]))
+        elif type(expr).__name__ in _INVERSES:
+            ref = self._through_derivative(type(expr).__name__, expr.args[0])
+        elif type(expr).__name__ in RECIPROCALS:  # sec(u) = 1/cos(u) ... (the canonical system has none)
+            ref = self.visit(smooth_form(expr))
         else:
-            raise UnsupportedExpressionError(
-                f"cannot build a Taylor kernel for {type(expr).__name__} in {expr}; "
-                "supported: +, *, /, powers with constant exponent, sin, cos, exp, log"
-            )
+            # HybridModel refuses these when it is built; this is for direct callers.
+            raise UnsupportedExpressionError(unsupported(expr, "the expression") or f"cannot expand {expr}")
         self.memo[expr] = ref
         return ref
 
@@ -305,8 +333,8 @@ class _Builder:
         return self._div(self._product(num), self._product(den))
 
     def _pow(self, base: sp.Expr, exponent: sp.Expr) -> _Ref:
-        if not self._is_constant(exponent):
-            raise UnsupportedExpressionError(f"exponent {exponent} depends on the state or time")
+        if not self._is_constant(exponent):  # b**e = exp(e log b) (heyoka's decomposition)
+            return self._exp(self._mul(self.visit(exponent), self.visit(sp.log(base))))
         b = self.visit(base)
         if exponent.is_Integer:
             n = int(exponent)
@@ -370,6 +398,90 @@ class _Builder:
         self.nodes.append((c, lambda k: [], {s}))
         self.trig[arg] = (s, c)
         return s, c
+
+    def _sinhcosh(self, arg: sp.Expr) -> tuple[str, str]:
+        """``sinh`` and ``cosh`` of ``arg`` as a pair: ``s' = c u'``, ``c' = s u'``."""
+        if arg in self.hyperbolic:
+            return self.hyperbolic[arg]
+        u = self.visit(arg)
+        s, c = self._name(), self._name()
+        S, C = _General(s), _General(c)
+        u0 = self.term(u, 0)
+        emit_du, du = self.weighted(u, f"{s}_du")
+
+        def emit(k: int) -> list[str]:
+            if k == 0:
+                return [f"{s}_0 = math.sinh({u0})", f"{c}_0 = math.cosh({u0})"]
+            return [
+                *emit_du(k),
+                f"{s}_{k} = {_div_by(_sum(self.products(du, C, k, lo=1)), k)}",
+                f"{c}_{k} = {_div_by(_sum(self.products(du, S, k, lo=1)), k)}",
+            ]
+
+        self.nodes.append((s, emit, self.deps(u)))
+        self.nodes.append((c, lambda k: [], {s}))  # (an alias, as for sin/cos)
+        self.hyperbolic[arg] = (s, c)
+        return s, c
+
+    @classmethod
+    def square(cls, ref: _General, k: int) -> str:
+        """Coefficient ``k`` of ``ref**2``: ``sum_j ref_j ref_(k-j)``, each cross term once, doubled."""
+        pairs = [f"{ref.name}_{j} * {ref.name}_{k - j}" for j in range((k + 1) // 2)]
+        parts = [f"2.0 * {_sum(pairs)}"] if pairs else []
+        if k % 2 == 0:
+            parts.append(f"{ref.name}_{k // 2} * {ref.name}_{k // 2}")
+        return " + ".join(parts)
+
+    def _tan(self, arg: sp.Expr, hyperbolic: bool) -> _Ref:
+        """``tan`` (``tanh``) of ``arg``: ``t' = q u'`` with ``q = 1 + t^2`` (``1 - t^2``).
+
+        ``q`` is the node's second series; its value ``1 - tanh(u)^2`` is computed as
+        ``1 / cosh(u)^2``, accurate where ``tanh(u)`` rounds to 1.
+        """
+        u = self.visit(arg)
+        name = self._name()
+        t, q = _General(name), _General(f"{name}_q")
+        u0 = self.term(u, 0)
+        emit_du, du = self.weighted(u, f"{name}_du")
+
+        def emit(k: int) -> list[str]:
+            if k == 0:
+                if hyperbolic:
+                    return [
+                        f"{name}_0 = math.tanh({u0})",
+                        f"{name}_ch = math.cosh({u0})",
+                        f"{q.name}_0 = 1.0 / ({name}_ch * {name}_ch)",
+                    ]
+                return [f"{name}_0 = math.tan({u0})", f"{q.name}_0 = 1.0 + {name}_0 * {name}_0"]
+            sq = self.square(t, k)
+            return [
+                *emit_du(k),
+                f"{name}_{k} = {_div_by(_sum(self.products(du, q, k, lo=1)), k)}",
+                f"{q.name}_{k} = -({sq})" if hyperbolic else f"{q.name}_{k} = {sq}",
+            ]
+
+        self.nodes.append((name, emit, self.deps(u)))
+        return t
+
+    def _through_derivative(self, function: str, arg: sp.Expr) -> _Ref:
+        """``F(arg)`` for ``F`` in :data:`_INVERSES`: ``a_0 = F(u_0)``, ``a_k = (1/k) sum_j j u_j g_(k-j)``.
+
+        ``g = F'(u)`` is expanded as an expression of ``arg`` (sharing its
+        sub-expressions with the rest of the kernel).
+        """
+        u = self.visit(arg)
+        g = self.visit(_INVERSES[function](arg))
+        name = self._name()
+        u0 = self.term(u, 0)
+        emit_du, du = self.weighted(u, f"{name}_du")
+
+        def emit(k: int) -> list[str]:
+            if k == 0:
+                return [f"{name}_0 = math.{function}({u0})"]
+            return [*emit_du(k), f"{name}_{k} = {_div_by(_sum(self.products(du, g, k, lo=1)), k)}"]
+
+        self.nodes.append((name, emit, self.deps(u, g)))
+        return _General(name)
 
     def _exp(self, u: _Ref) -> _Ref:
         name = self._name()
