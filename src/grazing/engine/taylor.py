@@ -373,8 +373,19 @@ class _Builder:
         return _General(name)
 
     def _sincos(self, arg: sp.Expr) -> tuple[str, str]:
-        if arg in self.trig:
-            return self.trig[arg]
+        """``sin`` and ``cos`` of ``arg`` as a pair: ``s' = c u'``, ``c' = -s u'``."""
+        return self._pair(arg, self.trig, ("math.sin", "math.cos"), "-")
+
+    def _sinhcosh(self, arg: sp.Expr) -> tuple[str, str]:
+        """``sinh`` and ``cosh`` of ``arg`` as a pair: ``s' = c u'``, ``c' = s u'``."""
+        return self._pair(arg, self.hyperbolic, ("math.sinh", "math.cosh"), "")
+
+    def _pair(
+        self, arg: sp.Expr, known: dict[sp.Expr, tuple[str, str]], functions: tuple[str, str], sign: str
+    ) -> tuple[str, str]:
+        """Two functions of ``arg`` whose derivatives are each other's: ``s' = c u'``, ``c' = sign s u'``."""
+        if arg in known:
+            return known[arg]
         u = self.visit(arg)
         if isinstance(u, _Const):  # pragma: no cover - constant arguments are folded by visit
             raise AssertionError("constant argument")
@@ -382,45 +393,22 @@ class _Builder:
         S, C = _General(s), _General(c)
         u0 = self.term(u, 0)
         emit_du, du = self.weighted(u, f"{s}_du")
+        f_s, f_c = functions
 
         def emit(k: int) -> list[str]:
             if k == 0:
-                return [f"{s}_0 = math.sin({u0})", f"{c}_0 = math.cos({u0})"]
+                return [f"{s}_0 = {f_s}({u0})", f"{c}_0 = {f_c}({u0})"]
             return [
                 *emit_du(k),
                 f"{s}_{k} = {_div_by(_sum(self.products(du, C, k, lo=1)), k)}",
-                f"{c}_{k} = -{_div_by(_sum(self.products(du, S, k, lo=1)), k)}",
+                f"{c}_{k} = {sign}{_div_by(_sum(self.products(du, S, k, lo=1)), k)}",
             ]
 
-        # One node computes both; the cosine is registered as an alias with no
-        # code of its own that depends on the sine node.
+        # One node computes both; the second is registered as an alias with no
+        # code of its own that depends on the first node.
         self.nodes.append((s, emit, self.deps(u)))
         self.nodes.append((c, lambda k: [], {s}))
-        self.trig[arg] = (s, c)
-        return s, c
-
-    def _sinhcosh(self, arg: sp.Expr) -> tuple[str, str]:
-        """``sinh`` and ``cosh`` of ``arg`` as a pair: ``s' = c u'``, ``c' = s u'``."""
-        if arg in self.hyperbolic:
-            return self.hyperbolic[arg]
-        u = self.visit(arg)
-        s, c = self._name(), self._name()
-        S, C = _General(s), _General(c)
-        u0 = self.term(u, 0)
-        emit_du, du = self.weighted(u, f"{s}_du")
-
-        def emit(k: int) -> list[str]:
-            if k == 0:
-                return [f"{s}_0 = math.sinh({u0})", f"{c}_0 = math.cosh({u0})"]
-            return [
-                *emit_du(k),
-                f"{s}_{k} = {_div_by(_sum(self.products(du, C, k, lo=1)), k)}",
-                f"{c}_{k} = {_div_by(_sum(self.products(du, S, k, lo=1)), k)}",
-            ]
-
-        self.nodes.append((s, emit, self.deps(u)))
-        self.nodes.append((c, lambda k: [], {s}))  # (an alias, as for sin/cos)
-        self.hyperbolic[arg] = (s, c)
+        known[arg] = (s, c)
         return s, c
 
     @classmethod
