@@ -56,3 +56,46 @@ def mirror(model: HybridModel, state: np.ndarray, t0: float, period: int = 1) ->
     phase = 2 * math.pi * (((t0 + 0.5 * T) / T) % 1.0)
     sol = grazing.simulate(model, state, t0=t0, periods=period, phase=phase)
     return -sol.samples[-1]
+
+
+def half_map(model: HybridModel, state: np.ndarray, t0: float) -> tuple[np.ndarray, np.ndarray]:
+    """``G(x) = -x(t0 + T/2)`` from ``x(t0) = x``, and its Jacobian: the stroboscopic map is ``P = G o G``.
+
+    By the symmetry, the motion from ``-x(t0 + T/2)`` at ``t0 + T/2`` is the mirror image of the
+    motion from ``x`` at ``t0``, so ``P(x) = G(G(x))``.  A symmetric period-1 orbit is a fixed
+    point of ``G`` (:func:`mirror` is ``G`` for period 1), and it breaks its symmetry where ``G``
+    has the multiplier -1: there ``P`` has the multiplier ``(-1)^2 = 1`` with an antisymmetric
+    eigenvector.  Impacts on the way are applied, with their saltation matrices.
+    """
+    T = model.period
+    phase = 2 * math.pi * (((t0 + 0.5 * T) / T) % 1.0)
+    sol = grazing.simulate(model, state, t0=t0, periods=1, phase=phase, jacobian=True)
+    return -sol.samples[-1], -sol.jacobian
+
+
+def symmetry_breaking(
+    model: HybridModel, param: str, state: np.ndarray, t0: float, lo: float, hi: float
+) -> float:
+    """Where the symmetric period-1 orbit through ``state`` (at ``t0``) breaks its symmetry, for
+    ``param`` in ``[lo, hi]``: the zero of ``det(G_x + I)`` on the fixed points of :func:`half_map`,
+    each found by Newton's method (an independent route to the branch point of ``P``)."""
+    from scipy.optimize import brentq
+
+    guess = [np.array(state, dtype=float)]
+    eye = np.eye(len(state))
+
+    def test(value: float) -> float:
+        m = model.with_params(**{param: value})
+        x = guess[0].copy()
+        for _ in range(40):
+            g, J = half_map(m, x, t0)
+            step = np.linalg.solve(J - eye, x - g)
+            x = x + step
+            if np.max(np.abs(step)) < 1e-14:
+                break
+        g, J = half_map(m, x, t0)
+        assert np.max(np.abs(g - x)) < 1e-11, "no symmetric orbit"
+        guess[0] = x
+        return float(np.linalg.det(J + eye))
+
+    return float(brentq(test, lo, hi, xtol=1e-15, rtol=1e-15))

@@ -140,13 +140,14 @@ class Step:
     def explained(self) -> bool:
         """Do the located points account for the change of the number of unstable multipliers?
 
-        Each located point moves that number by its :attr:`Located.crossings`, up or down: the
-        change must be reachable so (no larger than their sum, of the same parity), and no test
+        Each located point moves that number by its :attr:`Located.crossings`, up or down (a
+        Neimark-Sacker pair by two, never by none): the change must be such a sum, and no test
         function may have changed sign without its point.
         """
-        change = abs(self.unstable[1] - self.unstable[0])
-        most = sum(loc.crossings for loc in self.located)
-        return not self.missed and change <= most and (most - change) % 2 == 0
+        reachable = {0}
+        for loc in self.located:
+            reachable = {total + sign * loc.crossings for total in reachable for sign in (1, -1)}
+        return not self.missed and self.unstable[1] - self.unstable[0] in reachable
 
     def describe(self) -> str:
         """What happened over the step, in words (for the ``unlocated`` special point)."""

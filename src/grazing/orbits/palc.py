@@ -479,7 +479,7 @@ def locate(
     return best
 
 
-INTERPOLATION_WIDTH = 2e-3
+INTERPOLATION_WIDTH = 2e-4
 """:func:`locate_by_interpolation` narrows its bracket to this width (relative to ``max(1, |u|)``):
 a cubic's error there is of the order of its fourth power, its nodes stay a quarter of it from
 the zero."""

@@ -107,7 +107,10 @@ def crossing_starts(
     """The first orbits of the branch that crosses, at the branch point ``u_star``, the branch
     followed along ``along``, in both directions: ``(orbit, direction)`` pairs (none found: empty).
     """
-    _, DF, _ = evaluate(u_star)
+    try:
+        _, DF, _ = evaluate(u_star)
+    except GrazingError:
+        return []
     _, _, vt = np.linalg.svd(DF)
     null = vt[-2:]  # the two right singular vectors of the smallest singular values (one is zero)
     c = null @ along
