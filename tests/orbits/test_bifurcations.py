@@ -209,9 +209,10 @@ def test_no_switch_beyond_the_largest_period(monkeypatch):
     a_pd = ball_period_doubling(1)
     orbit = ball_orbit(1, 1.3)
     br = continue_orbit(orbit.model, "amplitude", 1.3, a_pd + 0.1, orbit=orbit, switch=True)
-    assert set(br.segments) == {0} and not br.special[0].switched
-    assert br.status.startswith("stopped at the period-doubling at amplitude = 1.5268237")
-    assert "periods above 1 are not switched to" in br.status
+    (pd,) = br.special
+    assert set(br.segments) == {0} and pd.kind == "period-doubling" and not pd.switched
+    assert pd.note == "not switched to the period-2 orbit born here: periods above 1 are not switched to"
+    assert br.status == f"reached the bound amplitude = {a_pd + 0.1:.10g}"  # along the period-1 orbit
 
 
 # --------------------------------------------------------------------------

@@ -404,11 +404,8 @@ def continue_(
                 "kind": sp_.kind,
                 "value": back(sp_.param),
                 **({"stop": model.stop_names[sp_.stop]} if sp_.kind == "grazing" else {}),
-                **(
-                    {"between": [back(v) for v in sp_.between], "note": sp_.note}
-                    if sp_.between is not None
-                    else {}
-                ),
+                **({"between": [back(v) for v in sp_.between]} if sp_.between is not None else {}),
+                **({"note": sp_.note} if sp_.note else {}),
                 "index": sp_.index,
                 "multipliers": complex_list(sp_.multipliers),
                 "state": sp_.orbit.state,
@@ -440,7 +437,7 @@ def continue_(
             continue
         mu = ", ".join(f"{x:+.4f}{y:+.4f}i" for x, y in sp_["multipliers"])
         on = f" (stop {sp_['stop']})" if sp_.get("stop", "stop") != "stop" else ""  # as graze prints it
-        switched = "   (switched here)" if point.switched else ""
+        switched = "   (switched here)" if point.switched else (f"   ({point.note})" if point.note else "")
         click.echo(f"  {sp_['kind']:16s} {par.show(point.param, '.8g')}   multipliers {mu}{on}{switched}")
     if segs > 1:
         for i, (origin, status) in enumerate(zip(branch.segment_origin, branch.segment_status)):

@@ -35,15 +35,16 @@ between two points must be explained by the points located there; where it is
 not, the branch reports an ``unlocated`` special point ("unlocated stability
 change between p1 and p2"): no change of stability passes silently.
 
-With ``switch=True`` a segment of the branch ends at the first special point
-met where another branch of periodic orbits starts -- a period-doubling, a
-branch point, or a grazing where the impact sequence changes -- and the
-continuation goes on along that branch as a new *segment*
-(:mod:`grazing.orbits.switching`): the period-``2n`` orbit born at a
-period-doubling (up to period :data:`~grazing.core.options.MAX_PERIOD`), the
-other branch through a branch point (both of its directions, one segment
-each), the orbit with the new impact sequence at a grazing.  Each new segment
-switches in the same way at the first such point it meets.
+With ``switch=True`` the continuation switches branches, each branch switched
+to being a new *segment* (:mod:`grazing.orbits.switching`): at every grazing
+where the impact sequence changes, onto the orbit with the new sequence (the
+old orbit ends there); and at the first period-doubling or branch point met,
+onto the branch born there instead of going on along this one: the
+period-``2n`` orbit (up to period :data:`~grazing.core.options.MAX_PERIOD`),
+or the other branch through the branch point, both ways (one segment each,
+the second after the first and everything it switched to).  Later
+period-doublings and branch points are reported, not switched at: one switch
+of that kind per run keeps the branch a chain, not a tree.
 
 The stroboscopic map is not smooth where an impact falls on its section, so
 the section is chosen away from impacts (``t0=None``, the default) and moved
@@ -137,7 +138,8 @@ class SpecialPoint:
         For a grazing: the index of the stop grazed.
     note
         For an unlocated stability change: what was seen, in words ("unlocated stability
-        change between omega = 0.9 and omega = 0.95: ...", the values in display units).
+        change between omega = 0.9 and omega = 0.95: ...", the values in display units); for
+        a period-doubling or branch point where ``switch`` found no branch to follow: why.
     between
         For an unlocated stability change: the parameter values of the two points.
     tangent
@@ -497,7 +499,7 @@ class _Continuation:
     def segment(self, start: Start) -> list[Start]:
         """Follow one segment from ``start``; the starts of the branches it switches to."""
         branch, s, nx = self.branch, self.s, self.nx
-        seg = branch.segments[-1] + 1 if branch.segments else 0
+        seg = len(branch.segment_origin)
         branch.segment_origin.append(start.origin)
         orbit, sign, direction = start.orbit, start.sign, start.direction
         prev: PalcPoint | None = None
@@ -537,7 +539,9 @@ class _Continuation:
                 if self.progress is not None:
                     self.progress(len(branch), float(pt.u[-1]))
                 if switch_at is not None:
-                    return self._switch_smooth(switch_at, evaluate)
+                    starts = self._switch_smooth(switch_at, evaluate)
+                    if starts:
+                        return starts  # (else the point says why, and the branch goes on)
             status = palc.status
             assert prev is not None and prev.tangent is not None
             sign = math.copysign(1.0, prev.tangent[nx]) if prev.tangent[nx] != 0 else sign
@@ -608,38 +612,33 @@ class _Continuation:
         return [Start(new, sign, None, len(branch.special) - 1)]
 
     def _switch_smooth(self, at: SpecialPoint, evaluate) -> list[Start]:
-        """The segment ends just past a period-doubling or branch point: the branches born there."""
+        """The starts of the branches born at a period-doubling or branch point just passed; none (the
+        point's note says why) if there is none to follow.  Only the first such point is tried."""
         branch, par = self.branch, self.par
+        self.switched_smooth = True
         i = next(j for j in range(len(branch.special) - 1, -1, -1) if branch.special[j] is at)
-        where = f"the {at.kind} at {par.show(at.param)}"
         starts: list[Start] = []
         if at.kind == "period-doubling":
             n2 = 2 * at.orbit.period
-            if n2 > MAX_PERIOD:
-                branch.segment_status.append(
-                    f"stopped at {where}: the period-{n2} orbit born there is not followed (periods above "
-                    f"{MAX_PERIOD} are not switched to)"
-                )
-                return []
-            found = doubled_start(at.orbit, self.param, self.s)
-            if found is None:
-                branch.segment_status.append(f"stopped at {where}: no period-{n2} orbit was found next to it")
-                return []
-            orbit, direction = found
-            starts = [Start(orbit, math.copysign(1.0, direction[-1] or 1.0), direction, i)]
+            found = doubled_start(at.orbit, self.param, self.s) if n2 <= MAX_PERIOD else None
+            if found is not None:
+                orbit, direction = found
+                starts = [Start(orbit, math.copysign(1.0, direction[-1] or 1.0), direction, i)]
+            why = f"periods above {MAX_PERIOD} are not switched to" if n2 > MAX_PERIOD else "none was found"
+            missing = f"not switched to the period-{n2} orbit born here: {why}"
             what = f"the period-{n2} orbit born there"
         else:
             assert at.tangent is not None
             u_star = np.append(at.orbit.state, at.param)
             for orbit, direction in crossing_starts(evaluate, u_star, at.tangent, self.s):
                 starts.append(Start(orbit, math.copysign(1.0, direction[-1] or 1.0), direction, i))
-            if not starts:
-                branch.segment_status.append(f"stopped at {where}: no other branch was found through it")
-                return []
+            missing = "not switched: no other branch was found through it"
             what = "the other branch through it" + (" (both directions)" if len(starts) == 2 else "")
+        if not starts:
+            branch.special[i] = dataclasses.replace(at, note=missing)
+            return []
         branch.special[i] = dataclasses.replace(at, switched=True)
-        branch.segment_status.append(f"switched at {where} to {what}")
-        self.switched_smooth = True
+        branch.segment_status.append(f"switched at the {at.kind} at {par.show(at.param)} to {what}")
         return starts
 
 
@@ -695,13 +694,11 @@ def continue_orbit(
         stop; an impacting branch ends where it loses or gains an impact on
         any stop, at that stop's grazing.
     switch
-        End each segment at the first special point met where another branch
-        starts -- a period-doubling, a branch point (both reported in
-        ``detect``) or a grazing where the impact sequence changes -- and go on
-        along that branch as a new segment: the period-``2n`` orbit, both
-        directions of the other branch through a branch point (one segment
-        each), the orbit with the new impact sequence.  New segments switch in
-        the same way; they are followed in the order they are found, while
+        Switch branches, each switch starting a new segment: at every grazing
+        where the impact sequence changes, onto the orbit with the new
+        sequence; at the first period-doubling or branch point met (of the
+        kinds in ``detect``), onto the period-``2n`` orbit born there or along
+        the other branch through it, both ways.  Segments are followed while
         points remain (``settings.max_points`` in all).  A virtual branch has
         no grazing where its impact sequence changes: ``switch`` with
         ``virtual=True`` (or a virtual starting ``orbit``) raises
