@@ -154,6 +154,27 @@ def test_switching_at_the_branch_point_gives_the_mirror_image_pair(name):
     assert {ends[0].stop, ends[1].stop} == {0, 1}
 
 
+def test_the_curved_branch_of_the_pitchfork_passes_the_branch_point_where_the_parameter_turns():
+    """The two-sided oscillator at omega = 1.4, amp from 2 down: the attractor is asymmetric; its branch
+    turns back at the pitchfork, through the branch point, onto its mirror image (no multiplier
+    crosses the unit circle: +1 is touched).  Switching there gives the symmetric branch, both ways."""
+    m = two_sided_oscillator(omega=1.4)
+    orbit = find_orbit(m.with_params(amp=2.0), t0=None)
+    assert np.max(np.abs(mirror(orbit.model, orbit.state, orbit.t0) - orbit.state)) > 0.1  # asymmetric
+    br = continue_orbit(m, "amp", 2.0, 0.5, orbit=orbit, switch=True)
+    (bp,) = br.special
+    assert bp.kind == "branch point" and bp.turns and bp.switched
+    assert np.min(np.abs(bp.multipliers - 1)) < 1e-9
+    assert br.segment_origin == [-1, 0, 0] and br.status == "reached the bound amp = 2"
+    assert br.segment_status[1] == "reached the bound amp = 0.5"
+    for k in (1, 2):
+        for o in [o for o, seg in zip(br.orbits, br.segments) if seg == k]:
+            np.testing.assert_allclose(mirror(o.model, o.state, o.t0), o.state, atol=1e-9)  # symmetric
+    sym = next(o for o, seg in zip(br.orbits, br.segments) if seg == 1)
+    ref = symmetry_breaking(m, "amp", sym.state, sym.t0, bp.param - 0.01, bp.param + 0.01)
+    assert bp.param == pytest.approx(ref, abs=1e-10)
+
+
 # --------------------------------------------------------------------------
 # folds, period-doubling, switching at a period-doubling
 
