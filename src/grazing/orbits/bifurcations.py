@@ -55,7 +55,7 @@ VERIFY_TOL = 1e-5
 """A located point's multiplier must lie this close to its defining value (+1, -1, the unit circle)."""
 
 
-def test_function(kind: str, orbit: PeriodicOrbit) -> float:
+def orbit_test(kind: str, orbit: PeriodicOrbit) -> float:
     """Test function of a special point (smooth along a branch of one impact signature)."""
     J = orbit.monodromy
     eye = np.eye(J.shape[0])
@@ -183,7 +183,7 @@ def between(evaluate: BranchEquations, a: PalcPoint, b: PalcPoint, s: PalcSettin
     oa, ob = a.payload, b.payload
     found: list[Located] = []
     missed: list[str] = []
-    through_one = sign_changed(test_function("fold", oa), test_function("fold", ob))
+    through_one = sign_changed(orbit_test("fold", oa), orbit_test("fold", ob))
     turns = sign_changed(float(a.tangent[index]), float(b.tangent[index]))
     if sign_changed(branch_test(a), branch_test(b)):
         loc = locate_by_interpolation(evaluate, a, b, branch_test, s)
@@ -197,7 +197,7 @@ def between(evaluate: BranchEquations, a: PalcPoint, b: PalcPoint, s: PalcSettin
     elif turns:
         # (located by det(P_x - I) where it changes sign: the point where the multiplier is 1)
         if through_one:
-            loc = locate(evaluate, a, b, lambda p: test_function("fold", p.payload), s)
+            loc = locate(evaluate, a, b, lambda p: orbit_test("fold", p.payload), s)
         else:
             loc = locate(evaluate, a, b, lambda p: float(p.tangent[index]), s)  # type: ignore[index]
         if loc is not None and verified("fold", loc.payload):
@@ -207,9 +207,9 @@ def between(evaluate: BranchEquations, a: PalcPoint, b: PalcPoint, s: PalcSettin
     elif through_one:
         missed.append("fold or branch point")
     for kind in ("period-doubling", "neimark-sacker"):
-        if not sign_changed(test_function(kind, oa), test_function(kind, ob)):
+        if not sign_changed(orbit_test(kind, oa), orbit_test(kind, ob)):
             continue
-        loc = locate(evaluate, a, b, lambda p, k=kind: test_function(k, p.payload), s)  # type: ignore[misc]
+        loc = locate(evaluate, a, b, lambda p, k=kind: orbit_test(k, p.payload), s)  # type: ignore[misc]
         if loc is not None and verified(kind, loc.payload):
             found.append(Located(kind, loc))
         else:

@@ -66,7 +66,7 @@ import numpy as np
 from grazing.core.model import HybridModel
 from grazing.core.options import MAX_PERIOD
 from grazing.errors import ConvergenceError, GrazingError, InvalidParameterError
-from grazing.orbits.bifurcations import Located, between, test_function, verified
+from grazing.orbits.bifurcations import Located, between, orbit_test, verified
 from grazing.orbits.branch_equations import branch_equations
 from grazing.orbits.contact import GrazingPoint, refine_grazing
 from grazing.orbits.palc import (
@@ -107,7 +107,7 @@ ContinuationSettings = PalcSettings
 """Options of :func:`continue_orbit` (see :class:`~grazing.orbits.palc.PalcSettings`)."""
 
 _evaluator = branch_equations  # (the former private name)
-_test_function = test_function
+_test_function = orbit_test
 _verified = verified
 _switch_orbit = new_sequence_orbit
 
@@ -317,9 +317,9 @@ def _stop_guard_min(orbit: PeriodicOrbit, stop: int) -> float:
 
 def _detect(evaluate, kind: str, a: PalcPoint, b: PalcPoint, s: PalcSettings) -> PalcPoint | None:
     """The point of ``kind`` (an orbit-based test function) between ``a`` and ``b``, located and verified."""
-    if not sign_changed(test_function(kind, a.payload), test_function(kind, b.payload)):
+    if not sign_changed(orbit_test(kind, a.payload), orbit_test(kind, b.payload)):
         return None
-    loc = locate(evaluate, a, b, lambda p: test_function(kind, p.payload), s)
+    loc = locate(evaluate, a, b, lambda p: orbit_test(kind, p.payload), s)
     return loc if loc is not None and verified(kind, loc.payload) else None
 
 
