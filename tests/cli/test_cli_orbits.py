@@ -221,3 +221,94 @@ def test_a_parameter_named_like_an_option_leaves_the_option_alone(capsys, tmp_pa
     assert res["period"] == 1 and res["values"][-1] == pytest.approx(3.2)
     code = main([*model, "--param", "period", "--start", "2.8", "--stop", "3.2", "--set", "period=3"])
     assert code == 2 and "--set period=3 is not used with --param period" in capsys.readouterr().err
+
+
+# --------------------------------------------------------------------------
+# issue 27: branch points, unlocated stability changes, switching at period-doublings and branch points
+
+WALLED = [
+    "--model",
+    f"{Path(__file__).resolve().parents[1] / 'orbits' / 'symmetric_models.py'}:walled_pendulum",
+]
+SYMMETRIC = [*WALLED, "--set", "A=0.3", "--param", "Om", "--start", "1.2", "--stop", "0.6"]
+BALL = (
+    "--model bouncing-ball --param amplitude --start 1.3 --stop 1.6 --period 1 --initial 2.56,-2.51".split()
+)
+OLD_KEYS = {"params", "param", "period", "virtual", "values", "states", "multipliers", "stable", "impacts",
+            "segments", "section_times", "switch", "special", "status", "out"}  # fmt: skip
+
+
+def test_continue_tells_a_branch_point_from_a_fold_and_reaches_the_grazing(capsys):
+    """A model file with a symmetric orbit: its symmetry-breaking branch point (it was reported as a
+    fold) and, on the unstable branch, its grazing (it ended with "step size fell below 1e-06")."""
+    res = run_json(["continue", *SYMMETRIC], capsys)
+    assert set(res) >= OLD_KEYS | {"periods", "segment_status"}
+    assert [s["kind"] for s in res["special"]] == ["branch point", "grazing"]
+    bp, graze = res["special"]
+    assert min(abs(complex(*z) - 1) for z in bp["multipliers"]) < 1e-9 and bp["switched"] is False
+    assert res["status"].startswith(f"ended at a grazing at Om = {graze['value']:.10g} with stop 'west'")
+    assert res["periods"] == [1] * len(res["values"]) and set(res["segments"]) == {0}
+    out = run_text(["continue", *SYMMETRIC], capsys)
+    assert f"  branch point     Om = {bp['value']:.8g}   multipliers +1.0000+0.0000i" in out
+    assert "fold" not in out and "step size" not in out
+
+
+def test_continue_switch_at_a_period_doubling(capsys):
+    """The bouncing ball (r = 0.5, g = omega = 1): the period-1 orbit period-doubles at the closed form's
+    amplitude; with --switch the branch goes on along the period-2 orbit, a second segment."""
+    import math
+
+    a_pd = math.sqrt((math.pi / 3) ** 2 + (2 * 1.25 / 2.25) ** 2)
+    plain = run_json(["continue", *BALL], capsys)
+    res = run_json(["continue", *BALL, "--switch"], capsys)
+    assert set(plain["periods"]) == {1} and [s["kind"] for s in plain["special"]] == ["period-doubling"]
+    pd = res["special"][0]
+    assert pd["kind"] == "period-doubling" and pd["switched"] is True
+    assert pd["value"] == pytest.approx(a_pd, abs=1e-8) == plain["special"][0]["value"]
+    k = res["segments"].index(1)
+    assert res["periods"][:k] == [1] * k and res["periods"][k:] == [2] * (len(res["periods"]) - k)
+    assert res["segment_status"] == [
+        f"switched at the period-doubling at amplitude = {pd['value']:.10g} to the period-2 orbit born there",
+        "reached the bound amplitude = 1.6",
+    ]
+    assert res["status"] == "reached the bound amplitude = 1.6" and res["values"][-1] == 1.6
+    out = run_text(["continue", *BALL, "--switch"], capsys)
+    assert "points of the period-1 orbit in 2 segments (switched at: period-doubling; periods 1, 2)" in out
+    assert (
+        "  segment 1, period 2 (from the period-doubling at amplitude = 1.5268237): reached the bound" in out
+    )
+
+
+def test_continue_switch_at_a_branch_point_follows_both_directions(capsys):
+    res = run_json(["continue", *SYMMETRIC, "--switch"], capsys)
+    assert res["segment_status"][0].startswith("switched at the branch point at Om = ")
+    assert res["segment_status"][0].endswith("to the other branch through it (both directions)")
+    halves = [s for s in res["special"] if s["kind"] == "grazing" and s["switched"]][:2]
+    # the two asymmetric orbits lose their weaker impact at the same value, one on each wall
+    assert halves[0]["value"] == pytest.approx(halves[1]["value"], abs=1e-10)
+    assert {halves[0]["stop"], halves[1]["stop"]} == {"east", "west"}
+
+
+def test_continue_reports_an_unlocated_stability_change(capsys, monkeypatch):
+    """Steps too coarse to locate it (the command's --max-step always refines where stability changes;
+    here the library is made to step from c = 1.2 to c = -0.5 at once): one line says so."""
+    import grazing.orbits
+    from grazing.orbits import PalcSettings
+
+    real = grazing.orbits.continue_orbit
+
+    def coarse(*args, **kwargs):
+        return real(*args, **{**kwargs, "settings": PalcSettings(ds=2.0, ds_max=2.0, ds_refine=2.0)})
+
+    monkeypatch.setattr(grazing.orbits, "continue_orbit", coarse)
+    model = f"{Path(__file__).resolve().parents[1] / 'orbits' / 'any_damping.py'}:any_damping"
+    argv = ["continue", "--model", model, "--param", "c", "--start", "1.2", "--stop", "-0.5", "--virtual",
+            "--period", "1", "--initial", "0,0"]  # fmt: skip
+    (unlocated,) = run_json(argv, capsys)["special"]
+    assert unlocated["kind"] == "unlocated" and unlocated["between"] == [1.2, -0.5]
+    assert unlocated["value"] == pytest.approx(0.35)
+    assert unlocated["note"].startswith(
+        "unlocated stability change between c = 1.2 and c = -0.5: stable -> 2"
+    )
+    out = run_text(argv, capsys)
+    assert f"  unlocated        {unlocated['note']}\n" in out

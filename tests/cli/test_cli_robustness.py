@@ -323,6 +323,28 @@ IGNORED_OPTIONS = [
         ],
         "--set omega=2.5 is not used with --param omega: the swept values replace it",
     ),
+    # issue 27: branch switching (at period-doublings and branch points too: still a physical branch's)
+    (
+        [
+            "continue",
+            "--model",
+            f"{Path(__file__).resolve().parents[1] / 'orbits' / 'symmetric_models.py'}:walled_pendulum",
+            *"--set A=0.3 --param Om --start 1.2 --stop 0.6 --virtual --switch".split(),
+        ],
+        "--switch is not used with --virtual: a virtual branch ignores the stops",
+    ),
+    (
+        [
+            "continue",
+            "--model",
+            "bouncing-ball",
+            *"--param amplitude --start 1.3 --stop 1.6".split(),
+            "--switch",
+            "--period",
+            "65",
+        ],
+        "'--period': 65 is not in the range 1<=x<=64",
+    ),
 ]
 
 MEMORY = [

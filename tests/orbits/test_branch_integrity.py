@@ -41,8 +41,10 @@ def test_period5_branch_finds_the_period_doubling_and_ends_at_its_grazing(period
     pd, graze = br.special
     # the independent check of the location: a multiplier is -1 there (from the orbit's own monodromy)
     np.testing.assert_allclose(np.min(np.abs(pd.multipliers + 1)), 0, atol=1e-6)
-    # regression pin: where issue 11's finer run put it (0.445393)
+    # regression pin: where issue 11's finer run put it (0.445393), and issue 27's value (0.44539259)
     assert pd.param == pytest.approx(0.445393, abs=2e-6)
+    assert pd.param == pytest.approx(0.44539259, abs=5e-9)
+    assert not pd.switched and not pd.turns
     # Stable before the period-doubling, unstable after it, each from its own monodromy.
     values = np.array(br.values)
     stable = np.array([o.stable for o in br.orbits])

@@ -324,8 +324,10 @@ def graze_curve(
               "--switch).")  # fmt: skip
 @click.option("--max-step", type=POSITIVE, default=0.04, show_default=True, help="Largest continuation step.")
 @click.option("--switch", is_flag=True,
-              help="At a grazing where the impact sequence changes, continue on the orbit with the new "
-              "sequence (a new branch segment) instead of ending there (a physical branch only: not "
+              help="Switch branches, each switch starting a new branch segment: at the first "
+              "period-doubling or branch point met, onto the period-2n orbit born there or the other "
+              "branch through it (both ways); at every grazing where the impact sequence changes, onto "
+              "the orbit with the new sequence instead of ending there (a physical branch only: not "
               "with --virtual).")  # fmt: skip
 @netcdf_out_option
 @json_option
@@ -345,9 +347,10 @@ def continue_(
     overwrite: bool,
     as_json: bool,
 ) -> None:
-    """Pseudo-arclength continuation of a periodic orbit, with folds, period-doublings,
-    Neimark-Sacker points and grazings located.  A branch of an impacting orbit ends at
-    the grazing where its impact sequence changes (see --switch)."""
+    """Pseudo-arclength continuation of a periodic orbit, with folds, branch points,
+    period-doublings, Neimark-Sacker points and grazings located; a stability change that none
+    explains is reported as unlocated.  A branch of an impacting orbit ends at the grazing where
+    its impact sequence changes (see --switch)."""
     from grazing.orbits import PalcSettings, continue_orbit
 
     par = model_parameter(model, cparam)
@@ -355,7 +358,8 @@ def continue_(
     refuse_varied([name], f"with --param {cparam}: the branch starts at --start")
     refuse_unused(
         ["switch"], virtual is True, "with --virtual: a virtual branch ignores the stops, so its impact "
-        "sequence never changes (it is followed through its grazings)",
+        "sequence never changes (it is followed through its grazings); branches are switched on the "
+        "physical orbit",
     )  # fmt: skip
     watch = stop_option_index(model, stop_name)
     if start == stop:
@@ -392,6 +396,7 @@ def continue_(
         "stable": [o.stable for o in branch.orbits],
         "impacts": [o.impacts for o in branch.orbits],
         "segments": branch.segments,
+        "periods": branch.periods,
         "section_times": branch.sections,
         "switch": switch,
         "special": [
@@ -399,12 +404,16 @@ def continue_(
                 "kind": sp_.kind,
                 "value": back(sp_.param),
                 **({"stop": model.stop_names[sp_.stop]} if sp_.kind == "grazing" else {}),
+                **({"between": [back(v) for v in sp_.between]} if sp_.between is not None else {}),
+                **({"note": sp_.note} if sp_.note else {}),
                 "index": sp_.index,
                 "multipliers": complex_list(sp_.multipliers),
                 "state": sp_.orbit.state,
+                "switched": sp_.switched,
             }
             for sp_ in branch.special
         ],
+        "segment_status": branch.segment_status,
         "status": branch.status,
         "out": str(out) if out else None,
     }
@@ -414,12 +423,27 @@ def continue_(
         emit_json(res)
         return
     kind = "virtual (stop ignored)" if branch.virtual else "physical"
-    segs = max(branch.segments) + 1 if branch.segments else 1
-    more = f" in {segs} segments (impact sequence switched at grazings)" if segs > 1 else ""
+    segs = len(branch.segment_status)
+    more = ""
+    if segs > 1:
+        kinds = dict.fromkeys(sp_.kind for sp_ in branch.special if sp_.switched)
+        periods = sorted(set(branch.periods.tolist()))
+        listed = f"period{'s' * (len(periods) > 1)} {', '.join(map(str, periods))}"
+        more = f" in {segs} segments (switched at: {', '.join(kinds)}; {listed})"
     click.echo(f"{len(branch)} points of the period-{branch.period} orbit{more}, {kind}; {branch.status}")
     for point, sp_ in zip(branch.special, res["special"]):
+        if point.between is not None:  # an unlocated stability change: what was seen, in words
+            click.echo(f"  {sp_['kind']:16s} {point.note}")
+            continue
         mu = ", ".join(f"{x:+.4f}{y:+.4f}i" for x, y in sp_["multipliers"])
         on = f" (stop {sp_['stop']})" if sp_.get("stop", "stop") != "stop" else ""  # as graze prints it
-        click.echo(f"  {sp_['kind']:16s} {par.show(point.param, '.8g')}   multipliers {mu}{on}")
+        switched = "   (switched here)" if point.switched else (f"   ({point.note})" if point.note else "")
+        click.echo(f"  {sp_['kind']:16s} {par.show(point.param, '.8g')}   multipliers {mu}{on}{switched}")
+    if segs > 1:
+        for i, (origin, status) in enumerate(zip(branch.segment_origin, branch.segment_status)):
+            at = branch.special[origin] if origin >= 0 else None
+            start = f" (from the {at.kind} at {par.show(at.param, '.8g')})" if at is not None else ""
+            period = branch.periods[branch.segments.index(i)] if i in branch.segments else branch.period
+            click.echo(f"  segment {i}, period {period}{start}: {status}")
     if out is not None:
         click.echo(f"branch saved to {out}")

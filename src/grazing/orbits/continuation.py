@@ -2,9 +2,7 @@
 
 Unknowns ``u = (x, p)``: a point of the orbit on the stroboscopic section and
 the parameter.  Equations ``F(u) = P^n(x; p) - x = 0`` with Jacobian
-``[P_x - I, P_p]`` from the variational equations (saltation matrices at the
-impacts, parameter sensitivities as extra columns, the moving return time
-included for a parameter that sets the forcing period).  Each step predicts
+``[P_x - I, P_p]`` (:mod:`grazing.orbits.branch_equations`).  Each step predicts
 along the tangent (the null vector of the Jacobian) and corrects by Newton's
 method on ``F = 0`` plus the arclength condition (Keller 1977; Kuznetsov,
 *Elements of Applied Bifurcation Theory*, ch. 10).
@@ -16,22 +14,37 @@ of a near approach to the stop, passing through zero).  The branch therefore
 ends at that grazing: it is bracketed along the step, located exactly by
 solving the grazing equations (:mod:`grazing.orbits.contact`, Newton
 tolerance) and reported as a special point, as COCO's hybrid toolbox does.
-With ``switch=True`` the continuation goes on, deliberately, along the orbit
-with the new impact sequence, as a new *segment* of the branch.  Steps are
-halved where the corrector lands far from the predictor, where the tangent
-turns sharply, and where stability changes between two points, so that no
-special point is stepped over.
+Where Newton's method fails before the grazing (an impact speed tending to
+zero makes the saltation matrix, hence the map, singular), the grazing is
+located from the last point, if it lies ahead within the distance at which
+``v^2 / (2a)`` extrapolates to zero and its contact lies next to the
+vanishing impact.  Steps are halved where the corrector lands far from the
+predictor, where the tangent turns sharply, and where the number of
+multipliers outside the unit circle changes, so that no special point is
+stepped over.
 
-Special points are detected by sign changes of test functions between
-consecutive points and located by regula falsi along the secant:
+Between consecutive points the smooth special points are detected by sign
+changes of test functions and located to Newton tolerance
+(:mod:`grazing.orbits.bifurcations`): fold (the parameter turns, a multiplier
++1), branch point (the pseudo-arclength determinant changes sign, a multiplier
++1: symmetry breaking, transcritical), period-doubling (-1), Neimark-Sacker (a
+complex pair on the unit circle); and on virtual branches the grazing of every
+stop (the minimum of its guard reaches zero, refined by the grazing
+equations).  Every change of the number of multipliers outside the unit circle
+between two points must be explained by the points located there; where it is
+not, the branch reports an ``unlocated`` special point ("unlocated stability
+change between p1 and p2"): no change of stability passes silently.
 
-* fold: ``det(P_x - I)`` (a multiplier passes through +1);
-* period-doubling: ``det(P_x + I)`` (a multiplier passes through -1);
-* Neimark-Sacker: ``det(P_x) - 1`` with a complex pair (2-D maps; the
-  bialternate-product test in general);
-* grazing: the minimum of a stop's guard along a nonimpacting (virtual)
-  orbit reaches zero, for every stop (then refined by the grazing
-  equations), or the end of an impacting branch described above.
+With ``switch=True`` the continuation switches branches, each branch switched
+to being a new *segment* (:mod:`grazing.orbits.switching`): at every grazing
+where the impact sequence changes, onto the orbit with the new sequence (the
+old orbit ends there); and at the first period-doubling or branch point met,
+onto the branch born there instead of going on along this one: the
+period-``2n`` orbit (up to period :data:`~grazing.core.options.MAX_PERIOD`),
+or the other branch through the branch point, both ways (one segment each,
+the second after the first and everything it switched to).  Later
+period-doublings and branch points are reported, not switched at: one switch
+of that kind per run keeps the branch a chain, not a tree.
 
 The stroboscopic map is not smooth where an impact falls on its section, so
 the section is chosen away from impacts (``t0=None``, the default) and moved
@@ -51,8 +64,10 @@ from typing import Any
 import numpy as np
 
 from grazing.core.model import HybridModel
+from grazing.core.options import MAX_PERIOD
 from grazing.errors import ConvergenceError, GrazingError, InvalidParameterError
-from grazing.maps import flow_map
+from grazing.orbits.bifurcations import Located, between, orbit_test, verified
+from grazing.orbits.branch_equations import branch_equations
 from grazing.orbits.contact import GrazingPoint, refine_grazing
 from grazing.orbits.palc import (
     ACCEPT,
@@ -68,13 +83,20 @@ from grazing.orbits.palc import (
 from grazing.orbits.shooting import (
     SECTION_MARGIN,
     PeriodicOrbit,
-    _orbit_from,
     find_orbit,
     move_section,
     quiet_section,
 )
+from grazing.orbits.switching import Start, crossing_starts, doubled_start, new_sequence_orbit
 
-SPECIAL_KINDS = ("fold", "period-doubling", "neimark-sacker", "grazing")
+SPECIAL_KINDS = ("fold", "branch point", "period-doubling", "neimark-sacker", "grazing")
+"""The special points that :func:`continue_orbit` detects and locates (its ``detect``)."""
+
+UNLOCATED = "unlocated"
+"""The kind of a special point that stands for a stability change no located point explains."""
+
+SWITCH_KINDS = ("period-doubling", "branch point", "grazing")
+"""The special points where another branch starts: ``switch`` continues onto it."""
 
 RESECTION_MARGIN = 0.01
 """An impact closer than this fraction of a period to the section moves the section."""
@@ -84,6 +106,11 @@ _RESECTION = "an impact approaches the section"
 ContinuationSettings = PalcSettings
 """Options of :func:`continue_orbit` (see :class:`~grazing.orbits.palc.PalcSettings`)."""
 
+_evaluator = branch_equations  # (the former private name)
+_test_function = orbit_test
+_verified = verified
+_switch_orbit = new_sequence_orbit
+
 
 @dataclass(frozen=True)
 class SpecialPoint:
@@ -92,14 +119,16 @@ class SpecialPoint:
     Attributes
     ----------
     kind
-        One of :data:`SPECIAL_KINDS`.
+        One of :data:`SPECIAL_KINDS`, or :data:`UNLOCATED`.
     index
         The branch point just before it.
     param
-        The parameter value where it occurs.
+        The parameter value where it occurs (for an unlocated stability change: the middle of
+        the two points' values, :attr:`between`).
     orbit
         The periodic orbit there (for a grazing: the orbit where the branch
-        ends, next to the grazing).
+        ends, next to the grazing; for an unlocated stability change: the orbit at point
+        ``index``).
     grazing
         For a grazing: the grazing orbit itself, solved from the grazing
         equations (contact state and time, monodromy on the section through
@@ -107,6 +136,20 @@ class SpecialPoint:
         did not converge, in which case ``param`` is the end of the bracket.
     stop
         For a grazing: the index of the stop grazed.
+    note
+        For an unlocated stability change: what was seen, in words ("unlocated stability
+        change between omega = 0.9 and omega = 0.95: ...", the values in display units); for
+        a period-doubling or branch point where ``switch`` found no branch to follow: why.
+    between
+        For an unlocated stability change: the parameter values of the two points.
+    tangent
+        For a fold, branch point, period-doubling or Neimark-Sacker point: the branch's unit
+        tangent there, in ``u = (x, p)`` (a branch point: the tangent of the branch followed).
+    turns
+        For a branch point: the parameter turns there (the curved branch of a pitchfork); for a
+        fold, always.
+    switched
+        The continuation switched there onto another branch (``switch``).
     """
 
     kind: str
@@ -115,6 +158,11 @@ class SpecialPoint:
     orbit: PeriodicOrbit
     grazing: GrazingPoint | None = None
     stop: int = 0
+    note: str = ""
+    between: tuple[float, float] | None = None
+    tangent: np.ndarray | None = None
+    turns: bool = False
+    switched: bool = False
 
     @property
     def multipliers(self) -> np.ndarray:
@@ -130,18 +178,26 @@ class Branch:
     ----------
     param
         Name of the continuation parameter.
+    period
+        The starting orbit's period (see :attr:`periods` for each point's).
     values
         Parameter value at each point.
     orbits
         The periodic orbit at each point (state on its section ``orbit.t0``,
         multipliers, impacts...).
     segments
-        Segment index of each point: 0, then one more after each deliberate
-        switch onto the orbit with a new impact sequence (``switch=True``).
+        Segment index of each point: 0, then one more for each branch followed after a
+        switch (``switch=True``).
     special
-        Located special points, in order along the branch.
+        Located special points, in order along the branch (segment after segment).
     status
-        Why the continuation stopped.
+        Why the continuation stopped (its last segment; :attr:`segment_status` has each
+        segment's).
+    segment_status
+        Why each segment ended.
+    segment_origin
+        For each segment, the index in :attr:`special` of the point it was switched to from
+        (-1 for the first).
     """
 
     model: HybridModel
@@ -154,6 +210,8 @@ class Branch:
     segments: list[int] = field(default_factory=list)
     special: list[SpecialPoint] = field(default_factory=list)
     status: str = ""
+    segment_status: list[str] = field(default_factory=list)
+    segment_origin: list[int] = field(default_factory=list)
 
     def __len__(self) -> int:
         return len(self.values)
@@ -165,6 +223,12 @@ class Branch:
     @property
     def multipliers(self) -> np.ndarray:
         return np.array([o.multipliers for o in self.orbits])
+
+    @property
+    def periods(self) -> np.ndarray:
+        """The period of each point's orbit, in forcing periods (it doubles after a switch at a
+        period-doubling)."""
+        return np.array([o.period for o in self.orbits], dtype=int)
 
     @property
     def guard_min(self) -> np.ndarray:
@@ -187,6 +251,7 @@ class Branch:
             "param": ("point", np.asarray(self.values)),
             "arclength": ("point", np.asarray(self.arclength)),
             "segment": ("point", np.asarray(self.segments, dtype=np.int32)),
+            "period": ("point", self.periods.astype(np.int32)),
             "section_time": ("point", self.sections),
             "state": (("point", "component"), self.states),
             "multiplier_re": (("point", "multiplier"), mu.real),
@@ -207,6 +272,8 @@ class Branch:
                 ("special", "multiplier"),
                 np.array([np.abs(s.multipliers) for s in self.special]).reshape(-1, len(names)),
             ),
+            "special_note": ("special", np.array([s.note for s in self.special], dtype=str)),
+            "special_switched": ("special", np.array([s.switched for s in self.special], dtype=np.int8)),
         }
         # Where each orbit comes closest to the stop (its largest angle, for the pendulum).
         nan = np.full(len(names), np.nan)
@@ -214,6 +281,7 @@ class Branch:
         data["closest_state"] = (("point", "component"), np.array(closest).reshape(-1, len(names)))
         ds = xr.Dataset(data, coords={"component": names, "multiplier": np.arange(len(names))})
         ds.param.attrs["long_name"] = self.param
+        ds.period.attrs["long_name"] = "period of the orbit in forcing periods"
         attrs: dict[str, Any] = {
             "model": self.model.name,
             "continuation_parameter": self.param,
@@ -239,38 +307,6 @@ class Branch:
 # ----------------------------------------------------------------------------
 
 
-def _evaluator(model: HybridModel, param: str, period: int, t0: float, virtual: bool, stop: int = 0):
-    """``u = (x, p) -> (F, DF, orbit)`` for the branch equations ``P^n(x; p) - x = 0``."""
-    n = model.n_states
-    eye = np.eye(n)
-
-    def evaluate(u: np.ndarray) -> tuple[np.ndarray, np.ndarray, PeriodicOrbit]:
-        m = model.with_params(**{param: float(u[-1])})
-        x = u[:-1]
-        fm = flow_map(m, x, t0=t0, periods=period, sensitivities=[param], virtual=virtual, stop_name=stop)
-        if not fm.solution.jacobian_valid:
-            raise ConvergenceError("the orbit sticks to the stop: no Jacobian across sticking")
-        F = fm.image - x
-        orbit = _orbit_from(m, x, t0, period, fm, virtual, [float(np.max(np.abs(F)))], stop)
-        return F, np.hstack([fm.jacobian - eye, fm.sensitivity]), orbit
-
-    return evaluate
-
-
-def _test_function(kind: str, orbit: PeriodicOrbit) -> float:
-    """Test function of a special point (smooth along a branch of one impact signature)."""
-    J = orbit.monodromy
-    eye = np.eye(J.shape[0])
-    if kind == "fold":
-        return float(np.linalg.det(J - eye))
-    if kind == "period-doubling":
-        return float(np.linalg.det(J + eye))
-    if kind == "neimark-sacker":
-        complex_pair = bool(np.any(np.abs(orbit.multipliers.imag) > 1e-12))
-        return float(np.linalg.det(J) - 1.0) if complex_pair else math.nan
-    raise ValueError(f"unknown special point kind {kind!r}")
-
-
 def _stop_guard_min(orbit: PeriodicOrbit, stop: int) -> float:
     """The smallest value of stop ``stop``'s guard along a virtual orbit: zero where it grazes that stop.
 
@@ -279,24 +315,12 @@ def _stop_guard_min(orbit: PeriodicOrbit, stop: int) -> float:
     return orbit.guard_min_by_stop[stop][0] if orbit.virtual else math.nan
 
 
-def _verified(kind: str, orbit: PeriodicOrbit) -> bool:
-    """Does a located point satisfy the defining condition of its kind?"""
-    mu = orbit.multipliers
-    if kind == "fold":
-        return bool(np.min(np.abs(mu - 1.0)) < 1e-5)
-    if kind == "period-doubling":
-        return bool(np.min(np.abs(mu + 1.0)) < 1e-5)
-    if kind == "neimark-sacker":
-        pair = mu[np.abs(mu.imag) > 1e-12]
-        return bool(pair.size and np.min(np.abs(np.abs(pair) - 1.0)) < 1e-5)
-    return True
-
-
 def _detect(evaluate, kind: str, a: PalcPoint, b: PalcPoint, s: PalcSettings) -> PalcPoint | None:
-    if not sign_changed(_test_function(kind, a.payload), _test_function(kind, b.payload)):
+    """The point of ``kind`` (an orbit-based test function) between ``a`` and ``b``, located and verified."""
+    if not sign_changed(orbit_test(kind, a.payload), orbit_test(kind, b.payload)):
         return None
-    loc = locate(evaluate, a, b, lambda p: _test_function(kind, p.payload), s)
-    return loc if loc is not None and _verified(kind, loc.payload) else None
+    loc = locate(evaluate, a, b, lambda p: orbit_test(kind, p.payload), s)
+    return loc if loc is not None and verified(kind, loc.payload) else None
 
 
 def _detect_grazing(
@@ -327,7 +351,8 @@ def grazing_margin(orbit: PeriodicOrbit) -> tuple[float, np.ndarray | None, floa
     impacts (``h`` at a local minimum of the guard) and, over the impacts,
     ``v^2 / (2 a)`` (how deep the local parabola of a low-velocity impact
     reaches, ``v`` the impact speed and ``a = L_f^2 h``).  Both tend to zero
-    linearly in the parameter as the orbit approaches a grazing from its side.
+    linearly in the parameter as the orbit approaches a grazing from its side
+    (``v^2 / (2 a)`` may also tend to zero quadratically, where ``v`` does linearly).
     ``stop`` is the index of the stop concerned (closest approaches and
     impacts on every stop are considered).
     """
@@ -346,10 +371,30 @@ def grazing_margin(orbit: PeriodicOrbit) -> tuple[float, np.ndarray | None, floa
     return best
 
 
+AHEAD_FACTOR = 2.0
+"""A grazing located from the last point of a branch whose Newton steps failed before it is accepted
+up to this many times the distance at which the margin (:func:`grazing_margin`) extrapolates to zero."""
+
+NEAR_CONTACT = 0.05
+"""A grazing located that way must touch the stop within this fraction of a forcing period of the
+vanishing impact (or closest approach), and within this fraction of ``max(1, |x|)`` of its state."""
+
+
 def _locate_grazing(
-    last: PeriodicOrbit, beyond: PeriodicOrbit | None, param: str, virtual: bool
+    last: PeriodicOrbit,
+    beyond: PeriodicOrbit | None,
+    param: str,
+    virtual: bool,
+    ahead: float | None = None,
 ) -> GrazingPoint | None:
-    """The grazing orbit at the end of a branch, from its last orbit (Newton on the contact equations)."""
+    """The grazing orbit at the end of a branch, from its last orbit (Newton on the contact equations).
+
+    With ``beyond`` (the first orbit past the boundary) the grazing must lie between the two.
+    Without it, within ``1e-4 max(1, |p|)`` of the last value ``p``, or, given ``ahead`` (where
+    the margin extrapolates to zero), ahead of ``p`` in the direction of travel up to
+    :data:`AHEAD_FACTOR` times that distance, with its contact next to the vanishing impact
+    (:data:`NEAR_CONTACT`): the same orbit's grazing.
+    """
     _, y, tg, _, stop = grazing_margin(last)
     if y is None:
         return None
@@ -364,32 +409,237 @@ def _locate_grazing(
     scale = max(1.0, abs(p))
     if beyond is not None:
         q = beyond.model.params[param]
-        ok = min(p, q) - 1e-8 * scale <= pg <= max(p, q) + 1e-8 * scale
-    else:
-        ok = abs(pg - p) <= 1e-4 * scale
-    return point if ok else None
+        return point if min(p, q) - 1e-8 * scale <= pg <= max(p, q) + 1e-8 * scale else None
+    if abs(pg - p) <= 1e-4 * scale:
+        return point
+    if ahead is None or not (pg - p) * (ahead - p) > 0 or abs(pg - p) > AHEAD_FACTOR * abs(ahead - p):
+        return None
+    T = last.model.period
+    lag = (point.t_graze - tg) / T
+    near_time = abs(lag - round(lag)) <= NEAR_CONTACT
+    near_state = float(np.max(np.abs(point.contact - y))) <= NEAR_CONTACT * max(1.0, float(np.max(np.abs(y))))
+    return point if near_time and near_state else None
 
 
-def _switch_orbit(
-    last: PeriodicOrbit, param: str, value: float, direction: float, virtual: bool
-) -> PeriodicOrbit | None:
-    """An orbit with another impact signature than ``last``, just past the grazing at ``value``."""
-    p = last.model.params[param]
-    par = next(q for q in last.model.parameters if q.name == param)
-    for sign in (direction, -direction):
-        for eps in (1e-7, 1e-6, 1e-5, 1e-4):
-            trial = value + sign * eps * max(1.0, abs(value))
-            try:
-                par.check(trial)
-                orbit = find_orbit(
-                    last.model.with_params(**{param: trial}), last.state, period=last.period, t0=last.t0,
-                    virtual=virtual, stop_name=last.stop,
-                )  # fmt: skip
-            except GrazingError:
+class _Continuation:
+    """One run of :func:`continue_orbit`: its settings, the branch it fills, one segment at a time."""
+
+    def __init__(self, model: HybridModel, param: str, branch: Branch, s: PalcSettings,
+                 bounds: tuple[float, float], detect: tuple[str, ...], switch: bool,
+                 progress: Callable[[int, float], None] | None):  # fmt: skip
+        self.model, self.param, self.branch, self.s = model, param, branch, s
+        self.par = model.parameter(param)
+        self.nx = model.n_states
+        self.bounds = {self.nx: bounds}
+        self.detect, self.switch, self.progress = detect, switch, progress
+        self.virtual = branch.virtual
+        self.switched_smooth = False  # switched at a period-doubling or branch point (done once)
+
+    # -- acceptance of a step -------------------------------------------------------------
+
+    def check(self, prev: PalcPoint, cand: PalcPoint) -> tuple[str, str]:
+        a, b = prev.payload, cand.payload
+        if not self.virtual and b.signature != a.signature:
+            what = "loses" if sum(b.signature) < sum(a.signature) else "gains"
+            if sum(b.signature) == sum(a.signature):
+                what = "changes"
+            return BOUNDARY, (
+                f"the orbit {what} an impact (impacts per forcing period {list(a.signature)} -> "
+                f"{list(b.signature)}): a grazing"
+            )
+        if not self.virtual and b.section_clearance() < RESECTION_MARGIN:
+            return STOP, _RESECTION
+        if np.sum(np.abs(a.multipliers) > 1.0) != np.sum(np.abs(b.multipliers) > 1.0):
+            return REFINE, "stability changes"
+        return ACCEPT, ""
+
+    @staticmethod
+    def margin(pt: PalcPoint) -> float:
+        return grazing_margin(pt.payload)[0]
+
+    # -- special points between two points --------------------------------------------------
+
+    def _special_between(self, evaluate, prev: PalcPoint, pt: PalcPoint, n: int) -> SpecialPoint | None:
+        """Record the special points between ``prev`` and ``pt``; the first where ``switch`` acts."""
+        branch, index = self.branch, len(self.branch) - 1
+        step = between(evaluate, prev, pt, self.s, self.nx)
+        first: SpecialPoint | None = None
+        for loc in step.located:
+            if loc.kind not in self.detect:
                 continue
-            if orbit.signature != last.signature and abs(trial - p) > 0:
-                return orbit
-    return None
+            sp_ = self._special(loc, index)
+            branch.special.append(sp_)
+            if first is None and self.switch and not self.switched_smooth and loc.kind in SWITCH_KINDS:
+                first = sp_
+        if not step.explained:
+            p1, p2 = float(prev.u[-1]), float(pt.u[-1])
+            note = (
+                f"unlocated stability change between {self.par.show(p1)} and {self.par.show(p2)}: "
+                f"{step.describe()}"
+            )
+            branch.special.append(
+                SpecialPoint(UNLOCATED, index, 0.5 * (p1 + p2), prev.payload, note=note, between=(p1, p2))
+            )
+        if "grazing" in self.detect and self.virtual:  # the grazing of any stop
+            for j in range(self.model.n_stops):
+                found = _detect_grazing(evaluate, j, prev, pt, self.param, n, self.s)
+                if found is not None:
+                    branch.special.append(dataclasses.replace(found, index=index))
+        return first
+
+    @staticmethod
+    def _special(loc: Located, index: int) -> SpecialPoint:
+        return SpecialPoint(
+            loc.kind, index, float(loc.point.u[-1]), loc.point.payload, tangent=loc.point.tangent,
+            turns=loc.turns,
+        )  # fmt: skip
+
+    # -- one segment ------------------------------------------------------------------------
+
+    def segment(self, start: Start) -> list[Start]:
+        """Follow one segment from ``start``; the starts of the branches it switches to."""
+        branch, s, nx = self.branch, self.s, self.nx
+        seg = len(branch.segment_origin)
+        branch.segment_origin.append(start.origin)
+        orbit, sign, direction = start.orbit, start.sign, start.direction
+        prev: PalcPoint | None = None
+        while True:
+            n = orbit.period
+            evaluate = branch_equations(self.model, self.param, n, orbit.t0, self.virtual, orbit.stop)
+            u0 = np.append(orbit.state, orbit.model.params[self.param])
+            try:
+                F, DF, orb = evaluate(u0)
+            except GrazingError as exc:
+                if seg == 0 and prev is None:
+                    raise ConvergenceError(f"cannot start the continuation: {exc}") from None
+                branch.segment_status.append(f"cannot continue from {self.par.show(u0[-1])}: {exc}")
+                return []
+            palc = Palc(
+                evaluate, PalcPoint(u0, F, DF, orb), index=nx, sign=sign, bounds=self.bounds,
+                settings=dataclasses.replace(s, max_points=max(2, s.max_points - len(branch) + 1)),
+                names={nx: self.param}, shows={nx: self.par.show}, check=self.check,
+                margin=None if self.virtual else self.margin, direction=direction,
+            )  # fmt: skip
+            direction = None
+            restarted = prev is not None  # the section moved: the same orbit, already on the branch
+            for k, pt in enumerate(palc):
+                if k == 0 and restarted:
+                    prev = pt
+                    continue
+                switch_at = None
+                if prev is not None:
+                    switch_at = self._special_between(evaluate, prev, pt, n)
+                    branch.arclength.append(branch.arclength[-1] + float(np.linalg.norm(pt.u - prev.u)))
+                else:
+                    branch.arclength.append(branch.arclength[-1] if branch.arclength else 0.0)
+                branch.values.append(float(pt.u[-1]))
+                branch.orbits.append(pt.payload)
+                branch.segments.append(seg)
+                prev = pt
+                if self.progress is not None:
+                    self.progress(len(branch), float(pt.u[-1]))
+                if switch_at is not None:
+                    starts = self._switch_smooth(switch_at, evaluate)
+                    if starts:
+                        return starts  # (else the point says why, and the branch goes on)
+            status = palc.status
+            assert prev is not None and prev.tangent is not None
+            sign = math.copysign(1.0, prev.tangent[nx]) if prev.tangent[nx] != 0 else sign
+            last: PeriodicOrbit = prev.payload
+            if status == _RESECTION and len(branch) < s.max_points:
+                try:
+                    orbit = move_section(last, quiet_section(last))
+                except GrazingError as exc:
+                    status = f"{_RESECTION} and the orbit could not be found on another section ({exc})"
+                    branch.segment_status.append(status)
+                    return []
+                continue
+            if palc.boundary is None:
+                branch.segment_status.append(status)
+                return []
+            return self._grazing_end(palc, prev, sign)
+
+    # -- how a segment ends -----------------------------------------------------------------
+
+    def _grazing_end(self, palc: Palc, prev: PalcPoint, sign: float) -> list[Start]:
+        """The segment ends at a grazing (bracketed, or ahead of a point beyond which Newton fails)."""
+        branch, par = self.branch, self.par
+        boundary = palc.boundary
+        assert boundary is not None
+        last: PeriodicOrbit = prev.payload
+        beyond = boundary.after.payload if boundary.after is not None else None
+        point = _locate_grazing(last, beyond, self.param, self.virtual, boundary.ahead)
+        if point is None and not boundary.reached:
+            branch.segment_status.append(palc.status)  # the steps beyond jumped to another orbit
+            return []
+        value = point.model.params[self.param] if point is not None else float(prev.u[-1])
+        where_stop = grazing_margin(last)[4] if point is None else point.stop
+        graze = SpecialPoint("grazing", len(branch) - 1, value, last, point, where_stop)
+        where = par.show(value)
+        if self.model.n_stops > 1:
+            where = f"{where} with stop {self.model.stop_names[where_stop]!r}"
+        if point is None:
+            where += (
+                f" (bracketed only: the grazing equations did not converge; last orbit at "
+                f"{par.show(prev.u[-1])})"
+            )
+        reason = boundary.reason
+        if not boundary.reached:
+            what = grazing_margin(last)[3]
+            reason = f"an impact speed reaches zero: the orbit {what}"
+            if what == "gains an impact":
+                reason = f"the orbit touches the stop between its impacts: it {what}"
+            reason += " (located from this side: the branch does not continue beyond it)"
+        status = f"ended at a grazing at {where}: {reason}"
+        if not self.switch:
+            branch.special.append(graze)
+            branch.segment_status.append(
+                status + "; the orbit with the new impact sequence can be followed with switch (--switch)"
+            )
+            return []
+        new = new_sequence_orbit(last, self.param, value, sign, self.virtual)
+        if new is None:
+            branch.special.append(graze)
+            branch.segment_status.append(
+                status + "; no orbit with another impact sequence was found just past it to switch to"
+            )
+            return []
+        branch.special.append(dataclasses.replace(graze, switched=True))
+        branch.segment_status.append(status + "; switched to the orbit with the new impact sequence")
+        if new.section_clearance() < SECTION_MARGIN:
+            new = move_section(new, quiet_section(new))
+        sign = math.copysign(1.0, new.model.params[self.param] - value)
+        return [Start(new, sign, None, len(branch.special) - 1)]
+
+    def _switch_smooth(self, at: SpecialPoint, evaluate) -> list[Start]:
+        """The starts of the branches born at a period-doubling or branch point just passed; none (the
+        point's note says why) if there is none to follow.  Only the first such point is tried."""
+        branch, par = self.branch, self.par
+        self.switched_smooth = True
+        i = next(j for j in range(len(branch.special) - 1, -1, -1) if branch.special[j] is at)
+        starts: list[Start] = []
+        if at.kind == "period-doubling":
+            n2 = 2 * at.orbit.period
+            found = doubled_start(at.orbit, self.param, self.s) if n2 <= MAX_PERIOD else None
+            if found is not None:
+                orbit, direction = found
+                starts = [Start(orbit, math.copysign(1.0, direction[-1] or 1.0), direction, i)]
+            why = f"periods above {MAX_PERIOD} are not switched to" if n2 > MAX_PERIOD else "none was found"
+            missing = f"not switched to the period-{n2} orbit born here: {why}"
+            what = f"the period-{n2} orbit born there"
+        else:
+            assert at.tangent is not None
+            u_star = np.append(at.orbit.state, at.param)
+            for orbit, direction in crossing_starts(evaluate, u_star, at.tangent, self.s):
+                starts.append(Start(orbit, math.copysign(1.0, direction[-1] or 1.0), direction, i))
+            missing = "not switched: no other branch was found through it"
+            what = "the other branch through it" + (" (both directions)" if len(starts) == 2 else "")
+        if not starts:
+            branch.special[i] = dataclasses.replace(at, note=missing)
+            return []
+        branch.special[i] = dataclasses.replace(at, switched=True)
+        branch.segment_status.append(f"switched at the {at.kind} at {par.show(at.param)} to {what}")
+        return starts
 
 
 def continue_orbit(
@@ -434,7 +684,9 @@ def continue_orbit(
     settings
         Step control (:class:`~grazing.orbits.palc.PalcSettings`).
     detect
-        Special points to detect and locate (any of ``SPECIAL_KINDS``).
+        Special points to report (any of ``SPECIAL_KINDS``).  Every kind is
+        located wherever it explains a stability change; a change that no
+        located point explains is always reported, as :data:`UNLOCATED`.
     stop_name
         For models with several stops: the stop (name or index; default the
         starting orbit's, else the first) whose grazing a nonimpacting branch
@@ -442,10 +694,14 @@ def continue_orbit(
         stop; an impacting branch ends where it loses or gains an impact on
         any stop, at that stop's grazing.
     switch
-        At a grazing where the impact sequence changes, continue onto the orbit
-        with the new sequence (a new segment of the branch) instead of ending.
-        A virtual branch has no such grazing: ``switch`` with ``virtual=True``
-        (or a virtual starting ``orbit``) raises
+        Switch branches, each switch starting a new segment: at every grazing
+        where the impact sequence changes, onto the orbit with the new
+        sequence; at the first period-doubling or branch point met (of the
+        kinds in ``detect``), onto the period-``2n`` orbit born there or along
+        the other branch through it, both ways.  Segments are followed while
+        points remain (``settings.max_points`` in all).  A virtual branch has
+        no grazing where its impact sequence changes: ``switch`` with
+        ``virtual=True`` (or a virtual starting ``orbit``) raises
         :class:`~grazing.errors.InvalidParameterError`.
     progress
         Called as ``progress(points, param_value)`` after each point.
@@ -477,12 +733,11 @@ def continue_orbit(
         raise InvalidParameterError("start and stop must differ")
     m0 = model.with_params(**{param: start})
     model.with_params(**{param: stop})  # the end of the range must be a valid value too
-    par = model.parameter(param)
     if switch and (virtual or (virtual is None and orbit is not None and orbit.virtual)):
         raise InvalidParameterError(
             "switch has no effect on a virtual branch: it ignores the stops, so its impact sequence never "
             "changes (it is followed through its grazings, which are located); continue the physical "
-            "orbit (virtual=False) to switch at a grazing"
+            "orbit (virtual=False) to switch at its grazings, period-doublings and branch points"
         )
     if switch and virtual is None:
         virtual = False  # a nonimpacting orbit too: followed up to its grazing, then switched
@@ -508,121 +763,19 @@ def continue_orbit(
             orbit = move_section(orbit, quiet_section(orbit))
     elif virtual is None:
         virtual = orbit.virtual
-    virtual = bool(virtual)
-    n = orbit.period
-    nx = model.n_states
-    branch = Branch(model=model, param=param, period=n, virtual=virtual)
-    bounds = {nx: (min(start, stop), max(start, stop))}
-
-    def check(prev: PalcPoint, cand: PalcPoint) -> tuple[str, str]:
-        a, b = prev.payload, cand.payload
-        if not virtual and b.signature != a.signature:
-            what = "loses" if sum(b.signature) < sum(a.signature) else "gains"
-            if sum(b.signature) == sum(a.signature):
-                what = "changes"
-            return BOUNDARY, (
-                f"the orbit {what} an impact (impacts per forcing period {list(a.signature)} -> "
-                f"{list(b.signature)}): a grazing"
+    branch = Branch(model=model, param=param, period=orbit.period, virtual=bool(virtual))
+    run = _Continuation(
+        model, param, branch, s, (min(start, stop), max(start, stop)), tuple(detect), switch, progress
+    )
+    pending = [Start(orbit, math.copysign(1.0, stop - start))]  # (a stack: each chain to its end first)
+    while pending:
+        if len(branch) >= s.max_points:
+            left = len(pending)
+            branch.segment_status[-1] += (
+                f"; {left} branch{'es' * (left > 1)} switched to not followed: maximum number of points "
+                "reached"
             )
-        if not virtual and b.section_clearance() < RESECTION_MARGIN:
-            return STOP, _RESECTION
-        if a.stable != b.stable:
-            return REFINE, "stability changes"
-        return ACCEPT, ""
-
-    def margin(pt: PalcPoint) -> float:
-        return grazing_margin(pt.payload)[0]
-
-    sign = math.copysign(1.0, stop - start)
-    segment = 0
-    prev: PalcPoint | None = None
-    status = ""
-    while True:
-        evaluate = _evaluator(model, param, n, orbit.t0, virtual, orbit.stop)
-        u0 = np.append(orbit.state, orbit.model.params[param])
-        try:
-            F, DF, orb = evaluate(u0)
-        except GrazingError as exc:
-            raise ConvergenceError(f"cannot start the continuation: {exc}") from None
-        palc = Palc(
-            evaluate, PalcPoint(u0, F, DF, orb), index=nx, sign=sign, bounds=bounds,
-            settings=dataclasses.replace(s, max_points=max(2, s.max_points - len(branch) + 1)),
-            names={nx: param}, shows={nx: par.show}, check=check, margin=None if virtual else margin,
-        )  # fmt: skip
-        restarted = prev is not None and segment == branch.segments[-1]  # the section moved
-        for k, pt in enumerate(palc):
-            if k == 0 and restarted:
-                prev = pt  # the same orbit on a moved section: already on the branch
-                continue
-            if prev is not None and branch.segments and branch.segments[-1] == segment:
-                for kind in detect:
-                    if kind == "grazing":  # (virtual branches) the grazing of any stop
-                        for j in range(model.n_stops):
-                            found = _detect_grazing(evaluate, j, prev, pt, param, n, s)
-                            if found is not None:
-                                branch.special.append(dataclasses.replace(found, index=len(branch) - 1))
-                        continue
-                    loc = _detect(evaluate, kind, prev, pt, s)
-                    if loc is None:
-                        continue
-                    value = float(loc.u[-1])
-                    branch.special.append(SpecialPoint(kind, len(branch) - 1, value, loc.payload, None))
-                branch.arclength.append(branch.arclength[-1] + float(np.linalg.norm(pt.u - prev.u)))
-            else:
-                branch.arclength.append(branch.arclength[-1] if branch.arclength else 0.0)
-            branch.values.append(float(pt.u[-1]))
-            branch.orbits.append(pt.payload)
-            branch.segments.append(segment)
-            prev = pt
-            if progress is not None:
-                progress(len(branch), float(pt.u[-1]))
-        status = palc.status
-        assert prev is not None and prev.tangent is not None
-        sign = math.copysign(1.0, prev.tangent[nx]) if prev.tangent[nx] != 0 else sign
-        last: PeriodicOrbit = prev.payload
-        if status == _RESECTION and len(branch) < s.max_points:
-            try:
-                orbit = move_section(last, quiet_section(last))
-            except GrazingError as exc:
-                status = f"{_RESECTION} and the orbit could not be found on another section ({exc})"
-                break
-            continue
-        if palc.boundary is None:
             break
-        beyond = palc.boundary.after.payload if palc.boundary.after is not None else None
-        point = _locate_grazing(last, beyond, param, virtual)
-        if point is None and not palc.boundary.reached:
-            break  # steps beyond jumped to another orbit, and no grazing is just ahead: say so
-        value = point.model.params[param] if point is not None else float(prev.u[-1])
-        where_stop = grazing_margin(last)[4] if point is None else point.stop
-        branch.special.append(SpecialPoint("grazing", len(branch) - 1, value, last, point, where_stop))
-        where = par.show(value)
-        if model.n_stops > 1:
-            where = f"{where} with stop {model.stop_names[where_stop]!r}"
-        if point is None:
-            where += (
-                f" (bracketed only: the grazing equations did not converge; last orbit at "
-                f"{par.show(prev.u[-1])})"
-            )
-        reason = palc.boundary.reason
-        if not palc.boundary.reached:
-            what = grazing_margin(last)[3]
-            reason = f"an impact speed reaches zero: the orbit {what}"
-            if what == "gains an impact":
-                reason = f"the orbit touches the stop between its impacts: it {what}"
-            reason += " (located from this side: the branch does not continue beyond it)"
-        status = f"ended at a grazing at {where}: {reason}"
-        if not switch:
-            status += "; the orbit with the new impact sequence can be followed with switch (--switch)"
-            break
-        new = _switch_orbit(last, param, value, sign, virtual)
-        if new is None:
-            status += "; no orbit with another impact sequence was found just past it to switch to"
-            break
-        orbit = new
-        sign = math.copysign(1.0, new.model.params[param] - value)
-        segment += 1
-        if new.section_clearance() < SECTION_MARGIN:
-            orbit = move_section(new, quiet_section(new))
-    branch.status = status
+        pending.extend(reversed(run.segment(pending.pop())))
+    branch.status = branch.segment_status[-1]
     return branch

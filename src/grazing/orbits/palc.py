@@ -107,6 +107,34 @@ class Boundary:
     reached: bool = True
     """False when the points beyond did not approach the curve as the bracket shrank (the
     corrector jumped to another curve): then there is no boundary here."""
+    ahead: float | None = None
+    """For an unconfirmed boundary (``after`` None, not ``reached``): where the caller's margin,
+    extrapolated from the last two points, reaches zero (the value of the component ``index``),
+    by the farther of the two extrapolations of :func:`margin_zeros`; None without such a margin."""
+
+
+def margin_zeros(margins: list[tuple[float, float]]) -> tuple[float, float] | None:
+    """Where a margin tending to zero vanishes, from its last two values ``[(u0, m0), (u1, m1)]``.
+
+    A boundary margin (an impact speed squared, say) vanishes linearly or quadratically in ``u``;
+    returns the zeros of the linear and of the quadratic extrapolation (``sqrt(m)`` linear)
+    through the two points, ``(linear, quadratic)``, or None when the margin is not decreasing
+    towards zero.  For a margin ``~ d^k`` with ``1 <= k <= 2`` (``d`` the distance to its zero),
+    the linear zero lies at most as far as the true one and the quadratic at least as far.
+
+    Examples
+    --------
+    >>> margin_zeros([(0.0, 4.0), (1.0, 1.0)])  # m = (2 - u)^2: the quadratic zero is exact
+    (1.3333333333333333, 2.0)
+    """
+    if len(margins) < 2:
+        return None
+    (p0, m0), (p1, m1) = margins[-2], margins[-1]
+    if not (m0 > m1 > 0) or p1 == p0:
+        return None
+    linear = m1 / (m0 - m1)
+    quadratic = math.sqrt(m1) / (math.sqrt(m0) - math.sqrt(m1))
+    return p1 + linear * (p1 - p0), p1 + quadratic * (p1 - p0)
 
 
 def tangent(DF: np.ndarray, previous: np.ndarray | None = None) -> np.ndarray:
@@ -163,7 +191,8 @@ def newton(evaluate: Evaluate, u0: np.ndarray, s: PalcSettings) -> PalcPoint | N
 class Palc:
     """Iterator over the points of a solution curve of ``F(u) = 0``.
 
-    The curve starts in the direction where ``u[index]`` moves with ``sign``.
+    The curve starts in the direction where ``u[index]`` moves with ``sign``, or, given a
+    ``direction`` vector, along it (leaving a branch point, where ``u[index]`` may not move).
     ``bounds`` maps component indices to ``(lo, hi)``: when a prediction
     leaves one of them, the last point is placed exactly on that bound and the
     iteration ends.  ``names`` gives the components' names for messages, and
@@ -188,6 +217,7 @@ class Palc:
         shows: dict[int, Callable[[float], str]] | None = None,
         check: Check | None = None,
         margin: Callable[[PalcPoint], float] | None = None,
+        direction: np.ndarray | None = None,
     ):
         self.evaluate = evaluate
         self.first = first
@@ -199,11 +229,12 @@ class Palc:
         self.check = check
         self.margin = margin
         t = tangent(first.DF)
-        if t[index] * sign < 0:
+        if (t[index] * sign if direction is None else t @ direction) < 0:
             t = -t
         first.tangent = t
         self.status = ""
         self.boundary: Boundary | None = None
+        self._margins: list[tuple[float, float]] = []  # (u[index], margin) of the last accepted points
 
     def _name(self, i: int) -> str:
         return self.names.get(i, f"u[{i}]")
@@ -233,7 +264,8 @@ class Palc:
         unconfirmed, for the caller to check.
         """
         if self.margin is not None:
-            self.boundary = Boundary(cur, None, why, reached=False)
+            zeros = margin_zeros(self._margins)
+            self.boundary = Boundary(cur, None, why, reached=False, ahead=None if zeros is None else zeros[1])
         self.status = f"step size fell below {self.s.ds_min:g} at {self._where(cur)}: {why}"
 
     def _jumped(self, margins: list[tuple[float, float]], cand: PalcPoint) -> bool:
@@ -248,13 +280,12 @@ class Palc:
         """
         if len(margins) < 2:
             return False
-        (p0, m0), (p1, m1) = margins[-2], margins[-1]
+        (_, m0), (p1, m1) = margins[-2], margins[-1]
         pc = float(cand.u[self.index])
-        if not (m0 > m1 > 0) or p1 == p0:
+        zeros = margin_zeros(margins)
+        if zeros is None:
             return m1 > 0 and not m0 > m1  # moving away from the boundary: a jump
-        linear = m1 / (m0 - m1)
-        quadratic = math.sqrt(m1) / (math.sqrt(m0) - math.sqrt(m1))
-        p_star = p1 + min(linear, quadratic) * (p1 - p0)
+        p_star = zeros[0]  # the nearer of the two
         return (pc - p1) / (p_star - p1) < 0.5
 
     def _step(self, cur: PalcPoint, sigma: float) -> PalcPoint | None:
@@ -317,7 +348,7 @@ class Palc:
         yield cur
         ds = s.ds
         count = 1
-        margins: list[tuple[float, float]] = []  # (u[index], margin) of the accepted points
+        margins = self._margins  # (u[index], margin) of the accepted points
         if self.margin is not None:
             margins.append((float(cur.u[self.index]), self.margin(cur)))
         while count < s.max_points:
@@ -446,6 +477,74 @@ def locate(
                 flo *= 0.5
             side = 1
     return best
+
+
+INTERPOLATION_WIDTH = 2e-4
+""":func:`locate_by_interpolation` narrows its bracket to this width (relative to ``max(1, |u|)``):
+a cubic's error there is of the order of its fourth power, its nodes stay a quarter of it from
+the zero."""
+
+
+def locate_by_interpolation(
+    evaluate: Evaluate,
+    a: PalcPoint,
+    b: PalcPoint,
+    test: Callable[[PalcPoint], float],
+    s: PalcSettings,
+    *,
+    rounds: int = 8,
+) -> PalcPoint | None:
+    """Zero of ``test`` between consecutive points ``a`` and ``b`` (signs differ), where the corrector
+    is ill-conditioned near the zero (a branch point, where another curve crosses this one).
+
+    There the residual grows only quadratically off the curves, so a corrected point close to
+    the zero is known only to the square root of the Newton tolerance, and may lie on the
+    other curve.  Instead, ``test`` and ``u`` are interpolated by cubics in the secant
+    parameter ``sigma`` through ``a``, ``b`` and two points corrected (as in :func:`locate`)
+    at ``sigma`` in (0.25, 0.5, 0.75), the two farthest from the linear estimate of the zero:
+    regular points of this curve.  The cubic's zero gives ``u``, evaluated there.  Until the
+    bracket is narrower than :data:`INTERPOLATION_WIDTH` and the residual there within the
+    tolerance ``s.tol``, the same is done between the two points around the zero (up to
+    ``rounds`` times).  None if no point is found.
+    """
+    fa, fb = test(a), test(b)
+    for _ in range(rounds):
+        d = b.u - a.u
+        dn = d / np.linalg.norm(d)
+        guess = fa / (fa - fb)
+        inner = sorted(sorted((0.25, 0.5, 0.75), key=lambda c: -abs(c - guess))[:2])
+        nodes = [(0.0, a, fa)]
+        for sig in inner:
+            pt = correct(evaluate, a.u + sig * d, dn, s)
+            if pt is None:
+                return None
+            pt.tangent = tangent(pt.DF, a.tangent)
+            nodes.append((sig, pt, test(pt)))
+        nodes.append((1.0, b, fb))
+        sigmas = np.array([node[0] for node in nodes])
+        values = np.array([node[2] for node in nodes])
+        if not np.all(np.isfinite(values)):
+            return None
+        roots = np.roots(np.polyfit(sigmas, values, 3))
+        real = roots[(np.abs(roots.imag) < 1e-12) & (roots.real >= 0.0) & (roots.real <= 1.0)].real
+        if not real.size:
+            return None
+        root = float(real[np.argmin(np.abs(real - guess))])
+        weights = [np.prod([(root - sj) / (si - sj) for sj in sigmas if sj != si]) for si in sigmas]
+        u = sum(w * node[1].u for w, node in zip(weights, nodes))  # Lagrange's interpolation at the root
+        found = None
+        try:
+            F, DF, payload = evaluate(u)
+            if np.all(np.isfinite(F)) and np.max(np.abs(F)) <= s.tol:
+                found = PalcPoint(u, F, DF, payload, tangent(DF, a.tangent))
+        except (GrazingError, np.linalg.LinAlgError, FloatingPointError):
+            pass
+        narrow = float(np.linalg.norm(d)) <= INTERPOLATION_WIDTH * max(1.0, float(np.linalg.norm(a.u)))
+        k = next((i for i in range(3) if (values[i] > 0) != (values[i + 1] > 0)), None)
+        if (found is not None and narrow) or k is None:
+            return found
+        (_, a, fa), (_, b, fb) = nodes[k], nodes[k + 1]
+    return found
 
 
 def sign_changed(fa: float, fb: float) -> bool:
