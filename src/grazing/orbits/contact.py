@@ -53,6 +53,9 @@ class GrazingPoint:
         Names of the other stops that the orbit passes through, computed with
         the stops ignored (a nonimpacting orbit).  Where there are any, the
         grazing is not a motion of the system: it hits those stops first.
+    guard_mins
+        The smallest value of every stop's guard along the orbit (zero, to
+        rounding, for the stop grazed; negative for a stop it passes through).
     """
 
     model: HybridModel
@@ -65,6 +68,7 @@ class GrazingPoint:
     impacts: int = 0
     stop: int = 0
     crossed: tuple[str, ...] = ()
+    guard_mins: tuple[float, ...] = ()
 
     @property
     def stop_name(self) -> str:
@@ -135,6 +139,7 @@ def contact_system(
             impacts=fm.impacts,
             stop=stop,
             crossed=() if events else _crossed(m, fm.solution.guard_min_by_stop, stop),
+            guard_mins=tuple(g[0] for g in fm.solution.guard_min_by_stop or ()),
         )
         return F, DF, point
 
