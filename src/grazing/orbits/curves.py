@@ -71,8 +71,8 @@ START_KINDS = {
 """The kind of the one-parameter special point (:class:`~grazing.orbits.continuation.SpecialPoint`) each
 curve starts from."""
 
-BETA_TOL = 1e-7
-"""Largest ``|beta|`` on a branch-point curve: beyond it the branch point does not persist in two
+SHIFT_TOL = 1e-7
+"""Largest ``|shift|`` on a branch-point curve: beyond it the branch point does not persist in two
 parameters (the model lacks the symmetry that makes it generic)."""
 
 _RESECTION = "an impact approaches the section"
@@ -452,9 +452,9 @@ class _Follower:
                     d.pal[-1] = pt
                     system.accept(pt.payload)
                     continue
-                if abs(pt.payload.beta) > BETA_TOL:
+                if abs(pt.payload.shift) > SHIFT_TOL:
                     d.status = (
-                        f"beta = {pt.payload.beta:.3g} beyond {self.show(d.points[-1].values)}: the "
+                        f"shift = {pt.payload.shift:.3g} beyond {self.show(d.points[-1].values)}: the "
                         "branch point does not persist in two parameters (the model lacks the symmetry that "
                         "keeps it)"
                     )
@@ -705,7 +705,7 @@ def follow_curve(
 
     >>> import math, grazing
     >>> m = grazing.models.bouncing_ball(amplitude=1.5, r=0.5)
-    >>> curve = follow_curve(m, "fold", "amplitude", 1.5, 0.5, "r", (0.45, 0.55), x0=[0.5, 3.2], period=1)
+    >>> curve = follow_curve(m, "fold", "amplitude", 1.5, 0.5, "r", (0.45, 0.55), x0=[3.26, -2.34], period=1)
     >>> a, r = curve.values("amplitude"), curve.values("r")
     >>> bool(np.allclose(a, np.pi * (1 - r) / (1 + r), atol=1e-8)), float(r.min()), float(r.max())
     (True, 0.45, 0.55)

@@ -27,9 +27,9 @@ loses rank: ``M - I`` is singular and ``P_p1`` lies in its range
 (``w^T P_p1 = 0``, ``w`` the left null vector).  Where a branch point persists
 along a curve (a symmetric system: a symmetric orbit losing its symmetry), the
 equations ``P^n - x = 0`` are singular on the curve (two branches cross); they
-are regularised with an unknown ``beta`` as ``P^n(x; p) - x + beta psi = 0``
+are regularised with an unknown ``shift`` as ``P^n(x; p) - x + shift psi = 0``
 (``psi`` the left null vector of the last point), with ``g = 0`` and
-``w^T P_p1 = 0``: ``beta`` is zero on the curve (Govaerts 2000, sec. 4.2;
+``w^T P_p1 = 0``: ``shift`` is zero on the curve (Govaerts 2000, sec. 4.2;
 MatCont's branch point continuation).
 
 The grazing of an orbit (a contact with a stop at zero normal speed) is
@@ -178,7 +178,7 @@ class Evaluation:
         ``g``, or the guard at the contact for a grazing.
     tests
         The codimension-two test functions (:func:`codim2_tests`).
-    beta
+    shift
         The regularising unknown of a branch-point curve (zero on the curve).
     solution
         The bordered system's solution (null vectors), if any.
@@ -188,7 +188,7 @@ class Evaluation:
     grazing: GrazingPoint | None
     condition: float
     tests: dict[str, float] = field(default_factory=dict)
-    beta: float = 0.0
+    shift: float = 0.0
     solution: Bordered | None = None
 
     @property
@@ -203,7 +203,7 @@ class Evaluation:
 class OrbitSystem:
     """The extended system of a fold, period-doubling, Neimark-Sacker or branch-point curve.
 
-    Unknowns ``u = (x, p1, p2)`` (and ``beta`` for a branch point, last);
+    Unknowns ``u = (x, p1, p2)`` (and ``shift`` for a branch point, last);
     ``evaluate(u) -> (F, DF, Evaluation)``.  The bordering vectors are those of
     the last accepted point: :meth:`accept` updates them.
     """
@@ -219,7 +219,7 @@ class OrbitSystem:
         self.borders = Borders.of(defining_matrix(kind, monodromy))
 
     def start(self, orbit: PeriodicOrbit) -> np.ndarray:
-        """The unknowns at an orbit (``beta = 0``)."""
+        """The unknowns at an orbit (``shift = 0``)."""
         u = np.concatenate([orbit.state, [orbit.model.params[q] for q in self.params]])
         return np.append(u, 0.0) if self.kind == "branch-point" else u
 
@@ -297,9 +297,9 @@ class OrbitSystem:
     def _branch_point(
         self, u: np.ndarray, orbit: PeriodicOrbit, fm: FlowMap, sol: Bordered, T: list[np.ndarray]
     ) -> tuple[np.ndarray, np.ndarray, Evaluation]:
-        """``(P^n - x + beta psi, g, w^T P_p1)`` and its Jacobian in ``(x, p1, p2, beta)``."""
+        """``(P^n - x + shift psi, g, w^T P_p1)`` and its Jacobian in ``(x, p1, p2, shift)``."""
         n = self.n
-        x, p, beta = u[:n], u[n : n + 2], float(u[n + 2])
+        x, p, shift = u[:n], u[n : n + 2], float(u[n + 2])
         M, S = fm.jacobian, fm.sensitivity
         psi = self.borders.b
         Tp = self.along(x, p, np.zeros(n), np.array([1.0, 0.0]), fm.impacts)  # d/dp1 [P_x, P_p]
@@ -309,7 +309,7 @@ class OrbitSystem:
         dw = (sol.inverse_transposed @ -np.vstack([Q, np.zeros((1, n + 2))]))[:n]
         g2 = float(sol.w @ S[:, 0])
         grad_g2 = S[:, 0] @ dw + sol.w @ Tp
-        F = np.concatenate([fm.image - x + beta * psi, [sol.g, g2]])
+        F = np.concatenate([fm.image - x + shift * psi, [sol.g, g2]])
         DF = np.zeros((n + 2, n + 3))
         DF[:n, :n] = M - np.eye(n)
         DF[:n, n : n + 2] = S
@@ -317,7 +317,7 @@ class OrbitSystem:
         DF[n, : n + 2] = grad_g
         DF[n + 1, : n + 2] = grad_g2
         tests = codim2_tests("branch-point", orbit.multipliers)
-        return F, DF, Evaluation(orbit, None, sol.g, tests, beta, sol)
+        return F, DF, Evaluation(orbit, None, sol.g, tests, shift, sol)
 
 
 class GrazingSystem:
