@@ -116,6 +116,30 @@ def limit_condition(kind: str, point: GrazingPoint, loses: bool) -> float:
     )
 
 
+def _gradient(f, u: np.ndarray, fu: float) -> np.ndarray:
+    """The gradient of ``f`` at ``u`` by central differences, one-sided where a step leaves the domain
+    (a contact state moved beyond its stop)."""
+    grad = np.empty(u.size)
+    for k in range(u.size):
+        h = 1e-7 * max(1.0, abs(u[k]))
+        e = np.zeros(u.size)
+        e[k] = h
+        values = []
+        for step in (e, -e):
+            try:
+                values.append(f(u + step))
+            except FAILURES:
+                values.append(None)
+        plus, minus = values
+        if plus is not None and minus is not None:
+            grad[k] = (plus - minus) / (2 * h)
+        elif plus is not None or minus is not None:
+            grad[k] = (plus - fu) / h if plus is not None else (fu - minus) / h  # type: ignore[operator]
+        else:
+            raise GrazingError("no difference step stays in the domain")
+    return grad
+
+
 def meeting_point(
     kind: str, params: tuple[str, str], events: bool, near: GrazingPoint, loses: bool
 ) -> GrazingPoint | None:
@@ -143,12 +167,7 @@ def meeting_point(
             c = limit_condition(kind, point, loses)
             if not math.isfinite(c):
                 return None
-            grad = np.empty(n + 3)
-            for k in range(n + 3):
-                h = 1e-7 * max(1.0, abs(u[k]))
-                e = np.zeros(n + 3)
-                e[k] = h
-                grad[k] = (condition(u + e) - condition(u - e)) / (2 * h)
+            grad = _gradient(condition, u, c)
             du = np.linalg.solve(np.vstack([DF, grad]), -np.append(F, c))
         except FAILURES:  # a failed evaluation or a singular system: not found
             return None

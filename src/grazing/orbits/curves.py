@@ -320,7 +320,7 @@ def _start_point(branch: Branch, kind: str, stop: int | None) -> SpecialPoint:
     raise NotFoundError(
         f"{what} on the period-{branch.period} branch from {par.show(lo, '.8g')} to {par.show(hi, '.8g')}: "
         + (f"met {met} instead" if met else "met no special point")
-        + f" (the branch {'ends' if branch.status else 'stops'}: {branch.status})"
+        + f"; the branch {branch.status}"
     )
 
 
