@@ -21,7 +21,7 @@ from scipy.optimize import brentq, minimize_scalar, root
 import grazing
 from grazing.errors import InvalidParameterError, NotFoundError
 from grazing.models import bouncing_ball, impact_damper, impact_oscillator, two_sided_oscillator
-from grazing.orbits import PalcSettings, continue_orbit, find_orbit, follow_curve
+from grazing.orbits import PalcSettings, continue_orbit, find_grazings, find_orbit, follow_curve
 from grazing.orbits.bordered import Borders, bialternate, bordered
 from grazing.orbits.continuation import SPECIAL_KINDS
 from grazing.orbits.crossings import limit_condition
@@ -551,3 +551,63 @@ def test_bad_input_is_refused_before_any_work():
         follow_curve(m, "fold", "amplitude", 1.5, 0.5, "r", (0.6, 0.7))
     with pytest.raises(NotFoundError, match=r"no period-doubling .* met fold at amplitude = 1.0471976"):
         follow_curve(m, "period-doubling", "amplitude", 1.5, 0.5, "r", (0.4, 0.6), x0=x0, period=1)
+
+
+# --------------------------------------------------------------------------
+# A cusp, and the grazing of a nonimpacting orbit along its fold curve
+
+
+def _duffing(stop: float):
+    x, v, t = sp.symbols("x v t")
+    c, k, A, w, s = sp.symbols("c k A w s")
+    return grazing.HybridModel(
+        "duffing", [x, v], t,
+        [grazing.Parameter("c", 0.1), grazing.Parameter("k", 0.5), grazing.Parameter("A", 0.5),
+         grazing.Parameter("w", 1.0, lower=0, lower_open=True), grazing.Parameter("s", stop)],
+        vector_field=[v, -c * v - x - k * x**3 + A * sp.cos(w * t)], guard=s - x, reset=[x, -0.8 * v],
+        period=2 * sp.pi / w,
+    )  # fmt: skip
+
+
+def test_fold_curve_through_its_cusp_and_a_grazing_of_the_nonimpacting_orbit():
+    """The hardening Duffing oscillator's two folds of its response curve meet in a cusp; the orbit
+    (followed with the stop ignored) touches the stop at x = 1.8 somewhere along the curve."""
+    m = _duffing(1.8)
+    curve = follow_curve(m, "fold", "w", 0.8, 2.5, "A", (0.05, 0.8), period=1)
+    assert curve.virtual and curve.status.count("reached the bound A = 0.8") == 2  # over the cusp and back
+    _condition_holds(curve, "fold", tol=1e-7)
+    kinds = [s.kind for s in curve.special]
+    assert kinds == ["cusp", "grazing"] or kinds == ["grazing", "cusp"]
+    cusp = curve.special[kinds.index("cusp")]
+    a_c = cusp.values[1]
+    for factor, folds in ((1.02, 2), (0.98, 0)):  # two folds just above the cusp, none below
+        b = continue_orbit(m.with_params(A=a_c * factor), "w", 0.8, 2.5, period=1, virtual=True)
+        assert [s.kind for s in b.special if s.kind != "grazing"] == ["fold"] * folds
+    touch = curve.special[kinds.index("grazing")]
+    assert touch.located and touch.grazing is not None
+    np.testing.assert_allclose(touch.state, [1.8, 0.0], atol=1e-10)  # on the stop, at zero speed
+    assert np.min(np.abs(touch.multipliers - 1)) < 1e-7  # a fold orbit: the curves meet there
+
+
+# --------------------------------------------------------------------------
+# Grazing curves from a nonimpacting orbit and from an impacting one
+
+
+@pytest.mark.parametrize("start", ["nonimpacting", "impacting"])
+def test_pendulum_grazing_curves_agree_with_the_one_parameter_grazings(start, pendulum_period5):
+    """The period-1 nonimpacting orbit grazes where the period-5 orbit loses its one impact (eta ~ 0.4451 at
+    40 deg): both grazing curves are the grazing of the nonimpacting orbit (find_grazings)."""
+    m = pendulum_period5.model
+    if start == "nonimpacting":
+        curve = follow_curve(m, "grazing", "eta", 0.40, 0.5, "theta_hat", (39 * DEG, 41 * DEG), period=1)
+        assert curve.virtual and curve.period == 1
+    else:
+        curve = follow_curve(m, "grazing", "eta", 0.446, 0.44, "theta_hat", (39 * DEG, 41 * DEG),
+                             orbit=pendulum_period5)  # fmt: skip
+        assert not curve.virtual and curve.period == 5 and curve.start.grazing.impacts == 0
+    th = curve.values("theta_hat")
+    assert th.min() == 39 * DEG and th.max() == 41 * DEG
+    for p in (curve.points[0], curve.points[-1]):
+        points, _ = find_grazings(m.with_params(theta_hat=p.values[1]), "eta", 0.40, 0.5)
+        assert p.values[0] == pytest.approx(points[0].model.params["eta"], abs=1e-9)
+        assert abs(p.condition) < 1e-10 and p.grazing.accel > 0
