@@ -611,3 +611,55 @@ def test_pendulum_grazing_curves_agree_with_the_one_parameter_grazings(start, pe
         points, _ = find_grazings(m.with_params(theta_hat=p.values[1]), "eta", 0.40, 0.5)
         assert p.values[0] == pytest.approx(points[0].model.params["eta"], abs=1e-9)
         assert abs(p.condition) < 1e-10 and p.grazing.accel > 0
+
+
+@pytest.mark.parametrize(
+    ("kind", "before", "after", "changed"),
+    [
+        ("fold", [1.0, 0.9], [1.0, 1.1], "1:1 resonance"),
+        ("fold", [1.0, -0.9], [1.0, -1.1], "fold-flip"),
+        (
+            "fold",
+            [1.0, 0.2, 0.5 + 0.8j, 0.5 - 0.8j],
+            [1.0, 0.2, 0.6 + 0.85j, 0.6 - 0.85j],
+            "fold-neimark-sacker",
+        ),
+        ("period-doubling", [-1.0, 0.9], [-1.0, 1.1], "fold-flip"),
+        ("period-doubling", [-1.0, -0.9], [-1.0, -1.1], "1:2 resonance"),
+        ("neimark-sacker", [0.9 + 0.43589j, 0.9 - 0.43589j], [1.1, 1 / 1.1], "1:1 resonance"),
+        ("neimark-sacker", [-0.9 + 0.43589j, -0.9 - 0.43589j], [-1.1, -1 / 1.1], "1:2 resonance"),
+        (
+            "neimark-sacker",
+            [0.1 + 0.99499j, 0.1 - 0.99499j],
+            [-0.1 + 0.99499j, -0.1 - 0.99499j],
+            "1:4 resonance",
+        ),
+        ("neimark-sacker", [-0.4 + 0.91652j, -0.4 - 0.91652j], [-0.6 + 0.8j, -0.6 - 0.8j], "1:3 resonance"),
+        (
+            "neimark-sacker",
+            [0.6 + 0.8j, 0.6 - 0.8j, 0.9, 0.1],
+            [0.6 + 0.8j, 0.6 - 0.8j, 1.1, 0.1],
+            "fold-neimark-sacker",
+        ),
+        (
+            "neimark-sacker",
+            [0.6 + 0.8j, 0.6 - 0.8j, -0.9, 0.1],
+            [0.6 + 0.8j, 0.6 - 0.8j, -1.1, 0.1],
+            "flip-neimark-sacker",
+        ),
+        ("grazing", [0.5, 0.9], [0.5, 1.1], "fold"),
+        ("grazing", [0.5, -0.9], [0.5, -1.1], "period-doubling"),
+    ],
+)
+def test_each_codimension_two_test_function_changes_sign_at_its_own_point_only(kind, before, after, changed):
+    from grazing.orbits.extended import CODIM2_TESTS, codim2_tests
+
+    a = codim2_tests(kind, np.array(before, dtype=complex), cusp=1.0)
+    b = codim2_tests(kind, np.array(after, dtype=complex), cusp=1.0)
+    assert set(a) == set(CODIM2_TESTS[kind])
+    flipped = {
+        name
+        for name in a
+        if not (math.isnan(a[name]) or math.isnan(b[name])) and (a[name] > 0) != (b[name] > 0)
+    }
+    assert flipped == {changed}
