@@ -327,12 +327,10 @@ def _start_point(branch: Branch, kind: str, stop: int | None) -> SpecialPoint:
 class _Direction:
     """The curve followed from its start in one direction (a sequence of PALC runs: the section moves)."""
 
-    def __init__(self, follower: _Follower, sign: float):
-        self.f = follower
-        self.sign = sign
+    def __init__(self) -> None:
         self.points: list[CurvePoint] = []
         self.pal: list[PalcPoint] = []
-        self.special: list[tuple[int, CurveSpecial]] = []  # (index of the point before it, special)
+        self.special: list[tuple[int, CurveSpecial]] = []  # (index of the point on the start's side, special)
         self.status = ""
 
 
@@ -430,7 +428,7 @@ class _Follower:
 
     def run(self, start: PeriodicOrbit | GrazingPoint, sign: float, index: int) -> _Direction:
         """Follow the curve from ``start`` with component ``index`` moving in direction ``sign``."""
-        d = _Direction(self, sign)
+        d = _Direction()
         i1 = self.offset()
         bounds = {i1: self.bounds1, i1 + 1: self.bounds2}
         names = {i1: self.params[0], i1 + 1: self.params[1]}
@@ -454,7 +452,7 @@ class _Follower:
                     continue
                 if abs(pt.payload.shift) > SHIFT_TOL:
                     d.status = (
-                        f"shift = {pt.payload.shift:.3g} beyond {self.show(d.points[-1].values)}: the "
+                        f"shift = {pt.payload.shift:.3g} at {self.show(self.curve_point(pt).values)}: the "
                         "branch point does not persist in two parameters (the model lacks the symmetry that "
                         "keeps it)"
                     )
@@ -499,11 +497,13 @@ class _Follower:
             if not sign_changed(ta.get(name, math.nan), tb.get(name, math.nan)):
                 continue
             loc = locate(system, a, b, lambda p, name=name: p.payload.tests[name], self.s)
-            if loc is None:
-                continue
-            value = loc.payload.tests[name]
-            if not abs(value) <= max(self.s.locate_tol, 1e-6 * max(abs(ta[name]), abs(tb[name]))):
+            ends = max(abs(ta[name]), abs(tb[name]))
+            value = math.nan if loc is None else loc.payload.tests[name]
+            if abs(value) > ends:
                 continue  # a pole, not a zero (the cusp coefficient at a 1:1 resonance, say)
+            if loc is None or not abs(value) <= max(self.s.locate_tol, 1e-6 * ends):
+                found.append((0.0, self.special_at(name, len(d.points) - 1, a, located=False), None))
+                continue  # bracketed only: said so (its values are those of the point before it)
             where = float(np.dot(loc.u - a.u, b.u - a.u) / np.dot(b.u - a.u, b.u - a.u))
             found.append((where, self.special_at(name, len(d.points) - 1, loc), loc))
         if self.virtual and self.kind != "grazing":
@@ -514,12 +514,13 @@ class _Follower:
         found.sort(key=lambda item: item[0])
         for _, special, loc in found:
             if special.kind in ENDING.get(self.kind, ()):
-                assert loc is not None
-                self.append(d, loc)  # the curve ends at it: its last point
+                if loc is not None:
+                    self.append(d, loc)  # the curve ends at it: its last point
                 d.special.append((len(d.points) - 1, special))
                 pair = "+1" if special.kind == "1:1 resonance" else "-1"
+                where = self.show(special.values) + ("" if special.located else " (bracketed only)")
                 d.status = (
-                    f"ended at a {special.kind} at {self.show(special.values)}: the pair of multipliers "
+                    f"ended at a {special.kind} at {where}: the pair of multipliers "
                     f"meets at {pair} and becomes real beyond it (a neutral saddle, not a Neimark-Sacker "
                     "bifurcation)"
                 )
@@ -527,9 +528,9 @@ class _Follower:
             d.special.append((special.index, special))
         return False
 
-    def special_at(self, kind: str, index: int, pt: PalcPoint) -> CurveSpecial:
+    def special_at(self, kind: str, index: int, pt: PalcPoint, located: bool = True) -> CurveSpecial:
         cp = self.curve_point(pt)
-        return CurveSpecial(kind, index, cp.values, cp.multipliers, cp.state)
+        return CurveSpecial(kind, index, cp.values, cp.multipliers, cp.state, located)
 
     def show(self, values: tuple[float, float]) -> str:
         return f"{self.pars[0].show(values[0])}, {self.pars[1].show(values[1])}"
