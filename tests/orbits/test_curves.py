@@ -663,3 +663,53 @@ def test_each_codimension_two_test_function_changes_sign_at_its_own_point_only(k
         if not (math.isnan(a[name]) or math.isnan(b[name])) and (a[name] > 0) != (b[name] > 0)
     }
     assert flipped == {changed}
+
+
+def _one_sided_where_needed(system, u: np.ndarray) -> np.ndarray:
+    """Central differences of ``system``'s equations, one-sided where a step leaves its domain (a contact
+    state moved beyond its stop)."""
+    F0 = system(u)[0]
+    cols = []
+    for k in range(u.size):
+        h = 1e-6 * max(1.0, abs(u[k]))
+        e = np.zeros(u.size)
+        e[k] = h
+        try:
+            plus = system(u + e)[0]
+        except grazing.GrazingError:
+            plus = None
+        try:
+            minus = system(u - e)[0]
+        except grazing.GrazingError:
+            minus = None
+        if plus is not None and minus is not None:
+            cols.append((plus - minus) / (2 * h))
+        else:
+            cols.append((plus - F0) / h if plus is not None else (F0 - minus) / h)
+    return np.array(cols).T
+
+
+@pytest.mark.parametrize("case", ["nonimpacting pendulum", "impacting two-sided oscillator"])
+def test_grazing_system_jacobian_in_two_parameters(case):
+    """The contact equations in two parameters, for a grazing orbit without other impacts (the flow with
+    the stops ignored) and for one with an impact on the other stop (the flow with its impacts; omega
+    sets the period)."""
+    from grazing.orbits.extended import GrazingSystem
+
+    if case == "nonimpacting pendulum":
+        m = grazing.models.pendulum("B", theta_hat=math.radians(40))
+        points, _ = find_grazings(m, "eta", 0.4, 0.5)
+        point, params = points[0], ("eta", "theta_hat")
+    else:
+        m = two_sided_oscillator(amp=0.5, gap_left=1.5)
+        branch = continue_orbit(m, "omega", 1.1, 1.35, period=1)
+        (sp_,) = [s for s in branch.special if s.kind == "grazing"]
+        point, params = sp_.grazing, ("omega", "amp")
+        assert point.impacts == 1 and point.stop_name == "left"
+    system = GrazingSystem(m, params, point.period, point.impacts > 0, point.stop)
+    u = system.start(point)
+    F, DF, _ = system(u)
+    assert np.max(np.abs(F)) < 1e-10
+    fd = _one_sided_where_needed(system, u)
+    for row, fd_row in zip(DF, fd):
+        assert np.max(np.abs(row - fd_row)) <= 1e-5 * max(1.0, float(np.max(np.abs(fd_row)))), (row, fd_row)
