@@ -713,3 +713,23 @@ def test_grazing_system_jacobian_in_two_parameters(case):
     fd = _one_sided_where_needed(system, u)
     for row, fd_row in zip(DF, fd):
         assert np.max(np.abs(row - fd_row)) <= 1e-5 * max(1.0, float(np.max(np.abs(fd_row)))), (row, fd_row)
+
+
+def test_grazing_curve_meets_a_fold_and_ends_at_a_double_grazing():
+    """The oscillator between two stops, on its orbit with one impact on the right stop that grazes the
+    left one: along the grazing curve in (omega, amp) the grazing orbit passes a fold (a multiplier +1),
+    and at low omega it comes to touch the right stop in free flight as well: a double grazing, where
+    the curve ends (the contact equations fail past it)."""
+    from grazing.orbits.curves import DOUBLE_GRAZING_MARGIN
+
+    m = two_sided_oscillator(amp=0.5, gap_left=1.5)
+    curve = follow_curve(m, "grazing", "omega", 1.1, 1.35, "amp", (0.1, 2.0), period=1)
+    assert [s.kind for s in curve.special] == ["fold", "double grazing"]
+    fold, double = curve.special
+    assert fold.located and np.min(np.abs(fold.multipliers - 1)) < 1e-7
+    assert not double.located and double.index == len(curve) - 1
+    assert curve.status.endswith("a double grazing, located from this side)")
+    last = curve.points[-1].grazing
+    h_right = last.approach_by_stop[0][0]  # the right stop's closest approach in free flight
+    assert 0 <= h_right < DOUBLE_GRAZING_MARGIN and last.impacts == 1 and last.stop_name == "left"
+    _condition_holds(curve, "grazing")

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from grazing.core.model import HybridModel
+from grazing.core.solution import Impacts
 from grazing.errors import ConvergenceError
 from grazing.maps import flow_map
 from grazing.orbits.palc import PalcSettings, newton
@@ -56,6 +57,12 @@ class GrazingPoint:
     guard_mins
         The smallest value of every stop's guard along the orbit (zero, to
         rounding, for the stop grazed; negative for a stop it passes through).
+    other_impacts
+        The orbit's other impacts over one period from the contact (with their
+        speeds and states; empty for a flow with the stops ignored).
+    approach_by_stop
+        ``(h, t, x)`` of every stop's closest approach in free flight (None
+        where there is none), as :attr:`PeriodicOrbit.approach_by_stop`.
     """
 
     model: HybridModel
@@ -69,6 +76,8 @@ class GrazingPoint:
     stop: int = 0
     crossed: tuple[str, ...] = ()
     guard_mins: tuple[float, ...] = ()
+    other_impacts: Impacts | None = None
+    approach_by_stop: tuple[tuple[float, float, np.ndarray] | None, ...] = ()
 
     @property
     def stop_name(self) -> str:
@@ -140,6 +149,8 @@ def contact_system(
             stop=stop,
             crossed=() if events else _crossed(m, fm.solution.guard_min_by_stop, stop),
             guard_mins=tuple(g[0] for g in fm.solution.guard_min_by_stop or ()),
+            other_impacts=fm.solution.impacts,
+            approach_by_stop=fm.solution.approach_by_stop or (),
         )
         return F, DF, point
 

@@ -75,6 +75,10 @@ SHIFT_TOL = 1e-7
 """Largest ``|shift|`` on a branch-point curve: beyond it the branch point does not persist in two
 parameters (the model lacks the symmetry that makes it generic)."""
 
+DOUBLE_GRAZING_MARGIN = 1e-6
+"""Where a grazing curve gets stuck with its orbit this close to another contact with a stop
+(:func:`_other_contact_margin`), it ends at a double grazing."""
+
 _RESECTION = "an impact approaches the section"
 
 
@@ -301,6 +305,32 @@ def _with_events(point: GrazingPoint) -> bool:
     return point.impacts > 0
 
 
+def _other_contact_margin(point: GrazingPoint) -> float:
+    """How far a grazing orbit is from another contact with a stop (a double grazing).
+
+    The smaller of ``v^2 / (2 |a|)`` over its other impacts (``v`` the impact
+    speed, ``a = L_f^2 h``) and of every stop's closest approach in free flight
+    other than the grazing contact itself (as
+    :func:`~grazing.orbits.continuation.grazing_margin`): both tend to zero as
+    another contact forms.
+    """
+    best = math.inf
+    imp = point.other_impacts
+    if imp is not None:
+        for t, v, x, j in zip(imp.t, imp.speed, imp.state, imp.stop):
+            a = abs(point.model.normal_accel(x, t, int(j)))
+            best = min(best, v * v / (2 * a) if a > 0 else math.inf)
+    T = point.model.period
+    for j, approach in enumerate(point.approach_by_stop):
+        if approach is None:
+            continue
+        h, t, _ = approach
+        at_contact = min(abs(t - point.t_graze), abs(t - point.t_graze - point.period * T)) < 1e-6 * T
+        if not (j == point.stop and at_contact):
+            best = min(best, max(h, 0.0))
+    return best
+
+
 def _crossing(point: GrazingPoint) -> bool:
     """Does a grazing orbit computed with the stops ignored pass through a stop (other than touching)?"""
     return bool(point.guard_mins) and min(point.guard_mins) < -CROSSING_TOL
@@ -411,6 +441,8 @@ class _Follower:
         return ACCEPT, ""
 
     def margin(self, pt: PalcPoint) -> float:
+        if self.kind == "grazing":
+            return _other_contact_margin(pt.payload.grazing)
         return grazing_margin(pt.payload.orbit)[0]
 
     # -- following ------------------------------------------------------------
@@ -442,7 +474,7 @@ class _Follower:
                 system, first, index=index, sign=sign, bounds=bounds,
                 settings=dataclasses.replace(self.s, max_points=max(2, self.s.max_points - len(d.points))),
                 names=names, shows=shows, check=self.check,
-                margin=None if (self.virtual or self.kind == "grazing") else self.margin,
+                margin=None if self.virtual and self.kind != "grazing" else self.margin,
             )  # fmt: skip
             ended = False
             for k, pt in enumerate(palc):
@@ -600,12 +632,20 @@ class _Follower:
         before = d.pal[-1]
         index = len(d.points) - 1
         if self.kind == "grazing":
-            if boundary.reached:
-                cp = self.curve_point(before)
+            cp = self.curve_point(before)
+            near = _other_contact_margin(before.payload.grazing)
+            if boundary.reached or near <= DOUBLE_GRAZING_MARGIN:
                 d.special.append(
                     (index, CurveSpecial("double grazing", index, cp.values, cp.multipliers, cp.state, False))
                 )
-                d.status = f"ended at a double grazing at {self.show(cp.values)}: {boundary.reason}"
+                reason = boundary.reason
+                if not boundary.reached:
+                    reason = (
+                        f"the grazing orbit comes within {near:.1e} of another contact with a stop (an "
+                        "impact speed or a closest approach tends to zero: a double grazing, located from "
+                        "this side)"
+                    )
+                d.status = f"ended at a double grazing at {self.show(cp.values)}: {reason}"
             return
         orbit = before.payload.orbit
         _, y, t, what, stop = grazing_margin(orbit)
