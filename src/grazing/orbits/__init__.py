@@ -3,7 +3,8 @@
 from grazing.maps import flow_map
 from grazing.orbits.contact import GrazingPoint, refine_grazing
 from grazing.orbits.continuation import Branch, ContinuationSettings, SpecialPoint, continue_orbit
-from grazing.orbits.curves import BifurcationCurve, CurvePoint, CurveSpecial, follow_curve
+from grazing.orbits.curve_data import BifurcationCurve, CurvePoint, CurveSpecial
+from grazing.orbits.curves import follow_curve
 from grazing.orbits.grazing import GrazingCurve, find_grazings, grazing_curve
 from grazing.orbits.palc import PalcSettings
 from grazing.orbits.shooting import PeriodicOrbit, find_orbit
