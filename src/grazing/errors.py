@@ -27,6 +27,11 @@ class ConvergenceError(GrazingError, RuntimeError):
     """A Newton iteration did not converge."""
 
 
+class NotFoundError(GrazingError, LookupError):
+    """What was sought does not occur where it was sought (no fold between the start and stop values of a
+    branch, say); the message names what was found instead."""
+
+
 class ForeignFileError(InvalidParameterError):
     """An output's path holds a file grazing did not write (or one changed since): it is left as it is."""
 

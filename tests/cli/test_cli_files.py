@@ -24,6 +24,11 @@ MAP = ["map", "--param1", "eta", "--start1", "0.44", "--stop1", "0.45", "--num1"
        "theta-hat", "--start2", "30", "--stop2", "31", "--num2", "6", "--periods", "10", "--transient", "20",
        "--workers", "1"]  # fmt: skip
 
+CURVE = (
+    "curve --kind period-doubling --param eta --start 0.446 --stop 0.44 --param2 theta-hat "
+    "--range 39.95,40.05 --out"
+).split()  # issue 27: curves
+
 COMMANDS = {
     "simulate": (["simulate", "--periods", "3", "--transient", "10", "--trajectory"], ".csv"),
     "iso-damping": (["iso-damping", "--relation", "paper", "--num", "400", "--out"], ".csv"),
@@ -33,6 +38,8 @@ COMMANDS = {
     "graze-curve": (["graze-curve", "--start-deg", "30", "--max-step", "0.2", "--out"], ".nc"),
     "synthesize": (["synthesize", "--eta", "0.446", "--periods", "8", "--transient", "0", "--out"], ".csv"),
     "analyze": (["analyze", "rec.csv", "--plot"], ".png"),
+    # issue 27: curves
+    "curve": (CURVE, ".nc"),
 }
 """Each command with cheap arguments, ending with its output option; the output's suffix."""
 

@@ -140,6 +140,9 @@ MAP = [
     "3",
 ]
 
+# issue 27: curves
+CURVE = "curve --param eta --start 0.446 --stop 0.44 --param2 theta-hat --range 39,41".split()
+
 FORMER_TRACEBACKS = [
     ([*MAP, "--tol", "nan"], "--tol must be in (0, 0.01), got nan"),
     ([*MAP, "--tol", "0"], "--tol must be in (0, 0.01), got 0"),
@@ -206,6 +209,32 @@ ACCEPTED_BUT_WRONG = [
     (
         ["simulate", "--model", "exits.py:model"],
         "--model: exits.py failed to load: it called sys.exit(0) (it printed: bye)",
+    ),
+    # issue 27: curves
+    ([*CURVE, "--kind", "flip"], "Invalid value for '--kind': 'flip' is not one of 'fold', 'period-doubling"),
+    ([*CURVE, "--kind", "fold", "--param2", "eta"], "--param2 must differ from --param (both are eta)"),
+    (
+        [*CURVE, "--kind", "fold", "--range", "41,42"],
+        "--range 41,42 excludes the start value of --param2 theta_hat: theta_hat = 40 deg",
+    ),
+    ([*CURVE, "--kind", "fold", "--range", "41,39"], "--range: LO must be below HI, got 41,39"),
+    (
+        [*CURVE, "--kind", "fold"],
+        "--kind fold: no fold on the period-5 branch from eta = 0.446 to eta = 0.4451212: met "
+        "period-doubling at eta = 0.44539259, grazing at eta = 0.44512118 instead; the branch ended at a "
+        "grazing",
+    ),
+    ([*CURVE, "--kind", "fold", "--out", "mine.nc"], "mine.nc exists and was not written by grazing"),
+    ([*CURVE, "--kind", "fold", "--out", "c.txt"], "--out must name a .nc file, got 'c.txt'"),
+    (
+        "curve --model bouncing-ball --kind fold --param r --start 0.5 --stop 2 --param2 amplitude "
+        "--range 0,1".split(),
+        "r = 2 is outside [0, 1]",
+    ),
+    (
+        "curve --model bouncing-ball --kind fold --param amplitude --start 1.5 --stop 0.5 --param2 rr "
+        "--range 0,1".split(),
+        "--param2: unknown parameter 'rr' for model 'bouncing-ball' (known: amplitude, omega, gravity, r)",
     ),
 ]
 
@@ -345,6 +374,10 @@ IGNORED_OPTIONS = [
         ],
         "'--period': 65 is not in the range 1<=x<=64",
     ),
+    # issue 27: curves
+    ([*CURVE, "--kind", "fold", "--eta", "0.45"], "--eta is not used with --param eta: the branch starts at"),
+    ([*CURVE, "--kind", "fold", "--set", "eta=0.45"], "--set eta=0.45 is not used with --param eta"),
+    ([*CURVE, "--kind", "fold", "--overwrite"], "--overwrite is not used without --out"),
 ]
 
 MEMORY = [
@@ -581,6 +614,7 @@ WORK = [
     ("grazing.experiment.synthetic", "synthetic_recording"),
     ("grazing.experiment.synthetic", "synthetic_sweep"),
     ("grazing.report", "build_report"),
+    ("grazing.orbits", "follow_curve"),  # issue 27: curves
 ]
 
 
@@ -768,6 +802,24 @@ for _cmd, _suffix in (("simulate", ".csv"), ("graze-curve", ".nc"), ("continue",
     COMMANDS[_cmd][_option] = [*COMMANDS[_cmd][_option], *FOREIGN.get(_suffix, ["myreport", "a/b/c"])]
 REQUIRED = ["--param", "--start", "--stop", "--num", "--param1", "--start1", "--stop1", "--num1", "--param2",
             "--start2", "--stop2", "--num2", "PATH"]  # fmt: skip
+# issue 27: curves
+COMMANDS["curve"] = {
+    **MODEL,
+    "--kind": ["fold", "period-doubling", "neimark-sacker", "branch-point", "grazing", "flip"],
+    "--param": PARAMS,
+    "--start": ["0.4", "30", "0.5"],
+    "--stop": ["0.5", "35", "0.9"],
+    "--param2": PARAMS,
+    "--range": ["30,50", "0.3,0.5", "0.1,0.9", "50,30", "1"],
+    "--period": ["1", "5"],
+    "--initial": ["0,0", "0;0"],
+    "--stop-name": ["stop", "back", "front"],
+    "--max-step": ["0.04"],
+    "--out": ["c.nc", "c.txt", "nodir/c.nc", *FOREIGN[".nc"]],
+    "--overwrite": None,
+    "--json": None,
+}
+REQUIRED += ["--kind", "--range"]
 REAL_WORK = ("simulate", "sweep", "map", "damping", "synthesize", "analyze")
 
 
@@ -828,7 +880,8 @@ def ignored(argv: list[str]) -> list[str]:
     cmd, g = argv[0], _given(argv)
     bad = []
     sets = _sets(argv)  # issue 26: models (a parameter given by --set counts as its option)
-    if cmd in ("simulate", "orbit", "graze", "graze-curve", "continue", "sweep", "map", "normal-form"):
+    if cmd in ("simulate", "orbit", "graze", "graze-curve", "continue", "sweep", "map", "normal-form",
+               "curve"):  # fmt: skip
         if all(o in g or o in sets for o in ("--alpha", "--beta", "--r")) and "--case" in g:
             bad.append("--case")
         bad += [o for o in sets if o in g]  # the option and --set of one parameter
@@ -841,7 +894,7 @@ def ignored(argv: list[str]) -> list[str]:
         bad.append("--eta")
     if cmd == "graze-curve" and "--theta-hat" in g:
         bad.append("--theta-hat")
-    if cmd in ("continue", "sweep"):
+    if cmd in ("continue", "sweep", "curve"):
         bad += [f"--{g['--param']}"] if f"--{g.get('--param')}" in g else []
     if cmd == "map":
         bad += [f"--{g[p]}" for p in ("--param1", "--param2") if f"--{g.get(p)}" in g]

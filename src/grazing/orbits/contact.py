@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from grazing.core.model import HybridModel
+from grazing.core.solution import Impacts
 from grazing.errors import ConvergenceError
 from grazing.maps import flow_map
 from grazing.orbits.palc import PalcSettings, newton
@@ -53,6 +54,15 @@ class GrazingPoint:
         Names of the other stops that the orbit passes through, computed with
         the stops ignored (a nonimpacting orbit).  Where there are any, the
         grazing is not a motion of the system: it hits those stops first.
+    guard_mins
+        The smallest value of every stop's guard along the orbit (zero, to
+        rounding, for the stop grazed; negative for a stop it passes through).
+    other_impacts
+        The orbit's other impacts over one period from the contact (with their
+        speeds and states; empty for a flow with the stops ignored).
+    approach_by_stop
+        ``(h, t, x)`` of every stop's closest approach in free flight (None
+        where there is none), as :attr:`PeriodicOrbit.approach_by_stop`.
     """
 
     model: HybridModel
@@ -65,6 +75,9 @@ class GrazingPoint:
     impacts: int = 0
     stop: int = 0
     crossed: tuple[str, ...] = ()
+    guard_mins: tuple[float, ...] = ()
+    other_impacts: Impacts | None = None
+    approach_by_stop: tuple[tuple[float, float, np.ndarray] | None, ...] = ()
 
     @property
     def stop_name(self) -> str:
@@ -135,6 +148,9 @@ def contact_system(
             impacts=fm.impacts,
             stop=stop,
             crossed=() if events else _crossed(m, fm.solution.guard_min_by_stop, stop),
+            guard_mins=tuple(g[0] for g in fm.solution.guard_min_by_stop or ()),
+            other_impacts=fm.solution.impacts,
+            approach_by_stop=fm.solution.approach_by_stop or (),
         )
         return F, DF, point
 

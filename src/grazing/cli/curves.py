@@ -1,0 +1,186 @@
+"""``grazing curve``: a fold, period-doubling, Neimark-Sacker, branch-point or grazing curve in two
+parameters."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import click
+import numpy as np
+
+import grazing
+from grazing.cli.common import (
+    InputError,
+    Progress,
+    check_out,
+    complex_list,
+    emit_json,
+    json_option,
+    model_options,
+    model_parameter,
+    model_params_json,
+    netcdf_out_option,
+    parse_pair,
+    parse_state,
+    refuse_varied,
+    save_dataset,
+    stop_name_option,
+    stop_option_index,
+)
+from grazing.cli.validate import ANGLE_DEG, FINITE, ORBIT_PERIOD, POSITIVE
+from grazing.errors import NotFoundError
+from grazing.orbits.curves import CURVE_KINDS
+
+
+def _range(text: str, par: grazing.Parameter, model: grazing.HybridModel) -> tuple[float, float]:
+    """``--range LO,HI`` of the second parameter (display unit), which must hold its start value."""
+    lo, hi = (par.from_display(v) for v in parse_pair(text, "--range", "LO,HI"))
+    if not lo < hi:
+        raise InputError(f"--range: LO must be below HI, got {text}")
+    value = model.params[par.name]
+    if not lo <= value <= hi:
+        raise InputError(
+            f"--range {text} excludes the start value of --param2 {par.name}: {par.show(value, 'g')} (the "
+            f"curve starts there; set it with --set {par.name}=VALUE)"
+        )
+    return lo, hi
+
+
+def _values(curve: Any, values: tuple[float, float]) -> dict[str, float]:
+    """Both parameters by name, in their display units."""
+    return {p.name: p.to_display(v) for p, v in zip(_parameters(curve), values)}
+
+
+def _parameters(curve: Any) -> tuple[grazing.Parameter, grazing.Parameter]:
+    return curve.model.parameter(curve.params[0]), curve.model.parameter(curve.params[1])
+
+
+@click.command("curve")
+@model_options(any_model=True)
+@click.option(
+    "--kind",
+    type=click.Choice(CURVE_KINDS),
+    required=True,
+    help="The bifurcation to follow: the first one of this kind met from --start towards --stop.",
+)
+@click.option("--param", "cparam", required=True, metavar="NAME",
+              help="The continuation parameter, searched from --start towards --stop for the bifurcation "
+              "(angles in degrees).")  # fmt: skip
+@click.option("--start", type=FINITE, required=True, help="Start value of --param (display unit).")
+@click.option("--stop", type=FINITE, required=True, help="End value of --param (display unit).")
+@click.option("--param2", "param2", required=True, metavar="NAME",
+              help="The second parameter: the curve starts at its value in the model and follows the "
+              "bifurcation in (--param, --param2).")  # fmt: skip
+@click.option("--range", "prange", required=True, metavar="LO,HI",
+              help="Interval of --param2 (display unit) in which the curve is followed, both ways from "
+              "its start value.")  # fmt: skip
+@click.option("--period", type=ORBIT_PERIOD, help="Period of the orbit (default: detected).")
+@click.option("--initial", metavar="X1,X2,...", help="Initial guess at time 0, one number per state.")
+@stop_name_option
+@click.option("--max-step", type=POSITIVE, default=0.04, show_default=True, help="Largest continuation step.")
+@netcdf_out_option
+@json_option
+def curve(
+    model: grazing.HybridModel,
+    case: str,
+    kind: str,
+    cparam: str,
+    start: float,
+    stop: float,
+    param2: str,
+    prange: str,
+    period: int | None,
+    initial: str | None,
+    stop_name: str | None,
+    max_step: float,
+    out: Path | None,
+    overwrite: bool,
+    as_json: bool,
+) -> None:
+    """Follow a fold, period-doubling, Neimark-Sacker, branch point or grazing of a periodic orbit in two
+    parameters, with its codimension-two points (cusps, fold-flips, resonances, where it meets a grazing).
+
+    The orbit is continued in --param from --start towards --stop up to its first bifurcation of
+    --kind, which is then followed in (--param, --param2) while --param2 stays in --range."""
+    from grazing.orbits import PalcSettings, follow_curve
+
+    p1 = model_parameter(model, cparam, "--param")
+    p2 = model_parameter(model, param2, "--param2")
+    if p1.name == p2.name:
+        raise InputError(f"--param2 must differ from --param (both are {p1.name})")
+    refuse_varied([p1.name], f"with --param {cparam}: the branch starts at --start")
+    watch = stop_option_index(model, stop_name)
+    if start == stop:
+        raise InputError(f"--start and --stop must differ, got {start:g} and {stop:g}")
+    if p1.name == "theta_hat" and model.name == "pendulum":
+        for opt, v in (("--start", start), ("--stop", stop)):
+            if not ANGLE_DEG.accepts(v):
+                raise InputError(f"{opt} for theta-hat must be {ANGLE_DEG.describe()}, got {v:g}")
+    a, b = p1.from_display(start), p1.from_display(stop)
+    for v in (a, b):  # both ends within the parameter's bounds, before any work
+        model.with_params(**{p1.name: v})
+    lo, hi = _range(prange, p2, model)
+    check_out(out, ".nc", overwrite=overwrite)
+    x0 = parse_state(initial, model.with_params(**{p1.name: a})) if initial else None
+    bars = {"branch": Progress("continuing", enabled=not as_json),
+            "curve": Progress("following the curve", enabled=not as_json)}  # fmt: skip
+    seen = [model.params[p2.name]] * 2
+
+    def progress(stage: str, points: int, v1: float, v2: float) -> None:
+        if stage == "branch":
+            bars[stage](int(1000 * abs(v1 - a) / abs(b - a)), 1000)
+        else:
+            bars["branch"].close()
+            seen[:] = [min(seen[0], v2), max(seen[1], v2)]
+            bars[stage](int(1000 * (seen[1] - seen[0]) / (hi - lo)), 1000)
+
+    try:
+        result = follow_curve(
+            model, kind, p1.name, a, b, p2.name, (lo, hi), x0=None if x0 is None else np.array(x0),
+            period=period, stop_name=watch if stop_name is not None else None,
+            settings=PalcSettings(ds=min(0.01, max_step), ds_max=max_step), progress=progress,
+        )  # fmt: skip
+    except NotFoundError as exc:
+        raise InputError(f"--kind {kind}: {exc}") from None
+    finally:
+        for bar in bars.values():
+            bar.close()
+    if out is not None:
+        save_dataset(result.to_dataset(), out, overwrite)
+    res = {
+        "kind": kind,
+        "params": [p1.name, p2.name],
+        "points": [
+            {**_values(result, pt.values), "multipliers": complex_list(pt.multipliers), "state": pt.state,
+             "period": pt.period, "impacts": pt.impacts, "section_time": pt.section_time,
+             "stable": pt.stable}
+            for pt in result.points
+        ],
+        "special": [
+            {"kind": sp_.kind, **_values(result, sp_.values), "located": sp_.located,
+             "multipliers": complex_list(sp_.multipliers), "index": sp_.index}
+            for sp_ in result.special
+        ],
+        "status": result.status,
+        "start": {**_values(result, result.points[result.start_index].values), "index": result.start_index},
+        "model": model.name,
+        "model_params": model_params_json(model, case),
+        "virtual": result.virtual,
+        "out": str(out) if out else None,
+    }  # fmt: skip
+    if as_json:
+        emit_json(res)
+        return
+    where = ", ".join(p.show(v, ".8g") for p, v in zip((p1, p2), result.points[result.start_index].values))
+    click.echo(
+        f"{len(result)} points of the {kind} curve of the period-{result.period} orbit in ({p1.name}, "
+        f"{p2.name}) from {where}; {result.status}"
+    )
+    for sp_ in result.special:
+        at = ", ".join(p.show(v, ".8g") for p, v in zip((p1, p2), sp_.values))
+        mu = ", ".join(f"{x:+.4f}{y:+.4f}i" for x, y in complex_list(sp_.multipliers))
+        note = "" if sp_.located else " (not located exactly)"
+        click.echo(f"  {sp_.kind:22s} {at}   multipliers {mu}{note}")
+    if out is not None:
+        click.echo(f"curve saved to {out}")

@@ -1,0 +1,210 @@
+"""The record of a bifurcation curve in two parameters: its points, its codimension-two points, its dataset.
+
+:func:`~grazing.orbits.curves.follow_curve` computes a :class:`BifurcationCurve`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from grazing.core.model import HybridModel
+from grazing.orbits.contact import GrazingPoint
+from grazing.orbits.continuation import Branch, SpecialPoint
+from grazing.orbits.shooting import PeriodicOrbit
+
+
+@dataclass(frozen=True)
+class CurvePoint:
+    """A point of a bifurcation curve.
+
+    Attributes
+    ----------
+    values
+        The two parameters' values (model units).
+    state
+        The orbit's point on its section (a grazing curve: the contact state).
+    section_time
+        The section's time (a grazing curve: the contact's forcing phase, in ``[0, T)``).
+    multipliers
+        The Floquet multipliers (a grazing curve: of the grazing orbit, the contact not an impact).
+    impacts
+        Impacts per period of the orbit (a grazing curve: besides the grazing contact).
+    period
+        Period of the orbit in forcing periods.
+    condition
+        The defining condition's value (zero on the curve, to Newton's tolerance).
+    orbit, grazing
+        The periodic orbit (fold, period-doubling, Neimark-Sacker, branch-point curves) or
+        the grazing orbit (grazing curves).
+    """
+
+    values: tuple[float, float]
+    state: np.ndarray
+    section_time: float
+    multipliers: np.ndarray
+    impacts: int
+    period: int
+    condition: float
+    orbit: PeriodicOrbit | None = None
+    grazing: GrazingPoint | None = None
+
+    @property
+    def stable(self) -> bool:
+        return bool(np.max(np.abs(self.multipliers)) < 1.0)
+
+
+@dataclass(frozen=True)
+class CurveSpecial:
+    """A codimension-two point on a curve (between points ``index`` and ``index + 1``).
+
+    Attributes
+    ----------
+    kind
+        What the curve meets: ``"grazing"`` (the orbit gains or loses an impact: the
+        curve ends), ``"double grazing"`` (on a grazing curve), ``"cusp"``,
+        ``"fold-flip"``, ``"1:1 resonance"`` ... (see
+        :data:`~grazing.orbits.extended.CODIM2_TESTS`).
+    index
+        The curve point next to it on the side of the curve's start (the point itself when it is
+        one: a point that ends the curve).
+    values
+        Both parameters' values there.
+    multipliers, state
+        At the point (a grazing: of the grazing orbit).
+    located
+        False when it is only bracketed between two points (``values`` then
+        those of the last point before it).
+    grazing
+        For a grazing: the grazing orbit, solved from the grazing equations.
+    """
+
+    kind: str
+    index: int
+    values: tuple[float, float]
+    multipliers: np.ndarray
+    state: np.ndarray
+    located: bool = True
+    grazing: GrazingPoint | None = None
+
+
+@dataclass
+class BifurcationCurve:
+    """A curve of bifurcations of a periodic orbit in two parameters (:func:`follow_curve`).
+
+    Attributes
+    ----------
+    model
+        The model (the values of other parameters).
+    kind
+        One of :data:`CURVE_KINDS`.
+    params
+        The two parameters' names: the continuation parameter and the second one.
+    period
+        Period of the orbit in forcing periods.
+    virtual
+        The orbit is computed with the stops ignored (a nonimpacting orbit).
+    points
+        The points, in order along the curve.
+    special
+        Codimension-two points, in order along the curve.
+    status
+        Why the curve ends at its first and at its last point.
+    start
+        The one-parameter special point the curve starts from (on ``branch``).
+    start_index
+        Its index among :attr:`points`.
+    branch
+        The one-parameter branch on which the start was found.
+    """
+
+    model: HybridModel
+    kind: str
+    params: tuple[str, str]
+    period: int
+    virtual: bool
+    points: list[CurvePoint] = field(default_factory=list)
+    special: list[CurveSpecial] = field(default_factory=list)
+    status: str = ""
+    start: SpecialPoint | None = None
+    start_index: int = 0
+    branch: Branch | None = None
+
+    def __len__(self) -> int:
+        return len(self.points)
+
+    def values(self, name: str) -> np.ndarray:
+        """One parameter's values along the curve."""
+        return np.array([p.values[self.params.index(name)] for p in self.points])
+
+    @property
+    def states(self) -> np.ndarray:
+        return np.array([p.state for p in self.points]).reshape(-1, self.model.n_states)
+
+    @property
+    def multipliers(self) -> np.ndarray:
+        return np.array([p.multipliers for p in self.points]).reshape(-1, self.model.n_states)
+
+    def to_dataset(self) -> Any:
+        """The curve as an :class:`xarray.Dataset` (one ``point`` per curve point, one ``special`` per
+        codimension-two point); the parameters are ``param1`` and ``param2`` (named in their
+        ``long_name`` and in the ``params`` attribute)."""
+        import xarray as xr
+
+        import grazing
+
+        names = list(self.model.state_names)
+        k = len(names)
+        mu = self.multipliers
+        sp_mu = np.array([s.multipliers for s in self.special]).reshape(-1, k)
+        sp_state = np.array([s.state for s in self.special]).reshape(-1, k)
+        data: dict[str, Any] = {
+            "param1": ("point", self.values(self.params[0])),
+            "param2": ("point", self.values(self.params[1])),
+            "state": (("point", "component"), self.states),
+            "section_time": ("point", np.array([p.section_time for p in self.points])),
+            "multiplier_re": (("point", "multiplier"), mu.real),
+            "multiplier_im": (("point", "multiplier"), mu.imag),
+            "abs_multiplier": (("point", "multiplier"), np.abs(mu)),
+            "stable": ("point", np.array([p.stable for p in self.points], dtype=np.int8)),
+            "impacts": ("point", np.array([p.impacts for p in self.points], dtype=np.int32)),
+            "condition": ("point", np.array([p.condition for p in self.points])),
+            "special_kind": ("special", np.array([s.kind for s in self.special], dtype=str)),
+            "special_index": ("special", np.array([s.index for s in self.special], dtype=np.int32)),
+            "special_param1": ("special", np.array([s.values[0] for s in self.special], dtype=float)),
+            "special_param2": ("special", np.array([s.values[1] for s in self.special], dtype=float)),
+            "special_located": ("special", np.array([s.located for s in self.special], dtype=np.int8)),
+            "special_state": (("special", "component"), sp_state),
+            "special_multiplier_re": (("special", "multiplier"), sp_mu.real),
+            "special_multiplier_im": (("special", "multiplier"), sp_mu.imag),
+        }  # fmt: skip
+        ds = xr.Dataset(data, coords={"component": names, "multiplier": np.arange(k)})
+        for var, name in (("param1", self.params[0]), ("param2", self.params[1])):
+            ds[var].attrs["long_name"] = name
+            ds["special_" + var].attrs["long_name"] = name
+        ds.section_time.attrs["long_name"] = "contact phase" if self.kind == "grazing" else "section time"
+        attrs: dict[str, Any] = {
+            "model": self.model.name,
+            "kind": self.kind,
+            "params": ",".join(self.params),
+            "period": self.period,
+            "virtual": int(self.virtual),
+            "status": self.status,
+            "start_index": self.start_index,
+            "grazing_version": grazing.__version__,
+        }
+        for name, v in self.model.params.items():
+            if name not in self.params:
+                attrs[f"param_{name}"] = v
+        ds.attrs.update(attrs)
+        return ds
+
+    def to_netcdf(self, path: str | Path, overwrite: bool = False) -> None:
+        """Save :meth:`to_dataset` to a NetCDF file (:func:`grazing.outputs.write_netcdf`: all at once,
+        with grazing's mark; a file there that grazing did not write is refused unless ``overwrite``)."""
+        from grazing.outputs import write_netcdf
+
+        write_netcdf(path, self.to_dataset(), overwrite=overwrite)

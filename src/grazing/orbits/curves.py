@@ -1,0 +1,634 @@
+"""Curves of bifurcations of periodic orbits in two parameters, with their codimension-two points.
+
+:func:`follow_curve` continues an orbit in one parameter (:func:`~grazing.orbits.continuation.continue_orbit`)
+up to the first special point of the kind asked for (fold, period-doubling,
+Neimark-Sacker, branch point or grazing) and follows that point in two
+parameters by pseudo-arclength continuation of an extended system
+(:mod:`grazing.orbits.extended`: the shooting equations with saltation
+matrices and a minimally augmented defining condition, or the contact
+equations of a grazing), in both directions from the start.
+
+Along the curve a branch keeps its impact signature (impacts in each forcing
+period): where the orbit gains or loses an impact, the curve meets a grazing
+curve (a codimension-two point).  The step is bracketed there, as
+:func:`~grazing.orbits.continuation.continue_orbit` brackets a grazing on a
+branch (bisection with a secant on the grazing margin), the point is solved
+from the grazing equations (the contact equations in both parameters with the
+point on the curve's secant) and the curve ends.  A curve of an orbit computed
+with the stops ignored (a nonimpacting orbit) reports its grazings and goes on.
+The other codimension-two points are zeros of test functions
+(:data:`~grazing.orbits.extended.CODIM2_TESTS`), located by regula falsi
+along the curve; the 1:1 and 1:2 resonances end a Neimark-Sacker curve.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from grazing.core.model import HybridModel, Parameter
+from grazing.errors import ConvergenceError, GrazingError, InvalidParameterError, NotFoundError
+from grazing.orbits.contact import GrazingPoint
+from grazing.orbits.continuation import (
+    RESECTION_MARGIN,
+    Branch,
+    SpecialPoint,
+    continue_orbit,
+    grazing_margin,
+)
+from grazing.orbits.crossings import meeting_point, nearest_grazing
+from grazing.orbits.curve_data import BifurcationCurve, CurvePoint, CurveSpecial
+from grazing.orbits.extended import CODIM2_TESTS, ENDING, Evaluation, GrazingSystem, OrbitSystem
+from grazing.orbits.palc import (
+    ACCEPT,
+    BOUNDARY,
+    STOP,
+    Palc,
+    PalcPoint,
+    PalcSettings,
+    correct,
+    locate,
+    sign_changed,
+    tangent,
+)
+from grazing.orbits.shooting import CROSSING_TOL, PeriodicOrbit, move_section, quiet_section
+
+CURVE_KINDS = ("fold", "period-doubling", "neimark-sacker", "branch-point", "grazing")
+"""The kinds of curves :func:`follow_curve` follows."""
+
+START_KINDS = {
+    "fold": "fold",
+    "period-doubling": "period-doubling",
+    "neimark-sacker": "neimark-sacker",
+    "branch-point": "branch point",
+    "grazing": "grazing",
+}
+"""The kind of the one-parameter special point (:class:`~grazing.orbits.continuation.SpecialPoint`) each
+curve starts from."""
+
+SHIFT_TOL = 1e-7
+"""Largest ``|shift|`` on a branch-point curve: beyond it the branch point does not persist in two
+parameters (the model lacks the symmetry that makes it generic)."""
+
+DOUBLE_GRAZING_MARGIN = 1e-6
+"""Where a grazing curve gets stuck with its orbit this close to another contact with a stop
+(:func:`_other_contact_margin`), it ends at a double grazing."""
+
+_RESECTION = "an impact approaches the section"
+
+
+Progress = Callable[[str, int, float, float], None]
+"""``progress(stage, points, value1, value2)``: stage ``"branch"`` (the one-parameter continuation
+to the start) or ``"curve"``."""
+
+
+# ----------------------------------------------------------------------------
+
+
+def _interval(par: Parameter) -> tuple[float, float]:
+    """Where a curve may go in ``par``: its interval, open ends moved inside by a hair."""
+
+    def inside(bound: float, toward: float, is_open: bool) -> float:
+        if math.isinf(bound) or not is_open:
+            return bound
+        return bound + toward * 1e-9 * max(1.0, abs(bound))
+
+    return inside(par.lower, 1.0, par.lower_open), inside(par.upper, -1.0, par.upper_open)
+
+
+def _with_events(point: GrazingPoint) -> bool:
+    """Is a grazing orbit's flow computed with its impacts (else with the stops ignored)?
+
+    Only if it has impacts besides the contact: an orbit that just touches the
+    stop is the same orbit with the stops ignored, and Newton's method on the
+    contact equations is then free of the impacts that its iterates make where
+    they end slightly beyond the stop.
+    """
+    return point.impacts > 0
+
+
+def _other_contact_margin(point: GrazingPoint) -> float:
+    """How far a grazing orbit is from another contact with a stop (a double grazing).
+
+    The smaller of ``v^2 / (2 |a|)`` over its other impacts (``v`` the impact
+    speed, ``a = L_f^2 h``) and of every stop's closest approach in free flight
+    other than the grazing contact itself (as
+    :func:`~grazing.orbits.continuation.grazing_margin`): both tend to zero as
+    another contact forms.
+    """
+    best = math.inf
+    imp = point.other_impacts
+    if imp is not None:
+        for t, v, x, j in zip(imp.t, imp.speed, imp.state, imp.stop):
+            a = abs(point.model.normal_accel(x, t, int(j)))
+            best = min(best, v * v / (2 * a) if a > 0 else math.inf)
+    T = point.model.period
+    for j, approach in enumerate(point.approach_by_stop):
+        if approach is None:
+            continue
+        h, t, _ = approach
+        at_contact = min(abs(t - point.t_graze), abs(t - point.t_graze - point.period * T)) < 1e-6 * T
+        if not (j == point.stop and at_contact):
+            best = min(best, max(h, 0.0))
+    return best
+
+
+def _crossing(point: GrazingPoint) -> bool:
+    """Does a grazing orbit computed with the stops ignored pass through a stop (other than touching)?"""
+    return bool(point.guard_mins) and min(point.guard_mins) < -CROSSING_TOL
+
+
+def _start_point(branch: Branch, kind: str, stop: int | None) -> SpecialPoint:
+    """The first special point of ``kind`` on ``branch``, or :class:`NotFoundError` naming what was met."""
+    wanted = START_KINDS[kind]
+    for sp_ in branch.special:
+        if sp_.kind == wanted and (kind != "grazing" or stop is None or sp_.stop == stop):
+            return sp_
+    par = branch.model.parameter(branch.param)
+    lo, hi = branch.values[0], branch.values[-1]
+    what = f"no {wanted}" + (f" with stop {branch.model.stop_names[stop]!r}" if kind == "grazing" and
+                             stop is not None else "")  # fmt: skip
+    met = ", ".join(f"{s.kind} at {par.show(s.param, '.8g')}" for s in branch.special)
+    raise NotFoundError(
+        f"{what} on the period-{branch.period} branch from {par.show(lo, '.8g')} to {par.show(hi, '.8g')}: "
+        + (f"met {met} instead" if met else "met no special point")
+        + f"; the branch {branch.status}"
+    )
+
+
+class _Direction:
+    """The curve followed from its start in one direction (a sequence of PALC runs: the section moves)."""
+
+    def __init__(self) -> None:
+        self.points: list[CurvePoint] = []
+        self.pal: list[PalcPoint] = []
+        self.special: list[tuple[int, CurveSpecial]] = []  # (index of the point on the start's side, special)
+        self.status = ""
+
+
+class _Follower:
+    """Follows one curve from a start point (see :func:`follow_curve`)."""
+
+    def __init__(
+        self, model: HybridModel, kind: str, params: tuple[str, str], range2: tuple[float, float],
+        period: int, virtual: bool, stop: int, settings: PalcSettings,
+        progress: Callable[[int, float, float], None] | None,
+    ):  # fmt: skip
+        self.model, self.kind, self.params, self.period = model, kind, params, period
+        self.virtual, self.stop, self.s, self.progress = virtual, stop, settings, progress
+        self.n = model.n_states
+        self.pars = (model.parameter(params[0]), model.parameter(params[1]))
+        lo1, hi1 = _interval(self.pars[0])
+        lo2, hi2 = _interval(self.pars[1])
+        self.bounds1 = (lo1, hi1)
+        self.bounds2 = (max(range2[0], lo2), min(range2[1], hi2))
+        self.count = 0
+
+    # -- the systems --------------------------------------------------------
+    def offset(self) -> int:
+        """Index of ``p1`` in the unknowns (``p2`` follows it)."""
+        return self.n + 1 if self.kind == "grazing" else self.n
+
+    def system(self, start: PeriodicOrbit | GrazingPoint) -> OrbitSystem | GrazingSystem:
+        if self.kind == "grazing":
+            assert isinstance(start, GrazingPoint)
+            return GrazingSystem(self.model, self.params, self.period, _with_events(start), start.stop)
+        assert isinstance(start, PeriodicOrbit)
+        return OrbitSystem(
+            self.model,
+            self.kind,
+            self.params,
+            self.period,
+            start.t0,
+            self.virtual,
+            self.stop,
+            start.monodromy,
+        )
+
+    def curve_point(self, pt: PalcPoint) -> CurvePoint:
+        ev: Evaluation = pt.payload
+        i = self.offset()
+        values = (float(pt.u[i]), float(pt.u[i + 1]))
+        if ev.grazing is not None:
+            g = ev.grazing
+            return CurvePoint(values, g.contact.copy(), g.phase, g.multipliers, g.impacts, self.period,
+                              ev.condition, None, g)  # fmt: skip
+        o = ev.orbit
+        assert o is not None
+        return CurvePoint(
+            values, o.state.copy(), o.t0, o.multipliers, o.impacts, self.period, ev.condition, o
+        )
+
+    # -- checks -------------------------------------------------------------
+    def check(self, prev: PalcPoint, cand: PalcPoint) -> tuple[str, str]:
+        a, b = prev.payload, cand.payload
+        if self.kind == "grazing":
+            ga, gb = a.grazing, b.grazing
+            if gb.impacts != ga.impacts or _crossing(gb) != _crossing(ga) or gb.accel <= 0:
+                return BOUNDARY, "the grazing orbit meets another contact with a stop (a double grazing)"
+            return ACCEPT, ""
+        if self.virtual:
+            return ACCEPT, ""
+        oa, ob = a.orbit, b.orbit
+        if ob.signature != oa.signature:
+            what = "loses" if sum(ob.signature) < sum(oa.signature) else "gains"
+            if sum(ob.signature) == sum(oa.signature):
+                what = "changes"
+            return BOUNDARY, (
+                f"the orbit {what} an impact (impacts per forcing period {list(oa.signature)} -> "
+                f"{list(ob.signature)}): the curve meets a grazing"
+            )
+        if ob.section_clearance() < RESECTION_MARGIN:
+            return STOP, _RESECTION
+        return ACCEPT, ""
+
+    def margin(self, pt: PalcPoint) -> float:
+        if self.kind == "grazing":
+            return _other_contact_margin(pt.payload.grazing)
+        return grazing_margin(pt.payload.orbit)[0]
+
+    # -- following ------------------------------------------------------------
+    def first(self, system: OrbitSystem | GrazingSystem, u0: np.ndarray, index: int) -> PalcPoint:
+        """The start, corrected onto the curve with component ``index`` fixed."""
+        e = np.zeros(u0.size)
+        e[index] = 1.0
+        pt = correct(system, u0, e, self.s)
+        if pt is None:
+            raise ConvergenceError(
+                f"the {self.kind} curve's equations did not converge at its start "
+                f"({self.pars[0].show(u0[self.offset()])}, {self.pars[1].show(u0[self.offset() + 1])})"
+            )
+        return pt
+
+    def run(self, start: PeriodicOrbit | GrazingPoint, sign: float, index: int) -> _Direction:
+        """Follow the curve from ``start`` with component ``index`` moving in direction ``sign``."""
+        d = _Direction()
+        i1 = self.offset()
+        bounds = {i1: self.bounds1, i1 + 1: self.bounds2}
+        names = {i1: self.params[0], i1 + 1: self.params[1]}
+        shows = {i1: self.pars[0].show, i1 + 1: self.pars[1].show}
+        current = start
+        while True:
+            system = self.system(current)
+            u0 = system.start(current)
+            first = self.first(system, u0, i1 + 1 if not d.pal else index)
+            palc = Palc(
+                system, first, index=index, sign=sign, bounds=bounds,
+                settings=dataclasses.replace(self.s, max_points=max(2, self.s.max_points - len(d.points))),
+                names=names, shows=shows, check=self.check,
+                margin=None if self.virtual and self.kind != "grazing" else self.margin,
+            )  # fmt: skip
+            ended = False
+            for k, pt in enumerate(palc):
+                if k == 0 and d.pal:  # the same point on a moved section
+                    d.pal[-1] = pt
+                    system.accept(pt.payload)
+                    continue
+                if abs(pt.payload.shift) > SHIFT_TOL:
+                    d.status = (
+                        f"shift = {pt.payload.shift:.3g} at {self.show(self.curve_point(pt).values)}: the "
+                        "branch point does not persist in two parameters (the model lacks the symmetry that "
+                        "keeps it)"
+                    )
+                    return d
+                if d.pal and self.detect(system, d, d.pal[-1], pt):
+                    ended = True
+                    break
+                self.append(d, pt)
+                system.accept(pt.payload)
+            if ended:
+                return d
+            d.status = palc.status
+            last = d.pal[-1]
+            assert last.tangent is not None
+            sign = math.copysign(1.0, last.tangent[index]) if last.tangent[index] != 0 else sign
+            if d.status == _RESECTION and len(d.points) < self.s.max_points:
+                try:
+                    current = move_section(last.payload.orbit, quiet_section(last.payload.orbit))
+                except GrazingError as exc:
+                    d.status = f"{_RESECTION} and the orbit could not be found on another section ({exc})"
+                    return d
+                continue
+            if palc.boundary is not None:
+                self.end_at_grazing(d, palc)
+            return d
+
+    def append(self, d: _Direction, pt: PalcPoint) -> None:
+        d.pal.append(pt)
+        d.points.append(self.curve_point(pt))
+        self.count += 1
+        if self.progress is not None:
+            v = d.points[-1].values
+            self.progress(self.count, v[0], v[1])
+
+    # -- codimension-two points ------------------------------------------------
+    def detect(self, system: Any, d: _Direction, a: PalcPoint, b: PalcPoint) -> bool:
+        """Locate the codimension-two points between ``a`` and ``b``; True if one ends the curve
+        (then the curve ends at it: it is the last point)."""
+        found: list[tuple[float, CurveSpecial, PalcPoint | None]] = []
+        ta, tb = a.payload.tests, b.payload.tests
+        for name in CODIM2_TESTS[self.kind]:
+            if not sign_changed(ta.get(name, math.nan), tb.get(name, math.nan)):
+                continue
+            loc = locate(system, a, b, lambda p, name=name: p.payload.tests[name], self.s)
+            ends = max(abs(ta[name]), abs(tb[name]))
+            value = math.nan if loc is None else loc.payload.tests[name]
+            if abs(value) > ends:
+                continue  # a pole, not a zero (the cusp coefficient at a 1:1 resonance, say)
+            if loc is None or not abs(value) <= max(self.s.locate_tol, 1e-6 * ends):
+                found.append((0.0, self.special_at(name, len(d.points) - 1, a, located=False), None))
+                continue  # bracketed only: said so (its values are those of the point before it)
+            where = float(np.dot(loc.u - a.u, b.u - a.u) / np.dot(b.u - a.u, b.u - a.u))
+            found.append((where, self.special_at(name, len(d.points) - 1, loc), loc))
+        if self.virtual and self.kind != "grazing":
+            for j in range(self.model.n_stops):
+                hit = self.grazing_of_virtual(system, j, a, b, len(d.points) - 1)
+                if hit is not None:
+                    found.append(hit)
+        found.sort(key=lambda item: item[0])
+        for _, special, loc in found:
+            if special.kind in ENDING.get(self.kind, ()):
+                if loc is not None:
+                    self.append(d, loc)  # the curve ends at it: its last point
+                d.special.append((len(d.points) - 1, special))
+                pair = "+1" if special.kind == "1:1 resonance" else "-1"
+                where = self.show(special.values) + ("" if special.located else " (bracketed only)")
+                d.status = (
+                    f"ended at a {special.kind} at {where}: the pair of multipliers "
+                    f"meets at {pair} and becomes real beyond it (a neutral saddle, not a Neimark-Sacker "
+                    "bifurcation)"
+                )
+                return True
+            d.special.append((special.index, special))
+        return False
+
+    def special_at(self, kind: str, index: int, pt: PalcPoint, located: bool = True) -> CurveSpecial:
+        cp = self.curve_point(pt)
+        return CurveSpecial(kind, index, cp.values, cp.multipliers, cp.state, located)
+
+    def show(self, values: tuple[float, float]) -> str:
+        return f"{self.pars[0].show(values[0])}, {self.pars[1].show(values[1])}"
+
+    def grazing_of_virtual(
+        self, system: Any, j: int, a: PalcPoint, b: PalcPoint, index: int
+    ) -> tuple[float, CurveSpecial, None] | None:
+        """A virtual orbit's grazing of stop ``j`` between ``a`` and ``b`` (it goes on: a virtual curve
+        reports its grazings)."""
+
+        def test(p: PalcPoint) -> float:
+            return p.payload.orbit.guard_min_by_stop[j][0]
+
+        if not sign_changed(test(a), test(b)):
+            return None
+        loc = locate(system, a, b, test, self.s)
+        if loc is None:
+            return None
+        _, t, x = loc.payload.orbit.guard_min_by_stop[j]
+        point, exact = self.solve_grazing(x, t, j, loc, None, 0, False)
+        where = float(np.dot(loc.u - a.u, b.u - a.u) / np.dot(b.u - a.u, b.u - a.u))
+        return where, self.grazing_special(index, loc, point, exact), None
+
+    def grazing_special(
+        self, index: int, before: PalcPoint, point: GrazingPoint | None, exact: bool
+    ) -> CurveSpecial:
+        if point is None:
+            cp = self.curve_point(before)
+            return CurveSpecial("grazing", index, cp.values, cp.multipliers, cp.state, located=False)
+        values = (point.model.params[self.params[0]], point.model.params[self.params[1]])
+        return CurveSpecial("grazing", index, values, point.multipliers, point.contact.copy(), exact, point)
+
+    def solve_grazing(
+        self, y: np.ndarray, t: float, stop: int, before: PalcPoint, after: PalcPoint | None, others: int,
+        loses: bool,
+    ) -> tuple[GrazingPoint | None, bool]:  # fmt: skip
+        """The grazing orbit where the curve meets the grazing curve, after ``before`` (before ``after``).
+
+        ``(y, t)``: a guess of the contact; ``others``: the grazing orbit's
+        impacts besides it; ``loses``: the curve's orbit loses an impact there
+        (else it gains one).  Returns the point and whether it was solved as
+        the meeting point itself (:func:`~grazing.orbits.crossings.meeting_point`;
+        else it is the grazing orbit nearest ``before``).  Without other impacts
+        the grazing orbit is computed with the stops ignored (:func:`_with_events`),
+        and then it must cross none.
+        """
+        i1 = self.offset()
+        pb = before.u[i1 : i1 + 2]
+        scale = max(1.0, float(np.max(np.abs(pb))))
+        reach = 0.0 if after is None else float(np.linalg.norm(after.u[i1 : i1 + 2] - pb))
+        first = not self.virtual and others > 0
+        for events in (first,) if self.virtual else (first, not first):
+            near = nearest_grazing(self.model, self.params, self.period, events, stop, y, t, pb)
+            if near is None or near.impacts != others or (not events and _crossing(near)):
+                continue
+            pn = np.array([near.model.params[q] for q in self.params])
+            if float(np.linalg.norm(pn - pb)) > reach + 1e-4 * scale:
+                continue  # another grazing, not this one
+            exact = meeting_point(self.kind, self.params, events, near, loses)
+            return (near, False) if exact is None else (exact, True)
+        return None, False
+
+    def end_at_grazing(self, d: _Direction, palc: Palc) -> None:
+        """The curve ends at a boundary: the orbit gains or loses an impact (a codimension-two grazing)."""
+        boundary = palc.boundary
+        assert boundary is not None
+        before = d.pal[-1]
+        index = len(d.points) - 1
+        if self.kind == "grazing":
+            cp = self.curve_point(before)
+            near = _other_contact_margin(before.payload.grazing)
+            if boundary.reached or near <= DOUBLE_GRAZING_MARGIN:
+                d.special.append(
+                    (index, CurveSpecial("double grazing", index, cp.values, cp.multipliers, cp.state, False))
+                )
+                reason = boundary.reason
+                if not boundary.reached:
+                    reason = (
+                        f"the grazing orbit comes within {near:.1e} of another contact with a stop (an "
+                        "impact speed or a closest approach tends to zero: a double grazing, located from "
+                        "this side)"
+                    )
+                d.status = f"ended at a double grazing at {self.show(cp.values)}: {reason}"
+            return
+        orbit = before.payload.orbit
+        _, y, t, what, stop = grazing_margin(orbit)
+        loses = what == "loses an impact"
+        point, exact = (None, False)
+        if y is not None:
+            point, exact = self.solve_grazing(
+                y, t, stop, before, boundary.after, orbit.impacts - loses, loses
+            )
+        if point is None and not boundary.reached:
+            return  # stuck (Newton's method fails beyond the last point), no grazing just ahead: as palc says
+        special = self.grazing_special(index, before, point, exact)
+        d.special.append((index, special))
+        where = self.show(special.values)
+        if self.model.n_stops > 1:
+            where += f" with stop {self.model.stop_names[stop]!r}"
+        reason = boundary.reason
+        if not boundary.reached:
+            reason = f"an impact speed reaches zero: the orbit {what}"
+            if what == "gains an impact":
+                reason = f"the orbit touches the stop between its impacts: it {what}"
+        if point is None:
+            where += " (bracketed only: the grazing equations did not converge)"
+        elif not exact:
+            where += " (the grazing nearest the curve's last point: the meeting point did not converge)"
+        d.status = f"ended at a grazing at {where}: {reason}"
+
+
+def follow_curve(
+    model: HybridModel,
+    kind: str,
+    param: str,
+    start: float,
+    stop: float,
+    param2: str,
+    range2: tuple[float, float],
+    *,
+    x0: np.ndarray | None = None,
+    orbit: PeriodicOrbit | None = None,
+    period: int | None = None,
+    stop_name: int | str | None = None,
+    settings: PalcSettings | None = None,
+    progress: Progress | None = None,
+) -> BifurcationCurve:
+    """Follow a bifurcation of a periodic orbit in two parameters.
+
+    The orbit at ``param = start`` is continued towards ``stop``
+    (:func:`~grazing.orbits.continuation.continue_orbit`) up to its first
+    special point of ``kind``; that point is followed in ``(param, param2)``
+    in both directions, each until ``param2`` leaves ``range2``, a parameter
+    leaves its own interval, or the curve ends at a codimension-two point that
+    ends it (a grazing, where the orbit's impact sequence changes; a 1:1 or 1:2
+    resonance on a Neimark-Sacker curve), or Newton's method fails.
+
+    Parameters
+    ----------
+    model
+        The model with the other parameters set; its value of ``param2`` is where
+        the curve starts.
+    kind
+        ``"fold"``, ``"period-doubling"``, ``"neimark-sacker"``, ``"branch-point"``
+        or ``"grazing"`` (:data:`CURVE_KINDS`).
+    param, start, stop
+        The continuation parameter and the interval searched for the start.
+    param2, range2
+        The second parameter and its interval ``(lo, hi)`` (model units), which
+        must hold its value in ``model``.
+    x0, orbit, period
+        The starting orbit or a guess for it (as for :func:`continue_orbit`).
+    stop_name
+        A stop (name or index): for ``"grazing"``, the first grazing with that
+        stop (default: the first grazing); a nonimpacting orbit's branch looks for
+        its grazings first (as for :func:`continue_orbit`).
+    settings
+        Step control (:class:`~grazing.orbits.palc.PalcSettings`; ``max_points``
+        for each direction).
+    progress
+        Called as ``progress(stage, points, value1, value2)`` after each point
+        (stage ``"branch"``, then ``"curve"``).
+
+    Returns
+    -------
+    BifurcationCurve
+
+    Raises
+    ------
+    NotFoundError
+        When the branch meets no special point of ``kind``: the message names
+        the special points met instead.
+    InvalidParameterError
+        An unknown kind or parameter, ``param2`` equal to ``param``, a
+        ``range2`` without the value of ``param2``.
+
+    Examples
+    --------
+    The fold of the period-1 orbit of the ball on a vibrating table (``g = omega = 1``) lies at
+    ``amplitude = pi (1 - r) / (1 + r)``:
+
+    >>> import math, grazing
+    >>> m = grazing.models.bouncing_ball(amplitude=1.5, r=0.5)
+    >>> curve = follow_curve(m, "fold", "amplitude", 1.5, 0.5, "r", (0.45, 0.55), x0=[3.26, -2.34], period=1)
+    >>> a, r = curve.values("amplitude"), curve.values("r")
+    >>> bool(np.allclose(a, np.pi * (1 - r) / (1 + r), atol=1e-8)), float(r.min()), float(r.max())
+    (True, 0.45, 0.55)
+    """
+    if kind not in CURVE_KINDS:
+        raise InvalidParameterError(f"unknown curve kind {kind!r} (known: {', '.join(CURVE_KINDS)})")
+    for name in (param, param2):
+        model.parameter(name)  # unknown names: one line naming the known ones
+    if param2 == param:
+        raise InvalidParameterError(f"the second parameter must differ from the first ({param!r})")
+    lo, hi = (float(v) for v in range2)
+    if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
+        raise InvalidParameterError(f"range2 must be two finite numbers lo < hi, got {range2!r}")
+    par2 = model.parameter(param2)
+    value2 = model.params[param2]
+    if not lo <= value2 <= hi:
+        raise InvalidParameterError(
+            f"the range {par2.show_range(lo, hi)} excludes the start value {par2.show(value2)}"
+        )
+    s = settings or PalcSettings()
+
+    def branch_progress(points: int, value: float) -> None:
+        if progress is not None:
+            progress("branch", points, value, value2)
+
+    watch = None if stop_name is None else model.stop_index(stop_name)
+    branch = continue_orbit(
+        model, param, start, stop, x0=None if x0 is None else np.asarray(x0, dtype=float), orbit=orbit,
+        period=period, settings=s, progress=branch_progress, stop_name=watch,
+    )  # fmt: skip
+    sp_ = _start_point(branch, kind, watch)
+    if kind == "grazing":
+        if sp_.grazing is None:
+            raise ConvergenceError(
+                f"the grazing at {model.parameter(param).show(sp_.param)} was bracketed but its equations "
+                "did not converge: no grazing curve"
+            )
+        first: PeriodicOrbit | GrazingPoint = sp_.grazing
+    else:
+        first = sp_.orbit
+    return _follow_from(
+        model, kind, (param, param2), (lo, hi), first, branch.virtual, sp_.orbit.stop, s,
+        None if progress is None else lambda k, v1, v2: progress("curve", k, v1, v2), sp_, branch,
+    )  # fmt: skip
+
+
+def _follow_from(
+    model: HybridModel, kind: str, params: tuple[str, str], range2: tuple[float, float],
+    first: PeriodicOrbit | GrazingPoint, virtual: bool, stop: int, settings: PalcSettings,
+    progress: Callable[[int, float, float], None] | None = None, sp_: SpecialPoint | None = None,
+    branch: Branch | None = None,
+) -> BifurcationCurve:  # fmt: skip
+    """Follow the curve of ``kind`` through the orbit (or grazing orbit) ``first``, both ways from it,
+    and join the two halves in order along the curve."""
+    f = _Follower(model, kind, params, range2, first.period, virtual, stop, settings, progress)
+    system = f.system(first)
+    i1 = f.offset()
+    u0 = system.start(first)
+    t = tangent(f.first(system, u0, i1 + 1).DF)
+    index = i1 if abs(t[i1]) >= abs(t[i1 + 1]) else i1 + 1  # the parameter that moves most
+    back = f.run(first, -1.0, index)
+    ahead = f.run(first, 1.0, index)
+    curve = BifurcationCurve(
+        model=f.model,
+        kind=f.kind,
+        params=f.params,
+        period=f.period,
+        virtual=f.virtual,
+        start=sp_,
+        branch=branch,
+    )
+    nb = len(back.points)
+    curve.points = back.points[::-1] + ahead.points[1:]
+    curve.start_index = nb - 1
+    specials = [(nb - 1 - i, s) for i, s in reversed(back.special)]
+    specials += [(nb - 1 + i, s) for i, s in ahead.special]
+    curve.special = [dataclasses.replace(s, index=i) for i, s in specials]
+    curve.status = f"at the first point: {back.status}; at the last point: {ahead.status}"
+    return curve
