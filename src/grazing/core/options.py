@@ -56,6 +56,34 @@ cycles shows a longer period fewer than three times."""
 CHUNK_SIZE = 50
 """Points per chunk of a one-parameter sweep: the unit of parallel work and of saving."""
 
+CHAIN_TOL = PERIOD_TOL
+"""A chunk of a sweep computed from a guess is kept when its first point ends on the periodic orbit,
+at the same point of it, as from the chain's state: samples and final state equal to this."""
+
+CHAOS_THRESHOLD = 1e-3
+"""Largest Lyapunov exponent (per unit time) above which an aperiodic run counts as chaotic; within
+it of zero, quasi-periodic."""
+
+BASIN_TRANSIENT = 300
+"""Forcing periods run from each initial state of a basin before its attractor is sampled."""
+
+BASIN_PERIODS = 50
+"""Forcing periods sampled on the attractor each initial state of a basin ends on."""
+
+BASIN_CHUNK = 512
+"""Initial states per chunk of a basin computation: the unit of parallel work and of saving."""
+
+CELLS = 64
+"""Cells along each side of the grid box on which the points of aperiodic attractors are recorded
+(the size of a cell is the box's extent over this)."""
+
+MATCH_TOL = 1e-4
+"""Two periodic orbits are one attractor when each point of one is within this many cells of a point
+of the other (a periodic orbit's samples repeat to 1e-6)."""
+
+ESCAPE_FACTOR = 1e6
+"""A state farther than this many times the grid box's extent from the box has escaped."""
+
 IMPACTS = ("none", "sampled", "all")
 """What :class:`SaveAt` can record of the impacts."""
 

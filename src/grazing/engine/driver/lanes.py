@@ -20,7 +20,10 @@ period of at most ``ADAPTIVE_MAX_PERIOD``, when ``adaptive``), then either
 variational equations from the identity, the Lyapunov sums taken over the
 last ``periods``.  ``jobs`` are runs of consecutive points; within a job each
 point starts from the previous one's final state (unless ``fresh``, or the
-previous point failed), every job from ``x0`` at time 0.
+previous point failed: then from ``x0`` at time 0), every job's first point
+from its own start ``firsts`` (a time and a state: ``x0`` at time 0 for a
+sweep's chunk, the previous chunk's final state to continue a chain, a grid
+point of initial states at its phase).
 """
 
 import math
@@ -157,6 +160,7 @@ def sweep_lanes(
     fresh,
     periodic,
     x0,
+    firsts,
     pvs,
     Ts,
     sphase,
@@ -183,7 +187,8 @@ def sweep_lanes(
 ):
     """Compute the sweep points of ``jobs`` on ``lanes`` lanes (see the module); results into ``out_*``.
 
-    Job ``j`` starts from state ``x0[j]``.  Per point ``p``: parameter
+    Job ``j``'s first point starts from state ``firsts[j, 1:]`` at time
+    ``firsts[j, 0]``; a point after a failed one from ``x0[j]`` at time 0.  Per point ``p``: parameter
     vector ``pvs[p]``, period ``Ts[p]``, sampling phase ``sphase[p]`` (local
     time), start time of a point continued from the previous one
     ``tcarry[p]`` (periodic models), local time of the discontinuity map
@@ -268,6 +273,7 @@ def sweep_lanes(
             while li[lane, L_STAGE] == IDLE and li[lane, L_JOBEND] >= 0:
                 p = li[lane, L_POINT] + 1
                 carried = li[lane, L_STATUS] == STATUS_OK and li[lane, L_JOBEND] > 0
+                first = False
                 if li[lane, L_JOBEND] == 0 or p >= li[lane, L_JOBEND]:
                     if control[2] > 0 and active >= control[2]:
                         break  # (this thread has its share of the jobs running)
@@ -279,9 +285,14 @@ def sweep_lanes(
                     li[lane, L_JOBEND] = jobs[job, 1]
                     li[lane, L_JOB] = job
                     carried = False
+                    first = True
                 li[lane, L_POINT] = p
                 T = Ts[p]
-                if fresh or not carried:
+                if first:
+                    for i in range(n):
+                        XS[i, lane] = firsts[li[lane, L_JOB], 1 + i]
+                    t0 = firsts[li[lane, L_JOB], 0]
+                elif fresh or not carried:
                     for i in range(n):
                         XS[i, lane] = x0[li[lane, L_JOB], i]
                     t0 = 0.0
