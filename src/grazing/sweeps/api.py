@@ -174,7 +174,9 @@ def sweep(
     x0
         Initial state (of every chunk; of every point with ``fresh``).
     direction
-        ``"up"`` or ``"down"``: the order the values are visited in.
+        ``"up"`` or ``"down"``: the order the values are visited in; ``"both"``:
+        up, then down from ``x0`` again, kept apart (hysteresis): the dataset's
+        variables gain a first dimension ``direction`` (``"up"``, ``"down"``).
     settings
         How each point is computed (:class:`~grazing.core.options.SweepSettings`:
         ``transient``, ``periods``, ``phase``, ``fresh``, ``chunk_size``,
@@ -194,6 +196,11 @@ def sweep(
     attributes ``flag_values`` and ``flag_meanings`` say so too).  A failed
     point has NaN samples and Lyapunov exponent and -1 impacts; the sweep
     goes on, its next point starting afresh from ``x0``.
+
+    Unless ``fresh``, the sweep is one chain: each point starts from the
+    previous one's final state, and the result at every point is that of one
+    continuous chain (``chunk_size = 0``) whatever the chunking, the threads
+    or the cluster (:mod:`grazing.sweeps.chain`).
 
     Examples
     --------

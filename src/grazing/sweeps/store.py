@@ -33,7 +33,7 @@ from grazing.sweeps.ownership import (
     create_store,
     lock_for,
 )
-from grazing.sweeps.spec import ChunkResult, SweepSpec, spec_summary
+from grazing.sweeps.spec import DIRECTIONS, ChunkResult, SweepSpec, spec_summary
 from grazing.sweeps.status import NOT_COMPUTED, STATUS_DTYPE, status_attrs
 
 __all__ = [
@@ -195,6 +195,17 @@ def build_dataset(spec: SweepSpec, arrays: dict[str, np.ndarray], attrs: dict[st
         if k not in spec.params:
             ds.attrs[f"param_{k}"] = v
     ds.attrs.update(attrs or {})
+    if len(spec.params) == 1 and spec.segments == 2:  # up and down (direction "both"): each by value
+        n = spec.segment_points
+        halves = [ds.isel(point=slice(k * n, (k + 1) * n)).sortby("value") for k in range(2)]
+        halves = [h.assign_coords(point=np.arange(n)) for h in halves]
+        both = xr.concat([h.drop_vars(["stop_level"]) for h in halves], dim="direction", coords="minimal",
+                         compat="override")  # fmt: skip
+        ds = both.assign_coords(direction=list(DIRECTIONS[:2])).drop_vars("point")
+        ds["stop_level"] = halves[0]["stop_level"].drop_vars("point")
+        ds.attrs["directions"] = (
+            "up, down: the values visited upwards, then downwards from x0 again (two chains)"
+        )
     if len(spec.shape) == 2:
         n2, n1 = spec.shape
         p1, p2 = spec.params
