@@ -77,9 +77,13 @@ CELLS = 64
 """Cells along each side of the grid box on which the points of aperiodic attractors are recorded
 (the size of a cell is the box's extent over this)."""
 
-MATCH_TOL = 1e-4
+MATCH_TOL = 1e-3
 """Two periodic orbits are one attractor when each point of one is within this many cells of a point
 of the other (a periodic orbit's samples repeat to 1e-6)."""
+
+BASIN_REFINE = 1
+"""Times an initial state whose end state is aperiodic is run on for another transient before it is
+classified (a chaotic transient, or one slow to settle, then ends on its attractor)."""
 
 ESCAPE_FACTOR = 1e6
 """A state farther than this many times the grid box's extent from the box has escaped."""

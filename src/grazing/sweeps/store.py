@@ -434,6 +434,15 @@ class ZarrStore:
             ) from None
         self._done[res.index] = True
 
+    def read_chunk(self, i: int) -> ChunkResult:
+        """The stored results of chunk ``i`` (done)."""
+        sl = self.spec.chunk(i)
+        got = {name: self._read(name, lambda z: np.asarray(z[sl])) for name in _VARIABLES}
+        t = float(self._read(END_TIME, lambda z: z[i])) if self._has_end_time else math.nan
+        t_final = np.full(sl.stop - sl.start, np.nan)
+        t_final[-1] = t
+        return ChunkResult(index=i, t_final=t_final, **got)
+
     def chain_start(self, i: int) -> ChainStart:
         """Where the chain goes on after chunk ``i`` (done): :func:`~grazing.sweeps.chain.start_after`."""
         last = self.spec.chunk(i).stop - 1
