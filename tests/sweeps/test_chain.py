@@ -25,7 +25,7 @@ OMEGAS = np.linspace(0.5, 1.6, 221)
 
 
 def assert_same_chain(chain, chunked) -> None:
-    """Every point alike: status, period, and on a periodic orbit the same samples (to the chain's tolerance)."""
+    """Every point alike: status, period, and on a periodic orbit the samples (to the chain's tolerance)."""
     np.testing.assert_array_equal(chunked.status.values, chain.status.values)
     np.testing.assert_array_equal(chunked.period.values, chain.period.values)
     periodic = chain.period.values > 0

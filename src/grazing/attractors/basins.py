@@ -17,7 +17,7 @@ from __future__ import annotations
 import json
 import time
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -27,12 +27,11 @@ from grazing.attractors.classify import Attractor, Catalogue
 from grazing.attractors.grid import StateGrid, as_states, beyond_stops, default_cell, start_time, state_grid
 from grazing.core.model import HybridModel
 from grazing.core.options import (
-    BASIN_CHUNK,
-    BASIN_PERIODS,
-    BASIN_REFINE,
-    BASIN_TRANSIENT,
+    BASIN_ADAPTIVE_TOL,
     ESCAPE_FACTOR,
-    SWEEP_TOL,
+    BasinSettings,
+    refuse_unknown,
+    with_shorthands,
 )
 from grazing.errors import InvalidParameterError
 from grazing.sweeps.spec import ChunkResult, SweepSpec
@@ -83,52 +82,48 @@ class AttractorSet:
         raise KeyError(ident)
 
 
-def basin_spec(
-    model: HybridModel,
-    states: np.ndarray,
-    *,
-    phase: float,
-    transient: int,
-    periods: int,
-    chunk_size: int = BASIN_CHUNK,
-    lyapunov: bool = True,
-    tol: float = SWEEP_TOL,
-) -> SweepSpec:
-    """The fresh sweep whose points are the initial states ``states`` (each from its own, at ``phase``)."""
+def basin_spec(model: HybridModel, states: np.ndarray, settings: BasinSettings, lyapunov: bool) -> SweepSpec:
+    """The fresh sweep whose points are the initial states ``states``, each from its own at the phase."""
     return SweepSpec(
         model=model,
         params=(),
         points=((),) * states.shape[0],
         x0=tuple(float(v) for v in states[0]),
-        transient=transient,
-        periods=periods,
-        phase=phase,
+        transient=settings.transient,
+        periods=settings.periods,
+        phase=settings.phase,
         fresh=True,
-        chunk_size=chunk_size,
+        chunk_size=settings.chunk_size,
         adaptive=True,
         lyapunov=lyapunov,
-        tol=tol,
+        tol=settings.tol,
         starts=states,
+        adaptive_tol=BASIN_ADAPTIVE_TOL,
     )
+
+
+@dataclass(frozen=True)
+class _Run:
+    """Where the end states are computed and kept."""
+
+    workers: int | None
+    client: Any
+    store: Any
+    progress: Progress | None
 
 
 def find_attractors(
     model: HybridModel,
     states: Any,
     *,
-    phase: float = 0.0,
-    transient: int = BASIN_TRANSIENT,
-    periods: int = BASIN_PERIODS,
-    refine: int = BASIN_REFINE,
+    settings: BasinSettings | None = None,
     cell: Sequence[float] | None = None,
     escape: float | None = None,
-    lyapunov: bool = True,
-    tol: float = SWEEP_TOL,
-    chunk_size: int = BASIN_CHUNK,
     workers: int | None = None,
     client: Any = None,
     store: Any = None,
     progress: Progress | None = None,
+    **shorthands: Any,
 ) -> AttractorSet:
     """The attractors reached from the initial states ``states`` (rows), and which one each reaches.
 
@@ -138,33 +133,29 @@ def find_attractors(
         The model with its parameter values.
     states
         Initial states, one row each (a grid: :func:`basins`; a random sample...).
-    phase
-        Forcing phase of the initial states and of the samples, in radians.
-    transient, periods
-        Forcing periods run before sampling, and sampled (at least 2 whole
-        cycles of the longest period to recognise).
-    refine
-        Times an aperiodic end state is run on for another ``transient`` before it is classified.
+    settings
+        How each initial state is run (:class:`~grazing.core.options.BasinSettings`:
+        ``transient``, ``periods``, ``phase``, ``refine``, ``lyapunov``, ``tol``,
+        ``chunk_size``); those names are also accepted as keyword arguments.
     cell
         Size of a cell per state component (default: the initial states' box
         over :data:`~grazing.core.options.CELLS`).
     escape
         Distance from the box (in each component) beyond which a state has
-        escaped (default :data:`~grazing.core.options.ESCAPE_FACTOR` times the box's largest side).
-    lyapunov
-        Compute the largest Lyapunov exponents (which tell chaos from quasi-periodicity).
-    tol
-        Integrator tolerance.
-    chunk_size
-        Initial states per chunk (the unit of parallel work and of saving in ``store``).
+        escaped (default :data:`~grazing.core.options.ESCAPE_FACTOR` times the
+        box's largest side or coordinate, at least 1).
     workers, client
         Local threads, or a Dask client (as for :func:`grazing.sweeps.run_sweep`).
     store
         A Zarr store (path, or an open :class:`~grazing.sweeps.store.ZarrStore`
-        of the same computation) keeping every finished chunk: interrupted and
-        run again, it computes only what is missing.
+        of the same computation) keeping every finished chunk of the first
+        run: interrupted and run again, it computes only the chunks missing.
     progress
         Called as ``progress(done, total)``.
+
+    The first run of every initial state computes no Lyapunov exponent: the
+    aperiodic end states get theirs when they are run on (``refine``), and each
+    orbit from one of its points.
 
     Examples
     --------
@@ -175,76 +166,49 @@ def find_attractors(
     ([('sticking', 1), ('periodic', 1)], [1, 2])
     """
     start = time.perf_counter()
-    if int(refine) < 0:
-        raise InvalidParameterError(f"refine must be >= 0, got {refine}")
+    used: set[str] = set()
+    s = with_shorthands(settings, BasinSettings, shorthands, used)
+    refuse_unknown("find_attractors", shorthands, used)
     x = as_states(model, states)
-    t0 = start_time(model, phase)
+    t0 = start_time(model, s.phase)
     invalid = beyond_stops(model, x, t0)
     valid = np.flatnonzero(~invalid)
     box = x[valid] if valid.size else x
-    cells = (
-        default_cell(box)
-        if cell is None
-        else np.broadcast_to(np.asarray(cell, dtype=float), (model.n_states,))
-    )
+    cells = default_cell(box) if cell is None else np.broadcast_to(np.asarray(cell, dtype=float), x.shape[1:])
     if not np.all(np.isfinite(cells) & (cells > 0)):
         raise InvalidParameterError(f"cell sizes must be positive numbers, got {cell!r}")
-    origin = box.min(axis=0)
-    reach = ESCAPE_FACTOR * max(float(np.ptp(box, axis=0).max()), float(np.abs(box).max()), 1.0)
-    bound = reach if escape is None else float(escape)
-    if not bound > 0:
+    side = float(np.ptp(box, axis=0).max())
+    reach = ESCAPE_FACTOR * max(side, float(np.abs(box).max()), 1.0) if escape is None else float(escape)
+    if not reach > 0:
         raise InvalidParameterError(f"escape must be a positive distance, got {escape!r}")
-    catalogue = Catalogue(
-        model, x.shape[0], cells, origin, bound + float(np.ptp(box, axis=0).max()), periods, t0
-    )
+    catalogue = Catalogue(model, x.shape[0], cells, box.min(axis=0), reach + side, s.periods, t0)
     if valid.size:
-        spec = basin_spec(
-            model,
-            x[valid],
-            phase=phase,
-            transient=transient,
-            periods=periods,
-            chunk_size=chunk_size,
-            lyapunov=lyapunov,
-            tol=tol,
-        )
-        deferred = _run(
-            spec,
-            valid,
-            catalogue,
-            refine > 0,
-            workers,
-            client,
-            store,
-            progress,
-            x.shape[0] - valid.size,
-            x.shape[0],
-        )
-        for n in range(refine):
-            deferred = _refine(
-                model,
-                catalogue,
-                deferred,
-                phase,
-                transient,
-                periods,
-                lyapunov,
-                tol,
-                chunk_size,
-                workers,
-                client,
-                last=n == refine - 1,
-            )
+        run = _Run(workers, client, store, progress)
+        spec = basin_spec(model, x[valid], s, s.lyapunov and s.refine == 0)
+        deferred = _run(spec, valid, catalogue, s.refine > 0, run, x.shape[0] - valid.size, x.shape[0])
+        for n in range(s.refine):
+            last = n == s.refine - 1
+            deferred = _refine(model, catalogue, deferred, s, last, replace(run, store=None, progress=None))
+        if s.lyapunov:
+            _orbit_exponents(model, catalogue, s, workers, client)
     attractors, labels = catalogue.attractors(int(invalid.sum()))
-    return AttractorSet(
-        tuple(attractors),
-        labels,
-        np.array(cells),
-        float(phase),
-        int(transient),
-        int(periods),
-        time.perf_counter() - start,
-    )
+    seconds = time.perf_counter() - start
+    return AttractorSet(tuple(attractors), labels, np.array(cells), s.phase, s.transient, s.periods, seconds)
+
+
+def _orbit_exponents(model: HybridModel, catalogue: Catalogue, s: BasinSettings, workers: int | None,
+                     client: Any) -> None:  # fmt: skip
+    """Each periodic orbit's largest Lyapunov exponent, from one of its points."""
+    from grazing.sweeps.api import run_sweep
+
+    orbits = catalogue.orbits()
+    if not orbits:
+        return
+    points = np.array([catalogue.entries[k].points[0] for k in orbits])
+    one = replace(s, chunk_size=max(1, len(orbits)))  # (on the orbit: the adaptive transient ends at once)
+    ds = run_sweep(basin_spec(model, points, one, True), workers=workers, client=client)
+    for k, value in zip(orbits, ds.lyapunov.values):
+        catalogue.entries[k].exponents = [float(value)]
 
 
 @dataclass
@@ -258,15 +222,8 @@ class _Deferred:
 class _InOrder:
     """Classifies the chunks of a spec in their order, as they arrive (or are read from the store)."""
 
-    def __init__(
-        self,
-        spec: SweepSpec,
-        which: np.ndarray,
-        catalogue: Catalogue,
-        defer: bool,
-        store: Any,
-        done: set[int],
-    ) -> None:
+    def __init__(self, spec: SweepSpec, which: np.ndarray, catalogue: Catalogue, defer: bool, store: Any,
+                 done: set[int]) -> None:  # fmt: skip
         self.spec, self.which, self.catalogue, self.defer = spec, which, catalogue, defer
         self.store, self.done = store, done
         self.pending: dict[int, ChunkResult] = {}
@@ -298,74 +255,44 @@ class _InOrder:
         )
 
 
-def _run(
-    spec: SweepSpec,
-    which: np.ndarray,
-    catalogue: Catalogue,
-    defer: bool,
-    workers: int | None,
-    client: Any,
-    store: Any,
-    progress: Progress | None,
-    offset: int,
-    total: int,
-) -> _Deferred:
-    """Run (or read from ``store``) every chunk of ``spec`` and classify them (initial states ``which``)."""
+def _run(spec: SweepSpec, which: np.ndarray, catalogue: Catalogue, defer: bool, run: _Run, offset: int,
+         total: int) -> _Deferred:  # fmt: skip
+    """Run (or read from the store) every chunk of ``spec`` and classify them (initial states ``which``)."""
     from grazing.sweeps.executor import chunk_results
 
-    if isinstance(store, (str, Path)):
+    if isinstance(run.store, (str, Path)):
         from grazing.sweeps.store import open_store
 
-        with open_store(store, spec) as opened:
-            return _run(spec, which, catalogue, defer, workers, client, opened, progress, offset, total)
+        with open_store(run.store, spec) as opened:
+            return _run(spec, which, catalogue, defer, replace(run, store=opened), offset, total)
+    store = run.store
     done = {i for i in range(spec.n_chunks) if store is not None and store.is_done(i)}
     todo = [i for i in range(spec.n_chunks) if i not in done]
     order = _InOrder(spec, which, catalogue, defer, store, done)
     order.take()
-    if progress is not None:
-        progress(offset + order.counted, total)
+    if run.progress is not None:
+        run.progress(offset + order.counted, total)
     if todo:
-        results = chunk_results(spec, todo, workers, client)
+        results = chunk_results(spec, todo, run.workers, run.client)
         try:
             for res in results:
                 if store is not None:
                     store.write(res)
                 order.take(res)
-                if progress is not None:
-                    progress(offset + order.counted, total)
+                if run.progress is not None:
+                    run.progress(offset + order.counted, total)
         finally:
             results.close()
     return order.deferred()
 
 
-def _refine(
-    model: HybridModel,
-    catalogue: Catalogue,
-    deferred: _Deferred,
-    phase: float,
-    transient: int,
-    periods: int,
-    lyapunov: bool,
-    tol: float,
-    chunk_size: int,
-    workers: int | None,
-    client: Any,
-    last: bool,
-) -> _Deferred:
+def _refine(model: HybridModel, catalogue: Catalogue, deferred: _Deferred, s: BasinSettings, last: bool,
+            run: _Run) -> _Deferred:  # fmt: skip
     """Run the deferred end states on for another transient, from where they ended; classify them."""
     if deferred.index.size == 0:
         return deferred
-    spec = basin_spec(
-        model,
-        deferred.states,
-        phase=phase,
-        transient=transient,
-        periods=periods,
-        chunk_size=chunk_size,
-        lyapunov=lyapunov,
-        tol=tol,
-    )
-    return _run(spec, deferred.index, catalogue, not last, workers, client, None, None, 0, 0)
+    spec = basin_spec(model, deferred.states, s, s.lyapunov and last)
+    return _run(spec, deferred.index, catalogue, not last, run, 0, 0)
 
 
 def basins(

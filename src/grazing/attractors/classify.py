@@ -322,6 +322,10 @@ class Catalogue:
 
     # ------------------------------------------------------------------ the result
 
+    def orbits(self) -> list[int]:
+        """The entries of the periodic orbits found (merged ones left out)."""
+        return [k for k, e in enumerate(self.entries) if e.family == "periodic" and self.root(k) == k]
+
     def attractors(self, invalid: int = 0) -> tuple[list[Attractor], np.ndarray]:
         """The attractors (ids 1, 2, ... by first initial state; ``invalid`` initial states as id 0) and
         each initial state's id."""

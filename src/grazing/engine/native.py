@@ -43,9 +43,9 @@ import numpy as np
 
 DRIVER_ARGUMENTS = (
     "m", "lanes", "jobs", "control", "fresh", "periodic", "x0", "firsts", "pvs", "Ts", "sphase", "tcarry",
-    "zdms", "transient", "periods", "adaptive", "lyapunov", "safety", "chatter_tol", "zdm_on", "zdm_a",
-    "zdm_e", "zdm_window", "watch", "out_samples", "out_by_stop", "out_lyap", "out_used", "out_x", "out_t",
-    "out_status",
+    "zdms", "transient", "periods", "adaptive", "adaptive_tol", "lyapunov", "safety", "chatter_tol", "zdm_on",
+    "zdm_a", "zdm_e", "zdm_window", "watch", "out_samples", "out_by_stop", "out_lyap", "out_used", "out_x",
+    "out_t", "out_status",
 )  # fmt: skip
 """The arguments of :func:`grazing.engine.driver.lanes.sweep_lanes`; the loaded entry point takes them too."""
 _KERNELS = ("fns", "nx", "nsens", "nstops", "order", "sticks", "mlanes")
@@ -60,7 +60,7 @@ _ARRAYS = {
 }  # fmt: skip
 """dtype and dimensions of the array arguments (C-contiguous)."""
 _BOOLS = ("fresh", "periodic", "adaptive", "lyapunov", "zdm_on")
-_FLOATS = ("safety", "chatter_tol", "zdm_a", "zdm_window")
+_FLOATS = ("adaptive_tol", "safety", "chatter_tol", "zdm_a", "zdm_window")
 _PREFIX = "grazing_native"
 _ENTRY = "sweep_lanes"
 _RETURNED = (0, -2)

@@ -61,7 +61,7 @@ def batch_key(spec: SweepSpec) -> tuple[Any, ...]:
         zdm = (float(z.accel), tuple(np.asarray(z.direction, dtype=float)), float(z.window), int(z.stop))
     return (
         id(spec.model._def), spec.model.periodic, taylor_order(spec.tol), spec.tol, spec.transient,
-        spec.periods, spec.adaptive, spec.lyapunov, zdm,
+        spec.periods, spec.adaptive, spec.adaptive_tol, spec.lyapunov, zdm,
     )  # fmt: skip
 
 
@@ -188,6 +188,7 @@ class LaneBatch:
             int(spec.transient),
             int(spec.periods),
             bool(spec.adaptive),
+            float(spec.adaptive_tol),
             bool(spec.lyapunov),
             float(step_safety(spec.tol, self._order)),
             float(CHATTER_TOL),

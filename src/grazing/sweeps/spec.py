@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from grazing.core.model import HybridModel
-from grazing.core.options import SWEEP_TOL, SweepSettings
+from grazing.core.options import ADAPTIVE_TOL, SWEEP_TOL, SweepSettings
 from grazing.errors import InvalidParameterError
 
 DEFAULT_SWEEP_TOL = SWEEP_TOL
@@ -74,6 +74,8 @@ class SweepSpec:
         ``n_points`` rows), at the sampling phase of its forcing period (a
         grid of initial states, :mod:`grazing.attractors`); None: ``x0`` at
         time 0.
+    adaptive_tol
+        The tolerance to which the samples must repeat for an adaptive transient to end.
     resume
         ``(t, x)``: the first point continues a chain from state ``x`` at time
         ``t`` instead of starting from ``x0`` at time 0 (a chunk run again from
@@ -97,6 +99,7 @@ class SweepSpec:
     zdm: DiscontinuityMapLike = None
     segments: int = 1
     starts: Any = field(default=None, compare=False, repr=False)
+    adaptive_tol: float = ADAPTIVE_TOL
     resume: tuple[float, tuple[float, ...]] | None = None
 
     def __post_init__(self) -> None:
@@ -202,6 +205,8 @@ class SweepSpec:
             d["starts_sha256"] = hashlib.sha256(self.starts.tobytes()).hexdigest()
         if self.resume is not None:
             d["resume"] = [self.resume[0], list(self.resume[1])]
+        if self.adaptive_tol != ADAPTIVE_TOL:
+            d["adaptive_tol"] = self.adaptive_tol
         return d
 
     def fingerprint(self) -> str:

@@ -14,8 +14,8 @@ path's: the results are the same numbers, bit for bit.
 
 A point is the protocol of :func:`grazing.sweeps.run.run_point`: the
 transient in blocks of ``ADAPTIVE_BLOCK`` periods (stopped early, at the
-point of the cycle where it would have ended, once the samples repeat with a
-period of at most ``ADAPTIVE_MAX_PERIOD``, when ``adaptive``), then either
+point of the cycle where it would have ended, once the samples repeat to
+``adaptive_tol`` with a period of at most ``ADAPTIVE_MAX_PERIOD``, when ``adaptive``), then either
 ``periods`` sampled periods, or (``lyapunov``) ``align + periods`` with the
 variational equations from the identity, the Lyapunov sums taken over the
 last ``periods``.  ``jobs`` are runs of consecutive points; within a job each
@@ -46,7 +46,6 @@ from grazing.engine.stepping import new_table, step_factor, step_from_norms, ste
 LANE_ROOT_ROWS, LANE_ROOT_MIN_COLS = work_shape(0)
 ADAPTIVE_BLOCK = 32  # (grazing.sweeps.run.ADAPTIVE_BLOCK)
 ADAPTIVE_MAX_PERIOD = 16
-ADAPTIVE_TOL = 1e-9
 LYAPUNOV_ALIGN = 16
 VECTOR_MIN_LANES = 3
 """Fewest lanes of a kind for which the lane function is called (else the scalar one, lane by lane)."""
@@ -169,6 +168,7 @@ def sweep_lanes(
     transient,
     periods,
     adaptive,
+    adaptive_tol,
     lyapunov,
     safety,
     chatter_tol,
@@ -684,7 +684,7 @@ def sweep_lanes(
                 used = li[lane, L_USED]
                 nxt = -1
                 if adaptive and blk == ADAPTIVE_BLOCK:
-                    per = repeats_with_period(buf[lane], blk, n, ADAPTIVE_TOL, ADAPTIVE_MAX_PERIOD)
+                    per = repeats_with_period(buf[lane], blk, n, adaptive_tol, ADAPTIVE_MAX_PERIOD)
                     if per > 0:
                         extra = (budget - used) % per
                         if extra:
