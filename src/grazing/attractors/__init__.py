@@ -12,6 +12,7 @@ along a parameter (global continuation, as Attractors.jl's).
 
 from grazing.attractors.basins import AttractorSet, basins, find_attractors, to_dataset
 from grazing.attractors.classify import KINDS, Attractor
+from grazing.attractors.continuation import continue_attractors
 from grazing.attractors.grid import StateGrid, state_grid
 
 __all__ = [
@@ -20,6 +21,7 @@ __all__ = [
     "AttractorSet",
     "StateGrid",
     "basins",
+    "continue_attractors",
     "find_attractors",
     "state_grid",
     "to_dataset",
