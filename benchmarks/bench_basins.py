@@ -26,9 +26,8 @@ import math
 import os
 import time
 
-from _common import Meter, bench_parser, emit, loadavg, log, machine_info, versions_line, wait_quiet
-
 import grazing
+from _common import Meter, bench_parser, emit, loadavg, log, machine_info, versions_line, wait_quiet
 from grazing.attractors import basins
 
 
@@ -65,7 +64,9 @@ def main() -> None:
 
     def table() -> None:
         print(f"basin of the pendulum, {result['grid']} initial states, 300 + 50 periods each")
-        print(f"  wall time {m.seconds:.1f} s, CPU time {cpu:.1f} s ({cpu / m.seconds:.2f} cores busy with it)")
+        print(
+            f"  wall time {m.seconds:.1f} s, CPU time {cpu:.1f} s ({cpu / m.seconds:.2f} cores busy with it)"
+        )
         print(f"  other processes kept {m.others:.2f} cores busy; {versions_line(info)}")
         for ident, kind, period, frac in found:
             print(f"  attractor {ident}: {kind}, period {period}, fraction {frac:.4f}")

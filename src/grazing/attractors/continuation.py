@@ -243,7 +243,11 @@ def to_dataset(model: HybridModel, param: str, grid: Any, steps: Sequence[Step],
     """The dataset of :func:`continue_attractors`."""
     import xarray as xr
 
-    followed = sorted({g for step in steps for g in step.ids.values()})
+    shown = [
+        [a for a in st.found.attractors if a.kind not in OUTCOMES or st.fractions()[st.ids[a.id]] > 0]
+        for st in steps
+    ]  # (an outcome of seeds alone, off the grid, is no attractor: left out)
+    followed = sorted({st.ids[a.id] for st, atts in zip(steps, shown) for a in atts})
     col = {g: j for j, g in enumerate(followed)}
     nv, na, n = len(steps), len(followed), model.n_states
     fraction = np.zeros((nv, na))
@@ -252,12 +256,12 @@ def to_dataset(model: HybridModel, param: str, grid: Any, steps: Sequence[Step],
     period = np.full((nv, na), -1, dtype=np.int32)
     impacts = np.full((nv, na), np.nan)
     lyap = np.full((nv, na), np.nan)
-    longest = max([min(len(a.points), KEPT_POINTS) for st in steps for a in st.found.attractors] + [1])
+    longest = max([min(len(a.points), KEPT_POINTS) for atts in shown for a in atts] + [1])
     points = np.full((nv, na, longest, n), np.nan)
     labels = np.zeros((nv, *grid.shape), dtype=np.int32)
     for i, st in enumerate(steps):
         fr = st.fractions()
-        for a in st.found.attractors:
+        for a in shown[i]:
             j = col[st.ids[a.id]]
             present[i, j] = True
             fraction[i, j] = fr[st.ids[a.id]]
