@@ -32,6 +32,7 @@ LAYERS = {
     "grazing.normalform": 6,
     "grazing.sweeps": 6,
     "grazing.experiment": 7,
+    "grazing.attractors": 7,
     "grazing.plotting": 8,
     "grazing.report": 9,
     "grazing.cli": 10,
@@ -39,7 +40,7 @@ LAYERS = {
 """The layer of every part of the package (the facade ``grazing/__init__`` is above them all)."""
 
 GENERIC = ("grazing.core", "grazing.engine", "grazing.maps", "grazing.orbits", "grazing.sweeps",
-           "grazing.normalform", "grazing.plotting", "grazing.parallel")  # fmt: skip
+           "grazing.normalform", "grazing.plotting", "grazing.parallel", "grazing.attractors")  # fmt: skip
 """The layers that know no particular model."""
 
 PENDULUM_NAMES = {"eta", "theta_hat", "theta", "dtheta", "tau", "alpha", "beta"}

@@ -142,6 +142,9 @@ MAP = [
 
 # issue 27: curves
 CURVE = "curve --param eta --start 0.446 --stop 0.44 --param2 theta-hat --range 39,41".split()
+BASINS = ["basins", "--model", "bouncing-ball", "--x-range", "0,1", "--y-range", "-1,1", "--num", "2,2"]
+ATTRACTORS = ["attractors", "--model", "bouncing-ball", "--param", "amplitude", "--start", "0.5", "--stop",
+              "0.8", "--num", "2", "--x-range", "0,1", "--y-range", "-1,1", "--num-grid", "2,2"]  # fmt: skip
 
 FORMER_TRACEBACKS = [
     ([*MAP, "--tol", "nan"], "--tol must be in (0, 0.01), got nan"),
@@ -236,6 +239,41 @@ ACCEPTED_BUT_WRONG = [
         "--range 0,1".split(),
         "--param2: unknown parameter 'rr' for model 'bouncing-ball' (known: amplitude, omega, gravity, r)",
     ),
+    # issue 28: attractors
+    ([*BASINS[:-1], "0,5"], "--num must be at least 1 along each state (an empty grid), got '0,5'"),
+    ([*BASINS[:-1], "3"], "--num must be N1,N2 (two whole numbers), got '3'"),
+    (
+        [*BASINS, "--states", "0,5"],
+        "--states: state index 5 is out of range: model 'bouncing-ball' has 2 states",
+    ),
+    ([*BASINS, "--states", "y,w"], "--states: unknown state 'w' for model 'bouncing-ball'"),
+    ([*BASINS, "--states", "1,1"], "--states: the two states of the grid must differ"),
+    (
+        [
+            "basins",
+            "--model",
+            "impact-damper",
+            "--x-range",
+            "0,1",
+            "--y-range",
+            "-1,1",
+            "--num",
+            "2,2",
+            "--fixed",
+            "w=1",
+        ],
+        "--fixed: unknown fixed state 'w' for model 'impact-damper'",
+    ),
+    ([*BASINS, "--fixed", "y=1"], "--fixed: state y is varied by the grid: it cannot be fixed"),
+    ([*BASINS, "--fixed", "y"], "--fixed 'y': expected STATE=VALUE (a number)"),
+    ([*BASINS[:4], "1,0", *BASINS[5:]], "the range of y must have LO < HI"),
+    ([*BASINS[:4], "0,nan", *BASINS[5:]], "--x-range must be finite numbers, got '0,nan'"),
+    ([*BASINS, "--out", "mine.nc"], "mine.nc exists and was not written by grazing"),
+    ([*BASINS, "--plot", "mine.png"], "mine.png exists and was not written by grazing"),
+    ([*BASINS, "--out", "b.txt"], "--out must end in .nc or .zarr, got 'b.txt'"),
+    ([*ATTRACTORS, "--out", "b.zarr"], "--out must end in .nc, got 'b.zarr'"),
+    ([*ATTRACTORS[:4], "r", *ATTRACTORS[5:8], "2", *ATTRACTORS[9:]], "r = 2 is outside [0, 1]"),
+    ([*ATTRACTORS[:-1], "0,2"], "--num-grid must be at least 1 along each state (an empty grid)"),
 ]
 
 IGNORED_OPTIONS = [
@@ -378,6 +416,36 @@ IGNORED_OPTIONS = [
     ([*CURVE, "--kind", "fold", "--eta", "0.45"], "--eta is not used with --param eta: the branch starts at"),
     ([*CURVE, "--kind", "fold", "--set", "eta=0.45"], "--set eta=0.45 is not used with --param eta"),
     ([*CURVE, "--kind", "fold", "--overwrite"], "--overwrite is not used without --out"),
+    # issue 28: attractors
+    ([*SWEEP, "--direction", "both", "--fresh"], "--fresh is not used with --direction both"),
+    ([*BASINS, "--overwrite"], "--overwrite is not used without --out or --plot"),
+    ([*BASINS, "--wait"], "--wait is not used without a Zarr store"),
+    ([*BASINS, "--wait", "--out", "b.nc"], "--wait is not used without a Zarr store"),
+    ([*ATTRACTORS, "--overwrite"], "--overwrite is not used without --out or --plot"),
+    ([*ATTRACTORS, "--set", "amplitude=0.6"], "--set amplitude=0.6 is not used with --param amplitude"),
+    (
+        [
+            "attractors",
+            "--param",
+            "eta",
+            "--start",
+            "0.44",
+            "--stop",
+            "0.45",
+            "--num",
+            "2",
+            "--eta",
+            "0.4",
+            "--x-range",
+            "0,0.5",
+            "--y-range",
+            "-1,1",
+            "--num-grid",
+            "2,2",
+        ],
+        "--eta is not used with --param eta",
+    ),
+    ([*ATTRACTORS[:10], "1", *ATTRACTORS[11:]], "--stop is not used with --num 1 (its one value is --start"),
 ]
 
 MEMORY = [
@@ -410,6 +478,10 @@ MEMORY = [
     (["iso-damping", "--num", "100000000"], "a curve of 1e+08 points needs about"),
     (["synthesize", "--eta", "0.446", "--periods", "10000000", "--out", "x.csv"], "a recording of"),
     (["damping", "--r", "1", "--beta", "0", "--peaks", "1000000000000"], "a free decay of 1e+12 peaks"),
+    # issue 28: attractors
+    ([*BASINS[:-1], "100000,100000"], "a basin of 1e+10 initial states needs about"),
+    ([*BASINS[:-1], "100000,100000", "--out", "b.zarr"], "use a coarser grid (--num)"),
+    ([*ATTRACTORS[:10], "1000", *ATTRACTORS[11:-1], "30000,30000"], "1000 basins of 9e+08 initial states"),
 ]
 
 
@@ -615,6 +687,8 @@ WORK = [
     ("grazing.experiment.synthetic", "synthetic_sweep"),
     ("grazing.report", "build_report"),
     ("grazing.orbits", "follow_curve"),  # issue 27: curves
+    ("grazing.attractors.basins", "find_attractors"),  # issue 28: attractors
+    ("grazing.attractors.continuation", "continue_attractors"),
 ]
 
 
@@ -785,6 +859,43 @@ COMMANDS: dict[str, dict[str, list[str] | None]] = {
     },
     "report": {"--out": ["rep", ""]},
 }
+# issue 28: attractors
+GRID = {
+    "--x-range": ["0,1", "-1,1", "1,0", "0,nan"],
+    "--y-range": ["-1,1", "0,0"],
+    "--states": ["0,1", "y,v", "0,2", "1,1"],
+    "--fixed": ["y=1", "v=0", "w=1", "v"],
+    "--phase": ["0", "1.5"],
+    "--transient": ["0", "3"],
+    "--periods": ["1", "2", "3"],
+    "--refine": ["0", "1"],
+    "--no-lyapunov": None,
+    "--tol": ["1e-10"],
+    "--workers": ["1", "2"],
+    "--plot": ["b.png", "b.txt", "mine.png"],
+    "--overwrite": None,
+    "--json": None,
+}
+COMMANDS["basins"] = {
+    "--model": ["bouncing-ball", "pendulum"],
+    **GRID,
+    "--num": ["2,2", "1,3", "0,2", "3"],
+    "--chunk-size": ["1", "100"],
+    "--out": ["b.nc", "b.zarr", "b.txt", "mine.nc", "nodir/b.nc"],
+    "--wait": None,
+}
+COMMANDS["attractors"] = {
+    "--model": ["bouncing-ball"],
+    "--param": ["amplitude", "r", "gamma"],
+    "--start": ["0.5"],
+    "--stop": ["0.8", "0.5"],
+    "--num": ["1", "2"],
+    **GRID,
+    "--num-grid": ["2,2", "0,1"],
+    "--seeds": ["0", "3"],
+    "--out": ["a.nc", "a.zarr", "mine.nc"],
+}
+COMMANDS["sweep"]["--direction"] = [*COMMANDS["sweep"]["--direction"], "both"]
 # issue 26: orbits
 for _cmd in ("graze", "normal-form", "graze-curve"):
     COMMANDS[_cmd]["--initial"] = ["0,0", "-0.5,0.1", "0;0"]
@@ -820,6 +931,7 @@ COMMANDS["curve"] = {
     "--json": None,
 }
 REQUIRED += ["--kind", "--range"]
+REQUIRED += ["--x-range", "--y-range", "--num-grid"]  # issue 28: attractors
 REAL_WORK = ("simulate", "sweep", "map", "damping", "synthesize", "analyze")
 
 
@@ -932,6 +1044,19 @@ def ignored(argv: list[str]) -> list[str]:
         bad.append("--overwrite")
     if cmd in ("sweep", "map") and "--overwrite" in g and str(g.get("--out", "")).endswith(".zarr"):
         bad.append("--overwrite")
+    # issue 28: attractors
+    if cmd == "sweep" and "--fresh" in g and g.get("--direction") == "both":
+        bad.append("--fresh")
+    if cmd in ("basins", "attractors"):
+        bad = [b for b in bad if b != "--overwrite"]
+        if "--overwrite" in g and "--out" not in g and "--plot" not in g:
+            bad.append("--overwrite")
+        if "--wait" in g and not str(g.get("--out", "")).endswith(".zarr"):
+            bad.append("--wait")
+    if cmd == "attractors":
+        bad += [f"--{g['--param']}"] if f"--{g.get('--param')}" in g else []
+        if g.get("--num") == "1" and "--stop" in g and _number(g.get("--stop")) != _number(g.get("--start")):
+            bad.append("--stop")
     return bad
 
 

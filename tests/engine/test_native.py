@@ -78,8 +78,10 @@ def sweep_arguments() -> tuple[list, int]:
     values = dict(
         m=kern.table, lanes=1, jobs=np.array([[0, 1]], dtype=np.int64), control=np.zeros(3, dtype=np.int64),
         fresh=False, periodic=bool(model.periodic), x0=np.array([[0.5, 0.0]]),
+        firsts=np.array([[0.0, 0.5, 0.0]]),
         pvs=model.param_vector.reshape(1, -1).copy(), Ts=np.array([float(model.period)]), sphase=np.zeros(1),
-        tcarry=np.zeros(1), zdms=np.zeros(1), transient=4, periods=periods, adaptive=False, lyapunov=False,
+        tcarry=np.zeros(1), zdms=np.zeros(1), transient=4, periods=periods, adaptive=False, adaptive_tol=1e-9,
+        lyapunov=False,
         safety=1.5, chatter_tol=1e-9, zdm_on=False, zdm_a=1.0, zdm_e=np.zeros(n), zdm_window=0.0, watch=0,
         out_samples=np.full((1, periods, n), np.nan),
         out_by_stop=np.zeros((1, model.n_stops), dtype=np.int64), out_lyap=np.zeros(1),
@@ -102,6 +104,7 @@ def test_the_entry_point_computes_and_refuses_wrong_arrays() -> None:
         (out, np.zeros((1, 3, 4))[:, :, ::2]),  # not contiguous
         (x0, np.zeros((1, 3))),  # x0 of the wrong size
         (x0, np.zeros((2, 2))),  # x0 not one per job
+        (x0 + 1, np.zeros((1, 2))),  # firsts without the time
     )
     for index, bad in wrong_arrays:
         wrong = list(args)

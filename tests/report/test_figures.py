@@ -13,7 +13,18 @@ from scipy.optimize import minimize_scalar
 
 from grazing.models import pendulum
 from grazing.orbits import continue_orbit, find_orbit
-from grazing.report import FIGURES, diagrams, fig06, fig07, fig08, fig12, figmap, figstops, paper
+from grazing.report import (
+    FIGURES,
+    diagrams,
+    fig06,
+    fig07,
+    fig08,
+    fig12,
+    figattractors,
+    figmap,
+    figstops,
+    paper,
+)
 from grazing.report.base import Comparison, FigureResult
 from grazing.report.diagrams import Panel, Settings
 from grazing.sweeps.windows import Window
@@ -288,3 +299,18 @@ def test_two_stop_section_checks_every_closed_form(built) -> None:
     assert all(c.verdict == "agree" and c.kind == "self-check" for c in res.comparisons), [
         (c.quantity, c.ours) for c in res.comparisons if c.verdict != "agree"
     ]
+
+
+# ----------------------------------------------------------------------------- issue 28: attractors
+
+
+def test_attractors_section(built) -> None:
+    """The hysteresis loop at the second grazing: every self-check agrees, the loop brackets the grazing."""
+    out, res = _built(figattractors, built)
+    assert (out / "attractors_second_grazing.png").stat().st_size > 10_000
+    assert all(c.verdict == "agree" for c in res.comparisons), [
+        (c.quantity, c.ours) for c in res.comparisons if c.verdict != "agree"
+    ]
+    assert {c.kind for c in res.comparisons} == {"self-check", "paper"}
+    text = " ".join(res.notes)
+    assert "from rest" in text and "0.5473" in text  # the grazing, from continuation

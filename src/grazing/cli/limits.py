@@ -185,3 +185,31 @@ DECAY_CYCLE = 200 * 3 * VALUE * (TRAJECTORY_COPIES + 1)
 def decay_bytes(cycles: int) -> float:
     """Memory of a free decay simulated over ``cycles`` cycles."""
     return float(cycles) * DECAY_CYCLE
+
+
+BASIN_POINT = 160
+"""Per initial state of a basin besides its state: labels, flags, the sweep point, a deferred end state."""
+BASIN_JSON = 48
+"""Per initial state with ``--json`` (its label as a Python int and as text)."""
+
+
+def basin_bytes(
+    n_points: float,
+    periods: int,
+    n_states: int,
+    *,
+    chunk_points: int,
+    workers: int,
+    as_json: bool,
+    values: int = 1,
+) -> float:
+    """Memory of ``basins`` and ``attractors``: per initial state (state, labels), and the chunks in flight.
+
+    The end states are classified chunk by chunk, so only the chunks in flight hold samples; the
+    labels of every parameter value (``values``) are kept.
+    """
+    per_point = BASIN_POINT + 3 * n_states * VALUE + (BASIN_JSON if as_json else 0)
+    flight = float(chunk_points) * (2 * workers + 2) * periods * n_states * VALUE * 2
+    return float(n_points) * (per_point + 4 * (values - 1)) + min(
+        flight, float(n_points) * periods * n_states * 16
+    )

@@ -121,12 +121,14 @@ class _SweepRun:
     """
 
     def __init__(
-        self, ds: Any, period: np.ndarray, status: np.ndarray, arrays: dict[str, np.ndarray] | None = None
-    ):
+        self, ds: Any, period: np.ndarray, status: np.ndarray, arrays: dict[str, np.ndarray] | None = None,
+        impacts: np.ndarray | None = None,
+    ):  # fmt: skip
         self.ds = ds
         self.period = period
         self.status = status
         self.arrays = arrays
+        self.impacts = impacts
 
 
 def _run_sweep_spec(
@@ -175,7 +177,7 @@ def _run_sweep_spec(
             spec, store=store, workers=workers, client=client, progress=bar, timeout=timeout,
             notice=lambda msg: click.echo(f"grazing: {msg}", err=True), load=not (streamed or memory),
         )  # fmt: skip
-        flat = {name: store.read(name) for name in ("period", "status")} if streamed else None
+        flat = {name: store.read(name) for name in ("period", "status", "impacts")} if streamed else None
     finally:
         bar.close()
         if store is not None and not memory:
@@ -189,25 +191,51 @@ def _run_sweep_spec(
     if out is not None and out.suffix.lower() == ".nc":
         save_dataset(ds, out, overwrite)
     if flat is None:  # (the dataset's points, flattened: in visiting order, as the spec lists them)
-        flat = {name: ds[name].values.ravel() for name in ("period", "status")}
-    return _SweepRun(ds, flat["period"], flat["status"])
+        flat = {name: _visiting_order(ds, name) for name in ("period", "status")}
+    return _SweepRun(ds, flat["period"], flat["status"], impacts=flat.get("impacts"))
+
+
+def _visiting_order(ds: Any, name: str) -> np.ndarray:
+    """A sweep dataset's variable along its points in visiting order (``--direction both``: up, then down)."""
+    values = ds[name].values
+    if "direction" in ds[name].dims:  # (each direction sorted by value: down is visited the other way)
+        return np.concatenate([values[0], values[1][::-1]])
+    return values.ravel()
 
 
 def _sweep_json(spec: Any, run: _SweepRun, param: str, shown: np.ndarray) -> dict[str, Any]:
     """The sweep's ``--json`` keys, points sorted by value, from its arrays or its dataset."""
-    from grazing.sweeps.status import reasons
     from grazing.sweeps.store import impacts_per_period
 
     if run.arrays is not None:
         a = run.arrays
+    elif "direction" in run.ds.dims:
+        names = ("samples", "period", "impacts", "lyapunov", "transient_used", "impacts_by_stop", "status")
+        a = {k: _visiting_order(run.ds, k) for k in names}
     else:
         a = {k: run.ds[k].values for k in ("samples", "period", "impacts", "lyapunov", "transient_used",
                                              "impacts_by_stop", "status")}  # fmt: skip
-    by_value = np.argsort(np.asarray(spec.points, dtype=float)[:, 0], kind="stable")
     ipp, ipp_stop = impacts_per_period(spec, a)
+    if spec.segments == 2:  # --direction both: each per-point key is {"up": [...], "down": [...]}
+        n = spec.segment_points
+        halves = [slice(0, n), slice(n, 2 * n)]
+        half = [{k: v[sl] for k, v in a.items()} for sl in halves]
+        parts = [
+            _point_keys(type(spec)(**{**spec.__dict__, "points": spec.points[sl], "segments": 1}), h, ipp[sl],
+                        ipp_stop[sl])
+            for sl, h in zip(halves, half)
+        ]  # fmt: skip
+        return {"param": param, "values": np.sort(shown),
+                **{key: {"up": parts[0][key], "down": parts[1][key]} for key in parts[0]}}  # fmt: skip
+    return {"param": param, "values": np.sort(shown), **_point_keys(spec, a, ipp, ipp_stop)}
+
+
+def _point_keys(spec: Any, a: dict[str, np.ndarray], ipp: np.ndarray, ipp_stop: np.ndarray) -> dict[str, Any]:
+    """The per-point keys of a sweep's ``--json``, sorted by value."""
+    from grazing.sweeps.status import reasons
+
+    by_value = np.argsort(np.asarray(spec.points, dtype=float)[:, 0], kind="stable")
     return {
-        "param": param,
-        "values": np.sort(shown),
         "period": a["period"][by_value],
         "impacts_per_period": ipp[by_value],
         "lyapunov": a["lyapunov"][by_value],
@@ -236,8 +264,9 @@ def _outcomes(period: np.ndarray, status: np.ndarray) -> tuple[int, int, str]:
 @click.option("--start", type=FINITE, required=True, help="First parameter value.")
 @click.option("--stop", type=FINITE, required=True, help="Last parameter value.")
 @click.option("--num", type=count(1), required=True, help="Number of parameter values.")
-@click.option("--direction", type=click.Choice(["up", "down"]), default="up", show_default=True,
-              help="Order in which the values are visited.")  # fmt: skip
+@click.option("--direction", type=click.Choice(["up", "down", "both"]), default="up", show_default=True,
+              help="Order in which the values are visited; both: up, then down from --initial again, both "
+              "kept (hysteresis).")  # fmt: skip
 @click.option(
     "--method",
     type=click.Choice(["flow", "map"]),
@@ -258,20 +287,23 @@ def sweep_cmd(
     """Brute-force bifurcation diagram: stroboscopic samples, periods, impacts and
     Lyapunov exponents along a parameter range."""
     from grazing.sweeps.spec import sweep_spec
-    from grazing.sweeps.status import failures, reasons
 
     par = model_parameter(model, sparam)
     name = par.name
     refuse_varied([name], f"with --param {sparam}: the swept values replace it")
     refuse_unused(["stop"], num == 1 and stop != start, ONE_VALUE.format(num="--num", start="--start"))
     refuse_unused(["which"], method != "map", "without --method map")
+    same = "with --direction both (from --initial at every point, both directions are the same)"
+    refuse_unused(["fresh"], direction == "both", same)
     chunk_size = CHUNK_SIZE if chunk_size is None else chunk_size
+    runs = 2 if direction == "both" else 1
+    n_states = model.n_states
     _check_sweep_options(
-        out, scheduler, chunk_size, num, periods, model.n_states, workers, as_json, "a sweep", overwrite
+        out, scheduler, chunk_size, runs * num, periods, n_states, workers, as_json, "a sweep", overwrite
     )
     shown = np.linspace(start, stop, num)
     vals = np.array([par.from_display(v) for v in shown])
-    order = np.sort(vals) if direction == "up" else np.sort(vals)[::-1]
+    order = np.sort(vals) if direction != "down" else np.sort(vals)[::-1]
     x0 = parse_state(initial, model)
     for v in (order[0], order[-1]):
         model.with_params(**{name: v})
@@ -293,23 +325,72 @@ def sweep_cmd(
         res.update({"direction": direction, "fresh": fresh, "transient": transient, "periods": periods,
                     "chunk_size": spec.size, "elapsed_s": elapsed, "out": str(out) if out else None,
                     "method": method, "grazing": graze_info})  # fmt: skip
+        if direction == "both":
+            res["hysteresis"] = [_hysteresis_json(h, par) for h in _hysteresis(spec, run)]
         emit_json(res)
         return
-    by_value = np.argsort(order, kind="stable")  # (the points in visiting order, sorted like the values)
-    per, status = run.period[by_value], run.status[by_value]
+    click.echo(f"{num} values of {sparam} in {elapsed:.1f} s ({runs * num / elapsed:.0f} points/s)")
+    for k, way in enumerate(["up", "down"] if direction == "both" else [direction]):
+        here = slice(k * num, (k + 1) * num)  # (the points of one direction, in visiting order)
+        by_value = np.argsort(order if way == "up" else order[::-1], kind="stable")
+        if direction == "both":
+            click.echo(f"{way}:")
+        _summary(run.period[here][by_value], run.status[here][by_value], np.sort(shown), sparam)
+    if direction == "both":
+        found = _hysteresis(spec, run)
+        click.echo(f"up and down differ at {sum(h.points for h in found)} values" + (":" if found else ""))
+        for h in found:
+            lo, hi = par.to_display(h.start), par.to_display(h.stop)
+            click.echo(f"  {sparam} in [{lo:.6g}, {hi:.6g}] ({h.points} values): up {h.up}, down {h.down}")
+    if out is not None:
+        click.echo(f"saved to {out}")
+
+
+def _summary(per: np.ndarray, status: np.ndarray, shown: np.ndarray, sparam: str) -> None:
+    """The summary lines of a sweep's points (sorted by value): periodic windows, failed points."""
+    from grazing.sweeps.status import failures, reasons
+
     periodic, aperiodic, failed = _outcomes(per, status)
-    click.echo(f"{num} values of {sparam} in {elapsed:.1f} s ({num / elapsed:.0f} points/s)")
     click.echo(f"periodic points: {periodic}, no period <= 64: {aperiodic}, {failed}")
     ok = status == Status.OK
     for p in sorted(set(per[ok & (per > 0)].tolist()))[:12]:
-        sel = np.sort(shown)[ok & (per == p)]
+        sel = shown[ok & (per == p)]
         click.echo(f"  period {p:2d}: {sel.size} points, {sparam} in [{sel.min():.6g}, {sel.max():.6g}]")
     words = np.array(reasons(status))
     for why in failures(status):
-        sel = np.sort(shown)[words == why]
+        sel = shown[words == why]
         click.echo(f"  failed, {why}: {sel.size} points, {sparam} in [{sel.min():.6g}, {sel.max():.6g}]")
-    if out is not None:
-        click.echo(f"saved to {out}")
+
+
+def _hysteresis(spec: Any, run: _SweepRun) -> list[Any]:
+    """Where the sweep up and the sweep down (``--direction both``) end differently."""
+    from grazing.sweeps.store import build_dataset
+    from grazing.sweeps.windows import find_hysteresis
+
+    if run.arrays is not None:
+        return find_hysteresis(build_dataset(spec, run.arrays))
+    if run.ds is not None:
+        return find_hysteresis(run.ds)
+    # Streamed to a store: from the periods and impacts read back (orbits of one period are not compared).
+    import xarray as xr
+
+    flat = {"period": run.period, "status": run.status, "impacts": run.impacts}
+    n = spec.segment_points
+    values = np.asarray(spec.points[:n], dtype=float)[:, 0]
+    order = np.argsort(values, kind="stable")
+    both = {k: np.stack([v[:n][order], v[n:][::-1][order]]) for k, v in flat.items()}
+    dims = ("direction", "point")
+    light = xr.Dataset(
+        {"period": (dims, both["period"]), "status": (dims, both["status"]),
+         "impacts_per_period": (dims, both["impacts"].astype(float))},
+        coords={"direction": ["up", "down"], "value": ("point", values[order])},
+    )  # fmt: skip
+    return find_hysteresis(light)
+
+
+def _hysteresis_json(h: Any, par: Any) -> dict[str, Any]:
+    return {"start": par.to_display(h.start), "stop": par.to_display(h.stop), "points": h.points,
+            "up": h.up, "down": h.down}  # fmt: skip
 
 
 _GRAZE_SEARCH = {"eta": (0.2, 1.0), "theta_hat": (-3.1, 3.1)}

@@ -56,6 +56,45 @@ cycles shows a longer period fewer than three times."""
 CHUNK_SIZE = 50
 """Points per chunk of a one-parameter sweep: the unit of parallel work and of saving."""
 
+ADAPTIVE_TOL = 1e-9
+"""A sweep's adaptive transient ends once the samples repeat to this (with a period of at most 16)."""
+
+BASIN_ADAPTIVE_TOL = 1e-7
+"""The same for the initial states of a basin: their orbits are told apart to 1e-3 cells, and recognised
+periodic to 1e-6."""
+
+CHAIN_TOL = PERIOD_TOL
+"""A chunk of a sweep computed from a guess is kept when its first point ends on the periodic orbit,
+at the same point of it, as from the chain's state: samples and final state equal to this."""
+
+CHAOS_THRESHOLD = 1e-3
+"""Largest Lyapunov exponent (per unit time) above which an aperiodic run counts as chaotic; within
+it of zero, quasi-periodic."""
+
+BASIN_TRANSIENT = 300
+"""Forcing periods run from each initial state of a basin before its attractor is sampled."""
+
+BASIN_PERIODS = 50
+"""Forcing periods sampled on the attractor each initial state of a basin ends on."""
+
+BASIN_CHUNK = 512
+"""Initial states per chunk of a basin computation: the unit of parallel work and of saving."""
+
+CELLS = 64
+"""Cells along each side of the grid box on which the points of aperiodic attractors are recorded
+(the size of a cell is the box's extent over this)."""
+
+MATCH_TOL = 1e-3
+"""Two periodic orbits are one attractor when each point of one is within this many cells of a point
+of the other (a periodic orbit's samples repeat to 1e-6)."""
+
+BASIN_REFINE = 1
+"""Times an initial state whose end state is aperiodic is run on for another transient before it is
+classified (a chaotic transient, or one slow to settle, then ends on its attractor)."""
+
+ESCAPE_FACTOR = 1e6
+"""A state farther than this many times the grid box's extent from the box has escaped."""
+
 IMPACTS = ("none", "sampled", "all")
 """What :class:`SaveAt` can record of the impacts."""
 
@@ -233,6 +272,47 @@ class SweepSettings:
         _set(self, "chunk_size", _count("chunk size", self.chunk_size, 0))
         _set(self, "phase", _finite("phase", self.phase))
         _set(self, "tol", _tolerance("tol", self.tol))
+
+
+@dataclass(frozen=True)
+class BasinSettings:
+    """How every initial state of a basin computation is run (:mod:`grazing.attractors`).
+
+    Attributes
+    ----------
+    transient, periods
+        Forcing periods run before sampling, and sampled (at least 2: a period
+        is recognised when it repeats twice).
+    phase
+        Forcing phase of the initial states and of the samples, in radians.
+    refine
+        Times an initial state whose end state is aperiodic is run on for
+        another ``transient`` before it is classified.
+    lyapunov
+        Compute largest Lyapunov exponents (of the aperiodic end states, which
+        they tell chaotic from quasi-periodic, and of one point of each orbit).
+    tol
+        Local error tolerance of the integrator.
+    chunk_size
+        Initial states per chunk: the unit of parallel work and of saving.
+    """
+
+    transient: int = BASIN_TRANSIENT
+    periods: int = BASIN_PERIODS
+    phase: float = 0.0
+    refine: int = BASIN_REFINE
+    lyapunov: bool = True
+    tol: float = SWEEP_TOL
+    chunk_size: int = BASIN_CHUNK
+
+    def __post_init__(self) -> None:
+        _set(self, "transient", _count("transient", self.transient, 0))
+        _set(self, "periods", _count("periods", self.periods, 2))
+        _set(self, "refine", _count("refine", self.refine, 0))
+        _set(self, "chunk_size", _count("chunk size", self.chunk_size, 1))
+        _set(self, "phase", _finite("phase", self.phase))
+        _set(self, "tol", _tolerance("tol", self.tol))
+        _set(self, "lyapunov", bool(self.lyapunov))
 
 
 def with_shorthands(

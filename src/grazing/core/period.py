@@ -33,8 +33,34 @@ def detect_period(
     s = np.asarray(samples, dtype=float)
     if s.ndim == 1:
         s = s[:, None]
-    m = s.shape[0]
+    return int(detect_periods(s[None], tol, max_period)[0])
+
+
+def detect_periods(
+    samples: np.ndarray,
+    tol: float = DEFAULT_PERIOD_TOL,
+    max_period: int = DEFAULT_MAX_PERIOD,
+) -> np.ndarray:
+    """:func:`detect_period` of each run: ``samples`` of shape ``(runs, samples, components)``.
+
+    Examples
+    --------
+    >>> s = np.array([[[1.0], [2.0], [1.0], [2.0]], [[0.1], [0.5], [0.3], [0.9]]])
+    >>> detect_periods(s).tolist()
+    [2, 0]
+    """
+    s = np.asarray(samples, dtype=float)
+    if s.ndim != 3:
+        raise ValueError(f"samples must have shape (runs, samples, components), got {s.shape}")
+    found = np.zeros(s.shape[0], dtype=np.int64)
+    todo = np.arange(s.shape[0])
+    m = s.shape[1]
     for p in range(1, min(max_period, m // 2) + 1):
-        if np.max(np.abs(s[p:] - s[:-p])) <= tol:
-            return p
-    return 0
+        if todo.size == 0:
+            break
+        part = s[todo]
+        # (a NaN anywhere makes the maximum NaN, which is not <= tol: not periodic)
+        periodic = np.max(np.abs(part[:, p:] - part[:, :-p]), axis=(1, 2)) <= tol
+        found[todo[periodic]] = p
+        todo = todo[~periodic]
+    return found

@@ -42,16 +42,17 @@ from typing import Any
 import numpy as np
 
 DRIVER_ARGUMENTS = (
-    "m", "lanes", "jobs", "control", "fresh", "periodic", "x0", "pvs", "Ts", "sphase", "tcarry", "zdms",
-    "transient", "periods", "adaptive", "lyapunov", "safety", "chatter_tol", "zdm_on", "zdm_a", "zdm_e",
-    "zdm_window", "watch", "out_samples", "out_by_stop", "out_lyap", "out_used", "out_x", "out_t",
-    "out_status",
+    "m", "lanes", "jobs", "control", "fresh", "periodic", "x0", "firsts", "pvs", "Ts", "sphase", "tcarry",
+    "zdms", "transient", "periods", "adaptive", "adaptive_tol", "lyapunov", "safety", "chatter_tol", "zdm_on",
+    "zdm_a", "zdm_e", "zdm_window", "watch", "out_samples", "out_by_stop", "out_lyap", "out_used", "out_x",
+    "out_t", "out_status",
 )  # fmt: skip
 """The arguments of :func:`grazing.engine.driver.lanes.sweep_lanes`; the loaded entry point takes them too."""
 _KERNELS = ("fns", "nx", "nsens", "nstops", "order", "sticks", "mlanes")
 """The fields of ``m`` (:class:`grazing.engine.records.Kernels`)."""
 _ARRAYS = {
     "fns": ("i8", 1), "sticks": ("?", 1), "jobs": ("i8", 2), "control": ("i8", 1), "x0": ("f8", 2),
+    "firsts": ("f8", 2),
     "pvs": ("f8", 2), "Ts": ("f8", 1), "sphase": ("f8", 1), "tcarry": ("f8", 1), "zdms": ("f8", 1),
     "zdm_e": ("f8", 1),
     "out_samples": ("f8", 3), "out_by_stop": ("i8", 2), "out_lyap": ("f8", 1), "out_used": ("i8", 1),
@@ -59,7 +60,7 @@ _ARRAYS = {
 }  # fmt: skip
 """dtype and dimensions of the array arguments (C-contiguous)."""
 _BOOLS = ("fresh", "periodic", "adaptive", "lyapunov", "zdm_on")
-_FLOATS = ("safety", "chatter_tol", "zdm_a", "zdm_window")
+_FLOATS = ("adaptive_tol", "safety", "chatter_tol", "zdm_a", "zdm_window")
 _PREFIX = "grazing_native"
 _ENTRY = "sweep_lanes"
 _RETURNED = (0, -2)
@@ -249,7 +250,7 @@ def _shapes(values: dict[str, Any]) -> dict[str, tuple[int, ...]]:
     njobs = values["jobs"].shape[0]
     return {
         **per_point, "fns": values["fns"].shape, "sticks": (nstops,), "jobs": (njobs, 2), "control": (3,),
-        "x0": (njobs, nx), "pvs": values["pvs"].shape, "zdm_e": (nx,),
+        "x0": (njobs, nx), "firsts": (njobs, nx + 1), "pvs": values["pvs"].shape, "zdm_e": (nx,),
         "out_samples": (npts, values["periods"], nx),
         "out_by_stop": (npts, nstops), "out_x": (npts, nx),
     }  # fmt: skip

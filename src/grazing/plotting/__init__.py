@@ -6,12 +6,14 @@ grazing`` never loads it and never selects a backend); the helpers draw on an
 :func:`plot_time_series`, :func:`plot_delay`.  :mod:`~grazing.plotting.diagrams`:
 :func:`plot_bifurcation`, :func:`visible_windows`, :func:`label_windows`,
 :func:`mark_grazings`, :func:`period_classes`, :func:`plot_period_map`.
+:mod:`~grazing.plotting.attractors`: :func:`plot_basins`, :func:`plot_fractions`.
 :mod:`~grazing.plotting.labels`: axis labels from parameter and state metadata.
 The array helpers :func:`~grazing.experiment.signal.uniform_resample` and
 :func:`~grazing.experiment.signal.delay_coordinates` live with the signal
 processing.
 """
 
+from grazing.plotting.attractors import plot_basins, plot_fractions
 from grazing.plotting.diagrams import (
     label_windows,
     mark_grazings,
@@ -31,8 +33,10 @@ __all__ = [
     "mark_grazings",
     "param_label",
     "period_classes",
+    "plot_basins",
     "plot_bifurcation",
     "plot_delay",
+    "plot_fractions",
     "plot_period_map",
     "plot_time_series",
     "visible_windows",

@@ -202,7 +202,10 @@ def plot_bifurcation(
 
     Every stroboscopic sample of every point is a small black dot, as in the
     paper's figs 2, 7, 8, 10 and 12.  Works for any one-parameter dataset of
-    :func:`grazing.sweeps.sweep` (direct simulation or discontinuity map).
+    :func:`grazing.sweeps.sweep` (direct simulation or discontinuity map); a
+    sweep up and down (``direction="both"``) is drawn in two colours
+    (:data:`DIRECTION_COLORS`, with a legend), its windows labelled from the
+    sweep up.
 
     Parameters
     ----------
@@ -258,13 +261,25 @@ def plot_bifurcation(
     labels, units = dataset_states(ds)
     yscale = state_scale(units[component], degrees) if units else angle_scale(degrees)
     value = np.asarray(ds["value"].values, dtype=float)
-    samples = np.asarray(ds["samples"].values, dtype=float)[:, :, component]  # (point, sample)
-    x = np.repeat(value * xscale, samples.shape[1])
-    y = samples.ravel() * yscale
-    ok = np.isfinite(y)
-    kw = {"ls": "none", "marker": ".", "ms": 1.2, "mew": 0.0, "color": "k", "rasterized": True}
-    kw.update(dot_kw or {})
-    ax.plot(x[ok], y[ok], **kw)
+    ways = [str(d) for d in ds["direction"].values] if "direction" in ds.dims else [None]
+    ys = []
+    for way in ways:  # (a sweep up and down: each direction in its colour)
+        part = ds if way is None else ds.sel(direction=way)
+        samples = np.asarray(part["samples"].values, dtype=float)[:, :, component]  # (point, sample)
+        x = np.repeat(value * xscale, samples.shape[1])
+        y = samples.ravel() * yscale
+        ok = np.isfinite(y)
+        kw = {"ls": "none", "marker": ".", "ms": 1.2, "mew": 0.0, "color": "k", "rasterized": True}
+        if way is not None:
+            kw.update({"color": DIRECTION_COLORS[way], "label": f"swept {way}", "alpha": 0.8})
+        kw.update(dot_kw or {})
+        ax.plot(x[ok], y[ok], **kw)
+        ys.append(y[ok])
+    y = np.concatenate(ys)
+    ok = np.ones(y.size, dtype=bool)
+    if ways[0] is not None:
+        ax.legend(loc="upper right", fontsize=8, markerscale=8, frameon=False)
+        ds = ds.sel(direction="up")
     lo, hi = float(value.min() * xscale), float(value.max() * xscale)
     pad = 0.005 * (hi - lo) if hi > lo else 0.5
     ax.set_xlim(lo - pad, hi + pad)
@@ -295,6 +310,10 @@ def plot_bifurcation(
     unit = state_unit(units[component], degrees) if units else ""
     ax.set_ylabel(f"{with_unit(sym, unit)} at {tname} = {period}k")
     return runs
+
+
+DIRECTION_COLORS = {"up": "tab:blue", "down": "tab:orange"}
+"""The colours of a sweep up and of a sweep down in :func:`plot_bifurcation`."""
 
 
 def period_classes(

@@ -18,6 +18,8 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
+from grazing.core.options import CHAOS_THRESHOLD as LYAPUNOV_CHAOS
+
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
 
@@ -27,7 +29,7 @@ Progress = Callable[[str], None]
 DPI = 150
 """Resolution of every PNG in the report."""
 
-CHAOS_THRESHOLD = 1e-3
+CHAOS_THRESHOLD = LYAPUNOV_CHAOS
 """Largest Lyapunov exponent (per unit time) above which an aperiodic run counts as chaotic."""
 
 Kind = Literal["paper", "experiment", "self-check"]

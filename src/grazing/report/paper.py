@@ -322,3 +322,11 @@ FIG12_PATTERN = (
 
 EQ3_BETA = "β = κ/(2ω0), ω0 = 2√(g_e/L) (eq. 3)"
 EQ19 = "b(x_im, 0) = −√(2a(x_im)) (0, −(1+r), 0)ᵀ with a = 𝓛²_f h (eq. 19)"
+
+# ---------------------------------------------------------------------------- issue 28: attractors
+
+SUDDEN_RETURN = (
+    "at the reverse grazing (η = 0.5475, θ̂ = 40°) “the transition back to nonimpacting behaviour is much "
+    "more sudden and does not appear to involve any appreciable chaotic behaviour”"
+)
+"""§6.1, on the second grazing at 40°."""

@@ -17,7 +17,14 @@ from typing import Any
 from grazing.core.model import HybridModel
 from grazing.core.options import SweepSettings, refuse_unknown, with_shorthands
 from grazing.errors import InvalidParameterError
-from grazing.sweeps.executor import DASK_NOTICE_AFTER, chunk_results, local_results
+from grazing.sweeps.chain import ChainLine, settle
+from grazing.sweeps.executor import (
+    DASK_NOTICE_AFTER,
+    chain_window,
+    chunk_results,
+    compute_parts,
+    local_results,
+)
 from grazing.sweeps.spec import DiscontinuityMapLike, SweepSpec, map_spec, sweep_spec
 
 __all__ = ["DASK_NOTICE_AFTER", "parameter_map", "run_sweep", "run_sweeps", "sweep"]
@@ -80,6 +87,18 @@ def run_sweep(
     done_points = spec.n_points - sum(spec.chunk(i).stop - spec.chunk(i).start for i in todo)
     if progress is not None:
         progress(done_points, spec.n_points)
+    if is_chained(spec):  # (the chunks of a chain: settled into the one chain's results)
+        counted = [done_points]
+
+        def write(_line: int, res: Any) -> None:
+            sink.write(res)
+            counted[0] += res.period.size
+            if progress is not None:
+                progress(counted[0], spec.n_points)
+
+        window = chain_window(workers, memory=isinstance(sink, MemoryStore) and client is None)
+        settle([ChainLine(spec, sink, todo)], compute_parts(workers, client, timeout, notice), write, window)
+        return sink.dataset() if load else None
     results = chunk_results(spec, todo, workers, client, timeout, notice)
     try:
         for res in results:
@@ -115,10 +134,20 @@ def run_sweeps(specs: Sequence[SweepSpec], *, workers: int | None = None) -> lis
 
     unique = {id(spec): spec for spec in specs}  # (a spec given twice is computed once)
     sinks = {key: MemoryStore(spec) for key, spec in unique.items()}
-    parts = [(spec, i) for spec in unique.values() for i in range(spec.n_chunks)]
+    parts = [(spec, i) for spec in unique.values() if not is_chained(spec) for i in range(spec.n_chunks)]
     for (spec, _), res in local_results(parts, workers):
         sinks[id(spec)].write(res)
+    chained = [spec for spec in unique.values() if is_chained(spec)]
+    lines = [ChainLine(spec, sinks[id(spec)], list(range(spec.n_chunks))) for spec in chained]
+    if lines:
+        write = lambda k, res: lines[k].sink.write(res)  # noqa: E731
+        settle(lines, compute_parts(workers, None), write, chain_window(0, True))
     return [sinks[id(spec)].dataset() for spec in specs]
+
+
+def is_chained(spec: SweepSpec) -> bool:
+    """Whether the chunks of ``spec`` are parts of chains (carried, and some chain has several chunks)."""
+    return spec.carried and spec.n_chunks > spec.segments
 
 
 def sweep(
@@ -145,7 +174,9 @@ def sweep(
     x0
         Initial state (of every chunk; of every point with ``fresh``).
     direction
-        ``"up"`` or ``"down"``: the order the values are visited in.
+        ``"up"`` or ``"down"``: the order the values are visited in; ``"both"``:
+        up, then down from ``x0`` again, kept apart (hysteresis): the dataset's
+        variables gain a first dimension ``direction`` (``"up"``, ``"down"``).
     settings
         How each point is computed (:class:`~grazing.core.options.SweepSettings`:
         ``transient``, ``periods``, ``phase``, ``fresh``, ``chunk_size``,
@@ -165,6 +196,11 @@ def sweep(
     attributes ``flag_values`` and ``flag_meanings`` say so too).  A failed
     point has NaN samples and Lyapunov exponent and -1 impacts; the sweep
     goes on, its next point starting afresh from ``x0``.
+
+    Unless ``fresh``, the sweep is one chain: each point starts from the
+    previous one's final state, and the result at every point is that of one
+    continuous chain (``chunk_size = 0``) whatever the chunking, the threads
+    or the cluster (:mod:`grazing.sweeps.chain`).
 
     Examples
     --------

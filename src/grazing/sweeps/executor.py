@@ -25,7 +25,7 @@ from typing import Any
 
 from grazing.errors import GrazingError
 from grazing.parallel import in_flight
-from grazing.sweeps.run import batch_key, run_chunks, stream_chunks
+from grazing.sweeps.run import batch_key, run_parts, stream_chunks
 from grazing.sweeps.spec import ChunkResult, SweepSpec
 
 
@@ -100,10 +100,11 @@ def local_batches(parts: Sequence[Part], threads: int) -> list[list[Part]]:
     for group in groups.values():
         batch: list[Part] = []
         jobs = points = values = 0
-        for spec, i in group:
+        for part in group:
+            spec, i = part
             sl = spec.chunk(i)
             size = sl.stop - sl.start
-            batch.append((spec, i))
+            batch.append(part)  # (the caller's own tuple: it finds its results by it)
             jobs += size if spec.fresh else 1
             points += size
             values += size * spec.periods * spec.model.n_states
@@ -130,6 +131,19 @@ def _dask_workers(client: Any) -> int:
         return len(client.scheduler_info().get("workers", {}))
 
 
+def part_groups(parts: Sequence[Part], workers: int) -> list[list[Part]]:
+    """``parts`` (specs sharing a batch key) in groups of consecutive parts, as :func:`chunk_groups` makes."""
+    from grazing.engine.llvmgen import lane_width
+
+    if not parts:
+        return []
+    spec = parts[0][0]
+    lanes = lane_width()
+    per = math.ceil(4 * lanes / spec.size) if spec.fresh else 2 * lanes
+    per = max(1, min(per, math.ceil(len(parts) / max(1, workers))))
+    return [list(parts[i : i + per]) for i in range(0, len(parts), per)]
+
+
 def _dask_results(
     spec: SweepSpec,
     todo: Sequence[int],
@@ -137,7 +151,18 @@ def _dask_results(
     timeout: float | None,
     notice: Callable[[str], None] | None,
 ) -> Iterator[ChunkResult]:
-    """Chunk results from a Dask cluster, with a bounded number of chunks submitted ahead.
+    """Chunk results from a Dask cluster (see :func:`dask_parts`)."""
+    for _, res in dask_parts([(spec, i) for i in todo], client, timeout, notice):
+        yield res
+
+
+def dask_parts(
+    parts: Sequence[Part],
+    client: Any,
+    timeout: float | None,
+    notice: Callable[[str], None] | None,
+) -> Iterator[tuple[Part, ChunkResult]]:
+    """Each of ``parts`` with its result from a Dask cluster, with a bounded number of groups submitted ahead.
 
     Without any worker for :data:`DASK_NOTICE_AFTER` seconds, ``notice`` is
     told once; without any for ``timeout`` seconds, :class:`SweepTimeoutError`.
@@ -145,28 +170,35 @@ def _dask_results(
     from distributed import wait
 
     address = getattr(getattr(client, "scheduler", None), "address", "the scheduler")
-    queue = iter(chunk_groups(spec, todo, max(1, _dask_workers(client))))
-    pending: set[Any] = set()
+    groups: list[list[Part]] = []
+    by_key: dict[tuple[Any, ...], list[Part]] = {}
+    for part in parts:
+        by_key.setdefault(batch_key(part[0]), []).append(part)
+    for same in by_key.values():
+        groups += part_groups(same, max(1, _dask_workers(client)))
+    queue = iter(groups)
+    pending: dict[Any, list[Part]] = {}
     idle_since: float | None = None
     noticed = False
     try:
         while True:
             window = max(64, in_flight(_dask_workers(client)))  # one look at the cluster per round
             for group in queue:
-                pending.add(client.submit(run_chunks, spec, group, pure=False))
+                pending[client.submit(run_parts, group, pure=False)] = group
                 if len(pending) >= window:
                     break
             if not pending:
                 break
             try:
-                res = wait(pending, timeout=POLL_INTERVAL, return_when="FIRST_COMPLETED")
-                finished, pending = set(res.done), set(res.not_done)
+                res = wait(list(pending), timeout=POLL_INTERVAL, return_when="FIRST_COMPLETED")
+                finished = set(res.done)
             except TimeoutError:
                 finished = set()
             if finished:
                 idle_since = None
                 for fut in finished:
-                    yield from _dask_result(fut)
+                    group = pending.pop(fut)
+                    yield from zip(group, _dask_result(fut))
                 continue
             if _dask_workers(client):
                 idle_since = None
@@ -197,6 +229,31 @@ def _dask_result(fut: Any) -> list[ChunkResult]:
     except Exception as exc:
         text = " ".join(str(exc).split())[:200]
         raise GrazingError(f"a chunk failed on the Dask cluster: {type(exc).__name__}: {text}") from None
+
+
+def chain_window(threads: int | None, memory: bool) -> int:
+    """Most chunks of carried sweeps held at a time while they are settled (:mod:`grazing.sweeps.chain`).
+
+    All of them when the results are kept in memory anyway; else enough to
+    fill every thread's lanes twice over (two chains per lane).
+    """
+    from grazing.engine.llvmgen import lane_width
+
+    if memory:
+        return 1 << 62
+    return 2 * max(1, lane_width()) * max(1, threads or os.cpu_count() or 1)
+
+
+def compute_parts(
+    workers: int | None,
+    client: Any,
+    timeout: float | None = None,
+    notice: Callable[[str], None] | None = None,
+) -> Callable[[list[Part]], Iterator[tuple[Part, ChunkResult]]]:
+    """How chunks are computed: on the local cores (``workers`` threads) or on a Dask ``client``'s cluster."""
+    if client is not None:
+        return lambda parts: dask_parts(parts, client, timeout, notice)
+    return lambda parts: local_results(parts, workers)
 
 
 def chunk_results(

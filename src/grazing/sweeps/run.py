@@ -39,8 +39,9 @@ from typing import Any
 
 import numpy as np
 
+from grazing.core.model import HybridModel
 from grazing.core.options import CHATTER_TOL
-from grazing.core.period import DEFAULT_MAX_PERIOD, DEFAULT_PERIOD_TOL, detect_period
+from grazing.core.period import DEFAULT_MAX_PERIOD, DEFAULT_PERIOD_TOL, detect_periods
 from grazing.core.solution import Status
 from grazing.engine.codegen import taylor_order
 from grazing.engine.native import load_sweep_lanes
@@ -60,7 +61,7 @@ def batch_key(spec: SweepSpec) -> tuple[Any, ...]:
         zdm = (float(z.accel), tuple(np.asarray(z.direction, dtype=float)), float(z.window), int(z.stop))
     return (
         id(spec.model._def), spec.model.periodic, taylor_order(spec.tol), spec.tol, spec.transient,
-        spec.periods, spec.adaptive, spec.lyapunov, zdm,
+        spec.periods, spec.adaptive, spec.adaptive_tol, spec.lyapunov, zdm,
     )  # fmt: skip
 
 
@@ -93,21 +94,51 @@ class LaneBatch:
         spec0 = parts[0][0]
         model = spec0.model
         n, m, nstops = model.n_states, spec0.periods, model.n_stops
-        slices = [spec.chunk(i) for spec, i in parts]
-        models, phases, tcarry, zdms, jobs, x0s, bounds = [], [], [], [], [], [], []
+        two_pi = 2 * math.pi
+        cache: dict[tuple[Any, ...], tuple[HybridModel, float]] = {}  # (a grid of starts shares its point)
+
+        def at(spec: SweepSpec, base: tuple[Any, ...], pt: tuple[float, ...]) -> tuple[HybridModel, float]:
+            key = (*base, pt)
+            if key not in cache:
+                mm = spec.model_at(pt)
+                cache[key] = (mm, float(mm.period))
+            return cache[key]
+
+        pv_list, t_list, phases, tcarry, zdms = [], [], [], [], []
+        jobs: list[tuple[int, int]] = []
+        x0s: list[tuple[float, ...]] = []
+        firsts: list[np.ndarray] = []
+        bounds = []
         first = 0
-        for (spec, _), sl in zip(parts, slices):
+        for spec, i in parts:
+            sl = spec.chunk(i)
             size = sl.stop - sl.start
-            here = [spec.model_at(pt) for pt in spec.points[sl]]
-            Ts = [float(mm.period) for mm in here]
-            models += here
-            phases += [(spec.phase % (2 * math.pi)) / (2 * math.pi) * T for T in Ts]
-            tcarry += [(spec.phase / (2 * math.pi)) % 1.0 * T for T in Ts]
-            zdms += [float(spec.zdm.phase) % T if spec.zdm is not None else 0.0 for T in Ts]
+            base = (id(spec.model._def), tuple(spec.model.param_vector), spec.params)
+            here = [at(spec, base, pt) for pt in spec.points[sl]]
+            Ts = np.array([T for _, T in here])
+            pv_list += [mm.param_vector for mm, _ in here]
+            t_list.append(Ts)
+            phases.append((spec.phase % two_pi) / two_pi * Ts)
+            carry = (spec.phase / two_pi) % 1.0 * Ts
+            tcarry.append(carry)
+            zdms.append(np.array([float(spec.zdm.phase) % T for T in Ts]) if spec.zdm is not None else 0 * Ts)
+            x0 = np.asarray(spec.x0, dtype=float)
             # Jobs: runs of points, each continuing from the previous (a chunk; every point when fresh).
-            runs = [(j, j + 1) for j in range(first, first + size)] if spec.fresh else [(first, first + size)]
-            jobs += runs
-            x0s += [spec.x0] * len(runs)
+            if spec.fresh:
+                jobs += [(j, j + 1) for j in range(first, first + size)]
+                x0s += [spec.x0] * size
+                if spec.starts is not None:  # (each from its own state, at its sampling phase)
+                    firsts.append(np.column_stack([carry, spec.starts[sl]]))
+                else:
+                    firsts.append(np.tile(np.concatenate([[0.0], x0]), (size, 1)))
+            else:
+                jobs.append((first, first + size))
+                x0s.append(spec.x0)
+                if i == 0 and spec.resume is not None:  # (continuing a chain: grazing.sweeps.chain)
+                    t, x = spec.resume
+                    firsts.append(np.array([[float(t), *x]]))
+                else:
+                    firsts.append(np.concatenate([[0.0], x0])[None])
             bounds.append((first, first + size))
             first += size
         npts = first
@@ -118,11 +149,12 @@ class LaneBatch:
         self._spec0 = spec0
         self.jobs = np.array(jobs, dtype=np.int64).reshape(-1, 2)
         self.x0 = np.array(x0s, dtype=float).reshape(-1, n)
-        self.pvs = np.array([mm.param_vector for mm in models], dtype=float).reshape(npts, -1)
-        self.Ts = np.array([float(mm.period) for mm in models])
-        self.sphase = np.array(phases, dtype=float)
-        self.tcarry = np.array(tcarry, dtype=float)
-        self.zdms = np.array(zdms, dtype=float)
+        self.firsts = np.ascontiguousarray(np.concatenate(firsts), dtype=float).reshape(-1, n + 1)
+        self.pvs = np.array(pv_list, dtype=float).reshape(npts, -1)
+        self.Ts = np.concatenate(t_list)
+        self.sphase = np.concatenate(phases)
+        self.tcarry = np.concatenate(tcarry)
+        self.zdms = np.concatenate(zdms).astype(float)
         self.fresh = all(spec.fresh for spec, _ in parts)  # (a fresh spec's jobs are single points anyway)
         self.control = np.zeros(3, dtype=np.int64)  # [next job, stop, most jobs at a time per thread]
         self.samples = np.full((npts, m, n), np.nan)
@@ -147,6 +179,7 @@ class LaneBatch:
             self.fresh,
             bool(spec.model.periodic),
             self.x0,
+            self.firsts,
             self.pvs,
             self.Ts,
             self.sphase,
@@ -155,6 +188,7 @@ class LaneBatch:
             int(spec.transient),
             int(spec.periods),
             bool(spec.adaptive),
+            float(spec.adaptive_tol),
             bool(spec.lyapunov),
             float(step_safety(spec.tol, self._order)),
             float(CHATTER_TOL),
@@ -190,22 +224,19 @@ class LaneBatch:
         status = self.status[part]
         good = status == Status.OK
         samples = self.samples[part]
+        period = np.full(b - a, -1, dtype=np.int32)
+        period[good] = detect_periods(samples[good], DEFAULT_PERIOD_TOL, DEFAULT_MAX_PERIOD)
         return ChunkResult(
             index=self.parts[k][1],
             samples=np.where(good[:, None, None], samples, np.nan),
-            period=np.array(
-                [
-                    detect_period(s, DEFAULT_PERIOD_TOL, DEFAULT_MAX_PERIOD) if g else -1
-                    for s, g in zip(samples, good)
-                ],
-                dtype=np.int32,
-            ),
+            period=period,
             impacts=np.where(good, self.by_stop[part].sum(axis=1), -1).astype(np.int32),
             lyapunov=np.where(good, self.lyap[part], np.nan),
             transient_used=np.where(good, self.used[part], -1).astype(np.int32),
             x_final=np.where(good[:, None], self.x_final[part], np.nan),
             impacts_by_stop=np.where(good[:, None], self.by_stop[part], -1).astype(np.int32),
             status=status.astype(STATUS_DTYPE),
+            t_final=np.where(good, self.t_final[part], np.nan),
         )
 
 
@@ -215,10 +246,15 @@ def run_chunks(spec: SweepSpec, indices: Sequence[int]) -> list[ChunkResult]:
     Each chunk's result is a pure function of the spec and its index: the
     same whichever chunks are computed with it.
     """
+    return run_parts([(spec, i) for i in indices])
+
+
+def run_parts(parts: Sequence[tuple[SweepSpec, int]]) -> list[ChunkResult]:
+    """Compute ``parts`` (``(spec, index)``, specs sharing a :func:`batch_key`) together; in order."""
     start = time.perf_counter()
-    batch = LaneBatch([(spec, i) for i in indices])
+    batch = LaneBatch(parts)
     batch.run()
-    results = [batch.result(k) for k in range(len(indices))]
+    results = [batch.result(k) for k in range(len(parts))]
     seconds = time.perf_counter() - start
     for res in results:  # (the chunks ran together: each is charged its share)
         res.seconds = seconds / len(results)

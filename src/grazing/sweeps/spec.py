@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from grazing.core.model import HybridModel
-from grazing.core.options import SWEEP_TOL, SweepSettings
+from grazing.core.options import ADAPTIVE_TOL, SWEEP_TOL, SweepSettings
 from grazing.errors import InvalidParameterError
 
 DEFAULT_SWEEP_TOL = SWEEP_TOL
@@ -65,6 +65,22 @@ class SweepSpec:
         Iterate the discontinuity-map Poincare map instead of the flow: the
         stop is ignored and Nordmark's map applied once per period at the
         grazing phase (``--method map``).
+    segments
+        The points are this many chains of equal length, one after the other
+        (a two-parameter map: its rows; a sweep up and down: two), each
+        starting from ``x0``; no chunk holds points of two chains.
+    starts
+        With ``fresh``: each point's own initial state (an array of
+        ``n_points`` rows), at the sampling phase of its forcing period (a
+        grid of initial states, :mod:`grazing.attractors`); None: ``x0`` at
+        time 0.
+    adaptive_tol
+        The tolerance to which the samples must repeat for an adaptive transient to end.
+    resume
+        ``(t, x)``: the first point continues a chain from state ``x`` at time
+        ``t`` instead of starting from ``x0`` at time 0 (a chunk run again from
+        the final state of the chunk before it, :mod:`grazing.sweeps.chain`);
+        after a failed point the chain still starts again from ``x0``.
     """
 
     model: HybridModel
@@ -81,10 +97,23 @@ class SweepSpec:
     tol: float = DEFAULT_SWEEP_TOL
     shape: tuple[int, ...] = field(default=())
     zdm: DiscontinuityMapLike = None
+    segments: int = 1
+    starts: Any = field(default=None, compare=False, repr=False)
+    adaptive_tol: float = ADAPTIVE_TOL
+    resume: tuple[float, tuple[float, ...]] | None = None
 
     def __post_init__(self) -> None:
         if not self.points:
             raise InvalidParameterError("a sweep needs at least one point")
+        if self.segments < 1 or len(self.points) % self.segments:
+            raise InvalidParameterError(
+                f"{len(self.points)} points cannot be {self.segments} chains of equal length"
+            )
+        if self.starts is not None:
+            starts = np.ascontiguousarray(self.starts, dtype=float)
+            if not self.fresh or starts.shape != (len(self.points), self.model.n_states):
+                raise InvalidParameterError("starts needs a fresh sweep and one initial state per point")
+            object.__setattr__(self, "starts", starts)
         for p in self.params:
             if p not in self.model.params:
                 raise InvalidParameterError(
@@ -105,16 +134,36 @@ class SweepSpec:
         return len(self.points)
 
     @property
+    def segment_points(self) -> int:
+        """Points per chain (the whole sweep unless it has several ``segments``)."""
+        return self.n_points // self.segments
+
+    @property
     def size(self) -> int:
         """Points per chunk."""
-        return self.chunk_size or self.n_points
+        return self.chunk_size or self.segment_points
+
+    @property
+    def chunks_per_segment(self) -> int:
+        return math.ceil(self.segment_points / self.size)
 
     @property
     def n_chunks(self) -> int:
-        return math.ceil(self.n_points / self.size)
+        return self.segments * self.chunks_per_segment
 
     def chunk(self, i: int) -> slice:
-        return slice(i * self.size, min((i + 1) * self.size, self.n_points))
+        per, n = self.chunks_per_segment, self.segment_points
+        seg, j = divmod(i, per)
+        return slice(seg * n + j * self.size, seg * n + min((j + 1) * self.size, n))
+
+    def chain_first(self, i: int) -> bool:
+        """Whether chunk ``i`` starts a chain (from ``x0``): the first chunk of its segment."""
+        return i % self.chunks_per_segment == 0
+
+    @property
+    def carried(self) -> bool:
+        """Whether each point continues from the previous one (chunks are parts of one chain)."""
+        return not self.fresh
 
     def model_at(self, point: Sequence[float]) -> HybridModel:
         return self.model.with_params(**dict(zip(self.params, point)))
@@ -149,11 +198,23 @@ class SweepSpec:
             "store_layout": STORE_LAYOUT,
             "grazing_version": grazing.__version__,
         }
+        if not self.fresh:  # (the chunks are one chain, whatever the chunking: grazing.sweeps.chain)
+            d["chain"] = True
+            d["segments"] = self.segments
+        if self.starts is not None:
+            d["starts_sha256"] = hashlib.sha256(self.starts.tobytes()).hexdigest()
+        if self.resume is not None:
+            d["resume"] = [self.resume[0], list(self.resume[1])]
+        if self.adaptive_tol != ADAPTIVE_TOL:
+            d["adaptive_tol"] = self.adaptive_tol
         return d
 
     def fingerprint(self) -> str:
         return hashlib.sha256(json.dumps(self.description(), sort_keys=True).encode()).hexdigest()[:16]
 
+
+DIRECTIONS = ("up", "down", "both")
+"""The orders a one-parameter sweep visits its values in (``both``: up, then down, two chains)."""
 
 STORE_LAYOUT = 3
 """The version of what a store holds (2: impacts on each stop, 3: each point's status); a store of
@@ -174,6 +235,7 @@ class ChunkResult:
     status: np.ndarray  # (points,) each point's Status code (grazing.sweeps.status): 0 ok, else why it failed
     impacts_by_stop: np.ndarray | None = None  # (points, n_stops) impacts on each stop in the sampled span
     seconds: float = 0.0
+    t_final: np.ndarray | None = None  # (points,) time of x_final (not stored: a chain continues from it)
 
 
 def spec_summary(spec: SweepSpec) -> dict[str, Any]:
@@ -193,20 +255,31 @@ def sweep_spec(
     settings: SweepSettings | None = None,
     zdm: DiscontinuityMapLike = None,
 ) -> SweepSpec:
-    """The spec of a one-parameter sweep of ``param`` over ``values``, visited in ``direction``."""
+    """The spec of a one-parameter sweep of ``param`` over ``values``, visited in ``direction``.
+
+    ``direction`` is ``"up"``, ``"down"`` or ``"both"``: up, then down from
+    ``x0`` again, as two chains (``segments = 2``) of one sweep.
+    """
     s = settings or SweepSettings()
     vals = np.asarray(values, dtype=float)
     if vals.ndim != 1 or vals.size == 0 or not np.all(np.isfinite(vals)):
         raise InvalidParameterError("values must be a non-empty list of finite numbers")
-    if direction not in ("up", "down"):
-        raise InvalidParameterError(f"direction must be 'up' or 'down', got {direction!r}")
-    order = np.sort(vals) if direction == "up" else np.sort(vals)[::-1]
+    if direction not in DIRECTIONS:
+        raise InvalidParameterError(f"direction must be 'up', 'down' or 'both', got {direction!r}")
+    if direction == "both" and s.fresh:
+        raise InvalidParameterError(
+            "direction 'both' needs a sweep that carries its state (with fresh, every point starts from "
+            "x0: both directions are the same)"
+        )
+    up = np.sort(vals)
+    order = {"up": up, "down": up[::-1], "both": np.concatenate([up, up[::-1]])}[direction]
     first = model.with_params(**{param: float(order[0])}) if param in model.params else model
     x = np.zeros(model.n_states) if x0 is None else np.asarray(x0, dtype=float)
     return SweepSpec(
         model=model,
         params=(param,),
         points=tuple((float(v),) for v in order),
+        segments=2 if direction == "both" else 1,
         x0=tuple(float(v) for v in first.check_state(x)),
         transient=s.transient,
         periods=s.periods,
@@ -232,7 +305,8 @@ def map_spec(
 ) -> SweepSpec:
     """The spec of a two-parameter map: each row (fixed ``param2``) swept in increasing ``param1``.
 
-    With ``settings.chunk_size = 0`` (``parameter_map``'s default) one row is one chunk.
+    Each row is a chain of its own from ``x0`` (``segments``, unless fresh);
+    with ``settings.chunk_size = 0`` (``parameter_map``'s default) one row is one chunk.
     """
     s = settings or SweepSettings(chunk_size=0)
     v1 = np.sort(np.asarray(values1, dtype=float))
@@ -258,4 +332,5 @@ def map_spec(
         lyapunov=s.lyapunov,
         tol=s.tol,
         shape=(v2.size, v1.size),
+        segments=1 if s.fresh else v2.size,
     )

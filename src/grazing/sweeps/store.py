@@ -14,6 +14,7 @@ transient...) is refused; so is anything at the path that grazing did not make
 from __future__ import annotations
 
 import json
+import math
 import os
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -23,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from grazing.errors import GrazingError, WriteError
+from grazing.sweeps.chain import ChainStart, start_after
 from grazing.sweeps.lock import StoreBusyError, StoreLock
 from grazing.sweeps.ownership import (
     ForeignStoreError,
@@ -31,7 +33,7 @@ from grazing.sweeps.ownership import (
     create_store,
     lock_for,
 )
-from grazing.sweeps.spec import ChunkResult, SweepSpec, spec_summary
+from grazing.sweeps.spec import DIRECTIONS, ChunkResult, SweepSpec, spec_summary
 from grazing.sweeps.status import NOT_COMPUTED, STATUS_DTYPE, status_attrs
 
 __all__ = [
@@ -72,6 +74,9 @@ _STORED = {
 }
 """The per-point variables of a sweep, as the stores hold them (flat along ``point``)."""
 _VARIABLES = tuple(_STORED)
+
+END_TIME = "chunk_end_time"
+"""Per chunk: the time its last point ended at, where a chain goes on from (a model that is not periodic)."""
 
 
 def _shapes(spec: SweepSpec) -> dict[str, tuple[int, ...]]:
@@ -190,6 +195,17 @@ def build_dataset(spec: SweepSpec, arrays: dict[str, np.ndarray], attrs: dict[st
         if k not in spec.params:
             ds.attrs[f"param_{k}"] = v
     ds.attrs.update(attrs or {})
+    if len(spec.params) == 1 and spec.segments == 2:  # up and down (direction "both"): each by value
+        n = spec.segment_points
+        halves = [ds.isel(point=slice(k * n, (k + 1) * n)).sortby("value") for k in range(2)]
+        halves = [h.assign_coords(point=np.arange(n)) for h in halves]
+        both = xr.concat([h.drop_vars(["stop_level"]) for h in halves], dim="direction", coords="minimal",
+                         compat="override")  # fmt: skip
+        ds = both.assign_coords(direction=list(DIRECTIONS[:2])).drop_vars("point")
+        ds["stop_level"] = halves[0]["stop_level"].drop_vars("point")
+        ds.attrs["directions"] = (
+            "up, down: the values visited upwards, then downwards from x0 again (two chains)"
+        )
     if len(spec.shape) == 2:
         n2, n1 = spec.shape
         p1, p2 = spec.params
@@ -212,6 +228,7 @@ class MemoryStore:
         self.spec = spec
         self.arrays = _empty_arrays(spec)
         self.done = np.zeros(spec.n_chunks, dtype=bool)
+        self.end_time = np.full(spec.n_chunks, np.nan)
         self.attrs = attrs or {}
 
     def is_done(self, i: int) -> bool:
@@ -221,7 +238,14 @@ class MemoryStore:
         sl = self.spec.chunk(res.index)
         for key in self.arrays:
             self.arrays[key][sl] = getattr(res, key)
+        self.end_time[res.index] = _end_time(res)
         self.done[res.index] = True
+
+    def chain_start(self, i: int) -> ChainStart:
+        """Where the chain goes on after chunk ``i`` (written): :func:`~grazing.sweeps.chain.start_after`."""
+        last = self.spec.chunk(i).stop - 1
+        x, status = self.arrays["x_final"][last], int(self.arrays["status"][last])
+        return start_after(self.spec, i, status, x, float(self.end_time[i]))
 
     def dataset(self) -> Any:
         return build_dataset(self.spec, self.arrays, self.attrs)
@@ -287,6 +311,7 @@ class ZarrStore:
             self._done = self._read("chunk_done", lambda z: np.asarray(z[:], dtype=bool))
             if self._done.shape != (spec.n_chunks,):
                 raise StoreDamagedError(self._damaged("chunk_done has the wrong shape"))
+            self._has_end_time = (self.path / END_TIME).is_dir()  # (not in earlier fresh sweeps' stores)
         except BaseException:
             self.close()
             raise
@@ -370,6 +395,8 @@ class ZarrStore:
         nc = self.spec.n_chunks
         data["chunk_done"] = ("chunk", da.zeros(nc, dtype=np.int8, chunks=min(nc, 1 << 20)))
         encoding["chunk_done"] = {"chunks": (1,), "fill_value": 0}
+        data[END_TIME] = ("chunk", da.full(nc, np.nan, dtype=np.float64, chunks=min(nc, 1 << 20)))
+        encoding[END_TIME] = {"chunks": (1,), "fill_value": np.nan}
         ds = xr.Dataset(data)
         ds["status"].attrs.update(status_attrs())
         summary = spec_summary(self.spec)
@@ -393,6 +420,8 @@ class ZarrStore:
         sl = self.spec.chunk(res.index)
         part = _flat({name: getattr(res, name) for name in _VARIABLES})
         flag = xr.Dataset({"chunk_done": ("chunk", np.ones(1, dtype=np.int8))})
+        if self._has_end_time:
+            flag[END_TIME] = ("chunk", np.array([_end_time(res)]))
         try:
             part.to_zarr(str(self.path), region={"point": sl}, consolidated=False)
             flag.to_zarr(
@@ -404,6 +433,23 @@ class ZarrStore:
                 "before are kept: make room and run the command again to resume"
             ) from None
         self._done[res.index] = True
+
+    def read_chunk(self, i: int) -> ChunkResult:
+        """The stored results of chunk ``i`` (done)."""
+        sl = self.spec.chunk(i)
+        got = {name: self._read(name, lambda z: np.asarray(z[sl])) for name in _VARIABLES}
+        t = float(self._read(END_TIME, lambda z: z[i])) if self._has_end_time else math.nan
+        t_final = np.full(sl.stop - sl.start, np.nan)
+        t_final[-1] = t
+        return ChunkResult(index=i, t_final=t_final, **got)
+
+    def chain_start(self, i: int) -> ChainStart:
+        """Where the chain goes on after chunk ``i`` (done): :func:`~grazing.sweeps.chain.start_after`."""
+        last = self.spec.chunk(i).stop - 1
+        x = self._read("x_final", lambda z: np.asarray(z[last], dtype=float))
+        status = int(self._read("status", lambda z: z[last]))
+        t = float(self._read(END_TIME, lambda z: z[i])) if self._has_end_time else math.nan
+        return start_after(self.spec, i, status, x, t)
 
     def _check_complete(self) -> None:
         missing = int((~self._done).sum())
@@ -419,6 +465,11 @@ class ZarrStore:
         arrays = {k: self.read(k) for k in _VARIABLES}
         attrs = {k: v for k, v in self._read_attrs().items() if k not in ("initialized",)}
         return build_dataset(self.spec, arrays, {**attrs, **self.attrs})
+
+
+def _end_time(res: ChunkResult) -> float:
+    """The time a chunk's last point ended at (nan: failed, or not known)."""
+    return math.nan if res.t_final is None else float(res.t_final[-1])
 
 
 def _short(exc: BaseException) -> str:

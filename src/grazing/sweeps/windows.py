@@ -153,3 +153,99 @@ def compare_windows(reference: Any, other: Any, origin: float, min_points: int =
         best = min(same, key=lambda o: abs(o.start - w.start) + abs(o.stop - w.stop)) if same else None
         rows.append(WindowComparison(w.period, w, best, abs(w.start - origin)))
     return rows
+
+
+@dataclass(frozen=True)
+class Hysteresis:
+    """A run of consecutive values where a sweep up and a sweep down end on different attractors.
+
+    Attributes
+    ----------
+    first, last
+        Indices of the first and last point of the run (in increasing parameter order).
+    start, stop
+        Their parameter values (in the dataset's units).
+    up, down
+        The window labels (:attr:`Window.label`) of the two sweeps at the run's first point.
+    """
+
+    first: int
+    last: int
+    start: float
+    stop: float
+    up: str
+    down: str
+
+    @property
+    def points(self) -> int:
+        return self.last - self.first + 1
+
+
+def orbits_differ(a: np.ndarray, b: np.ndarray, period: int, tol: float) -> bool:
+    """Whether two runs of samples (``(samples, components)``) of one ``period`` are on different orbits.
+
+    The last ``period`` samples of each are the orbit's points: the orbits differ when a point of one is
+    farther than ``tol`` (in every component's largest difference) from every point of the other.
+
+    Examples
+    --------
+    >>> a = np.array([[0.0], [1.0], [0.0], [1.0]])
+    >>> orbits_differ(a, a[::-1], 2, 1e-9), orbits_differ(a, a + 0.5, 2, 1e-9)
+    (False, True)
+    """
+    pa, pb = a[-period:], b[-period:]
+    d = np.max(np.abs(pa[:, None, :] - pb[None, :, :]), axis=2)  # (points of a, points of b)
+    return bool(max(d.min(axis=1).max(), d.min(axis=0).max()) > tol)
+
+
+def find_hysteresis(ds: Any, tol: float = 1e-4) -> list[Hysteresis]:
+    """The runs of values where a sweep with ``direction = "both"`` ends differently up and down.
+
+    Two points differ when their statuses, periods or impacting differ, or when
+    both are periodic with one period on different orbits (:func:`orbits_differ`,
+    ``tol``; not compared without ``samples`` in ``ds``).  Aperiodic points of
+    both directions count as alike.
+
+    Examples
+    --------
+    >>> import xarray as xr
+    >>> per = [[1, 1, 2, 2], [1, 3, 3, 2]]
+    >>> ds = xr.Dataset(
+    ...     {"period": (("direction", "point"), per),
+    ...      "impacts_per_period": (("direction", "point"), np.ones((2, 4))),
+    ...      "status": (("direction", "point"), np.zeros((2, 4), dtype=int)),
+    ...      "samples": (("direction", "point", "sample", "component"), np.zeros((2, 4, 6, 1)))},
+    ...     coords={"direction": ["up", "down"], "value": ("point", [0.1, 0.2, 0.3, 0.4])})
+    >>> [(h.start, h.stop, h.up, h.down) for h in find_hysteresis(ds)]
+    [(0.2, 0.3, '1', '3')]
+    """
+    up, down = ds.sel(direction="up"), ds.sel(direction="down")
+    order = np.argsort(np.asarray(ds["value"].values, dtype=float), kind="stable")
+    value = np.asarray(ds["value"].values, dtype=float)[order]
+    pu, pd = (np.asarray(x["period"].values, dtype=int)[order] for x in (up, down))
+    iu, idn = ((np.asarray(x["impacts_per_period"].values, dtype=float)[order] > 0) for x in (up, down))
+    su, sd = (np.asarray(x["status"].values, dtype=int)[order] for x in (up, down))
+    differ = (su != sd) | (pu != pd) | (iu != idn)
+    if "samples" in ds:
+        xu, xd = (np.asarray(x["samples"].values, dtype=float)[order] for x in (up, down))
+        for k in np.flatnonzero(~differ & (pu > 0) & (su == 0)):
+            differ[k] = orbits_differ(xu[k], xd[k], int(pu[k]), tol)
+
+    def label(period: int, impacting: bool) -> str:
+        return Window(period, impacting, 0, 0, 0.0, 0.0, 0.0, 0.0).label
+
+    out = []
+    k = 0
+    n = value.size
+    while k < n:
+        if not differ[k]:
+            k += 1
+            continue
+        j = k
+        while j + 1 < n and differ[j + 1]:
+            j += 1
+        out.append(
+            Hysteresis(k, j, float(value[k]), float(value[j]), label(pu[k], iu[k]), label(pd[k], idn[k]))
+        )
+        k = j + 1
+    return out

@@ -14,13 +14,16 @@ path's: the results are the same numbers, bit for bit.
 
 A point is the protocol of :func:`grazing.sweeps.run.run_point`: the
 transient in blocks of ``ADAPTIVE_BLOCK`` periods (stopped early, at the
-point of the cycle where it would have ended, once the samples repeat with a
-period of at most ``ADAPTIVE_MAX_PERIOD``, when ``adaptive``), then either
+point of the cycle where it would have ended, once the samples repeat to
+``adaptive_tol`` with a period of at most ``ADAPTIVE_MAX_PERIOD``, when ``adaptive``), then either
 ``periods`` sampled periods, or (``lyapunov``) ``align + periods`` with the
 variational equations from the identity, the Lyapunov sums taken over the
 last ``periods``.  ``jobs`` are runs of consecutive points; within a job each
 point starts from the previous one's final state (unless ``fresh``, or the
-previous point failed), every job from ``x0`` at time 0.
+previous point failed: then from ``x0`` at time 0), every job's first point
+from its own start ``firsts`` (a time and a state: ``x0`` at time 0 for a
+sweep's chunk, the previous chunk's final state to continue a chain, a grid
+point of initial states at its phase).
 """
 
 import math
@@ -43,7 +46,6 @@ from grazing.engine.stepping import new_table, step_factor, step_from_norms, ste
 LANE_ROOT_ROWS, LANE_ROOT_MIN_COLS = work_shape(0)
 ADAPTIVE_BLOCK = 32  # (grazing.sweeps.run.ADAPTIVE_BLOCK)
 ADAPTIVE_MAX_PERIOD = 16
-ADAPTIVE_TOL = 1e-9
 LYAPUNOV_ALIGN = 16
 VECTOR_MIN_LANES = 3
 """Fewest lanes of a kind for which the lane function is called (else the scalar one, lane by lane)."""
@@ -157,6 +159,7 @@ def sweep_lanes(
     fresh,
     periodic,
     x0,
+    firsts,
     pvs,
     Ts,
     sphase,
@@ -165,6 +168,7 @@ def sweep_lanes(
     transient,
     periods,
     adaptive,
+    adaptive_tol,
     lyapunov,
     safety,
     chatter_tol,
@@ -183,7 +187,8 @@ def sweep_lanes(
 ):
     """Compute the sweep points of ``jobs`` on ``lanes`` lanes (see the module); results into ``out_*``.
 
-    Job ``j`` starts from state ``x0[j]``.  Per point ``p``: parameter
+    Job ``j``'s first point starts from state ``firsts[j, 1:]`` at time
+    ``firsts[j, 0]``; a point after a failed one from ``x0[j]`` at time 0.  Per point ``p``: parameter
     vector ``pvs[p]``, period ``Ts[p]``, sampling phase ``sphase[p]`` (local
     time), start time of a point continued from the previous one
     ``tcarry[p]`` (periodic models), local time of the discontinuity map
@@ -268,6 +273,7 @@ def sweep_lanes(
             while li[lane, L_STAGE] == IDLE and li[lane, L_JOBEND] >= 0:
                 p = li[lane, L_POINT] + 1
                 carried = li[lane, L_STATUS] == STATUS_OK and li[lane, L_JOBEND] > 0
+                first = False
                 if li[lane, L_JOBEND] == 0 or p >= li[lane, L_JOBEND]:
                     if control[2] > 0 and active >= control[2]:
                         break  # (this thread has its share of the jobs running)
@@ -279,9 +285,14 @@ def sweep_lanes(
                     li[lane, L_JOBEND] = jobs[job, 1]
                     li[lane, L_JOB] = job
                     carried = False
+                    first = True
                 li[lane, L_POINT] = p
                 T = Ts[p]
-                if fresh or not carried:
+                if first:
+                    for i in range(n):
+                        XS[i, lane] = firsts[li[lane, L_JOB], 1 + i]
+                    t0 = firsts[li[lane, L_JOB], 0]
+                elif fresh or not carried:
                     for i in range(n):
                         XS[i, lane] = x0[li[lane, L_JOB], i]
                     t0 = 0.0
@@ -673,7 +684,7 @@ def sweep_lanes(
                 used = li[lane, L_USED]
                 nxt = -1
                 if adaptive and blk == ADAPTIVE_BLOCK:
-                    per = repeats_with_period(buf[lane], blk, n, ADAPTIVE_TOL, ADAPTIVE_MAX_PERIOD)
+                    per = repeats_with_period(buf[lane], blk, n, adaptive_tol, ADAPTIVE_MAX_PERIOD)
                     if per > 0:
                         extra = (budget - used) % per
                         if extra:

@@ -1,0 +1,392 @@
+"""Attractors and their basins from many initial states: :func:`find_attractors`, :func:`basins`.
+
+Every initial state is a point of a fresh sweep with its own start
+(:class:`~grazing.sweeps.spec.SweepSpec` with ``starts``): the sweep engine
+runs them on SIMD lanes, one lane per initial state, on the local cores or a
+Dask cluster, and can keep them in a resumable Zarr store.  The results are
+classified chunk by chunk, in order (:class:`~grazing.attractors.classify.Catalogue`),
+so memory holds one label per initial state, not their samples.  An initial
+state whose end state is aperiodic is run on from that end state for another
+transient (``refine`` times) before it is classified: a chaotic transient, or
+an orbit slow to settle, then ends on its attractor.  Initial states beyond a
+stop are labelled ``invalid`` and not run.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from grazing.attractors.classify import Attractor, Catalogue
+from grazing.attractors.grid import StateGrid, as_states, beyond_stops, default_cell, start_time, state_grid
+from grazing.core.model import HybridModel
+from grazing.core.options import (
+    BASIN_ADAPTIVE_TOL,
+    ESCAPE_FACTOR,
+    BasinSettings,
+    refuse_unknown,
+    with_shorthands,
+)
+from grazing.errors import InvalidParameterError
+from grazing.sweeps.spec import ChunkResult, SweepSpec
+
+Progress = Callable[[int, int], None]
+"""Called as ``progress(initial_states_done, initial_states_total)``."""
+
+
+@dataclass(frozen=True)
+class AttractorSet:
+    """The attractors found from a set of initial states, and the attractor of each.
+
+    Attributes
+    ----------
+    attractors
+        Every attractor (and outcome: escaping, failed, invalid) with its basin
+        fraction, in the order of its first initial state (``invalid`` first, id 0).
+    labels
+        The id of the attractor of each initial state.
+    cell
+        The cell size per state component (aperiodic attractors are sets of cells).
+    phase
+        The forcing phase of the initial states and of the samples (radians).
+    transient, periods
+        Forcing periods run before sampling, and sampled.
+    seconds
+        Wall time of the computation.
+    """
+
+    attractors: tuple[Attractor, ...]
+    labels: np.ndarray
+    cell: np.ndarray
+    phase: float
+    transient: int
+    periods: int
+    seconds: float = 0.0
+
+    @property
+    def fractions(self) -> dict[int, float]:
+        """Each id's share of the initial states (summing to 1)."""
+        return {a.id: a.fraction for a in self.attractors}
+
+    def attractor(self, ident: int) -> Attractor:
+        """The attractor with id ``ident``."""
+        for a in self.attractors:
+            if a.id == ident:
+                return a
+        raise KeyError(ident)
+
+
+def basin_spec(model: HybridModel, states: np.ndarray, settings: BasinSettings, lyapunov: bool) -> SweepSpec:
+    """The fresh sweep whose points are the initial states ``states``, each from its own at the phase."""
+    return SweepSpec(
+        model=model,
+        params=(),
+        points=((),) * states.shape[0],
+        x0=tuple(float(v) for v in states[0]),
+        transient=settings.transient,
+        periods=settings.periods,
+        phase=settings.phase,
+        fresh=True,
+        chunk_size=settings.chunk_size,
+        adaptive=True,
+        lyapunov=lyapunov,
+        tol=settings.tol,
+        starts=states,
+        adaptive_tol=BASIN_ADAPTIVE_TOL,
+    )
+
+
+@dataclass(frozen=True)
+class _Run:
+    """Where the end states are computed and kept."""
+
+    workers: int | None
+    client: Any
+    store: Any
+    progress: Progress | None
+
+
+def find_attractors(
+    model: HybridModel,
+    states: Any,
+    *,
+    settings: BasinSettings | None = None,
+    cell: Sequence[float] | None = None,
+    escape: float | None = None,
+    workers: int | None = None,
+    client: Any = None,
+    store: Any = None,
+    progress: Progress | None = None,
+    **shorthands: Any,
+) -> AttractorSet:
+    """The attractors reached from the initial states ``states`` (rows), and which one each reaches.
+
+    Parameters
+    ----------
+    model
+        The model with its parameter values.
+    states
+        Initial states, one row each (a grid: :func:`basins`; a random sample...).
+    settings
+        How each initial state is run (:class:`~grazing.core.options.BasinSettings`:
+        ``transient``, ``periods``, ``phase``, ``refine``, ``lyapunov``, ``tol``,
+        ``chunk_size``); those names are also accepted as keyword arguments.
+    cell
+        Size of a cell per state component (default: the initial states' box
+        over :data:`~grazing.core.options.CELLS`).
+    escape
+        Distance from the box (in each component) beyond which a state has
+        escaped (default :data:`~grazing.core.options.ESCAPE_FACTOR` times the
+        box's largest side or coordinate, at least 1).
+    workers, client
+        Local threads, or a Dask client (as for :func:`grazing.sweeps.run_sweep`).
+    store
+        A Zarr store (path, or an open :class:`~grazing.sweeps.store.ZarrStore`
+        of the same computation) keeping every finished chunk of the first
+        run: interrupted and run again, it computes only the chunks missing.
+    progress
+        Called as ``progress(done, total)``.
+
+    The first run of every initial state computes no Lyapunov exponent: the
+    aperiodic end states get theirs when they are run on (``refine``), and each
+    orbit from one of its points.
+
+    Examples
+    --------
+    >>> import numpy as np, grazing
+    >>> ball = grazing.models.bouncing_ball(amplitude=0.8, r=0.8, omega=1.0, gravity=1.0)
+    >>> found = find_attractors(ball, [[0.0, 0.8], [3.6, -2.0]], workers=1)
+    >>> [(a.kind, a.period) for a in found.attractors], found.labels.tolist()
+    ([('sticking', 1), ('periodic', 1)], [1, 2])
+    """
+    start = time.perf_counter()
+    used: set[str] = set()
+    s = with_shorthands(settings, BasinSettings, shorthands, used)
+    refuse_unknown("find_attractors", shorthands, used)
+    x = as_states(model, states)
+    t0 = start_time(model, s.phase)
+    invalid = beyond_stops(model, x, t0)
+    valid = np.flatnonzero(~invalid)
+    box = x[valid] if valid.size else x
+    cells = default_cell(box) if cell is None else np.broadcast_to(np.asarray(cell, dtype=float), x.shape[1:])
+    if not np.all(np.isfinite(cells) & (cells > 0)):
+        raise InvalidParameterError(f"cell sizes must be positive numbers, got {cell!r}")
+    side = float(np.ptp(box, axis=0).max())
+    reach = ESCAPE_FACTOR * max(side, float(np.abs(box).max()), 1.0) if escape is None else float(escape)
+    if not reach > 0:
+        raise InvalidParameterError(f"escape must be a positive distance, got {escape!r}")
+    catalogue = Catalogue(model, x.shape[0], cells, box.min(axis=0), reach + side, s.periods, t0)
+    if valid.size:
+        run = _Run(workers, client, store, progress)
+        spec = basin_spec(model, x[valid], s, s.lyapunov and s.refine == 0)
+        deferred = _run(spec, valid, catalogue, s.refine > 0, run, x.shape[0] - valid.size, x.shape[0])
+        for n in range(s.refine):
+            last = n == s.refine - 1
+            deferred = _refine(model, catalogue, deferred, s, last, replace(run, store=None, progress=None))
+        if s.lyapunov:
+            _orbit_exponents(model, catalogue, s, workers, client)
+    attractors, labels = catalogue.attractors(int(invalid.sum()))
+    seconds = time.perf_counter() - start
+    return AttractorSet(tuple(attractors), labels, np.array(cells), s.phase, s.transient, s.periods, seconds)
+
+
+def _orbit_exponents(model: HybridModel, catalogue: Catalogue, s: BasinSettings, workers: int | None,
+                     client: Any) -> None:  # fmt: skip
+    """Each periodic orbit's largest Lyapunov exponent, from one of its points."""
+    from grazing.sweeps.api import run_sweep
+
+    orbits = catalogue.orbits()
+    if not orbits:
+        return
+    points = np.array([catalogue.entries[k].points[0] for k in orbits])
+    one = replace(s, chunk_size=max(1, len(orbits)))  # (on the orbit: the adaptive transient ends at once)
+    ds = run_sweep(basin_spec(model, points, one, True), workers=workers, client=client)
+    for k, value in zip(orbits, ds.lyapunov.values):
+        catalogue.entries[k].exponents = [float(value)]
+
+
+@dataclass
+class _Deferred:
+    """Initial states (their indices) whose end state was aperiodic, and those end states."""
+
+    index: np.ndarray
+    states: np.ndarray
+
+
+class _InOrder:
+    """Classifies the chunks of a spec in their order, as they arrive (or are read from the store)."""
+
+    def __init__(self, spec: SweepSpec, which: np.ndarray, catalogue: Catalogue, defer: bool, store: Any,
+                 done: set[int]) -> None:  # fmt: skip
+        self.spec, self.which, self.catalogue, self.defer = spec, which, catalogue, defer
+        self.store, self.done = store, done
+        self.pending: dict[int, ChunkResult] = {}
+        self.next = 0
+        self.counted = 0
+        self.index: list[np.ndarray] = []
+        self.states: list[np.ndarray] = []
+
+    def take(self, res: ChunkResult | None = None) -> None:
+        """Keep ``res``; classify every chunk now ready in order (computed, or in the store)."""
+        if res is not None:
+            self.pending[res.index] = res
+        while self.next < self.spec.n_chunks and (self.next in self.pending or self.next in self.done):
+            i = self.next
+            part = self.pending.pop(i) if i in self.pending else self.store.read_chunk(i)
+            sl = self.spec.chunk(i)
+            later = self.catalogue.add(0, part, which=self.which[sl], defer=self.defer)
+            if later.size:
+                self.index.append(self.which[sl][later])
+                self.states.append(np.asarray(part.x_final, dtype=float)[later])
+            self.counted += sl.stop - sl.start
+            self.next += 1
+
+    def deferred(self) -> _Deferred:
+        n = self.spec.model.n_states
+        return _Deferred(
+            np.concatenate(self.index) if self.index else np.zeros(0, dtype=np.int64),
+            np.concatenate(self.states) if self.states else np.zeros((0, n)),
+        )
+
+
+def _run(spec: SweepSpec, which: np.ndarray, catalogue: Catalogue, defer: bool, run: _Run, offset: int,
+         total: int) -> _Deferred:  # fmt: skip
+    """Run (or read from the store) every chunk of ``spec`` and classify them (initial states ``which``)."""
+    from grazing.sweeps.executor import chunk_results
+
+    if isinstance(run.store, (str, Path)):
+        from grazing.sweeps.store import open_store
+
+        with open_store(run.store, spec) as opened:
+            return _run(spec, which, catalogue, defer, replace(run, store=opened), offset, total)
+    store = run.store
+    done = {i for i in range(spec.n_chunks) if store is not None and store.is_done(i)}
+    todo = [i for i in range(spec.n_chunks) if i not in done]
+    order = _InOrder(spec, which, catalogue, defer, store, done)
+    order.take()
+    if run.progress is not None:
+        run.progress(offset + order.counted, total)
+    if todo:
+        results = chunk_results(spec, todo, run.workers, run.client)
+        try:
+            for res in results:
+                if store is not None:
+                    store.write(res)
+                order.take(res)
+                if run.progress is not None:
+                    run.progress(offset + order.counted, total)
+        finally:
+            results.close()
+    return order.deferred()
+
+
+def _refine(model: HybridModel, catalogue: Catalogue, deferred: _Deferred, s: BasinSettings, last: bool,
+            run: _Run) -> _Deferred:  # fmt: skip
+    """Run the deferred end states on for another transient, from where they ended; classify them."""
+    if deferred.index.size == 0:
+        return deferred
+    spec = basin_spec(model, deferred.states, s, s.lyapunov and last)
+    return _run(spec, deferred.index, catalogue, not last, run, 0, 0)
+
+
+def basins(
+    model: HybridModel,
+    x_range: Sequence[float],
+    y_range: Sequence[float],
+    num: Sequence[int],
+    *,
+    states: Sequence[str | int] = (0, 1),
+    fixed: Mapping[str | int, float] | None = None,
+    phase: float = 0.0,
+    **options: Any,
+) -> Any:
+    """Basins of attraction on a grid of initial states: an :class:`xarray.Dataset`.
+
+    The grid (:func:`~grazing.attractors.grid.state_grid`) is ``num[0] x
+    num[1]`` initial states over ``x_range`` x ``y_range`` in the state
+    components ``states`` (indices or names), the others at their ``fixed``
+    values (default 0), at forcing phase ``phase``; ``options`` are those of
+    :func:`find_attractors`.
+
+    Returns a dataset with ``label`` (``y``, ``x``: the attractor id of each
+    initial state; 0 beyond a stop), and along ``attractor`` (the ids):
+    ``kind``, ``period``, ``impacts_per_period``, ``lyapunov``, ``fraction``,
+    ``count``, ``reason``, ``points`` (``attractor``, ``point``,
+    ``component``; NaN-padded) and ``n_points``.
+
+    Examples
+    --------
+    >>> import grazing
+    >>> ball = grazing.models.bouncing_ball(amplitude=0.8, r=0.8)
+    >>> ds = basins(ball, (-1.0, 6.0), (-4.0, 4.0), (8, 8), workers=1)  # (below the table at y < 0)
+    >>> ds.kind.values.tolist(), float(ds.fraction.sum()), ds.label.values[0].tolist()
+    (['invalid', 'periodic', 'sticking'], 1.0, [0, 1, 2, 2, 2, 1, 1, 1])
+    """
+    grid = state_grid(model, x_range, y_range, num, states=states, fixed=fixed, phase=phase)
+    found = find_attractors(model, grid.states_array(), phase=grid.phase, **options)
+    return to_dataset(model, grid, found)
+
+
+def to_dataset(model: HybridModel, grid: StateGrid, found: AttractorSet) -> Any:
+    """The dataset of :func:`basins` from the grid and what :func:`find_attractors` found on it."""
+    import xarray as xr
+
+    i, j = grid.states
+    names = model.state_names
+    atts = found.attractors
+    longest = max([len(a.points) for a in atts] + [1])
+    points = np.full((len(atts), longest, model.n_states), np.nan)
+    for k, a in enumerate(atts):
+        points[k, : len(a.points)] = a.points
+    ds = xr.Dataset(
+        {
+            "label": (("y", "x"), found.labels.reshape(grid.shape).astype(np.int32)),
+            "kind": ("attractor", np.array([a.kind for a in atts], dtype=str)),
+            "period": ("attractor", np.array([a.period for a in atts], dtype=np.int32)),
+            "impacts_per_period": ("attractor", np.array([a.impacts_per_period for a in atts], dtype=float)),
+            "lyapunov": ("attractor", np.array([a.lyapunov for a in atts], dtype=float)),
+            "fraction": ("attractor", np.array([a.fraction for a in atts], dtype=float)),
+            "count": ("attractor", np.array([a.count for a in atts], dtype=np.int64)),
+            "reason": ("attractor", np.array([a.reason for a in atts], dtype=str)),
+            "points": (("attractor", "point", "component"), points),
+            "n_points": ("attractor", np.array([len(a.points) for a in atts], dtype=np.int32)),
+        },
+        coords={
+            "x": ("x", grid.x),
+            "y": ("y", grid.y),
+            "attractor": ("attractor", np.array([a.id for a in atts], dtype=np.int32)),
+            "component": ("component", list(names)),
+        },
+    )
+    labels, units = model.state_labels, model.state_units
+    ds["x"].attrs.update({"long_name": names[i], "symbol": labels[i], "units": units[i] if units else ""})
+    ds["y"].attrs.update({"long_name": names[j], "symbol": labels[j], "units": units[j] if units else ""})
+    ds["label"].attrs["description"] = "the id of the attractor each initial state ends on (0: beyond a stop)"
+    ds["kind"].attrs["description"] = (
+        "periodic, sticking, chaotic, quasiperiodic, aperiodic, escaping, failed, invalid"
+    )
+    ds["points"].attrs["description"] = "states on the attractor at the sampling phase (NaN-padded)"
+    ds.attrs.update(
+        {
+            "model": model.name,
+            "params": json.dumps(dict(model.params)),
+            "states": f"{names[i]},{names[j]}",
+            "initial_state": json.dumps(list(grid.base)),
+            "phase": grid.phase,
+            "transient": found.transient,
+            "periods": found.periods,
+            "cell": json.dumps(found.cell.tolist()),
+            "state_labels": json.dumps(list(labels)),
+            "state_units": json.dumps(list(units)),
+            "time_label": model.time_label,
+            "forcing_period": float(model.period),
+            "seconds": found.seconds,
+        }
+    )
+    return ds

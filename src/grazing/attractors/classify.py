@@ -1,0 +1,421 @@
+"""Which attractor each end state is on: classification, and end states recognised as one attractor.
+
+Each initial state is run for a transient, then sampled at the forcing phase
+(a sweep point of :mod:`grazing.sweeps`); its end state is
+
+- **failed** (the run failed: step limit, accumulating impacts) or
+  **escaping** (its samples leave a bound around the grid, or it overflowed);
+- **periodic** (its samples repeat with a period ``p <= 64``): on the orbit
+  made of its last ``p`` samples.  Two end states are on one orbit when each
+  point of one is within :data:`~grazing.core.options.MATCH_TOL` cells of a
+  point of the other (whatever point of the cycle each ended at: a distance
+  between point sets, as Attractors.jl matches attractors).  An orbit whose
+  points all lie on a stop, without impacts, is **sticking** (riding on it);
+- aperiodic: its samples are recorded on a grid of cells (the cell grid of
+  Attractors.jl's recurrences); end states whose samples share a cell are
+  on one attractor, which is **chaotic** (the median largest Lyapunov
+  exponent of its end states above
+  :data:`~grazing.core.options.CHAOS_THRESHOLD`), **quasiperiodic** (within
+  it of zero) or **aperiodic** (no exponent: the motion sticks, or it is
+  still settling).
+
+:class:`Catalogue` takes the results chunk by chunk, in order (so that the
+attractors and their ids do not depend on which chunk finished first), and
+keeps only one label per initial state and each attractor's summary: memory
+does not grow with the samples.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from grazing.core.model import ON_STOP_TOL, HybridModel
+from grazing.core.options import CHAOS_THRESHOLD, MATCH_TOL
+from grazing.core.solution import Status
+from grazing.sweeps.spec import ChunkResult
+from grazing.sweeps.status import reason
+
+KINDS = ("periodic", "sticking", "chaotic", "quasiperiodic", "aperiodic", "escaping", "failed", "invalid")
+"""What an initial state can end on (``invalid``: beyond a stop, not run)."""
+
+MAX_POINTS = 2000
+"""Most sampled points kept of an aperiodic attractor (the first end states' samples)."""
+
+MAX_EXPONENTS = 4096
+"""Most Lyapunov exponents of an aperiodic attractor's end states kept for its median."""
+
+INVALID = 0
+"""The label of an initial state beyond a stop (not run); attractors are numbered from 1."""
+
+
+@dataclass
+class Attractor:
+    """An attractor (or an outcome: escaping, failed, invalid) and the initial states that end on it.
+
+    Attributes
+    ----------
+    id
+        Its label (1, 2, ... in the order of the first initial state on it; 0: invalid).
+    kind
+        One of :data:`KINDS`.
+    period
+        Period in forcing periods (0: aperiodic; -1: an outcome without one).
+    impacts_per_period
+        Impacts per period of the orbit (per forcing period when aperiodic; nan for an outcome).
+    lyapunov
+        Largest Lyapunov exponent per unit time (the median over its end states; nan: not computed).
+    points
+        States on it at the sampling phase: the orbit's points, or sampled points of an aperiodic one.
+    reason
+        Why, for a failed or escaping outcome (``"step limit"``, ``"non-finite state"``, ``"left the
+        bound"``, ``"beyond a stop"``); else ``""``.
+    count
+        Initial states ending on it.
+    fraction
+        ``count`` over all initial states.
+    first
+        The index of its first initial state.
+    """
+
+    id: int
+    kind: str
+    period: int
+    impacts_per_period: float
+    lyapunov: float
+    points: np.ndarray
+    reason: str = ""
+    count: int = 0
+    fraction: float = 0.0
+    first: int = 0
+
+    def to_json(self) -> dict[str, Any]:
+        """The attractor as plain JSON data (``id``, ``kind``, ``period``, ``points``, ``lyapunov`` ...)."""
+        return {
+            "id": self.id,
+            "kind": self.kind,
+            "period": self.period if self.period >= 0 else None,
+            "impacts_per_period": _finite(self.impacts_per_period),
+            "points": self.points.tolist(),
+            "lyapunov": _finite(self.lyapunov),
+            "reason": self.reason or None,
+            "count": self.count,
+            "fraction": self.fraction,
+        }
+
+
+def _finite(v: float) -> float | None:
+    return float(v) if math.isfinite(v) else None
+
+
+@dataclass
+class _Entry:
+    """An attractor being collected (possibly merged into another: see :attr:`Catalogue.parent`)."""
+
+    family: str  # "periodic", "aperiodic", "escaping", "failed"
+    first: int
+    period: int = -1
+    points: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    impacts: float = math.nan
+    exponents: list[float] = field(default_factory=list)
+    count: int = 0
+    reason: str = ""
+    cells: set[bytes] = field(default_factory=set)
+
+
+class Catalogue:
+    """The attractors found so far, and the label of every initial state given to it.
+
+    Parameters
+    ----------
+    model
+        The model (its stops decide what is sticking).
+    n_points
+        Initial states in all (indices ``0 .. n_points - 1``).
+    cell
+        Size of a cell in each state component (aperiodic attractors are sets
+        of cells; periodic orbits match to ``MATCH_TOL`` cells).
+    origin
+        A corner of the cell grid.
+    escape
+        A state farther than this (in every component's largest difference)
+        from ``origin`` has escaped.
+    periods
+        Sampled periods of each end state (impacts per period from the counts).
+    t_sample
+        The time of the samples within a forcing period (for the stops' guards).
+    """
+
+    def __init__(
+        self,
+        model: HybridModel,
+        n_points: int,
+        cell: np.ndarray,
+        origin: np.ndarray,
+        escape: float,
+        periods: int,
+        t_sample: float,
+    ) -> None:
+        self.model = model
+        self.cell = np.asarray(cell, dtype=float)
+        self.origin = np.asarray(origin, dtype=float)
+        self.escape = float(escape)
+        self.periods = int(periods)
+        self.t_sample = float(t_sample)
+        self.labels = np.full(
+            n_points, -1, dtype=np.int64
+        )  # entry of each initial state (-1: invalid/not yet)
+        self.entries: list[_Entry] = []
+        self.parent: list[int] = []
+        self._by_period: dict[int, list[int]] = {}
+        self._outcome: dict[tuple[str, str], int] = {}
+        self._owner: dict[bytes, int] = {}
+
+    # ------------------------------------------------------------------ entries
+
+    def _new(self, entry: _Entry) -> int:
+        self.entries.append(entry)
+        self.parent.append(len(self.parent))
+        return len(self.entries) - 1
+
+    def root(self, k: int) -> int:
+        """The entry ``k`` is merged into."""
+        while self.parent[k] != k:
+            self.parent[k] = self.parent[self.parent[k]]
+            k = self.parent[k]
+        return k
+
+    def _union(self, a: int, b: int) -> int:
+        a, b = self.root(a), self.root(b)
+        if a == b:
+            return a
+        keep, gone = (a, b) if self.entries[a].first <= self.entries[b].first else (b, a)
+        self.parent[gone] = keep
+        e, g = self.entries[keep], self.entries[gone]
+        e.count += g.count
+        e.exponents = (e.exponents + g.exponents)[:MAX_EXPONENTS]
+        if len(e.points) < MAX_POINTS and len(g.points):
+            e.points = np.concatenate([e.points, g.points[: MAX_POINTS - len(e.points)]])
+        e.cells |= g.cells
+        for key in g.cells:
+            self._owner[key] = keep
+        g.cells = set()
+        return keep
+
+    # ------------------------------------------------------------------ adding end states
+
+    def add(
+        self, first: int, res: ChunkResult, which: np.ndarray | None = None, defer: bool = False
+    ) -> np.ndarray:
+        """Classify the end states of ``res`` (initial states ``first + k``, or ``which[k]``) and label them.
+
+        With ``defer``, the aperiodic ones are not labelled: their positions in
+        ``res`` are returned, to be continued (:func:`grazing.attractors.basins`
+        runs them further before deciding); else an empty array.
+        """
+        index = first + np.arange(res.status.size) if which is None else np.asarray(which)
+        status = np.asarray(res.status, dtype=int)
+        samples = np.asarray(res.samples, dtype=float)
+        period = np.asarray(res.period, dtype=int)
+        ok = status == Status.OK
+        far = np.zeros(status.size, dtype=bool)
+        if ok.any():
+            dist = np.max(np.abs(samples[ok] - self.origin), axis=(1, 2))
+            far[ok] = ~(dist <= self.escape)
+        for k in np.flatnonzero(~ok | far):
+            if far[k]:
+                self._outcome_label(int(index[k]), "escaping", "left the bound")
+            elif status[k] == Status.NONFINITE:
+                self._outcome_label(int(index[k]), "escaping", reason(int(status[k])))
+            else:
+                self._outcome_label(int(index[k]), "failed", reason(int(status[k])))
+        settled = ok & ~far
+        self._add_periodic(index, res, np.flatnonzero(settled & (period > 0)))
+        aperiodic = np.flatnonzero(settled & (period <= 0))
+        if defer:
+            return aperiodic
+        self._add_aperiodic(index, res, aperiodic)
+        return np.zeros(0, dtype=np.int64)
+
+    def _outcome_label(self, i: int, family: str, why: str) -> None:
+        key = (family, why)
+        if key not in self._outcome:
+            self._outcome[key] = self._new(_Entry(family, i, reason=why))
+        k = self._outcome[key]
+        self.entries[k].count += 1
+        self.labels[i] = k
+
+    def _add_periodic(self, index: np.ndarray, res: ChunkResult, rows: np.ndarray) -> None:
+        if rows.size == 0:
+            return
+        period = np.asarray(res.period, dtype=int)
+        tol = MATCH_TOL * self.cell
+        for p in np.unique(period[rows]):
+            sel = rows[period[rows] == p]
+            cyc = np.asarray(res.samples, dtype=float)[sel, -p:, :]  # (states, p, n): the orbit's points
+            start = np.argmin(cyc[:, :, 0], axis=1)  # (each cycle from its point of least first component)
+            turn = (start[:, None] + np.arange(p)[None, :]) % p
+            cyc = cyc[np.arange(sel.size)[:, None], turn]
+            keys = np.floor((cyc[:, 0, :] - self.origin) / tol).astype(np.int64)
+            uniq, inverse = np.unique(keys, axis=0, return_inverse=True)
+            inverse = inverse.ravel()
+            for g in range(uniq.shape[0]):
+                members = np.flatnonzero(inverse == g)
+                rep = members[0]
+                k = self._periodic_entry(int(p), cyc[rep], int(index[sel[rep]]), res, int(sel[rep]))
+                e = self.entries[k]
+                e.count += members.size
+                exps = np.asarray(res.lyapunov, dtype=float)[sel[members]]
+                e.exponents = e.exponents + [float(v) for v in exps[: MAX_EXPONENTS - len(e.exponents)]]
+                self.labels[index[sel[members]]] = k
+
+    def _periodic_entry(self, p: int, points: np.ndarray, first: int, res: ChunkResult, row: int) -> int:
+        """The entry of the period-``p`` orbit through ``points`` (a new one if none found so far is it)."""
+        for k in self._by_period.get(p, []):
+            k = self.root(k)
+            if set_distance(self.entries[k].points, points, self.cell) <= MATCH_TOL:
+                return k
+        impacts = float(res.impacts[row]) / self.periods * p if res.impacts[row] >= 0 else math.nan
+        k = self._new(_Entry("periodic", first, period=p, points=points.copy(), impacts=impacts))
+        self._by_period.setdefault(p, []).append(k)
+        return k
+
+    def _add_aperiodic(self, index: np.ndarray, res: ChunkResult, rows: np.ndarray) -> None:
+        """Aperiodic end states: grouped when their samples share a cell, then merged with the attractors
+        found before that share one."""
+        if rows.size == 0:
+            return
+        from scipy.sparse import coo_matrix
+        from scipy.sparse.csgraph import connected_components
+
+        samples = np.asarray(res.samples, dtype=float)[rows]  # (states, periods, n)
+        m, P, n = samples.shape
+        q = np.floor((samples.reshape(-1, n) - self.origin) / self.cell).astype(np.int64)
+        keys = np.ascontiguousarray(q).view(np.dtype((np.void, 8 * n))).ravel()
+        ukeys, cell_of = np.unique(keys, return_inverse=True)
+        cell_of = cell_of.ravel()
+        owner = np.repeat(np.arange(m), P)
+        graph = coo_matrix((np.ones(m * P), (owner, m + cell_of)), shape=(m + ukeys.size, m + ukeys.size))
+        _, comp = connected_components(graph, directed=False)
+        lyap = np.asarray(res.lyapunov, dtype=float)[rows]
+        impacts = np.asarray(res.impacts, dtype=float)[rows] / self.periods
+        for c in np.unique(comp[:m]):
+            members = np.flatnonzero(comp[:m] == c)
+            cells = {bytes(ukeys[u]) for u in np.unique(cell_of[np.isin(owner, members)])}
+            first = int(index[rows[members[0]]])
+            pts = samples[members].reshape(-1, n)[:MAX_POINTS]
+            mean_impacts = float(np.mean(impacts[members]))
+            k = self._new(_Entry("aperiodic", first, period=0, points=pts.copy(), impacts=mean_impacts))
+            e = self.entries[k]
+            e.count = members.size
+            e.exponents = [float(v) for v in lyap[members][:MAX_EXPONENTS]]
+            e.cells = cells
+            owners = {self.root(self._owner[key]) for key in cells if key in self._owner}
+            for key in cells:
+                self._owner[key] = k
+            for o in sorted(owners):
+                k = self._union(k, o)
+            self.labels[index[rows[members]]] = k
+
+    # ------------------------------------------------------------------ the result
+
+    def orbits(self) -> list[int]:
+        """The entries of the periodic orbits found (merged ones left out)."""
+        return [k for k, e in enumerate(self.entries) if e.family == "periodic" and self.root(k) == k]
+
+    def attractors(self, invalid: int = 0) -> tuple[list[Attractor], np.ndarray]:
+        """The attractors (ids 1, 2, ... by first initial state; ``invalid`` initial states as id 0) and
+        each initial state's id."""
+        roots = sorted({self.root(k) for k in range(len(self.entries))}, key=lambda k: self.entries[k].first)
+        roots = [k for k in roots if self.entries[k].count > 0]
+        total = self.labels.size
+        ids = {k: i + 1 for i, k in enumerate(roots)}
+        out = []
+        if invalid:
+            n = self.model.n_states
+            out.append(
+                Attractor(
+                    INVALID,
+                    "invalid",
+                    -1,
+                    math.nan,
+                    math.nan,
+                    np.zeros((0, n)),
+                    "beyond a stop",
+                    invalid,
+                    invalid / total,
+                    -1,
+                )
+            )
+        for k in roots:
+            e = self.entries[k]
+            kind, exponent = self._kind(e)
+            pts = e.points if e.points.size else np.zeros((0, self.model.n_states))
+            out.append(
+                Attractor(
+                    ids[k],
+                    kind,
+                    e.period,
+                    e.impacts,
+                    exponent,
+                    pts,
+                    e.reason,
+                    e.count,
+                    e.count / total,
+                    e.first,
+                )
+            )
+        table = np.array(
+            [
+                ids[self.root(k)] if self.entries[self.root(k)].count else INVALID
+                for k in range(len(self.entries))
+            ],
+            dtype=np.int64,
+        )
+        labels = np.full(total, INVALID, dtype=np.int64)
+        done = self.labels >= 0
+        labels[done] = table[self.labels[done]]
+        return out, labels
+
+    def _kind(self, e: _Entry) -> tuple[str, float]:
+        exps = np.array([v for v in e.exponents if math.isfinite(v)])
+        exponent = float(np.median(exps)) if exps.size else math.nan
+        if e.family in ("escaping", "failed"):
+            return e.family, math.nan
+        if e.family == "periodic":
+            return ("sticking" if self._sticks(e) else "periodic"), exponent
+        if not math.isfinite(exponent):
+            return "aperiodic", exponent
+        if exponent > CHAOS_THRESHOLD:
+            return "chaotic", exponent
+        return ("quasiperiodic" if exponent >= -CHAOS_THRESHOLD else "aperiodic"), exponent
+
+    def _sticks(self, e: _Entry) -> bool:
+        """No impacts, and every point of the orbit on a stop: the motion rides on it."""
+        if not e.impacts == 0 or not self.model.has_sticking:
+            return False
+        for x in e.points:
+            tol = 1e3 * ON_STOP_TOL * max(1.0, float(np.max(np.abs(x))))
+            if not any(abs(self.model.guard(x, self.t_sample, j)) <= tol for j in range(self.model.n_stops)):
+                return False
+        return True
+
+
+def set_distance(a: np.ndarray, b: np.ndarray, cell: np.ndarray) -> float:
+    """The Hausdorff distance between two point sets, in cells (each component over its cell size).
+
+    Examples
+    --------
+    >>> a = np.array([[0.0, 0.0], [1.0, 0.0]])
+    >>> set_distance(a, a[::-1], np.ones(2)), set_distance(a, a + [0.0, 0.5], np.array([1.0, 0.25]))
+    (0.0, 2.0)
+    """
+    a = np.asarray(a, dtype=float) / cell
+    b = np.asarray(b, dtype=float) / cell
+    if a.size == 0 or b.size == 0:
+        return math.inf
+    d = np.max(np.abs(a[:, None, :] - b[None, :, :]), axis=2)
+    return float(max(d.min(axis=1).max(), d.min(axis=0).max()))
