@@ -51,7 +51,8 @@ ORBITS = {
     "impact-damper": {"impacts": 2},  # the secondary mass hits each wall once per period
     # chaotic at its default parameters (tests/engine/test_reference.py): no period-1 orbit near
     "impact-oscillator": "period-1 orbit left the allowed region",
-    "bouncing-ball": "the default initial guess sticks",  # the ball rides on the table (amplitude 0.1 < gravity)
+    # the ball rides on the table (amplitude 0.1 < gravity)
+    "bouncing-ball": "the default initial guess sticks",
 }
 
 
