@@ -180,3 +180,17 @@ def test_build_report_only_unknown_name_fails_before_computing(tmp_path: Path) -
     with pytest.raises(ValueError, match="no figure"):
         build_report(tmp_path, only=["nope"])
     assert not (tmp_path / "index.html").exists()
+
+
+def test_report_only_help_names_every_figure() -> None:
+    """``grazing report --help`` lists every name ``--only`` takes (each one selects its figure)."""
+    from grazing.cli.report import report
+    from grazing.report import FIGURES, select
+
+    (only,) = [p for p in report.params if p.name == "only"]
+    for m in FIGURES:
+        name = f"fig{m.FIGURE_ID.zfill(2)}" if m.FIGURE_ID.isdigit() else m.FIGURE_ID
+        assert select([name]) == [m]
+        if m.FIGURE_ID.isdigit() and name not in ("fig02", "fig04", "fig06", "fig12"):
+            continue  # (fig06 ... fig12: the numbered figures in between)
+        assert name in only.help, name
