@@ -53,9 +53,9 @@ MAX_PERIOD = 8
 class Settings:
     """The window of the plane, the map's resolution and where the curves start."""
 
-    eta: tuple[float, float, int] = (0.41, 0.485, 301)
+    eta: tuple[float, float, int] = (0.41, 0.485, 251)
     """η range and number of columns."""
-    theta_hat_deg: tuple[float, float, int] = (24.0, 54.0, 121)
+    theta_hat_deg: tuple[float, float, int] = (24.0, 54.0, 101)
     """θ̂ range (degrees) and number of rows."""
     transient: int = 400
     periods: int = 64
@@ -195,7 +195,8 @@ def follow_from_map(
         model = grazing.models.pendulum("B", eta=eta, theta_hat=theta_hat)
         where = f"η = {eta:.5f}, θ̂ = {math.degrees(theta_hat):.2f}°"
         try:
-            orbit = find_orbit(model, x_final[row, col], period=period, virtual=period == 1)
+            guess = np.array(x_final[row, col], dtype=float)  # (a contiguous copy: the kernels need one)
+            orbit = find_orbit(model, guess, period=period, virtual=period == 1)
             if orbit.period != period or orbit.impacts != (0 if period == 1 else 1):
                 failures.append(
                     f"at {where} the orbit found has period {orbit.period}, {orbit.impacts} impacts"
@@ -293,12 +294,6 @@ def draw(run: AddingRun, path: Path) -> None:
         for sp in wc.curve.special:
             if sp.kind in ("grazing", "double grazing"):
                 ax.plot(sp.values[0], math.degrees(sp.values[1]), **MEETS)
-        if wc.period > 1 and wc.kind == "period-doubling":
-            top = int(np.argmax(th))
-            ax.annotate(
-                str(wc.period), (eta[top], th[top]), xytext=(-4, -2), textcoords="offset points",
-                ha="right", va="top", fontsize=10, fontweight="bold",
-            )  # fmt: skip
     eta = run.ds["eta"].values
     th = np.degrees(run.ds["theta_hat"].values)
     ax.set_xlim(eta[0] - 0.5 * (eta[1] - eta[0]), eta[-1] + 0.5 * (eta[1] - eta[0]))
