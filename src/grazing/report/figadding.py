@@ -98,6 +98,14 @@ class WindowCurve:
         return {"period-doubling": "pd"}.get(self.kind, self.kind) + str(self.period)
 
     @property
+    def bounding(self) -> np.ndarray:
+        """The points that bound a window: all of them, but on a grazing curve only those where the
+        grazing orbit is stable (an unstable orbit is no window of the map)."""
+        if self.kind != "grazing":
+            return np.ones(len(self.curve), dtype=bool)
+        return np.array([p.stable for p in self.curve.points], dtype=bool)
+
+    @property
     def label(self) -> str:
         if self.period == 1:
             return "grazing curve of the nonimpacting orbit (fig 6)"
@@ -136,6 +144,7 @@ class AddingRun:
             self.ds["eta"].values,
             np.degrees(self.ds["theta_hat"].values),
             self.classes(),
+            where=wc.bounding,
         )
 
 
@@ -274,6 +283,8 @@ STYLES: dict[str, dict[str, Any]] = {
 }
 """How each kind of curve is drawn (the nonimpacting orbit's grazing curve: :data:`NONIMPACTING`)."""
 NONIMPACTING = {"color": "magenta", "ls": "-", "lw": 2.0}
+UNSTABLE = {"color": "white", "ls": "-", "lw": 0.7}
+"""A grazing curve where the grazing orbit is unstable (it bounds no window)."""
 MEETS = {"ls": "", "marker": "o", "ms": 5.5, "color": "white", "mec": "black", "mew": 1.0}
 """The marker of a codimension-two point where a curve ends at a grazing."""
 
@@ -287,10 +298,15 @@ def draw(run: AddingRun, path: Path) -> None:
     ax = fig.subplots()
     plot_period_map(ax, run.ds, max_period=MAX_PERIOD)
     edge = [patheffects.withStroke(linewidth=2.8, foreground="0.2")]
+    thin = [patheffects.withStroke(linewidth=1.8, foreground="0.2")]
     for wc in run.curves:
         style = NONIMPACTING if wc.period == 1 else STYLES[wc.kind]
         eta, th = wc.curve.values("eta"), np.degrees(wc.curve.values("theta_hat"))
-        ax.plot(eta, th, **style, path_effects=None if wc.period == 1 else edge)
+        bound = wc.bounding
+        ax.plot(eta, np.where(bound, th, np.nan), **style, path_effects=None if wc.period == 1 else edge)
+        if not bound.all():  # (widened by a point, so that the two parts meet)
+            unstable = np.convolve(~bound, [1, 1, 1], mode="same") > 0
+            ax.plot(eta, np.where(unstable, th, np.nan), **UNSTABLE, path_effects=thin)
         for sp in wc.curve.special:
             if sp.kind in ("grazing", "double grazing"):
                 ax.plot(sp.values[0], math.degrees(sp.values[1]), **MEETS)
@@ -302,6 +318,9 @@ def draw(run: AddingRun, path: Path) -> None:
         Line2D([], [], **STYLES["period-doubling"], path_effects=edge, label="period-doubling curves"),
         Line2D([], [], **STYLES["fold"], path_effects=edge, label="fold curves"),
         Line2D([], [], **STYLES["grazing"], path_effects=edge, label="grazing curves (an impact is gained)"),
+        Line2D(
+            [], [], **UNSTABLE, path_effects=thin, label="grazing curves of an unstable orbit (no window)"
+        ),
         Line2D([], [], **NONIMPACTING, label="grazing curve of the nonimpacting orbit"),
         Line2D([], [], **MEETS, label="a curve ends at a grazing"),
     ]
@@ -335,7 +354,9 @@ def build(out_dir: Path, progress: Progress | None = None, settings: Settings | 
         "orbits of period 2–5 with one impact per period, each started from the map's cells of its window "
         "near "
         f"θ̂ = {s.start_deg:g}°, and the grazing curve of the nonimpacting period-1 orbit (magenta). "
-        "Circles: where a curve ends because the orbit gains or loses an impact (a codimension-two point).",
+        "Circles: where a curve ends because the orbit gains or loses an impact (a codimension-two point). "
+        "Thin white: a grazing curve where the grazing orbit is unstable (beyond where the fold curve meets "
+        "it); it bounds no window and is not checked against the map.",
         "Period map of the period-adding windows of case B with their continued boundaries",
     )
     return FigureResult(
@@ -377,9 +398,10 @@ def comparisons(run: AddingRun) -> tuple[Comparison, ...]:
                 c.fraction if c.inside else None,
                 None if c.verdict == "not comparable" else c.verdict == "agree",
                 kind="self-check",
-                rule="at every point of the curve inside the map, the map's cells one cell width away on "
-                "either side across the curve (one cell along each axis counting the same) have different "
-                "colours: agree when that holds at every point",
+                rule="at every point of the curve inside the map (on a grazing curve, where the grazing "
+                "orbit is stable), the map's cells one cell width away on either side across the curve (one "
+                "cell along each axis counting the same) differ in period or in impacts per period: agree "
+                "when that holds at every point",
                 source="continuation against the map",
                 paper_text="every point",
                 ours_text=f"{c.holds} of {c.inside} points" if c.inside else "no point inside the map",

@@ -359,7 +359,12 @@ class CurveOnMap:
 
 
 def curve_on_map(
-    x: Sequence[float], y: Sequence[float], grid_x: Sequence[float], grid_y: Sequence[float], classes: Any
+    x: Sequence[float],
+    y: Sequence[float],
+    grid_x: Sequence[float],
+    grid_y: Sequence[float],
+    classes: Any,
+    where: Sequence[bool] | None = None,
 ) -> CurveOnMap:
     """Whether a curve lies on a change of class in a map, within the map's resolution.
 
@@ -367,7 +372,8 @@ def curve_on_map(
     ``grid_y``, both equally spaced) the curve's normal is taken in cell units (one cell width
     along each axis counts the same); the rule holds there when the cells one cell width away on
     either side along the normal (``classes[row, column]``, nearest cell) differ.  Points less
-    than one cell from the map's edge are left out.
+    than one cell from the map's edge are left out, and those where ``where`` is false (they
+    still set the normal of their neighbours).
 
     Examples
     --------
@@ -395,8 +401,9 @@ def curve_on_map(
     ny, nx = cls.shape
     inside = holds = 0
     failed = []
+    checked = np.ones(len(u), dtype=bool) if where is None else np.asarray(where, dtype=bool)
     for i in range(len(u)):
-        if not (1 <= u[i] <= nx - 2 and 1 <= v[i] <= ny - 2):
+        if not (checked[i] and 1 <= u[i] <= nx - 2 and 1 <= v[i] <= ny - 2):
             continue
         inside += 1
         a = cls[_nearest(v[i] + nv[i]), _nearest(u[i] + nu[i])]
