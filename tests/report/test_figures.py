@@ -275,6 +275,12 @@ def test_map_consistent_with_grazing_curve(builtmap) -> None:
     _images_ok(out, res)
     below = _row(res, "below the grazing curve")
     assert below.ours == 0 and below.verdict == "agree" and below.kind == "self-check"
+    # issue 30: the map was blank (drawn in radians on an axis in degrees): its data knows θ̂ is an angle
+    import xarray as xr
+
+    with xr.open_dataset(out / "map_eta_theta_hat.nc") as ds:
+        assert ds.theta_hat.attrs["angle"] == 1 and ds.theta_hat.attrs["symbol"] == "θ̂"
+        assert ds.eta.attrs["symbol"] == "η"
 
 
 def test_map_classify_counts(tmp_path: Path) -> None:

@@ -122,6 +122,7 @@ class AddingRun:
     map_seconds: float = 0.0
     map_cpu_seconds: float = 0.0
     curve_seconds: float = 0.0
+    curve_cpu_seconds: float = 0.0
     transient: int = 0
     periods: int = 0
 
@@ -230,7 +231,7 @@ def compute(s: Settings, progress: Progress | None = None) -> AddingRun:
         label="period adding: map",
     )  # fmt: skip
     run = AddingRun(ds, map_seconds=seconds, map_cpu_seconds=cpu, transient=s.transient, periods=s.periods)
-    start = time.perf_counter()
+    start, cpu = time.perf_counter(), figmap.cpu_seconds()
     lo, hi = float(ds["eta"].values[0]), float(ds["eta"].values[-1])
     near = rows_near(ds, s.start_deg)
 
@@ -263,6 +264,7 @@ def compute(s: Settings, progress: Progress | None = None) -> AddingRun:
             continue
         add("fold", n, start_cells(ds, rows_near(ds, end, below=end), n, s.tries, upwards=False), lo)
     run.curve_seconds = time.perf_counter() - start
+    run.curve_cpu_seconds = figmap.cpu_seconds() - cpu
     return run
 
 
@@ -541,7 +543,8 @@ def notes(run: AddingRun, s: Settings) -> tuple[str, ...]:
     out.append(f"Curves started from the map's cells: {starts}.")
     out.append(
         f"Cost: the map {run.map_cpu_seconds:.1f} CPU seconds ({run.map_seconds:.1f} s) for "
-        f"{s.eta[2] * s.theta_hat_deg[2]} points; the {len(run.curves)} curves {run.curve_seconds:.1f} s."
+        f"{s.eta[2] * s.theta_hat_deg[2]} points; the {len(run.curves)} curves "
+        f"{run.curve_cpu_seconds:.1f} CPU seconds ({run.curve_seconds:.1f} s)."
     )
     return tuple(out)
 
