@@ -45,6 +45,8 @@ from grazing.report.rules import CurveOnMap, criterion_row, curve_on_map
 FIGURE_ID = "adding"
 PERIODS = (2, 3, 4, 5)
 """The windows whose boundaries are continued."""
+HEADLINE = "Boundaries of the period-adding windows from continuation not everywhere on a change in the map"
+"""The line of every differing row of the section in the list of differences (one line links them all)."""
 MAX_PERIOD = 8
 """Longest period with a colour of its own in the map (as in the map of the whole plane)."""
 
@@ -119,6 +121,9 @@ class AddingRun:
     ds: Any
     curves: list[WindowCurve] = field(default_factory=list)
     missing: list[str] = field(default_factory=list)
+    """Notes on the curves that could not be continued or were not searched."""
+    absent: list[str] = field(default_factory=list)
+    """The labels of the curves searched for and not found (each a row of the table: not comparable)."""
     map_seconds: float = 0.0
     map_cpu_seconds: float = 0.0
     curve_seconds: float = 0.0
@@ -242,6 +247,7 @@ def compute(s: Settings, progress: Progress | None = None) -> AddingRun:
         if wc is None:
             why = "; ".join(failures) if failures else "no cell of its window in the rows tried"
             run.missing.append(f"No {what} curve: {why}.")
+            run.absent.append(f"{what.removeprefix('the ')} curve")
             say(f"period adding: no {what} curve")
             return None
         run.curves.append(wc)
@@ -408,7 +414,23 @@ def comparisons(run: AddingRun) -> tuple[Comparison, ...]:
                 paper_text="every point",
                 ours_text=f"{c.holds} of {c.inside} points" if c.inside else "no point inside the map",
                 note=_failure_note(run, wc, c),
-                headline=f"The {wc.label} against the period map",
+                headline=HEADLINE,
+            )
+        )
+    for label in run.absent:
+        rows.append(
+            criterion_row(
+                FIGURE_ID,
+                f"{label} on a change of period in the map",
+                "on a change of period",
+                None,
+                None,
+                kind="self-check",
+                rule="the curve could not be continued from the map's cells (see the notes): nothing checked",
+                source="continuation against the map",
+                paper_text="every point",
+                ours_text="no curve",
+                headline=f"No {label}",
             )
         )
     return tuple(rows)
