@@ -49,6 +49,10 @@ HEADLINE = "Boundaries of the period-adding windows from continuation not everyw
 """The line of every differing row of the section in the list of differences (one line links them all)."""
 MAX_PERIOD = 8
 """Longest period with a colour of its own in the map (as in the map of the whole plane)."""
+COLOURS = MAX_PERIOD + 4
+"""The number of colour classes of :func:`period_classes` (failed, aperiodic, period 1 without and with
+impacts, periods 2 ... MAX_PERIOD, longer): a class of :meth:`AddingRun.classes` is
+``colour + COLOURS * impacts per period``."""
 
 
 @dataclass(frozen=True)
@@ -140,7 +144,7 @@ class AddingRun:
         )
         per = np.asarray(self.ds["period"].values)
         impacts = np.where(per > 0, np.round(np.nan_to_num(self.ds["impacts_per_period"].values)), 0)
-        return np.asarray(codes) + (MAX_PERIOD + 4) * impacts.astype(int)
+        return np.asarray(codes) + COLOURS * impacts.astype(int)
 
     def check(self, wc: WindowCurve) -> CurveOnMap:
         """The rule for one curve: on a change of the map's colour, within one cell."""
@@ -437,9 +441,15 @@ def comparisons(run: AddingRun) -> tuple[Comparison, ...]:
 
 
 def class_label(code: int) -> str:
-    """The words for a class of :meth:`AddingRun.classes`: ``"aperiodic"``, ``"period 3, 2 impacts"``."""
+    """The words for a class of :meth:`AddingRun.classes`.
+
+    Examples
+    --------
+    >>> class_label(1), class_label(5 + COLOURS), class_label(2)
+    ('aperiodic', 'period 3, 1 impact per period', 'period 1, 0 impacts per period')
+    """
     _, labels, _ = period_classes(np.array([1]), np.array([0]), MAX_PERIOD)
-    colour, impacts = code % (MAX_PERIOD + 4), code // (MAX_PERIOD + 4)
+    colour, impacts = code % COLOURS, code // COLOURS
     if colour < 2:
         return labels[colour]
     period = labels[colour].split(",")[0]
