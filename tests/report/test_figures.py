@@ -397,3 +397,9 @@ def test_curve_rule_fails_off_the_boundary(adding_run) -> None:
             "aperiodic",
             "period 3, 1 impact per period",
         }
+
+
+def test_a_curve_not_continued_is_a_row_not_comparable() -> None:
+    run = figadding.AddingRun(ds=None, absent=["period-5 fold curve"], missing=["No period-5 fold curve."])
+    (row,) = figadding.comparisons(run)
+    assert row.verdict == "not comparable" and row.ours_text == "no curve" and "period-5 fold" in row.quantity
