@@ -403,3 +403,19 @@ def test_a_curve_not_continued_is_a_row_not_comparable() -> None:
     run = figadding.AddingRun(ds=None, absent=["period-5 fold curve"], missing=["No period-5 fold curve."])
     (row,) = figadding.comparisons(run)
     assert row.verdict == "not comparable" and row.ours_text == "no curve" and "period-5 fold" in row.quantity
+
+
+def test_fold_misses_are_measured_against_the_nonimpacting_grazing(adding_run) -> None:
+    """The explanation of a fold curve's misses: its distance in cells to the nonimpacting orbit's grazing
+    curve (here a curve moved by 2.5 cells stands for both)."""
+    import dataclasses
+
+    run, wc = adding_run
+    cell = float(run.ds.eta[1] - run.ds.eta[0])
+    moved = [dataclasses.replace(p, values=(p.values[0] + 2.5 * cell, p.values[1])) for p in wc.curve.points]
+    fold = dataclasses.replace(wc, kind="fold")
+    grazing1 = dataclasses.replace(wc.curve, points=moved)
+    first = dataclasses.replace(wc, period=1, kind="grazing", curve=grazing1)
+    probe = figadding.AddingRun(run.ds, curves=[first, fold], transient=run.transient, periods=run.periods)
+    text = figadding._why(probe, fold, probe.check(fold))
+    assert "The fold lies 2.5–2.5 cells (η) below the nonimpacting orbit's grazing" in text
