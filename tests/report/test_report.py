@@ -137,6 +137,7 @@ def test_only_rebuilds_one_figure_and_keeps_the_others(built, tmp_path: Path) ->
 def test_select_names() -> None:
     assert [m.FIGURE_ID for m in select(["fig07", "fig7", "7"])] == ["7"]
     assert [m.FIGURE_ID for m in select(["map", "fig12", "fig02"])] == ["2", "12", "map"]
+    assert [m.FIGURE_ID for m in select(["adding", "figadding", "map"])] == ["map", "adding"]  # issue 27
     with pytest.raises(ValueError, match="no figure"):
         select(["fig5"])
 

@@ -15,7 +15,7 @@ Examples
 --------
 >>> from grazing.report import FIGURES, PAPER_FIGURES
 >>> [m.FIGURE_ID for m in FIGURES]
-['2', '4', '6', '7', '8', '9', '10', '11', '12', 'map', 'stops', 'attractors', 'eq']
+['2', '4', '6', '7', '8', '9', '10', '11', '12', 'map', 'adding', 'stops', 'attractors', 'eq']
 >>> set(PAPER_FIGURES) <= {m.FIGURE_ID for m in FIGURES}
 True
 >>> [m.FIGURE_ID for m in select(["fig07", "10", "figmap"])]
@@ -46,6 +46,7 @@ from grazing.report import (
     fig10,
     fig11,
     fig12,
+    figadding,  # issue 27
     figattractors,  # issue 28
     figmap,
     figstops,
@@ -80,6 +81,7 @@ FIGURES: tuple[ModuleType, ...] = (
     fig11,
     fig12,
     figmap,
+    figadding,  # issue 27
     figstops,
     figattractors,  # issue 28
     errata,

@@ -203,7 +203,7 @@ def _grouped(rows: Sequence[Comparison]) -> list[tuple[str, list[Comparison]]]:
 
 def _figures_of(rows: Sequence[Comparison]) -> str:
     figs = list(dict.fromkeys(r.figure for r in rows))
-    names = [f if f in ("eq", "map") else f"fig {f}" for f in figs]
+    names = [f"fig {f}" if f.isdigit() else f for f in figs]
     return ", ".join(names)
 
 
