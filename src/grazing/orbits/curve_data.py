@@ -5,6 +5,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -40,6 +41,13 @@ class CurvePoint:
     orbit, grazing
         The periodic orbit (fold, period-doubling, Neimark-Sacker, branch-point curves) or
         the grazing orbit (grazing curves).
+    accuracy
+        How far the critical multipliers may be from the curve's condition (``|mu - 1|`` on a
+        fold or branch-point curve, ``|mu + 1|`` on a period-doubling curve, ``|mu_i mu_j - 1|``
+        on a Neimark-Sacker curve), given ``condition`` and double precision
+        (:func:`~grazing.orbits.extended.multiplier_accuracy`): about ``1e-10`` times the
+        monodromy's non-normality, and far worse within ``1e-5`` of a grazing (the saltation
+        matrix's ``1 / v``).  nan on a grazing curve.
     """
 
     values: tuple[float, float]
@@ -51,6 +59,7 @@ class CurvePoint:
     condition: float
     orbit: PeriodicOrbit | None = None
     grazing: GrazingPoint | None = None
+    accuracy: float = math.nan
 
     @property
     def stable(self) -> bool:
@@ -172,6 +181,7 @@ class BifurcationCurve:
             "stable": ("point", np.array([p.stable for p in self.points], dtype=np.int8)),
             "impacts": ("point", np.array([p.impacts for p in self.points], dtype=np.int32)),
             "condition": ("point", np.array([p.condition for p in self.points])),
+            "accuracy": ("point", np.array([p.accuracy for p in self.points])),
             "special_kind": ("special", np.array([s.kind for s in self.special], dtype=str)),
             "special_index": ("special", np.array([s.index for s in self.special], dtype=np.int32)),
             "special_param1": ("special", np.array([s.values[0] for s in self.special], dtype=float)),

@@ -220,7 +220,8 @@ class _Follower:
         o = ev.orbit
         assert o is not None
         return CurvePoint(
-            values, o.state.copy(), o.t0, o.multipliers, o.impacts, self.period, ev.condition, o
+            values, o.state.copy(), o.t0, o.multipliers, o.impacts, self.period, ev.condition, o,
+            accuracy=ev.accuracy,
         )
 
     # -- checks -------------------------------------------------------------
