@@ -222,7 +222,7 @@ class _Follower:
         return CurvePoint(
             values, o.state.copy(), o.t0, o.multipliers, o.impacts, self.period, ev.condition, o,
             accuracy=ev.accuracy,
-        )
+        )  # fmt: skip
 
     # -- checks -------------------------------------------------------------
     def check(self, prev: PalcPoint, cand: PalcPoint) -> tuple[str, str]:
