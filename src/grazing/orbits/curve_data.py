@@ -17,6 +17,10 @@ from grazing.orbits.contact import GrazingPoint
 from grazing.orbits.continuation import Branch, SpecialPoint
 from grazing.orbits.shooting import PeriodicOrbit
 
+ACCURACY_NOTE = 1e-6
+"""Points whose multipliers are known less well than this (:attr:`CurvePoint.accuracy`) are named
+in the command's summary (:meth:`BifurcationCurve.imprecise`)."""
+
 
 @dataclass(frozen=True)
 class CurvePoint:
@@ -148,6 +152,11 @@ class BifurcationCurve:
     def values(self, name: str) -> np.ndarray:
         """One parameter's values along the curve."""
         return np.array([p.values[self.params.index(name)] for p in self.points])
+
+    def imprecise(self, tol: float = ACCURACY_NOTE) -> list[int]:
+        """The indices of the points whose multipliers are known only to worse than ``tol``
+        (:attr:`CurvePoint.accuracy`: in double precision, near a grazing)."""
+        return [i for i, p in enumerate(self.points) if p.accuracy > tol]
 
     @property
     def states(self) -> np.ndarray:
