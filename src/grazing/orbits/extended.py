@@ -83,10 +83,10 @@ def multiplier_accuracy(kind: str, M: np.ndarray, sol: Bordered) -> float:
     The distance of ``mu`` from 1 (fold, branch point), of ``mu`` from -1
     (period-doubling), of ``mu_i mu_j`` from 1 (Neimark-Sacker) that the point's
     defining condition ``g`` and double precision allow: ``|g| / |w^T v|`` (the
-    first-order eigenvalue of ``A`` nearest zero: :attr:`Bordered.eigenvalue_condition`)
-    plus the condition number of that eigenvalue times the rounding error of
-    ``A`` (:data:`MONODROMY_ROUNDING` ``eps |M|``; ``2 eps |M|^2`` times it for
-    ``M (.) M``).  Where ``M`` is far from normal, as near a grazing, where a
+    first-order eigenvalue of ``A`` nearest zero) plus the condition number of
+    that eigenvalue (:attr:`~grazing.orbits.bordered.Bordered.eigenvalue_condition`)
+    times the rounding error of ``A`` (:data:`MONODROMY_ROUNDING` ``eps |M|``;
+    ``2 eps |M|^2`` times it for ``M (.) M``).  Where ``M`` is far from normal, as near a grazing, where a
     saltation matrix holds ``1 / v`` with ``v`` the impact speed, both the
     condition number and ``|M|`` grow like ``1 / v``: a Newton tolerance on ``g``
     then bounds the multipliers only to this accuracy, and no point represented
