@@ -154,7 +154,7 @@ def curve(
         "points": [
             {**_values(result, pt.values), "multipliers": complex_list(pt.multipliers), "state": pt.state,
              "period": pt.period, "impacts": pt.impacts, "section_time": pt.section_time,
-             "stable": pt.stable}
+             "stable": pt.stable, "accuracy": pt.accuracy}
             for pt in result.points
         ],
         "special": [
@@ -182,5 +182,13 @@ def curve(
         mu = ", ".join(f"{x:+.4f}{y:+.4f}i" for x, y in complex_list(sp_.multipliers))
         note = "" if sp_.located else " (not located exactly)"
         click.echo(f"  {sp_.kind:22s} {at}   multipliers {mu}{note}")
+    imprecise = result.imprecise()
+    if imprecise:
+        worst = max(result.points[i].accuracy for i in imprecise)
+        click.echo(
+            f"note: the multipliers of {len(imprecise)} points are known only to {worst:.1g}: their "
+            "monodromy is far from normal (as next to a grazing, where the saltation matrix holds 1/v, "
+            "v the impact speed) and double precision does no better"
+        )
     if out is not None:
         click.echo(f"curve saved to {out}")
