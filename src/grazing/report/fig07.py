@@ -48,14 +48,29 @@ def _angles(ths: list[float]) -> str:
     return ", ".join(f"{t:g}°" for t in ths) or "no angle"
 
 
+def chaos_width_text(theta_hat_deg: float, width: float) -> str:
+    """How much aperiodic motion a sweep found past grazing, in words true to the number.
+
+    Examples
+    --------
+    >>> chaos_width_text(10.0, 5.3e-6), chaos_width_text(20.0, 0.0)
+    ('aperiodic over 5.3e-06 in η at 10°', 'no aperiodic point at 20°')
+    """
+    if width <= 0:
+        return f"no aperiodic point at {theta_hat_deg:g}°"
+    return f"aperiodic over {width:.1e} in η at {theta_hat_deg:g}°"
+
+
 def headlines(runs: Runs) -> dict[str, str]:
     """The one-line differences of the figure, naming the stop angles where they occur."""
-    no_chaos, no_cascade, mus = [], [], []
+    no_chaos, no_cascade, mus, widths = [], [], [], []
     for p in PANELS:
         main, fine = runs.of(p, "main"), runs.finest(p)
         assert main is not None
-        if max(fine.aperiodic_width(), main.aperiodic_width()) < diagrams.APPRECIABLE_WIDTH:
+        width = max(fine.aperiodic_width(), main.aperiodic_width())
+        if width < diagrams.APPRECIABLE_WIDTH:
             no_chaos.append(p.theta_hat_deg)
+            widths.append(chaos_width_text(p.theta_hat_deg, width))
             if main.grazings:
                 z = main.grazings[0].multipliers[0]
                 mus.append(f"{z.real:.2f} ± {abs(z.imag):.2f}i".replace("-", "−"))
@@ -67,9 +82,10 @@ def headlines(runs: Runs) -> dict[str, str]:
     ]
     off = [(t, d) for t, d in diffs if abs(d) > paper.EXPERIMENT[f"{t:g}"].eta_c.tolerance]
     return {
-        "chaos": f"No visible chaos past the first grazing at θ̂ = {_angles(no_chaos)} (case B): the grazing "
-        f"orbit's multipliers there ({'; '.join(mus)}) are complex, near the negative or the imaginary axis, "
-        "where eq. 21's test on |λ| alone does not apply",
+        "chaos": f"Chaos past the first grazing is too narrow to see at the paper's scale (under "
+        f"{diagrams.APPRECIABLE_WIDTH:g} in η) at θ̂ = {_angles(no_chaos)} (case B): {'; '.join(widths)}. "
+        f"The grazing orbit's multipliers there ({'; '.join(mus)}) are complex, near the negative or the "
+        "imaginary axis, where eq. 21's test on |λ| alone does not apply",
         "cascade": f"No reverse period-adding cascade (≥ 3 windows, periods falling by one) at θ̂ = "
         f"{_angles(no_cascade)} (case B)",
         "eta_c": (
