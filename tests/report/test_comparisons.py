@@ -84,7 +84,35 @@ def test_scoreboard_counts_the_rows(data: dict, built) -> None:
         cells = re.search(rf'kind-{kind}">{kind}</span>.*?</tr>', built.page, flags=re.S)
         assert cells is not None
         nums = [int(x) for x in re.findall(r'<td class="num">(\d+)</td>', cells.group(0))]
-        assert nums == [counts["agree"], counts["differ"], counts["not comparable"], sum(counts.values())]
+        assert nums == [
+            counts["agree"],
+            counts["differ"],
+            counts["erratum"],
+            counts["not comparable"],
+            sum(counts.values()),
+        ]
+    # the errata count apart from the disagreements: the two columns share no row
+    errata = sum(r["erratum"] for r in data["rows"])
+    assert errata >= 5 and data["scoreboard"]["paper"]["erratum"] == errata
+    differ = sum(r["verdict"] == "differ" and not r["erratum"] for r in data["rows"] if r["kind"] == "paper")
+    assert data["scoreboard"]["paper"]["differ"] == differ
+
+
+def test_self_checks_name_their_reference_not_the_paper(data: dict, built) -> None:
+    """A self-check's reference is ours (a closed form, another computation): never in a "paper" column."""
+    page = built.page
+    for r in data["rows"]:
+        if r["kind"] != "self-check":
+            assert not r["reference"], r["quantity"]
+            continue
+        start = page.index(f'<tr id="{r["id"]}">')
+        table = page.rfind("<table", 0, start)
+        header = page[table : page.index("</thead>", table)]
+        assert "<th>reference</th>" in header and "<th>paper</th>" not in header, r["id"]
+    closed = [r for r in data["rows"] if r["figure"] == "stops" and r["reference"] == "closed form"]
+    assert len(closed) >= 6
+    liouville = next(r for r in data["rows"] if "Liouville" in r["quantity"])
+    assert "closed form" in liouville["reference"]
 
 
 def test_every_difference_is_listed_at_the_top_with_a_link(data: dict, built) -> None:

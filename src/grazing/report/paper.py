@@ -23,6 +23,8 @@ CITATION = (
     "P. T. Piiroinen, L. N. Virgin, A. R. Champneys, “Chaos and period-adding: experimental and numerical "
     "verification of the grazing bifurcation”, J. Nonlinear Sci. 14 (2004) 383–404"
 )
+DOI = "10.1007/s00332-004-0616-y"
+"""The paper's DOI (linked from the report as ``https://doi.org/`` + DOI)."""
 
 
 @dataclass(frozen=True)

@@ -93,6 +93,7 @@ def numeric_row(
     paper_text: str = "",
     ours_text: str = "",
     synthetic: bool = False,
+    reference: str = "",
 ) -> Comparison:
     """A number against a number: ``agree`` exactly when ``|ours − paper| <= tolerance``.
 
@@ -138,6 +139,7 @@ def numeric_row(
         synthetic=synthetic,
         headline=headline if verdict != "agree" else "",
         erratum=erratum and verdict != "agree",
+        reference=reference,
     )
 
 
@@ -206,6 +208,7 @@ def criterion_row(
     delta: float | None = None,
     delta_text: str = "",
     synthetic: bool = False,
+    reference: str = "",
 ) -> Comparison:
     """A stated criterion: ``agree`` when it holds, ``differ`` when not, ``not comparable`` for None."""
     verdict: Verdict = "not comparable" if holds is None else ("agree" if holds else "differ")
@@ -226,6 +229,7 @@ def criterion_row(
         synthetic=synthetic,
         headline=headline if verdict != "agree" else "",
         erratum=erratum and verdict == "differ",
+        reference=reference,
     )
 
 
