@@ -369,7 +369,8 @@ def build(out_dir: Path, progress: Progress | None = None) -> FigureResult:
                 rule=f"agree when at least {PIPELINE_SHARE:.0%} of the synthetic recordings (noise, filter, "
                 "trigger sampling, period detection) give the noise-free model's period at the nearest η "
                 "of the model's sweep",
-                paper_text="(pipeline check)",
+                paper_text="the model's period at each η",
+                reference="the noise-free model",
                 ours_text=f"{k} of {n} recovered",
                 headline="The measurement pipeline misreads the period of synthetic recordings",
             )
@@ -386,7 +387,8 @@ def build(out_dir: Path, progress: Progress | None = None) -> FigureResult:
                 synthetic=True,
                 rule="agree when the period detected on the synthetic recording equals that of the model's "
                 "noise-free samples (0: none up to 32)",
-                paper_text=f"model: {row['model_period'] or 'none'}",
+                paper_text=f"period {row['model_period'] or 'none'}",
+                reference="the noise-free model",
                 ours_text=f"detected: {row['period'] or 'none'}",
                 note=f"Noise estimated at {row['noise']:.1e} rad.",
                 headline="The measurement pipeline misreads the period of synthetic recordings",
