@@ -170,7 +170,7 @@ def _segments(values: np.ndarray, angle: np.ndarray, stable: np.ndarray) -> list
 
 LETTERS: dict[str, dict[str, Any]] = {
     "A": {"xytext": (-4, 1), "textcoords": "offset points", "ha": "right"},
-    "B": {"xytext": (5, 1), "textcoords": "offset points", "ha": "left"},
+    "B": {"xytext": (0, 4), "textcoords": "offset points", "ha": "center", "va": "bottom"},
     "C": {
         "xytext": (42, 10),
         "textcoords": "offset points",
@@ -178,9 +178,10 @@ LETTERS: dict[str, dict[str, Any]] = {
         "va": "center",
         "arrowprops": {"arrowstyle": "-", "color": "tab:green", "lw": 0.8, "shrinkA": 1, "shrinkB": 2},
     },
-    "D": {"xytext": (0, -7), "textcoords": "offset points", "ha": "center", "va": "top"},
+    "D": {"xytext": (0, -9), "textcoords": "offset points", "ha": "center", "va": "top"},
 }
-"""Where the letters of the response curves sit, from each curve's peak: A left, B right; C, whose peak
+"""Where the letters of the response curves sit, from each curve's peak: A left, B above (A's curve passes
+right of B's peak, A's lower fold left of it); C, whose peak
 lies between B's curve above and D's below, out in the free space to the right on a leader line; D under
 its own arch."""
 
