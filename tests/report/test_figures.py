@@ -208,9 +208,18 @@ def test_fig07_build(built7) -> None:
     ]
     firsts = [r for r in res.comparisons if "first appreciable" in r.quantity]
     assert len(firsts) == 4 and all(r.verdict == "agree" for r in firsts), [r.ours_text for r in firsts]
-    chaos = [r for r in res.comparisons if "chaos past the first grazing" in r.quantity]
+    chaos = [
+        r for r in res.comparisons if "chaos past the first grazing" in r.quantity and "A/L" not in r.quantity
+    ]
     assert [r.verdict for r in chaos] == ["differ", "differ", "agree", "agree"]
     assert "10°, 20°" in chaos[0].headline
+    # the headline states what the sweeps found (issue 30: it said "no visible chaos" over a 5e-6 band)
+    assert "visible chaos" not in chaos[0].headline
+    for row, th in zip(chaos[:2], (10, 20)):
+        said = (
+            f"aperiodic over {row.ours:.1e} in η at {th}°" if row.ours > 0 else f"no aperiodic point at {th}°"
+        )
+        assert said in row.headline, (said, row.headline)
     ends = [r for r in res.comparisons if "how the impacting region ends" in r.quantity]
     assert len(ends) == 3 and all(r.verdict == "differ" and "fold" in r.ours for r in ends)
     eta_c = [r for r in res.comparisons if "experiment's η_c" in r.quantity]
@@ -419,3 +428,24 @@ def test_fold_misses_are_measured_against_the_nonimpacting_grazing(adding_run) -
     probe = figadding.AddingRun(run.ds, curves=[first, fold], transient=run.transient, periods=run.periods)
     text = figadding._why(probe, fold, probe.check(fold))
     assert "The fold lies 2.5–2.5 cells (η) below the nonimpacting orbit's grazing" in text
+
+
+def test_fig10_caption_promises_hatching_only_where_the_data_has_it(built) -> None:
+    """Hatched is where the map has no impacts but the full system has, on the same η grid (issue 30)."""
+    import xarray as xr
+
+    from grazing.report import fig10
+
+    _, result = _built(fig10, built)
+    caption = result.images[0].caption
+    hatched = 0
+    for p in fig07.PANELS:
+        group = f"{p.key}_main"
+        with (
+            xr.open_dataset(built.out / "fig07_sweeps.nc", group=group, engine="h5netcdf") as flow,
+            xr.open_dataset(built.out / "fig10_map_sweeps.nc", group=group, engine="h5netcdf") as mapped,
+        ):
+            quiet = (mapped["period"].values == 1) & (mapped["impacts_per_period"].values == 0)
+            hatched += int((quiet & (flow["impacts_per_period"].values > 0)).sum())
+    assert ("Hatched:" in caption) == (hatched > 0), (hatched, caption)
+    assert ("Nothing is hatched" in caption) == (hatched == 0)

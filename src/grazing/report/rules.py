@@ -96,6 +96,7 @@ def numeric_row(
     paper_text: str = "",
     ours_text: str = "",
     synthetic: bool = False,
+    reference: str = "",
 ) -> Comparison:
     """A number against a number: ``agree`` exactly when ``|ours − paper| <= tolerance``.
 
@@ -141,6 +142,7 @@ def numeric_row(
         synthetic=synthetic,
         headline=headline if verdict != "agree" else "",
         erratum=erratum and verdict != "agree",
+        reference=reference,
     )
 
 
@@ -209,6 +211,7 @@ def criterion_row(
     delta: float | None = None,
     delta_text: str = "",
     synthetic: bool = False,
+    reference: str = "",
 ) -> Comparison:
     """A stated criterion: ``agree`` when it holds, ``differ`` when not, ``not comparable`` for None."""
     verdict: Verdict = "not comparable" if holds is None else ("agree" if holds else "differ")
@@ -229,6 +232,7 @@ def criterion_row(
         synthetic=synthetic,
         headline=headline if verdict != "agree" else "",
         erratum=erratum and verdict == "differ",
+        reference=reference,
     )
 
 
