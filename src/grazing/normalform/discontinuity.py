@@ -47,7 +47,7 @@ from grazing.orbits.contact import GrazingPoint
 
 
 def zdm_direction(model: HybridModel, x: np.ndarray, t: float, stop: int = 0) -> np.ndarray:
-    """``e = (g_x - I) c / (grad(L_f h) . c)``: ``stop``'s reset jump per unit approach speed at ``x``."""
+    """``stop``'s reset jump per unit approach speed at ``x``: ``e = (g_x - I) c / (grad(L_f h) @ c)``."""
     _, _, gx = model.jacobians(x, t, stop)
     c = np.zeros(model.n_states)
     model.kernels().contact_dir(np.asarray(x, dtype=float), float(t), model.param_vector, c, stop)
