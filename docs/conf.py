@@ -12,6 +12,7 @@ from __future__ import annotations
 import importlib
 import inspect
 import os
+import shutil
 from pathlib import Path
 
 import grazing
@@ -31,7 +32,7 @@ extensions = [
     "sphinx.ext.mathjax",
 ]
 
-exclude_patterns = ["_build", "api/generated/*.md", "**/.ipynb_checkpoints", "README.md"]
+exclude_patterns = ["_build", "_ext", "**/.ipynb_checkpoints"]
 source_suffix = {".rst": "restructuredtext", ".md": "myst-nb"}
 root_doc = "index"
 
@@ -48,6 +49,19 @@ nb_execution_timeout = 300
 nb_execution_raise_on_error = True
 nb_execution_show_tb = True
 nb_merge_streams = True
+# A cell that writes to stderr (a warning, a log line) is a build warning, hence an error: the
+# tutorials must run cleanly, as scipy's examples must not warn.
+nb_output_stderr = "warn"
+
+# The kernels start with docs/_ext/ipython_startup.py, which reports a figure with an axes that
+# shows no data on stderr (so a blank figure fails the build too).
+_IPYTHON = DOCS / "_build" / "ipython"
+(_IPYTHON / "profile_default" / "startup").mkdir(parents=True, exist_ok=True)
+shutil.copyfile(DOCS / "_ext" / "ipython_startup.py", _IPYTHON / "profile_default" / "startup" / "00-grazing.py")
+os.environ["IPYTHONDIR"] = str(_IPYTHON)
+# ... and import the grazing this build documents (a kernel runs in the notebook's folder).
+_SRC = str(Path(grazing.__file__).resolve().parents[1])
+os.environ["PYTHONPATH"] = os.pathsep.join([_SRC, *filter(None, [os.environ.get("PYTHONPATH")])])
 
 # API reference: numpydoc renders the docstrings; autosummary writes one page per object.
 autosummary_generate = True

@@ -130,7 +130,30 @@ BLANK_FRACTION = 0.005
 """An image is blank when fewer than this fraction of its pixels differ from its background."""
 
 
-def painted_fraction(path: Path | str) -> float:
+def _image_rgb(path: Path | str | Any) -> Any:
+    """The image as an ``(h, w, 3)`` int16 array, transparent pixels over white."""
+    import numpy as np
+    from PIL import Image
+
+    with Image.open(path) as im:
+        rgba = np.asarray(im.convert("RGBA"), dtype=np.int16)
+    alpha = rgba[..., 3:4] / 255.0
+    return (rgba[..., :3] * alpha + 255 * (1 - alpha)).round().astype(np.int16)
+
+
+def _painted(rgb: Any) -> float:
+    """The fraction of pixels of ``rgb`` (``(..., 3)``) that differ from its most frequent colour."""
+    import numpy as np
+
+    flat = rgb.reshape(-1, 3)
+    if flat.size == 0:
+        return 0.0
+    colours, counts = np.unique(flat, axis=0, return_counts=True)
+    background = colours[np.argmax(counts)]
+    return float(np.mean(np.any(np.abs(flat - background) > 8, axis=1)))
+
+
+def painted_fraction(path: Path | str | Any) -> float:
     """The fraction of an image's pixels that differ from its background (its most frequent colour).
 
     Transparent pixels count as white; a pixel differs when one of its channels
@@ -146,18 +169,7 @@ def painted_fraction(path: Path | str) -> float:
     >>> painted_fraction(buf)
     0.02
     """
-    import numpy as np
-    from PIL import Image
-
-    with Image.open(path) as im:
-        rgba = np.asarray(im.convert("RGBA"), dtype=np.int16)
-    alpha = rgba[..., 3:4] / 255.0
-    rgb = (rgba[..., :3] * alpha + 255 * (1 - alpha)).round().astype(np.int16).reshape(-1, 3)
-    if rgb.size == 0:
-        return 0.0
-    colours, counts = np.unique(rgb, axis=0, return_counts=True)
-    background = colours[np.argmax(counts)]
-    return float(np.mean(np.any(np.abs(rgb - background) > 8, axis=1)))
+    return _painted(_image_rgb(path))
 
 
 def is_blank(path: Path | str) -> bool:
