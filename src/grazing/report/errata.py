@@ -152,8 +152,8 @@ def build(out_dir: Path, progress: Progress | None = None) -> FigureResult:
         images=(),
         summary=(
             "What the printed formulas give, computed, against what the paper's own numbers and our "
-            "discontinuity map need. The nondimensional equations of SPEC (θ″ + (2β/η)θ′ + sin θ/(4η²) = "
-            "α cos θ sin τ) are what every computation of the report uses."
+            "discontinuity map need. The nondimensional equations θ″ + (2β/η)θ′ + sin θ/(4η²) = "
+            "α cos θ sin τ (docs/equations.md) are what every computation of the report uses."
         ),
         comparisons=tuple(rows),
         seconds=time.perf_counter() - start,

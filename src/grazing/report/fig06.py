@@ -442,7 +442,8 @@ def comparisons(data: Fig6) -> tuple[Comparison, ...]:
                 headline="§6.1 quotes |λ| = 0.5114 at 40°, η = 0.445; its own multipliers have modulus "
                 "0.5078",
                 note=f"The paper's own multipliers 0.4606 ± 0.2137i have modulus {own:.4f}, as ours; the "
-                f"quoted 0.5114 fits neither (SPEC errata). Either value lies in 1/4 < |λ| < 2/3 (eq. 21).",
+                f"quoted 0.5114 fits neither (errata: docs/equations.md). Either value lies in "
+                f"1/4 < |λ| < 2/3 (eq. 21).",
             )
         )
     if c is not None:

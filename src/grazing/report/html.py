@@ -235,7 +235,7 @@ def differences_box(rows: Sequence[Comparison]) -> str:
         '<div class="differences" id="differences">',
         "<h3>Where we differ from the paper, and why</h3>",
         _difference_list(against),
-        "<h3>Errata in the paper (computed, see SPEC)</h3>",
+        "<h3>Errata in the paper (computed; explained in docs/equations.md)</h3>",
         _difference_list(errata),
         "<h3>Our own checks that fail</h3>",
         _difference_list(own),
