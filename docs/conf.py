@@ -28,16 +28,16 @@ extensions = [
     "numpydoc",
     "sphinx.ext.autodoc",
     "sphinx.ext.autosummary",
-    "sphinx.ext.mathjax",
 ]
 
 exclude_patterns = ["_build", "_ext", "**/.ipynb_checkpoints"]
 source_suffix = {".rst": "restructuredtext", ".md": "myst-nb"}
 root_doc = "index"
 
-# Markdown: $...$ maths, ::: fences, anchors for every heading down to level 3 (the pages link
-# to their own sections, e.g. user-models.md#supported-functions).
-myst_enable_extensions = ["dollarmath", "colon_fence", "deflist"]
+# Markdown: ::: fences, anchors for every heading down to level 3 (the pages link to their own
+# sections, e.g. user-models.md#supported-functions).  No TeX maths: MathJax would come from a
+# CDN, which a reader offline (and CI) does not reach; the equations are written in Unicode.
+myst_enable_extensions = ["colon_fence", "deflist"]
 myst_heading_anchors = 3
 
 # Notebooks: executed at build time, each cell's outputs cached (jupyter-cache) so that a rebuild
