@@ -46,7 +46,7 @@ if TYPE_CHECKING:  # pragma: no cover
 FIGURE_ID = "9"
 
 ALPHA_TABLE = paper.ALPHA_TABLE.value
-"""α of case B as tabulated (fig 7 caption)."""
+"""α of case B as tabulated (fig 7 caption; docs/equations.md)."""
 ALPHA_PRINTED = paper.ALPHA_PRINTED.value
 """α printed in §3: "In the experimental data the amplitude was set at α = 0.2258"."""
 ALPHA_APPARATUS = paper.ALPHA_APPARATUS
