@@ -20,6 +20,7 @@ from grazing.cli.common import (
     model_options,
     model_parameter,
     model_params_json,
+    multipliers_text,
     netcdf_out_option,
     parse_pair,
     parse_state,
@@ -179,7 +180,7 @@ def curve(
     )
     for sp_ in result.special:
         at = ", ".join(p.show(v, ".8g") for p, v in zip((p1, p2), sp_.values))
-        mu = ", ".join(f"{x:+.4f}{y:+.4f}i" for x, y in complex_list(sp_.multipliers))
+        mu = multipliers_text(sp_.multipliers)
         note = "" if sp_.located else " (not located exactly)"
         click.echo(f"  {sp_.kind:22s} {at}   multipliers {mu}{note}")
     imprecise = result.imprecise()
