@@ -254,37 +254,25 @@ def alpha_rows(alt: Runs) -> tuple[Comparison, ...]:
         width = max(fine.aperiodic_width(), run.aperiodic_width())
         tag = f"({p.key}) θ̂ = {p.theta_hat_deg:g}°, {label}"
         rows.append(
-            criterion_row(
-                FIGURE_ID,
-                f"{tag}: chaos past the first grazing",
-                "a jump to impacting chaotic motion",
+            _chaos_row(
+                tag,
                 width,
-                width >= diagrams.APPRECIABLE_WIDTH,
-                kind="paper",
                 rule=f"as with α = 0.2254: agree when aperiodic impacting motion spans at least "
                 f"{diagrams.APPRECIABLE_WIDTH:g} in η in total past the first grazing (main and magnified "
                 "sweeps)",
                 source="§6.1; §2.1 (A/L)",
-                paper_text="jump to chaos",
-                ours_text=f"aperiodic over {width:.1e} in η" if width > 0 else "no aperiodic motion",
                 headline=head_chaos,
                 note=f"First grazing with this α: η_g = {run.first_grazing:.6f}." + _fig9_note(p, fine),
             )
         )
         seq = _sequence(fine)
         rows.append(
-            criterion_row(
-                FIGURE_ID,
-                f"{tag}: reverse period-adding cascade past η_g",
-                "periods decreasing by one",
-                ", ".join(map(str, seq)) or "—",
-                diagrams.is_reverse_adding(seq),
-                kind="paper",
+            _cascade_row(
+                tag,
+                seq,
                 rule="as with α = 0.2254: agree when the clearly resolved windows past the first grazing are "
                 "at least three with periods decreasing by one",
                 source="§6.1; §2.1 (A/L)",
-                paper_text="…, 4, 3, 2, 1",
-                ours_text=" → ".join(map(str, seq)) or "—",
                 headline=head_cascade,
             )
         )
@@ -306,6 +294,44 @@ def _fig9_note(p: Panel, fine: PanelRun) -> str:
 def _sequence(run: PanelRun) -> list[int]:
     """The periods of the clearly resolved windows past the first grazing (:func:`diagrams.cascade`)."""
     return [w.period for w in diagrams.cascade(run)]
+
+
+def _chaos_row(tag: str, width: float, *, rule: str, source: str, headline: str, note: str) -> Comparison:
+    """The row "chaos past the first grazing" of a sweep whose aperiodic impacting motion spans ``width``."""
+    return criterion_row(
+        FIGURE_ID,
+        f"{tag}: chaos past the first grazing",
+        "a jump to impacting chaotic motion",
+        width,
+        width >= diagrams.APPRECIABLE_WIDTH,
+        kind="paper",
+        rule=rule,
+        source=source,
+        paper_text="jump to chaos",
+        ours_text=f"aperiodic over {width:.1e} in η" if width > 0 else "no aperiodic motion",
+        headline=headline,
+        note=note,
+    )
+
+
+def _cascade_row(
+    tag: str, seq: list[int], *, rule: str, source: str, headline: str, note: str = ""
+) -> Comparison:
+    """The row "reverse period-adding cascade past η_g" of a sweep whose resolved windows are ``seq``."""
+    return criterion_row(
+        FIGURE_ID,
+        f"{tag}: reverse period-adding cascade past η_g",
+        "periods decreasing by one",
+        ", ".join(map(str, seq)) or "—",
+        diagrams.is_reverse_adding(seq),
+        kind="paper",
+        rule=rule,
+        source=source,
+        paper_text="…, 4, 3, 2, 1",
+        ours_text=" → ".join(map(str, seq)) or "—",
+        headline=headline,
+        note=note,
+    )
 
 
 def panel_rows(runs: Runs, p: Panel, heads: dict[str, str]) -> list[Comparison]:
@@ -341,19 +367,13 @@ def panel_rows(runs: Runs, p: Panel, heads: dict[str, str]) -> list[Comparison]:
     g = main.grazings[0] if main.grazings else None
     mu = f"{g.multipliers[0].real:.3f} ± {abs(g.multipliers[0].imag):.3f}i".replace("-", "−") if g else "—"
     rows.append(
-        criterion_row(
-            FIGURE_ID,
-            f"{tag}: chaos past the first grazing",
-            "a jump to impacting chaotic motion",
+        _chaos_row(
+            tag,
             width,
-            width >= diagrams.APPRECIABLE_WIDTH,
-            kind="paper",
             rule=f"agree when aperiodic impacting motion (no period ≤ 50) spans at least "
             f"{diagrams.APPRECIABLE_WIDTH:g} in η in total between the first grazing and impacting "
             "period 1: chaos one could see in a diagram of the paper's range",
             source="§6.1",
-            paper_text="jump to chaos",
-            ours_text=f"aperiodic over {width:.1e} in η" if width > 0 else "no aperiodic motion",
             headline=heads["chaos"],
             note=f"The grazing orbit's multipliers are {mu} (|λ| = {g.abs_lambda:.3f}); eq. 21 looks at "
             "|λ| only, but with complex multipliers the argument decides (docs/normal-form.md §4)."
@@ -361,21 +381,15 @@ def panel_rows(runs: Runs, p: Panel, heads: dict[str, str]) -> list[Comparison]:
             else "",
         )
     )
-    seq = [w.period for w in diagrams.cascade(fine)]
+    seq = _sequence(fine)
     rows.append(
-        criterion_row(
-            FIGURE_ID,
-            f"{tag}: reverse period-adding cascade past η_g",
-            "periods decreasing by one",
-            ", ".join(map(str, seq)) or "—",
-            diagrams.is_reverse_adding(seq),
-            kind="paper",
+        _cascade_row(
+            tag,
+            seq,
             rule="agree when the clearly resolved windows past the first grazing (≥ 3 points and ≥ 1 % of "
             "the sweep's span, period-doubled satellites left out), up to impacting period 1, are at least "
             "three with periods decreasing by one",
             source="§6.1",
-            paper_text="…, 4, 3, 2, 1",
-            ours_text=" → ".join(map(str, seq)) or "—",
             headline=heads["cascade"],
             note="All windows of ≥ 2 points: "
             + ", ".join(str(w.period) for w in fine.after_grazing(2))
