@@ -19,7 +19,8 @@ install: $(STAMP)
 reproduce: $(STAMP)
 	$(BIN)/grazing report --out report
 
-# Open report/index.html in headless Chromium: every image shown, every link live (needs chromium).
+# Open report/index.html in headless Chromium: every image shown, every link live, and every plot area of
+# every figure drawn on, its data inside its limits, its labels inside the image (needs chromium).
 check-report: $(STAMP)
 	test -f report/index.html || $(MAKE) reproduce
 	$(BIN)/python -m grazing.report.browser report/index.html
