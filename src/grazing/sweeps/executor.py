@@ -25,7 +25,7 @@ from typing import Any
 
 from grazing.errors import GrazingError
 from grazing.parallel import in_flight
-from grazing.sweeps.run import batch_key, run_parts, stream_chunks
+from grazing.sweeps.run import LaneBatch, batch_key, run_parts, stream_chunks
 from grazing.sweeps.spec import ChunkResult, SweepSpec
 
 
@@ -117,11 +117,27 @@ def local_batches(parts: Sequence[Part], threads: int) -> list[list[Part]]:
 
 
 def local_results(parts: Sequence[Part], threads: int | None) -> Iterator[tuple[Part, ChunkResult]]:
-    """Each chunk of ``parts`` with its result as it finishes, by ``threads`` threads (None: one per core)."""
+    """Each chunk of ``parts`` with its result as it finishes, by ``threads`` threads (None: one per core).
+
+    The batches run one after the other; the next one's table of points
+    (:class:`~grazing.sweeps.run.LaneBatch`: a model per point, Python work) is
+    built by a thread of its own while the cores compute the one before, so
+    that they do not wait for it (a serial part of the sweep, issue 29).
+    """
+    from concurrent.futures import ThreadPoolExecutor
+
     threads = max(1, threads or os.cpu_count() or 1)
-    for batch in local_batches(parts, threads):
-        for k, result in stream_chunks(batch, threads):
-            yield batch[k], result
+    batches = local_batches(parts, threads)
+    if not batches:
+        return
+    with ThreadPoolExecutor(1, thread_name_prefix="grazing-batch") as pool:
+        upcoming = pool.submit(LaneBatch, batches[0])
+        for k, group in enumerate(batches):
+            batch = upcoming.result()
+            if k + 1 < len(batches):
+                upcoming = pool.submit(LaneBatch, batches[k + 1])
+            for i, result in stream_chunks(batch, threads):
+                yield group[i], result
 
 
 def _dask_workers(client: Any) -> int:
