@@ -134,7 +134,7 @@ def versions_line(m: dict[str, Any], packages: tuple[str, ...] = PACKAGES) -> st
 
 
 def isa_note(m: dict[str, Any]) -> str:
-    """", AVX-512 (8 doubles; grazing 8 lanes, heyoka 8)" from :func:`vector_isa`'s keys, if present."""
+    """ ", AVX-512 (8 doubles; grazing 8 lanes, heyoka 8)" from :func:`vector_isa`'s keys, if present."""
     if "vector_isa" not in m:
         return ""
     return (

@@ -62,17 +62,53 @@ def grazing_exe() -> str:
 
 
 def grazing_command(n: int, processes: int) -> list[str]:
-    return [grazing_exe(), "sweep", "--param", "eta", "--start", str(ETA_START), "--stop", str(ETA_STOP),
-            "--num", str(n), "--theta-hat", "40", *EQUAL_WORK, "--workers", str(processes), "--json"]  # fmt: skip
+    return [
+        grazing_exe(),
+        "sweep",
+        "--param",
+        "eta",
+        "--start",
+        str(ETA_START),
+        "--stop",
+        str(ETA_STOP),
+        "--num",
+        str(n),
+        "--theta-hat",
+        "40",
+        *EQUAL_WORK,
+        "--workers",
+        str(processes),
+        "--json",
+    ]
 
 
 def peer_command(n: int, processes: int, lanes: int) -> list[str]:
-    return [sys.executable, str(PEER), "--start", str(ETA_START), "--stop", str(ETA_STOP), "--num", str(n),
-            "--transient", str(TRANSIENT), "--periods", str(PERIODS), "--tol", str(TOL),
-            "--processes", str(processes), "--lanes", str(lanes), "--json"]  # fmt: skip
+    return [
+        sys.executable,
+        str(PEER),
+        "--start",
+        str(ETA_START),
+        "--stop",
+        str(ETA_STOP),
+        "--num",
+        str(n),
+        "--transient",
+        str(TRANSIENT),
+        "--periods",
+        str(PERIODS),
+        "--tol",
+        str(TOL),
+        "--processes",
+        str(processes),
+        "--lanes",
+        str(lanes),
+        "--json",
+    ]
 
 
-def interleaved(runners: dict[str, Callable[[], Any]], repeats: int, quiet: float) -> dict[str, dict[str, Any]]:
+def interleaved(
+    runners: dict[str, Callable[[], Any]], repeats: int, quiet: float
+) -> dict[str, dict[str, Any]]:
     """Each runner once (warm-up, its output kept), then ``repeats`` rounds of all of them in turn."""
     out: dict[str, Any] = {}
     for key, run in runners.items():
@@ -89,7 +125,11 @@ def interleaved(runners: dict[str, Callable[[], Any]], repeats: int, quiet: floa
             seconds[key].append(m.seconds)
             others[key].append(m.others)
     return {
-        k: {"seconds": Spread.of(seconds[k]).as_dict(), "others": Spread.of(others[k]).as_dict(), "output": out[k]}
+        k: {
+            "seconds": Spread.of(seconds[k]).as_dict(),
+            "others": Spread.of(others[k]).as_dict(),
+            "output": out[k],
+        }
         for k in runners
     }
 
@@ -107,7 +147,9 @@ def whole_process(n: int, processes: int, repeats: int, quiet: float) -> dict[st
     commands |= {f"heyoka-{lanes}": peer_command(n, processes, lanes) for lanes in LANES}
 
     def runner(cmd: list[str]) -> Callable[[], list[int]]:
-        return lambda: json.loads(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)["period"]
+        return lambda: json.loads(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)[
+            "period"
+        ]
 
     res = interleaved({k: runner(c) for k, c in commands.items()}, repeats, quiet)
     return finish(res, {k: shown(c) for k, c in commands.items()})
@@ -142,8 +184,16 @@ def in_process(n: int, processes: int, repeats: int, quiet: float) -> dict[str, 
     log(f"in-process: {n} points, {processes} worker(s), {repeats} rounds")
     etas = np.linspace(ETA_START, ETA_STOP, n)
     model = grazing.models.pendulum("B", theta_hat=math.radians(40.0))
-    options = {"x0": [0.0, 0.0], "transient": TRANSIENT, "periods": PERIODS, "fresh": True, "lyapunov": False,
-               "adaptive": False, "tol": TOL, "workers": processes}  # fmt: skip
+    options = {
+        "x0": [0.0, 0.0],
+        "transient": TRANSIENT,
+        "periods": PERIODS,
+        "fresh": True,
+        "lyapunov": False,
+        "adaptive": False,
+        "tol": TOL,
+        "workers": processes,
+    }
     runners: dict[str, Callable[[], Any]] = {
         "grazing": lambda: sweep(model, "eta", etas, **options).period.values.tolist()
     }
@@ -175,9 +225,17 @@ def compile_all(tol: float) -> None:
 def run(n: int, repeats: int, quiet: float) -> dict[str, Any]:
     processes = os.cpu_count() or 1
     return {
-        "settings": {"points": n, "eta": [ETA_START, ETA_STOP], "transient": TRANSIENT, "periods": PERIODS,
-                     "tol": TOL, "lanes_tried": list(LANES), "processes": processes, "repeats": repeats,
-                     "quiet_wait_s": quiet},  # fmt: skip
+        "settings": {
+            "points": n,
+            "eta": [ETA_START, ETA_STOP],
+            "transient": TRANSIENT,
+            "periods": PERIODS,
+            "tol": TOL,
+            "lanes_tried": list(LANES),
+            "processes": processes,
+            "repeats": repeats,
+            "quiet_wait_s": quiet,
+        },
         "whole_process": whole_process(n, processes, repeats, quiet),
         "in_process": in_process(n, processes, repeats, quiet),
         "in_process_one_core": in_process(n, 1, repeats, quiet),
@@ -188,7 +246,8 @@ def summary_lines(data: dict[str, Any]) -> list[str]:
     lines = []
     for part in ("whole_process", "in_process", "in_process_one_core"):
         d = data[part]
-        lines.append(f"{part}: heyoka's best {d['heyoka_best']}, grazing {d['speedup_median']:.2f}x as fast (medians)")
+        best, speedup = d["heyoka_best"], d["speedup_median"]
+        lines.append(f"{part}: heyoka's best {best}, grazing {speedup:.2f}x as fast (medians)")
         for key, c in d["configs"].items():
             s = c["seconds"]
             agree = c.get("periods")

@@ -144,7 +144,13 @@ def check_outcomes(ta: Any, used: int) -> None:
 
 
 def sweep(
-    etas: np.ndarray, transient: int, periods: int, tol: float, lanes: int, pool: Any = None, processes: int = 1
+    etas: np.ndarray,
+    transient: int,
+    periods: int,
+    tol: float,
+    lanes: int,
+    pool: Any = None,
+    processes: int = 1,
 ) -> list[int]:
     """The periods at ``etas``: in this process, or split over ``processes`` processes of ``pool``."""
     if pool is None:
