@@ -44,14 +44,18 @@ def emit(
     markdown: Callable[[], str],
     data: Callable[[], Any],
 ) -> None:
-    """Print the table, then the Markdown table with ``--markdown``, and write ``data()`` to ``--json``."""
+    """Print the table, then the Markdown table with ``--markdown``, and write ``data()`` to ``--json``.
+
+    The JSON also holds the Markdown table (key ``markdown``): ``run_all.py`` keeps it in the
+    saved run, and ``tables.py`` copies it into benchmarks/README.md.
+    """
     print_table()
     if args.markdown:
         print()
         print(markdown())
     if args.json:
         with open(args.json, "w") as fh:
-            json.dump(data(), fh, indent=2, default=float)
+            json.dump({**data(), "markdown": markdown()}, fh, indent=2, default=float)
 
 
 def log(msg: str) -> None:
