@@ -61,7 +61,7 @@ bench: $(STAMP)
 
 # Every benchmark the READMEs quote, into one saved run (benchmarks/results/latest.json, medians
 # with their spread, the machine and the date), then the READMEs' tables rewritten from it.
-# Run it on a quiet machine: about 20 minutes on 2 cores.
+# Run it on a quiet machine: about 15 minutes on 2 cores.
 bench-all: $(STAMP)
 	$(BIN)/python -m pip install --quiet -e ".[test,bench]"
 	$(BIN)/python benchmarks/run_all.py

@@ -2,7 +2,7 @@
 
 One command (``make bench-all``)::
 
-    python benchmarks/run_all.py                  # the full run (about 20 minutes on a quiet 2-core machine)
+    python benchmarks/run_all.py                  # the full run (about 15 minutes on a quiet 2-core machine)
     python benchmarks/run_all.py --quick          # smaller problems (about 3 minutes): proves the pipeline
     python benchmarks/run_all.py --only equal-work,sweep --out /tmp/run.json --no-tables
 
