@@ -76,6 +76,21 @@ def run_part(name: str, quick: bool, quiet_wait: float | None) -> dict[str, Any]
     return record
 
 
+def shown_command(argv: list[str]) -> str:
+    """The command as the record shows it (the reason of ``--provisional`` is a field of its own)."""
+    shown, skip = ["python benchmarks/run_all.py"], False
+    for arg in argv:
+        if skip:
+            shown.append("…")
+            skip = False
+        elif arg == "--provisional":
+            shown.append(arg)
+            skip = True
+        else:
+            shown.append("--provisional …" if arg.startswith("--provisional=") else arg)
+    return " ".join(shown)
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="the scripts' --quick problems (smaller, noisier)")
@@ -100,7 +115,7 @@ def main(argv: list[str] | None = None) -> int:
     machine["loadavg_end"] = loadavg()
     record = {
         "date": started.strftime("%Y-%m-%d %H:%M UTC"),
-        "command": " ".join(["python benchmarks/run_all.py", *(argv if argv is not None else sys.argv[1:])]),
+        "command": shown_command(argv if argv is not None else sys.argv[1:]),
         "quick": args.quick,
         "provisional": args.provisional,
         "commit": git_commit(),
