@@ -181,9 +181,9 @@ def readme_sweep(record: dict[str, Any]) -> str:
     one_core, no_adapt = (sweep_timing(sw, k)["seconds"] / ours for k in ("grazing-w1", "grazing-noadapt"))
     notes = [
         "",
-        f"Where the speed comes from (medians): both cores ({one_core:.1f}× "
-        f"for one core), adaptive transients ({no_adapt:.1f}× "
-        f"without them), the Lyapunov exponents ({ours / same:.2f}× the time without them), and the "
+        f"Where the speed comes from (medians): both cores (on one core the sweep takes {one_core:.1f}× as "
+        f"long), adaptive transients (without them {no_adapt:.1f}× as long); the Lyapunov exponents cost "
+        f"time (the default sweep takes {ours / same:.2f}× as long as without them); and the "
         f"engine: on one core, with one chain of points (one lane), full transients and no Lyapunov "
         f"exponents the sweep takes {plain:.2f} s, {loop / plain:.1f}× less than the heyoka loop at the same "
         "tolerance. \\* extrapolated.",
