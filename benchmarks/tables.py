@@ -294,6 +294,8 @@ def stored_markdown(name: str) -> Callable[[dict[str, Any]], str]:
     return lambda record: (
         part(record, name)["markdown"].strip()
         + (f"\n\nFrom the saved run of {record['date']} ([above](#the-saved-run)).")
+        if name in record["parts"]
+        else f"Not in the saved run of {record['date']} (`run_all.py --only` left it out)."
     )
 
 
@@ -311,6 +313,7 @@ BLOCKS: dict[Path, dict[str, Callable[[dict[str, Any]], str]]] = {
         "sweep-full": stored_markdown("sweep"),
         "grazing-curve-full": stored_markdown("grazing-curve"),
         "curves-full": stored_markdown("curves"),
+        "scaling-full": stored_markdown("scaling"),
     },
 }
 
