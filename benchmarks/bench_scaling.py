@@ -178,7 +178,53 @@ def measure(points: int, runs: int, default: bool) -> dict[str, Any]:
     }
 
 
-def report(results: list[dict[str, Any]]) -> None:
+def dask_against_threads(points: int, runs: int) -> dict[str, Any]:
+    """The equal-work sweep in one process on a local Dask cluster (a one-thread worker process per
+    core, started and warmed up first) against the same process's threads, interleaved."""
+    import numpy as np
+    from distributed import Client, LocalCluster
+
+    import grazing
+    from grazing.core.options import SweepSettings
+    from grazing.sweeps import sweep
+
+    ncores = os.cpu_count() or 1
+    model = grazing.models.pendulum("B")
+    values = np.linspace(0.44, 0.49, points)
+    settings = SweepSettings(fresh=True, lyapunov=False, adaptive=False, tol=1e-10)
+    log(f"Dask against threads, {points} points: {ncores} one-thread workers, {runs} interleaved runs")
+    with LocalCluster(n_workers=ncores, threads_per_worker=1, dashboard_address=None) as cluster:
+        with Client(cluster) as client:
+            sweep(model, "eta", values[: min(points, 200)], settings=settings, client=client)
+            sweep(model, "eta", values[: min(points, 200)], settings=settings)
+            threads, dask = [], []
+            for _ in range(runs):
+                start = time.perf_counter()
+                a = sweep(model, "eta", values, settings=settings)
+                threads.append(time.perf_counter() - start)
+                start = time.perf_counter()
+                b = sweep(model, "eta", values, settings=settings, client=client)
+                dask.append(time.perf_counter() - start)
+    same = bool(np.array_equal(np.asarray(a["period"]), np.asarray(b["period"])))
+    return {
+        "points": points,
+        "workers": ncores,
+        "threads_s": {"median": statistics.median(threads), "min": min(threads), "max": max(threads)},
+        "dask_s": {"median": statistics.median(dask), "min": min(dask), "max": max(dask)},
+        "ratio": statistics.median(dask) / statistics.median(threads),
+        "same_periods": same,
+    }
+
+
+def report(results: list[dict[str, Any]], dask: dict[str, Any] | None = None) -> None:
+    if dask is not None:
+        t, d = dask["threads_s"], dask["dask_s"]
+        print(
+            f"\nDask against threads, equal-work sweep of {dask['points']} points, {dask['workers']} cores: "
+            f"threads {t['median']:.2f} s ({t['min']:.2f}–{t['max']:.2f}), local Dask cluster "
+            f"{d['median']:.2f} s ({d['min']:.2f}–{d['max']:.2f}): {dask['ratio']:.2f}× as long; "
+            f"periods {'the same' if dask['same_periods'] else 'DIFFER'}"
+        )
     for r in results:
         m = r["phases_median"]
         print(
@@ -205,7 +251,7 @@ def report(results: list[dict[str, Any]]) -> None:
             print("    efficiency: " + "".join(f"{100 * p['efficiency']:>7.0f}%" for p in a["projection"]))
 
 
-def markdown(results: list[dict[str, Any]]) -> str:
+def markdown(results: list[dict[str, Any]], dask: dict[str, Any] | None = None) -> str:
     rows = [
         "| sweep | serial (s) | parallel (CPU-s) | " + " | ".join(f"{c} cores" for c in CORES) + " |",
         "|---|---:|---:|" + "---:|" * len(CORES),
@@ -218,6 +264,16 @@ def markdown(results: list[dict[str, Any]]) -> str:
                 f"| {r['sweep']}, {r['points']} points ({how}) "
                 f"| {a['serial']:.2f} | {a['parallel']:.1f} | {eff} |"
             )
+    if dask is not None:
+        t, d = dask["threads_s"], dask["dask_s"]
+        rows += [
+            "",
+            f"Equal-work sweep of {dask['points']} points on {dask['workers']} cores, in one process: "
+            f"threads {t['median']:.2f} s ({t['min']:.2f}–{t['max']:.2f}), a local Dask cluster of "
+            f"{dask['workers']} one-thread workers {d['median']:.2f} s ({d['min']:.2f}–{d['max']:.2f}), "
+            f"{dask['ratio']:.2f}× as long (issue 29: within 1.15×); periods "
+            f"{'the same' if dask['same_periods'] else 'differ'}.",
+        ]
     return "\n".join(rows)
 
 
@@ -226,6 +282,7 @@ def main() -> None:
     parser.add_argument("--points", type=int, default=4000, help="points of the sweep (default 4000)")
     parser.add_argument("--runs", type=int, default=3, help="runs of each measurement (default 3)")
     parser.add_argument("--default", action="store_true", help="also the default sweep (one chain)")
+    parser.add_argument("--dask", action="store_true", help="also a local Dask cluster against threads")
     args = parser.parse_args()
     load_start = loadavg()
     subprocess.run(
@@ -234,13 +291,14 @@ def main() -> None:
     results = [measure(args.points, args.runs, default=False)]
     if args.default:
         results.append(measure(args.points, args.runs, default=True))
+    dask = dask_against_threads(args.points, args.runs) if args.dask else None
     machine = machine_info()
     machine["load_average"] = [load_start, loadavg()]
     emit(
         args,
-        lambda: report(results),
-        lambda: markdown(results),
-        lambda: {"machine": machine, "results": results},
+        lambda: report(results, dask),
+        lambda: markdown(results, dask),
+        lambda: {"machine": machine, "results": results, "dask": dask},
     )
     print(f"\nload average {load_start} (start), {loadavg()} (end)")
 

@@ -44,7 +44,11 @@ PARTS: dict[str, tuple[str, list[str], list[str]]] = {
     "simulate": ("bench_simulate.py", [], ["--quick"]),
     "grazing-curve": ("bench_grazing_curve.py", [], []),
     "curves": ("bench_curves.py", [], []),
-    "scaling": ("bench_scaling.py", ["--points", "8000"], ["--points", "1000", "--runs", "2"]),
+    "scaling": (
+        "bench_scaling.py",
+        ["--points", "8000", "--dask"],
+        ["--points", "1000", "--runs", "2", "--dask"],
+    ),
 }
 QUIET_WAIT_SCRIPTS = {"bench_equal_work.py", "bench_sweep.py", "bench_grazing_curve.py", "bench_curves.py"}
 """The scripts that wait for other processes to go quiet before each timed run (``--quiet-wait``)."""
