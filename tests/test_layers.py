@@ -23,6 +23,7 @@ LAYERS = {
     "grazing.errors": 0,
     "grazing.atomic": 0,
     "grazing.outputs": 0,
+    "grazing.plot_areas": 0,
     "grazing.parallel": 0,
     "grazing.core": 1,
     "grazing.models": 2,

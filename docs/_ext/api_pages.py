@@ -35,6 +35,7 @@ INTERNAL = {
     "grazing.cli": "the command line, documented by `grazing --help` and the README",
     "grazing.atomic": "files written all at once (used by outputs)",
     "grazing.parallel": "the pool of worker processes",
+    "grazing.plot_areas": "the record of a saved figure's plot areas, read by make check-report",
 }
 """Modules of ``grazing`` left out of the reference, with the reason."""
 

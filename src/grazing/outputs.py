@@ -358,7 +358,7 @@ def save_png(
     fig: Any, path: str | Path, *, dpi: float, overwrite: bool = False, hint: str = PYTHON_HINT
 ) -> Path:
     """Save a matplotlib figure as a PNG with grazing's mark, all at once; return the path."""
-    from grazing.plotting.checks import LAYOUT_KEY, axes_layout, layout_text
+    from grazing.plot_areas import LAYOUT_KEY, axes_layout, layout_text
 
     check_replaceable(path, overwrite=overwrite, hint=hint)
     buf = io.BytesIO()

@@ -1,7 +1,7 @@
 """``make check-report`` judges what each saved figure shows, plot area by plot area.
 
 Every PNG grazing saves carries the layout of its plot areas
-(:func:`grazing.plotting.checks.axes_layout`); :func:`grazing.report.browser.image_problems`
+(:func:`grazing.plot_areas.axes_layout`); :func:`grazing.report.browser.image_problems`
 reads it back and looks at the pixels: a plot area nearly blank, data only outside the axis
 limits (the two-parameter map drawn in radians on a degree axis, issue 30), labels running
 off the image (fig 10's titles did, by a few pixels).
@@ -20,7 +20,7 @@ matplotlib.use("Agg")
 from matplotlib.figure import Figure
 
 from grazing.outputs import png_text, save_png
-from grazing.plotting.checks import LAYOUT_KEY, axes_layout, read_layout
+from grazing.plot_areas import LAYOUT_KEY, axes_layout, read_layout
 from grazing.report.browser import check_page, find_chromium, image_problems, main
 
 

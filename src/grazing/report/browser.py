@@ -201,7 +201,7 @@ def image_problems(path: Path | str) -> list[str]:
     """What is wrong with the content of a figure grazing saved, one line each.
 
     A PNG written by :func:`grazing.outputs.save_png` carries the layout of its
-    plot areas (:func:`grazing.plotting.checks.axes_layout`); each plot area is
+    plot areas (:func:`grazing.plot_areas.axes_layout`); each plot area is
     judged on the pixels of the image: nearly blank (fewer than
     :data:`AXES_BLANK_FRACTION` of its pixels drawn on, frame aside), data
     drawn only outside its axis limits, or labels and title running off the
@@ -225,7 +225,7 @@ def image_problems(path: Path | str) -> list[str]:
     import numpy as np
 
     from grazing.outputs import png_text
-    from grazing.plotting.checks import LAYOUT_KEY, read_layout
+    from grazing.plot_areas import LAYOUT_KEY, read_layout
 
     if Path(path).suffix.lower() != ".png":
         return []
