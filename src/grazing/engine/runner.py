@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from grazing.core.model import HybridModel
-from grazing.core.options import CHATTER_TOL, MACHINE_EPSILON
+from grazing.core.options import CHATTER_TOL, MACHINE_EPSILON, step_limit
 from grazing.core.solution import Status
 from grazing.engine.codegen import direction_columns, taylor_order
 from grazing.errors import SimulationError
@@ -251,7 +251,7 @@ class Runner:
         """Advance by ``periods`` samples, keeping (recording) the last ``keep``."""
         T = self.T
         if max_steps is None:
-            max_steps = 20000 * periods + 100_000
+            max_steps = step_limit(periods)
         start = (self.x, self.V, self.k, self.s, self.mode)  # a records.Start, as a plain tuple
         cfg = (  # a records.Config, as a plain tuple (see the driver's integrate)
             int(max_steps), periods, self.ks, float(self.ss), keep, bool(lyapunov),
@@ -275,31 +275,3 @@ class Runner:
             out.samples, out.impacts, out.n_impacts, out.sticking, out.trajectory, out.log_sums,
             out.lyap_span, gm[:, : 2 + n], gm[:, 2 + n :], out.jacobian_valid, out.steps,
         )  # fmt: skip
-
-
-def _compile_one(job: tuple[HybridModel, tuple[str, ...]]) -> None:
-    model, sens = job
-    Runner(model, np.zeros(model.n_states), variational=bool(sens), sensitivities=sens).advance(1, 1)
-
-
-def precompile(jobs: Sequence[tuple[HybridModel, tuple[str, ...]]], workers: int | None = None) -> None:
-    """Compile (or load) the kernels of several model variants in parallel processes.
-
-    Each job is ``(model, sensitivities)``.  numba caches the machine code on
-    disk, so afterwards every process loads it instead of compiling.  Useful
-    before a long computation on a machine that has not compiled them yet.
-    """
-    import os
-
-    from grazing.parallel import map_unordered
-
-    seen: set[tuple[int, int]] = set()
-    todo = []
-    for model, sens in jobs:  # jobs needing the same module compile it once
-        key = (id(model._def), direction_columns(len(sens)))
-        if key not in seen:
-            seen.add(key)
-            todo.append((model, sens))
-    # A fresh interpreter per worker (spawn): no half-initialised numba state is inherited.
-    for _ in map_unordered(_compile_one, todo, workers or os.cpu_count() or 1, start_method="spawn"):
-        pass

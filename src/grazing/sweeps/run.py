@@ -40,7 +40,6 @@ from typing import Any
 import numpy as np
 
 from grazing.core.model import HybridModel
-from grazing.core.options import CHATTER_TOL
 from grazing.core.period import DEFAULT_MAX_PERIOD, DEFAULT_PERIOD_TOL, detect_periods
 from grazing.core.solution import Status
 from grazing.engine.codegen import taylor_order
@@ -61,7 +60,7 @@ def batch_key(spec: SweepSpec) -> tuple[Any, ...]:
         zdm = (float(z.accel), tuple(np.asarray(z.direction, dtype=float)), float(z.window), int(z.stop))
     return (
         id(spec.model._def), spec.model.periodic, taylor_order(spec.tol), spec.tol, spec.transient,
-        spec.periods, spec.adaptive, spec.adaptive_tol, spec.lyapunov, zdm,
+        spec.periods, spec.adaptive, spec.adaptive_tol, spec.lyapunov, zdm, spec.chatter_tol,
     )  # fmt: skip
 
 
@@ -191,7 +190,7 @@ class LaneBatch:
             float(spec.adaptive_tol),
             bool(spec.lyapunov),
             float(step_safety(spec.tol, self._order)),
-            float(CHATTER_TOL),
+            float(spec.chatter_tol),
             z is not None,
             float(z.accel) if z is not None else 1.0,
             np.asarray(z.direction if z is not None else np.zeros(n), dtype=float),

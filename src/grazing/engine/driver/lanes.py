@@ -31,6 +31,7 @@ import math
 import numpy as np
 from numba import njit
 
+from grazing.core.options import STEPS_EXTRA, STEPS_PER_PERIOD
 from grazing.engine.abi import TC_FREE_LANES, TC_VAR_LANES, call_model
 from grazing.engine.driver.atomics import fetch_add, load_acquire, store_release
 from grazing.engine.driver.calls import tc_free, tc_stick, tc_var
@@ -137,7 +138,7 @@ def begin_request(li, lf, lane, periods, keep, use_var, T, zdm_s):
     li[lane, L_REC] = 1 if periods - keep == 0 else 0
     li[lane, L_LSTART] = li[lane, L_REC]
     li[lane, L_STEPS] = 0
-    li[lane, L_MAXSTEPS] = 20000 * periods + 100_000
+    li[lane, L_MAXSTEPS] = STEPS_PER_PERIOD * periods + STEPS_EXTRA  # (core.options.step_limit)
     li[lane, L_ZERO] = 0
     li[lane, L_JAC] = 1
     li[lane, L_VAR] = 1 if use_var else 0
