@@ -53,37 +53,42 @@ VECTOR_MIN_LANES = 3
 
 # A lane's stage in its point's protocol.
 IDLE, TRANSIENT, EXTRA, FINAL = 0, 1, 2, 3
-# Integer state of a lane (columns of ``li``).
-(
-    L_K,
-    L_MODE,
-    L_STUCK,
-    L_DEFL,
-    L_DEFL_STOP,
-    L_KS,
-    L_ISAMP,
-    L_NSAMP,
-    L_NKEEP,
-    L_REC,
-    L_LSTART,
-    L_STEPS,
-    L_MAXSTEPS,
-    L_ZERO,
-    L_JAC,
-    L_VAR,
-    L_KZ,
-    L_STATUS,
-    L_STAGE,
-    L_POINT,
-    L_JOBEND,
-    L_USED,
-    L_BLOCK,
-    L_RKS,
-    L_JOB,
-    L_NLI,
-) = range(26)
-# Float state of a lane (columns of ``lf``).
-F_S, F_SS, F_LT0, F_RSS, F_NLF = range(5)
+LANE_STATE = np.dtype(
+    [
+        # where the lane is in its point's protocol
+        ("stage", np.int64),  # IDLE, TRANSIENT, EXTRA or FINAL
+        ("point", np.int64),  # the point it computes
+        ("job", np.int64),  # the job (run of points) it follows
+        ("job_end", np.int64),  # the end of that job's points (0: none taken yet, -1: no more jobs)
+        ("status", np.int64),  # its point's Status code so far
+        ("block", np.int64),  # periods of the transient's current block
+        ("used", np.int64),  # transient periods run so far
+        ("req_ks", np.int64),  # the current request's first sample at (req_ks, req_ss) (Runner's ks, ss)
+        ("req_ss", np.float64),
+        # the run (loop.integrate's locals of the same names)
+        ("k", np.int64),  # time k T + s
+        ("s", np.float64),
+        ("mode", np.int64),  # 0 free flight, 1 sticking
+        ("stuck", np.int64),  # the stop it sticks to
+        ("defl", np.int64),  # known roots at u = 0 of the next step's event polynomial
+        ("defl_stop", np.int64),  # ... of this stop's
+        ("ks", np.int64),  # the next sample at (ks, ss)
+        ("ss", np.float64),
+        ("isamp", np.int64),  # samples taken
+        ("n_samples", np.int64),  # the request ends at this sample
+        ("n_keep", np.int64),  # its last n_keep are kept
+        ("recording", np.int64),  # 1: the recorded span has started
+        ("lyap_started", np.int64),  # 1: the Lyapunov sums have started, at lyap_t0
+        ("lyap_t0", np.float64),
+        ("steps", np.int64),
+        ("max_steps", np.int64),
+        ("zero_events", np.int64),  # consecutive events at u = 0
+        ("jac_valid", np.int64),  # 1: no impact without a Jacobian, no sticking
+        ("use_var", np.int64),  # 1: with the variational equations
+        ("kz", np.int64),  # the discontinuity map's next period
+    ]
+)
+"""The state of a lane: one record per lane (``ls[lane].k`` ...), compiled by numba as a struct."""
 
 
 @njit(cache=True)
@@ -130,25 +135,25 @@ def to_lane(X, O, rows, nstops, K, XT, OT, lane):
 
 
 @njit(cache=True)
-def begin_request(li, lf, lane, periods, keep, use_var, T, zdm_s):
-    """Start lane ``lane`` on ``periods`` samples keeping the last ``keep`` (``Runner.advance``)."""
-    li[lane, L_NSAMP] = periods
-    li[lane, L_NKEEP] = keep
-    li[lane, L_ISAMP] = 0
-    li[lane, L_REC] = 1 if periods - keep == 0 else 0
-    li[lane, L_LSTART] = li[lane, L_REC]
-    li[lane, L_STEPS] = 0
-    li[lane, L_MAXSTEPS] = STEPS_PER_PERIOD * periods + STEPS_EXTRA  # (core.options.step_limit)
-    li[lane, L_ZERO] = 0
-    li[lane, L_JAC] = 1
-    li[lane, L_VAR] = 1 if use_var else 0
-    li[lane, L_DEFL] = 0
-    li[lane, L_KS] = li[lane, L_RKS]
-    lf[lane, F_SS] = lf[lane, F_RSS]
-    k = li[lane, L_K]
-    s = lf[lane, F_S]
-    lf[lane, F_LT0] = k * T + s
-    li[lane, L_KZ] = k if s < zdm_s - 1e-9 * T else k + 1
+def begin_request(st, periods, keep, use_var, T, zdm_s):
+    """Start a lane (state ``st``) on ``periods`` samples keeping the last ``keep`` (``Runner.advance``)."""
+    st.n_samples = periods
+    st.n_keep = keep
+    st.isamp = 0
+    st.recording = 1 if periods - keep == 0 else 0
+    st.lyap_started = st.recording
+    st.steps = 0
+    st.max_steps = STEPS_PER_PERIOD * periods + STEPS_EXTRA  # (core.options.step_limit)
+    st.zero_events = 0
+    st.jac_valid = 1
+    st.use_var = 1 if use_var else 0
+    st.defl = 0
+    st.ks = st.req_ks
+    st.ss = st.req_ss
+    k = st.k
+    s = st.s
+    st.lyap_t0 = k * T + s
+    st.kz = k if s < zdm_s - 1e-9 * T else k + 1
 
 
 @njit(cache=False, nogil=True)  # (compiled once per machine into its own object file, grazing.engine.native)
@@ -220,8 +225,7 @@ def sweep_lanes(
     keep_max = max(periods, ADAPTIVE_BLOCK)
     use_lanes = L > 1 and L == m.lanes and m.fns[TC_FREE_LANES] != 0  # (the lane functions' width)
 
-    li = np.zeros((L, L_NLI), dtype=np.int64)
-    lf = np.zeros((L, F_NLF))
+    ls = np.zeros(L, dtype=LANE_STATE)
     XS = np.zeros((ntot, L))  # the lanes' states (and variational matrices), lane by lane
     Xs = np.zeros((ntot, K))  # one lane's coefficients from a scalar function
     Os = np.zeros((nstops, K))
@@ -265,49 +269,49 @@ def sweep_lanes(
 
     active = 0
     for lane in range(L):
-        li[lane, L_STAGE] = IDLE
+        ls[lane].stage = IDLE
     while True:
         if load_acquire(control, 1) != 0:  # the caller stops the sweep: unfinished points stay at -1
             return
         # Idle lanes take the next point: their job's next one, else the next job's first.
         for lane in range(L):
-            while li[lane, L_STAGE] == IDLE and li[lane, L_JOBEND] >= 0:
-                p = li[lane, L_POINT] + 1
-                carried = li[lane, L_STATUS] == STATUS_OK and li[lane, L_JOBEND] > 0
+            while ls[lane].stage == IDLE and ls[lane].job_end >= 0:
+                p = ls[lane].point + 1
+                carried = ls[lane].status == STATUS_OK and ls[lane].job_end > 0
                 first = False
-                if li[lane, L_JOBEND] == 0 or p >= li[lane, L_JOBEND]:
+                if ls[lane].job_end == 0 or p >= ls[lane].job_end:
                     if control[2] > 0 and active >= control[2]:
                         break  # (this thread has its share of the jobs running)
                     job = fetch_add(control, 0, 1)
                     if job >= jobs.shape[0]:
-                        li[lane, L_JOBEND] = -1  # (no more jobs for this lane)
+                        ls[lane].job_end = -1  # (no more jobs for this lane)
                         break
                     p = jobs[job, 0]
-                    li[lane, L_JOBEND] = jobs[job, 1]
-                    li[lane, L_JOB] = job
+                    ls[lane].job_end = jobs[job, 1]
+                    ls[lane].job = job
                     carried = False
                     first = True
-                li[lane, L_POINT] = p
+                ls[lane].point = p
                 T = Ts[p]
                 if first:
                     for i in range(n):
-                        XS[i, lane] = firsts[li[lane, L_JOB], 1 + i]
-                    t0 = firsts[li[lane, L_JOB], 0]
+                        XS[i, lane] = firsts[ls[lane].job, 1 + i]
+                    t0 = firsts[ls[lane].job, 0]
                 elif fresh or not carried:
                     for i in range(n):
-                        XS[i, lane] = x0[li[lane, L_JOB], i]
+                        XS[i, lane] = x0[ls[lane].job, i]
                     t0 = 0.0
                 else:
                     t0 = tcarry[p] if periodic else out_t[p - 1]
                 k0, s0, ks0, ss0 = start_times(t0, T, sphase[p], periodic)
-                li[lane, L_K] = k0
-                lf[lane, F_S] = s0
-                li[lane, L_RKS] = ks0
-                lf[lane, F_RSS] = ss0
-                li[lane, L_MODE] = 0
-                li[lane, L_STUCK] = 0
-                li[lane, L_STATUS] = STATUS_OK
-                li[lane, L_USED] = 0
+                ls[lane].k = k0
+                ls[lane].s = s0
+                ls[lane].req_ks = ks0
+                ls[lane].req_ss = ss0
+                ls[lane].mode = 0
+                ls[lane].stuck = 0
+                ls[lane].status = STATUS_OK
+                ls[lane].used = 0
                 for j in range(npv):
                     pl[lane, j] = pvs[p, j]
                     PT[j, lane] = pvs[p, j]
@@ -317,13 +321,13 @@ def sweep_lanes(
                     logs[lane, j] = 0.0
                 if budget > 0:
                     blk = min(ADAPTIVE_BLOCK, budget)
-                    li[lane, L_BLOCK] = blk
-                    li[lane, L_STAGE] = TRANSIENT
-                    begin_request(li, lf, lane, blk, blk if adaptive else 0, False, T, zdms[p])
+                    ls[lane].block = blk
+                    ls[lane].stage = TRANSIENT
+                    begin_request(ls[lane], blk, blk if adaptive else 0, False, T, zdms[p])
                 else:
-                    li[lane, L_STAGE] = FINAL
+                    ls[lane].stage = FINAL
                     final_request(
-                        li, lf, XS, n, lane, align, periods, lyapunov, T, sphase[p], periodic, zdms[p]
+                        ls[lane], XS, n, lane, align, periods, lyapunov, T, sphase[p], periodic, zdms[p]
                     )
                 active += 1
         if active == 0:
@@ -334,15 +338,15 @@ def sweep_lanes(
         nvar = 0
         for lane in range(L):
             kinds[lane] = 0
-            if li[lane, L_STAGE] != IDLE and li[lane, L_MODE] == 0:
-                if li[lane, L_VAR] == 1:
+            if ls[lane].stage != IDLE and ls[lane].mode == 0:
+                if ls[lane].use_var == 1:
                     kinds[lane] = 2
                     nvar += 1
                 else:
                     kinds[lane] = 1
                     nfree += 1
         for lane in range(L):
-            SI[lane] = lf[lane, F_S]
+            SI[lane] = ls[lane].s
         for kind in (1, 2):
             count = nfree if kind == 1 else nvar
             rows = n if kind == 1 else ntot
@@ -387,25 +391,25 @@ def sweep_lanes(
             todo[lane] = 0
             flags[lane] = 0
             plain[lane] = 0
-            if li[lane, L_STAGE] == IDLE:
+            if ls[lane].stage == IDLE:
                 continue
-            p = li[lane, L_POINT]
+            p = ls[lane].point
             T = Ts[p]
-            k = li[lane, L_K]
-            s = lf[lane, F_S]
-            mode = li[lane, L_MODE]
+            k = ls[lane].k
+            s = ls[lane].s
+            mode = ls[lane].mode
             status = STATUS_OK
-            if li[lane, L_STEPS] >= li[lane, L_MAXSTEPS]:
+            if ls[lane].steps >= ls[lane].max_steps:
                 status = STATUS_STEP_LIMIT
             for i in range(n):
                 if not math.isfinite(XS[i, lane]):
                     status = STATUS_NONFINITE
             if status != STATUS_OK:
                 flags[lane] = 8
-                li[lane, L_STATUS] = status
+                ls[lane].status = status
                 continue
             if mode == 1:
-                stuck = li[lane, L_STUCK]
+                stuck = ls[lane].stuck
                 for i in range(n):
                     xl[i] = XS[i, lane]
                 tc_stick(m, xl, s, pl[lane], Xs, Os, stuck)
@@ -413,14 +417,14 @@ def sweep_lanes(
                 h = step_size(Xs, n, Os, nstops, stuck, order, T, factor)
             else:
                 h = step_from_norms(nx_[lane], n1_[lane], n2_[lane], order, T, factor)
-            isamp = li[lane, L_ISAMP]
-            rem = (li[lane, L_KS] - k) * T + (lf[lane, F_SS] - s)
+            isamp = ls[lane].isamp
+            rem = (ls[lane].ks - k) * T + (ls[lane].ss - s)
             is_last = False
-            if isamp == li[lane, L_NSAMP] - 1 and h >= rem:
+            if isamp == ls[lane].n_samples - 1 and h >= rem:
                 h = rem
                 is_last = True
             if zdm_on:
-                rem_z = (li[lane, L_KZ] - k) * T + (zdms[p] - s)
+                rem_z = (ls[lane].kz - k) * T + (zdms[p] - s)
                 if rem_z <= h:
                     h = rem_z
                     flags[lane] |= 4
@@ -429,7 +433,7 @@ def sweep_lanes(
                 flags[lane] |= 2
             hs[lane] = h
             todo[lane] = 1
-            plain[lane] = 1 if mode == 0 and li[lane, L_DEFL] == 0 else 0
+            plain[lane] = 1 if mode == 0 and ls[lane].defl == 0 else 0
 
         # No event on the step where every guard's polynomial is certainly positive (event_certificate
         # on vectors: the same coefficients as event_polynomial); the other lanes search lane by lane
@@ -465,17 +469,17 @@ def sweep_lanes(
                 u = -1.0
                 ev_stop = 0
             else:
-                mode = li[lane, L_MODE]
+                mode = ls[lane].mode
                 u, ev_stop = first_event(
                     m,
                     OT[:, :, lane],
                     h,
                     mode,
-                    li[lane, L_STUCK],
+                    ls[lane].stuck,
                     True,
                     watch if zdm_on else -1,
-                    li[lane, L_DEFL],
-                    li[lane, L_DEFL_STOP],
+                    ls[lane].defl,
+                    ls[lane].defl_stop,
                     False,
                     watch,
                     a,
@@ -483,14 +487,14 @@ def sweep_lanes(
                 )
             event = u >= 0.0 and h > 0.0
             if event and u == 0.0:
-                li[lane, L_ZERO] += 1
-                if li[lane, L_ZERO] > 3:
+                ls[lane].zero_events += 1
+                if ls[lane].zero_events > 3:
                     flags[lane] = 8
-                    li[lane, L_STATUS] = STATUS_ZENO
+                    ls[lane].status = STATUS_ZENO
                     todo[lane] = 0
                     continue
             else:
-                li[lane, L_ZERO] = 0
+                ls[lane].zero_events = 0
             is_last = (flags[lane] & 2) != 0
             h_acc = u * h if event else h
             if event and is_last and u >= 1.0:
@@ -499,18 +503,18 @@ def sweep_lanes(
                 flags[lane] |= 1
             evs[lane] = ev_stop
             dts[lane] = h_acc
-            p = li[lane, L_POINT]
+            p = ls[lane].point
             T = Ts[p]
-            k = li[lane, L_K]
-            s = lf[lane, F_S]
-            if (li[lane, L_KS] - k) * T + (lf[lane, F_SS] - s) <= h_acc:
-                recording = li[lane, L_REC] == 1
+            k = ls[lane].k
+            s = ls[lane].s
+            if (ls[lane].ks - k) * T + (ls[lane].ss - s) <= h_acc:
+                recording = ls[lane].recording == 1
                 isamp, ks, ss, recording, _, _, _, _ = take_samples(
                     m,
                     T,
                     periodic,
-                    li[lane, L_NSAMP],
-                    li[lane, L_NKEEP],
+                    ls[lane].n_samples,
+                    ls[lane].n_keep,
                     0.0,
                     XT[:, :, lane],
                     k,
@@ -518,11 +522,11 @@ def sweep_lanes(
                     h_acc,
                     event,
                     is_last,
-                    li[lane, L_MODE],
-                    li[lane, L_ISAMP],
-                    li[lane, L_KS],
-                    lf[lane, F_SS],
-                    li[lane, L_NSAMP] - li[lane, L_NKEEP],
+                    ls[lane].mode,
+                    ls[lane].isamp,
+                    ls[lane].ks,
+                    ls[lane].ss,
+                    ls[lane].n_samples - ls[lane].n_keep,
                     recording,
                     buf[lane],
                     sticks,
@@ -533,10 +537,10 @@ def sweep_lanes(
                     s,
                     xe,
                 )
-                li[lane, L_ISAMP] = isamp
-                li[lane, L_KS] = ks
-                lf[lane, F_SS] = ss
-                li[lane, L_REC] = 1 if recording else 0
+                ls[lane].isamp = isamp
+                ls[lane].ks = ks
+                ls[lane].ss = ss
+                ls[lane].recording = 1 if recording else 0
 
         # The advance of every stepping lane to the end of its accepted part (eval_rows on vectors):
         # the state in all, the variational equations in free flight.
@@ -550,29 +554,29 @@ def sweep_lanes(
                 for lane in range(L):
                     acc[lane] = acc[lane] * dts[lane] + XT[i, j, lane]
             for lane in range(L):
-                if todo[lane] == 1 and (i < n or (kinds[lane] == 2 and li[lane, L_MODE] == 0)):
+                if todo[lane] == 1 and (i < n or (kinds[lane] == 2 and ls[lane].mode == 0)):
                     XS[i, lane] = acc[lane]
 
         # Pass B, lane by lane: time, Lyapunov vectors, discontinuity map, impacts, the request's end.
         for lane in range(L):
             if flags[lane] == 8:  # the point failed (L_STATUS says why): the next point starts afresh
-                store_release(out_status, li[lane, L_POINT], li[lane, L_STATUS])
-                li[lane, L_STAGE] = IDLE
+                store_release(out_status, ls[lane].point, ls[lane].status)
+                ls[lane].stage = IDLE
                 active -= 1
                 continue
             if todo[lane] == 0:
                 continue
-            p = li[lane, L_POINT]
+            p = ls[lane].point
             T = Ts[p]
-            k = li[lane, L_K]
-            s = lf[lane, F_S] + dts[lane]
+            k = ls[lane].k
+            s = ls[lane].s + dts[lane]
             if periodic and s >= T:
                 s -= T
                 k += 1
-            li[lane, L_STEPS] += 1
-            li[lane, L_DEFL] = 0
-            mode = li[lane, L_MODE]
-            use_var = li[lane, L_VAR] == 1
+            ls[lane].steps += 1
+            ls[lane].defl = 0
+            mode = ls[lane].mode
+            use_var = ls[lane].use_var == 1
             nrows = ntot if (mode == 0 and use_var) else n
             event = (flags[lane] & 1) != 0
             zdm_hit = (flags[lane] & 4) != 0
@@ -580,7 +584,7 @@ def sweep_lanes(
             if lyap_now or zdm_hit or event:
                 for i in range(ntot):
                     xl[i] = XS[i, lane]
-                recording = li[lane, L_REC] == 1
+                recording = ls[lane].recording == 1
                 pv = pl[lane]
                 if lyap_now:
                     started, lt0 = lyapunov_step(
@@ -589,16 +593,16 @@ def sweep_lanes(
                         V,
                         ncol,
                         recording,
-                        li[lane, L_LSTART] == 1,
-                        lf[lane, F_LT0],
+                        ls[lane].lyap_started == 1,
+                        ls[lane].lyap_t0,
                         k * T + s,
                         scratch,
                         logs[lane],
                     )
-                    li[lane, L_LSTART] = 1 if started else 0
-                    lf[lane, F_LT0] = lt0
+                    ls[lane].lyap_started = 1 if started else 0
+                    ls[lane].lyap_t0 = lt0
                 if zdm_hit:
-                    li[lane, L_KZ] += 1
+                    ls[lane].kz += 1
                     applied, _ = discontinuity_map(
                         m,
                         xl,
@@ -618,17 +622,17 @@ def sweep_lanes(
                         imp,
                         0,
                     )
-                    if applied and recording and li[lane, L_STAGE] == FINAL:
+                    if applied and recording and ls[lane].stage == FINAL:
                         counts[lane, watch] += 1
                 if event:
                     ev_stop = evs[lane]
-                    stuck = li[lane, L_STUCK]
+                    stuck = ls[lane].stuck
                     if mode == 1 and ev_stop == stuck:
-                        li[lane, L_MODE] = 0
-                        li[lane, L_DEFL] = 3
-                        li[lane, L_DEFL_STOP] = stuck
+                        ls[lane].mode = 0
+                        ls[lane].defl = 3
+                        ls[lane].defl_stop = stuck
                     else:
-                        li[lane, L_MODE] = 0
+                        ls[lane].mode = 0
                         speed, _, _, salt_ok = apply_impact(
                             m,
                             xl,
@@ -649,11 +653,11 @@ def sweep_lanes(
                             0,
                         )
                         if not salt_ok:
-                            li[lane, L_JAC] = 0
-                        if recording and li[lane, L_STAGE] == FINAL:
+                            ls[lane].jac_valid = 0
+                        if recording and ls[lane].stage == FINAL:
                             counts[lane, ev_stop] += 1
-                        li[lane, L_DEFL] = 1
-                        li[lane, L_DEFL_STOP] = ev_stop
+                        ls[lane].defl = 1
+                        ls[lane].defl_stop = ev_stop
                         if m.sticks[ev_stop]:
                             dt_acc = chatter_remaining(m, xl, s, pv, ev_stop, speed, chatter_tol * T)
                             if dt_acc >= 0.0:
@@ -662,49 +666,53 @@ def sweep_lanes(
                                     s -= T
                                     k += 1
                                 enter_contact(m, xl, s, pv, ev_stop)
-                                li[lane, L_MODE] = 1
-                                li[lane, L_STUCK] = ev_stop
-                                li[lane, L_DEFL] = 0
-                                li[lane, L_JAC] = 0
+                                ls[lane].mode = 1
+                                ls[lane].stuck = ev_stop
+                                ls[lane].defl = 0
+                                ls[lane].jac_valid = 0
                 for i in range(ntot):
                     XS[i, lane] = xl[i]
-            li[lane, L_K] = k
-            lf[lane, F_S] = s
-            n_samples = li[lane, L_NSAMP]
-            if li[lane, L_ISAMP] < n_samples:
+            ls[lane].k = k
+            ls[lane].s = s
+            n_samples = ls[lane].n_samples
+            if ls[lane].isamp < n_samples:
                 continue
             # The request is done (Runner.advance returns): on to the next stage of the point.
             if periodic:
-                li[lane, L_RKS] += n_samples
+                ls[lane].req_ks += n_samples
             else:
-                lf[lane, F_RSS] += n_samples * T
-            stage = li[lane, L_STAGE]
+                ls[lane].req_ss += n_samples * T
+            stage = ls[lane].stage
             if stage == TRANSIENT:
-                blk = li[lane, L_BLOCK]
-                li[lane, L_USED] += blk
-                used = li[lane, L_USED]
+                blk = ls[lane].block
+                ls[lane].used += blk
+                used = ls[lane].used
                 nxt = -1
                 if adaptive and blk == ADAPTIVE_BLOCK:
                     per = repeats_with_period(buf[lane], blk, n, adaptive_tol, ADAPTIVE_MAX_PERIOD)
                     if per > 0:
                         extra = (budget - used) % per
                         if extra:
-                            li[lane, L_USED] += extra
-                            li[lane, L_STAGE] = EXTRA
-                            begin_request(li, lf, lane, extra, 0, False, T, zdms[p])
+                            ls[lane].used += extra
+                            ls[lane].stage = EXTRA
+                            begin_request(ls[lane], extra, 0, False, T, zdms[p])
                             continue
                         nxt = 0
                 if nxt < 0 and used < budget:
                     blk = min(ADAPTIVE_BLOCK, budget - used)
-                    li[lane, L_BLOCK] = blk
-                    begin_request(li, lf, lane, blk, blk if adaptive else 0, False, T, zdms[p])
+                    ls[lane].block = blk
+                    begin_request(ls[lane], blk, blk if adaptive else 0, False, T, zdms[p])
                     continue
-                li[lane, L_STAGE] = FINAL
-                final_request(li, lf, XS, n, lane, align, periods, lyapunov, T, sphase[p], periodic, zdms[p])
+                ls[lane].stage = FINAL
+                final_request(
+                    ls[lane], XS, n, lane, align, periods, lyapunov, T, sphase[p], periodic, zdms[p]
+                )
                 continue
             if stage == EXTRA:
-                li[lane, L_STAGE] = FINAL
-                final_request(li, lf, XS, n, lane, align, periods, lyapunov, T, sphase[p], periodic, zdms[p])
+                ls[lane].stage = FINAL
+                final_request(
+                    ls[lane], XS, n, lane, align, periods, lyapunov, T, sphase[p], periodic, zdms[p]
+                )
                 continue
             # FINAL: the point's results (a state that became non-finite on the last step fails the point).
             finite = True
@@ -714,9 +722,9 @@ def sweep_lanes(
                 for c in range(n):
                     finite = finite and math.isfinite(buf[lane, r, c])
             if not finite:
-                li[lane, L_STATUS] = STATUS_NONFINITE
+                ls[lane].status = STATUS_NONFINITE
                 store_release(out_status, p, STATUS_NONFINITE)
-                li[lane, L_STAGE] = IDLE
+                ls[lane].stage = IDLE
                 active -= 1
                 continue
             for r in range(periods):
@@ -726,8 +734,8 @@ def sweep_lanes(
                 out_by_stop[p, j] = counts[lane, j]
             lyap = math.nan
             if lyapunov:
-                span = k * T + s - lf[lane, F_LT0] if li[lane, L_LSTART] == 1 else 0.0
-                if li[lane, L_JAC] == 1 and span != 0.0:
+                span = k * T + s - ls[lane].lyap_t0 if ls[lane].lyap_started == 1 else 0.0
+                if ls[lane].jac_valid == 1 and span != 0.0:
                     lyap = logs[lane, 0] / span
                     for j in range(1, n):
                         v = logs[lane, j] / span
@@ -736,28 +744,28 @@ def sweep_lanes(
                         elif v > lyap:
                             lyap = v
             out_lyap[p] = lyap
-            out_used[p] = li[lane, L_USED] + align
+            out_used[p] = ls[lane].used + align
             for i in range(n):
                 out_x[p, i] = XS[i, lane]
             out_t[p] = k * T + s
             store_release(out_status, p, STATUS_OK)  # (after its results: another thread may read them now)
-            li[lane, L_STAGE] = IDLE
+            ls[lane].stage = IDLE
             active -= 1
 
 
 @njit(cache=True)
-def final_request(li, lf, XS, n, lane, align, periods, lyapunov, T, s_phase, periodic, zdm_s):
+def final_request(st, XS, n, lane, align, periods, lyapunov, T, s_phase, periodic, zdm_s):
     """The recorded stage of a point: with the variational equations (from the identity) for Lyapunov."""
     if lyapunov:  # a new Runner at the current time (as run_point's ``var``)
-        t0 = li[lane, L_K] * T + lf[lane, F_S]
+        t0 = st.k * T + st.s
         k0, s0, ks0, ss0 = start_times(t0, T, s_phase, periodic)
-        li[lane, L_K] = k0
-        lf[lane, F_S] = s0
-        li[lane, L_RKS] = ks0
-        lf[lane, F_RSS] = ss0
+        st.k = k0
+        st.s = s0
+        st.req_ks = ks0
+        st.req_ss = ss0
         for i in range(n):
             for c in range(n):
                 XS[n + i * n + c, lane] = 1.0 if i == c else 0.0
-        begin_request(li, lf, lane, align + periods, periods, True, T, zdm_s)
+        begin_request(st, align + periods, periods, True, T, zdm_s)
     else:
-        begin_request(li, lf, lane, periods, periods, False, T, zdm_s)
+        begin_request(st, periods, periods, False, T, zdm_s)
