@@ -39,6 +39,7 @@ from grazing.engine.driver.events import first_event
 from grazing.engine.driver.impacts import apply_impact, chatter_remaining, enter_contact
 from grazing.engine.driver.loop import STATUS_NONFINITE, STATUS_OK, STATUS_STEP_LIMIT, STATUS_ZENO
 from grazing.engine.driver.recording import take_samples
+from grazing.engine.driver.state import new_state
 from grazing.engine.driver.tangent import discontinuity_map, lyapunov_step
 from grazing.engine.polyroots import quadratic_bound, work_shape
 from grazing.engine.records import Kernels
@@ -53,42 +54,6 @@ VECTOR_MIN_LANES = 3
 
 # A lane's stage in its point's protocol.
 IDLE, TRANSIENT, EXTRA, FINAL = 0, 1, 2, 3
-LANE_STATE = np.dtype(
-    [
-        # where the lane is in its point's protocol
-        ("stage", np.int64),  # IDLE, TRANSIENT, EXTRA or FINAL
-        ("point", np.int64),  # the point it computes
-        ("job", np.int64),  # the job (run of points) it follows
-        ("job_end", np.int64),  # the end of that job's points (0: none taken yet, -1: no more jobs)
-        ("status", np.int64),  # its point's Status code so far
-        ("block", np.int64),  # periods of the transient's current block
-        ("used", np.int64),  # transient periods run so far
-        ("req_ks", np.int64),  # the current request's first sample at (req_ks, req_ss) (Runner's ks, ss)
-        ("req_ss", np.float64),
-        # the run (loop.integrate's locals of the same names)
-        ("k", np.int64),  # time k T + s
-        ("s", np.float64),
-        ("mode", np.int64),  # 0 free flight, 1 sticking
-        ("stuck", np.int64),  # the stop it sticks to
-        ("defl", np.int64),  # known roots at u = 0 of the next step's event polynomial
-        ("defl_stop", np.int64),  # ... of this stop's
-        ("ks", np.int64),  # the next sample at (ks, ss)
-        ("ss", np.float64),
-        ("isamp", np.int64),  # samples taken
-        ("n_samples", np.int64),  # the request ends at this sample
-        ("n_keep", np.int64),  # its last n_keep are kept
-        ("recording", np.int64),  # 1: the recorded span has started
-        ("lyap_started", np.int64),  # 1: the Lyapunov sums have started, at lyap_t0
-        ("lyap_t0", np.float64),
-        ("steps", np.int64),
-        ("max_steps", np.int64),
-        ("zero_events", np.int64),  # consecutive events at u = 0
-        ("jac_valid", np.int64),  # 1: no impact without a Jacobian, no sticking
-        ("use_var", np.int64),  # 1: with the variational equations
-        ("kz", np.int64),  # the discontinuity map's next period
-    ]
-)
-"""The state of a lane: one record per lane (``ls[lane].k`` ...), compiled by numba as a struct."""
 
 
 @njit(cache=True)
@@ -140,13 +105,13 @@ def begin_request(st, periods, keep, use_var, T, zdm_s):
     st.n_samples = periods
     st.n_keep = keep
     st.isamp = 0
-    st.recording = 1 if periods - keep == 0 else 0
+    st.recording = periods - keep == 0
     st.lyap_started = st.recording
     st.steps = 0
     st.max_steps = STEPS_PER_PERIOD * periods + STEPS_EXTRA  # (core.options.step_limit)
     st.zero_events = 0
-    st.jac_valid = 1
-    st.use_var = 1 if use_var else 0
+    st.jac_valid = True
+    st.use_var = use_var
     st.defl = 0
     st.ks = st.req_ks
     st.ss = st.req_ss
@@ -225,7 +190,7 @@ def sweep_lanes(
     keep_max = max(periods, ADAPTIVE_BLOCK)
     use_lanes = L > 1 and L == m.lanes and m.fns[TC_FREE_LANES] != 0  # (the lane functions' width)
 
-    ls = np.zeros(L, dtype=LANE_STATE)
+    ls = new_state(L)  # the lanes' runs and where each is in its point's protocol
     XS = np.zeros((ntot, L))  # the lanes' states (and variational matrices), lane by lane
     Xs = np.zeros((ntot, K))  # one lane's coefficients from a scalar function
     Os = np.zeros((nstops, K))
@@ -293,6 +258,8 @@ def sweep_lanes(
                     first = True
                 ls[lane].point = p
                 T = Ts[p]
+                ls[lane].T = T
+                ls[lane].wrap = periodic
                 if first:
                     for i in range(n):
                         XS[i, lane] = firsts[ls[lane].job, 1 + i]
@@ -339,7 +306,7 @@ def sweep_lanes(
         for lane in range(L):
             kinds[lane] = 0
             if ls[lane].stage != IDLE and ls[lane].mode == 0:
-                if ls[lane].use_var == 1:
+                if ls[lane].use_var:
                     kinds[lane] = 2
                     nvar += 1
                 else:
@@ -503,44 +470,10 @@ def sweep_lanes(
                 flags[lane] |= 1
             evs[lane] = ev_stop
             dts[lane] = h_acc
-            p = ls[lane].point
-            T = Ts[p]
-            k = ls[lane].k
-            s = ls[lane].s
-            if (ls[lane].ks - k) * T + (ls[lane].ss - s) <= h_acc:
-                recording = ls[lane].recording == 1
-                isamp, ks, ss, recording, _, _, _, _ = take_samples(
-                    m,
-                    T,
-                    periodic,
-                    ls[lane].n_samples,
-                    ls[lane].n_keep,
-                    0.0,
-                    XT[:, :, lane],
-                    k,
-                    s,
-                    h_acc,
-                    event,
-                    is_last,
-                    ls[lane].mode,
-                    ls[lane].isamp,
-                    ls[lane].ks,
-                    ls[lane].ss,
-                    ls[lane].n_samples - ls[lane].n_keep,
-                    recording,
-                    buf[lane],
-                    sticks,
-                    0,
-                    traj,
-                    0,
-                    k,
-                    s,
-                    xe,
-                )
-                ls[lane].isamp = isamp
-                ls[lane].ks = ks
-                ls[lane].ss = ss
-                ls[lane].recording = 1 if recording else 0
+            r = ls[lane]
+            if (r.ks - r.k) * r.T + (r.ss - r.s) <= h_acc:
+                r.n_stick = 0  # (sticking intervals are not recorded)
+                take_samples(m, r, XT[:, :, lane], h_acc, event, is_last, buf[lane], sticks, traj, xe)
 
         # The advance of every stepping lane to the end of its accepted part (eval_rows on vectors):
         # the state in all, the variational equations in free flight.
@@ -576,7 +509,7 @@ def sweep_lanes(
             ls[lane].steps += 1
             ls[lane].defl = 0
             mode = ls[lane].mode
-            use_var = ls[lane].use_var == 1
+            use_var = ls[lane].use_var
             nrows = ntot if (mode == 0 and use_var) else n
             event = (flags[lane] & 1) != 0
             zdm_hit = (flags[lane] & 4) != 0
@@ -584,7 +517,7 @@ def sweep_lanes(
             if lyap_now or zdm_hit or event:
                 for i in range(ntot):
                     xl[i] = XS[i, lane]
-                recording = ls[lane].recording == 1
+                recording = ls[lane].recording
                 pv = pl[lane]
                 if lyap_now:
                     started, lt0 = lyapunov_step(
@@ -593,13 +526,13 @@ def sweep_lanes(
                         V,
                         ncol,
                         recording,
-                        ls[lane].lyap_started == 1,
+                        ls[lane].lyap_started,
                         ls[lane].lyap_t0,
                         k * T + s,
                         scratch,
                         logs[lane],
                     )
-                    ls[lane].lyap_started = 1 if started else 0
+                    ls[lane].lyap_started = started
                     ls[lane].lyap_t0 = lt0
                 if zdm_hit:
                     ls[lane].kz += 1
@@ -653,7 +586,7 @@ def sweep_lanes(
                             0,
                         )
                         if not salt_ok:
-                            ls[lane].jac_valid = 0
+                            ls[lane].jac_valid = False
                         if recording and ls[lane].stage == FINAL:
                             counts[lane, ev_stop] += 1
                         ls[lane].defl = 1
@@ -669,7 +602,7 @@ def sweep_lanes(
                                 ls[lane].mode = 1
                                 ls[lane].stuck = ev_stop
                                 ls[lane].defl = 0
-                                ls[lane].jac_valid = 0
+                                ls[lane].jac_valid = False
                 for i in range(ntot):
                     XS[i, lane] = xl[i]
             ls[lane].k = k
@@ -734,8 +667,8 @@ def sweep_lanes(
                 out_by_stop[p, j] = counts[lane, j]
             lyap = math.nan
             if lyapunov:
-                span = k * T + s - ls[lane].lyap_t0 if ls[lane].lyap_started == 1 else 0.0
-                if ls[lane].jac_valid == 1 and span != 0.0:
+                span = k * T + s - ls[lane].lyap_t0 if ls[lane].lyap_started else 0.0
+                if ls[lane].jac_valid and span != 0.0:
                     lyap = logs[lane, 0] / span
                     for j in range(1, n):
                         v = logs[lane, j] / span

@@ -38,6 +38,7 @@ from grazing.engine.driver.calls import tc_free, tc_stick, tc_var
 from grazing.engine.driver.events import first_event
 from grazing.engine.driver.impacts import apply_impact, chatter_remaining, close_sticking, enter_contact
 from grazing.engine.driver.recording import finish_guard, take_samples, track_guard, trajectory_points
+from grazing.engine.driver.state import new_state
 from grazing.engine.driver.tangent import discontinuity_map, lyapunov_step, shift_period
 from grazing.engine.polyroots import work_shape
 from grazing.engine.records import Config, Kernels, Start
@@ -134,73 +135,79 @@ def integrate(start, pv, cfg, m):
     zdm_gh = np.zeros(n)
     zdm_gv = np.zeros(n)
 
-    k = start.k
-    s = start.s
-    mode = 1 if start.mode > 0 else 0
-    stuck = max(start.mode - 1, 0)  # the stop it sticks to
-    defl = 2 if cfg.touch_start else 0
-    defl_stop = watch  # the stop the known roots at u = 0 belong to
-    ks = cfg.ks
-    ss = cfg.ss
-    isamp = 0
+    r = new_state(1)[0]  # the run's state (see .state)
+    r.T = T
+    r.wrap = wrap
+    r.traj_dt = traj_dt
+    r.n_samples = n_samples
+    r.n_keep = n_keep
+    r.k = start.k
+    r.s = start.s
+    r.mode = 1 if start.mode > 0 else 0
+    r.stuck = max(start.mode - 1, 0)  # the stop it sticks to
+    r.defl = 2 if cfg.touch_start else 0
+    r.defl_stop = watch  # the stop the known roots at u = 0 belong to
+    r.ks = cfg.ks
+    r.ss = cfg.ss
+    r.isamp = 0
     keep_from = n_samples - n_keep
-    recording = keep_from == 0
-    lyap_t0 = k * T + s
-    lyap_started = recording
-    n_imp = 0
-    n_imp_rec = 0
-    n_stick = 0
-    n_traj = 0
-    kt = k
-    st = s
-    kz = k if s < cfg.zdm_s - 1e-9 * T else k + 1
+    r.recording = keep_from == 0
+    r.lyap_t0 = r.k * T + r.s
+    r.lyap_started = r.recording
+    r.n_imp = 0
+    r.n_imp_rec = 0
+    r.n_stick = 0
+    r.n_traj = 0
+    r.kt = r.k
+    r.st = r.s
+    r.kz = r.k if r.s < cfg.zdm_s - 1e-9 * T else r.k + 1
     sz = cfg.zdm_s
-    status = STATUS_OK
-    nsteps = 0
-    zero_events = 0
-    jac_valid = True
-    if recording and traj_dt > 0.0:
-        append_row(traj, 0, k * T + s, x, n)
-        n_traj = 1
-        st += traj_dt
-        while wrap and st >= T:
-            st -= T
-            kt += 1
-    if recording and mode == 1:  # the recorded span starts while sticking
-        append_pair(sticks, n_stick, k * T + s, math.nan)
-        n_stick += 1
+    r.status = STATUS_OK
+    r.steps = 0
+    r.zero_events = 0
+    r.jac_valid = True
+    if r.recording and traj_dt > 0.0:
+        append_row(traj, 0, r.k * T + r.s, x, n)
+        r.n_traj = 1
+        r.st += traj_dt
+        while wrap and r.st >= T:
+            r.st -= T
+            r.kt += 1
+    if r.recording and r.mode == 1:  # the recorded span starts while sticking
+        append_pair(sticks, r.n_stick, r.k * T + r.s, math.nan)
+        r.n_stick += 1
 
     while True:
-        if nsteps >= max_steps:
-            status = STATUS_STEP_LIMIT
+        if r.steps >= max_steps:
+            r.status = STATUS_STEP_LIMIT
             break
         if load_acquire(sigints, 0) != sigints_seen:  # Ctrl-C (grazing.engine.interrupts)
-            status = STATUS_INTERRUPTED
+            r.status = STATUS_INTERRUPTED
             break
         for i in range(n):
             if not math.isfinite(x[i]):
-                status = STATUS_NONFINITE
+                r.status = STATUS_NONFINITE
                 break
-        if status != STATUS_OK:
+        if r.status != STATUS_OK:
             break
         # The step: Taylor coefficients of the solution (and of the event function), and the step size.
-        if mode == 0:
+        if r.mode == 0:
             if use_var:
-                tc_var(m, x, s, pv, X, O)
+                tc_var(m, x, r.s, pv, X, O)
             else:
-                tc_free(m, x, s, pv, X, O)
+                tc_free(m, x, r.s, pv, X, O)
             h = step_size(X, ntot, O, nstops, 0, order, max_step, factor)
         else:
-            tc_stick(m, x, s, pv, X, O, stuck)  # the first n rows only
-            h = step_size(X, n, O, nstops, stuck, order, max_step, factor)
-        rem = (ks - k) * T + (ss - s)
+            tc_stick(m, x, r.s, pv, X, O, r.stuck)  # the first n rows only
+            h = step_size(X, n, O, nstops, r.stuck, order, max_step, factor)
+        rem = (r.ks - r.k) * T + (r.ss - r.s)
         is_last = False
-        if isamp == n_samples - 1 and h >= rem:
+        if r.isamp == n_samples - 1 and h >= rem:
             h = rem
             is_last = True
         zdm_hit = False
         if zdm_on:
-            rem_z = (kz - k) * T + (sz - s)
+            rem_z = (r.kz - r.k) * T + (sz - r.s)
             if rem_z <= h:
                 h = rem_z
                 zdm_hit = True
@@ -208,62 +215,59 @@ def integrate(start, pv, cfg, m):
 
         # The first event on the step (each guard's polynomial in u in [0, 1]).
         u, ev_stop = first_event(
-            m, O, h, mode, stuck, events, watch if zdm_on else -1, defl, defl_stop,
-            touch_end and is_last and mode == 0, watch, a, work,
+            m, O, h, r.mode, r.stuck, events, watch if zdm_on else -1, r.defl, r.defl_stop,
+            touch_end and is_last and r.mode == 0, watch, a, work,
         )  # fmt: skip
         event = u >= 0.0 and h > 0.0
         if event and u == 0.0:
-            zero_events += 1
-            if zero_events > 3:
-                status = STATUS_ZENO
+            r.zero_events += 1
+            if r.zero_events > 3:
+                r.status = STATUS_ZENO
                 break
         else:
-            zero_events = 0
+            r.zero_events = 0
         h_acc = u * h if event else h
         if event and is_last and u >= 1.0:
             event = False
-        nrows = ntot if mode == 0 else n
+        nrows = ntot if r.mode == 0 else n
 
         # What the step records within (0, h_acc].
-        if (ks - k) * T + (ss - s) <= h_acc:  # a sample is due on this step (about once a period)
-            isamp, ks, ss, recording, n_stick, n_traj, kt, st = take_samples(
-                m, T, wrap, n_samples, n_keep, traj_dt, X, k, s, h_acc, event, is_last, mode, isamp, ks, ss,
-                keep_from, recording, samples, sticks, n_stick, traj, n_traj, kt, st, xe,
-            )  # fmt: skip
-        if recording and traj_dt > 0.0:
-            n_traj, kt, st = trajectory_points(m, T, wrap, traj_dt, X, k, s, h_acc, traj, n_traj, kt, st, xe)
-        if recording and track_min and mode == 0 and h_acc > 0.0:
+        if (r.ks - r.k) * T + (r.ss - r.s) <= h_acc:  # a sample is due on this step (about once a period)
+            take_samples(m, r, X, h_acc, event, is_last, samples, sticks, traj, xe)
+        if r.recording and traj_dt > 0.0:
+            trajectory_points(m, r, X, h_acc, traj, xe)
+        if r.recording and track_min and r.mode == 0 and h_acc > 0.0:
             for j in range(nstops):  # every stop's closest approach
                 slope_end[j], slope_first[j] = track_guard(
-                    m, O, j, X, x, k * T + s, h, h_acc, defl if defl_stop == j else 0, event, gm, min_info[j],
-                    slope_end[j], slope_first[j], xe,
+                    m, O, j, X, x, r.k * T + r.s, h, h_acc, r.defl if r.defl_stop == j else 0, event, gm,
+                    min_info[j], slope_end[j], slope_first[j], xe,
                 )  # fmt: skip
 
         # Advance to the end of the accepted part of the step.
         eval_rows(X, nrows, order, h_acc, xe)
         for i in range(nrows):
             x[i] = xe[i]
-        s += h_acc
-        if wrap and s >= T:
-            if shift_sens and mode == 0:
-                shift_period(m, x, s, pv, Tp, ncol, fbuf)
-            s -= T
-            k += 1
-        nsteps += 1
-        defl = 0
-        if lyap and use_var and mode == 0:
-            lyap_started, lyap_t0 = lyapunov_step(
-                m, x, V, ncol, recording, lyap_started, lyap_t0, k * T + s, scratch, logs
+        r.s += h_acc
+        if wrap and r.s >= T:
+            if shift_sens and r.mode == 0:
+                shift_period(m, x, r.s, pv, Tp, ncol, fbuf)
+            r.s -= T
+            r.k += 1
+        r.steps += 1
+        r.defl = 0
+        if lyap and use_var and r.mode == 0:
+            r.lyap_started, r.lyap_t0 = lyapunov_step(
+                m, x, V, ncol, r.recording, r.lyap_started, r.lyap_t0, r.k * T + r.s, scratch, logs
             )
 
         if zdm_hit:
-            kz += 1
-            record = record_impacts == 2 or (record_impacts == 1 and recording)
-            applied, n_imp_rec = discontinuity_map(
+            r.kz += 1
+            record = record_impacts == 2 or (record_impacts == 1 and r.recording)
+            applied, r.n_imp_rec = discontinuity_map(
                 m,
                 x,
-                s,
-                k * T + s,
+                r.s,
+                r.k * T + r.s,
                 pv,
                 watch,
                 zdm_a,
@@ -276,78 +280,78 @@ def integrate(start, pv, cfg, m):
                 zdm_gv,
                 record,
                 imp,
-                n_imp_rec,
+                r.n_imp_rec,
             )
             if applied:
-                n_imp += 1
+                r.n_imp += 1
 
         if event:
-            if mode == 1 and ev_stop == stuck:
+            if r.mode == 1 and ev_stop == r.stuck:
                 # Release from sticking: the contact force changes sign.
-                mode = 0
-                defl = 3
-                defl_stop = stuck
-                if recording:
-                    close_sticking(sticks, n_stick, k * T + s)
+                r.mode = 0
+                r.defl = 3
+                r.defl_stop = r.stuck
+                if r.recording:
+                    close_sticking(sticks, r.n_stick, r.k * T + r.s)
             else:
-                if mode == 1:  # sticking to one stop, it hits another: the contact ends
-                    mode = 0
-                    if recording:
-                        close_sticking(sticks, n_stick, k * T + s)
+                if r.mode == 1:  # sticking to one stop, it hits another: the contact ends
+                    r.mode = 0
+                    if r.recording:
+                        close_sticking(sticks, r.n_stick, r.k * T + r.s)
                 # Impact: x holds the state on stop ev_stop, just before its reset.
-                record = record_impacts == 2 or (record_impacts == 1 and recording)
-                traj_on = recording and traj_dt > 0.0
-                speed, n_imp_rec, n_traj, salt_ok = apply_impact(
-                    m, x, xp, s, k * T + s, pv, ev_stop, use_var, ncol, nrows, V, record, imp, n_imp_rec,
-                    traj_on, traj, n_traj,
+                record = record_impacts == 2 or (record_impacts == 1 and r.recording)
+                traj_on = r.recording and traj_dt > 0.0
+                speed, r.n_imp_rec, r.n_traj, salt_ok = apply_impact(
+                    m, x, xp, r.s, r.k * T + r.s, pv, ev_stop, use_var, ncol, nrows, V, record, imp,
+                    r.n_imp_rec, traj_on, traj, r.n_traj,
                 )  # fmt: skip
-                jac_valid = jac_valid and salt_ok  # (an impact at zero normal speed has no Jacobian)
-                n_imp += 1
-                defl = 1
-                defl_stop = ev_stop
+                r.jac_valid = r.jac_valid and salt_ok  # (an impact at zero normal speed has no Jacobian)
+                r.n_imp += 1
+                r.defl = 1
+                r.defl_stop = ev_stop
                 if m.sticks[ev_stop]:
-                    dt_acc = chatter_remaining(m, x, s, pv, ev_stop, speed, chatter_time)
+                    dt_acc = chatter_remaining(m, x, r.s, pv, ev_stop, speed, chatter_time)
                     if dt_acc >= 0.0:  # complete chattering: on to the accumulation point, then sticking
-                        s += dt_acc
-                        if wrap and s >= T:  # (the Jacobian is not valid after sticking)
-                            s -= T
-                            k += 1
-                        enter_contact(m, x, s, pv, ev_stop)
-                        mode = 1
-                        stuck = ev_stop
-                        defl = 0
-                        jac_valid = False
-                        if recording:
-                            append_pair(sticks, n_stick, k * T + s, math.nan)
-                            n_stick += 1
-        if isamp >= n_samples:
+                        r.s += dt_acc
+                        if wrap and r.s >= T:  # (the Jacobian is not valid after sticking)
+                            r.s -= T
+                            r.k += 1
+                        enter_contact(m, x, r.s, pv, ev_stop)
+                        r.mode = 1
+                        r.stuck = ev_stop
+                        r.defl = 0
+                        r.jac_valid = False
+                        if r.recording:
+                            append_pair(sticks, r.n_stick, r.k * T + r.s, math.nan)
+                            r.n_stick += 1
+        if r.isamp >= n_samples:
             break
 
-    if track_min and mode == 0 and recording:
+    if track_min and r.mode == 0 and r.recording:
         for j in range(nstops):
-            finish_guard(m, x, s, pv, j, k * T + s, slope_end[j], slope_first[j], min_info[j])
-    close_sticking(sticks, n_stick, k * T + s)
-    lyap_span = k * T + s - lyap_t0 if (lyap and lyap_started) else 0.0
+            finish_guard(m, x, r.s, pv, j, r.k * T + r.s, slope_end[j], slope_first[j], min_info[j])
+    close_sticking(sticks, r.n_stick, r.k * T + r.s)
+    lyap_span = r.k * T + r.s - r.lyap_t0 if (lyap and r.lyap_started) else 0.0
     Vout = np.zeros((n, ncol))
     if use_var:
         unpack_var(x, n, ncol, Vout)
     # A plain tuple (the caller makes the Result): numba's boxing of a named tuple runs Python code
     # (unpickling the class) without checking it for an error, a crash if a Ctrl-C is pending.
     return (
-        status,
+        r.status,
         x[:n].copy(),
         Vout,
-        k,
-        s,
-        0 if mode == 0 else 1 + stuck,
-        nsteps,
-        n_imp,
-        samples[: max(0, min(n_keep, isamp - keep_from))].copy(),
-        table_rows(imp, n_imp_rec),
-        table_rows(sticks, n_stick),
-        table_rows(traj, n_traj),
+        r.k,
+        r.s,
+        0 if r.mode == 0 else 1 + r.stuck,
+        r.steps,
+        r.n_imp,
+        samples[: max(0, min(n_keep, r.isamp - keep_from))].copy(),
+        table_rows(imp, r.n_imp_rec),
+        table_rows(sticks, r.n_stick),
+        table_rows(traj, r.n_traj),
         logs,
         lyap_span,
         min_info,
-        jac_valid,
+        r.jac_valid,
     )

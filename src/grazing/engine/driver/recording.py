@@ -18,66 +18,64 @@ from grazing.engine.stepping import append_pair, append_row, eval_rows, poly_der
 
 
 @njit(cache=True, inline="always")
-def take_samples(
-    m, T, wrap, n_samples, n_keep, traj_dt, X, k, s, h_acc, event, is_last, mode, isamp, ks, ss, keep_from,
-    recording, samples, sticks, n_stick, traj, n_traj, kt, st, xe,
-):  # fmt: skip
-    """The samples within ``(0, h_acc]`` of the step; returns the updated sampling state.
+def take_samples(m, r, X, h_acc, event, is_last, samples, sticks, traj, xe):
+    """The samples within ``(0, h_acc]`` of the step of run ``r`` (a :data:`.state.RUN_STATE` record).
 
-    Returns ``(isamp, ks, ss, recording, n_stick, n_traj, kt, st)``: samples
-    taken, the next sample's time, whether the recorded span has started, and
-    the sticking-interval and trajectory counters (the span may start while
+    Updates the sampling state of ``r``: samples taken (into ``samples``, the
+    kept ones), the next sample's time, whether the recorded span has started,
+    and the sticking-interval and trajectory counters (the span may start while
     sticking, and starts the trajectory).
     """
     n = m.nx
     order = m.order
-    while isamp < n_samples:
-        dt = (ks - k) * T + (ss - s)
+    T = r.T
+    keep_from = r.n_samples - r.n_keep
+    while r.isamp < r.n_samples:
+        dt = (r.ks - r.k) * T + (r.ss - r.s)
         if dt > h_acc or (event and dt == h_acc and not is_last):
             break
-        if is_last and isamp == n_samples - 1:
+        if is_last and r.isamp == r.n_samples - 1:
             dt = h_acc
-        if isamp >= keep_from:
+        if r.isamp >= keep_from:
             eval_rows(X, n, order, dt, xe)
-            set_row(samples, isamp - keep_from, 0, xe, n)
-        isamp += 1
-        if wrap:
-            ks += 1
+            set_row(samples, r.isamp - keep_from, 0, xe, n)
+        r.isamp += 1
+        if r.wrap:
+            r.ks += 1
         else:
-            ss += T
-        if isamp == keep_from and not recording and n_keep > 0:
-            recording = True
-            if mode == 1:  # recording starts while sticking: the interval starts here
-                append_pair(sticks, n_stick, k * T + s + dt, math.nan)
-                n_stick += 1
-            if traj_dt > 0.0:
+            r.ss += T
+        if r.isamp == keep_from and not r.recording and r.n_keep > 0:
+            r.recording = True
+            if r.mode == 1:  # recording starts while sticking: the interval starts here
+                append_pair(sticks, r.n_stick, r.k * T + r.s + dt, math.nan)
+                r.n_stick += 1
+            if r.traj_dt > 0.0:
                 eval_rows(X, n, order, dt, xe)
-                append_row(traj, n_traj, k * T + s + dt, xe, n)
-                n_traj += 1
-                kt = k
-                st = s + dt + traj_dt
-                while wrap and st >= T:
-                    st -= T
-                    kt += 1
-    return isamp, ks, ss, recording, n_stick, n_traj, kt, st
+                append_row(traj, r.n_traj, r.k * T + r.s + dt, xe, n)
+                r.n_traj += 1
+                r.kt = r.k
+                r.st = r.s + dt + r.traj_dt
+                while r.wrap and r.st >= T:
+                    r.st -= T
+                    r.kt += 1
 
 
 @njit(cache=True, inline="always")
-def trajectory_points(m, T, wrap, traj_dt, X, k, s, h_acc, traj, n_traj, kt, st, xe):
-    """Trajectory points within the step, every ``traj_dt``; returns ``(n_traj, kt, st)``."""
+def trajectory_points(m, r, X, h_acc, traj, xe):
+    """Trajectory points of run ``r`` within the step, every ``r.traj_dt``, from ``(r.kt, r.st)`` on."""
     n = m.nx
+    T = r.T
     while True:
-        dt = (kt - k) * T + (st - s)
+        dt = (r.kt - r.k) * T + (r.st - r.s)
         if dt > h_acc:
             break
         eval_rows(X, n, m.order, dt, xe)
-        append_row(traj, n_traj, k * T + s + dt, xe, n)
-        n_traj += 1
-        st += traj_dt
-        while wrap and st >= T:
-            st -= T
-            kt += 1
-    return n_traj, kt, st
+        append_row(traj, r.n_traj, r.k * T + r.s + dt, xe, n)
+        r.n_traj += 1
+        r.st += r.traj_dt
+        while r.wrap and r.st >= T:
+            r.st -= T
+            r.kt += 1
 
 
 @njit(cache=True, inline="always")
