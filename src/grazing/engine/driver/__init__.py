@@ -17,6 +17,7 @@ in a piece that another one inlines.
 The pieces, in the order a step uses them:
 
 * :mod:`.state` -- the state of a run (one per lane), a named record;
+* :mod:`.step` -- the parts of a step that the loop and the lanes share;
 * :mod:`.calls` -- the model's functions through the address table;
 
 * :mod:`.events` -- the step (Taylor coefficients and step size) and event
@@ -39,8 +40,8 @@ from __future__ import annotations
 from pathlib import Path
 
 PIECES = (
-    "atomics.py", "state.py", "calls.py", "events.py", "recording.py", "tangent.py", "impacts.py", "loop.py",
-    "lanes.py",
+    "atomics.py", "state.py", "step.py", "calls.py", "events.py", "recording.py", "tangent.py", "impacts.py",
+    "loop.py", "lanes.py",
 )  # fmt: skip
 """The template files, in the order they are appended."""
 

@@ -37,9 +37,10 @@ from grazing.engine.driver.atomics import fetch_add, load_acquire, store_release
 from grazing.engine.driver.calls import tc_free, tc_stick, tc_var
 from grazing.engine.driver.events import first_event
 from grazing.engine.driver.impacts import apply_impact, chatter_remaining, enter_contact
-from grazing.engine.driver.loop import STATUS_NONFINITE, STATUS_OK, STATUS_STEP_LIMIT, STATUS_ZENO
+from grazing.engine.driver.loop import SPAN_CUT, STATUS_NONFINITE, STATUS_OK, STATUS_STEP_LIMIT, STATUS_ZENO
 from grazing.engine.driver.recording import take_samples
 from grazing.engine.driver.state import new_state
+from grazing.engine.driver.step import STEP_LAST, STEP_MAP, STEP_SPAN, step_end
 from grazing.engine.driver.tangent import discontinuity_map, lyapunov_step
 from grazing.engine.polyroots import quadratic_bound, work_shape
 from grazing.engine.records import Kernels
@@ -219,7 +220,7 @@ def sweep_lanes(
     hs = np.zeros(L)  # step
     dts = np.zeros(L)  # accepted part of it
     evs = np.zeros(L, dtype=np.int64)  # its stop
-    flags = np.zeros(L, dtype=np.int64)  # bit 1 event, 2 last, 4 discontinuity map, 8 failed
+    flags = np.zeros(L, dtype=np.int64)  # bit 1 event, 2 last, 4 discontinuity map, 8 failed, 16 span starts
     todo = np.zeros(L, dtype=np.int64)  # 1: the lane steps this round
     nx_ = np.zeros(L)  # step-size norms
     n1_ = np.zeros(L)
@@ -362,7 +363,6 @@ def sweep_lanes(
                 continue
             p = ls[lane].point
             T = Ts[p]
-            k = ls[lane].k
             s = ls[lane].s
             mode = ls[lane].mode
             status = STATUS_OK
@@ -384,20 +384,13 @@ def sweep_lanes(
                 h = step_size(Xs, n, Os, nstops, stuck, order, T, factor)
             else:
                 h = step_from_norms(nx_[lane], n1_[lane], n2_[lane], order, T, factor)
-            isamp = ls[lane].isamp
-            rem = (ls[lane].ks - k) * T + (ls[lane].ss - s)
-            is_last = False
-            if isamp == ls[lane].n_samples - 1 and h >= rem:
-                h = rem
-                is_last = True
-            if zdm_on:
-                rem_z = (ls[lane].kz - k) * T + (zdms[p] - s)
-                if rem_z <= h:
-                    h = rem_z
-                    flags[lane] |= 4
-                    is_last = is_last and rem_z >= rem
-            if is_last:
+            h, ends = step_end(ls[lane], h, SPAN_CUT and lyapunov, zdm_on, zdms[p])
+            if ends & STEP_LAST:
                 flags[lane] |= 2
+            if ends & STEP_MAP:
+                flags[lane] |= 4
+            if ends & STEP_SPAN:
+                flags[lane] |= 16
             hs[lane] = h
             todo[lane] = 1
             plain[lane] = 1 if mode == 0 and ls[lane].defl == 0 else 0
@@ -464,7 +457,7 @@ def sweep_lanes(
                 ls[lane].zero_events = 0
             is_last = (flags[lane] & 2) != 0
             h_acc = u * h if event else h
-            if event and is_last and u >= 1.0:
+            if event and (flags[lane] & (2 | 16)) != 0 and u >= 1.0:
                 event = False
             if event:
                 flags[lane] |= 1

@@ -39,6 +39,7 @@ from grazing.engine.driver.events import first_event
 from grazing.engine.driver.impacts import apply_impact, chatter_remaining, close_sticking, enter_contact
 from grazing.engine.driver.recording import finish_guard, take_samples, track_guard, trajectory_points
 from grazing.engine.driver.state import new_state
+from grazing.engine.driver.step import STEP_LAST, STEP_MAP, STEP_SPAN, step_end
 from grazing.engine.driver.tangent import discontinuity_map, lyapunov_step, shift_period
 from grazing.engine.polyroots import work_shape
 from grazing.engine.records import Config, Kernels, Start
@@ -59,6 +60,7 @@ STATUS_NONFINITE = int(Status.NONFINITE)
 STATUS_ZENO = int(Status.ZENO)
 STATUS_INTERRUPTED = int(Status.INTERRUPTED)
 ROOT_WORK_ROWS, ROOT_WORK_MIN_COLS = work_shape(0)
+SPAN_CUT = False
 
 
 @njit(cache=True, nogil=True)
@@ -141,6 +143,8 @@ def integrate(start, pv, cfg, m):
     r.traj_dt = traj_dt
     r.n_samples = n_samples
     r.n_keep = n_keep
+    r.use_var = use_var
+    r.max_steps = max_steps
     r.k = start.k
     r.s = start.s
     r.mode = 1 if start.mode > 0 else 0
@@ -200,18 +204,9 @@ def integrate(start, pv, cfg, m):
         else:
             tc_stick(m, x, r.s, pv, X, O, r.stuck)  # the first n rows only
             h = step_size(X, n, O, nstops, r.stuck, order, max_step, factor)
-        rem = (r.ks - r.k) * T + (r.ss - r.s)
-        is_last = False
-        if r.isamp == n_samples - 1 and h >= rem:
-            h = rem
-            is_last = True
-        zdm_hit = False
-        if zdm_on:
-            rem_z = (r.kz - r.k) * T + (sz - r.s)
-            if rem_z <= h:
-                h = rem_z
-                zdm_hit = True
-                is_last = is_last and rem_z >= rem
+        h, ends = step_end(r, h, SPAN_CUT and lyap, zdm_on, sz)  # (at a sample, at the map's phase)
+        is_last = (ends & STEP_LAST) != 0
+        zdm_hit = (ends & STEP_MAP) != 0
 
         # The first event on the step (each guard's polynomial in u in [0, 1]).
         u, ev_stop = first_event(
@@ -227,7 +222,7 @@ def integrate(start, pv, cfg, m):
         else:
             r.zero_events = 0
         h_acc = u * h if event else h
-        if event and is_last and u >= 1.0:
+        if event and (ends & (STEP_LAST | STEP_SPAN)) != 0 and u >= 1.0:
             event = False
         nrows = ntot if r.mode == 0 else n
 
