@@ -209,6 +209,26 @@ def test_lyapunov_of_periodic_orbit_matches_floquet_multipliers(pendulum_b, peri
     assert sol.lyapunov.sum() == pytest.approx(div, abs=50 * sol.n_steps * np.finfo(float).eps / span)
 
 
+def test_lyapunov_sums_start_at_the_sample_before_the_span(pendulum_b):
+    """issue 29: the span starts at the transient's last sample, inside a step; the sums start there too.
+
+    The sum of the exponents is the mean divergence over the span (see above):
+    ``-2 beta/eta + 2 ln r`` per impact in it.  The span runs from the
+    transient's last sample, ``t[0] - T``, to the end.  Sums that started at
+    the end of the step holding that sample, or counted the whole step, would
+    be off by the divergence over part of a step, ``~0.2 * 0.5 / span = 4e-4``.
+    """
+    T = pendulum_b.period
+    sol = grazing.simulate(pendulum_b, [0.0, 0.0], transient=7, periods=30, lyapunov=True, impacts="all")
+    start = sol.t[0] - T
+    span = sol.t_final - start
+    impacts = np.count_nonzero(sol.impacts.t > start)
+    assert 0 < impacts < len(sol.impacts)  # (impacts before and in the span)
+    p = pendulum_b.params
+    div = -2 * p["beta"] / p["eta"] + 2 * math.log(p["r"]) * impacts / span
+    assert sol.lyapunov.sum() == pytest.approx(div, abs=50 * sol.n_steps * np.finfo(float).eps / span)
+
+
 # --------------------------------------------------------------------------
 # Sampling, chunking, errors.
 
@@ -248,12 +268,6 @@ def test_results_do_not_depend_on_chunking(pendulum_b, monkeypatch):
     np.testing.assert_allclose(sol.lyapunov, ref.lyapunov, rtol=0, atol=1e-12)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="issue 26 (src/grazing/engine/driver/loop.py): when the transient ends exactly at a chunk "
-    "boundary, the Lyapunov span starts at the chunk's start; otherwise at the end of the first step "
-    "after the transient's last sample, whose growth is discarded: the exponents differ by ~1e-5",
-)
 def test_lyapunov_span_does_not_depend_on_where_chunks_end(pendulum_b, monkeypatch):
     ref = grazing.simulate(pendulum_b, [0.0, 0.0], transient=10, periods=40, lyapunov=True)
     monkeypatch.setattr(simulate_module, "CHUNK_PERIODS", 5)  # a chunk ends where the transient does

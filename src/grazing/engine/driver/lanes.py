@@ -37,10 +37,10 @@ from grazing.engine.driver.atomics import fetch_add, load_acquire, store_release
 from grazing.engine.driver.calls import tc_free, tc_stick, tc_var
 from grazing.engine.driver.events import first_event
 from grazing.engine.driver.impacts import apply_impact, chatter_remaining, enter_contact
-from grazing.engine.driver.loop import SPAN_CUT, STATUS_NONFINITE, STATUS_OK, STATUS_STEP_LIMIT, STATUS_ZENO
+from grazing.engine.driver.loop import STATUS_NONFINITE, STATUS_OK, STATUS_STEP_LIMIT, STATUS_ZENO
 from grazing.engine.driver.recording import take_samples
 from grazing.engine.driver.state import new_state
-from grazing.engine.driver.step import STEP_LAST, STEP_MAP, STEP_SPAN, step_end
+from grazing.engine.driver.step import STEP_LAST, STEP_MAP, step_end
 from grazing.engine.driver.tangent import discontinuity_map, lyapunov_step
 from grazing.engine.polyroots import quadratic_bound, work_shape
 from grazing.engine.records import Kernels
@@ -108,6 +108,7 @@ def begin_request(st, periods, keep, use_var, T, zdm_s):
     st.isamp = 0
     st.recording = periods - keep == 0
     st.lyap_started = st.recording
+    st.span_dt = math.nan
     st.steps = 0
     st.max_steps = STEPS_PER_PERIOD * periods + STEPS_EXTRA  # (core.options.step_limit)
     st.zero_events = 0
@@ -220,7 +221,7 @@ def sweep_lanes(
     hs = np.zeros(L)  # step
     dts = np.zeros(L)  # accepted part of it
     evs = np.zeros(L, dtype=np.int64)  # its stop
-    flags = np.zeros(L, dtype=np.int64)  # bit 1 event, 2 last, 4 discontinuity map, 8 failed, 16 span starts
+    flags = np.zeros(L, dtype=np.int64)  # bit 1 event, 2 last, 4 discontinuity map, 8 failed
     todo = np.zeros(L, dtype=np.int64)  # 1: the lane steps this round
     nx_ = np.zeros(L)  # step-size norms
     n1_ = np.zeros(L)
@@ -384,13 +385,11 @@ def sweep_lanes(
                 h = step_size(Xs, n, Os, nstops, stuck, order, T, factor)
             else:
                 h = step_from_norms(nx_[lane], n1_[lane], n2_[lane], order, T, factor)
-            h, ends = step_end(ls[lane], h, SPAN_CUT and lyapunov, zdm_on, zdms[p])
+            h, ends = step_end(ls[lane], h, zdm_on, zdms[p])
             if ends & STEP_LAST:
                 flags[lane] |= 2
             if ends & STEP_MAP:
                 flags[lane] |= 4
-            if ends & STEP_SPAN:
-                flags[lane] |= 16
             hs[lane] = h
             todo[lane] = 1
             plain[lane] = 1 if mode == 0 and ls[lane].defl == 0 else 0
@@ -457,7 +456,7 @@ def sweep_lanes(
                 ls[lane].zero_events = 0
             is_last = (flags[lane] & 2) != 0
             h_acc = u * h if event else h
-            if event and (flags[lane] & (2 | 16)) != 0 and u >= 1.0:
+            if event and is_last and u >= 1.0:
                 event = False
             if event:
                 flags[lane] |= 1
@@ -513,20 +512,8 @@ def sweep_lanes(
                 recording = ls[lane].recording
                 pv = pl[lane]
                 if lyap_now:
-                    started, lt0 = lyapunov_step(
-                        m,
-                        xl,
-                        V,
-                        ncol,
-                        recording,
-                        ls[lane].lyap_started,
-                        ls[lane].lyap_t0,
-                        k * T + s,
-                        scratch,
-                        logs[lane],
-                    )
-                    ls[lane].lyap_started = started
-                    ls[lane].lyap_t0 = lt0
+                    t = k * T + s
+                    lyapunov_step(m, ls[lane], xl, XT[:, :, lane], V, ncol, t, scratch, logs[lane], xe)
                 if zdm_hit:
                     ls[lane].kz += 1
                     applied, _ = discontinuity_map(
@@ -600,6 +587,7 @@ def sweep_lanes(
                     XS[i, lane] = xl[i]
             ls[lane].k = k
             ls[lane].s = s
+            ls[lane].span_dt = math.nan
             n_samples = ls[lane].n_samples
             if ls[lane].isamp < n_samples:
                 continue

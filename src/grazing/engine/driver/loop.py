@@ -17,7 +17,8 @@ vector field is T-periodic in time (``cfg.wrap``), so that the forcing phase
 does not lose precision over long runs.  Samples are taken at local times
 ``(ks, ss)``, ``(ks + 1, ss)``, ... (or ``ss``, ``ss + T``, ... without
 wrapping); the last ``n_keep`` are stored and define the recorded span
-(impacts, trajectory, minimum of the guard, Lyapunov sums).  ``start.mode``
+(impacts, trajectory, minimum of the guard, Lyapunov sums), which starts at
+the sample before the first kept one.  ``start.mode``
 is 0 in free flight, ``1 + j`` when sticking to stop ``j``; the final mode is
 returned so that a run can be continued.  ``cfg.stop`` is the stop a grazing
 analysis looks at: its guard's minimum is tracked, a grazing contact at the
@@ -39,7 +40,7 @@ from grazing.engine.driver.events import first_event
 from grazing.engine.driver.impacts import apply_impact, chatter_remaining, close_sticking, enter_contact
 from grazing.engine.driver.recording import finish_guard, take_samples, track_guard, trajectory_points
 from grazing.engine.driver.state import new_state
-from grazing.engine.driver.step import STEP_LAST, STEP_MAP, STEP_SPAN, step_end
+from grazing.engine.driver.step import STEP_LAST, STEP_MAP, step_end
 from grazing.engine.driver.tangent import discontinuity_map, lyapunov_step, shift_period
 from grazing.engine.polyroots import work_shape
 from grazing.engine.records import Config, Kernels, Start
@@ -60,7 +61,6 @@ STATUS_NONFINITE = int(Status.NONFINITE)
 STATUS_ZENO = int(Status.ZENO)
 STATUS_INTERRUPTED = int(Status.INTERRUPTED)
 ROOT_WORK_ROWS, ROOT_WORK_MIN_COLS = work_shape(0)
-SPAN_CUT = False
 
 
 @njit(cache=True, nogil=True)
@@ -158,6 +158,7 @@ def integrate(start, pv, cfg, m):
     r.recording = keep_from == 0
     r.lyap_t0 = r.k * T + r.s
     r.lyap_started = r.recording
+    r.span_dt = math.nan
     r.n_imp = 0
     r.n_imp_rec = 0
     r.n_stick = 0
@@ -204,7 +205,7 @@ def integrate(start, pv, cfg, m):
         else:
             tc_stick(m, x, r.s, pv, X, O, r.stuck)  # the first n rows only
             h = step_size(X, n, O, nstops, r.stuck, order, max_step, factor)
-        h, ends = step_end(r, h, SPAN_CUT and lyap, zdm_on, sz)  # (at a sample, at the map's phase)
+        h, ends = step_end(r, h, zdm_on, sz)  # (at the last sample, at the map's phase)
         is_last = (ends & STEP_LAST) != 0
         zdm_hit = (ends & STEP_MAP) != 0
 
@@ -222,7 +223,7 @@ def integrate(start, pv, cfg, m):
         else:
             r.zero_events = 0
         h_acc = u * h if event else h
-        if event and (ends & (STEP_LAST | STEP_SPAN)) != 0 and u >= 1.0:
+        if event and is_last and u >= 1.0:
             event = False
         nrows = ntot if r.mode == 0 else n
 
@@ -251,9 +252,8 @@ def integrate(start, pv, cfg, m):
         r.steps += 1
         r.defl = 0
         if lyap and use_var and r.mode == 0:
-            r.lyap_started, r.lyap_t0 = lyapunov_step(
-                m, x, V, ncol, r.recording, r.lyap_started, r.lyap_t0, r.k * T + r.s, scratch, logs
-            )
+            lyapunov_step(m, r, x, X, V, ncol, r.k * T + r.s, scratch, logs, xe)
+        r.span_dt = math.nan
 
         if zdm_hit:
             r.kz += 1

@@ -22,8 +22,9 @@ def take_samples(m, r, X, h_acc, event, is_last, samples, sticks, traj, xe):
     """The samples within ``(0, h_acc]`` of the step of run ``r`` (a :data:`.state.RUN_STATE` record).
 
     Updates the sampling state of ``r``: samples taken (into ``samples``, the
-    kept ones), the next sample's time, whether the recorded span has started,
-    and the sticking-interval and trajectory counters (the span may start while
+    kept ones), the next sample's time, whether the recorded span has started
+    (and where: ``r.span_dt`` into the step, at time ``r.lyap_t0``), and the
+    sticking-interval and trajectory counters (the span may start while
     sticking, and starts the trajectory).
     """
     n = m.nx
@@ -46,6 +47,8 @@ def take_samples(m, r, X, h_acc, event, is_last, samples, sticks, traj, xe):
             r.ss += T
         if r.isamp == keep_from and not r.recording and r.n_keep > 0:
             r.recording = True
+            r.span_dt = dt  # (where the Lyapunov sums start: tangent.lyapunov_step)
+            r.lyap_t0 = r.k * T + r.s + dt
             if r.mode == 1:  # recording starts while sticking: the interval starts here
                 append_pair(sticks, r.n_stick, r.k * T + r.s + dt, math.nan)
                 r.n_stick += 1

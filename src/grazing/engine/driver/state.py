@@ -44,6 +44,7 @@ RUN_STATE = np.dtype(
         ("recording", np.bool_),  # the recorded span has started
         ("lyap_started", np.bool_),  # the Lyapunov sums have started, at lyap_t0
         ("lyap_t0", np.float64),
+        ("span_dt", np.float64),  # the recorded span started this long into this step (nan: not in this step)
         ("kz", np.int64),  # the discontinuity map's next period
         # what is recorded (loop.integrate): counts and the next trajectory point at (kt, st)
         ("n_imp", np.int64),  # impacts

@@ -7,10 +7,11 @@ the state in ``x``): columns ``0 .. n-1`` are ``d x / d x0``, the next
 
 import math
 
+import numpy as np
 from numba import njit
 
 from grazing.engine.driver.calls import guard, guard_grad, normal_rate, normal_rate_grad, rhs
-from grazing.engine.stepping import append_record, orthonormalize, pack_var, unpack_var
+from grazing.engine.stepping import append_record, eval_rows, orthonormalize, pack_var, unpack_var
 
 
 @njit(cache=True)
@@ -31,24 +32,42 @@ def shift_period(m, x, s, pv, Tp, ncol, f):
 
 
 @njit(cache=True, inline="always")
-def lyapunov_step(m, x, V, ncol, recording, started, t0, t, scratch, logs):
-    """Gram-Schmidt on the tangent vectors after a step; returns ``(started, t0)``.
+def lyapunov_step(m, r, x, X, V, ncol, t, scratch, logs, xe):
+    """Gram-Schmidt on the tangent vectors of run ``r`` after a step that ends at time ``t``.
 
     Before the recorded span the vectors are only aligned (their growth is
-    discarded); from its start the log norms are summed into ``logs``.
+    discarded); from its start, ``r.lyap_t0``, the log norms are summed into
+    ``logs``.  A span that starts inside the step, ``r.span_dt`` after its
+    start (at a sample, :func:`.recording.take_samples`), counts the growth
+    from there: the log norms of the aligned vectors at the end of the step
+    less those of the vectors at the span's start, evaluated there from the
+    step's polynomials ``X`` (into ``xe``).  The sums are then the same
+    (to rounding) whether or not a step, or a call of the driver, ends at
+    that sample.
     """
     n = m.nx
-    unpack_var(x, n, ncol, V)
-    if recording and not started:
-        started = True
-        t0 = t
-        orthonormalize(V, n, scratch)
-    elif started:
+    if r.recording and not r.lyap_started:
+        r.lyap_started = True
+        if math.isnan(r.span_dt):  # (the span started in an earlier step, while sticking)
+            r.lyap_t0 = t
+            unpack_var(x, n, ncol, V)
+            orthonormalize(V, n, scratch)
+        else:
+            eval_rows(X, n + n * ncol, m.order, r.span_dt, xe)
+            unpack_var(xe, n, ncol, V)
+            before = np.zeros(n)
+            orthonormalize(V, n, before)  # the vectors' growth before the span ...
+            unpack_var(x, n, ncol, V)
+            orthonormalize(V, n, logs)
+            for c in range(n):
+                logs[c] -= before[c]  # ... is not the span's (the diagonal of R1^-1 R: log R - log R1)
+    elif r.lyap_started:
+        unpack_var(x, n, ncol, V)
         orthonormalize(V, n, logs)
     else:
-        orthonormalize(V, n, scratch)  # transient: align V, discard growth
+        unpack_var(x, n, ncol, V)
+        orthonormalize(V, n, scratch)  # before the span: align V, discard growth
     pack_var(V, n, ncol, x)
-    return started, t0
 
 
 @njit(cache=True)
