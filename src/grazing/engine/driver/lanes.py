@@ -43,7 +43,7 @@ from grazing.engine.driver.state import new_state
 from grazing.engine.driver.step import STEP_LAST, STEP_MAP, step_end
 from grazing.engine.driver.tangent import discontinuity_map, lyapunov_step
 from grazing.engine.polyroots import quadratic_bound, work_shape
-from grazing.engine.records import Kernels
+from grazing.engine.records import Kernels, LaneJobs, LanePoints, LaneResults, LaneSettings
 from grazing.engine.stepping import new_table, step_factor, step_from_norms, step_size
 
 LANE_ROOT_ROWS, LANE_ROOT_MIN_COLS = work_shape(0)
@@ -124,51 +124,20 @@ def begin_request(st, periods, keep, use_var, T, zdm_s):
 
 
 @njit(cache=False, nogil=True)  # (compiled once per machine into its own object file, grazing.engine.native)
-def sweep_lanes(
-    m,
-    lanes,
-    jobs,
-    control,
-    fresh,
-    periodic,
-    x0,
-    firsts,
-    pvs,
-    Ts,
-    sphase,
-    tcarry,
-    zdms,
-    transient,
-    periods,
-    adaptive,
-    adaptive_tol,
-    lyapunov,
-    safety,
-    chatter_tol,
-    zdm_on,
-    zdm_a,
-    zdm_e,
-    zdm_window,
-    watch,
-    out_samples,
-    out_by_stop,
-    out_lyap,
-    out_used,
-    out_x,
-    out_t,
-    out_status,
-):
-    """Compute the sweep points of ``jobs`` on ``lanes`` lanes (see the module); results into ``out_*``.
+def sweep_lanes(m, cfg, work, points, out):
+    """Compute the points of the jobs ``work`` on ``cfg.lanes`` lanes (see the module); results into ``out``.
 
-    Job ``j``'s first point starts from state ``firsts[j, 1:]`` at time
-    ``firsts[j, 0]``; a point after a failed one from ``x0[j]`` at time 0.  Per point ``p``: parameter
-    vector ``pvs[p]``, period ``Ts[p]``, sampling phase ``sphase[p]`` (local
-    time), start time of a point continued from the previous one
-    ``tcarry[p]`` (periodic models), local time of the discontinuity map
-    ``zdms[p]``.  ``out_status[p]`` becomes the point's
-    :class:`~grazing.core.solution.Status` code once it is finished: 0 once
-    its results are written, else why it failed (1 step limit, 2 non-finite
-    state, 3 accumulating impacts); the caller sets it to -1 before.
+    The arguments are the records of :data:`grazing.engine.records.SWEEP_RECORDS`
+    as plain tuples: the model's :class:`~grazing.engine.records.Kernels`, the
+    :class:`~grazing.engine.records.LaneSettings`, the
+    :class:`~grazing.engine.records.LaneJobs`, the
+    :class:`~grazing.engine.records.LanePoints` and the
+    :class:`~grazing.engine.records.LaneResults`.  Job ``j``'s first point
+    starts from state ``firsts[j, 1:]`` at time ``firsts[j, 0]``; a point after
+    a failed one from ``x0[j]`` at time 0.  ``out.status[p]`` becomes the
+    point's :class:`~grazing.core.solution.Status` code once it is finished: 0
+    once its results are written, else why it failed (1 step limit, 2
+    non-finite state, 3 accumulating impacts); the caller sets it to -1 before.
 
     Several threads may run the same call (the same arrays): they take the
     jobs in turn from the counter ``control[0]`` (0 at the start), each
@@ -178,18 +147,23 @@ def sweep_lanes(
     finished at -1.
     """
     m = Kernels(*m)
+    cfg = LaneSettings(*cfg)
+    work = LaneJobs(*work)
+    points = LanePoints(*points)
+    out = LaneResults(*out)
+    pvs, Ts, sphase, tcarry, zdms = points.pvs, points.Ts, points.sphase, points.tcarry, points.zdms
     n = m.nx
     order = m.order
     nstops = m.nstops
     K = order + 1
-    L = lanes
+    L = cfg.lanes
     ncol = n
     ntot = n + n * ncol
     npv = pvs.shape[1]
-    factor = step_factor(safety, order)
-    align = min(LYAPUNOV_ALIGN, transient) if lyapunov else 0
-    budget = transient - align
-    keep_max = max(periods, ADAPTIVE_BLOCK)
+    factor = step_factor(cfg.safety, order)
+    align = min(LYAPUNOV_ALIGN, cfg.transient) if cfg.lyapunov else 0
+    budget = cfg.transient - align
+    keep_max = max(cfg.periods, ADAPTIVE_BLOCK)
     use_lanes = L > 1 and L == m.lanes and m.fns[TC_FREE_LANES] != 0  # (the lane functions' width)
 
     ls = new_state(L)  # the lanes' runs and where each is in its point's protocol
@@ -205,7 +179,7 @@ def sweep_lanes(
     PT = np.zeros((npv, L))
     XT = np.zeros((ntot, K, L))
     OT = np.zeros((nstops, K, L))
-    work = np.zeros((LANE_ROOT_ROWS, max(K, LANE_ROOT_MIN_COLS)))
+    roots = np.zeros((LANE_ROOT_ROWS, max(K, LANE_ROOT_MIN_COLS)))
     a = np.zeros(K)
     xe = np.empty(ntot)
     xp = np.empty(ntot)
@@ -238,7 +212,7 @@ def sweep_lanes(
     for lane in range(L):
         ls[lane].stage = IDLE
     while True:
-        if load_acquire(control, 1) != 0:  # the caller stops the sweep: unfinished points stay at -1
+        if load_acquire(work.control, 1) != 0:  # the caller stops the sweep: unfinished points stay at -1
             return
         # Idle lanes take the next point: their job's next one, else the next job's first.
         for lane in range(L):
@@ -247,32 +221,32 @@ def sweep_lanes(
                 carried = ls[lane].status == STATUS_OK and ls[lane].job_end > 0
                 first = False
                 if ls[lane].job_end == 0 or p >= ls[lane].job_end:
-                    if control[2] > 0 and active >= control[2]:
+                    if work.control[2] > 0 and active >= work.control[2]:
                         break  # (this thread has its share of the jobs running)
-                    job = fetch_add(control, 0, 1)
-                    if job >= jobs.shape[0]:
+                    job = fetch_add(work.control, 0, 1)
+                    if job >= work.jobs.shape[0]:
                         ls[lane].job_end = -1  # (no more jobs for this lane)
                         break
-                    p = jobs[job, 0]
-                    ls[lane].job_end = jobs[job, 1]
+                    p = work.jobs[job, 0]
+                    ls[lane].job_end = work.jobs[job, 1]
                     ls[lane].job = job
                     carried = False
                     first = True
                 ls[lane].point = p
                 T = Ts[p]
                 ls[lane].T = T
-                ls[lane].wrap = periodic
+                ls[lane].wrap = cfg.periodic
                 if first:
                     for i in range(n):
-                        XS[i, lane] = firsts[ls[lane].job, 1 + i]
-                    t0 = firsts[ls[lane].job, 0]
-                elif fresh or not carried:
+                        XS[i, lane] = work.firsts[ls[lane].job, 1 + i]
+                    t0 = work.firsts[ls[lane].job, 0]
+                elif cfg.fresh or not carried:
                     for i in range(n):
-                        XS[i, lane] = x0[ls[lane].job, i]
+                        XS[i, lane] = work.x0[ls[lane].job, i]
                     t0 = 0.0
                 else:
-                    t0 = tcarry[p] if periodic else out_t[p - 1]
-                k0, s0, ks0, ss0 = start_times(t0, T, sphase[p], periodic)
+                    t0 = tcarry[p] if cfg.periodic else out.t[p - 1]
+                k0, s0, ks0, ss0 = start_times(t0, T, sphase[p], cfg.periodic)
                 ls[lane].k = k0
                 ls[lane].s = s0
                 ls[lane].req_ks = ks0
@@ -292,12 +266,10 @@ def sweep_lanes(
                     blk = min(ADAPTIVE_BLOCK, budget)
                     ls[lane].block = blk
                     ls[lane].stage = TRANSIENT
-                    begin_request(ls[lane], blk, blk if adaptive else 0, False, T, zdms[p])
+                    begin_request(ls[lane], blk, blk if cfg.adaptive else 0, False, T, zdms[p])
                 else:
                     ls[lane].stage = FINAL
-                    final_request(
-                        ls[lane], XS, n, lane, align, periods, lyapunov, T, sphase[p], periodic, zdms[p]
-                    )
+                    final_request(ls[lane], XS, n, lane, align, cfg, sphase[p], zdms[p])
                 active += 1
         if active == 0:
             break
@@ -385,7 +357,7 @@ def sweep_lanes(
                 h = step_size(Xs, n, Os, nstops, stuck, order, T, factor)
             else:
                 h = step_from_norms(nx_[lane], n1_[lane], n2_[lane], order, T, factor)
-            h, ends = step_end(ls[lane], h, zdm_on, zdms[p])
+            h, ends = step_end(ls[lane], h, cfg.zdm, zdms[p])
             if ends & STEP_LAST:
                 flags[lane] |= 2
             if ends & STEP_MAP:
@@ -400,7 +372,7 @@ def sweep_lanes(
         for lane in range(L if L == 1 else 0):
             plain[lane] = 0
         for r in range(nstops if L > 1 else 0):
-            if zdm_on and r == watch:
+            if cfg.zdm and r == cfg.stop:
                 continue
             for lane in range(L):
                 hk[lane] = 1.0
@@ -436,13 +408,13 @@ def sweep_lanes(
                     mode,
                     ls[lane].stuck,
                     True,
-                    watch if zdm_on else -1,
+                    cfg.stop if cfg.zdm else -1,
                     ls[lane].defl,
                     ls[lane].defl_stop,
                     False,
-                    watch,
+                    cfg.stop,
                     a,
-                    work,
+                    roots,
                 )
             event = u >= 0.0 and h > 0.0
             if event and u == 0.0:
@@ -485,7 +457,7 @@ def sweep_lanes(
         # Pass B, lane by lane: time, Lyapunov vectors, discontinuity map, impacts, the request's end.
         for lane in range(L):
             if flags[lane] == 8:  # the point failed (L_STATUS says why): the next point starts afresh
-                store_release(out_status, ls[lane].point, ls[lane].status)
+                store_release(out.status, ls[lane].point, ls[lane].status)
                 ls[lane].stage = IDLE
                 active -= 1
                 continue
@@ -495,7 +467,7 @@ def sweep_lanes(
             T = Ts[p]
             k = ls[lane].k
             s = ls[lane].s + dts[lane]
-            if periodic and s >= T:
+            if cfg.periodic and s >= T:
                 s -= T
                 k += 1
             ls[lane].steps += 1
@@ -505,7 +477,7 @@ def sweep_lanes(
             nrows = ntot if (mode == 0 and use_var) else n
             event = (flags[lane] & 1) != 0
             zdm_hit = (flags[lane] & 4) != 0
-            lyap_now = lyapunov and use_var and mode == 0
+            lyap_now = cfg.lyapunov and use_var and mode == 0
             if lyap_now or zdm_hit or event:
                 for i in range(ntot):
                     xl[i] = XS[i, lane]
@@ -522,10 +494,10 @@ def sweep_lanes(
                         s,
                         k * T + s,
                         pv,
-                        watch,
-                        zdm_a,
-                        zdm_e,
-                        zdm_window,
+                        cfg.stop,
+                        cfg.zdm_a,
+                        cfg.zdm_e,
+                        cfg.zdm_window,
                         use_var,
                         ncol,
                         V,
@@ -536,7 +508,7 @@ def sweep_lanes(
                         0,
                     )
                     if applied and recording and ls[lane].stage == FINAL:
-                        counts[lane, watch] += 1
+                        counts[lane, cfg.stop] += 1
                 if event:
                     ev_stop = evs[lane]
                     stuck = ls[lane].stuck
@@ -572,10 +544,10 @@ def sweep_lanes(
                         ls[lane].defl = 1
                         ls[lane].defl_stop = ev_stop
                         if m.sticks[ev_stop]:
-                            dt_acc = chatter_remaining(m, xl, s, pv, ev_stop, speed, chatter_tol * T)
+                            dt_acc = chatter_remaining(m, xl, s, pv, ev_stop, speed, cfg.chatter_tol * T)
                             if dt_acc >= 0.0:
                                 s += dt_acc
-                                if periodic and s >= T:
+                                if cfg.periodic and s >= T:
                                     s -= T
                                     k += 1
                                 enter_contact(m, xl, s, pv, ev_stop)
@@ -592,7 +564,7 @@ def sweep_lanes(
             if ls[lane].isamp < n_samples:
                 continue
             # The request is done (Runner.advance returns): on to the next stage of the point.
-            if periodic:
+            if cfg.periodic:
                 ls[lane].req_ks += n_samples
             else:
                 ls[lane].req_ss += n_samples * T
@@ -602,8 +574,8 @@ def sweep_lanes(
                 ls[lane].used += blk
                 used = ls[lane].used
                 nxt = -1
-                if adaptive and blk == ADAPTIVE_BLOCK:
-                    per = repeats_with_period(buf[lane], blk, n, adaptive_tol, ADAPTIVE_MAX_PERIOD)
+                if cfg.adaptive and blk == ADAPTIVE_BLOCK:
+                    per = repeats_with_period(buf[lane], blk, n, cfg.adaptive_tol, ADAPTIVE_MAX_PERIOD)
                     if per > 0:
                         extra = (budget - used) % per
                         if extra:
@@ -615,39 +587,35 @@ def sweep_lanes(
                 if nxt < 0 and used < budget:
                     blk = min(ADAPTIVE_BLOCK, budget - used)
                     ls[lane].block = blk
-                    begin_request(ls[lane], blk, blk if adaptive else 0, False, T, zdms[p])
+                    begin_request(ls[lane], blk, blk if cfg.adaptive else 0, False, T, zdms[p])
                     continue
                 ls[lane].stage = FINAL
-                final_request(
-                    ls[lane], XS, n, lane, align, periods, lyapunov, T, sphase[p], periodic, zdms[p]
-                )
+                final_request(ls[lane], XS, n, lane, align, cfg, sphase[p], zdms[p])
                 continue
             if stage == EXTRA:
                 ls[lane].stage = FINAL
-                final_request(
-                    ls[lane], XS, n, lane, align, periods, lyapunov, T, sphase[p], periodic, zdms[p]
-                )
+                final_request(ls[lane], XS, n, lane, align, cfg, sphase[p], zdms[p])
                 continue
             # FINAL: the point's results (a state that became non-finite on the last step fails the point).
             finite = True
             for i in range(n):
                 finite = finite and math.isfinite(XS[i, lane])
-            for r in range(periods):
+            for r in range(cfg.periods):
                 for c in range(n):
                     finite = finite and math.isfinite(buf[lane, r, c])
             if not finite:
                 ls[lane].status = STATUS_NONFINITE
-                store_release(out_status, p, STATUS_NONFINITE)
+                store_release(out.status, p, STATUS_NONFINITE)
                 ls[lane].stage = IDLE
                 active -= 1
                 continue
-            for r in range(periods):
+            for r in range(cfg.periods):
                 for c in range(n):
-                    out_samples[p, r, c] = buf[lane, r, c]
+                    out.samples[p, r, c] = buf[lane, r, c]
             for j in range(nstops):
-                out_by_stop[p, j] = counts[lane, j]
+                out.by_stop[p, j] = counts[lane, j]
             lyap = math.nan
-            if lyapunov:
+            if cfg.lyapunov:
                 span = k * T + s - ls[lane].lyap_t0 if ls[lane].lyap_started else 0.0
                 if ls[lane].jac_valid and span != 0.0:
                     lyap = logs[lane, 0] / span
@@ -657,22 +625,23 @@ def sweep_lanes(
                             lyap = math.nan
                         elif v > lyap:
                             lyap = v
-            out_lyap[p] = lyap
-            out_used[p] = ls[lane].used + align
+            out.lyap[p] = lyap
+            out.used[p] = ls[lane].used + align
             for i in range(n):
-                out_x[p, i] = XS[i, lane]
-            out_t[p] = k * T + s
-            store_release(out_status, p, STATUS_OK)  # (after its results: another thread may read them now)
+                out.x[p, i] = XS[i, lane]
+            out.t[p] = k * T + s
+            store_release(out.status, p, STATUS_OK)  # (after its results: another thread may read them now)
             ls[lane].stage = IDLE
             active -= 1
 
 
 @njit(cache=True)
-def final_request(st, XS, n, lane, align, periods, lyapunov, T, s_phase, periodic, zdm_s):
+def final_request(st, XS, n, lane, align, cfg, s_phase, zdm_s):
     """The recorded stage of a point: with the variational equations (from the identity) for Lyapunov."""
-    if lyapunov:  # a new Runner at the current time (as run_point's ``var``)
+    T = st.T
+    if cfg.lyapunov:  # a new Runner at the current time (as run_point's ``var``)
         t0 = st.k * T + st.s
-        k0, s0, ks0, ss0 = start_times(t0, T, s_phase, periodic)
+        k0, s0, ks0, ss0 = start_times(t0, T, s_phase, cfg.periodic)
         st.k = k0
         st.s = s0
         st.req_ks = ks0
@@ -680,6 +649,6 @@ def final_request(st, XS, n, lane, align, periods, lyapunov, T, s_phase, periodi
         for i in range(n):
             for c in range(n):
                 XS[n + i * n + c, lane] = 1.0 if i == c else 0.0
-        begin_request(st, align + periods, periods, True, T, zdm_s)
+        begin_request(st, align + cfg.periods, cfg.periods, True, T, zdm_s)
     else:
-        begin_request(st, periods, periods, False, T, zdm_s)
+        begin_request(st, cfg.periods, cfg.periods, False, T, zdm_s)
