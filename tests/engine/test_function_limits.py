@@ -20,12 +20,8 @@ MAX_POSITIONAL = 12
 
 KNOWN = {
     # path: function -> (lines, positional parameters) today; to be split (issue 29, item 1)
-    ("driver/events.py", "first_event"): (16, 13),
-    ("driver/impacts.py", "apply_impact"): (20, 17),
-    ("driver/lanes.py", "sweep_lanes"): (487, 5),
-    ("driver/loop.py", "integrate"): (276, 4),
-    ("driver/recording.py", "track_guard"): (40, 15),
-    ("driver/tangent.py", "discontinuity_map"): (27, 17),
+    ("driver/lanes.py", "sweep_lanes"): (417, 5),
+    ("driver/loop.py", "integrate"): (214, 4),
 }
 
 

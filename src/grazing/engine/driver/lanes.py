@@ -36,7 +36,7 @@ from grazing.engine.abi import TC_FREE_LANES, TC_VAR_LANES, call_model
 from grazing.engine.driver.atomics import fetch_add, load_acquire, store_release
 from grazing.engine.driver.calls import tc_free, tc_stick, tc_var
 from grazing.engine.driver.events import first_event
-from grazing.engine.driver.impacts import apply_impact, chatter_remaining, enter_contact
+from grazing.engine.driver.impacts import at_event
 from grazing.engine.driver.loop import STATUS_NONFINITE, STATUS_OK, STATUS_STEP_LIMIT, STATUS_ZENO
 from grazing.engine.driver.recording import take_samples
 from grazing.engine.driver.state import new_state
@@ -190,6 +190,7 @@ def sweep_lanes(m, cfg, work, points, out):
     imp = new_table(1, 3 + n)  # (impacts are counted, not recorded)
     sticks = new_table(1, 2)
     traj = new_table(1, 1 + n)
+    tables = (imp, sticks, traj)
     kinds = np.zeros(L, dtype=np.int64)  # 0 sticking or idle, 1 free flight, 2 with the variational equations
     # What a step decides for each lane (pass A), for the advance (vectors) and the rest (pass B).
     hs = np.zeros(L)  # step
@@ -400,22 +401,9 @@ def sweep_lanes(m, cfg, work, points, out):
                 u = -1.0
                 ev_stop = 0
             else:
-                mode = ls[lane].mode
-                u, ev_stop = first_event(
-                    m,
-                    OT[:, :, lane],
-                    h,
-                    mode,
-                    ls[lane].stuck,
-                    True,
-                    cfg.stop if cfg.zdm else -1,
-                    ls[lane].defl,
-                    ls[lane].defl_stop,
-                    False,
-                    cfg.stop,
-                    a,
-                    roots,
-                )
+                skip = cfg.stop if cfg.zdm else -1
+                run = ls[lane]
+                u, ev_stop = first_event(m, run, OT[:, :, lane], h, True, skip, False, cfg.stop, a, roots)
             event = u >= 0.0 and h > 0.0
             if event and u == 0.0:
                 ls[lane].zero_events += 1
@@ -434,10 +422,10 @@ def sweep_lanes(m, cfg, work, points, out):
                 flags[lane] |= 1
             evs[lane] = ev_stop
             dts[lane] = h_acc
-            r = ls[lane]
-            if (r.ks - r.k) * r.T + (r.ss - r.s) <= h_acc:
-                r.n_stick = 0  # (sticking intervals are not recorded)
-                take_samples(m, r, XT[:, :, lane], h_acc, event, is_last, buf[lane], sticks, traj, xe)
+            run = ls[lane]
+            if (run.ks - run.k) * run.T + (run.ss - run.s) <= h_acc:
+                run.n_stick = 0  # (sticking intervals are not recorded)
+                take_samples(m, run, XT[:, :, lane], h_acc, event, is_last, buf[lane], sticks, traj, xe)
 
         # The advance of every stepping lane to the end of its accepted part (eval_rows on vectors):
         # the state in all, the variational equations in free flight.
@@ -465,15 +453,15 @@ def sweep_lanes(m, cfg, work, points, out):
                 continue
             p = ls[lane].point
             T = Ts[p]
-            k = ls[lane].k
-            s = ls[lane].s + dts[lane]
-            if cfg.periodic and s >= T:
-                s -= T
-                k += 1
-            ls[lane].steps += 1
-            ls[lane].defl = 0
-            mode = ls[lane].mode
-            use_var = ls[lane].use_var
+            run = ls[lane]
+            run.s += dts[lane]
+            if cfg.periodic and run.s >= T:
+                run.s -= T
+                run.k += 1
+            run.steps += 1
+            run.defl = 0
+            mode = run.mode
+            use_var = run.use_var
             nrows = ntot if (mode == 0 and use_var) else n
             event = (flags[lane] & 1) != 0
             zdm_hit = (flags[lane] & 4) != 0
@@ -481,85 +469,27 @@ def sweep_lanes(m, cfg, work, points, out):
             if lyap_now or zdm_hit or event:
                 for i in range(ntot):
                     xl[i] = XS[i, lane]
-                recording = ls[lane].recording
+                recording = run.recording
                 pv = pl[lane]
                 if lyap_now:
-                    t = k * T + s
-                    lyapunov_step(m, ls[lane], xl, XT[:, :, lane], V, ncol, t, scratch, logs[lane], xe)
+                    t = run.k * T + run.s
+                    lyapunov_step(m, run, xl, XT[:, :, lane], V, ncol, t, scratch, logs[lane], xe)
                 if zdm_hit:
-                    ls[lane].kz += 1
-                    applied, _ = discontinuity_map(
-                        m,
-                        xl,
-                        s,
-                        k * T + s,
-                        pv,
-                        cfg.stop,
-                        cfg.zdm_a,
-                        cfg.zdm_e,
-                        cfg.zdm_window,
-                        use_var,
-                        ncol,
-                        V,
-                        gh,
-                        gv,
-                        False,
-                        imp,
-                        0,
-                    )
-                    if applied and recording and ls[lane].stage == FINAL:
+                    run.kz += 1
+                    applied = discontinuity_map(m, run, xl, pv, cfg, V, gh, gv, False, imp)
+                    if applied and recording and run.stage == FINAL:
                         counts[lane, cfg.stop] += 1
                 if event:
                     ev_stop = evs[lane]
-                    stuck = ls[lane].stuck
-                    if mode == 1 and ev_stop == stuck:
-                        ls[lane].mode = 0
-                        ls[lane].defl = 3
-                        ls[lane].defl_stop = stuck
-                    else:
-                        ls[lane].mode = 0
-                        speed, _, _, salt_ok = apply_impact(
-                            m,
-                            xl,
-                            xp,
-                            s,
-                            k * T + s,
-                            pv,
-                            ev_stop,
-                            use_var,
-                            ncol,
-                            nrows,
-                            V,
-                            False,
-                            imp,
-                            0,
-                            False,
-                            traj,
-                            0,
-                        )
-                        if not salt_ok:
-                            ls[lane].jac_valid = False
-                        if recording and ls[lane].stage == FINAL:
+                    if at_event(m, run, xl, xp, pv, ev_stop, nrows, V, cfg.chatter_tol * T, False, tables):
+                        if recording and run.stage == FINAL:
                             counts[lane, ev_stop] += 1
-                        ls[lane].defl = 1
-                        ls[lane].defl_stop = ev_stop
-                        if m.sticks[ev_stop]:
-                            dt_acc = chatter_remaining(m, xl, s, pv, ev_stop, speed, cfg.chatter_tol * T)
-                            if dt_acc >= 0.0:
-                                s += dt_acc
-                                if cfg.periodic and s >= T:
-                                    s -= T
-                                    k += 1
-                                enter_contact(m, xl, s, pv, ev_stop)
-                                ls[lane].mode = 1
-                                ls[lane].stuck = ev_stop
-                                ls[lane].defl = 0
-                                ls[lane].jac_valid = False
+                    run.n_stick = 0  # (sticking intervals are not recorded)
                 for i in range(ntot):
                     XS[i, lane] = xl[i]
-            ls[lane].k = k
-            ls[lane].s = s
-            ls[lane].span_dt = math.nan
+            run.span_dt = math.nan
+            k = run.k
+            s = run.s
             n_samples = ls[lane].n_samples
             if ls[lane].isamp < n_samples:
                 continue

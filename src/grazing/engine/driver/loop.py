@@ -37,8 +37,14 @@ from grazing.core.solution import Status
 from grazing.engine.driver.atomics import load_acquire
 from grazing.engine.driver.calls import tc_free, tc_stick, tc_var
 from grazing.engine.driver.events import first_event
-from grazing.engine.driver.impacts import apply_impact, chatter_remaining, close_sticking, enter_contact
-from grazing.engine.driver.recording import finish_guard, take_samples, track_guard, trajectory_points
+from grazing.engine.driver.impacts import at_event, close_sticking
+from grazing.engine.driver.recording import (
+    finish_guard,
+    new_guard_info,
+    take_samples,
+    track_guard,
+    trajectory_points,
+)
 from grazing.engine.driver.state import new_state
 from grazing.engine.driver.step import STEP_LAST, STEP_MAP, step_end
 from grazing.engine.driver.tangent import discontinuity_map, lyapunov_step, shift_period
@@ -97,9 +103,6 @@ def integrate(start, pv, cfg, m):
     record_impacts = cfg.record_impacts
     Tp = cfg.Tp
     chatter_time = cfg.chatter_time
-    zdm_a = cfg.zdm_a
-    zdm_e = cfg.zdm_e
-    zdm_window = cfg.zdm_window
     watch = cfg.stop
     sigints = cfg.sigints
     sigints_seen = cfg.sigints_seen
@@ -129,9 +132,8 @@ def integrate(start, pv, cfg, m):
     traj = new_table(64 if traj_dt > 0.0 else 1, 1 + n)
     logs = np.zeros(n)
     scratch = np.zeros(n)
-    min_info = np.full((nstops, 2 * (2 + n)), math.inf)  # per stop (see track_guard)
-    slope_end = np.full(nstops, math.nan)  # d guard / dt at the end of the previous free-flight step
-    slope_first = np.full(nstops, math.nan)  # ... at the start of the first recorded one
+    guard_info = new_guard_info(nstops, n)  # per stop: the guard's minimum, closest approach, slopes
+    tables = (imp, sticks, traj)
     fbuf = np.empty(n)
     shift_sens = use_var and m.nsens > 0 and wrap
     zdm_gh = np.zeros(n)
@@ -211,9 +213,8 @@ def integrate(start, pv, cfg, m):
 
         # The first event on the step (each guard's polynomial in u in [0, 1]).
         u, ev_stop = first_event(
-            m, O, h, r.mode, r.stuck, events, watch if zdm_on else -1, r.defl, r.defl_stop,
-            touch_end and is_last and r.mode == 0, watch, a, work,
-        )  # fmt: skip
+            m, r, O, h, events, watch if zdm_on else -1, touch_end and is_last and r.mode == 0, watch, a, work
+        )
         event = u >= 0.0 and h > 0.0
         if event and u == 0.0:
             r.zero_events += 1
@@ -234,10 +235,7 @@ def integrate(start, pv, cfg, m):
             trajectory_points(m, r, X, h_acc, traj, xe)
         if r.recording and track_min and r.mode == 0 and h_acc > 0.0:
             for j in range(nstops):  # every stop's closest approach
-                slope_end[j], slope_first[j] = track_guard(
-                    m, O, j, X, x, r.k * T + r.s, h, h_acc, r.defl if r.defl_stop == j else 0, event, gm,
-                    min_info[j], slope_end[j], slope_first[j], xe,
-                )  # fmt: skip
+                track_guard(m, r, O, j, X, x, h, h_acc, event, gm, guard_info[j], xe)
 
         # Advance to the end of the accepted part of the step.
         eval_rows(X, nrows, order, h_acc, xe)
@@ -258,73 +256,19 @@ def integrate(start, pv, cfg, m):
         if zdm_hit:
             r.kz += 1
             record = record_impacts == 2 or (record_impacts == 1 and r.recording)
-            applied, r.n_imp_rec = discontinuity_map(
-                m,
-                x,
-                r.s,
-                r.k * T + r.s,
-                pv,
-                watch,
-                zdm_a,
-                zdm_e,
-                zdm_window,
-                use_var,
-                ncol,
-                V,
-                zdm_gh,
-                zdm_gv,
-                record,
-                imp,
-                r.n_imp_rec,
-            )
-            if applied:
+            if discontinuity_map(m, r, x, pv, cfg, V, zdm_gh, zdm_gv, record, imp):
                 r.n_imp += 1
 
         if event:
-            if r.mode == 1 and ev_stop == r.stuck:
-                # Release from sticking: the contact force changes sign.
-                r.mode = 0
-                r.defl = 3
-                r.defl_stop = r.stuck
-                if r.recording:
-                    close_sticking(sticks, r.n_stick, r.k * T + r.s)
-            else:
-                if r.mode == 1:  # sticking to one stop, it hits another: the contact ends
-                    r.mode = 0
-                    if r.recording:
-                        close_sticking(sticks, r.n_stick, r.k * T + r.s)
-                # Impact: x holds the state on stop ev_stop, just before its reset.
-                record = record_impacts == 2 or (record_impacts == 1 and r.recording)
-                traj_on = r.recording and traj_dt > 0.0
-                speed, r.n_imp_rec, r.n_traj, salt_ok = apply_impact(
-                    m, x, xp, r.s, r.k * T + r.s, pv, ev_stop, use_var, ncol, nrows, V, record, imp,
-                    r.n_imp_rec, traj_on, traj, r.n_traj,
-                )  # fmt: skip
-                r.jac_valid = r.jac_valid and salt_ok  # (an impact at zero normal speed has no Jacobian)
+            record = record_impacts == 2 or (record_impacts == 1 and r.recording)
+            if at_event(m, r, x, xp, pv, ev_stop, nrows, V, chatter_time, record, tables):
                 r.n_imp += 1
-                r.defl = 1
-                r.defl_stop = ev_stop
-                if m.sticks[ev_stop]:
-                    dt_acc = chatter_remaining(m, x, r.s, pv, ev_stop, speed, chatter_time)
-                    if dt_acc >= 0.0:  # complete chattering: on to the accumulation point, then sticking
-                        r.s += dt_acc
-                        if wrap and r.s >= T:  # (the Jacobian is not valid after sticking)
-                            r.s -= T
-                            r.k += 1
-                        enter_contact(m, x, r.s, pv, ev_stop)
-                        r.mode = 1
-                        r.stuck = ev_stop
-                        r.defl = 0
-                        r.jac_valid = False
-                        if r.recording:
-                            append_pair(sticks, r.n_stick, r.k * T + r.s, math.nan)
-                            r.n_stick += 1
         if r.isamp >= n_samples:
             break
 
     if track_min and r.mode == 0 and r.recording:
         for j in range(nstops):
-            finish_guard(m, x, r.s, pv, j, r.k * T + r.s, slope_end[j], slope_first[j], min_info[j])
+            finish_guard(m, r, x, pv, j, guard_info[j])
     close_sticking(sticks, r.n_stick, r.k * T + r.s)
     lyap_span = r.k * T + r.s - r.lyap_t0 if (lyap and r.lyap_started) else 0.0
     Vout = np.zeros((n, ncol))
@@ -347,6 +291,6 @@ def integrate(start, pv, cfg, m):
         table_rows(traj, r.n_traj),
         logs,
         lyap_span,
-        min_info,
+        guard_info[:, : 2 * (2 + n)].copy(),
         r.jac_valid,
     )

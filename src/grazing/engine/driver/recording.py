@@ -9,7 +9,7 @@ in free flight), are tracked for grazing analysis.
 
 import math
 
-import numpy as np  # noqa: F401 - the names the pieces share in the generated module
+import numpy as np
 from numba import njit
 
 from grazing.engine.driver.calls import guard
@@ -82,33 +82,38 @@ def trajectory_points(m, r, X, h_acc, traj, xe):
 
 
 @njit(cache=True, inline="always")
-def track_guard(m, O, row, X, x, t, h, h_acc, defl, event, gm, min_info, slope_end, slope_first, xe):
-    """Minimum of event row ``row`` (a guard) over ``[t, t + h_acc)``, closest approach; returns the slopes.
+def track_guard(m, r, O, row, X, x, h, h_acc, event, gm, info, xe):
+    """Minimum of event row ``row`` (a guard) over the step of run ``r`` up to ``h_acc``, closest approach.
 
-    ``min_info[:2 + n]`` holds the smallest value, its time and the state
-    there; ``min_info[2 + n:]`` the same for the smallest local minimum in free
+    ``info`` is the stop's row of the guard's record (:func:`new_guard_info`):
+    ``info[:2 + n]`` holds the smallest value, its time and the state there;
+    ``info[2 + n:4 + 2n]`` the same for the smallest local minimum in free
     flight (where ``L_f h`` turns from negative to positive, inside the step
-    or at its start).  Returns ``(slope_end, slope_first)``: the guard's slope
-    at the end of this step (nan when an event follows) and at the start of
-    the first recorded step.
+    or at its start); the last two, the guard's slope at the end of the
+    previous step (nan when an event followed) and at the start of the
+    first recorded one.  ``x`` is the state at the step's start.
     """
     n = m.nx
     order = m.order
+    t = r.k * r.T + r.s
+    defl = r.defl if r.defl_stop == row else 0
+    slope_end = info[4 + 2 * n]
+    slope_first = info[5 + 2 * n]
     hk = 1.0
     for j in range(order + 1):
         gm[j] = O[row, j] * hk
         hk *= h
-    if gm[0] < min_info[0]:
-        min_info[0] = gm[0]
-        min_info[1] = t
-        set_slice(min_info, 2, x, n)
+    if gm[0] < info[0]:
+        info[0] = gm[0]
+        info[1] = t
+        set_slice(info, 2, x, n)
     if defl == 0:  # not leaving a contact
         if math.isnan(slope_first):
             slope_first = gm[1] / h
-        elif slope_end < 0.0 <= gm[1] and gm[0] < min_info[2 + n]:
-            min_info[2 + n] = gm[0]  # a local minimum exactly at the step boundary
-            min_info[3 + n] = t
-            set_slice(min_info, 4 + n, x, n)
+        elif slope_end < 0.0 <= gm[1] and gm[0] < info[2 + n]:
+            info[2 + n] = gm[0]  # a local minimum exactly at the step boundary
+            info[3 + n] = t
+            set_slice(info, 4 + n, x, n)
     uend = h_acc / h
     slope_end = poly_derivative(gm, order, uend) / h
     if gm[1] < 0.0 and slope_end > 0.0:
@@ -122,29 +127,39 @@ def track_guard(m, O, row, X, x, t, h, h_acc, defl, event, gm, min_info, slope_e
                 hi = mid
         um = 0.5 * (lo + hi)
         gv = horner(gm, order, um)
-        if gv < min_info[0] or gv < min_info[2 + n]:
+        if gv < info[0] or gv < info[2 + n]:
             eval_rows(X, n, order, um * h, xe)
         for base in (0, 2 + n):
-            if gv < min_info[base]:
-                min_info[base] = gv
-                min_info[base + 1] = t + um * h
-                set_slice(min_info, base + 2, xe, n)
+            if gv < info[base]:
+                info[base] = gv
+                info[base + 1] = t + um * h
+                set_slice(info, base + 2, xe, n)
     if event:
         slope_end = math.nan  # an impact or a release follows: no free-flight minimum here
-    return slope_end, slope_first
+    info[4 + 2 * n] = slope_end
+    info[5 + 2 * n] = slope_first
 
 
 @njit(cache=True)
-def finish_guard(m, x, s, pv, j, t, slope_end, slope_first, min_info):
-    """At the end of the run: the final state, and a minimum where the orbit closes."""
+def new_guard_info(nstops, n):
+    """Each stop's guard record (:func:`track_guard`): no minimum yet (inf), no slopes (nan)."""
+    info = np.full((nstops, 2 * (2 + n) + 2), math.inf)
+    info[:, 2 * (2 + n) :] = math.nan
+    return info
+
+
+@njit(cache=True)
+def finish_guard(m, r, x, pv, j, info):
+    """At the end of run ``r``: the final state, and a minimum where the orbit closes (``info`` of stop j)."""
     n = m.nx
-    g_end = guard(m, x, s, pv, j)
-    if g_end < min_info[0]:
-        min_info[0] = g_end
-        min_info[1] = t
-        set_slice(min_info, 2, x, n)
+    t = r.k * r.T + r.s
+    g_end = guard(m, x, r.s, pv, j)
+    if g_end < info[0]:
+        info[0] = g_end
+        info[1] = t
+        set_slice(info, 2, x, n)
     # A run over whole periods of an orbit ends where it started: a minimum there.
-    if slope_end < 0.0 <= slope_first and g_end < min_info[2 + n]:
-        min_info[2 + n] = g_end
-        min_info[3 + n] = t
-        set_slice(min_info, 4 + n, x, n)
+    if info[4 + 2 * n] < 0.0 <= info[5 + 2 * n] and g_end < info[2 + n]:
+        info[2 + n] = g_end
+        info[3 + n] = t
+        set_slice(info, 4 + n, x, n)

@@ -71,24 +71,32 @@ def lyapunov_step(m, r, x, X, V, ncol, t, scratch, logs, xe):
 
 
 @njit(cache=True)
-def discontinuity_map(m, x, s, t, pv, j, a, e, window, use_var, ncol, V, gh, gv, record, imp, n_rec):
-    """Nordmark's discontinuity map at leading order, at the grazing phase; returns ``(applied, n_rec)``.
+def discontinuity_map(m, r, x, pv, cfg, V, gh, gv, record, imp):
+    """Nordmark's discontinuity map at leading order, at the grazing phase; returns whether it applied.
 
-    With ``v = L_f h`` and ``delta = v^2 / (2 a) - h`` (how far the local
-    parabola would reach past the stop, ``a = L_f^2 h`` at the grazing
-    point): if ``delta > 0`` and ``|v| / a < window``, ``x <- x - e sqrt(2 a
-    delta)``, and the
-    variational matrix by ``dD/dx = I - e (grad S)^T``.  The kick is recorded
-    as an impact (time, speed ``S``, state) when ``record``.
+    ``cfg`` holds the map's settings (``stop`` the stop it stands for,
+    ``zdm_a``, ``zdm_e``, ``zdm_window``: the fields of
+    :class:`~grazing.engine.records.Config` and
+    :class:`~grazing.engine.records.LaneSettings`).  With ``v = L_f h`` and
+    ``delta = v^2 / (2 a) - h`` (how far the local parabola would reach past
+    the stop, ``a = L_f^2 h`` at the grazing point): if ``delta > 0`` and
+    ``|v| / a < window``, ``x <- x - e sqrt(2 a delta)``, and the variational
+    matrix by ``dD/dx = I - e (grad S)^T``.  The kick is recorded as an impact
+    (time, speed ``S``, state) in ``imp`` when ``record`` (``r.n_imp_rec``).
     """
     n = m.nx
+    ncol = n + m.nsens
+    j = cfg.stop
+    a = cfg.zdm_a
+    e = cfg.zdm_e
+    s = r.s
     hval = guard(m, x, s, pv, j)
     vn = normal_rate(m, x, s, pv, j)
     dz = vn * vn / (2.0 * a) - hval
-    if not (dz > 0.0 and abs(vn) < window * a):
-        return False, n_rec
+    if not (dz > 0.0 and abs(vn) < cfg.zdm_window * a):
+        return False
     sp_ = math.sqrt(2.0 * a * dz)
-    if use_var:
+    if r.use_var:
         # dD/dx = I - e (grad S)^T, grad S = a grad(delta) / S
         guard_grad(m, x, s, pv, gh, j)
         normal_rate_grad(m, x, s, pv, gv, j)
@@ -102,9 +110,9 @@ def discontinuity_map(m, x, s, t, pv, j, a, e, window, use_var, ncol, V, gh, gv,
                 V[i, c] -= e[i] * gs
         pack_var(V, n, ncol, x)
     if record:
-        append_record(imp, n_rec, t, sp_, x, n)
-        imp[0][n_rec, 2 + n] = j
-        n_rec += 1
+        append_record(imp, r.n_imp_rec, r.k * r.T + s, sp_, x, n)
+        imp[0][r.n_imp_rec, 2 + n] = j
+        r.n_imp_rec += 1
     for i in range(n):
         x[i] -= e[i] * sp_
-    return True, n_rec
+    return True
