@@ -36,12 +36,10 @@ from grazing.engine.abi import TC_FREE_LANES, TC_VAR_LANES, call_model
 from grazing.engine.driver.atomics import fetch_add, load_acquire, store_release
 from grazing.engine.driver.calls import tc_free, tc_stick, tc_var
 from grazing.engine.driver.events import first_event
-from grazing.engine.driver.impacts import at_event
 from grazing.engine.driver.loop import STATUS_NONFINITE, STATUS_OK, STATUS_STEP_LIMIT, STATUS_ZENO
 from grazing.engine.driver.recording import take_samples
 from grazing.engine.driver.state import new_state
-from grazing.engine.driver.step import STEP_LAST, STEP_MAP, step_end
-from grazing.engine.driver.tangent import discontinuity_map, lyapunov_step
+from grazing.engine.driver.step import STEP_LAST, STEP_MAP, end_step, step_end
 from grazing.engine.polyroots import quadratic_bound, work_shape
 from grazing.engine.records import Kernels, LaneJobs, LanePoints, LaneResults, LaneSettings
 from grazing.engine.stepping import new_table, step_factor, step_from_norms, step_size
@@ -191,6 +189,8 @@ def sweep_lanes(m, cfg, work, points, out):
     sticks = new_table(1, 2)
     traj = new_table(1, 1 + n)
     tables = (imp, sticks, traj)
+    fbuf = np.zeros(n)
+    Tp = np.zeros(0)  # (no sensitivities on lanes: end_step's period term is never taken)
     kinds = np.zeros(L, dtype=np.int64)  # 0 sticking or idle, 1 free flight, 2 with the variational equations
     # What a step decides for each lane (pass A), for the advance (vectors) and the rest (pass B).
     hs = np.zeros(L)  # step
@@ -454,40 +454,27 @@ def sweep_lanes(m, cfg, work, points, out):
             p = ls[lane].point
             T = Ts[p]
             run = ls[lane]
-            run.s += dts[lane]
-            if cfg.periodic and run.s >= T:
-                run.s -= T
-                run.k += 1
-            run.steps += 1
-            run.defl = 0
-            mode = run.mode
-            use_var = run.use_var
-            nrows = ntot if (mode == 0 and use_var) else n
-            event = (flags[lane] & 1) != 0
-            zdm_hit = (flags[lane] & 4) != 0
-            lyap_now = cfg.lyapunov and use_var and mode == 0
-            if lyap_now or zdm_hit or event:
-                for i in range(ntot):
-                    xl[i] = XS[i, lane]
-                recording = run.recording
-                pv = pl[lane]
-                if lyap_now:
-                    t = run.k * T + run.s
-                    lyapunov_step(m, run, xl, XT[:, :, lane], V, ncol, t, scratch, logs[lane], xe)
-                if zdm_hit:
-                    run.kz += 1
-                    applied = discontinuity_map(m, run, xl, pv, cfg, V, gh, gv, False, imp)
-                    if applied and recording and run.stage == FINAL:
-                        counts[lane, cfg.stop] += 1
-                if event:
-                    ev_stop = evs[lane]
-                    if at_event(m, run, xl, xp, pv, ev_stop, nrows, V, cfg.chatter_tol * T, False, tables):
-                        if recording and run.stage == FINAL:
-                            counts[lane, ev_stop] += 1
-                    run.n_stick = 0  # (sticking intervals are not recorded)
-                for i in range(ntot):
-                    XS[i, lane] = xl[i]
-            run.span_dt = math.nan
+            run.h_acc = dts[lane]
+            run.event = (flags[lane] & 1) != 0
+            run.ev_stop = evs[lane]
+            run.zdm_hit = (flags[lane] & 4) != 0
+            nrows = ntot if (run.mode == 0 and run.use_var) else n
+            for i in range(ntot):
+                xl[i] = XS[i, lane]
+            recording = run.recording  # (before the step's end)
+            buffers = (xp, V, scratch, logs[lane], xe, gh, gv, fbuf)
+            chatter_time = cfg.chatter_tol * T
+            kicked, impact = end_step(
+                m, run, xl, XT[:, :, lane], pl[lane], nrows, cfg, chatter_time, 0, Tp, buffers, tables
+            )
+            if recording and run.stage == FINAL:
+                if kicked:
+                    counts[lane, cfg.stop] += 1
+                if impact:
+                    counts[lane, run.ev_stop] += 1
+            run.n_stick = 0  # (sticking intervals are not recorded)
+            for i in range(ntot):
+                XS[i, lane] = xl[i]
             k = run.k
             s = run.s
             n_samples = ls[lane].n_samples

@@ -37,7 +37,7 @@ from grazing.core.solution import Status
 from grazing.engine.driver.atomics import load_acquire
 from grazing.engine.driver.calls import tc_free, tc_stick, tc_var
 from grazing.engine.driver.events import first_event
-from grazing.engine.driver.impacts import at_event, close_sticking
+from grazing.engine.driver.impacts import close_sticking
 from grazing.engine.driver.recording import (
     finish_guard,
     new_guard_info,
@@ -46,8 +46,7 @@ from grazing.engine.driver.recording import (
     trajectory_points,
 )
 from grazing.engine.driver.state import new_state
-from grazing.engine.driver.step import STEP_LAST, STEP_MAP, step_end
-from grazing.engine.driver.tangent import discontinuity_map, lyapunov_step, shift_period
+from grazing.engine.driver.step import STEP_LAST, STEP_MAP, end_step, step_end
 from grazing.engine.polyroots import work_shape
 from grazing.engine.records import Config, Kernels, Start
 from grazing.engine.stepping import (
@@ -135,9 +134,9 @@ def integrate(start, pv, cfg, m):
     guard_info = new_guard_info(nstops, n)  # per stop: the guard's minimum, closest approach, slopes
     tables = (imp, sticks, traj)
     fbuf = np.empty(n)
-    shift_sens = use_var and m.nsens > 0 and wrap
     zdm_gh = np.zeros(n)
     zdm_gv = np.zeros(n)
+    buffers = (xp, V, scratch, logs, xe, zdm_gh, zdm_gv, fbuf)  # (step.end_step's)
 
     r = new_state(1)[0]  # the run's state (see .state)
     r.T = T
@@ -241,28 +240,14 @@ def integrate(start, pv, cfg, m):
         eval_rows(X, nrows, order, h_acc, xe)
         for i in range(nrows):
             x[i] = xe[i]
-        r.s += h_acc
-        if wrap and r.s >= T:
-            if shift_sens and r.mode == 0:
-                shift_period(m, x, r.s, pv, Tp, ncol, fbuf)
-            r.s -= T
-            r.k += 1
-        r.steps += 1
-        r.defl = 0
-        if lyap and use_var and r.mode == 0:
-            lyapunov_step(m, r, x, X, V, ncol, r.k * T + r.s, scratch, logs, xe)
-        r.span_dt = math.nan
-
-        if zdm_hit:
-            r.kz += 1
-            record = record_impacts == 2 or (record_impacts == 1 and r.recording)
-            if discontinuity_map(m, r, x, pv, cfg, V, zdm_gh, zdm_gv, record, imp):
-                r.n_imp += 1
-
-        if event:
-            record = record_impacts == 2 or (record_impacts == 1 and r.recording)
-            if at_event(m, r, x, xp, pv, ev_stop, nrows, V, chatter_time, record, tables):
-                r.n_imp += 1
+        r.h_acc = h_acc
+        r.event = event
+        r.ev_stop = ev_stop
+        r.zdm_hit = zdm_hit
+        kicked, impact = end_step(
+            m, r, x, X, pv, nrows, cfg, chatter_time, record_impacts, Tp, buffers, tables
+        )
+        r.n_imp += int(kicked) + int(impact)
         if r.isamp >= n_samples:
             break
 

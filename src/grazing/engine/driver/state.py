@@ -46,6 +46,11 @@ RUN_STATE = np.dtype(
         ("lyap_t0", np.float64),
         ("span_dt", np.float64),  # the recorded span started this long into this step (nan: not in this step)
         ("kz", np.int64),  # the discontinuity map's next period
+        # what the current step decided (step.end_step)
+        ("h_acc", np.float64),  # its accepted part
+        ("event", np.bool_),  # it ends at an event ...
+        ("ev_stop", np.int64),  # ... on this stop
+        ("zdm_hit", np.bool_),  # it ends at the discontinuity map's phase
         # what is recorded (loop.integrate): counts and the next trajectory point at (kt, st)
         ("n_imp", np.int64),  # impacts
         ("n_imp_rec", np.int64),  # ... recorded

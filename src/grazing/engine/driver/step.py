@@ -4,7 +4,12 @@ Each takes the run's state (a :data:`.state.RUN_STATE` record): the one run
 of :func:`.loop.integrate`, or one lane of :func:`.lanes.sweep_lanes`.
 """
 
+import math
+
 from numba import njit
+
+from grazing.engine.driver.impacts import at_event
+from grazing.engine.driver.tangent import discontinuity_map, lyapunov_step, shift_period
 
 STEP_LAST = 1
 """The step ends at the run's last sample."""
@@ -33,3 +38,44 @@ def step_end(r, h, zdm_on, zdm_s):
             zdm_hit = True
             last = last and rem_z >= rem
     return h, (STEP_LAST if last else 0) | (STEP_MAP if zdm_hit else 0)
+
+
+@njit(cache=True, inline="always")
+def end_step(m, r, x, X, pv, nrows, cfg, chatter_time, record_impacts, Tp, work, tables):
+    """The end of the step of run ``r``, whose state ``x`` is already advanced; returns ``(zdm, impact)``.
+
+    The step, its accepted part ``r.h_acc`` and its event (``r.event`` on
+    stop ``r.ev_stop``, ``r.zdm_hit``) are those :func:`step_end` and the
+    event search chose; ``X`` holds its Taylor coefficients, ``nrows`` the
+    rows of ``x`` it advanced.  In order: the time (at a period boundary, the
+    sensitivities' period term, ``Tp`` = dT/dp), the Lyapunov vectors (with
+    ``cfg.lyapunov``), the discontinuity map (``cfg``'s), the event
+    (:func:`.impacts.at_event`, chattering shorter than ``chatter_time``).
+    Impacts (and kicks of the map) are recorded in ``tables`` as
+    ``record_impacts`` says (0 none, 1 in the recorded span, 2 all).
+    ``work`` holds the buffers ``(xp, V, scratch, logs, xe, gh, gv, f)``.
+    Returns whether the map kicked and whether there was an impact.
+    """
+    xp, V, scratch, logs, xe, gh, gv, f = work
+    ncol = m.nx + m.nsens
+    mode = r.mode
+    r.s += r.h_acc
+    if r.wrap and r.s >= r.T:
+        if m.nsens > 0 and r.use_var and mode == 0:
+            shift_period(m, x, r.s, pv, Tp, ncol, f)
+        r.s -= r.T
+        r.k += 1
+    r.steps += 1
+    r.defl = 0
+    if cfg.lyapunov and r.use_var and mode == 0:
+        lyapunov_step(m, r, x, X, V, ncol, r.k * r.T + r.s, scratch, logs, xe)
+    r.span_dt = math.nan
+    record = record_impacts == 2 or (record_impacts == 1 and r.recording)
+    kicked = False
+    if r.zdm_hit:
+        r.kz += 1
+        kicked = discontinuity_map(m, r, x, pv, cfg, V, gh, gv, record, tables[0])
+    impact = False
+    if r.event:
+        impact = at_event(m, r, x, xp, pv, r.ev_stop, nrows, V, chatter_time, record, tables)
+    return kicked, impact
