@@ -36,10 +36,9 @@ from grazing.engine.abi import TC_FREE_LANES, TC_VAR_LANES, call_model
 from grazing.engine.driver.atomics import fetch_add, load_acquire, store_release
 from grazing.engine.driver.calls import tc_free, tc_stick, tc_var
 from grazing.engine.driver.events import first_event
-from grazing.engine.driver.loop import STATUS_NONFINITE, STATUS_OK, STATUS_STEP_LIMIT, STATUS_ZENO
 from grazing.engine.driver.recording import take_samples
-from grazing.engine.driver.state import new_state
-from grazing.engine.driver.step import STEP_LAST, STEP_MAP, end_step, step_end
+from grazing.engine.driver.state import STATUS_NONFINITE, STATUS_OK, STATUS_STEP_LIMIT, new_state
+from grazing.engine.driver.step import STEP_LAST, accept_step, end_step, step_end
 from grazing.engine.polyroots import quadratic_bound, work_shape
 from grazing.engine.records import Kernels, LaneJobs, LanePoints, LaneResults, LaneSettings
 from grazing.engine.stepping import new_table, step_factor, step_from_norms, step_size
@@ -53,6 +52,8 @@ VECTOR_MIN_LANES = 3
 
 # A lane's stage in its point's protocol.
 IDLE, TRANSIENT, EXTRA, FINAL = 0, 1, 2, 3
+FAILED = 8
+"""A lane's step flag: its point failed."""
 
 
 @njit(cache=True)
@@ -195,8 +196,7 @@ def sweep_lanes(m, cfg, work, points, out):
     # What a step decides for each lane (pass A), for the advance (vectors) and the rest (pass B).
     hs = np.zeros(L)  # step
     dts = np.zeros(L)  # accepted part of it
-    evs = np.zeros(L, dtype=np.int64)  # its stop
-    flags = np.zeros(L, dtype=np.int64)  # bit 1 event, 2 last, 4 discontinuity map, 8 failed
+    flags = np.zeros(L, dtype=np.int64)  # how it ends (step.STEP_LAST, STEP_MAP), or FAILED
     todo = np.zeros(L, dtype=np.int64)  # 1: the lane steps this round
     nx_ = np.zeros(L)  # step-size norms
     n1_ = np.zeros(L)
@@ -346,7 +346,7 @@ def sweep_lanes(m, cfg, work, points, out):
                 if not math.isfinite(XS[i, lane]):
                     status = STATUS_NONFINITE
             if status != STATUS_OK:
-                flags[lane] = 8
+                flags[lane] = FAILED
                 ls[lane].status = status
                 continue
             if mode == 1:
@@ -359,10 +359,7 @@ def sweep_lanes(m, cfg, work, points, out):
             else:
                 h = step_from_norms(nx_[lane], n1_[lane], n2_[lane], order, T, factor)
             h, ends = step_end(ls[lane], h, cfg.zdm, zdms[p])
-            if ends & STEP_LAST:
-                flags[lane] |= 2
-            if ends & STEP_MAP:
-                flags[lane] |= 4
+            flags[lane] = ends
             hs[lane] = h
             todo[lane] = 1
             plain[lane] = 1 if mode == 0 and ls[lane].defl == 0 else 0
@@ -404,23 +401,14 @@ def sweep_lanes(m, cfg, work, points, out):
                 skip = cfg.stop if cfg.zdm else -1
                 run = ls[lane]
                 u, ev_stop = first_event(m, run, OT[:, :, lane], h, True, skip, False, cfg.stop, a, roots)
-            event = u >= 0.0 and h > 0.0
-            if event and u == 0.0:
-                ls[lane].zero_events += 1
-                if ls[lane].zero_events > 3:
-                    flags[lane] = 8
-                    ls[lane].status = STATUS_ZENO
-                    todo[lane] = 0
-                    continue
-            else:
-                ls[lane].zero_events = 0
-            is_last = (flags[lane] & 2) != 0
-            h_acc = u * h if event else h
-            if event and is_last and u >= 1.0:
-                event = False
-            if event:
-                flags[lane] |= 1
-            evs[lane] = ev_stop
+            run = ls[lane]
+            if not accept_step(run, h, flags[lane], u, ev_stop):  # (events accumulate)
+                flags[lane] = FAILED
+                todo[lane] = 0
+                continue
+            is_last = (flags[lane] & STEP_LAST) != 0
+            h_acc = run.h_acc
+            event = run.event
             dts[lane] = h_acc
             run = ls[lane]
             if (run.ks - run.k) * run.T + (run.ss - run.s) <= h_acc:
@@ -444,7 +432,7 @@ def sweep_lanes(m, cfg, work, points, out):
 
         # Pass B, lane by lane: time, Lyapunov vectors, discontinuity map, impacts, the request's end.
         for lane in range(L):
-            if flags[lane] == 8:  # the point failed (L_STATUS says why): the next point starts afresh
+            if flags[lane] == FAILED:  # the point failed (its status says why): the next point starts afresh
                 store_release(out.status, ls[lane].point, ls[lane].status)
                 ls[lane].stage = IDLE
                 active -= 1
@@ -454,10 +442,6 @@ def sweep_lanes(m, cfg, work, points, out):
             p = ls[lane].point
             T = Ts[p]
             run = ls[lane]
-            run.h_acc = dts[lane]
-            run.event = (flags[lane] & 1) != 0
-            run.ev_stop = evs[lane]
-            run.zdm_hit = (flags[lane] & 4) != 0
             nrows = ntot if (run.mode == 0 and run.use_var) else n
             for i in range(ntot):
                 xl[i] = XS[i, lane]

@@ -33,7 +33,6 @@ import math
 import numpy as np
 from numba import njit
 
-from grazing.core.solution import Status
 from grazing.engine.driver.atomics import load_acquire
 from grazing.engine.driver.calls import tc_free, tc_stick, tc_var
 from grazing.engine.driver.events import first_event
@@ -45,8 +44,14 @@ from grazing.engine.driver.recording import (
     track_guard,
     trajectory_points,
 )
-from grazing.engine.driver.state import new_state
-from grazing.engine.driver.step import STEP_LAST, STEP_MAP, end_step, step_end
+from grazing.engine.driver.state import (
+    STATUS_INTERRUPTED,
+    STATUS_NONFINITE,
+    STATUS_OK,
+    STATUS_STEP_LIMIT,
+    new_state,
+)
+from grazing.engine.driver.step import STEP_LAST, accept_step, end_step, step_end
 from grazing.engine.polyroots import work_shape
 from grazing.engine.records import Config, Kernels, Start
 from grazing.engine.stepping import (
@@ -60,11 +65,6 @@ from grazing.engine.stepping import (
     unpack_var,
 )
 
-STATUS_OK = int(Status.OK)
-STATUS_STEP_LIMIT = int(Status.STEP_LIMIT)
-STATUS_NONFINITE = int(Status.NONFINITE)
-STATUS_ZENO = int(Status.ZENO)
-STATUS_INTERRUPTED = int(Status.INTERRUPTED)
 ROOT_WORK_ROWS, ROOT_WORK_MIN_COLS = work_shape(0)
 
 
@@ -208,23 +208,15 @@ def integrate(start, pv, cfg, m):
             h = step_size(X, n, O, nstops, r.stuck, order, max_step, factor)
         h, ends = step_end(r, h, zdm_on, sz)  # (at the last sample, at the map's phase)
         is_last = (ends & STEP_LAST) != 0
-        zdm_hit = (ends & STEP_MAP) != 0
 
         # The first event on the step (each guard's polynomial in u in [0, 1]).
         u, ev_stop = first_event(
             m, r, O, h, events, watch if zdm_on else -1, touch_end and is_last and r.mode == 0, watch, a, work
         )
-        event = u >= 0.0 and h > 0.0
-        if event and u == 0.0:
-            r.zero_events += 1
-            if r.zero_events > 3:
-                r.status = STATUS_ZENO
-                break
-        else:
-            r.zero_events = 0
-        h_acc = u * h if event else h
-        if event and is_last and u >= 1.0:
-            event = False
+        if not accept_step(r, h, ends, u, ev_stop):  # (events accumulate)
+            break
+        h_acc = r.h_acc
+        event = r.event
         nrows = ntot if r.mode == 0 else n
 
         # What the step records within (0, h_acc].
@@ -240,10 +232,6 @@ def integrate(start, pv, cfg, m):
         eval_rows(X, nrows, order, h_acc, xe)
         for i in range(nrows):
             x[i] = xe[i]
-        r.h_acc = h_acc
-        r.event = event
-        r.ev_stop = ev_stop
-        r.zdm_hit = zdm_hit
         kicked, impact = end_step(
             m, r, x, X, pv, nrows, cfg, chatter_time, record_impacts, Tp, buffers, tables
         )

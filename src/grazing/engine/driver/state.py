@@ -16,6 +16,14 @@ Examples
 import numpy as np
 from numba import njit
 
+from grazing.core.solution import Status
+
+STATUS_OK = int(Status.OK)
+STATUS_STEP_LIMIT = int(Status.STEP_LIMIT)
+STATUS_NONFINITE = int(Status.NONFINITE)
+STATUS_ZENO = int(Status.ZENO)
+STATUS_INTERRUPTED = int(Status.INTERRUPTED)
+
 RUN_STATE = np.dtype(
     [
         # the run's settings that may differ from lane to lane

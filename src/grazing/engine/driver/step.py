@@ -9,9 +9,12 @@ import math
 from numba import njit
 
 from grazing.engine.driver.impacts import at_event
+from grazing.engine.driver.state import STATUS_ZENO
 from grazing.engine.driver.tangent import discontinuity_map, lyapunov_step, shift_period
 
-STEP_LAST = 1
+STEP_EVENT = 1
+"""The step ends at an event."""
+STEP_LAST = 2
 """The step ends at the run's last sample."""
 STEP_MAP = 4
 """The step ends at the discontinuity map's phase."""
@@ -38,6 +41,33 @@ def step_end(r, h, zdm_on, zdm_s):
             zdm_hit = True
             last = last and rem_z >= rem
     return h, (STEP_LAST if last else 0) | (STEP_MAP if zdm_hit else 0)
+
+
+@njit(cache=True, inline="always")
+def accept_step(r, h, ends, u, ev_stop):
+    """The accepted part of the step of run ``r`` (``h``, cut as ``ends`` says) and its event; False: none.
+
+    ``u`` is the first event on the step as a fraction of it (``u < 0``:
+    none), on stop ``ev_stop``.  Sets ``r.h_acc``, ``r.event``, ``r.ev_stop``
+    and ``r.zdm_hit``.  An event at the very end of a step that ends at the
+    run's last sample is left for the next run.  Returns False (``r.status``
+    ``ZENO``) when more than three events in a row come at ``u = 0``.
+    """
+    event = u >= 0.0 and h > 0.0
+    if event and u == 0.0:
+        r.zero_events += 1
+        if r.zero_events > 3:
+            r.status = STATUS_ZENO
+            return False
+    else:
+        r.zero_events = 0
+    r.h_acc = u * h if event else h
+    if event and (ends & STEP_LAST) != 0 and u >= 1.0:
+        event = False
+    r.event = event
+    r.ev_stop = ev_stop
+    r.zdm_hit = (ends & STEP_MAP) != 0
+    return True
 
 
 @njit(cache=True, inline="always")
