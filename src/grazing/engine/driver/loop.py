@@ -87,7 +87,6 @@ def integrate(start, pv, cfg, m):
     nstops = m.nstops
     # The settings read on every step, as locals (no record access in the loop).
     T = cfg.T
-    wrap = cfg.wrap
     use_var = cfg.use_var
     max_step = cfg.max_step
     max_steps = cfg.max_steps
@@ -139,49 +138,9 @@ def integrate(start, pv, cfg, m):
     buffers = (xp, V, scratch, logs, xe, zdm_gh, zdm_gv, fbuf)  # (step.end_step's)
 
     r = new_state(1)[0]  # the run's state (see .state)
-    r.T = T
-    r.wrap = wrap
-    r.traj_dt = traj_dt
-    r.n_samples = n_samples
-    r.n_keep = n_keep
-    r.use_var = use_var
-    r.max_steps = max_steps
-    r.k = start.k
-    r.s = start.s
-    r.mode = 1 if start.mode > 0 else 0
-    r.stuck = max(start.mode - 1, 0)  # the stop it sticks to
-    r.defl = 2 if cfg.touch_start else 0
-    r.defl_stop = watch  # the stop the known roots at u = 0 belong to
-    r.ks = cfg.ks
-    r.ss = cfg.ss
-    r.isamp = 0
+    start_run(m, r, start, cfg, x, tables)
     keep_from = n_samples - n_keep
-    r.recording = keep_from == 0
-    r.lyap_t0 = r.k * T + r.s
-    r.lyap_started = r.recording
-    r.span_dt = math.nan
-    r.n_imp = 0
-    r.n_imp_rec = 0
-    r.n_stick = 0
-    r.n_traj = 0
-    r.kt = r.k
-    r.st = r.s
-    r.kz = r.k if r.s < cfg.zdm_s - 1e-9 * T else r.k + 1
     sz = cfg.zdm_s
-    r.status = STATUS_OK
-    r.steps = 0
-    r.zero_events = 0
-    r.jac_valid = True
-    if r.recording and traj_dt > 0.0:
-        append_row(traj, 0, r.k * T + r.s, x, n)
-        r.n_traj = 1
-        r.st += traj_dt
-        while wrap and r.st >= T:
-            r.st -= T
-            r.kt += 1
-    if r.recording and r.mode == 1:  # the recorded span starts while sticking
-        append_pair(sticks, r.n_stick, r.k * T + r.s, math.nan)
-        r.n_stick += 1
 
     while True:
         if r.steps >= max_steps:
@@ -267,3 +226,56 @@ def integrate(start, pv, cfg, m):
         guard_info[:, : 2 * (2 + n)].copy(),
         r.jac_valid,
     )
+
+
+@njit(cache=True)
+def start_run(m, r, start, cfg, x, tables):
+    """Set the state ``r`` of a run from ``start`` with the settings ``cfg`` (its state ``x``).
+
+    A run whose recorded span starts at once records its first trajectory
+    point, and a sticking interval if it starts sticking (``tables`` =
+    ``(impacts, sticking, trajectory)``).
+    """
+    n = m.nx
+    T = cfg.T
+    r.T = T
+    r.wrap = cfg.wrap
+    r.traj_dt = cfg.traj_dt
+    r.n_samples = cfg.n_samples
+    r.n_keep = cfg.n_keep
+    r.use_var = cfg.use_var
+    r.max_steps = cfg.max_steps
+    r.k = start.k
+    r.s = start.s
+    r.mode = 1 if start.mode > 0 else 0
+    r.stuck = max(start.mode - 1, 0)  # the stop it sticks to
+    r.defl = 2 if cfg.touch_start else 0
+    r.defl_stop = cfg.stop  # the stop the known roots at u = 0 belong to
+    r.ks = cfg.ks
+    r.ss = cfg.ss
+    r.isamp = 0
+    r.recording = cfg.n_samples - cfg.n_keep == 0
+    r.lyap_t0 = r.k * T + r.s
+    r.lyap_started = r.recording
+    r.span_dt = math.nan
+    r.n_imp = 0
+    r.n_imp_rec = 0
+    r.n_stick = 0
+    r.n_traj = 0
+    r.kt = r.k
+    r.st = r.s
+    r.kz = r.k if r.s < cfg.zdm_s - 1e-9 * T else r.k + 1
+    r.status = STATUS_OK
+    r.steps = 0
+    r.zero_events = 0
+    r.jac_valid = True
+    if r.recording and r.traj_dt > 0.0:
+        append_row(tables[2], 0, r.k * T + r.s, x, n)
+        r.n_traj = 1
+        r.st += r.traj_dt
+        while r.wrap and r.st >= T:
+            r.st -= T
+            r.kt += 1
+    if r.recording and r.mode == 1:  # the recorded span starts while sticking
+        append_pair(tables[1], r.n_stick, r.k * T + r.s, math.nan)
+        r.n_stick += 1
