@@ -27,6 +27,7 @@ point of initial states at its phase).
 """
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -49,6 +50,19 @@ ADAPTIVE_MAX_PERIOD = 16
 LYAPUNOV_ALIGN = 16
 VECTOR_MIN_LANES = 3
 """Fewest lanes of a kind for which the lane function is called (else the scalar one, lane by lane)."""
+
+
+class LaneArrays(NamedTuple):
+    """The lanes' own arrays in :func:`sweep_lanes` (one row or column per lane)."""
+
+    ls: np.ndarray  # the lanes' runs (state.RUN_STATE records)
+    XS: np.ndarray  # (rows, lanes): their states (and variational matrices)
+    pl: np.ndarray  # (lanes, parameters): their parameter vectors ...
+    PT: np.ndarray  # ... and transposed, for the lane functions
+    logs: np.ndarray  # (lanes, nx): their Lyapunov sums
+    buf: np.ndarray  # (lanes, samples, nx): their kept samples
+    counts: np.ndarray  # (lanes, stops): their impacts on each stop
+
 
 # A lane's stage in its point's protocol.
 IDLE, TRANSIENT, EXTRA, FINAL = 0, 1, 2, 3
@@ -150,7 +164,8 @@ def sweep_lanes(m, cfg, work, points, out):
     work = LaneJobs(*work)
     points = LanePoints(*points)
     out = LaneResults(*out)
-    pvs, Ts, sphase, tcarry, zdms = points.pvs, points.Ts, points.sphase, points.tcarry, points.zdms
+    zdms = points.zdms
+    npv = points.pvs.shape[1]
     n = m.nx
     order = m.order
     nstops = m.nstops
@@ -158,7 +173,6 @@ def sweep_lanes(m, cfg, work, points, out):
     L = cfg.lanes
     ncol = n
     ntot = n + n * ncol
-    npv = pvs.shape[1]
     factor = step_factor(cfg.safety, order)
     align = min(LYAPUNOV_ALIGN, cfg.transient) if cfg.lyapunov else 0
     budget = cfg.transient - align
@@ -198,17 +212,13 @@ def sweep_lanes(m, cfg, work, points, out):
     dts = np.zeros(L)  # accepted part of it
     flags = np.zeros(L, dtype=np.int64)  # how it ends (step.STEP_LAST, STEP_MAP), or FAILED
     todo = np.zeros(L, dtype=np.int64)  # 1: the lane steps this round
-    nx_ = np.zeros(L)  # step-size norms
-    n1_ = np.zeros(L)
-    n2_ = np.zeros(L)
-    a0 = np.zeros(L)  # low coefficients and tail of an event polynomial
-    a1 = np.zeros(L)
-    a2 = np.zeros(L)
-    tl = np.zeros(L)
-    hk = np.zeros(L)
+    norms = (np.zeros(L), np.zeros(L), np.zeros(L))  # of the step sizes (lane_norms)
+    certs = (np.zeros(L), np.zeros(L), np.zeros(L), np.zeros(L), np.zeros(L))  # (no_events_certain)
     plain = np.zeros(L, dtype=np.int64)  # 1: no event on the step is certain so far
     acc = np.zeros(L)
 
+    la = LaneArrays(ls, XS, pl, PT, logs, buf, counts)
+    coeffs = (XT, OT, SI, Xs, Os, xl)
     active = 0
     for lane in range(L):
         ls[lane].stage = IDLE
@@ -217,179 +227,20 @@ def sweep_lanes(m, cfg, work, points, out):
             return
         # Idle lanes take the next point: their job's next one, else the next job's first.
         for lane in range(L):
-            while ls[lane].stage == IDLE and ls[lane].job_end >= 0:
-                p = ls[lane].point + 1
-                carried = ls[lane].status == STATUS_OK and ls[lane].job_end > 0
-                first = False
-                if ls[lane].job_end == 0 or p >= ls[lane].job_end:
-                    if work.control[2] > 0 and active >= work.control[2]:
-                        break  # (this thread has its share of the jobs running)
-                    job = fetch_add(work.control, 0, 1)
-                    if job >= work.jobs.shape[0]:
-                        ls[lane].job_end = -1  # (no more jobs for this lane)
-                        break
-                    p = work.jobs[job, 0]
-                    ls[lane].job_end = work.jobs[job, 1]
-                    ls[lane].job = job
-                    carried = False
-                    first = True
-                ls[lane].point = p
-                T = Ts[p]
-                ls[lane].T = T
-                ls[lane].wrap = cfg.periodic
-                if first:
-                    for i in range(n):
-                        XS[i, lane] = work.firsts[ls[lane].job, 1 + i]
-                    t0 = work.firsts[ls[lane].job, 0]
-                elif cfg.fresh or not carried:
-                    for i in range(n):
-                        XS[i, lane] = work.x0[ls[lane].job, i]
-                    t0 = 0.0
-                else:
-                    t0 = tcarry[p] if cfg.periodic else out.t[p - 1]
-                k0, s0, ks0, ss0 = start_times(t0, T, sphase[p], cfg.periodic)
-                ls[lane].k = k0
-                ls[lane].s = s0
-                ls[lane].req_ks = ks0
-                ls[lane].req_ss = ss0
-                ls[lane].mode = 0
-                ls[lane].stuck = 0
-                ls[lane].status = STATUS_OK
-                ls[lane].used = 0
-                for j in range(npv):
-                    pl[lane, j] = pvs[p, j]
-                    PT[j, lane] = pvs[p, j]
-                for j in range(nstops):
-                    counts[lane, j] = 0
-                for j in range(n):
-                    logs[lane, j] = 0.0
-                if budget > 0:
-                    blk = min(ADAPTIVE_BLOCK, budget)
-                    ls[lane].block = blk
-                    ls[lane].stage = TRANSIENT
-                    begin_request(ls[lane], blk, blk if cfg.adaptive else 0, False, T, zdms[p])
-                else:
-                    ls[lane].stage = FINAL
-                    final_request(ls[lane], XS, n, lane, align, cfg, sphase[p], zdms[p])
-                active += 1
+            active = take_point(m, cfg, work, points, out, la, lane, budget, align, active)
         if active == 0:
             break
 
-        # The Taylor coefficients: lanes in free flight by kind, on vectors where there are enough of them.
-        nfree = 0
-        nvar = 0
-        for lane in range(L):
-            kinds[lane] = 0
-            if ls[lane].stage != IDLE and ls[lane].mode == 0:
-                if ls[lane].use_var:
-                    kinds[lane] = 2
-                    nvar += 1
-                else:
-                    kinds[lane] = 1
-                    nfree += 1
-        for lane in range(L):
-            SI[lane] = ls[lane].s
-        for kind in (1, 2):
-            count = nfree if kind == 1 else nvar
-            rows = n if kind == 1 else ntot
-            if count == 0:
-                continue
-            if use_lanes and count >= VECTOR_MIN_LANES:
-                call_model(m.fns[TC_FREE_LANES if kind == 1 else TC_VAR_LANES], XS, 0.0, PT, XT, OT, SI, 0)
-            elif L == 1:  # one lane: the lane arrays are the scalar function's arrays
-                if kind == 1:
-                    tc_free(m, XS, SI[0], pl[0], XT, OT)
-                else:
-                    tc_var(m, XS, SI[0], pl[0], XT, OT)
-            else:  # lane by lane, into the lanes' columns
-                for lane in range(L):
-                    if kinds[lane] == kind:
-                        for i in range(rows):
-                            xl[i] = XS[i, lane]
-                        if kind == 1:
-                            tc_free(m, xl, SI[lane], pl[lane], Xs, Os)
-                        else:
-                            tc_var(m, xl, SI[lane], pl[lane], Xs, Os)
-                        to_lane(Xs, Os, rows, nstops, K, XT, OT, lane)
-
-        # The step sizes of the lanes in free flight: their norms on vectors (as step_size, row by row).
-        for lane in range(L):
-            nx_[lane] = abs(OT[0, 0, lane])
-            n1_[lane] = 0.0
-            n2_[lane] = 0.0
-        for r in range(nstops):
-            for lane in range(L):
-                n1_[lane] = max(n1_[lane], abs(OT[r, order - 1, lane]))
-                n2_[lane] = max(n2_[lane], abs(OT[r, order, lane]))
-        for i in range(ntot if nvar > 0 else n):
-            for lane in range(L):
-                if i < n or kinds[lane] == 2:
-                    nx_[lane] = max(nx_[lane], abs(XT[i, 0, lane]))
-                    n1_[lane] = max(n1_[lane], abs(XT[i, order - 1, lane]))
-                    n2_[lane] = max(n2_[lane], abs(XT[i, order, lane]))
+        # The Taylor coefficients: lanes in free flight by kind, on vectors where there are enough of them;
+        # the norms of their step sizes.
+        nvar = lane_coefficients(m, la, kinds, use_lanes, coeffs)
+        lane_norms(m, XT, OT, kinds, nvar, norms)
 
         # Pass A, lane by lane: the step, its events and its samples.
-        for lane in range(L):
-            todo[lane] = 0
-            flags[lane] = 0
-            plain[lane] = 0
-            if ls[lane].stage == IDLE:
-                continue
-            p = ls[lane].point
-            T = Ts[p]
-            s = ls[lane].s
-            mode = ls[lane].mode
-            status = STATUS_OK
-            if ls[lane].steps >= ls[lane].max_steps:
-                status = STATUS_STEP_LIMIT
-            for i in range(n):
-                if not math.isfinite(XS[i, lane]):
-                    status = STATUS_NONFINITE
-            if status != STATUS_OK:
-                flags[lane] = FAILED
-                ls[lane].status = status
-                continue
-            if mode == 1:
-                stuck = ls[lane].stuck
-                for i in range(n):
-                    xl[i] = XS[i, lane]
-                tc_stick(m, xl, s, pl[lane], Xs, Os, stuck)
-                to_lane(Xs, Os, n, nstops, K, XT, OT, lane)
-                h = step_size(Xs, n, Os, nstops, stuck, order, T, factor)
-            else:
-                h = step_from_norms(nx_[lane], n1_[lane], n2_[lane], order, T, factor)
-            h, ends = step_end(ls[lane], h, cfg.zdm, zdms[p])
-            flags[lane] = ends
-            hs[lane] = h
-            todo[lane] = 1
-            plain[lane] = 1 if mode == 0 and ls[lane].defl == 0 else 0
-
-        # No event on the step where every guard's polynomial is certainly positive (event_certificate
-        # on vectors: the same coefficients as event_polynomial); the other lanes search lane by lane
-        # (and a single lane at once).
-        for lane in range(L if L == 1 else 0):
-            plain[lane] = 0
-        for r in range(nstops if L > 1 else 0):
-            if cfg.zdm and r == cfg.stop:
-                continue
-            for lane in range(L):
-                hk[lane] = 1.0
-                tl[lane] = 0.0
-                a0[lane] = OT[r, 0, lane] * hk[lane]
-                hk[lane] *= hs[lane]
-                a1[lane] = OT[r, 1, lane] * hk[lane]
-                hk[lane] *= hs[lane]
-                a2[lane] = OT[r, 2, lane] * hk[lane]
-                hk[lane] *= hs[lane]
-            for j in range(3, K):
-                for lane in range(L):
-                    tl[lane] += abs(OT[r, j, lane] * hk[lane])
-                    hk[lane] *= hs[lane]
-            for lane in range(L):
-                if plain[lane] == 1 and not (
-                    a0[lane] > 0.0 and quadratic_bound(a0[lane], a1[lane], a2[lane], tl[lane]) > 0.0
-                ):
-                    plain[lane] = 0
+        plan_steps(m, cfg, la, zdms, norms, coeffs, factor, (hs, flags, todo, plain))
+        # No event on the step where every guard's polynomial is certainly positive; the other lanes
+        # search lane by lane (and a single lane at once).
+        no_events_certain(m, cfg, OT, hs, plain, certs)
         for lane in range(L):
             if todo[lane] == 0:
                 continue
@@ -399,8 +250,9 @@ def sweep_lanes(m, cfg, work, points, out):
                 ev_stop = 0
             else:
                 skip = cfg.stop if cfg.zdm else -1
-                run = ls[lane]
-                u, ev_stop = first_event(m, run, OT[:, :, lane], h, True, skip, False, cfg.stop, a, roots)
+                u, ev_stop = first_event(
+                    m, ls[lane], OT[:, :, lane], h, True, skip, False, cfg.stop, a, roots
+                )
             run = ls[lane]
             if not accept_step(run, h, flags[lane], u, ev_stop):  # (events accumulate)
                 flags[lane] = FAILED
@@ -410,25 +262,12 @@ def sweep_lanes(m, cfg, work, points, out):
             h_acc = run.h_acc
             event = run.event
             dts[lane] = h_acc
-            run = ls[lane]
             if (run.ks - run.k) * run.T + (run.ss - run.s) <= h_acc:
                 run.n_stick = 0  # (sticking intervals are not recorded)
                 take_samples(m, run, XT[:, :, lane], h_acc, event, is_last, buf[lane], sticks, traj, xe)
 
-        # The advance of every stepping lane to the end of its accepted part (eval_rows on vectors):
-        # the state in all, the variational equations in free flight.
-        for lane in range(L):
-            if todo[lane] == 0:
-                dts[lane] = 0.0
-        for i in range(ntot if nvar > 0 else n):
-            for lane in range(L):
-                acc[lane] = XT[i, order, lane]
-            for j in range(order - 1, -1, -1):
-                for lane in range(L):
-                    acc[lane] = acc[lane] * dts[lane] + XT[i, j, lane]
-            for lane in range(L):
-                if todo[lane] == 1 and (i < n or (kinds[lane] == 2 and ls[lane].mode == 0)):
-                    XS[i, lane] = acc[lane]
+        # The advance of every stepping lane to the end of its accepted part (eval_rows on vectors).
+        advance_lanes(m, la, XT, dts, todo, kinds, nvar, acc)
 
         # Pass B, lane by lane: time, Lyapunov vectors, discontinuity map, impacts, the request's end.
         for lane in range(L):
@@ -439,15 +278,13 @@ def sweep_lanes(m, cfg, work, points, out):
                 continue
             if todo[lane] == 0:
                 continue
-            p = ls[lane].point
-            T = Ts[p]
             run = ls[lane]
             nrows = ntot if (run.mode == 0 and run.use_var) else n
             for i in range(ntot):
                 xl[i] = XS[i, lane]
             recording = run.recording  # (before the step's end)
             buffers = (xp, V, scratch, logs[lane], xe, gh, gv, fbuf)
-            chatter_time = cfg.chatter_tol * T
+            chatter_time = cfg.chatter_tol * run.T
             kicked, impact = end_step(
                 m, run, xl, XT[:, :, lane], pl[lane], nrows, cfg, chatter_time, 0, Tp, buffers, tables
             )
@@ -459,81 +296,374 @@ def sweep_lanes(m, cfg, work, points, out):
             run.n_stick = 0  # (sticking intervals are not recorded)
             for i in range(ntot):
                 XS[i, lane] = xl[i]
-            k = run.k
-            s = run.s
             n_samples = ls[lane].n_samples
             if ls[lane].isamp < n_samples:
                 continue
             # The request is done (Runner.advance returns): on to the next stage of the point.
-            if cfg.periodic:
-                ls[lane].req_ks += n_samples
-            else:
-                ls[lane].req_ss += n_samples * T
-            stage = ls[lane].stage
-            if stage == TRANSIENT:
-                blk = ls[lane].block
-                ls[lane].used += blk
-                used = ls[lane].used
-                nxt = -1
-                if cfg.adaptive and blk == ADAPTIVE_BLOCK:
-                    per = repeats_with_period(buf[lane], blk, n, cfg.adaptive_tol, ADAPTIVE_MAX_PERIOD)
-                    if per > 0:
-                        extra = (budget - used) % per
-                        if extra:
-                            ls[lane].used += extra
-                            ls[lane].stage = EXTRA
-                            begin_request(ls[lane], extra, 0, False, T, zdms[p])
-                            continue
-                        nxt = 0
-                if nxt < 0 and used < budget:
-                    blk = min(ADAPTIVE_BLOCK, budget - used)
-                    ls[lane].block = blk
-                    begin_request(ls[lane], blk, blk if cfg.adaptive else 0, False, T, zdms[p])
-                    continue
-                ls[lane].stage = FINAL
-                final_request(ls[lane], XS, n, lane, align, cfg, sphase[p], zdms[p])
-                continue
-            if stage == EXTRA:
-                ls[lane].stage = FINAL
-                final_request(ls[lane], XS, n, lane, align, cfg, sphase[p], zdms[p])
-                continue
-            # FINAL: the point's results (a state that became non-finite on the last step fails the point).
-            finite = True
-            for i in range(n):
-                finite = finite and math.isfinite(XS[i, lane])
-            for r in range(cfg.periods):
-                for c in range(n):
-                    finite = finite and math.isfinite(buf[lane, r, c])
-            if not finite:
-                ls[lane].status = STATUS_NONFINITE
-                store_release(out.status, p, STATUS_NONFINITE)
-                ls[lane].stage = IDLE
+            if end_request(m, cfg, points, out, la, lane, budget, align):
                 active -= 1
-                continue
-            for r in range(cfg.periods):
-                for c in range(n):
-                    out.samples[p, r, c] = buf[lane, r, c]
-            for j in range(nstops):
-                out.by_stop[p, j] = counts[lane, j]
-            lyap = math.nan
-            if cfg.lyapunov:
-                span = k * T + s - ls[lane].lyap_t0 if ls[lane].lyap_started else 0.0
-                if ls[lane].jac_valid and span != 0.0:
-                    lyap = logs[lane, 0] / span
-                    for j in range(1, n):
-                        v = logs[lane, j] / span
-                        if math.isnan(lyap) or math.isnan(v):
-                            lyap = math.nan
-                        elif v > lyap:
-                            lyap = v
-            out.lyap[p] = lyap
-            out.used[p] = ls[lane].used + align
+
+
+@njit(cache=True)
+def lane_coefficients(m, la, kinds, use_lanes, coeffs):
+    """The Taylor coefficients of the lanes in free flight into ``XT``, ``OT``; returns how many have ``V``.
+
+    ``kinds[lane]`` becomes 0 (idle or sticking), 1 (free flight) or 2 (with
+    the variational equations); a kind with at least ``VECTOR_MIN_LANES``
+    lanes is computed by the model's lane function (``use_lanes``), the
+    others lane by lane.  ``coeffs`` = ``(XT, OT, SI, Xs, Os, xl)``: the lanes'
+    coefficients, their local times, one lane's coefficients and state.
+    """
+    XT, OT, SI, Xs, Os, xl = coeffs
+    ls, XS, pl, PT = la.ls, la.XS, la.pl, la.PT
+    n = m.nx
+    nstops = m.nstops
+    K = m.order + 1
+    L = ls.shape[0]
+    ntot = n + n * n
+    nfree = 0
+    nvar = 0
+    for lane in range(L):
+        kinds[lane] = 0
+        if ls[lane].stage != IDLE and ls[lane].mode == 0:
+            if ls[lane].use_var:
+                kinds[lane] = 2
+                nvar += 1
+            else:
+                kinds[lane] = 1
+                nfree += 1
+    for lane in range(L):
+        SI[lane] = ls[lane].s
+    for kind in (1, 2):
+        count = nfree if kind == 1 else nvar
+        rows = n if kind == 1 else ntot
+        if count == 0:
+            continue
+        if use_lanes and count >= VECTOR_MIN_LANES:
+            call_model(m.fns[TC_FREE_LANES if kind == 1 else TC_VAR_LANES], XS, 0.0, PT, XT, OT, SI, 0)
+        elif L == 1:  # one lane: the lane arrays are the scalar function's arrays
+            if kind == 1:
+                tc_free(m, XS, SI[0], pl[0], XT, OT)
+            else:
+                tc_var(m, XS, SI[0], pl[0], XT, OT)
+        else:  # lane by lane, into the lanes' columns
+            for lane in range(L):
+                if kinds[lane] == kind:
+                    for i in range(rows):
+                        xl[i] = XS[i, lane]
+                    if kind == 1:
+                        tc_free(m, xl, SI[lane], pl[lane], Xs, Os)
+                    else:
+                        tc_var(m, xl, SI[lane], pl[lane], Xs, Os)
+                    to_lane(Xs, Os, rows, nstops, K, XT, OT, lane)
+    return nvar
+
+
+@njit(cache=True)
+def lane_norms(m, XT, OT, kinds, nvar, norms):
+    """The norms of the lanes' step sizes (as ``step_size``, row by row, on vectors) into ``norms``."""
+    nx_, n1_, n2_ = norms
+    n = m.nx
+    order = m.order
+    nstops = m.nstops
+    L = XT.shape[2]
+    ntot = n + n * n
+    for lane in range(L):
+        nx_[lane] = abs(OT[0, 0, lane])
+        n1_[lane] = 0.0
+        n2_[lane] = 0.0
+    for r in range(nstops):
+        for lane in range(L):
+            n1_[lane] = max(n1_[lane], abs(OT[r, order - 1, lane]))
+            n2_[lane] = max(n2_[lane], abs(OT[r, order, lane]))
+    for i in range(ntot if nvar > 0 else n):
+        for lane in range(L):
+            if i < n or kinds[lane] == 2:
+                nx_[lane] = max(nx_[lane], abs(XT[i, 0, lane]))
+                n1_[lane] = max(n1_[lane], abs(XT[i, order - 1, lane]))
+                n2_[lane] = max(n2_[lane], abs(XT[i, order, lane]))
+
+
+@njit(cache=True)
+def no_events_certain(m, cfg, OT, hs, plain, certs):
+    """Clear ``plain[lane]`` where an event on the step of size ``hs[lane]`` is not excluded.
+
+    ``event_certificate`` on vectors (the same coefficients as
+    ``event_polynomial``): a lane stays ``plain`` where every guard's
+    polynomial is certainly positive on its step.  A single lane is never
+    plain (its search is as cheap).  ``certs`` = ``(a0, a1, a2, tl, hk)``.
+    """
+    a0, a1, a2, tl, hk = certs
+    nstops = m.nstops
+    K = m.order + 1
+    L = hs.shape[0]
+    for lane in range(L if L == 1 else 0):
+        plain[lane] = 0
+    for r in range(nstops if L > 1 else 0):
+        if cfg.zdm and r == cfg.stop:
+            continue
+        for lane in range(L):
+            hk[lane] = 1.0
+            tl[lane] = 0.0
+            a0[lane] = OT[r, 0, lane] * hk[lane]
+            hk[lane] *= hs[lane]
+            a1[lane] = OT[r, 1, lane] * hk[lane]
+            hk[lane] *= hs[lane]
+            a2[lane] = OT[r, 2, lane] * hk[lane]
+            hk[lane] *= hs[lane]
+        for j in range(3, K):
+            for lane in range(L):
+                tl[lane] += abs(OT[r, j, lane] * hk[lane])
+                hk[lane] *= hs[lane]
+        for lane in range(L):
+            if plain[lane] == 1 and not (
+                a0[lane] > 0.0 and quadratic_bound(a0[lane], a1[lane], a2[lane], tl[lane]) > 0.0
+            ):
+                plain[lane] = 0
+
+
+@njit(cache=True)
+def advance_lanes(m, la, XT, dts, todo, kinds, nvar, acc):
+    """Every stepping lane to the end of its accepted part ``dts[lane]`` (``eval_rows`` on vectors).
+
+    The state in all, the variational equations in free flight.
+    """
+    ls, XS = la.ls, la.XS
+    n = m.nx
+    order = m.order
+    L = dts.shape[0]
+    ntot = n + n * n
+    for lane in range(L):
+        if todo[lane] == 0:
+            dts[lane] = 0.0
+    for i in range(ntot if nvar > 0 else n):
+        for lane in range(L):
+            acc[lane] = XT[i, order, lane]
+        for j in range(order - 1, -1, -1):
+            for lane in range(L):
+                acc[lane] = acc[lane] * dts[lane] + XT[i, j, lane]
+        for lane in range(L):
+            if todo[lane] == 1 and (i < n or (kinds[lane] == 2 and ls[lane].mode == 0)):
+                XS[i, lane] = acc[lane]
+
+
+@njit(cache=True)
+def plan_steps(m, cfg, la, zdms, norms, coeffs, factor, plan):
+    """Each running lane's step: its size (from ``norms`` in free flight, the scalar sticking function
+    otherwise) and where it ends (:func:`.step.step_end`), or its point's failure.
+
+    ``plan`` = ``(hs, flags, todo, plain)``: the step, how it ends (or
+    ``FAILED``), whether the lane steps, whether it may skip the event search
+    (free flight, no known root at its start: :func:`no_events_certain`).
+    """
+    hs, flags, todo, plain = plan
+    nx_, n1_, n2_ = norms
+    XT, OT, _, Xs, Os, xl = coeffs
+    ls, XS, pl = la.ls, la.XS, la.pl
+    n = m.nx
+    order = m.order
+    nstops = m.nstops
+    K = order + 1
+    L = ls.shape[0]
+    for lane in range(L):
+        todo[lane] = 0
+        flags[lane] = 0
+        plain[lane] = 0
+        if ls[lane].stage == IDLE:
+            continue
+        p = ls[lane].point
+        T = ls[lane].T
+        s = ls[lane].s
+        mode = ls[lane].mode
+        status = STATUS_OK
+        if ls[lane].steps >= ls[lane].max_steps:
+            status = STATUS_STEP_LIMIT
+        for i in range(n):
+            if not math.isfinite(XS[i, lane]):
+                status = STATUS_NONFINITE
+        if status != STATUS_OK:
+            flags[lane] = FAILED
+            ls[lane].status = status
+            continue
+        if mode == 1:
+            stuck = ls[lane].stuck
             for i in range(n):
-                out.x[p, i] = XS[i, lane]
-            out.t[p] = k * T + s
-            store_release(out.status, p, STATUS_OK)  # (after its results: another thread may read them now)
-            ls[lane].stage = IDLE
-            active -= 1
+                xl[i] = XS[i, lane]
+            tc_stick(m, xl, s, pl[lane], Xs, Os, stuck)
+            to_lane(Xs, Os, n, nstops, K, XT, OT, lane)
+            h = step_size(Xs, n, Os, nstops, stuck, order, T, factor)
+        else:
+            h = step_from_norms(nx_[lane], n1_[lane], n2_[lane], order, T, factor)
+        h, ends = step_end(ls[lane], h, cfg.zdm, zdms[p])
+        flags[lane] = ends
+        hs[lane] = h
+        todo[lane] = 1
+        plain[lane] = 1 if mode == 0 and ls[lane].defl == 0 else 0
+
+
+@njit(cache=True)
+def take_point(m, cfg, work, points, out, la, lane, budget, align, active):
+    """An idle lane takes its job's next point, else the next job's first; returns the points now running.
+
+    ``la`` holds the lanes' arrays (:class:`LaneArrays`); ``active`` counts the
+    points this call is running (a thread with ``control[2]`` jobs running
+    takes no other job).
+    """
+    n = m.nx
+    nstops = m.nstops
+    ls, XS, pl, PT, logs, counts = la.ls, la.XS, la.pl, la.PT, la.logs, la.counts
+    pvs, Ts, sphase, tcarry, zdms = points.pvs, points.Ts, points.sphase, points.tcarry, points.zdms
+    npv = pvs.shape[1]
+    while ls[lane].stage == IDLE and ls[lane].job_end >= 0:
+        p = ls[lane].point + 1
+        carried = ls[lane].status == STATUS_OK and ls[lane].job_end > 0
+        first = False
+        if ls[lane].job_end == 0 or p >= ls[lane].job_end:
+            if work.control[2] > 0 and active >= work.control[2]:
+                break  # (this thread has its share of the jobs running)
+            job = fetch_add(work.control, 0, 1)
+            if job >= work.jobs.shape[0]:
+                ls[lane].job_end = -1  # (no more jobs for this lane)
+                break
+            p = work.jobs[job, 0]
+            ls[lane].job_end = work.jobs[job, 1]
+            ls[lane].job = job
+            carried = False
+            first = True
+        ls[lane].point = p
+        T = Ts[p]
+        ls[lane].T = T
+        ls[lane].wrap = cfg.periodic
+        if first:
+            for i in range(n):
+                XS[i, lane] = work.firsts[ls[lane].job, 1 + i]
+            t0 = work.firsts[ls[lane].job, 0]
+        elif cfg.fresh or not carried:
+            for i in range(n):
+                XS[i, lane] = work.x0[ls[lane].job, i]
+            t0 = 0.0
+        else:
+            t0 = tcarry[p] if cfg.periodic else out.t[p - 1]
+        k0, s0, ks0, ss0 = start_times(t0, T, sphase[p], cfg.periodic)
+        ls[lane].k = k0
+        ls[lane].s = s0
+        ls[lane].req_ks = ks0
+        ls[lane].req_ss = ss0
+        ls[lane].mode = 0
+        ls[lane].stuck = 0
+        ls[lane].status = STATUS_OK
+        ls[lane].used = 0
+        for j in range(npv):
+            pl[lane, j] = pvs[p, j]
+            PT[j, lane] = pvs[p, j]
+        for j in range(nstops):
+            counts[lane, j] = 0
+        for j in range(n):
+            logs[lane, j] = 0.0
+        if budget > 0:
+            blk = min(ADAPTIVE_BLOCK, budget)
+            ls[lane].block = blk
+            ls[lane].stage = TRANSIENT
+            begin_request(ls[lane], blk, blk if cfg.adaptive else 0, False, T, zdms[p])
+        else:
+            ls[lane].stage = FINAL
+            final_request(ls[lane], XS, n, lane, align, cfg, sphase[p], zdms[p])
+        active += 1
+    return active
+
+
+@njit(cache=True)
+def end_request(m, cfg, points, out, la, lane, budget, align):
+    """The lane's request is done (``Runner.advance`` returns): on to its point's next stage.
+
+    Returns True when the point is finished (its results written, or failed).
+    """
+    n = m.nx
+    ls, XS, buf = la.ls, la.XS, la.buf
+    Ts, sphase, zdms = points.Ts, points.sphase, points.zdms
+    p = ls[lane].point
+    T = Ts[p]
+    n_samples = ls[lane].n_samples
+    if cfg.periodic:
+        ls[lane].req_ks += n_samples
+    else:
+        ls[lane].req_ss += n_samples * T
+    stage = ls[lane].stage
+    if stage == TRANSIENT:
+        blk = ls[lane].block
+        ls[lane].used += blk
+        used = ls[lane].used
+        nxt = -1
+        if cfg.adaptive and blk == ADAPTIVE_BLOCK:
+            per = repeats_with_period(buf[lane], blk, n, cfg.adaptive_tol, ADAPTIVE_MAX_PERIOD)
+            if per > 0:
+                extra = (budget - used) % per
+                if extra:
+                    ls[lane].used += extra
+                    ls[lane].stage = EXTRA
+                    begin_request(ls[lane], extra, 0, False, T, zdms[p])
+                    return False
+                nxt = 0
+        if nxt < 0 and used < budget:
+            blk = min(ADAPTIVE_BLOCK, budget - used)
+            ls[lane].block = blk
+            begin_request(ls[lane], blk, blk if cfg.adaptive else 0, False, T, zdms[p])
+            return False
+        ls[lane].stage = FINAL
+        final_request(ls[lane], XS, n, lane, align, cfg, sphase[p], zdms[p])
+        return False
+    if stage == EXTRA:
+        ls[lane].stage = FINAL
+        final_request(ls[lane], XS, n, lane, align, cfg, sphase[p], zdms[p])
+        return False
+    return finish_point(m, cfg, out, la, lane, align)
+
+
+@njit(cache=True)
+def finish_point(m, cfg, out, la, lane, align):
+    """The point of a lane at the end of its last request: its results, or its failure; returns True."""
+    n = m.nx
+    nstops = m.nstops
+    ls, XS, logs, buf, counts = la.ls, la.XS, la.logs, la.buf, la.counts
+    p = ls[lane].point
+    T = ls[lane].T
+    k = ls[lane].k
+    s = ls[lane].s
+    finite = True  # (a state that became non-finite on the last step fails the point)
+    for i in range(n):
+        finite = finite and math.isfinite(XS[i, lane])
+    for r in range(cfg.periods):
+        for c in range(n):
+            finite = finite and math.isfinite(buf[lane, r, c])
+    if not finite:
+        ls[lane].status = STATUS_NONFINITE
+        store_release(out.status, p, STATUS_NONFINITE)
+        ls[lane].stage = IDLE
+        return True
+    for r in range(cfg.periods):
+        for c in range(n):
+            out.samples[p, r, c] = buf[lane, r, c]
+    for j in range(nstops):
+        out.by_stop[p, j] = counts[lane, j]
+    lyap = math.nan
+    if cfg.lyapunov:
+        span = k * T + s - ls[lane].lyap_t0 if ls[lane].lyap_started else 0.0
+        if ls[lane].jac_valid and span != 0.0:
+            lyap = logs[lane, 0] / span
+            for j in range(1, n):
+                v = logs[lane, j] / span
+                if math.isnan(lyap) or math.isnan(v):
+                    lyap = math.nan
+                elif v > lyap:
+                    lyap = v
+    out.lyap[p] = lyap
+    out.used[p] = ls[lane].used + align
+    for i in range(n):
+        out.x[p, i] = XS[i, lane]
+    out.t[p] = k * T + s
+    store_release(out.status, p, STATUS_OK)  # (after its results: another thread may read them now)
+    ls[lane].stage = IDLE
+    return True
 
 
 @njit(cache=True)
