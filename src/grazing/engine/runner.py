@@ -20,6 +20,7 @@ from grazing.core.model import HybridModel
 from grazing.core.options import CHATTER_TOL, MACHINE_EPSILON, step_limit
 from grazing.core.solution import Status
 from grazing.engine.codegen import direction_columns, taylor_order
+from grazing.engine.timebase import start_times
 from grazing.errors import SimulationError
 
 RECORD_IMPACTS = {"none": 0, "sampled": 1, "all": 2}
@@ -171,21 +172,10 @@ class Runner:
         self.chatter_time = chatter_tol * self.T
         self.set_params(model)
         T = self.T
-        snap = 1e-9 * T
         s_phase = (phase % (2 * math.pi)) / (2 * math.pi) * T
         self.mode = 0
-        if not model.periodic:
-            self.k, self.s, self.ks, self.ss = 0, float(t0), 0, float(t0) + T
-            self.k_start = 0
-            return
-        k0 = math.floor(t0 / T)
-        s0 = t0 - k0 * T
-        if s0 >= T - snap:  # just below a period boundary: keep s0 slightly negative
-            k0, s0 = k0 + 1, s0 - T
-        self.k, self.s = k0, s0
-        self.k_start = k0
-        self.ks = k0 if s0 < s_phase - snap else k0 + 1
-        self.ss = s_phase
+        self.k, self.s, self.ks, self.ss = start_times(float(t0), T, s_phase, bool(model.periodic))
+        self.k_start = self.k
 
     @property
     def t(self) -> float:

@@ -33,6 +33,7 @@ import numpy as np
 from numba import njit
 
 from grazing.core.options import STEPS_EXTRA, STEPS_PER_PERIOD
+from grazing.engine import timebase
 from grazing.engine.abi import TC_FREE_LANES, TC_VAR_LANES, call_model
 from grazing.engine.driver.atomics import fetch_add, load_acquire, store_release
 from grazing.engine.driver.calls import tc_free, tc_stick, tc_var
@@ -87,19 +88,8 @@ def repeats_with_period(samples, count, n, tol, max_period):
     return 0
 
 
-@njit(cache=True)
-def start_times(t0, T, s_phase, periodic):
-    """``(k, s, ks, ss)`` of a run starting at ``t0`` sampled at local time ``s_phase`` (as ``Runner``)."""
-    if not periodic:
-        return 0, t0, 0, t0 + T
-    snap = 1e-9 * T
-    k0 = math.floor(t0 / T)
-    s0 = t0 - k0 * T
-    if s0 >= T - snap:
-        k0 += 1
-        s0 -= T
-    ks = k0 if s0 < s_phase - snap else k0 + 1
-    return k0, s0, ks, s_phase
+start_times = njit(inline="always")(timebase.start_times)
+"""``(k, s, ks, ss)`` of a run starting at ``t0`` sampled at local time ``s_phase`` (as ``Runner``'s)."""
 
 
 @njit(cache=True)
