@@ -8,9 +8,9 @@ store, and a record passed to a function is a pointer to it.
 
 Examples
 --------
->>> r = new_state(1)[0]
->>> r.k, r.recording, r.steps
-(0, False, 0)
+>>> states = new_state(2)  # (from Python: a structured array, its fields by name)
+>>> states["k"].tolist(), states["recording"].tolist(), states.dtype["s"].name
+([0, 0], [False, False], 'float64')
 """
 
 import numpy as np
