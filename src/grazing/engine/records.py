@@ -82,6 +82,9 @@ class Config(NamedTuple):
     sigints_seen: int  # the count when the call started: the driver stops when it changes
 
 
+CALL = Config._fields[: Config._fields.index("T")]
+"""The fields of :class:`Config` that each call sets (built by name by the runner)."""
+
 STATIC = Config._fields[Config._fields.index("T") : Config._fields.index("stop") + 1]
 """The fields of :class:`Config` that stay the same for every call on one trajectory."""
 

@@ -20,6 +20,7 @@ from grazing.core.model import HybridModel
 from grazing.core.options import CHATTER_TOL, MACHINE_EPSILON, step_limit
 from grazing.core.solution import Status
 from grazing.engine.codegen import direction_columns, taylor_order
+from grazing.engine.records import CALL, STATIC
 from grazing.engine.timebase import start_times
 from grazing.errors import SimulationError
 
@@ -202,13 +203,16 @@ class Runner:
         T = float(self.model.period)
         z = self.zdm
         n = self.model.n_states
-        return (
-            T, bool(self.model.periodic), T, float(self.safety), bool(self.variational), bool(self.events),
-            float(self.chatter_time), z is not None, float(z.phase) % T if z is not None else 0.0,
-            float(z.accel) if z is not None else 1.0,
-            np.asarray(z.direction if z is not None else np.zeros(n), dtype=float),
-            float(z.window) if z is not None else 0.0, np.asarray(self.Tp, dtype=float), self.stop,
+        fields = dict(
+            T=T, wrap=bool(self.model.periodic), max_step=T, safety=float(self.safety),
+            use_var=bool(self.variational), events=bool(self.events), chatter_time=float(self.chatter_time),
+            zdm=z is not None, zdm_s=float(z.phase) % T if z is not None else 0.0,
+            zdm_a=float(z.accel) if z is not None else 1.0,
+            zdm_e=np.asarray(z.direction if z is not None else np.zeros(n), dtype=float),
+            zdm_window=float(z.window) if z is not None else 0.0, Tp=np.asarray(self.Tp, dtype=float),
+            stop=self.stop,
         )  # fmt: skip
+        return tuple(fields[name] for name in STATIC)
 
     def vector_field(self, x: np.ndarray, s: float) -> np.ndarray:
         """``f(x, s)`` with the kernels this runner already loaded."""
@@ -243,11 +247,13 @@ class Runner:
         if max_steps is None:
             max_steps = step_limit(periods)
         start = (self.x, self.V, self.k, self.s, self.mode)  # a records.Start, as a plain tuple
-        cfg = (  # a records.Config, as a plain tuple (see the driver's integrate)
-            int(max_steps), periods, self.ks, float(self.ss), keep, bool(lyapunov),
-            T / trajectory if trajectory else 0.0, bool(guard_min), RECORD_IMPACTS[impacts],
-            self.touch_start, self.touch_end, *self._static,
+        call = dict(
+            max_steps=int(max_steps), n_samples=periods, ks=self.ks, ss=float(self.ss), n_keep=keep,
+            lyapunov=bool(lyapunov), traj_dt=T / trajectory if trajectory else 0.0, track_min=bool(guard_min),
+            record_impacts=RECORD_IMPACTS[impacts], touch_start=self.touch_start, touch_end=self.touch_end,
         )  # fmt: skip
+        # A records.Config but its INTERRUPT fields, as a plain tuple (see the driver's integrate).
+        cfg = (*(call[name] for name in CALL), *self._static)
         out = self.kern.integrate(start, self.pv, cfg)
         if out.status != Status.OK:
             raise SimulationError(
