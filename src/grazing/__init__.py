@@ -9,6 +9,7 @@
 
 from __future__ import annotations
 
+from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
 from grazing import models
@@ -55,6 +56,17 @@ def __getattr__(name: str) -> Any:
         except PackageNotFoundError:  # pragma: no cover - running from a source tree
             return "0.0.0"
     raise AttributeError(f"module 'grazing' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    # What a user can reach: the public names (simulate, loaded lazily, included), the
+    # subpackages imported so far; not the names used only to write this module (Any, ...).
+    loaded = [
+        name
+        for name, value in globals().items()
+        if isinstance(value, ModuleType) and not name.startswith("_")
+    ]
+    return sorted({*__all__, *loaded})
 
 
 __all__ = [

@@ -30,9 +30,9 @@ def test_curve_json_keys_and_display_units(capsys):
     theta = [p["theta_hat"] for p in points]  # degrees on the command line and in its output
     assert min(theta) == pytest.approx(39.9, abs=1e-9) and max(theta) == pytest.approx(40.1, abs=1e-9)
     assert {p["period"] for p in points} == {5} and {p["impacts"] for p in points} == {1}
-    for p in points:  # a multiplier -1 at every point
+    for p in points:  # a multiplier -1 at every point, as accurately as the point says
         mu = np.array([complex(*z) for z in p["multipliers"]])
-        assert np.min(np.abs(mu + 1)) < 1e-6
+        assert np.min(np.abs(mu + 1)) <= p["accuracy"] < 1e-6
     assert res["special"] == [] and res["status"].count("reached the bound theta_hat = ") == 2
     assert res["start"]["theta_hat"] == pytest.approx(40.0) and res["start"]["eta"] == pytest.approx(
         0.4453926, abs=1e-7
@@ -63,3 +63,26 @@ def test_curve_of_the_grazing_of_an_impacting_orbit(capsys):
     for p in res["points"]:
         w = p["omega"]
         assert p["sigma"] == pytest.approx(1 / math.sqrt((1 - w * w) ** 2 + (0.1 * w) ** 2), abs=1e-9)
+
+
+def test_curve_says_where_its_multipliers_are_known_only_roughly(capsys, tmp_path):
+    """A random model's fold curve ends at a grazing: next to it the monodromy is so far from normal
+    that its multiplier 1 is known only to ~1e-5 (tests/orbits/test_curves.py measures it); the
+    summary says so, and --json gives every point's accuracy."""
+    path = tmp_path / "near.py"
+    path.write_text(
+        "from tests.orbits.test_curves import NEAR_GRAZING_FOLD\nMODEL = NEAR_GRAZING_FOLD.model()\n"
+    )
+    argv = (
+        f"curve --model {path}:MODEL --kind fold --param T --start 1.0 --stop 0.3 --param2 J "
+        "--range 0.7503125,0.7809375 --initial 0,1.8 --period 1"
+    ).split()
+    text = run(argv, capsys)
+    assert "ended at a grazing" in text
+    note = next(line for line in text.splitlines() if line.startswith("note: the multipliers of "))
+    worst = float(note.split("known only to ")[1].split(":")[0])
+    res = json.loads(run([*argv, "--json"], capsys))
+    accuracy = [p["accuracy"] for p in res["points"]]
+    assert worst == pytest.approx(max(accuracy), rel=0.5) and worst > 1e-6
+    assert int(note.split()[4]) == sum(a > 1e-6 for a in accuracy) >= 1
+    assert sum(a < 1e-9 for a in accuracy) >= len(accuracy) // 2  # away from the grazing

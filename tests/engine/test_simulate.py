@@ -322,3 +322,21 @@ def test_sticking_in_progress_when_recording_starts_is_reported(monkeypatch):
     for transient, expected in ((50, sol.sticking), (0, first.sticking)):
         chunked = grazing.simulate(m, [0.0, 0.0], transient=transient, periods=3)
         np.testing.assert_allclose(chunked.sticking, expected, atol=1e-9)
+
+
+@pytest.mark.parametrize("x0", [[0.0, 0.0], [-0.30952407456611286, 0.4508808109843482]])
+def test_a_dense_trajectory_covers_the_recorded_span_in_order(x0):
+    """Every row of a dense trajectory was written: its times rise from the span's start to its end,
+    each point where the flow from the last sample puts it (a refactoring once left rows unwritten)."""
+    m = pendulum("B", eta=0.446, theta_hat=math.radians(40))
+    sol = grazing.simulate(m, x0, transient=600, periods=37, trajectory=400)
+    t = sol.trajectory_t
+    T = 2 * math.pi
+    assert t[0] == pytest.approx(600 * T) and t[-1] == pytest.approx((600 + 37) * T)
+    assert np.all(np.diff(t) >= 0.0)  # (an impact is two rows at one time: before and after)
+    spacing = T / 400
+    # rows: every spacing, plus two at each impact of the span
+    assert len(t) == pytest.approx(37 * 400 + 1 + 2 * sol.impacts.t.size, abs=2)
+    assert np.all(np.isfinite(sol.trajectory))
+    assert np.all(sol.trajectory[:, 0] <= m.params["theta_hat"] + 1e-9)
+    assert np.max(np.diff(t)) <= spacing * (1 + 1e-9)

@@ -15,13 +15,27 @@ from pathlib import Path
 
 import pytest
 
-from grazing.report import build_report, diagrams, fig07, fig08, fig12, figattractors, figmap, figstops
+from grazing.report import (
+    build_report,
+    diagrams,
+    fig07,
+    fig08,
+    fig12,
+    figadding,
+    figattractors,
+    figmap,
+    figstops,
+)
 
 QUICK_DIAGRAMS = diagrams.Settings(points=150, zoom_points=80, overview_points=80, transient=300, periods=60)
 QUICK_FIG08 = fig08.Settings(points=150, transient=300, periods=60)
 QUICK_MAP = figmap.Settings(eta=(0.3, 0.9, 24), theta_hat_deg=(5.0, 58.0, 10), transient=300, periods=40)
 QUICK_STOPS = figstops.Settings(values=(0.5, 1.6, 45), transient=150, periods=16)
 QUICK_ATTRACTORS = figattractors.Settings(eta=(0.50, 0.70, 41), grid=(30, 30), checked_cells=6)  # issue 28
+QUICK_ADDING = figadding.Settings(
+    eta=(0.44, 0.48, 41), theta_hat_deg=(36.0, 44.0, 5), transient=300, periods=40
+)
+"""issue 27: the windows of period 2-5 at 40 degrees (their curves end at 36 and 44 degrees)."""
 
 
 @pytest.fixture(scope="session", autouse=True)
@@ -34,6 +48,7 @@ def quick_report_figures() -> Iterator[None]:
     mp.setattr(figmap, "SETTINGS", QUICK_MAP)
     mp.setattr(figstops, "SETTINGS", QUICK_STOPS)
     mp.setattr(figattractors, "SETTINGS", QUICK_ATTRACTORS)
+    mp.setattr(figadding, "SETTINGS", QUICK_ADDING)  # issue 27
     yield
     mp.undo()
 

@@ -84,7 +84,35 @@ def test_scoreboard_counts_the_rows(data: dict, built) -> None:
         cells = re.search(rf'kind-{kind}">{kind}</span>.*?</tr>', built.page, flags=re.S)
         assert cells is not None
         nums = [int(x) for x in re.findall(r'<td class="num">(\d+)</td>', cells.group(0))]
-        assert nums == [counts["agree"], counts["differ"], counts["not comparable"], sum(counts.values())]
+        assert nums == [
+            counts["agree"],
+            counts["differ"],
+            counts["erratum"],
+            counts["not comparable"],
+            sum(counts.values()),
+        ]
+    # the errata count apart from the disagreements: the two columns share no row
+    errata = sum(r["erratum"] for r in data["rows"])
+    assert errata >= 5 and data["scoreboard"]["paper"]["erratum"] == errata
+    differ = sum(r["verdict"] == "differ" and not r["erratum"] for r in data["rows"] if r["kind"] == "paper")
+    assert data["scoreboard"]["paper"]["differ"] == differ
+
+
+def test_self_checks_name_their_reference_not_the_paper(data: dict, built) -> None:
+    """A self-check's reference is ours (a closed form, another computation): never in a "paper" column."""
+    page = built.page
+    for r in data["rows"]:
+        if r["kind"] != "self-check":
+            assert not r["reference"], r["quantity"]
+            continue
+        start = page.index(f'<tr id="{r["id"]}">')
+        table = page.rfind("<table", 0, start)
+        header = page[table : page.index("</thead>", table)]
+        assert "<th>reference</th>" in header and "<th>paper</th>" not in header, r["id"]
+    closed = [r for r in data["rows"] if r["figure"] == "stops" and r["reference"] == "closed form"]
+    assert len(closed) >= 6
+    liouville = next(r for r in data["rows"] if "Liouville" in r["quantity"])
+    assert "closed form" in liouville["reference"]
 
 
 def test_every_difference_is_listed_at_the_top_with_a_link(data: dict, built) -> None:
@@ -111,9 +139,9 @@ def test_the_generous_verdicts_of_issue_14_are_gone(data: dict) -> None:
     assert d4["verdict"] == "differ" and abs(d4["ours"] - 0.0964) < 2e-3
     # fig 7: panel (a) is in the reverse period-adding verdicts; 10° and 20° show no visible chaos
     # (aperiodic over 5e-6 and 0 in η, against the 1e-3 a visible chaos needs)
-    adding = find("7", "reverse period-adding")
+    adding = [r for r in find("7", "reverse period-adding") if "A/L" not in r["quantity"]]
     assert len(adding) == 4 and adding[0]["quantity"].startswith("(a)")
-    chaos = find("7", "chaos past the first grazing")
+    chaos = [r for r in find("7", "chaos past the first grazing") if "A/L" not in r["quantity"]]
     assert [r["verdict"] for r in chaos][:2] == ["differ", "differ"]
     assert all(r["ours"] < 1e-4 for r in chaos[:2])
     # fig 7 / 12: the impacting region ends at a fold, not with the period-2 window
@@ -224,3 +252,39 @@ def test_drift_counts_each_resolved_edge_at_its_own_distance() -> None:
     # the period-2 window's start is within 3 steps of grazing: left out
     assert [round(d, 4) for d, _ in out] == [0.01, 0.05, 0.2]
     assert dict((round(d, 4), round(e, 4)) for d, e in out) == {0.01: 0.2, 0.05: 0.1, 0.2: 0.5}
+
+
+def test_the_paper_claims_of_issue_30_have_rows(data: dict) -> None:
+    """§3 (realistic r, β), §6.2 (case A), fig 11 and fig 7 (10°, 20°) with α = A/L: each a row, a rule."""
+    from grazing.experiment.damping import paper_protocol_damping
+
+    rows = data["rows"]
+
+    def one(fig: str, *words: str) -> dict:
+        found = [r for r in rows if r["figure"] == fig and all(w in r["quantity"] for w in words)]
+        assert len(found) == 1, (fig, words, [r["quantity"] for r in found])
+        return found[0]
+
+    # §3: on the reconstruction of the paper's curve, r = 0.5 and 0.8 give the printed β (0.015, 0.05);
+    # checked independently: the reconstruction's damping estimator gives D = 0.07 at (r, β)
+    for r, printed in paper.REALISTIC_RANGE:
+        row = one("4", f"β at r = {r:g}", "reconstruction")
+        assert row["verdict"] == "agree" and row["source"].startswith("§3")
+        assert paper_protocol_damping(r, row["ours"]).damping == pytest.approx(paper.DAMPING.value, abs=2e-4)
+        assert abs(row["ours"] - printed.value) <= printed.half_unit
+    model = one("4", "β at r = 0.5", "model's curve")
+    assert model["verdict"] == "differ" and "starts at r = 0.6" in model["ours_text"]
+    # §6.2: case A's θ̂_max is the top of its stable response, far above 50°
+    a = one("6", "§6.2", "case A")
+    assert a["verdict"] == "agree" and a["source"] == "§6.2"
+    top_a = float(re.search(r"case A ([\d.]+)°", a["ours_text"]).group(1))
+    top_b = float(re.search(r"case B ([\d.]+)°", a["ours_text"]).group(1))
+    assert top_a > 100.0 and top_b == pytest.approx(55.86, abs=0.1)  # B: the fold of fig 6 (row 6.14)
+    # fig 11 at the paper's η with α = A/L: period 5, as with 0.2254
+    al = one("11", "0.4458", "A/L")
+    assert al["verdict"] == "differ" and "period 5" in al["ours"]
+    # fig 7 with α = A/L at 10° and 20°: chaos past grazing stays under the appreciable width
+    for key in ("(a)", "(b)"):
+        chaos = one("7", key, "A/L", "chaos past the first grazing")
+        assert chaos["verdict"] == "differ" and chaos["ours"] < diagrams.APPRECIABLE_WIDTH
+        assert one("7", key, "A/L", "reverse period-adding")["verdict"] == "differ"

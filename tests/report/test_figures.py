@@ -20,6 +20,7 @@ from grazing.report import (
     fig07,
     fig08,
     fig12,
+    figadding,
     figattractors,
     figmap,
     figstops,
@@ -207,9 +208,18 @@ def test_fig07_build(built7) -> None:
     ]
     firsts = [r for r in res.comparisons if "first appreciable" in r.quantity]
     assert len(firsts) == 4 and all(r.verdict == "agree" for r in firsts), [r.ours_text for r in firsts]
-    chaos = [r for r in res.comparisons if "chaos past the first grazing" in r.quantity]
+    chaos = [
+        r for r in res.comparisons if "chaos past the first grazing" in r.quantity and "A/L" not in r.quantity
+    ]
     assert [r.verdict for r in chaos] == ["differ", "differ", "agree", "agree"]
     assert "10°, 20°" in chaos[0].headline
+    # the headline states what the sweeps found (issue 30: it said "no visible chaos" over a 5e-6 band)
+    assert "visible chaos" not in chaos[0].headline
+    for row, th in zip(chaos[:2], (10, 20)):
+        said = (
+            f"aperiodic over {row.ours:.1e} in η at {th}°" if row.ours > 0 else f"no aperiodic point at {th}°"
+        )
+        assert said in row.headline, (said, row.headline)
     ends = [r for r in res.comparisons if "how the impacting region ends" in r.quantity]
     assert len(ends) == 3 and all(r.verdict == "differ" and "fold" in r.ours for r in ends)
     eta_c = [r for r in res.comparisons if "experiment's η_c" in r.quantity]
@@ -274,6 +284,12 @@ def test_map_consistent_with_grazing_curve(builtmap) -> None:
     _images_ok(out, res)
     below = _row(res, "below the grazing curve")
     assert below.ours == 0 and below.verdict == "agree" and below.kind == "self-check"
+    # issue 30: the map was blank (drawn in radians on an axis in degrees): its data knows θ̂ is an angle
+    import xarray as xr
+
+    with xr.open_dataset(out / "map_eta_theta_hat.nc") as ds:
+        assert ds.theta_hat.attrs["angle"] == 1 and ds.theta_hat.attrs["symbol"] == "θ̂"
+        assert ds.eta.attrs["symbol"] == "η"
 
 
 def test_map_classify_counts(tmp_path: Path) -> None:
@@ -314,3 +330,122 @@ def test_attractors_section(built) -> None:
     assert {c.kind for c in res.comparisons} == {"self-check", "paper"}
     text = " ".join(res.notes)
     assert "from rest" in text and "0.5473" in text  # the grazing, from continuation
+
+
+# ----------------------------------------------------------------------------- issue 27: period adding
+
+
+def test_period_adding_section(built) -> None:
+    """The windows' curves drawn on the map and checked against it; the figure and its data beside it."""
+    import xarray as xr
+
+    out, res = _built(figadding, built)
+    assert res.title == "The period-adding structure in two parameters"
+    _images_ok(out, res)
+    assert [d.filename for d in res.data] == ["period_adding_map.nc", "period_adding_curves.nc"]
+    with xr.open_dataset(out / "period_adding_map.nc") as ds:
+        assert ds.period.dims == ("theta_hat", "eta") and ds.theta_hat.attrs["angle"] == 1
+    # every curve of every window at 40 degrees, each a row of the comparison table
+    names = [f"pd{n}" for n in figadding.PERIODS] + [f"grazing{n}" for n in (1, *figadding.PERIODS)]
+    rows = {c.quantity: c for c in res.comparisons}
+    assert len(rows) == len(names)
+    for name in names:
+        with xr.open_dataset(out / "period_adding_curves.nc", group=name) as c:
+            assert c.sizes["point"] >= 3
+            kind = "period-doubling" if name.startswith("pd") else "grazing"
+            assert c.attrs["kind"] == kind and c.attrs["period"] == int(name[-1])
+    for row in rows.values():
+        assert row.kind == "self-check" and row.verdict in ("agree", "differ")
+        holds, inside = map(int, re.fullmatch(r"(\d+) of (\d+) points", row.ours_text).groups())
+        assert row.ours == pytest.approx(holds / inside)
+        assert (row.verdict == "agree") == (holds == inside)
+        assert (row.note == "") == (holds == inside)
+    # the quick map's periodic curves end at its bounds in θ̂: no fold is searched, and the notes say so
+    assert sum(n.startswith("No period-") and "fold curve searched" in n for n in res.notes) == 4
+
+
+@pytest.fixture(scope="module")
+def adding_run():
+    """A map at about the report's resolution near 40 degrees, and the period-3 period-doubling curve."""
+    s = figadding.Settings(eta=(0.445, 0.465, 81), theta_hat_deg=(39.0, 41.0, 9))
+    ds, _, _ = figmap.period_map(
+        figmap.Settings(s.eta, s.theta_hat_deg, s.transient, s.periods), lambda _m: None
+    )
+    run = figadding.AddingRun(ds, transient=s.transient, periods=s.periods)
+    near = figadding.rows_near(ds, 40.0)
+    cells = figadding.start_cells(ds, near, 3, 2, upwards=False)
+    wc, failures = figadding.follow_from_map(ds, "period-doubling", 3, cells, 0.445)
+    assert wc is not None, failures
+    run.curves.append(wc)
+    return run, wc
+
+
+def test_curve_rule_fails_off_the_boundary(adding_run) -> None:
+    """The rule could fail: the period-3 period-doubling curve holds on the map, moved into the window it
+    does not (both sides period 3), nor far out in the chaos beside it."""
+    import dataclasses
+
+    run, wc = adding_run
+    on = run.check(wc)
+    assert on.inside >= 3 and on.holds == on.inside
+    # the one-parameter period-doubling at 40 degrees (continue_orbit) lies on the curve
+    m = pendulum("B", theta_hat=math.radians(40.0), eta=wc.eta)
+    branch = continue_orbit(m, "eta", wc.eta, 0.44, orbit=find_orbit(m, t0=None, period=3))
+    pd = next(s.param for s in branch.special if s.kind == "period-doubling")
+    th = wc.curve.values("theta_hat")
+    assert np.interp(math.radians(40.0), th[np.argsort(th)], wc.curve.values("eta")[np.argsort(th)]) == (
+        pytest.approx(pd, abs=1e-6)
+    )
+    cell = float(run.ds.eta[1] - run.ds.eta[0])
+    for shift in (5 * cell, -4 * cell):  # inside the window; in the chaos below it
+        moved = [dataclasses.replace(p, values=(p.values[0] + shift, p.values[1])) for p in wc.curve.points]
+        off = run.check(dataclasses.replace(wc, curve=dataclasses.replace(wc.curve, points=moved)))
+        assert off.inside == on.inside and off.holds < off.inside, shift
+        assert off.verdict == "differ" and off.failed
+        assert {figadding.class_label(f[2]) for f in off.failed} <= {
+            "aperiodic",
+            "period 3, 1 impact per period",
+        }
+
+
+def test_a_curve_not_continued_is_a_row_not_comparable() -> None:
+    run = figadding.AddingRun(ds=None, absent=["period-5 fold curve"], missing=["No period-5 fold curve."])
+    (row,) = figadding.comparisons(run)
+    assert row.verdict == "not comparable" and row.ours_text == "no curve" and "period-5 fold" in row.quantity
+
+
+def test_fold_misses_are_measured_against_the_nonimpacting_grazing(adding_run) -> None:
+    """The explanation of a fold curve's misses: its distance in cells to the nonimpacting orbit's grazing
+    curve (here a curve moved by 2.5 cells stands for both)."""
+    import dataclasses
+
+    run, wc = adding_run
+    cell = float(run.ds.eta[1] - run.ds.eta[0])
+    moved = [dataclasses.replace(p, values=(p.values[0] + 2.5 * cell, p.values[1])) for p in wc.curve.points]
+    fold = dataclasses.replace(wc, kind="fold")
+    grazing1 = dataclasses.replace(wc.curve, points=moved)
+    first = dataclasses.replace(wc, period=1, kind="grazing", curve=grazing1)
+    probe = figadding.AddingRun(run.ds, curves=[first, fold], transient=run.transient, periods=run.periods)
+    text = figadding._why(probe, fold, probe.check(fold))
+    assert "The fold lies 2.5–2.5 cells (η) below the nonimpacting orbit's grazing" in text
+
+
+def test_fig10_caption_promises_hatching_only_where_the_data_has_it(built) -> None:
+    """Hatched is where the map has no impacts but the full system has, on the same η grid (issue 30)."""
+    import xarray as xr
+
+    from grazing.report import fig10
+
+    _, result = _built(fig10, built)
+    caption = result.images[0].caption
+    hatched = 0
+    for p in fig07.PANELS:
+        group = f"{p.key}_main"
+        with (
+            xr.open_dataset(built.out / "fig07_sweeps.nc", group=group, engine="h5netcdf") as flow,
+            xr.open_dataset(built.out / "fig10_map_sweeps.nc", group=group, engine="h5netcdf") as mapped,
+        ):
+            quiet = (mapped["period"].values == 1) & (mapped["impacts_per_period"].values == 0)
+            hatched += int((quiet & (flow["impacts_per_period"].values > 0)).sum())
+    assert ("Hatched:" in caption) == (hatched > 0), (hatched, caption)
+    assert ("Nothing is hatched" in caption) == (hatched == 0)

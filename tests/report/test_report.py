@@ -62,6 +62,17 @@ def test_every_figure_writes_and_links_its_data(built) -> None:
     assert ds.attrs["theta_hat_deg"] == 40.0
     assert ds["eta"].values[0] == fig_range("7", "d")[0]
     ds.close()
+    # every image has a data file of its own figure beside it (fig03 was the one without, issue 30)
+    data_names = {d["filename"] for r in results for d in r["data"]}
+    for r in results:
+        for img in r["images"]:
+            prefix = img["filename"].split("_")[0]
+            assert any(n.startswith((prefix + "_", prefix + ".")) for n in data_names), (
+                f"{img['filename']}: no data file"
+            )
+    with xr.open_dataset(built.out / "fig03_synthetic_series.nc", group="a", engine="h5netcdf") as ds:
+        assert ds.attrs["synthetic"] == 1 and (ds.attrs["theta_hat_deg"], ds.attrs["eta"]) == (10.0, 0.35)
+        assert ds["theta_filtered"].size == ds["t"].size > 100
 
 
 def fig_range(fid: str, key: str) -> tuple[float, float]:
@@ -78,6 +89,34 @@ def test_provenance_on_the_page(built) -> None:
     for m in FIGURES:
         assert f'<a href="#fig{m.FIGURE_ID}">{m.FIGURE_ID}</a>' in page  # a compute-time row per figure
     assert re.search(r"<dt>commit</dt><dd><code>([0-9a-f]{40}(\+dirty)?|unknown)</code>", page)
+    # issue 30: llvmlite, the vector width, the state of the tree and the paper's DOI
+    assert re.search(r"\bllvmlite \d", page)
+    assert re.search(r"vector registers of [248] doubles", page)
+    dirty = re.search(r"<dt>source tree</dt><dd>([^<]+)</dd>", page)
+    assert dirty is not None
+    committed = re.search(r"<dt>commit</dt><dd><code>([^<]+)</code>", page).group(1)
+    assert ("dirty" in dirty.group(1)) == committed.endswith("+dirty")
+    assert 'href="https://doi.org/10.1007/s00332-004-0616-y"' in page
+    data = json.loads((built.out / "comparisons.json").read_text())
+    assert data["doi"] == "10.1007/s00332-004-0616-y" and data["vector_width"] in (2, 4, 8)
+
+
+def test_the_page_names_no_document_outside_the_report(built) -> None:
+    """No "SPEC" (a document not in the repository), no markdown backticks shown raw."""
+    text = re.sub(r"<[^>]+>", " ", built.page)
+    assert "SPEC" not in text
+    assert "`" not in text
+    for link in re.findall(r'href="(docs/[^"#]+)', built.page):
+        assert (built.out / link).is_file(), link
+
+
+def test_tables_scroll_and_figures_open_full_size_on_a_phone(built) -> None:
+    page = built.page
+    assert re.search(r"\.scroll \{[^}]*overflow-x: auto", page)
+    tables = page.count("<table")
+    assert tables >= 10 and page.count('<div class="scroll"><table') == tables, "a table outside its box"
+    for src in re.findall(r'<img src="([^"]+)"', page):
+        assert f'<a class="full" href="{src}">' in page, src
 
 
 def test_top_of_page_scoreboard_differences_cases_docs(built) -> None:
@@ -110,11 +149,13 @@ def test_table_holds_our_computed_periods(built) -> None:
     assert p == 5
     row = next(r for r in rows if r["figure"] == "9" and r["quantity"].startswith("(b)"))
     assert row["ours"] == f"period-{p}" and row["verdict"] == "agree"
-    # fig 9(a) as tabulated (alpha = 0.2254) does not reach the stop: a difference, in the errata
+    # fig 9(a) as tabulated (alpha = 0.2254) does not reach the stop: a difference, explained by an
+    # inference (the paper most likely used A/L), which is no erratum: nothing printed is shown wrong
     row_a = next(
         r for r in rows if r["figure"] == "9" and "0.2254" in r["quantity"] and "10°" in r["quantity"]
     )
-    assert row_a["ours"] == "period-1" and row_a["verdict"] == "differ" and row_a["erratum"]
+    assert row_a["ours"] == "period-1" and row_a["verdict"] == "differ" and not row_a["erratum"]
+    assert "inference" in row_a["headline"]
 
 
 def test_only_rebuilds_one_figure_and_keeps_the_others(built, tmp_path: Path) -> None:
@@ -137,6 +178,7 @@ def test_only_rebuilds_one_figure_and_keeps_the_others(built, tmp_path: Path) ->
 def test_select_names() -> None:
     assert [m.FIGURE_ID for m in select(["fig07", "fig7", "7"])] == ["7"]
     assert [m.FIGURE_ID for m in select(["map", "fig12", "fig02"])] == ["2", "12", "map"]
+    assert [m.FIGURE_ID for m in select(["adding", "figadding", "map"])] == ["map", "adding"]  # issue 27
     with pytest.raises(ValueError, match="no figure"):
         select(["fig5"])
 
@@ -180,3 +222,17 @@ def test_build_report_only_unknown_name_fails_before_computing(tmp_path: Path) -
     with pytest.raises(ValueError, match="no figure"):
         build_report(tmp_path, only=["nope"])
     assert not (tmp_path / "index.html").exists()
+
+
+def test_report_only_help_names_every_figure() -> None:
+    """``grazing report --help`` lists every name ``--only`` takes (each one selects its figure)."""
+    from grazing.cli.report import report
+    from grazing.report import FIGURES, select
+
+    (only,) = [p for p in report.params if p.name == "only"]
+    for m in FIGURES:
+        name = f"fig{m.FIGURE_ID.zfill(2)}" if m.FIGURE_ID.isdigit() else m.FIGURE_ID
+        assert select([name]) == [m]
+        if m.FIGURE_ID.isdigit() and name not in ("fig02", "fig04", "fig06", "fig12"):
+            continue  # (fig06 ... fig12: the numbered figures in between)
+        assert name in only.help, name

@@ -137,6 +137,17 @@ def test_two_parameter_map_shape():
     assert ds.period.shape == (3, 6)
     assert ds.period.values[2, 0] == 1  # 50 deg, far from resonance: nonimpacting period 1
     assert ds.impacts.values[2, 0] == 0
+    # issue 30: the coordinates keep what plots need (a map drawn in radians on a degree axis was blank)
+    assert ds.theta_hat.attrs["angle"] == 1 and ds.theta_hat.attrs["symbol"] == "θ̂"
+    assert ds.eta.attrs["angle"] == 0 and ds.eta.attrs["symbol"] == "η"
+    from matplotlib.figure import Figure
+
+    from grazing.plotting import plot_period_map
+
+    ax = Figure().add_subplot()
+    mesh = plot_period_map(ax, ds, colorbar=False)
+    ys = mesh.get_coordinates()[:, 0, 1]  # the cell edges along the θ̂ axis
+    assert ys.min() < 10 and ys.max() > 50 and ax.get_ylabel() == "θ̂ (degrees)"
 
 
 # --------------------------------------------------------------------------

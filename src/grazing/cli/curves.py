@@ -20,6 +20,7 @@ from grazing.cli.common import (
     model_options,
     model_parameter,
     model_params_json,
+    multipliers_text,
     netcdf_out_option,
     parse_pair,
     parse_state,
@@ -154,7 +155,7 @@ def curve(
         "points": [
             {**_values(result, pt.values), "multipliers": complex_list(pt.multipliers), "state": pt.state,
              "period": pt.period, "impacts": pt.impacts, "section_time": pt.section_time,
-             "stable": pt.stable}
+             "stable": pt.stable, "accuracy": pt.accuracy}
             for pt in result.points
         ],
         "special": [
@@ -179,8 +180,16 @@ def curve(
     )
     for sp_ in result.special:
         at = ", ".join(p.show(v, ".8g") for p, v in zip((p1, p2), sp_.values))
-        mu = ", ".join(f"{x:+.4f}{y:+.4f}i" for x, y in complex_list(sp_.multipliers))
+        mu = multipliers_text(sp_.multipliers)
         note = "" if sp_.located else " (not located exactly)"
         click.echo(f"  {sp_.kind:22s} {at}   multipliers {mu}{note}")
+    imprecise = result.imprecise()
+    if imprecise:
+        worst = max(result.points[i].accuracy for i in imprecise)
+        click.echo(
+            f"note: the multipliers of {len(imprecise)} points are known only to {worst:.1g}: their "
+            "monodromy is far from normal (as next to a grazing, where the saltation matrix holds 1/v, "
+            "v the impact speed) and double precision does no better"
+        )
     if out is not None:
         click.echo(f"curve saved to {out}")

@@ -15,6 +15,7 @@ from grazing.cli.common import (
     json_option,
     model_options,
     model_params_json,
+    multipliers_text,
     search_range,
     stop_name_option,
     stop_option_index,
@@ -95,7 +96,7 @@ def normal_form_cmd(
     if as_json:
         emit_json(res)
         return
-    mu = ", ".join(f"{z.real:+.4f}{z.imag:+.4f}i" for z in point.multipliers)
+    mu = multipliers_text(point.multipliers)
     where = "" if point.stop_name == "stop" else f" (stop {point.stop_name})"
     click.echo(f"{which} grazing at {par.show(point.model.params[par.name], '.6f')}{where}, "
                f"t_graze = {point.phase:.4f}")  # fmt: skip

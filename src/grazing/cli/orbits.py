@@ -22,6 +22,7 @@ from grazing.cli.common import (
     model_options,
     model_parameter,
     model_params_json,
+    multipliers_text,
     netcdf_out_option,
     parse_pair,
     parse_state,
@@ -197,7 +198,7 @@ def graze(
     if not points:
         click.echo(f"no grazing with stop {model.stop_names[stop]!r} for {par.show_range(lo, hi)}")
     for point, g in zip(points, res["grazings"]):
-        mu = ", ".join(f"{a:+.4f}{b:+.4f}i" for a, b in g["multipliers"])
+        mu = multipliers_text(g["multipliers"])
         where = "" if g["stop"] == "stop" else f" (stop {g['stop']})"
         click.echo(f"{par.show(point.model.params[par.name], '.6f')}{where}: multipliers {mu}, "
                    f"|lambda| = {g['abs_lambda']:.4f}, t_graze = {g['t_graze']:.4f}")  # fmt: skip
@@ -435,7 +436,7 @@ def continue_(
         if point.between is not None:  # an unlocated stability change: what was seen, in words
             click.echo(f"  {sp_['kind']:16s} {point.note}")
             continue
-        mu = ", ".join(f"{x:+.4f}{y:+.4f}i" for x, y in sp_["multipliers"])
+        mu = multipliers_text(sp_["multipliers"])
         on = f" (stop {sp_['stop']})" if sp_.get("stop", "stop") != "stop" else ""  # as graze prints it
         switched = "   (switched here)" if point.switched else (f"   ({point.note})" if point.note else "")
         click.echo(f"  {sp_['kind']:16s} {par.show(point.param, '.8g')}   multipliers {mu}{on}{switched}")

@@ -16,8 +16,9 @@ from grazing.cli.validate import path_type
               show_default=True, help="Output folder for index.html and figures: a report folder of "
               "grazing's, an empty folder, or a new one in an existing folder.")  # fmt: skip
 @click.option("--only", "only", multiple=True, metavar="FIGURE",
-              help="Rebuild only this figure (fig02, fig04, fig06 ... fig12, figmap, eq; repeatable) and "
-                   "re-render the page with the other figures of earlier builds in --out.")  # fmt: skip
+              help="Rebuild only this figure or section (fig02, fig04, fig06 ... fig12, map, adding, "
+                   "stops, attractors, eq; repeatable) and re-render the page with the other figures "
+                   "of earlier builds in --out.")  # fmt: skip
 @click.option("--overwrite", is_flag=True,
               help="Build into a folder that is not a report folder of grazing's, replacing the files of "
               "the report's names in it.")  # fmt: skip

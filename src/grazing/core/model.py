@@ -836,13 +836,15 @@ class HybridModel:
     def vector_field(self, x: Any, t: float = 0.0) -> np.ndarray:
         """``f(x, t)`` (evaluated by the compiled kernels)."""
         out = np.empty(self.n_states)
-        self.kernels().rhs(np.asarray(x, dtype=float), float(t), self.param_vector, out)
+        self.kernels().rhs(np.ascontiguousarray(x, dtype=float), float(t), self.param_vector, out)
         return out
 
     def guard(self, x: Any, t: float = 0.0, stop: int | str | None = None) -> float:
         """``h(x, t)`` of a stop (the first by default): positive in the allowed region."""
         j = self.stop_index(stop)
-        return float(self.kernels().guard(np.asarray(x, dtype=float), float(t), self.param_vector, j))
+        return float(
+            self.kernels().guard(np.ascontiguousarray(x, dtype=float), float(t), self.param_vector, j)
+        )
 
     def guards(self, x: Any, t: float = 0.0) -> np.ndarray:
         """Every stop's guard at ``(x, t)``, in the order of :attr:`stop_names`."""
@@ -852,13 +854,15 @@ class HybridModel:
         """``g(x, t)`` of a stop: the state just after an impact at ``x``."""
         out = np.empty(self.n_states)
         j = self.stop_index(stop)
-        self.kernels().reset(np.asarray(x, dtype=float), float(t), self.param_vector, out, j)
+        self.kernels().reset(np.ascontiguousarray(x, dtype=float), float(t), self.param_vector, out, j)
         return out
 
     def normal_accel(self, x: Any, t: float = 0.0, stop: int | str | None = None) -> float:
         """``L_f^2 h`` at ``(x, t)``: a guard's acceleration along the flow (compiled)."""
         j = self.stop_index(stop)
-        return float(self.kernels().normal_accel(np.asarray(x, dtype=float), float(t), self.param_vector, j))
+        return float(
+            self.kernels().normal_accel(np.ascontiguousarray(x, dtype=float), float(t), self.param_vector, j)
+        )
 
     def jacobians(
         self, x: Any, t: float = 0.0, stop: int | str | None = None

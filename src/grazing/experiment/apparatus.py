@@ -12,7 +12,7 @@ Damping: the model's equation of motion (paper eq. 4, the authoritative form)
 follows from eq. 2 with ``beta = kappa / (2 omega_0)``, as eq. 3 prints.  The
 paper's quoted values, however, (``kappa = 1.1`` for ``beta = 0.0426``,
 ``kappa = 1.238`` for ``beta = 0.048``) fit ``kappa = 4 omega_0 beta``
-(SPEC.md errata).  :meth:`Apparatus.kappa` offers both.
+(docs/equations.md, errata).  :meth:`Apparatus.kappa` offers both.
 """
 
 from __future__ import annotations

@@ -380,7 +380,7 @@ def paper_protocol_damping(
     Eq. 1 (``1 / (4 pi k_hat)``) applied to the free decay of the model with
     ``2 beta`` in place of ``beta`` -- the model whose damping term is
     ``kappa / omega`` with ``kappa = 4 omega_0 beta``, the conversion the
-    paper's quoted numbers follow (SPEC.md, erratum on eq. 3).  It gives
+    paper's quoted numbers follow (docs/equations.md, erratum on eq. 3).  It gives
     ``D = 0.070`` at the paper's points A, B, C and fig 4(a) and 0.071 at D,
     which the model itself (:func:`model_damping`) does not.
 

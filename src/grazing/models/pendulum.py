@@ -16,7 +16,7 @@ with ``theta`` as the state the flow does not depend on ``theta_hat`` at all
 (only the guard does).  ``theta_hat`` is in radians here; the command line
 takes degrees.
 
-The paper's named parameter sets (SPEC.md; errata: case D has beta = 0.068,
+The paper's named parameter sets (docs/equations.md; errata: case D has beta = 0.068,
 not 0.68, and the numerics use alpha = 0.2254):
 
 =========  ======  =====  ==============  =========================

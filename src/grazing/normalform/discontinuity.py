@@ -18,7 +18,7 @@ reset's jump per unit approach speed (``c`` the contact direction).  For the
 pendulum ``e = (0, 1 + r)``: the velocity jumps by ``-(1 + r) S``, away from
 the stop.  (The paper's eq. 19 takes the square root of ``L_f^2 h`` with the
 opposite sign convention, giving an imaginary root and a kick towards the
-stop; see SPEC.md.)
+stop; see docs/equations.md.)
 
 The Poincare map of the paper's eq. 20 is ``Pi = Phi_2 o D o Phi_1``: the
 nonlinear flow ignoring the stop, with ``D`` applied once per period at the
@@ -47,7 +47,7 @@ from grazing.orbits.contact import GrazingPoint
 
 
 def zdm_direction(model: HybridModel, x: np.ndarray, t: float, stop: int = 0) -> np.ndarray:
-    """``e = (g_x - I) c / (grad(L_f h) . c)``: ``stop``'s reset jump per unit approach speed at ``x``."""
+    """``stop``'s reset jump per unit approach speed at ``x``: ``e = (g_x - I) c / (grad(L_f h) @ c)``."""
     _, _, gx = model.jacobians(x, t, stop)
     c = np.zeros(model.n_states)
     model.kernels().contact_dir(np.asarray(x, dtype=float), float(t), model.param_vector, c, stop)

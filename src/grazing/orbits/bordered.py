@@ -30,6 +30,7 @@ For the monodromy ``M`` of a periodic orbit (the Jacobian of its period map):
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -115,6 +116,29 @@ class Bordered:
     def derivative(self, dA: np.ndarray) -> float:
         """``dg = -w^T dA v``: the change of ``g`` for a change ``dA`` of ``A``."""
         return float(-self.w @ dA @ self.v)
+
+    @property
+    def eigenvalue_condition(self) -> float:
+        """``|v| |w| / |w^T v|``: the condition number of ``A``'s eigenvalue nearest zero.
+
+        ``A + g b c^T`` is singular, with null vectors ``v`` and ``w``, so ``A``'s
+        eigenvalue nearest zero is ``-g / (w^T v)`` to first order in ``g``, and a
+        change ``dA`` moves it by at most this number times ``|dA|`` (Wilkinson's
+        ``1 / |cos|`` of the angle between the null vectors; 1 for a normal
+        matrix, large for a strongly non-normal one such as a monodromy near a
+        grazing, where a saltation matrix holds ``1 / v``, ``v`` the impact speed).
+        Infinite where the null vectors are orthogonal (a defective eigenvalue).
+
+        Examples
+        --------
+        >>> A = np.array([[1e-12, 1e4], [0.0, 0.5]])  # eigenvalue 1e-12, far from normal
+        >>> sol = bordered(A, Borders.of(A))
+        >>> bool(abs(-sol.g / (sol.w @ sol.v) - 1e-12) < 1e-20), round(sol.eigenvalue_condition / 2e4, 3)
+        (True, 1.0)
+        """
+        wv = abs(float(self.w @ self.v))
+        norms = float(np.linalg.norm(self.v) * np.linalg.norm(self.w))
+        return norms / wv if wv > 0 else math.inf
 
 
 def bordered(A: np.ndarray, borders: Borders) -> Bordered:

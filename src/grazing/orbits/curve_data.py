@@ -5,6 +5,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -15,6 +16,10 @@ from grazing.core.model import HybridModel
 from grazing.orbits.contact import GrazingPoint
 from grazing.orbits.continuation import Branch, SpecialPoint
 from grazing.orbits.shooting import PeriodicOrbit
+
+ACCURACY_NOTE = 1e-6
+"""Points whose multipliers are known less well than this (:attr:`CurvePoint.accuracy`) are named
+in the command's summary (:meth:`BifurcationCurve.imprecise`)."""
 
 
 @dataclass(frozen=True)
@@ -40,6 +45,13 @@ class CurvePoint:
     orbit, grazing
         The periodic orbit (fold, period-doubling, Neimark-Sacker, branch-point curves) or
         the grazing orbit (grazing curves).
+    accuracy
+        How far the critical multipliers may be from the curve's condition (``|mu - 1|`` on a
+        fold or branch-point curve, ``|mu + 1|`` on a period-doubling curve, ``|mu_i mu_j - 1|``
+        on a Neimark-Sacker curve), given ``condition`` and double precision
+        (:func:`~grazing.orbits.extended.multiplier_accuracy`): about ``1e-10`` times the
+        monodromy's non-normality, and far worse within ``1e-5`` of a grazing (the saltation
+        matrix's ``1 / v``).  nan on a grazing curve.
     """
 
     values: tuple[float, float]
@@ -51,6 +63,7 @@ class CurvePoint:
     condition: float
     orbit: PeriodicOrbit | None = None
     grazing: GrazingPoint | None = None
+    accuracy: float = math.nan
 
     @property
     def stable(self) -> bool:
@@ -140,6 +153,11 @@ class BifurcationCurve:
         """One parameter's values along the curve."""
         return np.array([p.values[self.params.index(name)] for p in self.points])
 
+    def imprecise(self, tol: float = ACCURACY_NOTE) -> list[int]:
+        """The indices of the points whose multipliers are known only to worse than ``tol``
+        (:attr:`CurvePoint.accuracy`: in double precision, near a grazing)."""
+        return [i for i, p in enumerate(self.points) if p.accuracy > tol]
+
     @property
     def states(self) -> np.ndarray:
         return np.array([p.state for p in self.points]).reshape(-1, self.model.n_states)
@@ -172,6 +190,7 @@ class BifurcationCurve:
             "stable": ("point", np.array([p.stable for p in self.points], dtype=np.int8)),
             "impacts": ("point", np.array([p.impacts for p in self.points], dtype=np.int32)),
             "condition": ("point", np.array([p.condition for p in self.points])),
+            "accuracy": ("point", np.array([p.accuracy for p in self.points])),
             "special_kind": ("special", np.array([s.kind for s in self.special], dtype=str)),
             "special_index": ("special", np.array([s.index for s in self.special], dtype=np.int32)),
             "special_param1": ("special", np.array([s.values[0] for s in self.special], dtype=float)),

@@ -220,8 +220,9 @@ class _Follower:
         o = ev.orbit
         assert o is not None
         return CurvePoint(
-            values, o.state.copy(), o.t0, o.multipliers, o.impacts, self.period, ev.condition, o
-        )
+            values, o.state.copy(), o.t0, o.multipliers, o.impacts, self.period, ev.condition, o,
+            accuracy=ev.accuracy,
+        )  # fmt: skip
 
     # -- checks -------------------------------------------------------------
     def check(self, prev: PalcPoint, cand: PalcPoint) -> tuple[str, str]:

@@ -179,10 +179,12 @@ def plot_fractions(ax: Axes, ds: Any, *, degrees: bool = True, legend: bool = Tr
     >>> from matplotlib.figure import Figure
     >>> from grazing.attractors import continue_attractors
     >>> ball = grazing.models.bouncing_ball(r=0.8)
-    >>> ds = continue_attractors(ball, "amplitude", [0.3, 0.5, 0.8], (0, 6), (-4, 4), (6, 6), workers=1)
+    >>> ds = continue_attractors(ball, "amplitude", [0.3, 0.5, 0.8], (-1, 6), (-4, 4), (8, 6), workers=1)
     >>> ax = Figure().add_subplot()
-    >>> len(plot_fractions(ax, ds)), ax.get_xlabel()  # (the ball riding, its period-1 orbit, invalid)
+    >>> len(plot_fractions(ax, ds)), ax.get_xlabel()  # heights below the table are invalid starts
     (3, 'A')
+    >>> [t.get_text() for t in ax.get_legend().get_texts()]
+    ['0: invalid', '1: sticking', '2: periodic']
     """
     par = dataset_parameter(ds, "value")
     scale = param_scale(par, degrees)

@@ -74,21 +74,43 @@ def visible_windows(
     return out
 
 
+BAR_DROP = 0.25
+"""How far a window's bar sits below its label's baseline, in units of the font size."""
+
+
+def label_rows(height_pt: float, fontsize: float, count: int = 3) -> tuple[float, ...]:
+    """Heights (axes fractions) of ``count`` label rows in axes ``height_pt`` points tall.
+
+    A label's text (about 1.2 font sizes tall with its descent) sits on its
+    row and its bar :data:`BAR_DROP` font sizes below; rows are 2 font sizes
+    apart, which leaves half a font size between a text and the bar above it.
+
+    Examples
+    --------
+    >>> [round(y, 3) for y in label_rows(200.0, 10.0)]
+    [0.935, 0.835, 0.735]
+    """
+    top = 1.0 - 1.3 * fontsize / height_pt
+    step = 2.0 * fontsize / height_pt
+    return tuple(top - k * step for k in range(count))
+
+
 def label_windows(
     ax: Axes,
     windows: list[Window],
     *,
     scale: float = 1.0,
-    rows: tuple[float, ...] = (0.955, 0.895, 0.835),
+    rows: tuple[float, ...] | None = None,
     fontsize: float = 9.0,
     min_gap: float = 0.006,
     color: str = "tab:blue",
 ) -> list[Window]:
     """Write the period above each window, with a bar showing its extent, without collisions.
 
-    The labels sit near the top of the axes (``rows`` in axes fractions).  Each
-    label occupies its bar and its text (estimated from the font size and the
-    axes width); the windows are placed widest first, each on the first row
+    The labels sit near the top of the axes (``rows`` in axes fractions), each
+    text above its bar.  Each label occupies its bar and its text (estimated
+    from the font size and the axes width); the windows are placed widest
+    first, each on the first row
     where it collides with nothing already placed there, ``min_gap`` (axes
     fraction) apart.  A window that fits on no row is left unlabelled: the
     caller lists the windows in a table anyway.  Draw the diagram and set the x
@@ -104,7 +126,9 @@ def label_windows(
         Factor from the windows' parameter units to the x axis (``180/pi``
         for an angle shown in degrees).
     rows
-        Heights of the label rows, in axes fractions.
+        Heights of the label rows, in axes fractions (default: three rows
+        :func:`label_rows` apart, so that a text never touches the bar of the
+        row above).
     fontsize
         Font size of the labels.
     min_gap
@@ -120,6 +144,9 @@ def label_windows(
     x0, x1 = ax.get_xlim()
     trans = ax.get_xaxis_transform()  # x in data, y in axes fraction
     width_pt = max(ax.get_position().width * ax.figure.get_figwidth() * 72.0, 1.0)
+    height_pt = max(ax.get_position().height * ax.figure.get_figheight() * 72.0, 1.0)
+    rows = label_rows(height_pt, fontsize) if rows is None else rows
+    bar_drop = BAR_DROP * fontsize / height_pt
 
     def extent(w: Window) -> tuple[float, float]:
         c = (w.center * scale - x0) / (x1 - x0)
@@ -143,7 +170,7 @@ def label_windows(
             continue
         y = rows[placed[k]]
         c = w.center * scale
-        ax.plot([w.lo * scale, w.hi * scale], [y - 0.012, y - 0.012], transform=trans, color=color,
+        ax.plot([w.lo * scale, w.hi * scale], [y - bar_drop, y - bar_drop], transform=trans, color=color,
                 lw=1.4, solid_capstyle="butt", clip_on=False)  # fmt: skip
         ax.text(c, y, w.label.split(" ")[0], transform=trans, ha="center", va="bottom",
                 fontsize=fontsize, color=color, clip_on=False)  # fmt: skip

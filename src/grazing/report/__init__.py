@@ -15,7 +15,7 @@ Examples
 --------
 >>> from grazing.report import FIGURES, PAPER_FIGURES
 >>> [m.FIGURE_ID for m in FIGURES]
-['2', '4', '6', '7', '8', '9', '10', '11', '12', 'map', 'stops', 'attractors', 'eq']
+['2', '4', '6', '7', '8', '9', '10', '11', '12', 'map', 'adding', 'stops', 'attractors', 'eq']
 >>> set(PAPER_FIGURES) <= {m.FIGURE_ID for m in FIGURES}
 True
 >>> [m.FIGURE_ID for m in select(["fig07", "10", "figmap"])]
@@ -46,9 +46,11 @@ from grazing.report import (
     fig10,
     fig11,
     fig12,
+    figadding,  # issue 27
     figattractors,  # issue 28
     figmap,
     figstops,
+    paper,
 )
 from grazing.report.base import Comparison, DataFile, Dynamics, FigureResult, Image, Progress
 from grazing.report.folder import check_report_folder, claim_report_folder
@@ -80,6 +82,7 @@ FIGURES: tuple[ModuleType, ...] = (
     fig11,
     fig12,
     figmap,
+    figadding,  # issue 27
     figstops,
     figattractors,  # issue 28
     errata,
@@ -91,8 +94,12 @@ PAPER_FIGURES = ("4", "6", "7", "8", "9", "10", "11", "12")
 
 INDEX = "index.html"
 COMPARISONS = "comparisons.json"
-DOCS = (("the grazing normal form", "normal-form.md"), ("the experiment tools", "experiment.md"))
-"""The documents linked from the top of the page (copied from the repository's ``docs/``)."""
+DOCS = (
+    ("the equations, units and the paper's errata", "equations.md"),
+    ("the grazing normal form", "normal-form.md"),
+    ("the experiment tools", "experiment.md"),
+)
+"""The documents linked from the top of the page (copied from the repository's ``docs/``, those it has)."""
 
 
 def select(names: Sequence[str]) -> list[ModuleType]:
@@ -143,7 +150,10 @@ def comparisons_json(results: Sequence[FigureResult], meta: ReportMeta) -> dict[
     rows = [r for f in results for r in f.comparisons]
     return {
         "paper": "Piiroinen, Virgin & Champneys, J. Nonlinear Sci. 14 (2004) 383-404",
+        "doi": paper.DOI,
         "commit": meta.commit,
+        "dirty": meta.dirty,
+        "vector_width": meta.vector_width,
         "rendered": meta.date,
         "versions": meta.versions,
         "rules": RULES_TEXT,
@@ -214,6 +224,8 @@ def build_report(
         cpu=prov.cpu,
         cores=prov.cores,
         system=prov.system,
+        vector_width=prov.vector_width,
+        dirty=prov.dirty,
         docs=_copy_docs(out),
         pending=tuple(f for f in PAPER_FIGURES if f not in done),
     )

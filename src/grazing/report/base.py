@@ -38,6 +38,8 @@ KINDS: tuple[str, ...] = ("paper", "experiment", "self-check")
 """``paper``: against the paper's numbers or figures; ``experiment``: against the paper's measurements
 (§2); ``self-check``: our own consistency (map against simulation, synthetic pipeline against model)."""
 VERDICTS: tuple[str, ...] = ("agree", "differ", "not comparable")
+REFERENCE = "reference"
+"""What the reference column of a self-check holds when its row does not say."""
 
 Value = float | int | str | tuple[float, float] | None
 """A compared value: a number, an interval ``(lo, hi)``, or text as the paper states it."""
@@ -126,7 +128,12 @@ class Comparison:
     headline
         One line for the “where we differ” box; rows with the same headline are listed together.
     erratum
-        True when the difference is an error in the paper (listed under the errata).
+        True when the difference is an error in the paper (listed under the errata, and counted apart
+        from the disagreements on the scoreboard).
+    reference
+        For a self-check, what ``paper`` holds (``"closed form"``, ``"simulation"``): the page shows
+        self-checks in a table of their own whose column is headed "reference", each cell with this
+        label (default :data:`REFERENCE`).
     id
         The HTML anchor of the row (set by :func:`number_rows`).
     """
@@ -148,6 +155,7 @@ class Comparison:
     synthetic: bool = False
     headline: str = ""
     erratum: bool = False
+    reference: str = ""
     id: str = ""
 
     def __post_init__(self) -> None:
@@ -157,6 +165,10 @@ class Comparison:
             raise ValueError(f"verdict must be one of {VERDICTS}, got {self.verdict!r}")
         if self.synthetic and self.kind != "self-check":
             raise ValueError("a row computed from synthetic recordings must be a self-check")
+        if self.reference and self.kind != "self-check":
+            raise ValueError("only a self-check has a reference other than the paper")
+        if self.erratum and self.verdict != "differ":
+            raise ValueError("an erratum is a row that differs from the paper")
         if not self.rule:
             raise ValueError(f"comparison {self.quantity!r} has no rule")
         for name in ("paper", "ours", "tolerance", "delta"):

@@ -5,11 +5,16 @@ commands on file descriptor 3, replies on 4, each message JSON ended by a NUL
 byte), so nothing but Chromium itself is needed.  The page is loaded; the
 browser reports every ``<img>`` that did not load (``naturalWidth == 0``),
 every link, and every in-page anchor without its target; links to local files
-are then checked on disk.  Links to other sites are listed, not fetched.
+are then checked on disk, and every local image that loaded is checked for
+paint (:func:`painted_fraction`: a blank image is a problem).  Links to other
+sites are listed, not fetched.  :func:`check_site` checks every page of a folder
+(the documentation site) in one browser, and also the anchors that links from
+one page name in another.
 
-Command line (``make check-report``)::
+Command line (``make check-report``, ``make docs-check``)::
 
     python -m grazing.report.browser report/index.html [--screenshot page.png]
+    python -m grazing.report.browser docs/_build/html
 
 exits with status 1 and one line per problem when something is missing.
 """
@@ -59,8 +64,12 @@ _PROBE = """(() => {
                        .filter(([raw]) => raw.length > 1
                                && !document.getElementById(decodeURIComponent(raw.slice(1))))
                        .map(([raw]) => raw);
+  const shown = imgs.filter(i => i.complete && i.naturalWidth > 0).map(i => [i.getAttribute('src'), i.src]);
+  const ids = Array.from(document.querySelectorAll('[id]')).map(e => e.id)
+                   .concat(Array.from(document.querySelectorAll('a[name]')).map(e => e.name));
   return JSON.stringify({title: document.title, images: imgs.length, broken: broken, links: links,
-                         anchors: anchors, height: document.documentElement.scrollHeight});
+                         anchors: anchors, shown: shown, ids: ids,
+                         height: document.documentElement.scrollHeight});
 })()"""
 
 
@@ -84,6 +93,12 @@ class PageCheck:
         Links to other sites (not checked).
     errors
         JavaScript exceptions thrown while loading.
+    blank_images
+        ``src`` of every local image that loaded but is blank (:func:`is_blank`).
+    ids
+        Every element id of the page (the targets of anchors).
+    local_links
+        Links to local files, as ``(href, absolute path, fragment)``.
     """
 
     title: str = ""
@@ -93,18 +108,77 @@ class PageCheck:
     broken_links: list[str] = field(default_factory=list)
     external: list[str] = field(default_factory=list)
     errors: list[str] = field(default_factory=list)
+    blank_images: list[str] = field(default_factory=list)
+    ids: set[str] = field(default_factory=set, repr=False)
+    local_links: list[tuple[str, Path, str]] = field(default_factory=list, repr=False)
 
     @property
     def ok(self) -> bool:
-        return not (self.broken_images or self.broken_links or self.errors)
+        return not (self.broken_images or self.broken_links or self.errors or self.blank_images)
 
     def problems(self) -> list[str]:
         """One line per problem."""
         return (
             [f"image not shown: {s}" for s in self.broken_images]
+            + [f"blank image: {s}" for s in self.blank_images]
             + [f"broken link: {s}" for s in self.broken_links]
             + [f"script error: {s}" for s in self.errors]
         )
+
+
+BLANK_FRACTION = 0.005
+"""An image is blank when fewer than this fraction of its pixels differ from its background."""
+
+
+def _image_rgb(path: Path | str | Any) -> Any:
+    """The image as an ``(h, w, 3)`` int16 array, transparent pixels over white."""
+    import numpy as np
+    from PIL import Image
+
+    with Image.open(path) as im:
+        rgba = np.asarray(im.convert("RGBA"), dtype=np.int16)
+    alpha = rgba[..., 3:4] / 255.0
+    return (rgba[..., :3] * alpha + 255 * (1 - alpha)).round().astype(np.int16)
+
+
+def _painted(rgb: Any) -> float:
+    """The fraction of pixels of ``rgb`` (``(..., 3)``) that differ from its most frequent colour."""
+    import numpy as np
+
+    flat = rgb.reshape(-1, 3)
+    if flat.size == 0:
+        return 0.0
+    colours, counts = np.unique(flat, axis=0, return_counts=True)
+    background = colours[np.argmax(counts)]
+    return float(np.mean(np.any(np.abs(flat - background) > 8, axis=1)))
+
+
+def painted_fraction(path: Path | str | Any) -> float:
+    """The fraction of an image's pixels that differ from its background (its most frequent colour).
+
+    Transparent pixels count as white; a pixel differs when one of its channels
+    differs by more than 8 of 255 (anti-aliasing and compression noise aside).
+
+    Examples
+    --------
+    >>> import io, numpy as np
+    >>> from PIL import Image
+    >>> img = np.full((100, 100, 3), 255, np.uint8)
+    >>> img[10:20, 10:30] = (0, 0, 200)
+    >>> buf = io.BytesIO(); Image.fromarray(img).save(buf, format="png")
+    >>> painted_fraction(buf)
+    0.02
+    """
+    return _painted(_image_rgb(path))
+
+
+def is_blank(path: Path | str) -> bool:
+    """True when the image at ``path`` is (nearly) one colour: :func:`painted_fraction` below
+    :data:`BLANK_FRACTION`.  Only raster images (PNG, JPEG, GIF, WebP) are judged; others are not blank.
+    """
+    if Path(path).suffix.lower() not in (".png", ".jpg", ".jpeg", ".gif", ".webp"):
+        return False
+    return painted_fraction(path) < BLANK_FRACTION
 
 
 def find_chromium() -> str | None:
@@ -240,72 +314,155 @@ def check_page(
     if screenshot is not None:
         check_replaceable(screenshot, overwrite=overwrite, hint="use another name, or --overwrite")
     page = Path(index).resolve()
-    if not page.is_file():
-        raise FileNotFoundError(page)
+    shots = {page: Path(screenshot)} if screenshot is not None else {}
+    return check_pages([page], chromium=chromium, screenshots=shots, width=width, timeout=timeout)[page]
+
+
+def check_pages(
+    pages: list[Path],
+    *,
+    chromium: str | None = None,
+    screenshots: dict[Path, Path] | None = None,
+    width: int = 1400,
+    timeout: float = 60.0,
+) -> dict[Path, PageCheck]:
+    """Load each of ``pages`` in turn in one headless Chromium and check it as :func:`check_page` does.
+
+    ``screenshots`` maps a page (resolved path) to the PNG to write of it (replaced
+    without a check: :func:`check_page` checks first).  Returns the check of
+    each page, by its resolved path.
+
+    Raises
+    ------
+    FileNotFoundError
+        When no Chromium is found or a page does not exist.
+    """
+    pages = [Path(p).resolve() for p in pages]
+    for page in pages:
+        if not page.is_file():
+            raise FileNotFoundError(page)
     exe = chromium or find_chromium()
     if exe is None:
         raise FileNotFoundError("no Chromium found (install chromium or set $CHROMIUM)")
+    shots = {Path(k).resolve(): v for k, v in (screenshots or {}).items()}
+    found: dict[Path, tuple[dict[str, Any], list[str]]] = {}
     with tempfile.TemporaryDirectory(prefix="grazing-chromium-") as profile:
         dt = _DevTools(exe, profile, timeout)
         try:
-            target = dt.send("Target.createTarget", {"url": "about:blank"})["targetId"]
-            session = dt.send("Target.attachToTarget", {"targetId": target, "flatten": True})["sessionId"]
-            dt.send("Page.enable", session=session)
-            dt.send("Runtime.enable", session=session)
-            dt.send(
-                "Emulation.setDeviceMetricsOverride",
-                {"width": width, "height": 900, "deviceScaleFactor": 1, "mobile": False},
-                session=session,
-            )
-            dt.send("Page.navigate", {"url": page.as_uri()}, session=session)
-            dt.wait_event("Page.loadEventFired")
-            res = dt.send("Runtime.evaluate", {"expression": _PROBE, "returnByValue": True}, session=session)
-            found = json.loads(res["result"]["value"])
-            errors = [
-                ev["params"]["exceptionDetails"].get("text", "exception")
-                for ev in dt.events
-                if ev.get("method") == "Runtime.exceptionThrown"
-            ]
-            if screenshot is not None:
-                height = int(found.get("height", 900))
-                shot = dt.send(
-                    "Page.captureScreenshot",
-                    {
-                        "format": "png",
-                        "captureBeyondViewport": True,
-                        "clip": {"x": 0, "y": 0, "width": width, "height": height, "scale": 1},
-                    },
-                    session=session,
-                )
-                write_png_bytes(screenshot, base64.b64decode(shot["data"]), overwrite=True)  # (checked)
+            for page in pages:
+                found[page] = _load(dt, page, width, shots.get(page))
         finally:
             dt.close()
+    return {page: _judge(*found[page]) for page in pages}
+
+
+def _load(dt: _DevTools, page: Path, width: int, screenshot: Path | None) -> tuple[dict[str, Any], list[str]]:
+    """Open ``page`` in a new tab, probe it (and take its screenshot), close the tab."""
+    dt.events.clear()
+    target = dt.send("Target.createTarget", {"url": "about:blank"})["targetId"]
+    session = dt.send("Target.attachToTarget", {"targetId": target, "flatten": True})["sessionId"]
+    dt.send("Page.enable", session=session)
+    dt.send("Runtime.enable", session=session)
+    dt.send(
+        "Emulation.setDeviceMetricsOverride",
+        {"width": width, "height": 900, "deviceScaleFactor": 1, "mobile": False},
+        session=session,
+    )
+    dt.send("Page.navigate", {"url": page.as_uri()}, session=session)
+    dt.wait_event("Page.loadEventFired")
+    res = dt.send("Runtime.evaluate", {"expression": _PROBE, "returnByValue": True}, session=session)
+    found = json.loads(res["result"]["value"])
+    errors = [
+        ev["params"]["exceptionDetails"].get("text", "exception")
+        for ev in dt.events
+        if ev.get("method") == "Runtime.exceptionThrown"
+    ]
+    if screenshot is not None:
+        height = int(found.get("height", 900))
+        shot = dt.send(
+            "Page.captureScreenshot",
+            {
+                "format": "png",
+                "captureBeyondViewport": True,
+                "clip": {"x": 0, "y": 0, "width": width, "height": height, "scale": 1},
+            },
+            session=session,
+        )
+        write_png_bytes(screenshot, base64.b64decode(shot["data"]), overwrite=True)  # (checked)
+    dt.send("Target.closeTarget", {"targetId": target})
+    return found, errors
+
+
+def _judge(found: dict[str, Any], errors: list[str]) -> PageCheck:
+    """The :class:`PageCheck` of what the probe found: local links and images checked on disk."""
     out = PageCheck(
         title=found["title"],
         images=found["images"],
         broken_images=found["broken"],
         links=len(found["links"]),
         errors=errors,
+        ids=set(found.get("ids", ())),
     )
     out.broken_links += found["anchors"]
     for raw, resolved in found["links"]:
         url = urlparse(resolved)
         if url.scheme == "file":
-            if not Path(unquote(url.path)).exists():
+            target = Path(unquote(url.path))
+            if not target.exists():
                 out.broken_links.append(raw)
+            else:
+                out.local_links.append((raw, target.resolve(), unquote(url.fragment)))
         elif url.scheme in ("http", "https"):
             out.external.append(resolved)
+    for raw, resolved in found.get("shown", ()):
+        url = urlparse(resolved)
+        if url.scheme == "file" and is_blank(unquote(url.path)):
+            out.blank_images.append(raw)
     return out
+
+
+def site_pages(folder: Path | str) -> list[Path]:
+    """The HTML pages of a built site, sorted (Sphinx's copies of the sources and static files left out)."""
+    root = Path(folder).resolve()
+    skip = {"_sources", "_static", "_images", "_modules"}
+    return sorted(p for p in root.rglob("*.html") if not skip & set(p.relative_to(root).parts[:-1]))
+
+
+def check_site(
+    folder: Path | str, *, chromium: str | None = None, timeout: float = 60.0
+) -> dict[Path, PageCheck]:
+    """Check every page of a built site (:func:`site_pages`) in one browser.
+
+    Beyond :func:`check_pages`: a link from one page to an anchor of another
+    page of the site (``api/x.html#name``) must find that anchor there.
+
+    Raises
+    ------
+    FileNotFoundError
+        When no Chromium is found, ``folder`` has no ``index.html``, or a page does not exist.
+    """
+    root = Path(folder).resolve()
+    if not (root / "index.html").is_file():
+        raise FileNotFoundError(root / "index.html")
+    results = check_pages(site_pages(root), chromium=chromium, timeout=timeout)
+    for res in results.values():
+        for raw, target, fragment in res.local_links:
+            other = results.get(target)
+            if fragment and other is not None and fragment not in other.ids:
+                res.broken_links.append(raw)
+    return results
 
 
 def main(argv: list[str] | None = None) -> int:
     """Command line: check a report page; exit status 1 on any problem, 2 when Chromium is missing."""
     ap = argparse.ArgumentParser(prog="python -m grazing.report.browser", description=__doc__.split("\n")[0])
-    ap.add_argument("index", type=Path, help="the report's index.html")
+    ap.add_argument("index", type=Path, help="the report's index.html, or a built site's folder (every page)")
     ap.add_argument("--screenshot", type=Path, help="write a PNG of the whole page here")
     ap.add_argument("--chromium", help="the browser executable (default: chromium on PATH, or $CHROMIUM)")
     ap.add_argument("--overwrite", action="store_true", help="replace a --screenshot grazing did not write")
     args = ap.parse_args(argv)
+    if args.index.is_dir():
+        return _main_site(args.index, args.chromium)
     try:
         res = check_page(
             args.index, chromium=args.chromium, screenshot=args.screenshot, overwrite=args.overwrite
@@ -320,6 +477,29 @@ def main(argv: list[str] | None = None) -> int:
         f"({len(res.external)} external, not fetched): " + ("all fine" if res.ok else "PROBLEMS")
     )
     return 0 if res.ok else 1
+
+
+def _main_site(folder: Path, chromium: str | None) -> int:
+    """Check every page of a site; one line per problem (with its page), a summary line."""
+    try:
+        results = check_site(folder, chromium=chromium)
+    except (FileNotFoundError, GrazingError) as exc:
+        print(f"check-site: {exc}", file=sys.stderr)
+        return 2
+    root = Path(folder).resolve()
+    bad = 0
+    for page, res in results.items():
+        for line in res.problems():
+            print(f"check-site: {page.relative_to(root)}: {line}", file=sys.stderr)
+        bad += not res.ok
+    images = sum(r.images for r in results.values())
+    links = sum(r.links for r in results.values())
+    external = len({u for r in results.values() for u in r.external})
+    print(
+        f"{folder}: {len(results)} pages, {images} images, {links} links ({external} external, not fetched): "
+        + ("all fine" if not bad else f"PROBLEMS on {bad} pages")
+    )
+    return 0 if not bad else 1
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -506,17 +506,28 @@ def spans(values: np.ndarray, mask: np.ndarray) -> list[tuple[float, float]]:
     return out
 
 
-def _shade(ax: Any, run: PanelRun, reference: PanelRun | None) -> None:
-    """Shade nonimpacting period-1 motion; hatch where the map has no impacts but the full system has."""
+def quiet_only_here(run: PanelRun, reference: PanelRun | None) -> tuple[np.ndarray, np.ndarray]:
+    """``(both, only_here)``: masks of the points of ``run`` on nonimpacting period 1 where ``reference``
+    (the full system on the same η grid) is nonimpacting too, and where it impacts.
+
+    Without a reference of the same grid every nonimpacting point counts as ``both``.  For the map's
+    diagrams (fig 10) ``only_here`` is what is hatched: the map has no impacts but the full system has.
+    """
     v = np.asarray(run.ds.value.values)
     per = np.asarray(run.ds.period.values)
     non = (per == 1) & (np.asarray(run.ds.impacts_per_period.values) == 0)
+    if reference is None or reference.ds.sizes["point"] != len(v):
+        return non, np.zeros_like(non)
+    ref_imp = np.asarray(reference.ds.impacts_per_period.values) > 0
+    return non & ~ref_imp, non & ref_imp
+
+
+def _shade(ax: Any, run: PanelRun, reference: PanelRun | None) -> None:
+    """Shade nonimpacting period-1 motion; hatch where the map has no impacts but the full system has."""
+    v = np.asarray(run.ds.value.values)
     trans = ax.get_xaxis_transform()
     lo, hi = ax.get_xlim()
-    both, only_map = non, np.zeros_like(non)
-    if reference is not None and reference.ds.sizes["point"] == len(v):
-        ref_imp = np.asarray(reference.ds.impacts_per_period.values) > 0
-        both, only_map = non & ~ref_imp, non & ref_imp
+    both, only_map = quiet_only_here(run, reference)
     for a, b in spans(v, both):
         ax.axvspan(a, b, color="#dfe9f3", lw=0, zorder=-1)
         if b - a >= 0.25 * (hi - lo):

@@ -131,6 +131,7 @@ def eq19_rows() -> list[Comparison]:
             -r,
             after / v,
             kind="self-check",
+            reference="restitution law",
             tolerance=1e-12,
             decimals=6,
             why_tolerance="1e-12 (the restitution law, exact)",
@@ -152,8 +153,10 @@ def build(out_dir: Path, progress: Progress | None = None) -> FigureResult:
         images=(),
         summary=(
             "What the printed formulas give, computed, against what the paper's own numbers and our "
-            "discontinuity map need. The nondimensional equations of SPEC (θ″ + (2β/η)θ′ + sin θ/(4η²) = "
-            "α cos θ sin τ) are what every computation of the report uses."
+            "discontinuity map need. Every computation of the report uses the nondimensional equations "
+            "(eqs. 4–5) as stated under “The paper's parameter cases” above: θ″ + (2β/η)θ′ + sin θ/(4η²) = "
+            "α cos θ sin τ while θ < θ̂, θ′ ← −r θ′ at θ = θ̂; the rows on eq. 3 below say how the rig's "
+            "units map onto them."
         ),
         comparisons=tuple(rows),
         seconds=time.perf_counter() - start,

@@ -45,7 +45,7 @@ from grazing.report.base import (
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
 from grazing.report.data import write_csv
-from grazing.report.rules import numeric_row
+from grazing.report.rules import criterion_row, numeric_row
 
 FIGURE_ID = "4"
 HEAD_NORM = (
@@ -147,7 +147,10 @@ def figure_4b(
         ``points``: for A-D, ``r``, ``beta`` (paper), ``D_model``, ``D_eq1``,
         ``D_paper_relation``, ``D_protocol``, ``beta_model_curve`` (the
         model's ``beta`` at that ``r`` for ``D``, None below its ``r_min``),
-        ``beta_protocol_curve``; ``image``.
+        ``beta_protocol_curve``; ``realistic``: for ``model`` and ``protocol``
+        the ``(r, beta)`` on that curve at the ends of §3's realistic range of
+        ``r`` (``beta`` None where the curve does not reach that ``r``);
+        ``image``.
 
     Examples
     --------
@@ -175,6 +178,14 @@ def figure_4b(
             except ValueError:
                 row[f"beta_{rel}_curve"] = None
         points[name] = row
+    realistic: dict[str, list[tuple[float, float | None]]] = {}
+    for rel in ("model", "protocol"):
+        realistic[rel] = []
+        for r, _ in paper.REALISTIC_RANGE:
+            try:
+                realistic[rel].append((r, beta_for_damping(r, damping, relation=rel)))  # type: ignore[arg-type]
+            except ValueError:
+                realistic[rel].append((r, None))
     fig = None
     if ax is None:
         fig, axes = new_figure(1, 1, (6.0, 4.2))
@@ -197,7 +208,13 @@ def figure_4b(
     ax.set_title(f"equal damping D = {damping:g}", fontsize="medium")
     ax.legend(loc="upper left", fontsize="small")
     image = finish_figure(fig, path, dpi)
-    return {"damping": float(damping), "curves": curves, "points": points, "image": image}
+    return {
+        "damping": float(damping),
+        "curves": curves,
+        "points": points,
+        "realistic": realistic,
+        "image": image,
+    }
 
 
 # ----------------------------------------------------------------------------
@@ -321,6 +338,40 @@ def comparisons(a: dict, b: dict) -> tuple[Comparison, ...]:
                 headline=HEAD_NORM if rel == "model" else "",
             )
         )
+    for rel, label in (("model", "the model's curve"), ("protocol", "the reconstruction")):
+        for (r, beta), (_, printed) in zip(b["realistic"][rel], paper.REALISTIC_RANGE):
+            quantity = f"(b) β at r = {r:g} (§3's realistic range of r) on {label}"
+            if beta is None:
+                rows.append(
+                    criterion_row(
+                        FIGURE_ID,
+                        quantity,
+                        printed.value,
+                        "none",
+                        False,
+                        kind="paper",
+                        rule=f"agree when {label} reaches r = {r:g} with a β ≥ 0 within half a unit of the "
+                        "printed β",
+                        source=printed.source,
+                        paper_text=printed.text,
+                        ours_text=f"no β ≥ 0: {label} starts at r = {b['curves'][rel]['r_min']:.4f}",
+                        headline=HEAD_NORM,
+                        note="With the eq. 6 normalisation the impacts alone damp more than D = 0.07 below "
+                        "that r.",
+                    )
+                )
+                continue
+            rows.append(
+                numeric_row(
+                    FIGURE_ID,
+                    quantity,
+                    printed,
+                    beta,
+                    kind="paper",
+                    decimals=4,
+                    headline=HEAD_NORM if rel == "model" else "",
+                )
+            )
     rows.append(
         numeric_row(
             FIGURE_ID,

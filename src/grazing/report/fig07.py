@@ -37,6 +37,10 @@ PANELS: tuple[Panel, ...] = (
 SETTINGS = Settings()
 """Resolution used by the report (tests patch a smaller one)."""
 
+ALPHA_AL_PANELS = ("a", "b")
+"""The panels recomputed with α = A/L (main and magnified sweeps): where the captions' α = 0.2254 shows no
+chaos past grazing, and where fig 9(a) fits only A/L."""
+
 HEAD_FOLD = (
     "The impacting region ends at a fold (saddle-node) of the impacting period-1 orbit beyond the second "
     "grazing, not with the period-2 window at the second grazing: past the period-2 window our sweeps stay "
@@ -48,14 +52,29 @@ def _angles(ths: list[float]) -> str:
     return ", ".join(f"{t:g}°" for t in ths) or "no angle"
 
 
+def chaos_width_text(theta_hat_deg: float, width: float) -> str:
+    """How much aperiodic motion a sweep found past grazing, in words true to the number.
+
+    Examples
+    --------
+    >>> chaos_width_text(10.0, 5.3e-6), chaos_width_text(20.0, 0.0)
+    ('aperiodic over 5.3e-06 in η at 10°', 'no aperiodic point at 20°')
+    """
+    if width <= 0:
+        return f"no aperiodic point at {theta_hat_deg:g}°"
+    return f"aperiodic over {width:.1e} in η at {theta_hat_deg:g}°"
+
+
 def headlines(runs: Runs) -> dict[str, str]:
     """The one-line differences of the figure, naming the stop angles where they occur."""
-    no_chaos, no_cascade, mus = [], [], []
+    no_chaos, no_cascade, mus, widths = [], [], [], []
     for p in PANELS:
         main, fine = runs.of(p, "main"), runs.finest(p)
         assert main is not None
-        if max(fine.aperiodic_width(), main.aperiodic_width()) < diagrams.APPRECIABLE_WIDTH:
+        width = max(fine.aperiodic_width(), main.aperiodic_width())
+        if width < diagrams.APPRECIABLE_WIDTH:
             no_chaos.append(p.theta_hat_deg)
+            widths.append(chaos_width_text(p.theta_hat_deg, width))
             if main.grazings:
                 z = main.grazings[0].multipliers[0]
                 mus.append(f"{z.real:.2f} ± {abs(z.imag):.2f}i".replace("-", "−"))
@@ -67,9 +86,10 @@ def headlines(runs: Runs) -> dict[str, str]:
     ]
     off = [(t, d) for t, d in diffs if abs(d) > paper.EXPERIMENT[f"{t:g}"].eta_c.tolerance]
     return {
-        "chaos": f"No visible chaos past the first grazing at θ̂ = {_angles(no_chaos)} (case B): the grazing "
-        f"orbit's multipliers there ({'; '.join(mus)}) are complex, near the negative or the imaginary axis, "
-        "where eq. 21's test on |λ| alone does not apply",
+        "chaos": f"Chaos past the first grazing is too narrow to see at the paper's scale (under "
+        f"{diagrams.APPRECIABLE_WIDTH:g} in η) at θ̂ = {_angles(no_chaos)} (case B): {'; '.join(widths)}. "
+        f"The grazing orbit's multipliers there ({'; '.join(mus)}) are complex, near the negative or the "
+        "imaginary axis, where eq. 21's test on |λ| alone does not apply",
         "cascade": f"No reverse period-adding cascade (≥ 3 windows, periods falling by one) at θ̂ = "
         f"{_angles(no_cascade)} (case B)",
         "eta_c": (
@@ -89,6 +109,15 @@ def build(out_dir: Path, progress: Progress | None = None, settings: Settings | 
     start = time.perf_counter()
     s = settings or SETTINGS
     runs = diagrams.run_panels(CASE, PANELS, s, progress=say, tag="fig 7: ")
+    alt = diagrams.run_panels(
+        CASE,
+        [p for p in PANELS if p.key in ALPHA_AL_PANELS],
+        s,
+        views=("main", "zoom"),
+        alpha=paper.ALPHA_APPARATUS,
+        progress=say,
+        tag="fig 7 (α = A/L): ",
+    )
     say("fig 7: drawing")
     names = ("fig07_bifurcation.png", "fig07_magnified.png", "fig07_overview.png")
     views = (runs.main, runs.zoom, runs.overview)
@@ -96,6 +125,7 @@ def build(out_dir: Path, progress: Progress | None = None, settings: Settings | 
         [(diagrams.draw_panels, (r, out_dir / n), {"case_label": CASE_LABEL}) for r, n in zip(views, names)]
         + [(diagrams.write_data, (runs, out_dir, "fig07_sweeps", CASE), {})]
     )
+    alt_nc, _ = diagrams.write_data(alt, out_dir, "fig07_sweeps_alpha_al", CASE)
     images = (
         Image(
             names[0],
@@ -129,6 +159,12 @@ def build(out_dir: Path, progress: Progress | None = None, settings: Settings | 
             "a_overview, ...): θ samples (rad), period, impacts per period",
         ),
         DataFile(csv.name, "every window (run of equal period) of every sweep, CSV"),
+        DataFile(
+            alt_nc.name,
+            f"the sweeps of panels {', '.join(ALPHA_AL_PANELS)} (main and magnified) with α = A/L = "
+            f"{paper.ALPHA_APPARATUS:.6f}, NetCDF, groups as above (their windows: "
+            f"{alt_nc.stem}_windows.csv)",
+        ),
     )
     cpu = sum(r.cpu_seconds for r in runs.all())
     summary = (
@@ -143,7 +179,7 @@ def build(out_dir: Path, progress: Progress | None = None, settings: Settings | 
         title="Figure 7: bifurcation diagrams in η, case B, θ̂ = 10°, 20°, 30°, 40°",
         images=images,
         summary=summary,
-        comparisons=comparisons(runs),
+        comparisons=comparisons(runs) + alpha_rows(alt),
         notes=notes(runs),
         seconds=time.perf_counter() - start,
         data=data,
@@ -197,6 +233,107 @@ def comparisons(runs: Runs) -> tuple[Comparison, ...]:
     return tuple(rows)
 
 
+def alpha_rows(alt: Runs) -> tuple[Comparison, ...]:
+    """Chaos and the cascade past the first grazing at 10° and 20° with α = A/L (rules as with 0.2254)."""
+    label = f"α = A/L = {paper.ALPHA_APPARATUS:.6f}"
+    widths, seqs = [], []
+    for run in alt.main:
+        fine = alt.finest(run.panel)
+        widths.append(
+            chaos_width_text(run.panel.theta_hat_deg, max(fine.aperiodic_width(), run.aperiodic_width()))
+        )
+        seqs.append(f"{run.panel.theta_hat_deg:g}°: " + (" → ".join(map(str, _sequence(fine))) or "—"))
+    head_chaos = (
+        f"With {label} too (the α that fits fig 9(a)), chaos past the first grazing stays too narrow to see: "
+        + "; ".join(widths)
+    )
+    head_cascade = f"With {label} too, no reverse period-adding cascade: " + "; ".join(seqs)
+    rows: list[Comparison] = []
+    for run in alt.main:
+        p, fine = run.panel, alt.finest(run.panel)
+        width = max(fine.aperiodic_width(), run.aperiodic_width())
+        tag = f"({p.key}) θ̂ = {p.theta_hat_deg:g}°, {label}"
+        rows.append(
+            _chaos_row(
+                tag,
+                width,
+                rule=f"as with α = 0.2254: agree when aperiodic impacting motion spans at least "
+                f"{diagrams.APPRECIABLE_WIDTH:g} in η in total past the first grazing (main and magnified "
+                "sweeps)",
+                source="§6.1; §2.1 (A/L)",
+                headline=head_chaos,
+                note=f"First grazing with this α: η_g = {run.first_grazing:.6f}." + _fig9_note(p, fine),
+            )
+        )
+        seq = _sequence(fine)
+        rows.append(
+            _cascade_row(
+                tag,
+                seq,
+                rule="as with α = 0.2254: agree when the clearly resolved windows past the first grazing are "
+                "at least three with periods decreasing by one",
+                source="§6.1; §2.1 (A/L)",
+                headline=head_cascade,
+            )
+        )
+    return tuple(rows)
+
+
+def _fig9_note(p: Panel, fine: PanelRun) -> str:
+    """Where fig 9(a)'s η lies against the aperiodic band of this sweep (at fig 9(a)'s stop angle)."""
+    th, eta, _ = paper.FIG9[0]
+    if p.theta_hat_deg != th:
+        return ""
+    inside = any(w.lo <= eta.value <= w.hi for w in fine.aperiodic_windows())
+    return (
+        f" Fig 9(a)'s η = {eta.text} lies {'inside' if inside else 'outside'} the aperiodic band of this "
+        "sweep (fig 9 finds it chaotic with this α)."
+    )
+
+
+def _sequence(run: PanelRun) -> list[int]:
+    """The periods of the clearly resolved windows past the first grazing (:func:`diagrams.cascade`)."""
+    return [w.period for w in diagrams.cascade(run)]
+
+
+def _chaos_row(tag: str, width: float, *, rule: str, source: str, headline: str, note: str) -> Comparison:
+    """The row "chaos past the first grazing" of a sweep whose aperiodic impacting motion spans ``width``."""
+    return criterion_row(
+        FIGURE_ID,
+        f"{tag}: chaos past the first grazing",
+        "a jump to impacting chaotic motion",
+        width,
+        width >= diagrams.APPRECIABLE_WIDTH,
+        kind="paper",
+        rule=rule,
+        source=source,
+        paper_text="jump to chaos",
+        ours_text=f"aperiodic over {width:.1e} in η" if width > 0 else "no aperiodic motion",
+        headline=headline,
+        note=note,
+    )
+
+
+def _cascade_row(
+    tag: str, seq: list[int], *, rule: str, source: str, headline: str, note: str = ""
+) -> Comparison:
+    """The row "reverse period-adding cascade past η_g" of a sweep whose resolved windows are ``seq``."""
+    return criterion_row(
+        FIGURE_ID,
+        f"{tag}: reverse period-adding cascade past η_g",
+        "periods decreasing by one",
+        ", ".join(map(str, seq)) or "—",
+        diagrams.is_reverse_adding(seq),
+        kind="paper",
+        rule=rule,
+        source=source,
+        paper_text="…, 4, 3, 2, 1",
+        ours_text=" → ".join(map(str, seq)) or "—",
+        headline=headline,
+        note=note,
+    )
+
+
 def panel_rows(runs: Runs, p: Panel, heads: dict[str, str]) -> list[Comparison]:
     """The rows of one panel: first window, chaos past grazing, reverse period adding, end of impacts."""
     main, fine, wide = runs.of(p, "main"), runs.finest(p), runs.widest(p)
@@ -230,19 +367,13 @@ def panel_rows(runs: Runs, p: Panel, heads: dict[str, str]) -> list[Comparison]:
     g = main.grazings[0] if main.grazings else None
     mu = f"{g.multipliers[0].real:.3f} ± {abs(g.multipliers[0].imag):.3f}i".replace("-", "−") if g else "—"
     rows.append(
-        criterion_row(
-            FIGURE_ID,
-            f"{tag}: chaos past the first grazing",
-            "a jump to impacting chaotic motion",
+        _chaos_row(
+            tag,
             width,
-            width >= diagrams.APPRECIABLE_WIDTH,
-            kind="paper",
             rule=f"agree when aperiodic impacting motion (no period ≤ 50) spans at least "
             f"{diagrams.APPRECIABLE_WIDTH:g} in η in total between the first grazing and impacting "
             "period 1: chaos one could see in a diagram of the paper's range",
             source="§6.1",
-            paper_text="jump to chaos",
-            ours_text=f"aperiodic over {width:.1e} in η" if width > 0 else "no aperiodic motion",
             headline=heads["chaos"],
             note=f"The grazing orbit's multipliers are {mu} (|λ| = {g.abs_lambda:.3f}); eq. 21 looks at "
             "|λ| only, but with complex multipliers the argument decides (docs/normal-form.md §4)."
@@ -250,21 +381,15 @@ def panel_rows(runs: Runs, p: Panel, heads: dict[str, str]) -> list[Comparison]:
             else "",
         )
     )
-    seq = [w.period for w in diagrams.cascade(fine)]
+    seq = _sequence(fine)
     rows.append(
-        criterion_row(
-            FIGURE_ID,
-            f"{tag}: reverse period-adding cascade past η_g",
-            "periods decreasing by one",
-            ", ".join(map(str, seq)) or "—",
-            diagrams.is_reverse_adding(seq),
-            kind="paper",
+        _cascade_row(
+            tag,
+            seq,
             rule="agree when the clearly resolved windows past the first grazing (≥ 3 points and ≥ 1 % of "
             "the sweep's span, period-doubled satellites left out), up to impacting period 1, are at least "
             "three with periods decreasing by one",
             source="§6.1",
-            paper_text="…, 4, 3, 2, 1",
-            ours_text=" → ".join(map(str, seq)) or "—",
             headline=heads["cascade"],
             note="All windows of ≥ 2 points: "
             + ", ".join(str(w.period) for w in fine.after_grazing(2))

@@ -46,7 +46,7 @@ if TYPE_CHECKING:  # pragma: no cover
 FIGURE_ID = "9"
 
 ALPHA_TABLE = paper.ALPHA_TABLE.value
-"""α of case B as tabulated (fig 7 caption; SPEC)."""
+"""α of case B as tabulated (fig 7 caption; docs/equations.md)."""
 ALPHA_PRINTED = paper.ALPHA_PRINTED.value
 """α printed in §3: "In the experimental data the amplitude was set at α = 0.2258"."""
 ALPHA_APPARATUS = paper.ALPHA_APPARATUS
@@ -261,10 +261,15 @@ def _per_period_maxima(sol: grazing.Solution) -> np.ndarray:
 def _draw_time_series(runs: list[CaseRun], path: Path) -> None:
     from matplotlib.figure import Figure
 
-    heights = [4.4 if r.case.theta_hat_deg == 10.0 else 2.8 for r in runs]
+    heights: list[float] = []
+    for r in runs:  # a magnified panel of its own under each run that has one (no inset over the curve)
+        heights += [2.8, 2.3] if r.fine is not None else [2.8]
     fig = Figure(figsize=(10.0, sum(heights) + 0.4), layout="constrained")
-    axes = fig.subplots(len(runs), 1, gridspec_kw={"height_ratios": heights})
-    for ax, run in zip(np.atleast_1d(axes), runs):
+    all_axes = list(np.atleast_1d(fig.subplots(len(heights), 1, gridspec_kw={"height_ratios": heights})))
+    axes = []
+    for run in runs:
+        ax = all_axes.pop(0)
+        axes.append(ax)
         c = run.case
         t0 = (
             run.dense.t[0] / run.model.period - 1.0
@@ -277,20 +282,25 @@ def _draw_time_series(runs: list[CaseRun], path: Path) -> None:
             fontsize=10,
             loc="left",
         )
-        if run.fine is not None:
-            _add_inset(ax, run)
         ax.grid(alpha=0.3)
-    handles, labels = np.atleast_1d(axes)[0].get_legend_handles_labels()
+        if run.fine is not None:
+            below = all_axes.pop(0)
+            below.sharex(ax)
+            ax.tick_params(labelbottom=False)
+            ax.set_xlabel("")
+            _draw_magnified(below, run)
+    handles, labels = axes[0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="outside upper center", ncols=3, fontsize=9, frameon=False)
     save_png(fig, path)
 
 
-def _add_inset(ax: Axes, run: CaseRun) -> None:
-    """Magnify the upper part of the time series (as the inset of the paper's fig 9(a)).
+def _draw_magnified(inset: Axes, run: CaseRun) -> None:
+    """Magnify the upper part of the time series (as the inset of the paper's fig 9(a)), in its own axes.
 
     Drawn from a separate run with :data:`FINE_POINTS` points per period over
     the periods shown, so that the peaks are resolved to ~1e-5 degrees, and
-    as θ − θ̂, with the impacts marked.
+    as θ − θ̂, with the impacts marked.  The axes ``inset`` sit under the
+    run's own, sharing its time axis.
     """
     sol = run.fine
     assert sol is not None and sol.trajectory is not None
@@ -298,13 +308,6 @@ def _add_inset(ax: Axes, run: CaseRun) -> None:
     stop = run.model.params["theta_hat"]
     maxima = _per_period_maxima(sol)
     depth = max(math.degrees(stop - float(maxima.min())), 1e-4)
-    main_lo, main_hi = ax.get_ylim()
-    from matplotlib.ticker import FixedLocator, MaxNLocator
-
-    ticks = MaxNLocator(nbins=5, steps=[1, 2, 5, 10]).tick_values(main_lo, main_hi)
-    ax.yaxis.set_major_locator(FixedLocator([y for y in ticks if main_lo <= y <= main_hi]))
-    ax.set_ylim(main_lo - 1.15 * (main_hi - main_lo), main_hi)  # room below the curve for the inset
-    inset = ax.inset_axes([0.07, 0.05, 0.91, 0.4])
     inset.plot(sol.trajectory_t / T, np.degrees(sol.trajectory[:, 0] - stop), color="tab:blue", lw=0.7)
     inset.axhline(0.0, color="tab:red", lw=1.0, ls="--")
     if len(sol.impacts):
@@ -317,20 +320,21 @@ def _add_inset(ax: Axes, run: CaseRun) -> None:
             color="tab:red",
             label="impact",
         )
-    inset.set_xlim(sol.trajectory_t[0] / T, sol.trajectory_t[-1] / T)
     inset.set_ylim(-3.0 * depth, 0.6 * depth)
     inset.tick_params(labelsize=8.5)
     inset.grid(alpha=0.3)
+    inset.set_ylabel("θ − θ̂ (degrees)")
+    inset.set_xlabel("τ / 2π (forcing periods)")
     n_imp = len(sol.impacts)
-    head = "θ − θ̂ in degrees, magnified near the stop: "
+    head = f"{run.case.panel} magnified near the stop: "
     if n_imp:
         text = (
-            f"{head}{n_imp} impacts (red triangles) in {SHOWN_PERIODS} periods; "
+            f"{head}{n_imp} impacts (red triangles) in {SHOWN_PERIODS} periods;\n"
             f"the other peaks fall short of the stop by up to {depth:.2g}°"
         )
     else:
         text = f"{head}no impacts; every peak stays {depth:.3f}° below the stop"
-    inset.set_title(text, fontsize=9, loc="left", pad=2)
+    inset.set_title(text, fontsize=9.5, loc="left")
 
 
 def _draw_delay(runs: list[CaseRun], path: Path) -> None:
@@ -383,8 +387,9 @@ def build(out_dir: Path, progress: Progress | None = None) -> FigureResult:
             ts_name,
             f"θ(τ) in degrees against τ/2π (forcing periods), {span_text}, after a transient of "
             f"{TRANSIENT} periods from rest (θ, θ′) = (0, 0) at τ = 0. Dashed red: the stop θ̂. "
-            "Black dots: the stroboscopic samples at τ = 2πk. The insets magnify the upper part of the "
-            "time series near the stop, as the inset of the paper's fig 9(a) does. Case B: r = 0.7675, "
+            "Black dots: the stroboscopic samples at τ = 2πk. Under (a) and (a′), a panel of its own "
+            "magnifies the upper part of the time series near the stop (θ − θ̂), as the inset of the paper's "
+            "fig 9(a) does. Case B: r = 0.7675, "
             "β = 0.048.",
             "Simulated time series of the pendulum angle for the fig 9 parameter points",
         ),
@@ -454,8 +459,11 @@ def write_data(runs: list[CaseRun], out_dir: Path) -> DataFile:
 
 HEAD_ALPHA = (
     "(a) θ̂ = 10°, η = 0.33294 is chaotic only with α = A/L = 0.225778 unrounded; with the tabulated "
-    "α = 0.2254 this η lies below the grazing point, on the nonimpacting orbit"
+    "α = 0.2254 this η lies below the grazing point, on the nonimpacting orbit. Our inference, not a "
+    "printed error: the paper most likely computed fig 9(a) with α = A/L"
 )
+"""The headline of rows (a) with the printed α: a difference explained by an inference, not an erratum
+(nothing printed is shown wrong by a computation; the α the paper used is not stated)."""
 
 
 def _comparison(
@@ -504,7 +512,6 @@ def _comparison(
         ours_text=d.short(),
         note=note + f" In full: {d.describe()}.",
         headline=HEAD_ALPHA if c.theta_hat_deg == 10.0 else f"{item}: not {c.paper}",
-        erratum=c.theta_hat_deg == 10.0,
     )
 
 

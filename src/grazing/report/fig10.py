@@ -65,6 +65,29 @@ def panel_matches(flow: Runs, mapped: Runs, p: Panel) -> list[tuple[str, WindowM
     return out
 
 
+def hatch_text(mapped: list[PanelRun], flow: list[PanelRun]) -> str:
+    """What the caption says about hatching: what the panels draw (:func:`diagrams.quiet_only_here`).
+
+    Hatched are the η values where the map has no impacts but the full system (fig 7) has; where no
+    panel has any, the caption says so instead of promising hatching.
+    """
+    hatched = []
+    for run in mapped:
+        ref = next((r for r in flow if r.panel == run.panel and r.view == run.view), None)
+        n = int(diagrams.quiet_only_here(run, ref)[1].sum())
+        if n:
+            hatched.append(f"({run.panel.key}) {n}")
+    if hatched:
+        return (
+            "Hatched: the map has no impacts but the full system does (fig 7), since the map knows only the "
+            f"first grazing; points hatched per panel: {', '.join(hatched)}."
+        )
+    return (
+        "Nothing is hatched: at every η of these panels where the map has no impacts, the full system "
+        "(fig 7) has none either."
+    )
+
+
 def _scale(run: PanelRun) -> tuple[float, str]:
     """A power of ten making η − η_g a number of a few digits, and its label."""
     span = run.eta_range[1] - run.eta_range[0]
@@ -205,13 +228,13 @@ def build(out_dir: Path, progress: Progress | None = None, settings: Settings | 
             "The diagrams of fig 7 (same η values, same starting state, each η from the previous final "
             "state) "
             "computed by iterating the discontinuity-map Poincaré map built at the first grazing of each "
-            "panel. Shaded: nonimpacting period 1. Hatched: the map has no impacts but the full system does "
-            "(fig 7): the map knows only the first grazing. Dashed red: grazings. Numbers: windows.",
+            f"panel. Shaded: nonimpacting period 1. {hatch_text(mapped.main, flow.main)} Dashed red: "
+            "grazings. Numbers: windows.",
             "Bifurcation diagrams computed with the discontinuity map",
         ),
         Image(
             zname,
-            "The magnified sweeps of fig 7, computed with the map.",
+            f"The magnified sweeps of fig 7, computed with the map. {hatch_text(mapped.zoom, flow.zoom)}",
             "Magnified bifurcation diagrams computed with the discontinuity map",
         ),
     )

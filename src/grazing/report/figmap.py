@@ -74,10 +74,12 @@ def max_angles(etas: np.ndarray) -> np.ndarray:
     return out
 
 
-def compute(s: Settings, progress: Progress | None = None) -> MapRun:
-    say = progress or (lambda _msg: None)
-    start, cpu = time.perf_counter(), time.process_time()
-    _children_cpu()  # reset the baseline: count only this map's worker processes
+def period_map(s: Settings, say: Progress, label: str = "map") -> tuple[Any, float, float]:
+    """Case B's period map at the resolution of ``s``: the dataset, its wall and CPU seconds.
+
+    The CPU seconds include the worker processes'.  ``label`` starts the progress messages.
+    """
+    start, cpu = time.perf_counter(), cpu_seconds()
     diagrams.warm_up("B")
     etas = np.linspace(*s.eta[:2], s.eta[2])
     ths = np.radians(np.linspace(*s.theta_hat_deg[:2], s.theta_hat_deg[2]))
@@ -86,7 +88,7 @@ def compute(s: Settings, progress: Progress | None = None) -> MapRun:
     def tick(done: int, total: int) -> None:
         if done >= total or done - rows_done[0] >= total // 4:
             rows_done[0] = done
-            say(f"map: {done}/{total} points after {time.perf_counter() - start:.1f} s")
+            say(f"{label}: {done}/{total} points after {time.perf_counter() - start:.1f} s")
 
     ds = parameter_map(
         grazing.models.pendulum("B"),
@@ -100,25 +102,26 @@ def compute(s: Settings, progress: Progress | None = None) -> MapRun:
         workers=s.workers,
         progress=tick,
     )
-    child_cpu = _children_cpu()
-    angles = max_angles(etas)
+    return ds, time.perf_counter() - start, cpu_seconds() - cpu
+
+
+def compute(s: Settings, progress: Progress | None = None) -> MapRun:
+    say = progress or (lambda _msg: None)
+    start, cpu = time.perf_counter(), cpu_seconds()
+    ds, _, _ = period_map(s, say)
+    angles = max_angles(np.asarray(ds["eta"].values))
     curve = grazing_curve(
         grazing.models.pendulum("B"), ("eta", "theta_hat"), math.radians(5.0), search=(0.2, 1.0)
     )
-    return MapRun(ds, angles, curve, time.perf_counter() - start, time.process_time() - cpu + child_cpu)
+    return MapRun(ds, angles, curve, time.perf_counter() - start, cpu_seconds() - cpu)
 
 
-_CHILD_CPU = [0.0]
-
-
-def _children_cpu() -> float:
-    """CPU time of finished child processes since the last call."""
+def cpu_seconds() -> float:
+    """CPU time of this process and of its finished child processes (the map's workers) so far."""
     import resource
 
     ru = resource.getrusage(resource.RUSAGE_CHILDREN)
-    total = ru.ru_utime + ru.ru_stime
-    new, _CHILD_CPU[0] = total - _CHILD_CPU[0], total
-    return new
+    return time.process_time() + ru.ru_utime + ru.ru_stime
 
 
 def draw(run: MapRun, path: Path) -> None:

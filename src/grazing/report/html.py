@@ -17,7 +17,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 from grazing.report import paper
-from grazing.report.base import KINDS, VERDICTS, Comparison, FigureResult, is_interval, is_number
+from grazing.report.base import KINDS, REFERENCE, Comparison, FigureResult, is_interval, is_number
 
 _CSS = """
 body { font: 15px/1.5 system-ui, -apple-system, "Segoe UI", sans-serif; color: #222;
@@ -35,8 +35,16 @@ dl.meta dd { margin: 0; }
 figure { margin: 1.5em 0; }
 figure img { max-width: 100%; height: auto; border: 1px solid #ddd; }
 figcaption { font-size: 0.92em; color: #444; margin-top: 0.3em; }
-table { border-collapse: collapse; font-size: 0.9em; margin: 0.8em 0; }
-table.rows { width: 100%; }
+table { border-collapse: collapse; font-size: 0.9em; margin: 0; }
+table.rows { width: 100%; min-width: 46em; }
+.scroll { overflow-x: auto; max-width: 100%; margin: 0.8em 0; -webkit-overflow-scrolling: touch; }
+code { overflow-wrap: anywhere; }
+@media (max-width: 600px) {
+  body { padding: 0 0.5em; margin: 1em auto; font-size: 14px; }
+  dl.meta { grid-template-columns: auto; }
+  dl.meta dd { margin-bottom: 0.4em; overflow-wrap: anywhere; }
+  figcaption a.full { display: inline-block; padding: 0.3em 0; font-weight: 600; }
+}
 th, td { border: 1px solid #ccc; padding: 0.3em 0.45em; vertical-align: top; text-align: left; }
 th { background: #f0f0f0; }
 td.num { text-align: right; font-variant-numeric: tabular-nums; white-space: nowrap; }
@@ -48,6 +56,7 @@ tr:target { outline: 3px solid #e0a000; }
         color: #fff; }
 .kind-paper { background: #4a7fb5; } .kind-experiment { background: #8a5bb5; }
 .kind-self-check { background: #777; }
+.kind-erratum { background: #b5651d; }
 .synthetic { background: #c0392b; }
 .small { font-size: 0.85em; color: #555; }
 details summary { cursor: pointer; color: #4a6b8a; }
@@ -75,6 +84,10 @@ class ReportMeta:
         Package versions (``{"python": ..., "numpy": ..., ...}``).
     cpu, cores, system
         The machine.
+    vector_width
+        Doubles per vector register the kernels use on this processor (0: unknown).
+    dirty
+        True when the source tree had uncommitted changes under ``src/``.
     docs
         ``(title, relative link)`` of the documents linked from the top.
     pending
@@ -90,6 +103,8 @@ class ReportMeta:
     cpu: str = ""
     cores: int = 0
     system: str = ""
+    vector_width: int = 0
+    dirty: bool = False
     docs: tuple[tuple[str, str], ...] = ()
     pending: tuple[str, ...] = ()
 
@@ -121,28 +136,45 @@ def row_label(row: Comparison) -> str:
     return row.id.removeprefix("row-").replace("-", ".") if row.id else ""
 
 
-def comparison_table(rows: Sequence[Comparison]) -> str:
-    """The comparison records as an HTML ``<table>`` (empty string for no rows).
+def scrolling(table: str) -> str:
+    """A table in a box of its own that scrolls sideways when the page is narrower than the table."""
+    return f'<div class="scroll">{table}</div>' if table else ""
+
+
+def comparison_table(rows: Sequence[Comparison], reference: str = "paper") -> str:
+    """The comparison records as an HTML ``<table>`` (empty string for no rows), in a scrolling box.
+
+    ``reference`` heads the column of what ours is compared with: ``"paper"`` for
+    rows against the paper or its measurements, ``"reference"`` for self-checks,
+    whose cells then name what their reference is (:attr:`Comparison.reference`).
 
     Examples
     --------
     >>> r = Comparison("9", "(b) period", "period-5", "period-5", "paper", "same", "agree", id="row-9-1")
     >>> page = comparison_table([r])
-    >>> 'id="row-9-1"' in page and 'class="agree"' in page
+    >>> 'id="row-9-1"' in page and 'class="agree"' in page and "<th>paper</th>" in page
+    True
+    >>> c = Comparison("s", "ω", 0.5, 0.5, "self-check", "same", "agree", reference="closed form")
+    >>> page = comparison_table([c], reference="reference")
+    >>> "<th>reference</th>" in page and "closed form" in page and "<th>paper</th>" not in page
     True
     """
     if not rows:
         return ""
     out = [
         '<table class="rows">',
-        "<thead><tr><th>#</th><th>quantity</th><th>paper</th><th>ours</th><th>Δ</th><th>verdict</th>"
-        "<th>rule, and why</th></tr></thead><tbody>",
+        f"<thead><tr><th>#</th><th>quantity</th><th>{_e(reference)}</th><th>ours</th><th>Δ</th>"
+        "<th>verdict</th><th>rule, and why</th></tr></thead><tbody>",
     ]
     for r in rows:
         badge = f'<span class="kind kind-{_e(r.kind)}">{_e(r.kind)}</span>'
         if r.synthetic:
             badge += '<span class="kind synthetic">synthetic data</span>'
+        if r.erratum:
+            badge += '<span class="kind kind-erratum">erratum</span>'
         src = f'<br><span class="small">{_e(r.source)}</span>' if r.source else ""
+        own = r.kind == "self-check"
+        label = f'<span class="small">{_e(r.reference or REFERENCE)}:</span> ' if own else ""
         delta = r.delta_text or ""
         if r.tolerance is not None:
             delta += f'<br><span class="small">tol {r.tolerance:.2g}</span>'
@@ -150,26 +182,38 @@ def comparison_table(rows: Sequence[Comparison]) -> str:
         out.append(
             f'<tr id="{_e(r.id)}"><td><a class="anchor" href="#{_e(r.id)}">{_e(row_label(r))}</a></td>'
             f"<td>{badge}{_e(r.quantity)}</td>"
-            f"<td>{_e(r.paper_text or value_text(r.paper))}{src}</td>"
+            f"<td>{label}{_e(r.paper_text or value_text(r.paper))}{src}</td>"
             f"<td>{_e(r.ours_text or value_text(r.ours))}</td>"
             f'<td class="num">{delta}</td>{_verdict_cell(r.verdict)}'
             f'<td class="small">{_e(r.rule)}{why}</td></tr>'
         )
     out.append("</tbody></table>")
-    return "\n".join(out)
+    return scrolling("\n".join(out))
+
+
+COUNTS: tuple[str, ...] = ("agree", "differ", "erratum", "not comparable")
+"""The scoreboard's columns: a row that differs because the paper is in error counts as ``erratum``,
+not among the disagreements (``differ``)."""
+
+
+def count_key(row: Comparison) -> str:
+    """The scoreboard column of a row: its verdict, or ``"erratum"`` for an erratum of the paper."""
+    return "erratum" if row.erratum else row.verdict
 
 
 def scoreboard(rows: Sequence[Comparison]) -> dict[str, dict[str, int]]:
-    """Counts of verdicts per kind: ``{"paper": {"agree": 12, "differ": 5, "not comparable": 0}, ...}``.
+    """Counts per kind and :data:`COUNTS`: ``{"paper": {"agree": 12, "differ": 5, "erratum": 2, ...}, ...}``.
 
     Examples
     --------
     >>> r = Comparison("9", "q", "a", "a", "paper", "same", "agree")
-    >>> scoreboard([r, r])["paper"]["agree"], scoreboard([r])["self-check"]["differ"]
-    (2, 0)
+    >>> e = Comparison("9", "q", "a", "b", "paper", "same", "differ", erratum=True)
+    >>> board = scoreboard([r, r, e])
+    >>> board["paper"]["agree"], board["paper"]["differ"], board["paper"]["erratum"]
+    (2, 0, 1)
     """
-    c = Counter((r.kind, r.verdict) for r in rows)
-    return {k: {v: c[(k, v)] for v in VERDICTS} for k in KINDS}
+    c = Counter((r.kind, count_key(r)) for r in rows)
+    return {k: {v: c[(k, v)] for v in COUNTS} for k in KINDS}
 
 
 def scoreboard_table(rows: Sequence[Comparison]) -> str:
@@ -180,18 +224,18 @@ def scoreboard_table(rows: Sequence[Comparison]) -> str:
         "self-check": "our own consistency (map vs simulation, synthetic pipeline)",
     }
     out = [
-        '<table class="score"><thead><tr><th>kind</th><th>agree</th><th>differ</th><th>not comparable</th>'
-        "<th>rows</th></tr></thead><tbody>"
+        '<table class="score"><thead><tr><th>kind</th><th>agree</th><th>differ</th>'
+        "<th>erratum in the paper</th><th>not comparable</th><th>rows</th></tr></thead><tbody>"
     ]
     for k in KINDS:
         b = board[k]
+        cells = "".join(f'<td class="num">{b[c]}</td>' for c in COUNTS)
         out.append(
             f'<tr><td><span class="kind kind-{k}">{k}</span> <span class="small">{_e(names[k])}</span></td>'
-            f'<td class="num">{b["agree"]}</td><td class="num">{b["differ"]}</td>'
-            f'<td class="num">{b["not comparable"]}</td><td class="num">{sum(b.values())}</td></tr>'
+            f'{cells}<td class="num">{sum(b.values())}</td></tr>'
         )
     out.append("</tbody></table>")
-    return "\n".join(out)
+    return scrolling("\n".join(out))
 
 
 def _grouped(rows: Sequence[Comparison]) -> list[tuple[str, list[Comparison]]]:
@@ -203,7 +247,7 @@ def _grouped(rows: Sequence[Comparison]) -> list[tuple[str, list[Comparison]]]:
 
 def _figures_of(rows: Sequence[Comparison]) -> str:
     figs = list(dict.fromkeys(r.figure for r in rows))
-    names = [f if f in ("eq", "map") else f"fig {f}" for f in figs]
+    names = [f"fig {f}" if f.isdigit() else f for f in figs]
     return ", ".join(names)
 
 
@@ -221,10 +265,30 @@ def _difference_list(rows: Sequence[Comparison], by_quantity: bool = False) -> s
     return "<ul>" + "\n".join(items) + "</ul>"
 
 
-def differences_box(rows: Sequence[Comparison]) -> str:
+def _errata_link(doc: str) -> str:
+    return f' Explained in <a href="{_e(doc)}">the equations, units and errata</a>.' if doc else ""
+
+
+ERRATA_INTRO = (
+    "Each erratum is computed in the row it links to: what the printed number or formula gives, set against "
+    "what the paper's own other numbers, or its apparatus (§2.1), need. They count apart from the "
+    "disagreements on the scoreboard."
+)
+
+
+def differences_box(rows: Sequence[Comparison], errata_doc: str = "") -> str:
     """The “where we differ” box: differences with the paper and experiment, errata, failed self-checks.
 
-    Each line is one headline, linked to every row it summarises.
+    Each line is one headline, linked to every row it summarises; ``errata_doc``
+    is the relative link of the document that explains the errata (none: the
+    page's rows alone).
+
+    Examples
+    --------
+    >>> e = Comparison("eq", "q", 1.0, 2.0, "paper", "r", "differ", erratum=True, headline="h", id="row-eq-1")
+    >>> box = differences_box([e], "docs/equations.md")
+    >>> "SPEC" in box, 'href="#row-eq-1"' in box, 'href="docs/equations.md"' in box
+    (False, True, True)
     """
     differ = [r for r in rows if r.verdict == "differ"]
     errata = [r for r in differ if r.erratum]
@@ -235,7 +299,8 @@ def differences_box(rows: Sequence[Comparison]) -> str:
         '<div class="differences" id="differences">',
         "<h3>Where we differ from the paper, and why</h3>",
         _difference_list(against),
-        "<h3>Errata in the paper (computed, see SPEC)</h3>",
+        "<h3>Errata in the paper</h3>",
+        f'<p class="small">{_e(ERRATA_INTRO)}{_errata_link(errata_doc)}</p>',
         _difference_list(errata),
         "<h3>Our own checks that fail</h3>",
         _difference_list(own),
@@ -260,6 +325,10 @@ RULES_TEXT = (
 
 
 # ---------------------------------------------------------------------------- sections
+
+
+ERRATA_DOC = "equations.md"
+"""The document of ``docs/`` that explains the equations, the units and the paper's errata."""
 
 
 def _cases_table() -> str:
@@ -303,7 +372,8 @@ def figure_section(fig: FigureResult) -> str:
         src = _e(img.filename)
         parts.append(
             f'<figure><a href="{src}"><img src="{src}" alt="{_e(img.alt or img.caption)}"></a>'
-            f'<figcaption>{_e(img.caption)} <a href="{src}">Full size</a>.</figcaption></figure>'
+            f'<figcaption>{_e(img.caption)} <a class="full" href="{src}">Open the full-size image</a>.'
+            "</figcaption></figure>"
         )
     if fig.data:
         items = "".join(
@@ -317,8 +387,18 @@ def figure_section(fig: FigureResult) -> str:
             for k in KINDS
             if any(board[k].values())
         )
+        against = [r for r in fig.comparisons if r.kind != "self-check"]
+        own = [r for r in fig.comparisons if r.kind == "self-check"]
         parts.append(f"<h3>The paper beside our computation</h3><p class='small'>{_e(tally)}</p>")
-        parts.append(comparison_table(fig.comparisons))
+        parts.append(comparison_table(against))
+        if own:
+            if against:
+                parts.append("<h3>Our own checks</h3>")
+            parts.append(
+                "<p class='small'>Checked against a reference of our own (named in each row), not against "
+                "the paper.</p>"
+            )
+            parts.append(comparison_table(own, reference="reference"))
     if fig.notes:
         parts.append("<h3>Notes</h3>")
         parts.extend(f"<p>{_e(n)}</p>" for n in fig.notes)
@@ -345,6 +425,17 @@ def render(figures: Sequence[FigureResult], meta: ReportMeta) -> str:
         else ""
     )
     versions = ", ".join(f"{k} {v}" for k, v in meta.versions.items())
+    timing = scrolling(_timing_table(figures, meta))
+    tree = (
+        "uncommitted changes under src/ (dirty): this build is not exactly the commit"
+        if meta.dirty
+        else ("clean (no uncommitted changes under src/)" if meta.commit else "not a git checkout")
+    )
+    lanes = (
+        f"vector registers of {meta.vector_width} doubles (the kernels' lanes)"
+        if meta.vector_width
+        else "vector width unknown"
+    )
     docs = " · ".join(f'<a href="{_e(link)}">{_e(title)}</a>' for title, link in meta.docs) or "—"
     head = f"""<!DOCTYPE html>
 <html lang="en">
@@ -357,7 +448,8 @@ def render(figures: Sequence[FigureResult], meta: ReportMeta) -> str:
 <body>
 <header>
 <h1>Reproducing the grazing pendulum paper with <code>grazing</code></h1>
-<p>This report recomputes the numerical figures of {_e(paper.CITATION)} with the <code>grazing</code> package
+<p>This report recomputes the numerical figures of {_e(paper.CITATION)}
+(<a href="https://doi.org/{_e(paper.DOI)}">doi:{_e(paper.DOI)}</a>) with the <code>grazing</code> package
 and sets every number the paper gives beside ours, with the rule that decides whether they agree.</p>
 <p class="callout">Every figure and every number under “ours” was computed by this build; nothing is copied
 from the paper except its numbers and quotations in the “paper” column, each with its section or figure
@@ -369,13 +461,13 @@ Every row: <a href="comparisons.json">comparisons.json</a>.</p>
 <h2>What we reproduce and what we do not</h2>
 {scoreboard_table(rows)}
 <p class="small">{_e(RULES_TEXT)}</p>
-{differences_box(rows)}
+{differences_box(rows, next((link for _, link in meta.docs if link.endswith(ERRATA_DOC)), ""))}
 </section>
 <section id="cases">
 <h2>The paper's parameter cases</h2>
 <p>θ″ + (2β/η)θ′ + sin θ/(4η²) = α cos θ sin τ while θ &lt; θ̂; θ′ ← −r θ′ at θ = θ̂ (eqs. 4–5). η = ω/ω0 is
 swept; θ̂ is the stop angle.</p>
-{_cases_table()}
+{scrolling(_cases_table())}
 <p class="small">α is printed as 0.2254 in the captions and as 0.2258 in §3; A/L = 50.8/225 = 0.225778. Our
 figures use 0.2254; fig 6's printed numbers and fig 9(a) fit A/L (see the rows).</p>
 <p>Documents: {docs}.</p>
@@ -383,14 +475,16 @@ figures use 0.2254; fig 6's printed numbers and fig 9(a) fit A/L (see the rows).
 <section id="provenance">
 <h2>How this report was built</h2>
 <dl class="meta">
+<dt>paper</dt><dd><a href="https://doi.org/{_e(paper.DOI)}">doi:{_e(paper.DOI)}</a></dd>
 <dt>commit</dt><dd><code>{_e(meta.commit or "unknown")}</code></dd>
+<dt>source tree</dt><dd>{tree}</dd>
 <dt>grazing</dt><dd>{_e(meta.version)}</dd>
 <dt>versions</dt><dd>{_e(versions)}</dd>
-<dt>machine</dt><dd>{_e(meta.cpu)}, {meta.cores} cores usable; {_e(meta.system)}</dd>
+<dt>machine</dt><dd>{_e(meta.cpu)}, {meta.cores} cores usable, {lanes}; {_e(meta.system)}</dd>
 <dt>rendered</dt><dd>{_e(meta.date)}</dd>
 <dt>this build</dt><dd>{meta.seconds:.1f} s, of which {meta.compile_seconds:.1f} s compiling the kernels</dd>
 </dl>
-{_timing_table(figures, meta)}
+{timing}
 </section>
 <nav><h2>Contents</h2><ul>
 {contents}

@@ -23,6 +23,8 @@ CITATION = (
     "P. T. Piiroinen, L. N. Virgin, A. R. Champneys, “Chaos and period-adding: experimental and numerical "
     "verification of the grazing bifurcation”, J. Nonlinear Sci. 14 (2004) 383–404"
 )
+DOI = "10.1007/s00332-004-0616-y"
+"""The paper's DOI (linked from the report as ``https://doi.org/`` + DOI)."""
 
 
 @dataclass(frozen=True)
@@ -160,6 +162,9 @@ CURVE_R_AT_BETA0 = Printed(
     "0.42", "§3: “if no linear damping is assumed (β = 0), then ... r is close to 0.42”", approximate=True
 )
 CURVE_BETA_AT_R1 = Printed("0.068", "§3: “when β ≈ 0.068, then r = 1”", approximate=True)
+_REALISTIC = "§3: “r ... between 0.5 and 0.8 ..., which corresponds to ... β between 0.015 and 0.05”"
+REALISTIC_RANGE = ((0.5, Printed("0.015", _REALISTIC)), (0.8, Printed("0.05", _REALISTIC)))
+"""§3: the realistic range of r for steel on steel and the β the curve of equal damping gives at its ends."""
 
 # ---------------------------------------------------------------------------- §2.2: the experiment
 
@@ -238,6 +243,13 @@ END_OF_IMPACTING = (
 # ---------------------------------------------------------------------------- §6.1: figs 6–11
 
 FIG6_THETA_MAX = Printed("55", "§6.1: “about 55° for case B”", approximate=True)
+CASE_A_OVERESTIMATES = (
+    "case A “greatly overestimates the value of θ̂_max observed experimentally (recall that no impacting "
+    "behaviour was observed for θ̂ = 50°)”"
+)
+"""§6.2, on case A against case B."""
+NO_IMPACTS_AT_DEG = 50.0
+"""§6.2 (and §2.2): the stop angle at which the experiment showed no impacting behaviour."""
 
 
 @dataclass(frozen=True)

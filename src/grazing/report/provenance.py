@@ -3,9 +3,9 @@
 Examples
 --------
 >>> p = collect()
->>> {"python", "numpy", "scipy", "numba", "sympy", "xarray"} <= set(p.versions)
+>>> {"python", "numpy", "scipy", "numba", "llvmlite", "sympy", "xarray"} <= set(p.versions)
 True
->>> p.cores >= 1
+>>> p.cores >= 1 and p.vector_width in (2, 4, 8) and p.dirty == p.commit.endswith("+dirty")
 True
 """
 
@@ -21,7 +21,7 @@ from typing import Any
 
 import grazing
 
-PACKAGES = ("numpy", "scipy", "numba", "sympy", "xarray", "matplotlib", "h5netcdf")
+PACKAGES = ("numpy", "scipy", "numba", "llvmlite", "sympy", "xarray", "matplotlib", "h5netcdf")
 """The packages whose versions the page states (with Python and grazing)."""
 
 
@@ -42,6 +42,12 @@ class Provenance:
         Logical cores usable by this process.
     system
         Operating system and machine.
+    vector_width
+        Doubles per vector register the compiled kernels use on this processor
+        (:func:`grazing.engine.llvmgen.lane_width`: 8 with AVX-512, 4 with AVX, else 2).
+    dirty
+        True when the source tree has uncommitted changes under ``src/`` (the build is then not
+        exactly the commit).
     """
 
     commit: str
@@ -49,6 +55,8 @@ class Provenance:
     cpu: str = ""
     cores: int = 1
     system: str = ""
+    vector_width: int = 0
+    dirty: bool = False
 
     def to_json(self) -> dict[str, Any]:
         return asdict(self)
@@ -109,10 +117,23 @@ def versions() -> dict[str, str]:
     return out
 
 
+def vector_width() -> int:
+    """Doubles per vector register of this processor as the kernels use it (0 when LLVM is unavailable)."""
+    try:
+        from grazing.engine.llvmgen import lane_width
+
+        return lane_width()
+    except Exception:  # pragma: no cover - stated as unknown, never fatal to a report
+        return 0
+
+
 def collect() -> Provenance:
     """The provenance of a build on this machine from this source tree."""
+    commit = git_commit()
     return Provenance(
-        commit=git_commit(),
+        commit=commit,
+        dirty=commit.endswith("+dirty"),
+        vector_width=vector_width(),
         versions=versions(),
         cpu=cpu_model(),
         cores=usable_cores(),

@@ -27,6 +27,9 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
 
 from grazing.report.base import Comparison, Kind, Value, Verdict, intervals_overlap
 from grazing.report.paper import Printed, PrintedComplex
@@ -93,6 +96,7 @@ def numeric_row(
     paper_text: str = "",
     ours_text: str = "",
     synthetic: bool = False,
+    reference: str = "",
 ) -> Comparison:
     """A number against a number: ``agree`` exactly when ``|ours − paper| <= tolerance``.
 
@@ -138,6 +142,7 @@ def numeric_row(
         synthetic=synthetic,
         headline=headline if verdict != "agree" else "",
         erratum=erratum and verdict != "agree",
+        reference=reference,
     )
 
 
@@ -206,6 +211,7 @@ def criterion_row(
     delta: float | None = None,
     delta_text: str = "",
     synthetic: bool = False,
+    reference: str = "",
 ) -> Comparison:
     """A stated criterion: ``agree`` when it holds, ``differ`` when not, ``not comparable`` for None."""
     verdict: Verdict = "not comparable" if holds is None else ("agree" if holds else "differ")
@@ -226,6 +232,7 @@ def criterion_row(
         synthetic=synthetic,
         headline=headline if verdict != "agree" else "",
         erratum=erratum and verdict == "differ",
+        reference=reference,
     )
 
 
@@ -320,3 +327,98 @@ def majority(matches: Sequence[WindowMatch], fraction: float = 0.5) -> tuple[int
     if n == 0:
         return 0, 0, "not comparable"
     return k, n, "agree" if k > fraction * n else "differ"
+
+
+# ---------------------------------------------------------------------------- curves on a map (issue 27)
+
+
+@dataclass(frozen=True)
+class CurveOnMap:
+    """A continued curve checked against a brute-force map (:func:`curve_on_map`).
+
+    Attributes
+    ----------
+    inside
+        The curve's points at least one cell from the map's edge (where both sides can be read).
+    holds
+        Those of them where the map's cells one cell width on either side across the curve differ.
+    failed
+        The points where they do not: ``(x, y, class on one side, class on the other)``.
+    """
+
+    inside: int
+    holds: int
+    failed: tuple[tuple[float, float, int, int], ...]
+
+    @property
+    def fraction(self) -> float:
+        return self.holds / self.inside if self.inside else math.nan
+
+    @property
+    def verdict(self) -> Verdict:
+        """``agree`` when it holds at every point inside the map; ``not comparable`` with none inside."""
+        if self.inside == 0:
+            return "not comparable"
+        return "agree" if self.holds == self.inside else "differ"
+
+
+def curve_on_map(
+    x: Sequence[float],
+    y: Sequence[float],
+    grid_x: Sequence[float],
+    grid_y: Sequence[float],
+    classes: Any,
+    where: Sequence[bool] | None = None,
+) -> CurveOnMap:
+    """Whether a curve lies on a change of class in a map, within the map's resolution.
+
+    At each point of the curve (``x``, ``y``, in the units of the map's cell centres ``grid_x``,
+    ``grid_y``, both equally spaced) the curve's normal is taken in cell units (one cell width
+    along each axis counts the same); the rule holds there when the cells one cell width away on
+    either side along the normal (``classes[row, column]``, nearest cell) differ.  Points less
+    than one cell from the map's edge are left out, and those where ``where`` is false (they
+    still set the normal of their neighbours).
+
+    Examples
+    --------
+    A map that changes from class 0 to class 1 at x = 2.5, and a vertical curve on it and off it:
+
+    >>> import numpy as np
+    >>> classes = (np.arange(6)[None, :] > 2).astype(int).repeat(5, axis=0)
+    >>> on = curve_on_map([2.5] * 5, [0, 1, 2, 3, 4], range(6), range(5), classes)
+    >>> on.inside, on.holds, on.verdict
+    (3, 3, 'agree')
+    >>> off = curve_on_map([4.0] * 5, [0, 1, 2, 3, 4], range(6), range(5), classes)
+    >>> off.holds, off.verdict, off.failed[0]
+    (0, 'differ', (4.0, 1.0, 1, 1))
+    """
+    cls = np.asarray(classes)
+    gx, gy = np.asarray(grid_x, dtype=float), np.asarray(grid_y, dtype=float)
+    u = (np.asarray(x, dtype=float) - gx[0]) / (gx[1] - gx[0])
+    v = (np.asarray(y, dtype=float) - gy[0]) / (gy[1] - gy[0])
+    if len(u) < 2:
+        return CurveOnMap(0, 0, ())
+    tu, tv = np.gradient(u), np.gradient(v)
+    norm = np.hypot(tu, tv)
+    norm[norm == 0] = 1.0
+    nu, nv = -tv / norm, tu / norm
+    ny, nx = cls.shape
+    inside = holds = 0
+    failed = []
+    checked = np.ones(len(u), dtype=bool) if where is None else np.asarray(where, dtype=bool)
+    for i in range(len(u)):
+        if not (checked[i] and 1 <= u[i] <= nx - 2 and 1 <= v[i] <= ny - 2):
+            continue
+        inside += 1
+        a = cls[_nearest(v[i] + nv[i]), _nearest(u[i] + nu[i])]
+        b = cls[_nearest(v[i] - nv[i]), _nearest(u[i] - nu[i])]
+        if a != b:
+            holds += 1
+        else:
+            failed.append((float(x[i]), float(y[i]), int(a), int(b)))
+    return CurveOnMap(inside, holds, tuple(failed))
+
+
+def _nearest(z: float) -> int:
+    """The index of the cell centre nearest to ``z`` (in cell units; halves round up)."""
+    return math.floor(z + 0.5)

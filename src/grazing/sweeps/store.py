@@ -159,10 +159,6 @@ def build_dataset(spec: SweepSpec, arrays: dict[str, np.ndarray], attrs: dict[st
         coords["value"] = ("point", pts[:, 0])
     data["stop_level"] = (("point", "component"), _stop_levels(spec))
     ds = xr.Dataset(data, coords=coords)
-    for name in spec.params:  # what plots need to label the parameter axes
-        par = spec.model.parameter(name)
-        meta = {"long_name": par.description or name, "symbol": par.label, "units": par.unit}
-        ds[name].attrs.update({**meta, "angle": int(par.angle)})
     ds["stop_level"].attrs["description"] = (
         "the state component's value on the stop, where the guard depends on that component alone (else nan)"
     )
@@ -218,7 +214,16 @@ def build_dataset(spec: SweepSpec, arrays: dict[str, np.ndarray], attrs: dict[st
         ds = ds.set_index(point=[p2 + "_index", p1 + "_index"]).unstack("point")
         ds = ds.assign_coords({p1: (p1 + "_index", pts[:n1, 0]), p2: (p2 + "_index", pts[::n1, 1])})
         ds = ds.swap_dims({p1 + "_index": p1, p2 + "_index": p2}).drop_vars([p1 + "_index", p2 + "_index"])
+    _label_parameters(ds, spec)  # last: reshaping a map (or a sweep up and down) rebuilds the coordinates
     return ds
+
+
+def _label_parameters(ds: Any, spec: SweepSpec) -> None:
+    """Give each parameter coordinate what plots need to label its axis: symbol, units, angle."""
+    for name in spec.params:
+        par = spec.model.parameter(name)
+        meta = {"long_name": par.description or name, "symbol": par.label, "units": par.unit}
+        ds[name].attrs.update({**meta, "angle": int(par.angle)})
 
 
 class MemoryStore:

@@ -1,0 +1,25 @@
+"""The facade ``grazing``: what ``dir(grazing)`` (and so tab completion) offers."""
+
+from __future__ import annotations
+
+import ast
+import subprocess
+import sys
+
+
+def test_dir_lists_every_public_name_and_nothing_used_only_to_write_the_module() -> None:
+    code = (
+        "import grazing; before = dir(grazing); import grazing.orbits; "
+        "print(sorted(before)); print('orbits' in dir(grazing)); print(sorted(grazing.__all__))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    before, orbits_after, public = out.splitlines()
+    names = ast.literal_eval(before)
+    assert set(ast.literal_eval(public)) <= set(names)
+    assert "simulate" in names and "__version__" in names  # both loaded on first use
+    assert not {"Any", "TYPE_CHECKING", "annotations", "ModuleType", "set_kernel_loader"} & set(names)
+    assert "orbits" not in names and orbits_after == "True"  # a subpackage once imported
+    import grazing
+
+    for name in names:
+        getattr(grazing, name)  # everything listed is there
