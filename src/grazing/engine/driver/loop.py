@@ -137,7 +137,12 @@ def integrate(start, pv, cfg, m):
     zdm_gv = np.zeros(n)
     buffers = (xp, V, scratch, logs, xe, zdm_gh, zdm_gv, fbuf)  # (step.end_step's)
 
-    r = new_state(1)[0]  # the run's state (see .state)
+    # The run's state (see .state) is the record r of the array runs. A record is a view that does not
+    # keep its array alive, and numba frees an array after its last use: runs is read again in the
+    # return statement, after the last allocation (r once pointed into freed memory, which the
+    # growing tables reused: a dense trajectory came back with thousands of unwritten rows).
+    runs = new_state(1)
+    r = runs[0]
     start_run(m, r, start, cfg, x, tables)
     keep_from = n_samples - n_keep
     sz = cfg.zdm_s
@@ -224,7 +229,7 @@ def integrate(start, pv, cfg, m):
         logs,
         lyap_span,
         guard_info[:, : 2 * (2 + n)].copy(),
-        r.jac_valid,
+        runs[0].jac_valid,  # (the last use of runs: see above)
     )
 
 

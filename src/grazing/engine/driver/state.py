@@ -4,7 +4,10 @@
 (an array of one), :func:`.lanes.sweep_lanes` one per lane; the pieces a step
 uses (:mod:`.recording` ...) read and update it by name.  numba compiles a
 record of a structured array as a struct: ``r.k`` is a load, ``r.k += 1`` a
-store, and a record passed to a function is a pointer to it.
+store, and a record passed to a function is a pointer to it.  A record does
+not keep its array alive: numba frees an array after the last use of its
+name, so the function that makes the array reads it again after the last
+use of its records (``tests/engine/test_state_lifetime.py`` checks it).
 
 Examples
 --------
