@@ -40,7 +40,7 @@ from grazing.engine.driver.calls import tc_free, tc_stick, tc_var
 from grazing.engine.driver.events import first_event
 from grazing.engine.driver.recording import take_samples
 from grazing.engine.driver.state import STATUS_NONFINITE, STATUS_OK, STATUS_STEP_LIMIT, new_state
-from grazing.engine.driver.step import STEP_LAST, accept_step, end_step, step_end
+from grazing.engine.driver.step import STEP_LAST, accept_step, end_plain_step, end_step, step_end
 from grazing.engine.polyroots import quadratic_bound, work_shape
 from grazing.engine.records import Kernels, LaneJobs, LanePoints, LaneResults, LaneSettings
 from grazing.engine.stepping import new_table, step_factor, step_from_norms, step_size
@@ -217,7 +217,8 @@ def sweep_lanes(m, cfg, work, points, out):
             return
         # Idle lanes take the next point: their job's next one, else the next job's first.
         for lane in range(L):
-            active = take_point(m, cfg, work, points, out, la, lane, budget, align, active)
+            if ls[lane].stage == IDLE and ls[lane].job_end >= 0:  # (a call only where it takes a point)
+                active = take_point(m, cfg, work, points, out, la, lane, budget, align, active)
         if active == 0:
             break
 
@@ -269,23 +270,24 @@ def sweep_lanes(m, cfg, work, points, out):
             if todo[lane] == 0:
                 continue
             run = ls[lane]
-            nrows = ntot if (run.mode == 0 and run.use_var) else n
-            for i in range(ntot):
-                xl[i] = XS[i, lane]
             recording = run.recording  # (before the step's end)
-            buffers = (xp, V, scratch, logs[lane], xe, gh, gv, fbuf)
-            chatter_time = cfg.chatter_tol * run.T
-            kicked, impact = end_step(
-                m, run, xl, XT[:, :, lane], pl[lane], nrows, cfg, chatter_time, 0, Tp, buffers, tables
-            )
-            if recording and run.stage == FINAL:
-                if kicked:
-                    counts[lane, cfg.stop] += 1
-                if impact:
-                    counts[lane, run.ev_stop] += 1
-            run.n_stick = 0  # (sticking intervals are not recorded)
-            for i in range(ntot):
-                XS[i, lane] = xl[i]
+            if not end_plain_step(run, cfg.lyapunov, m.nsens > 0):  # (the step's end has work to do)
+                nrows = ntot if (run.mode == 0 and run.use_var) else n
+                for i in range(ntot):
+                    xl[i] = XS[i, lane]
+                buffers = (xp, V, scratch, logs[lane], xe, gh, gv, fbuf)
+                chatter_time = cfg.chatter_tol * run.T
+                kicked, impact = end_step(
+                    m, run, xl, XT[:, :, lane], pl[lane], nrows, cfg, chatter_time, 0, Tp, buffers, tables
+                )
+                if recording and run.stage == FINAL:
+                    if kicked:
+                        counts[lane, cfg.stop] += 1
+                    if impact:
+                        counts[lane, run.ev_stop] += 1
+                run.n_stick = 0  # (sticking intervals are not recorded)
+                for i in range(ntot):
+                    XS[i, lane] = xl[i]
             n_samples = ls[lane].n_samples
             if ls[lane].isamp < n_samples:
                 continue
@@ -294,7 +296,7 @@ def sweep_lanes(m, cfg, work, points, out):
                 active -= 1
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def lane_coefficients(m, la, kinds, use_lanes, coeffs):
     """The Taylor coefficients of the lanes in free flight into ``XT``, ``OT``; returns how many have ``V``.
 
@@ -349,7 +351,7 @@ def lane_coefficients(m, la, kinds, use_lanes, coeffs):
     return nvar
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def lane_norms(m, XT, OT, kinds, nvar, norms):
     """The norms of the lanes' step sizes (as ``step_size``, row by row, on vectors) into ``norms``."""
     nx_, n1_, n2_ = norms
@@ -374,7 +376,7 @@ def lane_norms(m, XT, OT, kinds, nvar, norms):
                 n2_[lane] = max(n2_[lane], abs(XT[i, order, lane]))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def no_events_certain(m, cfg, OT, hs, plain, certs):
     """Clear ``plain[lane]`` where an event on the step of size ``hs[lane]`` is not excluded.
 
@@ -412,7 +414,7 @@ def no_events_certain(m, cfg, OT, hs, plain, certs):
                 plain[lane] = 0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def advance_lanes(m, la, XT, dts, todo, kinds, nvar, acc):
     """Every stepping lane to the end of its accepted part ``dts[lane]`` (``eval_rows`` on vectors).
 
@@ -437,7 +439,7 @@ def advance_lanes(m, la, XT, dts, todo, kinds, nvar, acc):
                 XS[i, lane] = acc[lane]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def plan_steps(m, cfg, la, zdms, norms, coeffs, factor, plan):
     """Each running lane's step: its size (from ``norms`` in free flight, the scalar sticking function
     otherwise) and where it ends (:func:`.step.step_end`), or its point's failure.

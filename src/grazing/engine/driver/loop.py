@@ -51,7 +51,7 @@ from grazing.engine.driver.state import (
     STATUS_STEP_LIMIT,
     new_state,
 )
-from grazing.engine.driver.step import STEP_LAST, accept_step, end_step, step_end
+from grazing.engine.driver.step import STEP_LAST, accept_step, end_plain_step, end_step, step_end
 from grazing.engine.polyroots import work_shape
 from grazing.engine.records import Config, Kernels, Start
 from grazing.engine.stepping import (
@@ -196,10 +196,11 @@ def integrate(start, pv, cfg, m):
         eval_rows(X, nrows, order, h_acc, xe)
         for i in range(nrows):
             x[i] = xe[i]
-        kicked, impact = end_step(
-            m, r, x, X, pv, nrows, cfg, chatter_time, record_impacts, Tp, buffers, tables
-        )
-        r.n_imp += int(kicked) + int(impact)
+        if not end_plain_step(r, lyap, m.nsens > 0):  # (the step's end has work to do)
+            kicked, impact = end_step(
+                m, r, x, X, pv, nrows, cfg, chatter_time, record_impacts, Tp, buffers, tables
+            )
+            r.n_imp += int(kicked) + int(impact)
         if r.isamp >= n_samples:
             break
 

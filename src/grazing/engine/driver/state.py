@@ -78,7 +78,8 @@ RUN_STATE = np.dtype(
         ("used", np.int64),  # transient periods run so far
         ("req_ks", np.int64),  # the current request's first sample at (req_ks, req_ss) (Runner's ks, ss)
         ("req_ss", np.float64),
-    ]
+    ],
+    align=True,  # (each field at a multiple of its size, each record at a multiple of 8 bytes: aligned loads)
 )
 """The fields of a run's state (see the comments); every field is zero (False) in a new one."""
 
