@@ -180,3 +180,52 @@ def test_the_entry_point_takes_the_drivers_records() -> None:
     args = sweep_arguments()
     with pytest.raises(TypeError, match="a LaneSettings"):
         native.load_sweep_lanes()(tuple(args[0]), tuple(args[1][:-1]), *(tuple(r) for r in args[2:]))
+
+
+def test_reference_counts_are_plain_adds_and_every_array_is_freed() -> None:
+    """The machine code counts references without atomic instructions (native.plain_reference_counts),
+    and still frees each array it allocates, once, when its count drops to zero."""
+    from numba import njit, types
+    from numba.core.runtime import _nrt_python, rtsys
+
+    @njit
+    def total(x, n):  # (not inlined: it is given its arrays, whose counts go up and down)
+        s = 0.0
+        for i in range(n):
+            s += x[i]
+        return s
+
+    def toy(n):
+        a = np.arange(n) * 1.0
+        b = np.ones(n)
+        parts = (a, b, a[1:])
+        s = 0.0
+        for k in range(3):
+            s += total(parts[k], parts[k].size)
+        return int(s)
+
+    dispatcher = njit(toy)
+    dispatcher.compile((types.int64,))
+    ir = native.plain_reference_counts(dispatcher.inspect_llvm((types.int64,)))
+    for name in ("NRT_incref", "NRT_decref"):
+        body = ir[ir.index(f"define linkonce_odr void @{name}") :]
+        body = body[: body.index("\n}\n")]
+        assert "atomic" not in body and "call void @NRT_MemInfo_call_dtor" in ir
+    assert native.plain_reference_counts("no such definitions") == "no such definitions"
+
+    loaded = native.load_object(native.object_file(njit(toy), (types.int64,), "toy"), "toy")
+    assert loaded is not None
+    address, _params, _library = loaded
+    entry = ctypes.CFUNCTYPE(ctypes.c_int64, ctypes.c_void_p)(address)
+    enabled = _nrt_python.memsys_stats_enabled()
+    _nrt_python.memsys_enable_stats()
+    try:
+        before = rtsys.get_allocation_stats()
+        for _ in range(100):
+            assert entry(np.array([10], dtype=np.int64).ctypes.data) in native._RETURNED
+        after = rtsys.get_allocation_stats()
+    finally:
+        if not enabled:
+            _nrt_python.memsys_disable_stats()
+    allocated, freed = after.alloc - before.alloc, after.free - before.free
+    assert allocated >= 200 and freed == allocated  # (two arrays per call, every one freed)
