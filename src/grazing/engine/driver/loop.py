@@ -137,12 +137,8 @@ def integrate(start, pv, cfg, m):
     zdm_gv = np.zeros(n)
     buffers = (xp, V, scratch, logs, xe, zdm_gh, zdm_gv, fbuf)  # (step.end_step's)
 
-    # The run's state (see .state) is the record r of the array runs. A record is a view that does not
-    # keep its array alive, and numba frees an array after its last use: runs is read again in the
-    # return statement, after the last allocation (r once pointed into freed memory, which the
-    # growing tables reused: a dense trajectory came back with thousands of unwritten rows).
-    runs = new_state(1)
-    r = runs[0]
+    runs = new_state(1)  # (read again in the return statement: a record does not keep its array alive)
+    r = runs[0]  # the run's state (see .state)
     start_run(m, r, start, cfg, x, tables)
     keep_from = n_samples - n_keep
     sz = cfg.zdm_s
