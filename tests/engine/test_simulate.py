@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 import grazing
 from grazing import InvalidParameterError, InvalidStateError, SimulationError
 from grazing.engine import simulate as simulate_module
-from grazing.models import bouncing_ball, impact_oscillator, pendulum
+from grazing.models import bouncing_ball, impact_oscillator, pendulum, two_sided_oscillator
 
 # --------------------------------------------------------------------------
 # Closed forms: a ball on a fixed floor, released from rest at height 1.
@@ -340,3 +340,27 @@ def test_a_dense_trajectory_covers_the_recorded_span_in_order(x0):
     assert np.all(np.isfinite(sol.trajectory))
     assert np.all(sol.trajectory[:, 0] <= m.params["theta_hat"] + 1e-9)
     assert np.max(np.diff(t)) <= spacing * (1 + 1e-9)
+
+
+@pytest.mark.parametrize(
+    ("make", "x0"),
+    [
+        (lambda: impact_oscillator(sigma=0.1, omega=2.0), [0.0, 0.5]),  # one stop
+        (lambda: two_sided_oscillator(), [0.0, 0.0]),  # two stops
+        (lambda: bouncing_ball(amplitude=1.2), [0.0, 0.0]),  # chattering and sticking
+    ],
+    ids=["impact-oscillator", "two-sided-oscillator", "bouncing-ball"],
+)
+def test_a_dense_trajectory_of_other_models_has_every_row(make, x0):
+    """Rows every T/100 over the recorded span plus two at each impact, in time order and finite (issue 29:
+    the run's state record once pointed into freed memory and the count of rows came back wrong)."""
+    m = make()
+    transient, periods, per_period = 50, 20, 100
+    sol = grazing.simulate(m, x0, transient=transient, periods=periods, trajectory=per_period)
+    t = sol.trajectory_t
+    T = m.period
+    assert t[0] == pytest.approx(transient * T) and t[-1] == pytest.approx((transient + periods) * T)
+    assert np.all(np.diff(t) >= 0.0) and np.all(np.isfinite(sol.trajectory))
+    assert len(t) == pytest.approx(periods * per_period + 1 + 2 * sol.impacts.t.size, abs=2)
+    assert np.max(np.diff(t)) <= T / per_period * (1 + 1e-9)
+    np.testing.assert_allclose(sol.trajectory[-1], sol.samples[-1], atol=1e-12)  # (the span ends at a sample)

@@ -183,7 +183,7 @@ def integrate(start, pv, cfg, m):
         if (r.ks - r.k) * T + (r.ss - r.s) <= h_acc:  # a sample is due on this step (about once a period)
             take_samples(m, r, X, h_acc, event, is_last, samples, sticks, traj, xe)
         if r.recording and traj_dt > 0.0:
-            trajectory_points(m, r, X, h_acc, traj, xe)
+            trajectory_points(m, r, X, h_acc, traj, xe, is_last and not event)
         if r.recording and track_min and r.mode == 0 and h_acc > 0.0:
             for j in range(nstops):  # every stop's closest approach
                 track_guard(m, r, O, j, X, x, h, h_acc, event, gm, guard_info[j], xe)

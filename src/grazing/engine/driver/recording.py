@@ -16,6 +16,9 @@ from grazing.engine.driver.calls import guard
 from grazing.engine.polyroots import horner
 from grazing.engine.stepping import append_pair, append_row, eval_rows, poly_derivative, set_row, set_slice
 
+TRAJECTORY_END_TOL = 1e-9
+"""A trajectory point at most this many spacings past the run's end is its end (rounding)."""
+
 
 @njit(cache=True, inline="always")
 def take_samples(m, r, X, h_acc, event, is_last, samples, sticks, traj, xe):
@@ -64,14 +67,21 @@ def take_samples(m, r, X, h_acc, event, is_last, samples, sticks, traj, xe):
 
 
 @njit(cache=True, inline="always")
-def trajectory_points(m, r, X, h_acc, traj, xe):
-    """Trajectory points of run ``r`` within the step, every ``r.traj_dt``, from ``(r.kt, r.st)`` on."""
+def trajectory_points(m, r, X, h_acc, traj, xe, run_end):
+    """Trajectory points of run ``r`` within the step, every ``r.traj_dt``, from ``(r.kt, r.st)`` on.
+
+    At the run's end (``run_end``: the step ends there, not at an event) a
+    point that the sums of ``traj_dt`` put past it by rounding is the end's
+    (the last row of a trajectory was missing where they came out a hair long).
+    """
     n = m.nx
     T = r.T
     while True:
         dt = (r.kt - r.k) * T + (r.st - r.s)
         if dt > h_acc:
-            break
+            if not (run_end and dt - h_acc <= TRAJECTORY_END_TOL * r.traj_dt):
+                break
+            dt = h_acc
         eval_rows(X, n, m.order, dt, xe)
         append_row(traj, r.n_traj, r.k * T + r.s + dt, xe, n)
         r.n_traj += 1
