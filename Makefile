@@ -4,7 +4,7 @@ VENV   ?= .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed-$(shell cat pyproject.toml | cksum | cut -d' ' -f1)
 
-.PHONY: install reproduce check-report docs docs-check test test-all bench lint clean
+.PHONY: install reproduce check-report docs docs-check test test-all bench bench-all lint clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -19,7 +19,8 @@ install: $(STAMP)
 reproduce: $(STAMP)
 	$(BIN)/grazing report --out report
 
-# Open report/index.html in headless Chromium: every image shown, every link live (needs chromium).
+# Open report/index.html in headless Chromium: every image shown, every link live, and every plot area of
+# every figure drawn on, its data inside its limits, its labels inside the image (needs chromium).
 check-report: $(STAMP)
 	test -f report/index.html || $(MAKE) reproduce
 	$(BIN)/python -m grazing.report.browser report/index.html
@@ -58,6 +59,13 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_simulate.py
 	$(BIN)/python benchmarks/bench_sweep.py
 	$(BIN)/python benchmarks/bench_grazing_curve.py
+
+# Every benchmark the READMEs quote, into one saved run (benchmarks/results/latest.json, medians
+# with their spread, the machine and the date), then the READMEs' tables rewritten from it.
+# Run it on a quiet machine: about 15 minutes on 2 cores.
+bench-all: $(STAMP)
+	$(BIN)/python -m pip install --quiet -e ".[test,bench]"
+	$(BIN)/python benchmarks/run_all.py
 
 lint: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks

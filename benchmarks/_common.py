@@ -8,14 +8,18 @@ import json
 import math
 import os
 import platform
+import statistics
 import subprocess
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from importlib.metadata import PackageNotFoundError, version
 from typing import Any
 
-PACKAGES = ("numpy", "scipy", "numba", "heyoka", "grazing")
+PACKAGES = ("numpy", "scipy", "numba", "llvmlite", "heyoka", "grazing")
+VECTOR_ISAS = (("avx512f", "AVX-512", 8), ("avx2", "AVX2", 4), ("avx", "AVX", 4), ("sse2", "SSE2", 2))
+"""(/proc/cpuinfo flag, name, doubles per register), widest first."""
 
 
 def bench_parser(doc: str, quiet_wait: float | None = None) -> argparse.ArgumentParser:
@@ -40,14 +44,18 @@ def emit(
     markdown: Callable[[], str],
     data: Callable[[], Any],
 ) -> None:
-    """Print the table, then the Markdown table with ``--markdown``, and write ``data()`` to ``--json``."""
+    """Print the table, then the Markdown table with ``--markdown``, and write ``data()`` to ``--json``.
+
+    The JSON also holds the Markdown table (key ``markdown``): ``run_all.py`` keeps it in the
+    saved run, and ``tables.py`` copies it into benchmarks/README.md.
+    """
     print_table()
     if args.markdown:
         print()
         print(markdown())
     if args.json:
         with open(args.json, "w") as fh:
-            json.dump(data(), fh, indent=2, default=float)
+            json.dump({**data(), "markdown": markdown()}, fh, indent=2, default=float)
 
 
 def log(msg: str) -> None:
@@ -79,33 +87,116 @@ def machine_info(packages: tuple[str, ...] = PACKAGES) -> dict[str, Any]:
     return {
         "cpu": cpu,
         "cores": os.cpu_count(),
+        **vector_isa(),
         "python": platform.python_version(),
         **versions,
         "loadavg_start": loadavg(),
     }
 
 
+def cpu_flags() -> set[str]:
+    """The processor's feature flags from /proc/cpuinfo (empty where there is none)."""
+    try:
+        with open("/proc/cpuinfo") as fh:
+            line = next((ln for ln in fh if ln.startswith("flags")), "")
+    except OSError:
+        return set()
+    return set(line.partition(":")[2].split())
+
+
+def vector_isa() -> dict[str, Any]:
+    """The widest vector instructions the processor has, and the lane widths the engines chose.
+
+    ``vector_isa`` / ``vector_doubles``: from /proc/cpuinfo's flags (AVX-512: 8 doubles per
+    register, AVX2: 4, ...); ``grazing_lanes``: the lanes of grazing's sweep kernels on this
+    machine; ``heyoka_simd_size``: heyoka's ``recommended_simd_size()`` (0: not installed).
+    """
+    flags = cpu_flags()
+    isa, doubles = next(((name, n) for flag, name, n in VECTOR_ISAS if flag in flags), ("unknown", 0))
+    try:
+        from grazing.report.provenance import vector_width
+
+        grazing_lanes = vector_width()
+    except Exception:  # never fatal to a benchmark
+        grazing_lanes = 0
+    try:
+        import heyoka as hy
+
+        heyoka_simd = int(hy.recommended_simd_size())
+    except ImportError:
+        heyoka_simd = 0
+    return {"vector_isa": isa, "vector_doubles": doubles, "grazing_lanes": grazing_lanes,
+            "heyoka_simd_size": heyoka_simd}  # fmt: skip
+
+
 def versions_line(m: dict[str, Any], packages: tuple[str, ...] = PACKAGES) -> str:
     pkgs = ", ".join(f"{p} {m[p]}" for p in packages if p in m)
     return (
-        f"{m['cpu']}, {m['cores']} cores; Python {m['python']}, {pkgs}; "
+        f"{m['cpu']}, {m['cores']} cores{isa_note(m)}; Python {m['python']}, {pkgs}; "
         f"load average {m['loadavg_start']} (start), {m.get('loadavg_end', 'n/a')} (end)"
     )
 
 
+def isa_note(m: dict[str, Any]) -> str:
+    """ ", AVX-512 (8 doubles; grazing 8 lanes, heyoka 8)" from :func:`vector_isa`'s keys, if present."""
+    if "vector_isa" not in m:
+        return ""
+    return (
+        f", {m['vector_isa']} ({m['vector_doubles']} doubles per register; lanes: grazing "
+        f"{m['grazing_lanes']}, heyoka {m['heyoka_simd_size']})"
+    )
+
+
+@dataclass(frozen=True)
+class Spread:
+    """Repeated measurements of one quantity: their median, smallest and largest, and all of them."""
+
+    median: float
+    min: float
+    max: float
+    runs: tuple[float, ...]
+
+    @classmethod
+    def of(cls, values: Sequence[float]) -> Spread:
+        """The spread of ``values`` (at least one).
+
+        >>> Spread.of([3.0, 1.0, 2.0, 10.0]).median, Spread.of([3.0, 1.0, 2.0]).max
+        (2.5, 3.0)
+        """
+        vals = tuple(float(v) for v in values)
+        return cls(statistics.median(vals), min(vals), max(vals), vals)
+
+    def scaled(self, factor: float) -> Spread:
+        """The same runs times ``factor`` (e.g. seconds to µs per period)."""
+        return Spread.of([v * factor for v in self.runs])
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"median": self.median, "min": self.min, "max": self.max, "runs": list(self.runs)}
+
+
 def command_seconds(cmd: list[str], repeats: int, **kwargs: Any) -> float:
-    """Best wall time of running ``cmd`` (a fresh process) ``repeats`` times."""
-    best = math.inf
+    """Median wall time of running ``cmd`` (a fresh process) ``repeats`` times."""
+    return command_spread(cmd, repeats, **kwargs).median
+
+
+def command_spread(cmd: list[str], repeats: int, **kwargs: Any) -> Spread:
+    """Wall times of running ``cmd`` (a fresh process) ``repeats`` times."""
+    times = []
     for _ in range(repeats):
         start = time.perf_counter()
         subprocess.run(cmd, check=True, **kwargs)
-        best = min(best, time.perf_counter() - start)
-    return best
+        times.append(time.perf_counter() - start)
+    return Spread.of(times)
 
 
 def process_seconds(code: str, repeats: int) -> float:
-    """Best wall time of ``python -c code`` in a fresh interpreter."""
+    """Median wall time of ``python -c code`` in a fresh interpreter."""
     return command_seconds([sys.executable, "-c", code], repeats)
+
+
+def process_spread(code: str, repeats: int) -> Spread:
+    """Wall times of ``python -c code`` in a fresh interpreter, ``repeats`` times."""
+    return command_spread([sys.executable, "-c", code], repeats)
 
 
 # ----------------------------------------------------------------------------- other processes' load
@@ -163,14 +254,22 @@ def wait_quiet(max_seconds: float, threshold: float = 0.3, window: float = 1.0) 
 
 
 def best_command(cmd: list[str], repeats: int, quiet: float = 0.0, **kwargs: Any) -> tuple[float, float]:
-    """Best wall time of ``cmd`` (a fresh process) over ``repeats`` runs, and ``others`` during it.
+    """Median wall time of ``cmd`` (a fresh process) over ``repeats`` runs, and the median ``others``.
 
     Before each run, waits up to ``quiet`` seconds for the machine to be quiet (:func:`wait_quiet`).
+    (The name is historical: it took the best run until issue 29.)
     """
-    best = (math.inf, math.nan)
+    spread, others = metered_command(cmd, repeats, quiet, **kwargs)
+    return spread.median, others.median
+
+
+def metered_command(cmd: list[str], repeats: int, quiet: float = 0.0, **kwargs: Any) -> tuple[Spread, Spread]:
+    """Wall times of ``cmd`` (a fresh process) over ``repeats`` runs, and ``others`` during each."""
+    seconds, others = [], []
     for _ in range(repeats):
         wait_quiet(quiet)
         with Meter() as m:
             subprocess.run(cmd, check=True, **kwargs)
-        best = min(best, (m.seconds, m.others))
-    return best
+        seconds.append(m.seconds)
+        others.append(m.others)
+    return Spread.of(seconds), Spread.of(others)

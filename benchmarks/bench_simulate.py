@@ -19,7 +19,7 @@ positive direction, the reset theta' <- -r theta' applied after each event):
 
 Measured, in one run:
 
-1. Time for 400 and 100,000 forcing periods, in-process (best of a few runs, after a
+1. Time for 400 and 100,000 forcing periods, in-process (median of a few runs, after a
    warm-up / construction), and the whole-process time of a fresh interpreter doing the
    100,000-period run (imports, grazing kernel load / heyoka JIT compilation included;
    scipy's is extrapolated from a shorter fresh-process run, see ``SCIPY_PROCESS_PERIODS``).
@@ -62,7 +62,17 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 import grazing
-from _common import bench_parser, emit, loadavg, log, machine_info, process_seconds, versions_line
+from _common import (
+    Spread,
+    bench_parser,
+    emit,
+    loadavg,
+    log,
+    machine_info,
+    process_seconds,
+    process_spread,
+    versions_line,
+)
 
 # ----------------------------------------------------------------------------- problem
 
@@ -107,6 +117,7 @@ class Run:
     samples: np.ndarray
     impact_t: np.ndarray
     seconds: float = math.nan
+    spread: Spread | None = None  # of the repeated runs' times
 
 
 @dataclass
@@ -118,6 +129,8 @@ class Timing:
     measured_periods: int  # periods actually run
     impacts: int
     deviation: float = math.nan  # max |diff| of the last TAIL samples from the reference
+    seconds_min: float = math.nan  # the spread of the repeated runs (scaled like `seconds`)
+    seconds_max: float = math.nan
 
     @property
     def extrapolated(self) -> bool:
@@ -132,9 +145,11 @@ class Timing:
 class ProcessTiming:
     engine: str
     periods: int  # periods the time refers to
-    seconds: float  # best fresh-process wall time (extrapolated to `periods` if measured on fewer)
+    seconds: float  # median fresh-process wall time (extrapolated to `periods` if measured on fewer)
     measured_periods: int
-    measured_seconds: float  # best fresh-process wall time for `measured_periods`
+    measured_seconds: float  # median fresh-process wall time for `measured_periods`
+    seconds_min: float = math.nan  # the spread of the runs (extrapolated like `seconds`)
+    seconds_max: float = math.nan
 
     @property
     def extrapolated(self) -> bool:
@@ -338,16 +353,18 @@ def scipy_loop(
 # ----------------------------------------------------------------------------- timing
 
 
-def best_of(fn: Callable[[], Run], repeats: int) -> Run:
-    best: Run | None = None
+def median_of(fn: Callable[[], Run], repeats: int) -> Run:
+    """``fn`` run ``repeats`` times: the middle run (by time), with the median time and the spread."""
+    runs = []
     for _ in range(repeats):
         start = time.perf_counter()
         run = fn()
         run.seconds = time.perf_counter() - start
-        if best is None or run.seconds < best.seconds:
-            best = run
-    assert best is not None
-    return best
+        runs.append(run)
+    spread = Spread.of([r.seconds for r in runs])
+    middle = sorted(runs, key=lambda r: r.seconds)[len(runs) // 2]
+    middle.seconds, middle.spread = spread.median, spread
+    return middle
 
 
 def process_code(engine: str, n_periods: int) -> str:
@@ -385,7 +402,12 @@ def process_code(engine: str, n_periods: int) -> str:
 
 def timing(engine: str, periods: int, run: Run, repeats: int) -> Timing:
     measured = run.samples.shape[0]
-    return Timing(engine, periods, run.seconds * periods / measured, repeats, measured, run.impact_t.size)
+    scale = periods / measured
+    spread = run.spread or Spread.of([run.seconds])
+    return Timing(
+        engine, periods, run.seconds * scale, repeats, measured, run.impact_t.size,
+        seconds_min=spread.min * scale, seconds_max=spread.max * scale,
+    )  # fmt: skip
 
 
 def time_engines(res: Results, quick: bool) -> dict[tuple[str, int], Run]:
@@ -421,8 +443,8 @@ def time_engines(res: Results, quick: bool) -> dict[tuple[str, int], Run]:
                 log(f"scipy: {n:,} periods predicted to take {predicted:.0f} s")
             elif engine == "scipy":
                 repeats = 3
-            log(f"{engine}: {measured:,} periods, best of {repeats} ...")
-            run = best_of(lambda e=engine, m=measured: runners[e](m), repeats)
+            log(f"{engine}: {measured:,} periods, median of {repeats} ...")
+            run = median_of(lambda e=engine, m=measured: runners[e](m), repeats)
             runs[engine, n] = run
             res.timings.append(timing(engine, n, run, repeats))
     return runs
@@ -436,13 +458,23 @@ def time_processes(res: Results, quick: bool) -> None:
         measured = LARGE
         if engine == "scipy":
             measured = SIZES[0] if quick else SCIPY_PROCESS_PERIODS
-        log(f"  {engine}: {measured:,} periods, best of {PROCESS_REPEATS} ...")
-        sec = process_seconds(process_code(engine, measured), PROCESS_REPEATS)
-        total = sec
+        log(f"  {engine}: {measured:,} periods, median of {PROCESS_REPEATS} ...")
+        spread = process_spread(process_code(engine, measured), PROCESS_REPEATS)
+        rest = 0.0
         if measured != LARGE:  # add the in-process time of the periods not run
             t = max((t for t in res.timings if t.engine == engine), key=lambda t: t.periods)
-            total += t.seconds / t.periods * (LARGE - measured)
-        res.process.append(ProcessTiming(engine, LARGE, total, measured, sec))
+            rest = t.seconds / t.periods * (LARGE - measured)
+        res.process.append(
+            ProcessTiming(
+                engine,
+                LARGE,
+                spread.median + rest,
+                measured,
+                spread.median,
+                seconds_min=spread.min + rest,
+                seconds_max=spread.max + rest,
+            )
+        )
 
 
 # ----------------------------------------------------------------------------- accuracy
@@ -459,7 +491,7 @@ def run_reference(res: Results, runs: dict[tuple[str, int], Run]) -> Run:
     ta = make_reference()
     fp = type(ta.time)
     log(f"reference ({np.dtype(fp).name}): {LARGE:,} periods ...")
-    ref = best_of(lambda: reference_loop(ta, LARGE, THETA_HAT, R), 1)
+    ref = median_of(lambda: reference_loop(ta, LARGE, THETA_HAT, R), 1)
     res.reference = {
         "fp_type": np.dtype(fp).name,
         "mantissa_bits": int(np.finfo(fp).nmant) + 1,
@@ -658,7 +690,7 @@ def print_table(res: Results) -> None:
         f"by {rf[RESET_DEV]:.2g}"
     )
     print(
-        "\nTime, in-process (best of `runs`; first-call / JIT costs excluded, see below); "
+        "\nTime, in-process (median of `runs`; first-call / JIT costs excluded, see below); "
         f"max|d| ref = max |diff| of the last {TAIL} samples from the reference"
     )
     print(
@@ -679,7 +711,7 @@ def print_table(res: Results) -> None:
         print(f"{LARGE:>8} {'scipy':10} {'skipped (--quick)':>10}")
     print(
         f"\nWhole process, fresh interpreter, {LARGE:,} periods (imports, kernel load/JIT incl.), "
-        f"best of {PROCESS_REPEATS}"
+        f"median of {PROCESS_REPEATS}"
     )
     for p in res.process:
         note = (
@@ -780,7 +812,7 @@ def markdown(res: Results) -> str:
         "time reset to 0 every period so the forcing phase is exact; "
         f"independent of grazing. Deviation = max |Δ| over both components of the last {TAIL} samples, "
         "at the same sample index.",
-        f"- Whole process: fresh interpreter, imports + kernel load / JIT compilation + run, best of "
+        f"- Whole process: fresh interpreter, imports + kernel load / JIT compilation + run, median of "
         f"{PROCESS_REPEATS}.",
     ]
     if "*" in marks:

@@ -28,7 +28,7 @@ Sweeps timed:
   mid-chunk), each started from grazing's final state of the previous point, full 500 + 100
   periods; its time is EXTRAPOLATED to all points (mean time per point x points).
 
-In-process times are the best of 3 interleaved runs (up to 6 while the best run was disturbed)
+In-process times are the median of 3 interleaved runs (their spread is recorded too)
 after a warm-up (grazing kernel load, heyoka
 JIT compilation excluded and reported separately).  The machine may be shared: before each timed
 run the script waits (up to ``--quiet-wait`` seconds) for other processes to go quiet, and it
@@ -65,13 +65,14 @@ from scipy.integrate import solve_ivp
 import grazing
 from _common import (
     Meter,
+    Spread,
     bench_parser,
-    best_command,
     command_seconds,
     emit,
     loadavg,
     log,
     machine_info,
+    metered_command,
     versions_line,
     wait_quiet,
 )
@@ -94,9 +95,7 @@ SWEEP_TOL = 1e-10  # grazing's sweep tolerance
 CHUNK = 50  # grazing's default chunk size
 SCIPY_STRIDE, SCIPY_OFFSET = 50, 25  # scipy runs points 25, 75, ... (mid-chunk)
 SCIPY_OPTS: dict[str, Any] = {"method": "DOP853", "rtol": 1e-10, "atol": 1e-12}
-REPEATS = 3  # in-process runs per sweep (interleaved, best taken)
-MAX_REPEATS = 6  # ... or up to this many while the best run was disturbed by other processes
-DISTURBED = 0.25  # cores used by other processes during a run that make it "disturbed"
+REPEATS = 3  # in-process runs per sweep (interleaved, the median taken)
 QUIET_WAIT = 20.0  # s: the most to wait before each timed run for other processes to go quiet
 PROCESS_REPEATS = 3
 
@@ -128,8 +127,8 @@ LABELS = {
 class Timing:
     key: str
     points: int  # points the time refers to
-    seconds: float  # (possibly extrapolated) time for `points`
-    others: float  # cores kept busy by other processes during the (best) run
+    seconds: float  # (possibly extrapolated) median time for `points`
+    others: float  # cores kept busy by other processes during the runs (median)
     repeats: int
     measured_points: int
     indices: list[int]  # points whose period was computed
@@ -137,6 +136,8 @@ class Timing:
     agree: int = 0  # points of `indices` where the period equals the default sweep's
     stable: int = 0  # of those, points whose period is the same at both neighbours in the default sweep
     agree_stable: int = 0
+    seconds_min: float = math.nan  # the spread of the repeated runs (extrapolated like `seconds`)
+    seconds_max: float = math.nan
 
     @property
     def extrapolated(self) -> bool:
@@ -152,11 +153,11 @@ class Results:
     machine: dict[str, Any]
     settings: dict[str, Any]
     timings: list[Timing] = field(default_factory=list)
-    process_seconds: float = math.nan
+    process_seconds: float = math.nan  # median
+    process_spread: tuple[float, float] = (math.nan, math.nan)  # (min, max)
     process_others: float = math.nan
     one_off: dict[str, float] = field(default_factory=dict)
     grazing_periods: list[int] = field(default_factory=list)
-    peer: dict[str, Any] = field(default_factory=dict)  # the equal-work comparison with heyoka's batch mode
 
 
 def detect_period(samples: np.ndarray, tol: float = PERIOD_TOL, max_period: int = MAX_PERIOD) -> int:
@@ -288,26 +289,25 @@ def scipy_point(eta: float, x0: np.ndarray) -> np.ndarray:
 
 def round_robin(
     runners: dict[str, Callable[[], Any]], repeats: int, quiet: float
-) -> dict[str, tuple[float, float, int, Any]]:
-    """Run every runner `repeats` times, interleaved; per runner the best (seconds, others, runs, output).
+) -> dict[str, tuple[Spread, float, int, Any]]:
+    """Run every runner `repeats` times, interleaved; per runner (seconds, others, runs, output).
 
-    Before each run, waits up to `quiet` seconds for other processes to go quiet; `others` is
-    the number of cores other processes kept busy during the best run.  Runners whose best run
-    was disturbed (others >= DISTURBED) get further runs, up to MAX_REPEATS in all.
+    ``seconds`` is the spread of the runs' wall times (the tables show its median); before
+    each run, waits up to `quiet` seconds for other processes to go quiet; ``others`` is the
+    median number of cores other processes kept busy during the runs.
     """
-    best: dict[str, tuple[float, float, int, Any]] = {}
-    for r in range(MAX_REPEATS):
-        todo = [k for k in runners if r < repeats or (quiet > 0 and best[k][1] >= DISTURBED)]
-        for key in todo:
+    seconds: dict[str, list[float]] = {k: [] for k in runners}
+    others: dict[str, list[float]] = {k: [] for k in runners}
+    outputs: dict[str, Any] = {}
+    for r in range(repeats):
+        for key, run in runners.items():
             log(f"  {key}: run {r + 1} ...")
             wait_quiet(quiet)
             with Meter() as m:
-                out = runners[key]()
-            if key not in best or m.seconds < best[key][0]:
-                best[key] = (m.seconds, m.others, r + 1, out)
-            else:
-                best[key] = (*best[key][:2], r + 1, best[key][3])
-    return best
+                outputs[key] = run()
+            seconds[key].append(m.seconds)
+            others[key].append(m.others)
+    return {k: (Spread.of(seconds[k]), Spread.of(others[k]).median, repeats, outputs[k]) for k in runners}
 
 
 def time_grazing(res: Results, etas: np.ndarray, quiet: float) -> np.ndarray:
@@ -316,13 +316,26 @@ def time_grazing(res: Results, etas: np.ndarray, quiet: float) -> np.ndarray:
     grazing_sweep(etas[:2], periods=4, transient=4, workers=1)  # kernel load (also the variational one)
     res.one_off["grazing kernel load (first call)"] = time.perf_counter() - start
     n = len(etas)
-    log(f"grazing variants: {n} points, best of {REPEATS} ...")
+    log(f"grazing variants: {n} points, median of {REPEATS} ...")
     runners = {key: (lambda o=opts: grazing_sweep(etas, **o)) for key, opts in GRAZING_VARIANTS.items()}
     x_final = None
     for key, (sec, others, runs, ds) in round_robin(runners, REPEATS, quiet).items():
         per = ds.period.values.astype(int)
         assert [detect_period(s) for s in ds.samples.values] == per.tolist(), "period rules differ"
-        res.timings.append(Timing(key, n, sec, others, runs, n, list(range(n)), per.tolist()))
+        res.timings.append(
+            Timing(
+                key,
+                n,
+                sec.median,
+                others,
+                runs,
+                n,
+                list(range(n)),
+                per.tolist(),
+                seconds_min=sec.min,
+                seconds_max=sec.max,
+            )
+        )
         if key == "grazing":
             res.grazing_periods = per.tolist()
             x_final = ds.x_final.values
@@ -342,10 +355,23 @@ def time_heyoka(res: Results, etas: np.ndarray, quiet: float) -> None:
         ta = make(tol)
         res.one_off[f"{key} JIT (taylor_adaptive construction)"] = time.perf_counter() - start
         runners[key] = lambda t=ta, d=three_d: heyoka_sweep(t, etas, d)
-    log(f"heyoka loops: {n} points, best of {REPEATS} ...")
+    log(f"heyoka loops: {n} points, median of {REPEATS} ...")
     for key, (sec, others, runs, samples) in round_robin(runners, REPEATS, quiet).items():
         periods = [detect_period(s) for s in samples]
-        res.timings.append(Timing(key, n, sec, others, runs, n, list(range(n)), periods))
+        res.timings.append(
+            Timing(
+                key,
+                n,
+                sec.median,
+                others,
+                runs,
+                n,
+                list(range(n)),
+                periods,
+                seconds_min=sec.min,
+                seconds_max=sec.max,
+            )
+        )
 
 
 def time_scipy(res: Results, etas: np.ndarray, x_final: np.ndarray, quiet: float) -> None:
@@ -388,73 +414,13 @@ def cli_command(n: int) -> list[str]:
 
 def time_process(res: Results, n: int, quiet: float) -> None:
     cmd = cli_command(n)
-    log(f"whole process: {' '.join(cmd[1:])} > /dev/null, best of {PROCESS_REPEATS} ...")
-    res.process_seconds, res.process_others = best_command(
-        cmd, PROCESS_REPEATS, quiet, stdout=subprocess.DEVNULL
-    )
+    log(f"whole process: {' '.join(cmd[1:])} > /dev/null, median of {PROCESS_REPEATS} ...")
+    spread, others = metered_command(cmd, PROCESS_REPEATS, quiet, stdout=subprocess.DEVNULL)
+    res.process_seconds, res.process_others = spread.median, others.median
+    res.process_spread = (spread.min, spread.max)
     res.one_off["python -c pass (fresh interpreter)"] = command_seconds(
         [sys.executable, "-c", "pass"], PROCESS_REPEATS
     )
-
-
-# ----------------------------------------------------------------------------- the expert peer
-
-PEER = Path(__file__).with_name("heyoka_batch_sweep.py")
-"""heyoka.py batch mode, as an expert writes a sweep (issue 15): one SIMD lane per η value."""
-
-EQUAL_WORK = ["--fresh", "--no-lyapunov", "--no-adaptive", "--tol", str(SWEEP_TOL)]
-"""grazing's options for the peer's work: every point from rest, full transients, no Lyapunov exponents."""
-
-
-def peer_commands(n: int, processes: int) -> tuple[list[str], list[str]]:
-    """The two whole-process commands of the equal-work comparison (ours, heyoka batch)."""
-    ours = [*cli_command(n), *EQUAL_WORK, "--workers", str(processes)]
-    theirs = [sys.executable, str(PEER), "--start", str(ETA_START), "--stop", str(ETA_STOP), "--num", str(n),
-              "--transient", str(TRANSIENT), "--periods", str(PERIODS), "--tol", str(SWEEP_TOL),
-              "--processes", str(processes), "--json"]  # fmt: skip
-    return ours, theirs
-
-
-def time_peer(res: Results, n: int, quiet: float) -> None:
-    """Equal work, whole processes, side by side: grazing's sweep and heyoka's batch-mode program."""
-    import json as json_
-
-    processes = os.cpu_count() or 1
-    ours_cmd, peer_cmd = peer_commands(n, processes)
-    log(f"equal work vs heyoka batch mode: {n} points, {processes} processes, best of {PROCESS_REPEATS} ...")
-    out = {}
-    for key, cmd in (("grazing", ours_cmd), ("heyoka-batch", peer_cmd)):
-        text = subprocess.run(
-            cmd, check=True, capture_output=True, text=True
-        ).stdout  # warm-up, and the periods
-        out[key] = json_.loads(text)["period"]
-    t_ours, o_ours = best_command(ours_cmd, PROCESS_REPEATS, quiet, stdout=subprocess.DEVNULL)
-    t_peer, o_peer = best_command(peer_cmd, PROCESS_REPEATS, quiet, stdout=subprocess.DEVNULL)
-    agree = sum(a == b for a, b in zip(out["grazing"], out["heyoka-batch"]))
-    import heyoka as hy_
-
-    res.peer = {
-        "points": n, "processes": processes, "lanes": hy_.recommended_simd_size(),
-        "grazing_s": t_ours, "grazing_others": o_ours, "heyoka_batch_s": t_peer,
-        "heyoka_batch_others": o_peer, "speedup": t_peer / t_ours, "periods_agree": agree,
-        "grazing_command": " ".join(ours_cmd[1:]), "heyoka_command": " ".join([PEER.name, *peer_cmd[2:]]),
-    }  # fmt: skip
-
-
-def peer_lines(res: Results) -> list[str]:
-    p = res.peer
-    if not p:
-        return []
-    return [
-        f"Equal work (every point from rest, {TRANSIENT} + {PERIODS} periods, tol {SWEEP_TOL:g}, "
-        "no Lyapunov), "
-        f"{p['points']} points, {p['processes']} cores, whole process (best of {PROCESS_REPEATS}):",
-        f"  grazing sweep {' '.join(EQUAL_WORK)} (a thread per core): {p['grazing_s']:.2f} s",
-        f"  heyoka.py batch mode ({p['lanes']} SIMD lanes per process, benchmarks/{PEER.name}): "
-        f"{p['heyoka_batch_s']:.2f} s",
-        f"  grazing is {p['speedup']:.2f}x as fast (issue 15's target: >= 1.5x); periods agree at "
-        f"{p['periods_agree']} of {p['points']} points",
-    ]
 
 
 # ----------------------------------------------------------------------------- agreement
@@ -530,7 +496,7 @@ def print_table(res: Results) -> None:
     print(f"Machine: {versions_line(m)}")
     print(f"Problem: {s['problem']}")
     print(
-        "\nTime, in-process (best of `runs`; kernel load / JIT excluded); x ours = time / ours; "
+        "\nTime, in-process (median of `runs`; kernel load / JIT excluded); x ours = time / ours; "
         "periods = ours: points where the detected period equals the default grazing sweep's "
         "(all; and at points whose period is the same at both neighbours in ours); "
         "others = cores kept busy by other processes during the run"
@@ -548,16 +514,14 @@ def print_table(res: Results) -> None:
     for t in res.timings:
         print(f"  {t.key:16} {LABELS[t.key]}")
     print(
-        f"\nWhole process (fresh `grazing sweep ... --json > /dev/null`, {ours(res).points} points, best of "
-        f"{PROCESS_REPEATS}): {res.process_seconds:.2f} s (others {res.process_others:.2f})"
+        f"\nWhole process (fresh `grazing sweep ... --json > /dev/null`, {ours(res).points} points, "
+        f"median of {PROCESS_REPEATS}): {res.process_seconds:.2f} s (others {res.process_others:.2f})"
     )
     for name, sec in res.one_off.items():
         print(f"  {name}: {sec:.3f} s")
     per = np.array(res.grazing_periods)
     vals, counts = np.unique(per, return_counts=True)
     print("\nPeriods in the default sweep: " + ", ".join(f"{v}: {c}" for v, c in zip(vals, counts)))
-    for line in peer_lines(res):
-        print(line)
     for key in ("grazing-plain", "heyoka-t", "heyoka-t-1e-10", "heyoka-3d", "scipy"):
         d = disagreements(res, key)
         at_chunk = sum(j % CHUNK == 0 for j, _, _ in d)
@@ -609,13 +573,11 @@ def markdown(res: Results) -> str:
         f"{SCIPY_OFFSET + SCIPY_STRIDE}, …, mid-chunk) each run for the full {TRANSIENT} + {PERIODS} periods "
         "from grazing's final state of the previous point; time = mean per point × "
         f"{n}; period agreement over those {sc.measured_points} points.",
-        f"- In-process: best of {REPEATS} interleaved runs (up to {MAX_REPEATS} while the best one was "
-        f"disturbed, i.e. other processes kept ≥ {DISTURBED} cores busy) after a warm-up; excluded: "
+        f"- In-process: median of {REPEATS} interleaved runs after a warm-up; excluded: "
         + ", ".join(f"{k} {v:.2f} s" for k, v in res.one_off.items() if "python -c" not in k)
-        + f". Whole process: best of {PROCESS_REPEATS}, imports and kernel load included. Before each "
+        + f". Whole process: median of {PROCESS_REPEATS}, imports and kernel load included. Before each "
         f"run, up to {res.settings['quiet_wait_s']:g} s of waiting for other processes to go quiet. "
-        "Other load: cores kept busy by other processes during the (best) run, from /proc/stat.",
-        *(f"- {line.strip()}" for line in peer_lines(res)),
+        "Other load: cores kept busy by other processes during the runs (median), from /proc/stat.",
         "- Targets (issue 4, not asserted):",
         *(f"  - {line}" for line in targets(res)),
         f"- Machine: {versions_line(res.machine)}.",
@@ -652,9 +614,9 @@ def to_json(res: Results) -> dict[str, Any]:
             for t in res.timings
         ],
         "process_seconds": res.process_seconds,
+        "process_seconds_min_max": list(res.process_spread),
         "process_others": res.process_others,
         "one_off_seconds": res.one_off,
-        "heyoka_batch_peer": res.peer,
         "targets": targets(res),
     }
 
@@ -670,7 +632,6 @@ def main(argv: list[str] | None = None) -> int:
     time_heyoka(res, etas, args.quiet_wait)
     time_scipy(res, etas, x_final, args.quiet_wait)
     time_process(res, n, args.quiet_wait)
-    time_peer(res, n, args.quiet_wait)
     fill_agreement(res)
     res.machine["loadavg_end"] = loadavg()
     emit(args, lambda: print_table(res), lambda: markdown(res), lambda: to_json(res))

@@ -3,10 +3,10 @@
 Every file grazing writes says so, together with a SHA-256 digest of what it holds:
 
 ==========  ===========================================================================
-CSV         a last line ``# written by grazing 0.1.0 (sha256 of the lines above: …)``
-NetCDF      the global attribute ``written_by``: ``grazing 0.1.0 (sha256 of the data: …)``
-PNG         the text chunk ``Software``: ``grazing 0.1.0 (sha256 of the image: …)``
-JSON        the key ``written_by``: ``grazing 0.1.0 (sha256 of the other keys: …)``
+CSV         a last line ``# written by grazing X.Y.Z (sha256 of the lines above: …)``
+NetCDF      the global attribute ``written_by``: ``grazing X.Y.Z (sha256 of the data: …)``
+PNG         the text chunk ``Software``: ``grazing X.Y.Z (sha256 of the image: …)``
+JSON        the key ``written_by``: ``grazing X.Y.Z (sha256 of the other keys: …)``
 ==========  ===========================================================================
 
 A file is grazing's (:func:`written_by_grazing`) when its mark is there and its
@@ -358,11 +358,44 @@ def save_png(
     fig: Any, path: str | Path, *, dpi: float, overwrite: bool = False, hint: str = PYTHON_HINT
 ) -> Path:
     """Save a matplotlib figure as a PNG with grazing's mark, all at once; return the path."""
+    from grazing.plotting.checks import LAYOUT_KEY, axes_layout, layout_text
+
     check_replaceable(path, overwrite=overwrite, hint=hint)
     buf = io.BytesIO()
     fig.savefig(buf, dpi=dpi, format="png", metadata={"Software": None})
-    write_bytes_atomic(path, mark_png(buf.getvalue()))
+    data = add_png_text(buf.getvalue(), LAYOUT_KEY, layout_text(axes_layout(fig)))
+    write_bytes_atomic(path, mark_png(data))
     return Path(path)
+
+
+def add_png_text(data: bytes, key: str, text: str) -> bytes:
+    """A PNG file's bytes with a text chunk ``key`` (replacing one of that key) right after the header.
+
+    Examples
+    --------
+    >>> import io
+    >>> from PIL import Image
+    >>> buf = io.BytesIO(); Image.new("RGB", (2, 2)).save(buf, format="png")
+    >>> png_text(add_png_text(buf.getvalue(), "note", "hello"), "note")
+    'hello'
+    """
+    same_key = key.encode("latin-1") + b"\0"
+    chunks = [(k, p) for k, p in _png_chunks(data) if not (k == b"tEXt" and p.startswith(same_key))]
+    out = [PNG_SIGNATURE]
+    for kind, payload in chunks:
+        out.append(_png_chunk(kind, payload))
+        if kind == b"IHDR":
+            out.append(_png_chunk(b"tEXt", key.encode("latin-1") + b"\0" + text.encode("latin-1")))
+    return b"".join(out)
+
+
+def png_text(data: bytes, key: str) -> str | None:
+    """The text of a PNG file's ``tEXt`` chunk ``key``, or None (ValueError if ``data`` is not a PNG file)."""
+    for kind, payload in _png_chunks(data):
+        name, sep, text = payload.partition(b"\0")
+        if kind == b"tEXt" and sep and name == key.encode("latin-1"):
+            return text.decode("latin-1")
+    return None
 
 
 def write_png_bytes(

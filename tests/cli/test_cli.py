@@ -195,3 +195,25 @@ def test_damping_refuses_more_peaks_than_its_free_decay_has(capsys):
         f"grazing: error: --peaks {most + 1}: the free decay at r = 0.7675, beta = 0.048 falls below "
         f"1e-10 rad after {most} peaks; ask for at most {most} --peaks\n"
     )
+
+
+def test_every_command_is_loaded_on_first_use_and_listed():
+    """The group imports a command's module only when it runs; the table names every command once."""
+    import subprocess
+    import sys
+
+    import click
+
+    from grazing.cli import COMMANDS, cli
+
+    code = (
+        "import sys; from grazing.cli import main; main(['sweep', '--help'])\n"
+        "print(sorted(m for m in sys.modules if m.startswith('grazing.cli.') or m == 'grazing.orbits'))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    loaded = out.strip().splitlines()[-1]
+    assert "grazing.cli.sweeps" in loaded
+    assert "grazing.cli.attractors" not in loaded and "grazing.orbits'" not in loaded
+    ctx = click.Context(cli)
+    commands = {name: cli.get_command(ctx, name) for name in cli.list_commands(ctx)}
+    assert set(commands) == set(COMMANDS) and all(c is not None and c.name == n for n, c in commands.items())

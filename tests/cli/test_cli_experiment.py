@@ -22,7 +22,7 @@ def test_the_experiment_commands_are_in_the_group():
     from grazing.cli.experiment import COMMANDS
 
     for cmd in COMMANDS:
-        assert cli.commands[cmd.name] is cmd
+        assert cli.get_command(None, cmd.name) is cmd
 
 
 def test_damping_json(cli, capsys):

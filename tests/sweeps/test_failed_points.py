@@ -268,4 +268,8 @@ def test_json_text_writes_null_for_every_non_finite_number():
         "text": "NaN",
     }  # fmt: skip
     finite = {"a": np.linspace(0, 1, 3), "b": [math.pi], "c": np.int64(3)}
-    assert json_text(finite) == json.dumps({"a": [0.0, 0.5, 1.0], "b": [math.pi], "c": 3})
+    text = json_text(finite)
+    assert strict_json(text) == {"a": [0.0, 0.5, 1.0], "b": [math.pi], "c": 3}  # (every float exactly)
+    assert text == json.dumps({"a": [0.0, 0.5, 1.0], "b": [math.pi], "c": 3}, separators=(",", ":"))
+    huge = {"n": 2**70, "x": [float("nan")]}  # (beyond orjson's integers: through json, still strict)
+    assert strict_json(json_text(huge)) == {"n": 2**70, "x": [None]}

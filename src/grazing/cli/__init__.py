@@ -9,30 +9,62 @@ non-zero exit status; nothing is written.
 
 from __future__ import annotations
 
+import importlib
+
 import click
 
 import grazing
-from grazing.cli import attractors, curves, experiment, normalform, orbits, report, simulate, sweeps
 from grazing.cli.common import EXIT_FAILURE, EXIT_INTERRUPTED, EXIT_USAGE, error_line
 from grazing.cli.limits import MEMORY_ENV
 from grazing.errors import GrazingError
 
-__all__ = ["cli", "main"]
+__all__ = ["COMMANDS", "cli", "main"]
+
+COMMANDS: dict[str, str] = {
+    "simulate": "simulate:simulate",
+    "orbit": "orbits:orbit",
+    "graze": "orbits:graze",
+    "graze-curve": "orbits:graze_curve",
+    "continue": "orbits:continue_",
+    "curve": "curves:curve",
+    "sweep": "sweeps:sweep_cmd",
+    "normal-form": "normalform:normal_form_cmd",
+    "map": "sweeps:map_cmd",
+    "report": "report:report",
+    "damping": "experiment:damping_cmd",
+    "iso-damping": "experiment:iso_damping_cmd",
+    "fit": "experiment:fit_cmd",
+    "analyze": "experiment:analyze_cmd",
+    "synthesize": "experiment:synthesize_cmd",
+    "basins": "attractors:basins_cmd",  # issue 28
+    "attractors": "attractors:attractors_cmd",
+}
+"""Every command: its name and where it is (``module of grazing.cli:object``), imported when it is used.
+
+A command's module is loaded only when that command runs (or ``--help`` lists
+them all): ``grazing sweep`` does not import the orbits, curves or attractors
+(about 60 ms of a process's start, a serial part of every sweep, issue 29).
+"""
 
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+class _LazyGroup(click.Group):
+    """A click group whose commands are imported on first use (:data:`COMMANDS`)."""
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        return sorted({*COMMANDS, *self.commands})
+
+    def get_command(self, ctx: click.Context, name: str) -> click.Command | None:
+        if name not in self.commands and name in COMMANDS:
+            module, attr = COMMANDS[name].split(":")
+            self.add_command(getattr(importlib.import_module(f"grazing.cli.{module}"), attr), name)
+        return self.commands.get(name)
+
+
+@click.group(cls=_LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(grazing.__version__, prog_name="grazing")
 def cli() -> None:
     """Simulate and analyse impacting systems (the inclined impacting pendulum of
     Piiroinen, Virgin & Champneys 2004 by default)."""
-
-
-for _command in (
-    simulate.simulate, orbits.orbit, orbits.graze, orbits.graze_curve, orbits.continue_, curves.curve,
-    sweeps.sweep_cmd, normalform.normal_form_cmd, sweeps.map_cmd, report.report, *experiment.COMMANDS,
-    *attractors.COMMANDS,  # issue 28
-):  # fmt: skip
-    cli.add_command(_command)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -23,6 +23,7 @@ from typing import Any
 
 import click
 import numpy as np
+import orjson
 
 import grazing
 from grazing.atomic import resolved
@@ -441,15 +442,28 @@ def emit_json(obj: dict[str, Any]) -> None:
 def json_text(obj: Any) -> str:
     """``obj`` as strict JSON: NaN and infinities become ``null``, numpy arrays and scalars plain values.
 
+    Encoded by orjson, which writes a numpy array without first making it a
+    list of Python floats (a 32000-point sweep's samples: 0.2 s instead of
+    2.8 s, a serial part of every sweep); the numbers are the same (shortest
+    round-trip form), the text compact.  What orjson cannot encode (an integer
+    beyond 64 bits...) goes through :mod:`json`.
+
     Examples
     --------
     >>> json_text({"a": [1.5, float("nan")], "b": np.array([[0.0, np.inf]]), "c": np.float32(2)})
-    '{"a": [1.5, null], "b": [[0.0, null]], "c": 2.0}'
+    '{"a":[1.5,null],"b":[[0.0,null]],"c":2.0}'
     """
+    try:
+        return orjson.dumps(obj, default=json_default, option=_ORJSON).decode()
+    except (orjson.JSONEncodeError, TypeError):
+        pass
     try:
         return json.dumps(obj, allow_nan=False, default=json_default)
     except ValueError:  # a non-finite float outside an array (arrays are converted by json_default)
         return json.dumps(_finite_or_null(obj), allow_nan=False, default=json_default)
+
+
+_ORJSON = orjson.OPT_SERIALIZE_NUMPY | orjson.OPT_NON_STR_KEYS
 
 
 def json_default(o: Any) -> Any:

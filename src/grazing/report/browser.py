@@ -95,6 +95,8 @@ class PageCheck:
         JavaScript exceptions thrown while loading.
     blank_images
         ``src`` of every local image that loaded but is blank (:func:`is_blank`).
+    figure_problems
+        ``src: problem`` for every plot area of a local figure that is wrong (:func:`image_problems`).
     ids
         Every element id of the page (the targets of anchors).
     local_links
@@ -109,18 +111,20 @@ class PageCheck:
     external: list[str] = field(default_factory=list)
     errors: list[str] = field(default_factory=list)
     blank_images: list[str] = field(default_factory=list)
+    figure_problems: list[str] = field(default_factory=list)
     ids: set[str] = field(default_factory=set, repr=False)
     local_links: list[tuple[str, Path, str]] = field(default_factory=list, repr=False)
 
     @property
     def ok(self) -> bool:
-        return not (self.broken_images or self.broken_links or self.errors or self.blank_images)
+        return not self.problems()
 
     def problems(self) -> list[str]:
         """One line per problem."""
         return (
             [f"image not shown: {s}" for s in self.broken_images]
             + [f"blank image: {s}" for s in self.blank_images]
+            + [f"figure: {s}" for s in self.figure_problems]
             + [f"broken link: {s}" for s in self.broken_links]
             + [f"script error: {s}" for s in self.errors]
         )
@@ -148,8 +152,9 @@ def _painted(rgb: Any) -> float:
     flat = rgb.reshape(-1, 3)
     if flat.size == 0:
         return 0.0
-    colours, counts = np.unique(flat, axis=0, return_counts=True)
-    background = colours[np.argmax(counts)]
+    packed = (flat[:, 0].astype(np.int32) << 16) | (flat[:, 1].astype(np.int32) << 8) | flat[:, 2]
+    commonest = int(np.argmax(np.bincount(packed, minlength=1)))  # (one pass; np.unique on rows sorts)
+    background = np.array([commonest >> 16, (commonest >> 8) & 255, commonest & 255])
     return float(np.mean(np.any(np.abs(flat - background) > 8, axis=1)))
 
 
@@ -179,6 +184,77 @@ def is_blank(path: Path | str) -> bool:
     if Path(path).suffix.lower() not in (".png", ".jpg", ".jpeg", ".gif", ".webp"):
         return False
     return painted_fraction(path) < BLANK_FRACTION
+
+
+AXES_INK = 40
+"""A pixel of a plot area is drawn on when a channel differs from the area's background by more
+than this (of 255): light grid lines and faint shading (alpha ≤ 0.3 over white) do not count."""
+
+AXES_BLANK_FRACTION = 0.002
+"""A plot area is nearly blank when fewer than this fraction of its pixels are drawn on (:data:`AXES_INK`)."""
+
+RUN_OFF = 0.002
+"""An axes runs off its image when its labels or title reach beyond the image by more than this fraction."""
+
+
+def image_problems(path: Path | str) -> list[str]:
+    """What is wrong with the content of a figure grazing saved, one line each.
+
+    A PNG written by :func:`grazing.outputs.save_png` carries the layout of its
+    plot areas (:func:`grazing.plotting.checks.axes_layout`); each plot area is
+    judged on the pixels of the image: nearly blank (fewer than
+    :data:`AXES_BLANK_FRACTION` of its pixels drawn on, frame aside), data
+    drawn only outside its axis limits, or labels and title running off the
+    image.  An image without a layout (a screenshot, an image grazing did not
+    draw) gets no line here (:func:`is_blank` judges it as a whole).
+
+    Examples
+    --------
+    >>> import matplotlib, tempfile, os
+    >>> matplotlib.use("Agg")
+    >>> from matplotlib.figure import Figure
+    >>> from grazing.outputs import save_png
+    >>> fig = Figure(figsize=(6, 3)); a, b = fig.subplots(1, 2)
+    >>> _ = a.plot([0, 1], [0, 1]); _ = b.plot([0.4, 0.9], [0.4, 0.9]); _ = b.set_xlim(24, 54)
+    >>> path = os.path.join(tempfile.mkdtemp(), "f.png")
+    >>> _ = save_png(fig, path, dpi=100)
+    >>> for line in image_problems(path): print(line)
+    axes 2 of 2: no data inside its limits (x in [24, 54], y in [0.375, 0.925])
+    axes 2 of 2: plot area nearly blank (0.0% drawn on)
+    """
+    import numpy as np
+
+    from grazing.outputs import png_text
+    from grazing.plotting.checks import LAYOUT_KEY, read_layout
+
+    if Path(path).suffix.lower() != ".png":
+        return []
+    try:
+        text = png_text(Path(path).read_bytes(), LAYOUT_KEY)
+        layouts = read_layout(text) if text is not None else []
+    except (OSError, ValueError) as exc:
+        return [f"unreadable figure ({exc})"]
+    if not layouts:
+        return []
+    rgb = _image_rgb(path)
+    h, w = rgb.shape[:2]
+    out = []
+    for lay in layouts:
+        if not lay.data_in_view:
+            out.append(f"{lay.name}: no data inside its limits ({lay.limits})")
+        left, top, right, bottom = lay.box
+        # the inside of the frame: 2 pixels in from each edge (the frame and inward ticks aside)
+        x0, x1 = int(np.ceil(left * w)) + 2, int(np.floor(right * w)) - 2
+        y0, y1 = int(np.ceil(top * h)) + 2, int(np.floor(bottom * h)) - 2
+        if x1 > x0 and y1 > y0:
+            area = rgb[y0:y1, x0:x1].reshape(-1, 3)
+            drawn = float(np.mean(np.any(np.abs(area - np.array(lay.facecolor)) > AXES_INK, axis=1)))
+            if drawn < AXES_BLANK_FRACTION:
+                out.append(f"{lay.name}: plot area nearly blank ({100 * drawn:.1f}% drawn on)")
+        ol, ot, orr, ob = lay.outer
+        if min(ol, ot) < -RUN_OFF or max(orr, ob) > 1 + RUN_OFF:
+            out.append(f"{lay.name}: its labels or title run off the image")
+    return out
 
 
 def find_chromium() -> str | None:
@@ -418,6 +494,8 @@ def _judge(found: dict[str, Any], errors: list[str]) -> PageCheck:
         url = urlparse(resolved)
         if url.scheme == "file" and is_blank(unquote(url.path)):
             out.blank_images.append(raw)
+        elif url.scheme == "file":
+            out.figure_problems += [f"{raw}: {line}" for line in image_problems(unquote(url.path))]
     return out
 
 

@@ -610,7 +610,7 @@ def draw_panels(
                 )
         title = f"({p.key}) θ̂ = {p.theta_hat_deg:g}°, {case_label}"
         if run.zoomed:
-            title += ", magnified past the first grazing"
+            title += ", zoomed past the first grazing"
             _offset_ticks(ax, run.first_grazing)
         ax.set_title(title, loc="left", fontsize=10.5)
     for ax in axes[len(runs) :]:

@@ -25,7 +25,7 @@ from typing import Any
 
 from grazing.errors import GrazingError
 from grazing.parallel import in_flight
-from grazing.sweeps.run import batch_key, run_parts, stream_chunks
+from grazing.sweeps.run import LaneBatch, batch_key, run_parts, stream_chunks
 from grazing.sweeps.spec import ChunkResult, SweepSpec
 
 
@@ -39,6 +39,12 @@ DASK_NOTICE_AFTER = 5.0
 POLL_INTERVAL = 0.5
 """Seconds between two looks at a Dask cluster while no chunk finishes."""
 
+TASK_POINTS = 256
+"""Fewest points of a Dask task of a fresh sweep (where there are enough: see :data:`TASKS_PER_WORKER`)."""
+
+TASKS_PER_WORKER = 8
+"""Fewest Dask tasks per worker of a fresh sweep."""
+
 BATCH_VALUES = 1 << 21
 """Most sample values (points x periods x states) of a local batch, beyond what filling the lanes takes."""
 
@@ -47,9 +53,12 @@ def chunk_groups(spec: SweepSpec, todo: Sequence[int], workers: int) -> list[lis
     """``todo`` split into groups of consecutive chunks, each computed together on SIMD lanes.
 
     A continuation sweep fills the lanes with one chunk each (up to two
-    chunks per lane: a lane whose chunk is done takes the next), a fresh one
-    with points (about four per lane); no group is bigger than an even share
-    of the chunks among the workers.
+    chunks per lane: a lane whose chunk is done takes the next), no group
+    bigger than an even share of the chunks among the workers.  A fresh one
+    gives each task at least :data:`TASK_POINTS` points (a task costs the
+    cluster a few milliseconds, and its lanes run idle at its end), yet at
+    least :data:`TASKS_PER_WORKER` tasks to each worker (the last tasks
+    finish at different times).
 
     Examples
     --------
@@ -58,12 +67,20 @@ def chunk_groups(spec: SweepSpec, todo: Sequence[int], workers: int) -> list[lis
     >>> spec = sweep_spec(grazing.models.pendulum("B"), "eta", [0.4 + 0.001 * i for i in range(100)])
     >>> [len(g) for g in chunk_groups(spec, range(spec.n_chunks), workers=2)]
     [1, 1]
+    >>> from grazing.core.options import SweepSettings
+    >>> values = [0.4 + 1e-6 * i for i in range(32000)]
+    >>> fresh = sweep_spec(grazing.models.pendulum("B"), "eta", values, settings=SweepSettings(fresh=True))
+    >>> [len(chunk_groups(fresh, range(fresh.n_chunks), workers=w)) for w in (2, 16)]
+    [107, 128]
     """
     from grazing.engine.llvmgen import lane_width
 
-    lanes = lane_width()
-    per = math.ceil(4 * lanes / spec.size) if spec.fresh else 2 * lanes
-    per = max(1, min(per, math.ceil(len(todo) / max(1, workers))))
+    workers = max(1, workers)
+    if spec.fresh:
+        per = min(math.ceil(TASK_POINTS / spec.size), math.ceil(len(todo) / (TASKS_PER_WORKER * workers)))
+    else:
+        per = min(2 * lane_width(), math.ceil(len(todo) / workers))
+    per = max(1, per)
     todo = list(todo)
     return [todo[i : i + per] for i in range(0, len(todo), per)]
 
@@ -117,11 +134,37 @@ def local_batches(parts: Sequence[Part], threads: int) -> list[list[Part]]:
 
 
 def local_results(parts: Sequence[Part], threads: int | None) -> Iterator[tuple[Part, ChunkResult]]:
-    """Each chunk of ``parts`` with its result as it finishes, by ``threads`` threads (None: one per core)."""
+    """Each chunk of ``parts`` with its result as it finishes, by ``threads`` threads (None: one per core).
+
+    The batches run one after the other; the next one's table of points
+    (:class:`~grazing.sweeps.run.LaneBatch`: a model per point, Python work) is
+    built by a thread of its own while the cores compute the one before, so
+    that they do not wait for it (a serial part of the sweep, issue 29).
+    """
+    from concurrent.futures import ThreadPoolExecutor
+
     threads = max(1, threads or os.cpu_count() or 1)
-    for batch in local_batches(parts, threads):
-        for k, result in stream_chunks(batch, threads):
-            yield batch[k], result
+    batches = local_batches(parts, threads)
+    if not batches:
+        return
+    with ThreadPoolExecutor(1, thread_name_prefix="grazing-batch") as pool:
+        upcoming = pool.submit(LaneBatch, batches[0])
+        for k, group in enumerate(batches):
+            batch = upcoming.result()
+            if k + 1 < len(batches):
+                upcoming = pool.submit(LaneBatch, batches[k + 1])
+            for i, result in stream_chunks(batch, threads):
+                yield group[i], result
+
+
+def _same(value: Any) -> Any:
+    """``value`` (a Dask task that keeps an argument on the cluster for the tasks that need it)."""
+    return value
+
+
+def run_indexed(specs: Sequence[SweepSpec], indices: Sequence[int]) -> list[ChunkResult]:
+    """:func:`~grazing.sweeps.run.run_parts` of the chunks ``indices[k]`` of ``specs[k]`` (a Dask task)."""
+    return run_parts(list(zip(specs, indices)))
 
 
 def _dask_workers(client: Any) -> int:
@@ -133,15 +176,9 @@ def _dask_workers(client: Any) -> int:
 
 def part_groups(parts: Sequence[Part], workers: int) -> list[list[Part]]:
     """``parts`` (specs sharing a batch key) in groups of consecutive parts, as :func:`chunk_groups` makes."""
-    from grazing.engine.llvmgen import lane_width
-
     if not parts:
         return []
-    spec = parts[0][0]
-    lanes = lane_width()
-    per = math.ceil(4 * lanes / spec.size) if spec.fresh else 2 * lanes
-    per = max(1, min(per, math.ceil(len(parts) / max(1, workers))))
-    return [list(parts[i : i + per]) for i in range(0, len(parts), per)]
+    return [[parts[k] for k in group] for group in chunk_groups(parts[0][0], range(len(parts)), workers)]
 
 
 def _dask_results(
@@ -177,6 +214,16 @@ def dask_parts(
     for same in by_key.values():
         groups += part_groups(same, max(1, _dask_workers(client)))
     queue = iter(groups)
+    shipped: dict[int, Any] = {}  # id(spec) -> the spec on the cluster
+
+    def on_cluster(spec: SweepSpec) -> Any:
+        """The spec sent to the cluster once, as the result of a task of its own (its points are in
+        it: sent with every task, they made the client's work grow as the square of the points, 8 ms
+        per task at 32000 points).  Not ``scatter``: that waits for a worker, this is queued."""
+        if id(spec) not in shipped:
+            shipped[id(spec)] = client.submit(_same, spec, pure=False)
+        return shipped[id(spec)]
+
     pending: dict[Any, list[Part]] = {}
     idle_since: float | None = None
     noticed = False
@@ -184,7 +231,8 @@ def dask_parts(
         while True:
             window = max(64, in_flight(_dask_workers(client)))  # one look at the cluster per round
             for group in queue:
-                pending[client.submit(run_parts, group, pure=False)] = group
+                specs = [on_cluster(spec) for spec, _ in group]
+                pending[client.submit(run_indexed, specs, [i for _, i in group], pure=False)] = group
                 if len(pending) >= window:
                     break
             if not pending:

@@ -252,15 +252,18 @@ def run_parts(parts: Sequence[tuple[SweepSpec, int]]) -> list[ChunkResult]:
     return results
 
 
-def stream_chunks(parts: Sequence[tuple[SweepSpec, int]], threads: int) -> Iterator[tuple[int, ChunkResult]]:
+def stream_chunks(
+    parts: Sequence[tuple[SweepSpec, int]] | LaneBatch, threads: int
+) -> Iterator[tuple[int, ChunkResult]]:
     """``(position in parts, result)`` of each chunk of ``parts`` as soon as it is finished.
 
-    The chunks are computed as one :class:`LaneBatch` by ``threads`` threads
-    sharing its jobs (the compiled driver runs without the GIL).  When the
-    consumer stops early (Ctrl-C, an error, ``close()``) the threads are
-    told to stop and have returned, at their next step, before this returns.
+    The chunks are computed as one :class:`LaneBatch` (``parts``, or a batch
+    already built of them) by ``threads`` threads sharing its jobs (the
+    compiled driver runs without the GIL).  When the consumer stops early
+    (Ctrl-C, an error, ``close()``) the threads are told to stop and have
+    returned, at their next step, before this returns.
     """
-    batch = LaneBatch(parts)
+    batch = parts if isinstance(parts, LaneBatch) else LaneBatch(parts)
     batch.control[2] = math.ceil(len(batch.jobs) / threads)  # (a few chains: as many on each thread)
     errors: list[BaseException] = []
     finished = threading.Semaphore(0)

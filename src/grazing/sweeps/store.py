@@ -105,8 +105,15 @@ def _stop_levels(spec: SweepSpec) -> np.ndarray:
     n = spec.model.n_states
     out = np.full((spec.n_points, n), np.nan)
     first = spec.model_at(spec.points[0])
+    system = spec.model.symbolic
+    swept = {sym for sym in system.params if str(sym) in spec.params}
+    constant = not (system.stops[0].guard.free_symbols & swept)  # (the first stop's, as stop_level's)
     for c in range(n):
-        if first.stop_level(c) is None:
+        level0 = first.stop_level(c)
+        if level0 is None:
+            continue
+        if constant:  # (the guard does not depend on the swept parameters: one level for every point)
+            out[:, c] = level0
             continue
         for i, pt in enumerate(spec.points):
             level = spec.model_at(pt).stop_level(c)
