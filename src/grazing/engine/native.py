@@ -131,8 +131,9 @@ def plain_reference_counts(text: str) -> str:
     count is shared between threads: the arrays it is given come without a
     memory manager (:func:`flatten`: a null pointer, whose count is never
     touched) and those it allocates are its own thread's, so plain adds count
-    the same.  The text is returned unchanged if numba's definitions are not
-    found (they stay atomic).
+    the same.  They are inlined where they are called (:func:`object_file`
+    runs LLVM's always-inliner, which touches nothing else).  The text is
+    returned unchanged if numba's definitions are not found (they stay atomic).
     """
     import re
 
@@ -141,7 +142,7 @@ def plain_reference_counts(text: str) -> str:
         found = re.search(pattern, text, flags=re.M | re.S)
         if found is None or "NRT_MemInfo_call_dtor" not in text:
             return text
-        head = f"define linkonce_odr void @{name}(ptr %m){found.group(2)}{{\nentry:\n"
+        head = f"define linkonce_odr void @{name}(ptr %m) alwaysinline nounwind {{\nentry:\n"
         text = text[: found.start()] + head + body + "}\n" + text[found.end() :]
     return text
 
@@ -183,6 +184,10 @@ def object_file(dispatcher: Any, signature: tuple[Any, ...], name: str) -> bytes
         f'declare i32 @"{target.name}"(ptr, ptr, {", ".join(params)})\n{entry}\n'
     )
     module.link_in(wrapper)
+    passes = llvm.create_new_module_pass_manager()
+    passes.add_always_inliner_pass()  # (only the counts above: numba's own code is not optimised again)
+    tuning = llvm.create_pipeline_tuning_options(0)
+    passes.run(module, llvm.create_pass_builder(_jit_target_machine(), tuning))
     needs = sorted(
         {f.name for f in module.functions if f.is_declaration and not f.name.startswith("llvm.")}
         | {g.name for g in module.global_variables if g.is_declaration}
