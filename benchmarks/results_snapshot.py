@@ -51,7 +51,8 @@ def main() -> None:
     s = grazing.simulate(b40, [0.1, 0.2], periods=10, sensitivities=["eta", "theta_hat"])
     show("simulate pendulum sensitivities", s.jacobian, s.samples)
     s = grazing.simulate(b40, [0.1, 0.2], transient=50, periods=50, lyapunov=True)
-    show("simulate pendulum lyapunov", s.lyapunov, s.samples)
+    show("simulate pendulum lyapunov", s.lyapunov)
+    show("simulate pendulum lyapunov: samples", s.samples)
     io = impact_oscillator(sigma=0.1, omega=2.0)
     s = grazing.simulate(
         io, [0.0, 0.5], t0=0.3, phase=1.0, periods=5, sensitivities=["omega"], guard_min=True
@@ -77,7 +78,8 @@ def main() -> None:
     vals = np.linspace(0.44, 0.49, 60)
     for workers in (1, 2):
         ds = sweep(b40, "eta", vals, periods=40, transient=300, workers=workers, chunk_size=10)
-        show(f"sweep eta ({workers} process(es))", ds.samples.values, ds.period.values, ds.lyapunov.values)
+        show(f"sweep eta ({workers} process(es))", ds.samples.values, ds.period.values)
+        show(f"sweep eta ({workers} process(es)) lyapunov", ds.lyapunov.values)
     ds = sweep(io, "omega", np.linspace(3.3, 3.6, 20), periods=20, transient=150, phase=1.3, workers=1)
     show("sweep oscillator omega", ds.samples.values, ds.impacts.values)
     point = find_grazing_point(pendulum("B", theta_hat=math.radians(40)), "eta", 0.2, 1.0, "first")
@@ -89,7 +91,8 @@ def main() -> None:
     show("sweep map method", ds.samples.values, ds.period.values)
     ds = parameter_map(pendulum("B"), "eta", np.linspace(0.42, 0.5, 8), "theta_hat",
                        np.radians(np.linspace(20, 45, 5)), periods=30, transient=200, workers=2)  # fmt: skip
-    show("parameter map", ds.period.values, ds.lyapunov.values)
+    show("parameter map", ds.period.values, ds.samples.values)
+    show("parameter map lyapunov", ds.lyapunov.values)
 
 
 if __name__ == "__main__":

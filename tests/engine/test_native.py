@@ -21,6 +21,7 @@ import pytest
 from grazing.core.options import SweepSettings
 from grazing.engine import codegen, native
 from grazing.engine.codegen import load_driver, taylor_order
+from grazing.engine.records import LaneJobs, LanePoints, LaneResults, LaneSettings
 from grazing.models import bouncing_ball, pendulum
 from grazing.sweeps import run
 from grazing.sweeps.spec import sweep_spec
@@ -70,47 +71,62 @@ def test_a_sweep_in_a_new_process_does_not_import_numba() -> None:
     assert out.stdout.strip() == "False"
 
 
-def sweep_arguments() -> tuple[list, int]:
-    """The arguments of ``sweep_lanes`` for one bouncing-ball point, and the index of ``out_samples``."""
+def sweep_arguments() -> list:
+    """The arguments of ``sweep_lanes`` for one bouncing-ball point: its records, as lists."""
     model = bouncing_ball()
     kern = model.kernels(0, taylor_order(1e-10))
     n, periods = model.n_states, 3
-    values = dict(
-        m=kern.table, lanes=1, jobs=np.array([[0, 1]], dtype=np.int64), control=np.zeros(3, dtype=np.int64),
-        fresh=False, periodic=bool(model.periodic), x0=np.array([[0.5, 0.0]]),
-        firsts=np.array([[0.0, 0.5, 0.0]]),
-        pvs=model.param_vector.reshape(1, -1).copy(), Ts=np.array([float(model.period)]), sphase=np.zeros(1),
-        tcarry=np.zeros(1), zdms=np.zeros(1), transient=4, periods=periods, adaptive=False, adaptive_tol=1e-9,
-        lyapunov=False,
-        safety=1.5, chatter_tol=1e-9, zdm_on=False, zdm_a=1.0, zdm_e=np.zeros(n), zdm_window=0.0, watch=0,
-        out_samples=np.full((1, periods, n), np.nan),
-        out_by_stop=np.zeros((1, model.n_stops), dtype=np.int64), out_lyap=np.zeros(1),
-        out_used=np.zeros(1, dtype=np.int64), out_x=np.zeros((1, n)), out_t=np.zeros(1),
-        out_status=np.full(1, -1, dtype=np.int64),
+    settings = LaneSettings(
+        lanes=1, fresh=False, periodic=bool(model.periodic), transient=4, periods=periods, adaptive=False,
+        adaptive_tol=1e-9, lyapunov=False, safety=1.5, chatter_tol=1e-9, zdm=False, zdm_a=1.0,
+        zdm_e=np.zeros(n), zdm_window=0.0, stop=0,
     )  # fmt: skip
-    assert tuple(values) == native.DRIVER_ARGUMENTS
-    return list(values.values()), native.DRIVER_ARGUMENTS.index("out_samples")
+    work = LaneJobs(
+        jobs=np.array([[0, 1]], dtype=np.int64), control=np.zeros(3, dtype=np.int64),
+        x0=np.array([[0.5, 0.0]]), firsts=np.array([[0.0, 0.5, 0.0]]),
+    )  # fmt: skip
+    points = LanePoints(
+        pvs=model.param_vector.reshape(1, -1).copy(), Ts=np.array([float(model.period)]), sphase=np.zeros(1),
+        tcarry=np.zeros(1), zdms=np.zeros(1),
+    )  # fmt: skip
+    out = LaneResults(
+        samples=np.full((1, periods, n), np.nan), by_stop=np.zeros((1, model.n_stops), dtype=np.int64),
+        lyap=np.zeros(1), used=np.zeros(1, dtype=np.int64), x=np.zeros((1, n)), t=np.zeros(1),
+        status=np.full(1, -1, dtype=np.int64),
+    )  # fmt: skip
+    return [list(kern.table), list(settings), list(work), list(points), list(out)]
+
+
+def call(sweep, args: list) -> None:
+    sweep(*(tuple(record) for record in args))
 
 
 def test_the_entry_point_computes_and_refuses_wrong_arrays() -> None:
     sweep = native.load_sweep_lanes()
-    args, out = sweep_arguments()
-    sweep(*args)
-    assert np.isfinite(args[out]).all() and args[-1][0] == 0
-    x0 = native.DRIVER_ARGUMENTS.index("x0")
+    args = sweep_arguments()
+    call(sweep, args)
+    samples, status = args[4][0], args[4][6]
+    assert np.isfinite(samples).all() and status[0] == 0
+    samples_at, x0_at = (4, 0), (2, 2)
     wrong_arrays = (
-        (out, np.zeros((1, 2, 2))),  # shape
-        (out, np.zeros((1, 3, 2), dtype=np.float32)),  # dtype
-        (out, np.zeros((1, 3, 4))[:, :, ::2]),  # not contiguous
-        (x0, np.zeros((1, 3))),  # x0 of the wrong size
-        (x0, np.zeros((2, 2))),  # x0 not one per job
-        (x0 + 1, np.zeros((1, 2))),  # firsts without the time
+        (samples_at, np.zeros((1, 2, 2))),  # shape
+        (samples_at, np.zeros((1, 3, 2), dtype=np.float32)),  # dtype
+        (samples_at, np.zeros((1, 3, 4))[:, :, ::2]),  # not contiguous
+        (x0_at, np.zeros((1, 3))),  # x0 of the wrong size
+        (x0_at, np.zeros((2, 2))),  # x0 not one per job
+        ((2, 3), np.zeros((1, 2))),  # firsts without the time
+        ((1, 12), np.zeros(3)),  # the discontinuity map's direction of the wrong size
     )
-    for index, bad in wrong_arrays:
-        wrong = list(args)
-        wrong[index] = bad
+    for (record, field), bad in wrong_arrays:
+        wrong = [list(r) for r in args]
+        wrong[record][field] = bad
         with pytest.raises(TypeError, match="must be a C-contiguous"):
-            sweep(*wrong)
+            call(sweep, wrong)
+    read_only = [list(r) for r in args]
+    read_only[4][2] = np.zeros(1)
+    read_only[4][2].flags.writeable = False
+    with pytest.raises(TypeError, match=r"LaneResults\.lyap must be writeable"):
+        call(sweep, read_only)
 
 
 def test_an_exception_in_the_machine_code_is_reported() -> None:
@@ -142,17 +158,74 @@ def test_a_damaged_cache_file_is_built_again(tmp_path, monkeypatch) -> None:
     native.load_sweep_lanes.cache_clear()
     try:
         sweep = native.load_sweep_lanes()
-        args, out = sweep_arguments()
-        sweep(*args)
-        assert np.isfinite(args[out]).all() and built == [1]
+        args = sweep_arguments()
+        call(sweep, args)
+        assert np.isfinite(args[4][0]).all() and built == [1]
         assert path.read_bytes() == source
     finally:
         native.load_sweep_lanes.cache_clear()
 
 
-def test_the_entry_point_takes_the_drivers_arguments() -> None:
+def test_the_entry_point_takes_the_drivers_records() -> None:
+    """The argument layout comes from the records: their fields, in order, are what the driver reads."""
     import inspect
 
-    assert tuple(inspect.signature(load_driver().sweep_lanes.py_func).parameters) == native.DRIVER_ARGUMENTS
-    with pytest.raises(TypeError, match=f"{len(native.DRIVER_ARGUMENTS)} arguments expected"):
+    from grazing.engine.records import SWEEP_RECORDS
+
+    assert len(inspect.signature(load_driver().sweep_lanes.py_func).parameters) == len(SWEEP_RECORDS)
+    labels = [label for label, _kind, _spec in native._layout()]
+    assert labels == [f"{r.__name__}.{name}" for r in SWEEP_RECORDS for name in r._fields]
+    with pytest.raises(TypeError, match=f"{len(SWEEP_RECORDS)} arguments expected"):
         native.load_sweep_lanes()(1, 2)
+    args = sweep_arguments()
+    with pytest.raises(TypeError, match="a LaneSettings"):
+        native.load_sweep_lanes()(tuple(args[0]), tuple(args[1][:-1]), *(tuple(r) for r in args[2:]))
+
+
+def test_reference_counts_are_plain_adds_and_every_array_is_freed() -> None:
+    """The machine code counts references without atomic instructions (native.plain_reference_counts),
+    and still frees each array it allocates, once, when its count drops to zero."""
+    from numba import njit, types
+    from numba.core.runtime import _nrt_python, rtsys
+
+    @njit
+    def total(x, n):  # (not inlined: it is given its arrays, whose counts go up and down)
+        s = 0.0
+        for i in range(n):
+            s += x[i]
+        return s
+
+    def toy(n):
+        a = np.arange(n) * 1.0
+        b = np.ones(n)
+        parts = (a, b, a[1:])
+        s = 0.0
+        for k in range(3):
+            s += total(parts[k], parts[k].size)
+        return int(s)
+
+    dispatcher = njit(toy)
+    dispatcher.compile((types.int64,))
+    ir = native.plain_reference_counts(dispatcher.inspect_llvm((types.int64,)))
+    for name in ("NRT_incref", "NRT_decref"):
+        body = ir[ir.index(f"define linkonce_odr void @{name}") :]
+        body = body[: body.index("\n}\n")]
+        assert "atomic" not in body and "call void @NRT_MemInfo_call_dtor" in ir
+    assert native.plain_reference_counts("no such definitions") == "no such definitions"
+
+    loaded = native.load_object(native.object_file(njit(toy), (types.int64,), "toy"), "toy")
+    assert loaded is not None
+    address, _params, _library = loaded
+    entry = ctypes.CFUNCTYPE(ctypes.c_int64, ctypes.c_void_p)(address)
+    enabled = _nrt_python.memsys_stats_enabled()
+    _nrt_python.memsys_enable_stats()
+    try:
+        before = rtsys.get_allocation_stats()
+        for _ in range(100):
+            assert entry(np.array([10], dtype=np.int64).ctypes.data) in native._RETURNED
+        after = rtsys.get_allocation_stats()
+    finally:
+        if not enabled:
+            _nrt_python.memsys_disable_stats()
+    allocated, freed = after.alloc - before.alloc, after.free - before.free
+    assert allocated >= 200 and freed == allocated  # (two arrays per call, every one freed)

@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 import grazing
 from grazing import InvalidParameterError, InvalidStateError, SimulationError
 from grazing.engine import simulate as simulate_module
-from grazing.models import bouncing_ball, impact_oscillator, pendulum
+from grazing.models import bouncing_ball, impact_oscillator, pendulum, two_sided_oscillator
 
 # --------------------------------------------------------------------------
 # Closed forms: a ball on a fixed floor, released from rest at height 1.
@@ -209,6 +209,26 @@ def test_lyapunov_of_periodic_orbit_matches_floquet_multipliers(pendulum_b, peri
     assert sol.lyapunov.sum() == pytest.approx(div, abs=50 * sol.n_steps * np.finfo(float).eps / span)
 
 
+def test_lyapunov_sums_start_at_the_sample_before_the_span(pendulum_b):
+    """issue 29: the span starts at the transient's last sample, inside a step; the sums start there too.
+
+    The sum of the exponents is the mean divergence over the span (see above):
+    ``-2 beta/eta + 2 ln r`` per impact in it.  The span runs from the
+    transient's last sample, ``t[0] - T``, to the end.  Sums that started at
+    the end of the step holding that sample, or counted the whole step, would
+    be off by the divergence over part of a step, ``~0.2 * 0.5 / span = 4e-4``.
+    """
+    T = pendulum_b.period
+    sol = grazing.simulate(pendulum_b, [0.0, 0.0], transient=7, periods=30, lyapunov=True, impacts="all")
+    start = sol.t[0] - T
+    span = sol.t_final - start
+    impacts = np.count_nonzero(sol.impacts.t > start)
+    assert 0 < impacts < len(sol.impacts)  # (impacts before and in the span)
+    p = pendulum_b.params
+    div = -2 * p["beta"] / p["eta"] + 2 * math.log(p["r"]) * impacts / span
+    assert sol.lyapunov.sum() == pytest.approx(div, abs=50 * sol.n_steps * np.finfo(float).eps / span)
+
+
 # --------------------------------------------------------------------------
 # Sampling, chunking, errors.
 
@@ -248,12 +268,6 @@ def test_results_do_not_depend_on_chunking(pendulum_b, monkeypatch):
     np.testing.assert_allclose(sol.lyapunov, ref.lyapunov, rtol=0, atol=1e-12)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="issue 26 (src/grazing/engine/driver/loop.py): when the transient ends exactly at a chunk "
-    "boundary, the Lyapunov span starts at the chunk's start; otherwise at the end of the first step "
-    "after the transient's last sample, whose growth is discarded: the exponents differ by ~1e-5",
-)
 def test_lyapunov_span_does_not_depend_on_where_chunks_end(pendulum_b, monkeypatch):
     ref = grazing.simulate(pendulum_b, [0.0, 0.0], transient=10, periods=40, lyapunov=True)
     monkeypatch.setattr(simulate_module, "CHUNK_PERIODS", 5)  # a chunk ends where the transient does
@@ -326,3 +340,27 @@ def test_a_dense_trajectory_covers_the_recorded_span_in_order(x0):
     assert np.all(np.isfinite(sol.trajectory))
     assert np.all(sol.trajectory[:, 0] <= m.params["theta_hat"] + 1e-9)
     assert np.max(np.diff(t)) <= spacing * (1 + 1e-9)
+
+
+@pytest.mark.parametrize(
+    ("make", "x0"),
+    [
+        (lambda: impact_oscillator(sigma=0.1, omega=2.0), [0.0, 0.5]),  # one stop
+        (lambda: two_sided_oscillator(), [0.0, 0.0]),  # two stops
+        (lambda: bouncing_ball(amplitude=1.2), [0.0, 0.0]),  # chattering and sticking
+    ],
+    ids=["impact-oscillator", "two-sided-oscillator", "bouncing-ball"],
+)
+def test_a_dense_trajectory_of_other_models_has_every_row(make, x0):
+    """Rows every T/100 over the recorded span plus two at each impact, in time order and finite (issue 29:
+    the run's state record once pointed into freed memory and the count of rows came back wrong)."""
+    m = make()
+    transient, periods, per_period = 50, 20, 100
+    sol = grazing.simulate(m, x0, transient=transient, periods=periods, trajectory=per_period)
+    t = sol.trajectory_t
+    T = m.period
+    assert t[0] == pytest.approx(transient * T) and t[-1] == pytest.approx((transient + periods) * T)
+    assert np.all(np.diff(t) >= 0.0) and np.all(np.isfinite(sol.trajectory))
+    assert len(t) == pytest.approx(periods * per_period + 1 + 2 * sol.impacts.t.size, abs=2)
+    assert np.max(np.diff(t)) <= T / per_period * (1 + 1e-9)
+    np.testing.assert_allclose(sol.trajectory[-1], sol.samples[-1], atol=1e-12)  # (the span ends at a sample)

@@ -318,3 +318,25 @@ def test_sweep_errors(argv, message, capsys, tmp_path, monkeypatch):
     err = capsys.readouterr().err
     assert code != 0 and message in err and len(err.strip().splitlines()) == 1
     assert list(tmp_path.iterdir()) == []
+
+
+def test_sweep_chatter_tol_is_a_setting_of_the_spec():
+    """issue 29: the sweep driver takes the spec's chatter_tol (it hard-coded the default)."""
+    import dataclasses
+
+    from grazing.core.options import CHATTER_TOL
+    from grazing.models import bouncing_ball
+    from grazing.sweeps.run import batch_key
+    from grazing.sweeps.spec import sweep_spec
+
+    settings = grazing.SweepSettings(transient=3, periods=10, lyapunov=False)
+    spec = sweep_spec(bouncing_ball(amplitude=1.2), "amplitude", [1.2], settings=settings)
+    assert spec.chatter_tol == CHATTER_TOL and "chatter_tol" not in spec.description()  # (stores kept)
+    never = dataclasses.replace(spec, chatter_tol=0.0)  # chattering is never summed in closed form
+    assert never.description()["chatter_tol"] == 0.0 and never.fingerprint() != spec.fingerprint()
+    assert batch_key(never) != batch_key(spec)
+    default, unsummed = run_chunk(spec, 0), run_chunk(never, 0)
+    assert default.status.tolist() == unsummed.status.tolist() == [0]
+    # The ball is thrown off the table and chatters back to rest on it, period after period: summed,
+    # a chattering sequence counts as the impacts before its tail; unsummed, every impact of it.
+    assert unsummed.impacts[0] > default.impacts[0] > 0

@@ -37,6 +37,12 @@ CHATTER_TOL = 1e-9
 """A chattering sequence whose remaining duration is below this fraction of the forcing
 period is summed in closed form and continued as sticking."""
 
+STEPS_PER_PERIOD = 20000
+"""The integrator's default step limit grows by this many steps per forcing period (:func:`step_limit`)."""
+
+STEPS_EXTRA = 100_000
+"""The integrator's default step limit for no forcing period at all (:func:`step_limit`)."""
+
 NEWTON_TOL = 1e-11
 """Periodic orbits: Newton's method stops when ``max |P^n(x) - x|`` is below this."""
 
@@ -203,6 +209,17 @@ class Tangent:
         return self.jacobian or self.lyapunov
 
 
+def step_limit(periods: int) -> int:
+    """The default step limit of a run over ``periods`` forcing periods.
+
+    Examples
+    --------
+    >>> step_limit(10)
+    300000
+    """
+    return STEPS_PER_PERIOD * periods + STEPS_EXTRA
+
+
 @dataclass(frozen=True)
 class Solver:
     """Settings of the Taylor integrator.
@@ -213,7 +230,8 @@ class Solver:
         Local error tolerance in (0, 0.01); sets the Taylor order (20 at the
         default, machine epsilon) and the step.
     max_steps
-        Abort after this many steps (default: ``20000 * periods + 100000``).
+        Abort after this many steps (default: :func:`step_limit` of the periods run,
+        transient included: ``20000 * periods + 100000``).
     chatter_tol
         A chattering sequence whose remaining duration is below this fraction
         of the period is summed to its accumulation point and continued as

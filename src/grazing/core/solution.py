@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from grazing.core.options import STEPS_PER_PERIOD
 from grazing.core.period import DEFAULT_MAX_PERIOD, DEFAULT_PERIOD_TOL, detect_period
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -69,8 +70,8 @@ _REASONS = {
     Status.OK: ("ok", "computed"),
     Status.STEP_LIMIT: (
         "step limit",
-        "the integrator reached its step limit (20000 steps per forcing period): the forcing period "
-        "is very long for the motion, the motion very fast, or the tolerance very small",
+        f"the integrator reached its step limit ({STEPS_PER_PERIOD} steps per forcing period): the forcing "
+        "period is very long for the motion, the motion very fast, or the tolerance very small",
     ),
     Status.NONFINITE: (
         "non-finite state",

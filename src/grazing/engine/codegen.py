@@ -372,14 +372,20 @@ def driver_key() -> str:
     """Cache key of the compiled driver: its sources and those of everything it inlines.
 
     numba's on-disk cache does not notice changes in functions imported from
-    other modules, so the sources of the helpers are part of the key.
+    other modules, so the sources of the helpers are part of the key, and so
+    are the values of the constants the driver takes from :mod:`grazing.core`
+    (the step limit, the status codes).
     """
     from importlib.metadata import version
 
+    from grazing.core.options import STEPS_EXTRA, STEPS_PER_PERIOD
+    from grazing.core.solution import Status
+
     here = Path(__file__).parent
-    files = [here / f for f in ("polyroots.py", "stepping.py", "records.py", "abi.py")]
+    files = [here / f for f in ("polyroots.py", "stepping.py", "records.py", "abi.py", "timebase.py")]
     deps = "".join(path.read_text() for path in [*files, *driver.template_files()])
-    return _key(_CODEGEN_VERSION, version("numba"), sys.version, deps)  # (numba's version, not imported)
+    constants = (STEPS_PER_PERIOD, STEPS_EXTRA, [(s.name, int(s)) for s in Status])  # (from core)
+    return _key(_CODEGEN_VERSION, version("numba"), sys.version, deps, constants)  # (numba's, not imported)
 
 
 def _init_numba_without_blas_probe() -> None:

@@ -21,9 +21,9 @@ own compiled function, which raises the error as a Python exception.
 
 Examples
 --------
->>> sweep = load_sweep_lanes()  # the driver's arguments; it writes the out_* arrays
->>> DRIVER_ARGUMENTS[:3], DRIVER_ARGUMENTS[-1]
-(('m', 'lanes', 'jobs'), 'out_status')
+>>> sweep = load_sweep_lanes()  # the driver's arguments (records.SWEEP_RECORDS); it writes the results
+>>> [label for label, kind, spec in _layout()][:3]
+['Kernels.fns', 'Kernels.nx', 'Kernels.nsens']
 """
 
 from __future__ import annotations
@@ -37,52 +37,55 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 from types import ModuleType
-from typing import Any
+from typing import Annotated, Any
 
 import numpy as np
 
-DRIVER_ARGUMENTS = (
-    "m", "lanes", "jobs", "control", "fresh", "periodic", "x0", "firsts", "pvs", "Ts", "sphase", "tcarry",
-    "zdms", "transient", "periods", "adaptive", "adaptive_tol", "lyapunov", "safety", "chatter_tol", "zdm_on",
-    "zdm_a", "zdm_e", "zdm_window", "watch", "out_samples", "out_by_stop", "out_lyap", "out_used", "out_x",
-    "out_t", "out_status",
-)  # fmt: skip
-"""The arguments of :func:`grazing.engine.driver.lanes.sweep_lanes`; the loaded entry point takes them too."""
-_KERNELS = ("fns", "nx", "nsens", "nstops", "order", "sticks", "mlanes")
-"""The fields of ``m`` (:class:`grazing.engine.records.Kernels`)."""
-_ARRAYS = {
-    "fns": ("i8", 1), "sticks": ("?", 1), "jobs": ("i8", 2), "control": ("i8", 1), "x0": ("f8", 2),
-    "firsts": ("f8", 2),
-    "pvs": ("f8", 2), "Ts": ("f8", 1), "sphase": ("f8", 1), "tcarry": ("f8", 1), "zdms": ("f8", 1),
-    "zdm_e": ("f8", 1),
-    "out_samples": ("f8", 3), "out_by_stop": ("i8", 2), "out_lyap": ("f8", 1), "out_used": ("i8", 1),
-    "out_x": ("f8", 2), "out_t": ("f8", 1), "out_status": ("i8", 1),
-}  # fmt: skip
-"""dtype and dimensions of the array arguments (C-contiguous)."""
-_BOOLS = ("fresh", "periodic", "adaptive", "lyapunov", "zdm_on")
-_FLOATS = ("adaptive_tol", "safety", "chatter_tol", "zdm_a", "zdm_window")
 _PREFIX = "grazing_native"
 _ENTRY = "sweep_lanes"
 _RETURNED = (0, -2)
 """numba's status codes of a function that returned (OK, None); the others report an exception."""
 
 
+def _layout() -> list[tuple[str, str, Any]]:
+    """The sweep driver's arguments, field by field: ``(record.field, kind, dtype and dimensions)``.
+
+    Derived from the annotations of :data:`grazing.engine.records.SWEEP_RECORDS`:
+    an array field is annotated with its dtype and dimensions, the others are
+    ``int``, ``float`` or ``bool``.
+    """
+    from typing import get_args, get_origin, get_type_hints
+
+    from grazing.engine.records import SWEEP_RECORDS
+
+    fields = []
+    for record in SWEEP_RECORDS:
+        for name, hint in get_type_hints(record, include_extras=True).items():
+            label = f"{record.__name__}.{name}"
+            if get_origin(hint) is Annotated:
+                fields.append((label, "array", get_args(hint)[1]))
+            elif hint in (int, float, bool):
+                fields.append((label, hint.__name__, None))
+            else:  # pragma: no cover - a record field the driver cannot take
+                raise TypeError(f"sweep driver: {label} has a type the machine code cannot take: {hint}")
+    return fields
+
+
 def _signature() -> Any:
-    """The numba signature of ``sweep_lanes`` for the arrays :data:`_ARRAYS` describes."""
+    """The numba signature of ``sweep_lanes``: a tuple of its fields' types per record."""
     from numba import types
 
+    from grazing.engine.records import SWEEP_RECORDS
+
     scalar = {"i8": types.int64, "f8": types.float64, "?": types.boolean}
-
-    def of(name: str) -> Any:
-        if name in _ARRAYS:
-            dtype, ndim = _ARRAYS[name]
-            return types.Array(scalar[dtype], ndim, "C")
-        if name in _BOOLS:
-            return types.boolean
-        return types.float64 if name in _FLOATS else types.int64
-
-    kernels = types.Tuple([of(name) for name in _KERNELS])
-    return tuple(kernels if name == "m" else of(name) for name in DRIVER_ARGUMENTS)
+    kinds = {"int": types.int64, "float": types.float64, "bool": types.boolean}
+    of = {
+        label: types.Array(scalar[spec[0]], spec[1], "C") if kind == "array" else kinds[kind]
+        for label, kind, spec in _layout()
+    }
+    return tuple(
+        types.Tuple([of[f"{record.__name__}.{name}"] for name in record._fields]) for record in SWEEP_RECORDS
+    )
 
 
 def _slot_loads(types_: list[str]) -> tuple[list[str], list[str]]:
@@ -102,6 +105,48 @@ def _slot_loads(types_: list[str]) -> tuple[list[str], list[str]]:
     return lines, args
 
 
+_REFCOUNTS = {
+    "NRT_incref": (
+        "  %null = icmp eq ptr %m, null\n  br i1 %null, label %done, label %add\n"
+        "add:\n  %c = load i64, ptr %m, align 8\n  %c1 = add i64 %c, 1\n  store i64 %c1, ptr %m, align 8\n"
+        "  br label %done\ndone:\n  ret void\n"
+    ),
+    "NRT_decref": (
+        "  %null = icmp eq ptr %m, null\n  br i1 %null, label %done, label %sub\n"
+        "sub:\n  %c = load i64, ptr %m, align 8\n  %c1 = sub i64 %c, 1\n  store i64 %c1, ptr %m, align 8\n"
+        "  %zero = icmp eq i64 %c1, 0\n  br i1 %zero, label %free, label %done\n"
+        "free:\n  call void @NRT_MemInfo_call_dtor(ptr %m)\n  br label %done\ndone:\n  ret void\n"
+    ),
+}
+
+
+def plain_reference_counts(text: str) -> str:
+    """numba's LLVM IR ``text`` with reference counts kept by plain (not atomic) adds.
+
+    numba counts the references to each array it allocates with atomic
+    instructions (an array may be shared between threads), about 20 cycles
+    each, and a numba function increments and decrements the count of each
+    array it is given: the sweep driver's pieces, given the lanes' arrays,
+    spent a fifth of its time on them.  In the driver's machine code no
+    count is shared between threads: the arrays it is given come without a
+    memory manager (:func:`flatten`: a null pointer, whose count is never
+    touched) and those it allocates are its own thread's, so plain adds count
+    the same.  They are inlined where they are called (:func:`object_file`
+    runs LLVM's always-inliner, which touches nothing else).  The text is
+    returned unchanged if numba's definitions are not found (they stay atomic).
+    """
+    import re
+
+    for name, body in _REFCOUNTS.items():
+        pattern = rf"^define linkonce_odr void @{name}\(ptr[^%\n]*%([\w.]+)\)([^{{\n]*)\{{\n.*?^\}}\n"
+        found = re.search(pattern, text, flags=re.M | re.S)
+        if found is None or "NRT_MemInfo_call_dtor" not in text:
+            return text
+        head = f"define linkonce_odr void @{name}(ptr %m) alwaysinline nounwind {{\nentry:\n"
+        text = text[: found.start()] + head + body + "}\n" + text[found.end() :]
+    return text
+
+
 def object_file(dispatcher: Any, signature: tuple[Any, ...], name: str) -> bytes:
     """The cache file of a numba function compiled for ``signature``: a JSON line, then an object file.
 
@@ -115,7 +160,7 @@ def object_file(dispatcher: Any, signature: tuple[Any, ...], name: str) -> bytes
     import llvmlite.binding as llvm
 
     dispatcher.compile(signature)
-    text = dispatcher.inspect_llvm(signature)
+    text = plain_reference_counts(dispatcher.inspect_llvm(signature))
     module = llvm.parse_assembly(text)
     target = module.get_function(dispatcher.overloads[signature].fndesc.llvm_func_name)
     params = [str(a.type) for a in target.arguments][2:]  # (after the return slot and the exception info)
@@ -139,6 +184,10 @@ def object_file(dispatcher: Any, signature: tuple[Any, ...], name: str) -> bytes
         f'declare i32 @"{target.name}"(ptr, ptr, {", ".join(params)})\n{entry}\n'
     )
     module.link_in(wrapper)
+    passes = llvm.create_new_module_pass_manager()
+    passes.add_always_inliner_pass()  # (only the counts above: numba's own code is not optimised again)
+    tuning = llvm.create_pipeline_tuning_options(0)
+    passes.run(module, llvm.create_pass_builder(_jit_target_machine(), tuning))
     needs = sorted(
         {f.name for f in module.functions if f.is_declaration and not f.name.startswith("llvm.")}
         | {g.name for g in module.global_variables if g.is_declaration}
@@ -243,51 +292,60 @@ def _resolvable(name: str) -> bool:
 
 
 def _shapes(values: dict[str, Any]) -> dict[str, tuple[int, ...]]:
-    """The shape each array argument must have, from the sizes the others give."""
-    nx, nstops, npts = values["nx"], values["nstops"], values["pvs"].shape[0]
-    names = ("Ts", "sphase", "tcarry", "zdms", "out_lyap", "out_used", "out_t", "out_status")
-    per_point = {name: (npts,) for name in names}
-    njobs = values["jobs"].shape[0]
+    """The shape each array field must have, from the sizes the others give (the driver does not check)."""
+    nx, nstops = values["Kernels.nx"], values["Kernels.nstops"]
+    npts, njobs = values["LanePoints.pvs"].shape[0], values["LaneJobs.jobs"].shape[0]
+    per_point = ("LanePoints.Ts", "LanePoints.sphase", "LanePoints.tcarry", "LanePoints.zdms")
+    per_point += ("LaneResults.lyap", "LaneResults.used", "LaneResults.t", "LaneResults.status")
     return {
-        **per_point, "fns": values["fns"].shape, "sticks": (nstops,), "jobs": (njobs, 2), "control": (3,),
-        "x0": (njobs, nx), "firsts": (njobs, nx + 1), "pvs": values["pvs"].shape, "zdm_e": (nx,),
-        "out_samples": (npts, values["periods"], nx),
-        "out_by_stop": (npts, nstops), "out_x": (npts, nx),
+        **{name: (npts,) for name in per_point}, "Kernels.fns": values["Kernels.fns"].shape,
+        "Kernels.sticks": (nstops,), "LaneJobs.jobs": (njobs, 2), "LaneJobs.control": (3,),
+        "LaneJobs.x0": (njobs, nx), "LaneJobs.firsts": (njobs, nx + 1),
+        "LanePoints.pvs": values["LanePoints.pvs"].shape,
+        "LaneSettings.zdm_e": (nx,), "LaneResults.samples": (npts, values["LaneSettings.periods"], nx),
+        "LaneResults.by_stop": (npts, nstops), "LaneResults.x": (npts, nx),
     }  # fmt: skip
 
 
 def flatten(arguments: tuple[Any, ...]) -> tuple[np.ndarray, list[str]]:
     """``sweep_lanes``'s arguments as numba passes them: 64-bit slots and their LLVM types.
 
-    An array is its memory manager (none), parent (none), size, item size,
-    data pointer, shape and strides; ``m`` is its fields; a boolean a byte.
-    Arrays of another dtype, dimension, shape or layout than the driver takes
-    are refused (``TypeError``).
+    The arguments are the records of :data:`grazing.engine.records.SWEEP_RECORDS`
+    (or plain tuples of their fields), each passed field by field: an array as
+    its memory manager (none), parent (none), size, item size, data pointer,
+    shape and strides; a boolean as a byte.  Arrays of another dtype,
+    dimension, shape or layout than the driver takes are refused
+    (``TypeError``).
     """
-    if len(arguments) != len(DRIVER_ARGUMENTS):
-        raise TypeError(f"sweep driver: {len(DRIVER_ARGUMENTS)} arguments expected, got {len(arguments)}")
-    values = dict(zip(DRIVER_ARGUMENTS, arguments, strict=True))
-    values.update(zip(_KERNELS, values.pop("m"), strict=True))
+    from grazing.engine.records import SWEEP_RECORDS
+
+    if len(arguments) != len(SWEEP_RECORDS):
+        raise TypeError(f"sweep driver: {len(SWEEP_RECORDS)} arguments expected, got {len(arguments)}")
+    values: dict[str, Any] = {}
+    for record, value in zip(SWEEP_RECORDS, arguments, strict=True):
+        if not isinstance(value, tuple) or len(value) != len(record._fields):
+            raise TypeError(f"sweep driver: a {record.__name__} ({len(record._fields)} fields) expected")
+        values.update((f"{record.__name__}.{name}", v) for name, v in zip(record._fields, value, strict=True))
     shapes = _shapes(values)
     slots: list[int] = []
     kinds: list[str] = []
-    for name in (*_KERNELS, *DRIVER_ARGUMENTS[1:]):
-        value = values[name]
-        if name in _ARRAYS:
-            dtype, ndim = _ARRAYS[name]
+    for label, kind, spec in _layout():
+        value = values[label]
+        if kind == "array":
+            dtype, ndim = spec
             a = value
             ok = isinstance(a, np.ndarray) and a.dtype == np.dtype(dtype) and a.ndim == ndim
-            if not (ok and a.flags.c_contiguous and a.shape == shapes[name]):
-                want = f"a C-contiguous {np.dtype(dtype)} array of shape {shapes[name]}"
-                raise TypeError(f"sweep driver: {name} must be {want}")
-            if name.startswith("out_") and not a.flags.writeable:
-                raise TypeError(f"sweep driver: {name} must be writeable")
+            if not (ok and a.flags.c_contiguous and a.shape == shapes[label]):
+                want = f"a C-contiguous {np.dtype(dtype)} array of shape {shapes[label]}"
+                raise TypeError(f"sweep driver: {label} must be {want}")
+            if label.startswith("LaneResults.") and not a.flags.writeable:
+                raise TypeError(f"sweep driver: {label} must be writeable")
             slots += [0, 0, a.size, a.itemsize, a.ctypes.data, *a.shape, *a.strides]
             kinds += ["ptr", "ptr", "i64", "i64", "ptr", *["i64"] * (2 * ndim)]
-        elif name in _BOOLS:
+        elif kind == "bool":
             slots.append(1 if value else 0)
             kinds.append("i8")
-        elif name in _FLOATS:
+        elif kind == "float":
             slots.append(int(np.float64(value).view(np.int64)))
             kinds.append("double")
         else:
@@ -307,10 +365,10 @@ def _caller(address: int, params: list[str], keep: Any) -> Callable[..., None]:
         if entry(slots.ctypes.data) not in _RETURNED:  # pragma: no cover - the driver raised
             from grazing.engine.codegen import load_driver
 
-            values = dict(zip(DRIVER_ARGUMENTS, arguments, strict=True))
-            values["control"][1] = 1  # (the other threads of the call stop)
-            values["control"] = np.zeros(3, dtype=np.int64)  # every job again, in this thread:
-            load_driver().sweep_lanes(*values.values())  # numba's function raises the error
+            m, cfg, work, points, out = arguments
+            work[1][1] = 1  # (the other threads of the call stop: LaneJobs.control)
+            again = (work[0], np.zeros(3, dtype=np.int64), *work[2:])  # every job again, in this thread:
+            load_driver().sweep_lanes(m, cfg, again, points, out)  # numba's function raises the error
             raise RuntimeError("the compiled sweep driver failed where numba's function did not")
 
     sweep_lanes.library = keep  # type: ignore[attr-defined]  # (the machine code lives as long as this)
@@ -322,7 +380,8 @@ def load_sweep_lanes() -> Callable[..., None]:
     """The sweep driver's entry point, loaded from the kernel cache (compiled by numba the first time).
 
     The returned function takes the arguments of
-    :func:`grazing.engine.driver.lanes.sweep_lanes`.  If numba's runtime
+    :func:`grazing.engine.driver.lanes.sweep_lanes` (the records of
+    :data:`grazing.engine.records.SWEEP_RECORDS`).  If numba's runtime
     cannot be given to the machine code (a numba that no longer provides a
     C helper), numba's own compiled function is returned instead.
     """

@@ -1,18 +1,32 @@
 """The records the compiled driver takes and returns: :class:`Start`, :class:`Config`, :class:`Kernels`,
-:class:`Result`.
+:class:`Result`; and the sweep driver's :class:`LaneSettings`, :class:`LaneJobs`, :class:`LanePoints`,
+:class:`LaneResults`.
 
 Named tuples, which numba compiles as structs: the driver,
 ``integrate(start, pv, config, kernels) -> result``, reads its settings by name (no
 positional argument lists) and returns one record that the runner reads by
 name.  Built by :class:`grazing.engine.runner.Runner` (the kernels by
-:mod:`grazing.engine.codegen`).
+:mod:`grazing.engine.codegen`).  The sweep driver,
+``sweep_lanes(kernels, settings, jobs, points, results)``, takes the records
+of a sweep (built by :class:`grazing.sweeps.run.LaneBatch`); their arrays are
+annotated with their dtype and dimensions (:data:`SWEEP_RECORDS`), from which
+:mod:`grazing.engine.native` derives the machine code's argument layout and
+its checks.
 """
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import Annotated, NamedTuple
 
 import numpy as np
+
+I8_1 = Annotated[np.ndarray, ("i8", 1)]
+I8_2 = Annotated[np.ndarray, ("i8", 2)]
+F8_1 = Annotated[np.ndarray, ("f8", 1)]
+F8_2 = Annotated[np.ndarray, ("f8", 2)]
+F8_3 = Annotated[np.ndarray, ("f8", 3)]
+BOOL_1 = Annotated[np.ndarray, ("?", 1)]
+"""C-contiguous arrays of a dtype (numpy's code) and number of dimensions, as the sweep driver takes them."""
 
 
 class Start(NamedTuple):
@@ -68,6 +82,9 @@ class Config(NamedTuple):
     sigints_seen: int  # the count when the call started: the driver stops when it changes
 
 
+CALL = Config._fields[: Config._fields.index("T")]
+"""The fields of :class:`Config` that each call sets (built by name by the runner)."""
+
 STATIC = Config._fields[Config._fields.index("T") : Config._fields.index("stop") + 1]
 """The fields of :class:`Config` that stay the same for every call on one trajectory."""
 
@@ -78,12 +95,12 @@ INTERRUPT = Config._fields[Config._fields.index("sigints") :]
 class Kernels(NamedTuple):
     """A model's compiled functions as the driver sees them: their addresses and the model's sizes."""
 
-    fns: np.ndarray  # int64 addresses, in the order of grazing.engine.abi.SLOTS then LANE_SLOTS
+    fns: I8_1  # int64 addresses, in the order of grazing.engine.abi.SLOTS then LANE_SLOTS
     nx: int  # states
     nsens: int  # sensitivity directions (columns of V after the first nx)
     nstops: int
     order: int  # of the Taylor polynomials
-    sticks: np.ndarray  # bool per stop: the stop has a sticking mode
+    sticks: BOOL_1  # bool per stop: the stop has a sticking mode
     lanes: int  # lanes of the lane functions (0: none)
 
 
@@ -106,3 +123,58 @@ class Result(NamedTuple):
     lyap_span: float
     guard_min: np.ndarray  # per stop (rows): [h, t, state..., h_approach, t_approach, state...]
     jacobian_valid: bool
+
+
+class LaneSettings(NamedTuple):
+    """How the sweep driver computes every point (:mod:`grazing.engine.driver.lanes`)."""
+
+    lanes: int  # lanes (the lane functions' width, or 1)
+    fresh: bool  # every point from its job's x0 at time 0 (else from the previous point's end)
+    periodic: bool  # the model is periodically forced (time kept as k T + s)
+    transient: int  # periods run before the samples ...
+    periods: int  # ... and sampled
+    adaptive: bool  # transients end early once the samples repeat ...
+    adaptive_tol: float  # ... to this
+    lyapunov: bool  # the largest Lyapunov exponent over the sampled periods
+    safety: float  # step safety exponent (grazing.engine.runner.step_safety)
+    chatter_tol: float  # chattering shorter than this fraction of a period is continued as sticking
+    zdm: bool  # the discontinuity map instead of the impacts on stop ``stop``
+    zdm_a: float  # its L_f^2 h at the grazing point
+    zdm_e: F8_1  # its direction e, (nx,)
+    zdm_window: float  # largest |L_f h| / a for which it is applied
+    stop: int  # the stop the discontinuity map stands for
+
+
+class LaneJobs(NamedTuple):
+    """The jobs of a sweep driver call: runs of consecutive points, taken by the lanes in turn."""
+
+    jobs: I8_2  # (jobs, 2): each job's first point and the end of its points
+    control: I8_1  # (3,): the next job, stop (1), most jobs at a time per thread (0: one per lane)
+    x0: F8_2  # (jobs, nx): a point's start after a failed one (and every point's when fresh), at time 0
+    firsts: F8_2  # (jobs, 1 + nx): the time and state each job's first point starts from
+
+
+class LanePoints(NamedTuple):
+    """Per point of a sweep driver call."""
+
+    pvs: F8_2  # (points, parameters): the parameter vector
+    Ts: F8_1  # the forcing period
+    sphase: F8_1  # the sampling phase (local time)
+    tcarry: F8_1  # the start time of a point continued from the previous one (periodic models)
+    zdms: F8_1  # the discontinuity map's local time
+
+
+class LaneResults(NamedTuple):
+    """What the sweep driver writes per point (the caller allocates it)."""
+
+    samples: F8_3  # (points, periods, nx)
+    by_stop: I8_2  # (points, stops): impacts on each stop over the sampled periods
+    lyap: F8_1  # the largest Lyapunov exponent (nan: none)
+    used: I8_1  # transient periods run
+    x: F8_2  # (points, nx): the final state ...
+    t: F8_1  # ... and time
+    status: I8_1  # the point's grazing.core.solution.Status code once finished (the caller sets -1)
+
+
+SWEEP_RECORDS = (Kernels, LaneSettings, LaneJobs, LanePoints, LaneResults)
+"""The records :func:`grazing.engine.driver.lanes.sweep_lanes` takes, in order (as plain tuples)."""

@@ -17,9 +17,11 @@ from typing import Any
 import numpy as np
 
 from grazing.core.model import HybridModel
-from grazing.core.options import CHATTER_TOL, MACHINE_EPSILON
+from grazing.core.options import CHATTER_TOL, MACHINE_EPSILON, step_limit
 from grazing.core.solution import Status
 from grazing.engine.codegen import direction_columns, taylor_order
+from grazing.engine.records import CALL, STATIC
+from grazing.engine.timebase import start_times
 from grazing.errors import SimulationError
 
 RECORD_IMPACTS = {"none": 0, "sampled": 1, "all": 2}
@@ -171,21 +173,10 @@ class Runner:
         self.chatter_time = chatter_tol * self.T
         self.set_params(model)
         T = self.T
-        snap = 1e-9 * T
         s_phase = (phase % (2 * math.pi)) / (2 * math.pi) * T
         self.mode = 0
-        if not model.periodic:
-            self.k, self.s, self.ks, self.ss = 0, float(t0), 0, float(t0) + T
-            self.k_start = 0
-            return
-        k0 = math.floor(t0 / T)
-        s0 = t0 - k0 * T
-        if s0 >= T - snap:  # just below a period boundary: keep s0 slightly negative
-            k0, s0 = k0 + 1, s0 - T
-        self.k, self.s = k0, s0
-        self.k_start = k0
-        self.ks = k0 if s0 < s_phase - snap else k0 + 1
-        self.ss = s_phase
+        self.k, self.s, self.ks, self.ss = start_times(float(t0), T, s_phase, bool(model.periodic))
+        self.k_start = self.k
 
     @property
     def t(self) -> float:
@@ -212,13 +203,16 @@ class Runner:
         T = float(self.model.period)
         z = self.zdm
         n = self.model.n_states
-        return (
-            T, bool(self.model.periodic), T, float(self.safety), bool(self.variational), bool(self.events),
-            float(self.chatter_time), z is not None, float(z.phase) % T if z is not None else 0.0,
-            float(z.accel) if z is not None else 1.0,
-            np.asarray(z.direction if z is not None else np.zeros(n), dtype=float),
-            float(z.window) if z is not None else 0.0, np.asarray(self.Tp, dtype=float), self.stop,
+        fields = dict(
+            T=T, wrap=bool(self.model.periodic), max_step=T, safety=float(self.safety),
+            use_var=bool(self.variational), events=bool(self.events), chatter_time=float(self.chatter_time),
+            zdm=z is not None, zdm_s=float(z.phase) % T if z is not None else 0.0,
+            zdm_a=float(z.accel) if z is not None else 1.0,
+            zdm_e=np.asarray(z.direction if z is not None else np.zeros(n), dtype=float),
+            zdm_window=float(z.window) if z is not None else 0.0, Tp=np.asarray(self.Tp, dtype=float),
+            stop=self.stop,
         )  # fmt: skip
+        return tuple(fields[name] for name in STATIC)
 
     def vector_field(self, x: np.ndarray, s: float) -> np.ndarray:
         """``f(x, s)`` with the kernels this runner already loaded."""
@@ -251,13 +245,15 @@ class Runner:
         """Advance by ``periods`` samples, keeping (recording) the last ``keep``."""
         T = self.T
         if max_steps is None:
-            max_steps = 20000 * periods + 100_000
+            max_steps = step_limit(periods)
         start = (self.x, self.V, self.k, self.s, self.mode)  # a records.Start, as a plain tuple
-        cfg = (  # a records.Config, as a plain tuple (see the driver's integrate)
-            int(max_steps), periods, self.ks, float(self.ss), keep, bool(lyapunov),
-            T / trajectory if trajectory else 0.0, bool(guard_min), RECORD_IMPACTS[impacts],
-            self.touch_start, self.touch_end, *self._static,
+        call = dict(
+            max_steps=int(max_steps), n_samples=periods, ks=self.ks, ss=float(self.ss), n_keep=keep,
+            lyapunov=bool(lyapunov), traj_dt=T / trajectory if trajectory else 0.0, track_min=bool(guard_min),
+            record_impacts=RECORD_IMPACTS[impacts], touch_start=self.touch_start, touch_end=self.touch_end,
         )  # fmt: skip
+        # A records.Config but its INTERRUPT fields, as a plain tuple (see the driver's integrate).
+        cfg = (*(call[name] for name in CALL), *self._static)
         out = self.kern.integrate(start, self.pv, cfg)
         if out.status != Status.OK:
             raise SimulationError(
@@ -275,31 +271,3 @@ class Runner:
             out.samples, out.impacts, out.n_impacts, out.sticking, out.trajectory, out.log_sums,
             out.lyap_span, gm[:, : 2 + n], gm[:, 2 + n :], out.jacobian_valid, out.steps,
         )  # fmt: skip
-
-
-def _compile_one(job: tuple[HybridModel, tuple[str, ...]]) -> None:
-    model, sens = job
-    Runner(model, np.zeros(model.n_states), variational=bool(sens), sensitivities=sens).advance(1, 1)
-
-
-def precompile(jobs: Sequence[tuple[HybridModel, tuple[str, ...]]], workers: int | None = None) -> None:
-    """Compile (or load) the kernels of several model variants in parallel processes.
-
-    Each job is ``(model, sensitivities)``.  numba caches the machine code on
-    disk, so afterwards every process loads it instead of compiling.  Useful
-    before a long computation on a machine that has not compiled them yet.
-    """
-    import os
-
-    from grazing.parallel import map_unordered
-
-    seen: set[tuple[int, int]] = set()
-    todo = []
-    for model, sens in jobs:  # jobs needing the same module compile it once
-        key = (id(model._def), direction_columns(len(sens)))
-        if key not in seen:
-            seen.add(key)
-            todo.append((model, sens))
-    # A fresh interpreter per worker (spawn): no half-initialised numba state is inherited.
-    for _ in map_unordered(_compile_one, todo, workers or os.cpu_count() or 1, start_method="spawn"):
-        pass

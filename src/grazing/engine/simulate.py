@@ -10,24 +10,16 @@ import numpy as np
 
 from grazing.core.model import HybridModel
 from grazing.core.options import (
-    CHATTER_TOL,
-    MACHINE_EPSILON,
     SaveAt,
     Solver,
     Tangent,
     refuse_unknown,
+    step_limit,
     with_shorthands,
 )
 from grazing.core.solution import Impacts, Solution
 from grazing.engine.runner import DiscontinuityMap, Runner
 from grazing.errors import InvalidParameterError
-
-DEFAULT_TOL = MACHINE_EPSILON
-"""Default local error tolerance of the Taylor integrator (machine epsilon)."""
-
-DEFAULT_CHATTER_TOL = CHATTER_TOL
-"""A chattering sequence whose remaining duration is below this fraction of the
-forcing period is summed in closed form and continued as sticking."""
 
 CHUNK_PERIODS = 4096
 """Runs are integrated in chunks of this many forcing periods."""
@@ -81,7 +73,7 @@ def simulate(
     solver
         Integrator settings (:class:`~grazing.core.options.Solver`): ``tol``
         (local error tolerance, sets the Taylor order), ``max_steps``
-        (default ``20000 * (transient + periods) + 10**5``), ``chatter_tol``
+        (default :func:`~grazing.core.options.step_limit` of ``transient + periods``), ``chatter_tol``
         (chattering shorter than this fraction of a period is summed to its
         accumulation point and continued as sticking).
     **shorthands
@@ -151,7 +143,7 @@ def simulate(
     ks_start = run.ks
     total = transient + periods
     if max_steps is None:
-        max_steps = 20000 * total + 100_000
+        max_steps = step_limit(total)
     done = 0
     steps = 0
     n_imp = 0

@@ -22,7 +22,6 @@ import math
 import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -235,14 +234,6 @@ def grazing_curve(
             progress(len(curve.points), float(pt.u[n + 2]))
     curve.status = palc.status
     return curve
-
-
-def save_dataset(ds: Any, path: str | Path, overwrite: bool = False) -> None:
-    """Write an xarray dataset to NetCDF (:func:`grazing.outputs.write_netcdf`: all at once, with
-    grazing's mark; a file there that grazing did not write is refused unless ``overwrite``)."""
-    from grazing.outputs import write_netcdf
-
-    write_netcdf(path, ds, overwrite=overwrite)
 
 
 def _closed_upper(par: Parameter) -> float:

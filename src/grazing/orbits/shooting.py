@@ -30,9 +30,6 @@ from grazing.errors import (
 )
 from grazing.maps import FlowMap, flow_map
 
-DEFAULT_TOL = NEWTON_TOL
-DEFAULT_MAX_ITER = NEWTON_MAX_ITER
-
 SECTION_MARGIN = 0.05
 """When an impact of the starting orbit lies within this fraction of a period of the
 stroboscopic section, an automatic section (``t0=None``) moves to a quiet phase."""
@@ -204,7 +201,7 @@ def quiet_section(orbit: PeriodicOrbit) -> float:
     return float((phases[i] + gaps[i] / 2) % 1.0 * T)
 
 
-def move_section(orbit: PeriodicOrbit, t_new: float, *, tol: float = DEFAULT_TOL) -> PeriodicOrbit:
+def move_section(orbit: PeriodicOrbit, t_new: float, *, tol: float = NEWTON_TOL) -> PeriodicOrbit:
     """The same orbit on the section through ``t_new`` (a time in ``[0, T)``).
 
     The orbit is followed from its section to the next time ``t_new (mod T)``
@@ -338,8 +335,8 @@ def find_orbit(
     period: int | None = None,
     t0: float | None = 0.0,
     virtual: bool = False,
-    tol: float = DEFAULT_TOL,
-    max_iter: int = DEFAULT_MAX_ITER,
+    tol: float = NEWTON_TOL,
+    max_iter: int = NEWTON_MAX_ITER,
     transient: int = 500,
     stop_name: int | str | None = None,
 ) -> PeriodicOrbit:

@@ -40,11 +40,11 @@ from typing import Any
 import numpy as np
 
 from grazing.core.model import HybridModel
-from grazing.core.options import CHATTER_TOL
 from grazing.core.period import DEFAULT_MAX_PERIOD, DEFAULT_PERIOD_TOL, detect_periods
 from grazing.core.solution import Status
 from grazing.engine.codegen import taylor_order
 from grazing.engine.native import load_sweep_lanes
+from grazing.engine.records import LaneJobs, LanePoints, LaneResults, LaneSettings
 from grazing.engine.runner import step_safety
 from grazing.sweeps.spec import ChunkResult, SweepSpec
 from grazing.sweeps.status import NOT_COMPUTED, STATUS_DTYPE
@@ -61,7 +61,7 @@ def batch_key(spec: SweepSpec) -> tuple[Any, ...]:
         zdm = (float(z.accel), tuple(np.asarray(z.direction, dtype=float)), float(z.window), int(z.stop))
     return (
         id(spec.model._def), spec.model.periodic, taylor_order(spec.tol), spec.tol, spec.transient,
-        spec.periods, spec.adaptive, spec.adaptive_tol, spec.lyapunov, zdm,
+        spec.periods, spec.adaptive, spec.adaptive_tol, spec.lyapunov, zdm, spec.chatter_tol,
     )  # fmt: skip
 
 
@@ -171,40 +171,31 @@ class LaneBatch:
         """Compute the batch's points (or, with other threads running it too, its share of them)."""
         spec, kern, z = self._spec0, self._kern, self._spec0.zdm
         n = spec.model.n_states
-        load_sweep_lanes()(
-            kern.table,
-            1 if len(self.jobs) == 1 else max(1, kern.LANES),  # (the lane functions' width, or one lane)
-            self.jobs,
-            self.control,
-            self.fresh,
-            bool(spec.model.periodic),
-            self.x0,
-            self.firsts,
-            self.pvs,
-            self.Ts,
-            self.sphase,
-            self.tcarry,
-            self.zdms,
-            int(spec.transient),
-            int(spec.periods),
-            bool(spec.adaptive),
-            float(spec.adaptive_tol),
-            bool(spec.lyapunov),
-            float(step_safety(spec.tol, self._order)),
-            float(CHATTER_TOL),
-            z is not None,
-            float(z.accel) if z is not None else 1.0,
-            np.asarray(z.direction if z is not None else np.zeros(n), dtype=float),
-            float(z.window) if z is not None else 0.0,
-            int(z.stop) if z is not None else 0,
-            self.samples,
-            self.by_stop,
-            self.lyap,
-            self.used,
-            self.x_final,
-            self.t_final,
-            self.status,
+        settings = LaneSettings(
+            lanes=1
+            if len(self.jobs) == 1
+            else max(1, kern.LANES),  # (the lane functions' width, or one lane)
+            fresh=self.fresh,
+            periodic=bool(spec.model.periodic),
+            transient=int(spec.transient),
+            periods=int(spec.periods),
+            adaptive=bool(spec.adaptive),
+            adaptive_tol=float(spec.adaptive_tol),
+            lyapunov=bool(spec.lyapunov),
+            safety=float(step_safety(spec.tol, self._order)),
+            chatter_tol=float(spec.chatter_tol),
+            zdm=z is not None,
+            zdm_a=float(z.accel) if z is not None else 1.0,
+            zdm_e=np.asarray(z.direction if z is not None else np.zeros(n), dtype=float),
+            zdm_window=float(z.window) if z is not None else 0.0,
+            stop=int(z.stop) if z is not None else 0,
         )
+        work = LaneJobs(self.jobs, self.control, self.x0, self.firsts)
+        points = LanePoints(self.pvs, self.Ts, self.sphase, self.tcarry, self.zdms)
+        out = LaneResults(
+            self.samples, self.by_stop, self.lyap, self.used, self.x_final, self.t_final, self.status
+        )
+        load_sweep_lanes()(kern.table, tuple(settings), tuple(work), tuple(points), tuple(out))
 
     def stop(self) -> None:
         """Have the threads running the batch return at their next step (unfinished points stay so)."""

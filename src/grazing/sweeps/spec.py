@@ -21,11 +21,11 @@ from typing import Any
 import numpy as np
 
 from grazing.core.model import HybridModel
-from grazing.core.options import ADAPTIVE_TOL, SWEEP_TOL, SweepSettings
+from grazing.core.options import ADAPTIVE_TOL, CHATTER_TOL, SweepSettings
 from grazing.errors import InvalidParameterError
 
-DEFAULT_SWEEP_TOL = SWEEP_TOL
-"""Local error tolerance of sweeps: far below the 1e-6 of period detection."""
+_SETTINGS = SweepSettings()
+"""The defaults of a sweep's settings (:class:`~grazing.core.options.SweepSettings`)."""
 
 DiscontinuityMapLike = Any
 """A :class:`grazing.engine.runner.DiscontinuityMap` (typed loosely: the spec does not run anything)."""
@@ -81,26 +81,31 @@ class SweepSpec:
         ``t`` instead of starting from ``x0`` at time 0 (a chunk run again from
         the final state of the chunk before it, :mod:`grazing.sweeps.chain`);
         after a failed point the chain still starts again from ``x0``.
+    chatter_tol
+        Chattering shorter than this fraction of the forcing period is summed
+        to its accumulation point and continued as sticking (as
+        :class:`~grazing.core.options.Solver`'s).
     """
 
     model: HybridModel
     params: tuple[str, ...]
     points: tuple[tuple[float, ...], ...]
     x0: tuple[float, ...]
-    transient: int = 500
-    periods: int = 100
-    phase: float = 0.0
-    fresh: bool = False
-    chunk_size: int = 50
-    adaptive: bool = True
-    lyapunov: bool = True
-    tol: float = DEFAULT_SWEEP_TOL
+    transient: int = _SETTINGS.transient
+    periods: int = _SETTINGS.periods
+    phase: float = _SETTINGS.phase
+    fresh: bool = _SETTINGS.fresh
+    chunk_size: int = _SETTINGS.chunk_size
+    adaptive: bool = _SETTINGS.adaptive
+    lyapunov: bool = _SETTINGS.lyapunov
+    tol: float = _SETTINGS.tol
     shape: tuple[int, ...] = field(default=())
     zdm: DiscontinuityMapLike = None
     segments: int = 1
     starts: Any = field(default=None, compare=False, repr=False)
     adaptive_tol: float = ADAPTIVE_TOL
     resume: tuple[float, tuple[float, ...]] | None = None
+    chatter_tol: float = CHATTER_TOL
 
     def __post_init__(self) -> None:
         if not self.points:
@@ -207,6 +212,8 @@ class SweepSpec:
             d["resume"] = [self.resume[0], list(self.resume[1])]
         if self.adaptive_tol != ADAPTIVE_TOL:
             d["adaptive_tol"] = self.adaptive_tol
+        if self.chatter_tol != CHATTER_TOL:
+            d["chatter_tol"] = self.chatter_tol
         return d
 
     def fingerprint(self) -> str:

@@ -16,6 +16,7 @@ in a piece that another one inlines.
 
 The pieces, in the order a step uses them:
 
+* :mod:`.state` -- the state of a run (one per lane), a named record;
 * :mod:`.calls` -- the model's functions through the address table;
 
 * :mod:`.events` -- the step (Taylor coefficients and step size) and event
@@ -27,6 +28,8 @@ The pieces, in the order a step uses them:
   orthonormalisation, the discontinuity map;
 * :mod:`.impacts` -- reset and saltation matrix, chattering summed to sticking,
   release;
+* :mod:`.step` -- the parts of a step that the loop and the lanes share:
+  where it ends, and its end (time, Lyapunov vectors, the map, the event);
 * :mod:`.loop` -- ``integrate(start, config) -> result`` over the records of
   :mod:`grazing.engine.records`;
 * :mod:`.lanes` -- the points of a sweep on SIMD lanes, the loop's step per
@@ -38,7 +41,8 @@ from __future__ import annotations
 from pathlib import Path
 
 PIECES = (
-    "atomics.py", "calls.py", "events.py", "recording.py", "tangent.py", "impacts.py", "loop.py", "lanes.py",
+    "atomics.py", "state.py", "calls.py", "events.py", "recording.py", "tangent.py", "impacts.py", "step.py",
+    "loop.py", "lanes.py",
 )  # fmt: skip
 """The template files, in the order they are appended."""
 

@@ -79,17 +79,22 @@ def event_certificate(a, tail):
 
 
 @njit(cache=True, inline="always")
-def first_event(m, O, h, mode, stuck, events, skip, defl, defl_stop, end_contact, end_stop, a, work):
-    """The first event on the step over every stop: ``(u, stop)``, ``u < 0`` when there is none.
+def first_event(m, run, O, h, events, skip, end_contact, end_stop, a, work):
+    """The first event on the step of ``run`` over every stop: ``(u, stop)``, ``u < 0`` when there is none.
 
-    ``mode`` 1 is sticking to stop ``stuck`` (its row is the contact force);
-    the known roots at ``u = 0`` (``defl``) belong to stop ``defl_stop``, a
+    ``run`` is the run's state (:data:`.state.RUN_STATE`): ``run.mode`` 1 is
+    sticking to stop ``run.stuck`` (its row is the contact force); the known
+    roots at ``u = 0`` (``run.defl``) belong to stop ``run.defl_stop``, a
     final grazing contact (``end_contact``) to ``end_stop``.  Without
     ``events`` only the contact force is watched; stop ``skip`` (the one the
     discontinuity map stands for; -1: none) is not.
     """
     u = -1.0
     stop = 0
+    mode = run.mode
+    stuck = run.stuck
+    defl = run.defl
+    defl_stop = run.defl_stop
     for r in range(m.nstops):
         force = mode == 1 and r == stuck
         if not (events or force) or r == skip:

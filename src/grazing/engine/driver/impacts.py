@@ -25,7 +25,7 @@ from grazing.engine.driver.calls import (
     reset_jac,
     rhs,
 )
-from grazing.engine.stepping import append_record, append_row, pack_var, unpack_var
+from grazing.engine.stepping import append_pair, append_record, append_row, pack_var, unpack_var
 
 
 @njit(cache=True)
@@ -115,36 +115,87 @@ def enter_contact(m, x, s, pv, j):
 
 
 @njit(cache=True)
-def apply_impact(m, x, xp, s, t, pv, j, use_var, ncol, nrows, V, record, imp, n_rec, traj_on, traj, n_traj):
-    """Reset the state on stop ``j`` (``x`` holds it) and its variational matrix; returns the speed.
+def apply_impact(m, r, x, xp, pv, j, nrows, V, record, tables):
+    """Reset the state of run ``r`` on stop ``j`` (``x`` holds it) and its variational matrix.
 
-    Returns ``(speed, n_rec, n_traj, jac_ok)``: the approach speed ``-L_f h``,
-    the impact and trajectory counters, and False when the variational matrix
-    could not be carried across (an impact at zero normal speed; the impact is recorded as
-    ``[t, speed, state before, j]`` when ``record``; both states go into the
-    trajectory when ``traj_on``).  Afterwards ``x`` holds the state after the
-    reset.
+    Returns ``(speed, jac_ok)``: the approach speed ``-L_f h``, and False when
+    the variational matrix could not be carried across (an impact at zero
+    normal speed).  The impact is recorded as ``[t, speed, state before, j]``
+    in ``tables[0]`` when ``record``; both states go into the trajectory
+    ``tables[2]`` when it is recorded (``r.recording``, ``r.traj_dt > 0``).
+    Afterwards the first ``nrows`` of ``x`` hold the state after the reset.
     """
     n = m.nx
+    ncol = n + m.nsens
+    s = r.s
+    t = r.k * r.T + s
     vn = normal_rate(m, x, s, pv, j)
     reset(m, x, s, pv, xp, j)
-    if use_var:
+    if r.use_var:
         unpack_var(x, n, ncol, V)
         jac_ok = saltation(m, x, xp, s, pv, j, V, ncol)
         pack_var(V, n, ncol, xp)
     else:
         jac_ok = True
     if record:
-        append_record(imp, n_rec, t, -vn, x, n)
-        imp[0][n_rec, 2 + n] = j
-        n_rec += 1
-    if traj_on:
-        append_row(traj, n_traj, t, x, n)
-        append_row(traj, n_traj + 1, t, xp, n)
-        n_traj += 2
+        imp = tables[0]
+        append_record(imp, r.n_imp_rec, t, -vn, x, n)
+        imp[0][r.n_imp_rec, 2 + n] = j
+        r.n_imp_rec += 1
+    if r.recording and r.traj_dt > 0.0:
+        traj = tables[2]
+        append_row(traj, r.n_traj, t, x, n)
+        append_row(traj, r.n_traj + 1, t, xp, n)
+        r.n_traj += 2
     for i in range(nrows):
         x[i] = xp[i]
-    return -vn, n_rec, n_traj, jac_ok
+    return -vn, jac_ok
+
+
+@njit(cache=True, inline="always")
+def at_event(m, r, x, xp, pv, j, nrows, V, chatter_time, record, tables):
+    """The event that ends the step of run ``r``, on stop ``j``; returns True for an impact.
+
+    Sticking to stop ``j``, its contact force changes sign: the release.
+    Otherwise an impact (:func:`apply_impact`; a contact with another stop
+    ends), and on a stop with a sticking mode a chattering sequence shorter
+    than ``chatter_time`` is summed to its accumulation point and continued as
+    sticking.  The sticking intervals of the recorded span go into
+    ``tables[1]`` (``r.n_stick``).
+    """
+    t = r.k * r.T + r.s
+    if r.mode == 1 and j == r.stuck:  # release from sticking: the contact force changes sign
+        r.mode = 0
+        r.defl = 3
+        r.defl_stop = r.stuck
+        if r.recording:
+            close_sticking(tables[1], r.n_stick, t)
+        return False
+    if r.mode == 1:  # sticking to one stop, it hits another: the contact ends
+        r.mode = 0
+        if r.recording:
+            close_sticking(tables[1], r.n_stick, t)
+    # Impact: x holds the state on stop j, just before its reset.
+    speed, jac_ok = apply_impact(m, r, x, xp, pv, j, nrows, V, record, tables)
+    r.jac_valid = r.jac_valid and jac_ok  # (an impact at zero normal speed has no Jacobian)
+    r.defl = 1
+    r.defl_stop = j
+    if m.sticks[j]:
+        dt_acc = chatter_remaining(m, x, r.s, pv, j, speed, chatter_time)
+        if dt_acc >= 0.0:  # complete chattering: on to the accumulation point, then sticking
+            r.s += dt_acc
+            if r.wrap and r.s >= r.T:  # (the Jacobian is not valid after sticking)
+                r.s -= r.T
+                r.k += 1
+            enter_contact(m, x, r.s, pv, j)
+            r.mode = 1
+            r.stuck = j
+            r.defl = 0
+            r.jac_valid = False
+            if r.recording:
+                append_pair(tables[1], r.n_stick, r.k * r.T + r.s, math.nan)
+                r.n_stick += 1
+    return True
 
 
 @njit(cache=True)

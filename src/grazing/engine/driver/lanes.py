@@ -27,20 +27,22 @@ point of initial states at its phase).
 """
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
+from grazing.core.options import STEPS_EXTRA, STEPS_PER_PERIOD
+from grazing.engine import timebase
 from grazing.engine.abi import TC_FREE_LANES, TC_VAR_LANES, call_model
 from grazing.engine.driver.atomics import fetch_add, load_acquire, store_release
 from grazing.engine.driver.calls import tc_free, tc_stick, tc_var
 from grazing.engine.driver.events import first_event
-from grazing.engine.driver.impacts import apply_impact, chatter_remaining, enter_contact
-from grazing.engine.driver.loop import STATUS_NONFINITE, STATUS_OK, STATUS_STEP_LIMIT, STATUS_ZENO
 from grazing.engine.driver.recording import take_samples
-from grazing.engine.driver.tangent import discontinuity_map, lyapunov_step
+from grazing.engine.driver.state import STATUS_NONFINITE, STATUS_OK, STATUS_STEP_LIMIT, new_state
+from grazing.engine.driver.step import STEP_LAST, accept_step, end_plain_step, end_step, step_end
 from grazing.engine.polyroots import quadratic_bound, work_shape
-from grazing.engine.records import Kernels
+from grazing.engine.records import Kernels, LaneJobs, LanePoints, LaneResults, LaneSettings
 from grazing.engine.stepping import new_table, step_factor, step_from_norms, step_size
 
 LANE_ROOT_ROWS, LANE_ROOT_MIN_COLS = work_shape(0)
@@ -50,39 +52,23 @@ LYAPUNOV_ALIGN = 16
 VECTOR_MIN_LANES = 3
 """Fewest lanes of a kind for which the lane function is called (else the scalar one, lane by lane)."""
 
+
+class LaneArrays(NamedTuple):
+    """The lanes' own arrays in :func:`sweep_lanes` (one row or column per lane)."""
+
+    ls: np.ndarray  # the lanes' runs (state.RUN_STATE records)
+    XS: np.ndarray  # (rows, lanes): their states (and variational matrices)
+    pl: np.ndarray  # (lanes, parameters): their parameter vectors ...
+    PT: np.ndarray  # ... and transposed, for the lane functions
+    logs: np.ndarray  # (lanes, nx): their Lyapunov sums
+    buf: np.ndarray  # (lanes, samples, nx): their kept samples
+    counts: np.ndarray  # (lanes, stops): their impacts on each stop
+
+
 # A lane's stage in its point's protocol.
 IDLE, TRANSIENT, EXTRA, FINAL = 0, 1, 2, 3
-# Integer state of a lane (columns of ``li``).
-(
-    L_K,
-    L_MODE,
-    L_STUCK,
-    L_DEFL,
-    L_DEFL_STOP,
-    L_KS,
-    L_ISAMP,
-    L_NSAMP,
-    L_NKEEP,
-    L_REC,
-    L_LSTART,
-    L_STEPS,
-    L_MAXSTEPS,
-    L_ZERO,
-    L_JAC,
-    L_VAR,
-    L_KZ,
-    L_STATUS,
-    L_STAGE,
-    L_POINT,
-    L_JOBEND,
-    L_USED,
-    L_BLOCK,
-    L_RKS,
-    L_JOB,
-    L_NLI,
-) = range(26)
-# Float state of a lane (columns of ``lf``).
-F_S, F_SS, F_LT0, F_RSS, F_NLF = range(5)
+FAILED = 8
+"""A lane's step flag: its point failed."""
 
 
 @njit(cache=True)
@@ -102,19 +88,8 @@ def repeats_with_period(samples, count, n, tol, max_period):
     return 0
 
 
-@njit(cache=True)
-def start_times(t0, T, s_phase, periodic):
-    """``(k, s, ks, ss)`` of a run starting at ``t0`` sampled at local time ``s_phase`` (as ``Runner``)."""
-    if not periodic:
-        return 0, t0, 0, t0 + T
-    snap = 1e-9 * T
-    k0 = math.floor(t0 / T)
-    s0 = t0 - k0 * T
-    if s0 >= T - snap:
-        k0 += 1
-        s0 -= T
-    ks = k0 if s0 < s_phase - snap else k0 + 1
-    return k0, s0, ks, s_phase
+start_times = njit(inline="always")(timebase.start_times)
+"""``(k, s, ks, ss)`` of a run starting at ``t0`` sampled at local time ``s_phase`` (as ``Runner``'s)."""
 
 
 @njit(cache=True)
@@ -129,73 +104,43 @@ def to_lane(X, O, rows, nstops, K, XT, OT, lane):
 
 
 @njit(cache=True)
-def begin_request(li, lf, lane, periods, keep, use_var, T, zdm_s):
-    """Start lane ``lane`` on ``periods`` samples keeping the last ``keep`` (``Runner.advance``)."""
-    li[lane, L_NSAMP] = periods
-    li[lane, L_NKEEP] = keep
-    li[lane, L_ISAMP] = 0
-    li[lane, L_REC] = 1 if periods - keep == 0 else 0
-    li[lane, L_LSTART] = li[lane, L_REC]
-    li[lane, L_STEPS] = 0
-    li[lane, L_MAXSTEPS] = 20000 * periods + 100_000
-    li[lane, L_ZERO] = 0
-    li[lane, L_JAC] = 1
-    li[lane, L_VAR] = 1 if use_var else 0
-    li[lane, L_DEFL] = 0
-    li[lane, L_KS] = li[lane, L_RKS]
-    lf[lane, F_SS] = lf[lane, F_RSS]
-    k = li[lane, L_K]
-    s = lf[lane, F_S]
-    lf[lane, F_LT0] = k * T + s
-    li[lane, L_KZ] = k if s < zdm_s - 1e-9 * T else k + 1
+def begin_request(st, periods, keep, use_var, T, zdm_s):
+    """Start a lane (state ``st``) on ``periods`` samples keeping the last ``keep`` (``Runner.advance``)."""
+    st.n_samples = periods
+    st.n_keep = keep
+    st.isamp = 0
+    st.recording = periods - keep == 0
+    st.lyap_started = st.recording
+    st.span_dt = math.nan
+    st.steps = 0
+    st.max_steps = STEPS_PER_PERIOD * periods + STEPS_EXTRA  # (core.options.step_limit)
+    st.zero_events = 0
+    st.jac_valid = True
+    st.use_var = use_var
+    st.defl = 0
+    st.ks = st.req_ks
+    st.ss = st.req_ss
+    k = st.k
+    s = st.s
+    st.lyap_t0 = k * T + s
+    st.kz = k if s < zdm_s - 1e-9 * T else k + 1
 
 
 @njit(cache=False, nogil=True)  # (compiled once per machine into its own object file, grazing.engine.native)
-def sweep_lanes(
-    m,
-    lanes,
-    jobs,
-    control,
-    fresh,
-    periodic,
-    x0,
-    firsts,
-    pvs,
-    Ts,
-    sphase,
-    tcarry,
-    zdms,
-    transient,
-    periods,
-    adaptive,
-    adaptive_tol,
-    lyapunov,
-    safety,
-    chatter_tol,
-    zdm_on,
-    zdm_a,
-    zdm_e,
-    zdm_window,
-    watch,
-    out_samples,
-    out_by_stop,
-    out_lyap,
-    out_used,
-    out_x,
-    out_t,
-    out_status,
-):
-    """Compute the sweep points of ``jobs`` on ``lanes`` lanes (see the module); results into ``out_*``.
+def sweep_lanes(m, cfg, work, points, out):
+    """Compute the points of the jobs ``work`` on ``cfg.lanes`` lanes (see the module); results into ``out``.
 
-    Job ``j``'s first point starts from state ``firsts[j, 1:]`` at time
-    ``firsts[j, 0]``; a point after a failed one from ``x0[j]`` at time 0.  Per point ``p``: parameter
-    vector ``pvs[p]``, period ``Ts[p]``, sampling phase ``sphase[p]`` (local
-    time), start time of a point continued from the previous one
-    ``tcarry[p]`` (periodic models), local time of the discontinuity map
-    ``zdms[p]``.  ``out_status[p]`` becomes the point's
-    :class:`~grazing.core.solution.Status` code once it is finished: 0 once
-    its results are written, else why it failed (1 step limit, 2 non-finite
-    state, 3 accumulating impacts); the caller sets it to -1 before.
+    The arguments are the records of :data:`grazing.engine.records.SWEEP_RECORDS`
+    as plain tuples: the model's :class:`~grazing.engine.records.Kernels`, the
+    :class:`~grazing.engine.records.LaneSettings`, the
+    :class:`~grazing.engine.records.LaneJobs`, the
+    :class:`~grazing.engine.records.LanePoints` and the
+    :class:`~grazing.engine.records.LaneResults`.  Job ``j``'s first point
+    starts from state ``firsts[j, 1:]`` at time ``firsts[j, 0]``; a point after
+    a failed one from ``x0[j]`` at time 0.  ``out.status[p]`` becomes the
+    point's :class:`~grazing.core.solution.Status` code once it is finished: 0
+    once its results are written, else why it failed (1 step limit, 2
+    non-finite state, 3 accumulating impacts); the caller sets it to -1 before.
 
     Several threads may run the same call (the same arrays): they take the
     jobs in turn from the counter ``control[0]`` (0 at the start), each
@@ -205,22 +150,26 @@ def sweep_lanes(
     finished at -1.
     """
     m = Kernels(*m)
+    cfg = LaneSettings(*cfg)
+    work = LaneJobs(*work)
+    points = LanePoints(*points)
+    out = LaneResults(*out)
+    zdms = points.zdms
+    npv = points.pvs.shape[1]
     n = m.nx
     order = m.order
     nstops = m.nstops
     K = order + 1
-    L = lanes
+    L = cfg.lanes
     ncol = n
     ntot = n + n * ncol
-    npv = pvs.shape[1]
-    factor = step_factor(safety, order)
-    align = min(LYAPUNOV_ALIGN, transient) if lyapunov else 0
-    budget = transient - align
-    keep_max = max(periods, ADAPTIVE_BLOCK)
+    factor = step_factor(cfg.safety, order)
+    align = min(LYAPUNOV_ALIGN, cfg.transient) if cfg.lyapunov else 0
+    budget = cfg.transient - align
+    keep_max = max(cfg.periods, ADAPTIVE_BLOCK)
     use_lanes = L > 1 and L == m.lanes and m.fns[TC_FREE_LANES] != 0  # (the lane functions' width)
 
-    li = np.zeros((L, L_NLI), dtype=np.int64)
-    lf = np.zeros((L, F_NLF))
+    ls = new_state(L)  # the lanes' runs and where each is in its point's protocol
     XS = np.zeros((ntot, L))  # the lanes' states (and variational matrices), lane by lane
     Xs = np.zeros((ntot, K))  # one lane's coefficients from a scalar function
     Os = np.zeros((nstops, K))
@@ -233,7 +182,7 @@ def sweep_lanes(
     PT = np.zeros((npv, L))
     XT = np.zeros((ntot, K, L))
     OT = np.zeros((nstops, K, L))
-    work = np.zeros((LANE_ROOT_ROWS, max(K, LANE_ROOT_MIN_COLS)))
+    roots = np.zeros((LANE_ROOT_ROWS, max(K, LANE_ROOT_MIN_COLS)))
     a = np.zeros(K)
     xe = np.empty(ntot)
     xp = np.empty(ntot)
@@ -244,218 +193,45 @@ def sweep_lanes(
     imp = new_table(1, 3 + n)  # (impacts are counted, not recorded)
     sticks = new_table(1, 2)
     traj = new_table(1, 1 + n)
+    tables = (imp, sticks, traj)
+    fbuf = np.zeros(n)
+    Tp = np.zeros(0)  # (no sensitivities on lanes: end_step's period term is never taken)
     kinds = np.zeros(L, dtype=np.int64)  # 0 sticking or idle, 1 free flight, 2 with the variational equations
     # What a step decides for each lane (pass A), for the advance (vectors) and the rest (pass B).
     hs = np.zeros(L)  # step
     dts = np.zeros(L)  # accepted part of it
-    evs = np.zeros(L, dtype=np.int64)  # its stop
-    flags = np.zeros(L, dtype=np.int64)  # bit 1 event, 2 last, 4 discontinuity map, 8 failed
+    flags = np.zeros(L, dtype=np.int64)  # how it ends (step.STEP_LAST, STEP_MAP), or FAILED
     todo = np.zeros(L, dtype=np.int64)  # 1: the lane steps this round
-    nx_ = np.zeros(L)  # step-size norms
-    n1_ = np.zeros(L)
-    n2_ = np.zeros(L)
-    a0 = np.zeros(L)  # low coefficients and tail of an event polynomial
-    a1 = np.zeros(L)
-    a2 = np.zeros(L)
-    tl = np.zeros(L)
-    hk = np.zeros(L)
+    norms = (np.zeros(L), np.zeros(L), np.zeros(L))  # of the step sizes (lane_norms)
+    certs = (np.zeros(L), np.zeros(L), np.zeros(L), np.zeros(L), np.zeros(L))  # (no_events_certain)
     plain = np.zeros(L, dtype=np.int64)  # 1: no event on the step is certain so far
     acc = np.zeros(L)
 
+    la = LaneArrays(ls, XS, pl, PT, logs, buf, counts)
+    coeffs = (XT, OT, SI, Xs, Os, xl)
     active = 0
     for lane in range(L):
-        li[lane, L_STAGE] = IDLE
+        ls[lane].stage = IDLE
     while True:
-        if load_acquire(control, 1) != 0:  # the caller stops the sweep: unfinished points stay at -1
+        if load_acquire(work.control, 1) != 0:  # the caller stops the sweep: unfinished points stay at -1
             return
         # Idle lanes take the next point: their job's next one, else the next job's first.
         for lane in range(L):
-            while li[lane, L_STAGE] == IDLE and li[lane, L_JOBEND] >= 0:
-                p = li[lane, L_POINT] + 1
-                carried = li[lane, L_STATUS] == STATUS_OK and li[lane, L_JOBEND] > 0
-                first = False
-                if li[lane, L_JOBEND] == 0 or p >= li[lane, L_JOBEND]:
-                    if control[2] > 0 and active >= control[2]:
-                        break  # (this thread has its share of the jobs running)
-                    job = fetch_add(control, 0, 1)
-                    if job >= jobs.shape[0]:
-                        li[lane, L_JOBEND] = -1  # (no more jobs for this lane)
-                        break
-                    p = jobs[job, 0]
-                    li[lane, L_JOBEND] = jobs[job, 1]
-                    li[lane, L_JOB] = job
-                    carried = False
-                    first = True
-                li[lane, L_POINT] = p
-                T = Ts[p]
-                if first:
-                    for i in range(n):
-                        XS[i, lane] = firsts[li[lane, L_JOB], 1 + i]
-                    t0 = firsts[li[lane, L_JOB], 0]
-                elif fresh or not carried:
-                    for i in range(n):
-                        XS[i, lane] = x0[li[lane, L_JOB], i]
-                    t0 = 0.0
-                else:
-                    t0 = tcarry[p] if periodic else out_t[p - 1]
-                k0, s0, ks0, ss0 = start_times(t0, T, sphase[p], periodic)
-                li[lane, L_K] = k0
-                lf[lane, F_S] = s0
-                li[lane, L_RKS] = ks0
-                lf[lane, F_RSS] = ss0
-                li[lane, L_MODE] = 0
-                li[lane, L_STUCK] = 0
-                li[lane, L_STATUS] = STATUS_OK
-                li[lane, L_USED] = 0
-                for j in range(npv):
-                    pl[lane, j] = pvs[p, j]
-                    PT[j, lane] = pvs[p, j]
-                for j in range(nstops):
-                    counts[lane, j] = 0
-                for j in range(n):
-                    logs[lane, j] = 0.0
-                if budget > 0:
-                    blk = min(ADAPTIVE_BLOCK, budget)
-                    li[lane, L_BLOCK] = blk
-                    li[lane, L_STAGE] = TRANSIENT
-                    begin_request(li, lf, lane, blk, blk if adaptive else 0, False, T, zdms[p])
-                else:
-                    li[lane, L_STAGE] = FINAL
-                    final_request(
-                        li, lf, XS, n, lane, align, periods, lyapunov, T, sphase[p], periodic, zdms[p]
-                    )
-                active += 1
+            if ls[lane].stage == IDLE and ls[lane].job_end >= 0:  # (a call only where it takes a point)
+                active = take_point(m, cfg, work, points, out, la, lane, budget, align, active)
         if active == 0:
             break
 
-        # The Taylor coefficients: lanes in free flight by kind, on vectors where there are enough of them.
-        nfree = 0
-        nvar = 0
-        for lane in range(L):
-            kinds[lane] = 0
-            if li[lane, L_STAGE] != IDLE and li[lane, L_MODE] == 0:
-                if li[lane, L_VAR] == 1:
-                    kinds[lane] = 2
-                    nvar += 1
-                else:
-                    kinds[lane] = 1
-                    nfree += 1
-        for lane in range(L):
-            SI[lane] = lf[lane, F_S]
-        for kind in (1, 2):
-            count = nfree if kind == 1 else nvar
-            rows = n if kind == 1 else ntot
-            if count == 0:
-                continue
-            if use_lanes and count >= VECTOR_MIN_LANES:
-                call_model(m.fns[TC_FREE_LANES if kind == 1 else TC_VAR_LANES], XS, 0.0, PT, XT, OT, SI, 0)
-            elif L == 1:  # one lane: the lane arrays are the scalar function's arrays
-                if kind == 1:
-                    tc_free(m, XS, SI[0], pl[0], XT, OT)
-                else:
-                    tc_var(m, XS, SI[0], pl[0], XT, OT)
-            else:  # lane by lane, into the lanes' columns
-                for lane in range(L):
-                    if kinds[lane] == kind:
-                        for i in range(rows):
-                            xl[i] = XS[i, lane]
-                        if kind == 1:
-                            tc_free(m, xl, SI[lane], pl[lane], Xs, Os)
-                        else:
-                            tc_var(m, xl, SI[lane], pl[lane], Xs, Os)
-                        to_lane(Xs, Os, rows, nstops, K, XT, OT, lane)
-
-        # The step sizes of the lanes in free flight: their norms on vectors (as step_size, row by row).
-        for lane in range(L):
-            nx_[lane] = abs(OT[0, 0, lane])
-            n1_[lane] = 0.0
-            n2_[lane] = 0.0
-        for r in range(nstops):
-            for lane in range(L):
-                n1_[lane] = max(n1_[lane], abs(OT[r, order - 1, lane]))
-                n2_[lane] = max(n2_[lane], abs(OT[r, order, lane]))
-        for i in range(ntot if nvar > 0 else n):
-            for lane in range(L):
-                if i < n or kinds[lane] == 2:
-                    nx_[lane] = max(nx_[lane], abs(XT[i, 0, lane]))
-                    n1_[lane] = max(n1_[lane], abs(XT[i, order - 1, lane]))
-                    n2_[lane] = max(n2_[lane], abs(XT[i, order, lane]))
+        # The Taylor coefficients: lanes in free flight by kind, on vectors where there are enough of them;
+        # the norms of their step sizes.
+        nvar = lane_coefficients(m, la, kinds, use_lanes, coeffs)
+        lane_norms(m, XT, OT, kinds, nvar, norms)
 
         # Pass A, lane by lane: the step, its events and its samples.
-        for lane in range(L):
-            todo[lane] = 0
-            flags[lane] = 0
-            plain[lane] = 0
-            if li[lane, L_STAGE] == IDLE:
-                continue
-            p = li[lane, L_POINT]
-            T = Ts[p]
-            k = li[lane, L_K]
-            s = lf[lane, F_S]
-            mode = li[lane, L_MODE]
-            status = STATUS_OK
-            if li[lane, L_STEPS] >= li[lane, L_MAXSTEPS]:
-                status = STATUS_STEP_LIMIT
-            for i in range(n):
-                if not math.isfinite(XS[i, lane]):
-                    status = STATUS_NONFINITE
-            if status != STATUS_OK:
-                flags[lane] = 8
-                li[lane, L_STATUS] = status
-                continue
-            if mode == 1:
-                stuck = li[lane, L_STUCK]
-                for i in range(n):
-                    xl[i] = XS[i, lane]
-                tc_stick(m, xl, s, pl[lane], Xs, Os, stuck)
-                to_lane(Xs, Os, n, nstops, K, XT, OT, lane)
-                h = step_size(Xs, n, Os, nstops, stuck, order, T, factor)
-            else:
-                h = step_from_norms(nx_[lane], n1_[lane], n2_[lane], order, T, factor)
-            isamp = li[lane, L_ISAMP]
-            rem = (li[lane, L_KS] - k) * T + (lf[lane, F_SS] - s)
-            is_last = False
-            if isamp == li[lane, L_NSAMP] - 1 and h >= rem:
-                h = rem
-                is_last = True
-            if zdm_on:
-                rem_z = (li[lane, L_KZ] - k) * T + (zdms[p] - s)
-                if rem_z <= h:
-                    h = rem_z
-                    flags[lane] |= 4
-                    is_last = is_last and rem_z >= rem
-            if is_last:
-                flags[lane] |= 2
-            hs[lane] = h
-            todo[lane] = 1
-            plain[lane] = 1 if mode == 0 and li[lane, L_DEFL] == 0 else 0
-
-        # No event on the step where every guard's polynomial is certainly positive (event_certificate
-        # on vectors: the same coefficients as event_polynomial); the other lanes search lane by lane
-        # (and a single lane at once).
-        for lane in range(L if L == 1 else 0):
-            plain[lane] = 0
-        for r in range(nstops if L > 1 else 0):
-            if zdm_on and r == watch:
-                continue
-            for lane in range(L):
-                hk[lane] = 1.0
-                tl[lane] = 0.0
-                a0[lane] = OT[r, 0, lane] * hk[lane]
-                hk[lane] *= hs[lane]
-                a1[lane] = OT[r, 1, lane] * hk[lane]
-                hk[lane] *= hs[lane]
-                a2[lane] = OT[r, 2, lane] * hk[lane]
-                hk[lane] *= hs[lane]
-            for j in range(3, K):
-                for lane in range(L):
-                    tl[lane] += abs(OT[r, j, lane] * hk[lane])
-                    hk[lane] *= hs[lane]
-            for lane in range(L):
-                if plain[lane] == 1 and not (
-                    a0[lane] > 0.0 and quadratic_bound(a0[lane], a1[lane], a2[lane], tl[lane]) > 0.0
-                ):
-                    plain[lane] = 0
+        plan_steps(m, cfg, la, zdms, norms, coeffs, factor, (hs, flags, todo, plain))
+        # No event on the step where every guard's polynomial is certainly positive; the other lanes
+        # search lane by lane (and a single lane at once).
+        no_events_certain(m, cfg, OT, hs, plain, certs)
         for lane in range(L):
             if todo[lane] == 0:
                 continue
@@ -464,299 +240,438 @@ def sweep_lanes(
                 u = -1.0
                 ev_stop = 0
             else:
-                mode = li[lane, L_MODE]
+                skip = cfg.stop if cfg.zdm else -1
                 u, ev_stop = first_event(
-                    m,
-                    OT[:, :, lane],
-                    h,
-                    mode,
-                    li[lane, L_STUCK],
-                    True,
-                    watch if zdm_on else -1,
-                    li[lane, L_DEFL],
-                    li[lane, L_DEFL_STOP],
-                    False,
-                    watch,
-                    a,
-                    work,
+                    m, ls[lane], OT[:, :, lane], h, True, skip, False, cfg.stop, a, roots
                 )
-            event = u >= 0.0 and h > 0.0
-            if event and u == 0.0:
-                li[lane, L_ZERO] += 1
-                if li[lane, L_ZERO] > 3:
-                    flags[lane] = 8
-                    li[lane, L_STATUS] = STATUS_ZENO
-                    todo[lane] = 0
-                    continue
-            else:
-                li[lane, L_ZERO] = 0
-            is_last = (flags[lane] & 2) != 0
-            h_acc = u * h if event else h
-            if event and is_last and u >= 1.0:
-                event = False
-            if event:
-                flags[lane] |= 1
-            evs[lane] = ev_stop
+            run = ls[lane]
+            if not accept_step(run, h, flags[lane], u, ev_stop):  # (events accumulate)
+                flags[lane] = FAILED
+                todo[lane] = 0
+                continue
+            is_last = (flags[lane] & STEP_LAST) != 0
+            h_acc = run.h_acc
+            event = run.event
             dts[lane] = h_acc
-            p = li[lane, L_POINT]
-            T = Ts[p]
-            k = li[lane, L_K]
-            s = lf[lane, F_S]
-            if (li[lane, L_KS] - k) * T + (lf[lane, F_SS] - s) <= h_acc:
-                recording = li[lane, L_REC] == 1
-                isamp, ks, ss, recording, _, _, _, _ = take_samples(
-                    m,
-                    T,
-                    periodic,
-                    li[lane, L_NSAMP],
-                    li[lane, L_NKEEP],
-                    0.0,
-                    XT[:, :, lane],
-                    k,
-                    s,
-                    h_acc,
-                    event,
-                    is_last,
-                    li[lane, L_MODE],
-                    li[lane, L_ISAMP],
-                    li[lane, L_KS],
-                    lf[lane, F_SS],
-                    li[lane, L_NSAMP] - li[lane, L_NKEEP],
-                    recording,
-                    buf[lane],
-                    sticks,
-                    0,
-                    traj,
-                    0,
-                    k,
-                    s,
-                    xe,
-                )
-                li[lane, L_ISAMP] = isamp
-                li[lane, L_KS] = ks
-                lf[lane, F_SS] = ss
-                li[lane, L_REC] = 1 if recording else 0
+            if (run.ks - run.k) * run.T + (run.ss - run.s) <= h_acc:
+                run.n_stick = 0  # (sticking intervals are not recorded)
+                take_samples(m, run, XT[:, :, lane], h_acc, event, is_last, buf[lane], sticks, traj, xe)
 
-        # The advance of every stepping lane to the end of its accepted part (eval_rows on vectors):
-        # the state in all, the variational equations in free flight.
-        for lane in range(L):
-            if todo[lane] == 0:
-                dts[lane] = 0.0
-        for i in range(ntot if nvar > 0 else n):
-            for lane in range(L):
-                acc[lane] = XT[i, order, lane]
-            for j in range(order - 1, -1, -1):
-                for lane in range(L):
-                    acc[lane] = acc[lane] * dts[lane] + XT[i, j, lane]
-            for lane in range(L):
-                if todo[lane] == 1 and (i < n or (kinds[lane] == 2 and li[lane, L_MODE] == 0)):
-                    XS[i, lane] = acc[lane]
+        # The advance of every stepping lane to the end of its accepted part (eval_rows on vectors).
+        advance_lanes(m, la, XT, dts, todo, kinds, nvar, acc)
 
         # Pass B, lane by lane: time, Lyapunov vectors, discontinuity map, impacts, the request's end.
         for lane in range(L):
-            if flags[lane] == 8:  # the point failed (L_STATUS says why): the next point starts afresh
-                store_release(out_status, li[lane, L_POINT], li[lane, L_STATUS])
-                li[lane, L_STAGE] = IDLE
+            if flags[lane] == FAILED:  # the point failed (its status says why): the next point starts afresh
+                store_release(out.status, ls[lane].point, ls[lane].status)
+                ls[lane].stage = IDLE
                 active -= 1
                 continue
             if todo[lane] == 0:
                 continue
-            p = li[lane, L_POINT]
-            T = Ts[p]
-            k = li[lane, L_K]
-            s = lf[lane, F_S] + dts[lane]
-            if periodic and s >= T:
-                s -= T
-                k += 1
-            li[lane, L_STEPS] += 1
-            li[lane, L_DEFL] = 0
-            mode = li[lane, L_MODE]
-            use_var = li[lane, L_VAR] == 1
-            nrows = ntot if (mode == 0 and use_var) else n
-            event = (flags[lane] & 1) != 0
-            zdm_hit = (flags[lane] & 4) != 0
-            lyap_now = lyapunov and use_var and mode == 0
-            if lyap_now or zdm_hit or event:
+            run = ls[lane]
+            recording = run.recording  # (before the step's end)
+            if not end_plain_step(run, cfg.lyapunov, m.nsens > 0):  # (the step's end has work to do)
+                nrows = ntot if (run.mode == 0 and run.use_var) else n
                 for i in range(ntot):
                     xl[i] = XS[i, lane]
-                recording = li[lane, L_REC] == 1
-                pv = pl[lane]
-                if lyap_now:
-                    started, lt0 = lyapunov_step(
-                        m,
-                        xl,
-                        V,
-                        ncol,
-                        recording,
-                        li[lane, L_LSTART] == 1,
-                        lf[lane, F_LT0],
-                        k * T + s,
-                        scratch,
-                        logs[lane],
-                    )
-                    li[lane, L_LSTART] = 1 if started else 0
-                    lf[lane, F_LT0] = lt0
-                if zdm_hit:
-                    li[lane, L_KZ] += 1
-                    applied, _ = discontinuity_map(
-                        m,
-                        xl,
-                        s,
-                        k * T + s,
-                        pv,
-                        watch,
-                        zdm_a,
-                        zdm_e,
-                        zdm_window,
-                        use_var,
-                        ncol,
-                        V,
-                        gh,
-                        gv,
-                        False,
-                        imp,
-                        0,
-                    )
-                    if applied and recording and li[lane, L_STAGE] == FINAL:
-                        counts[lane, watch] += 1
-                if event:
-                    ev_stop = evs[lane]
-                    stuck = li[lane, L_STUCK]
-                    if mode == 1 and ev_stop == stuck:
-                        li[lane, L_MODE] = 0
-                        li[lane, L_DEFL] = 3
-                        li[lane, L_DEFL_STOP] = stuck
-                    else:
-                        li[lane, L_MODE] = 0
-                        speed, _, _, salt_ok = apply_impact(
-                            m,
-                            xl,
-                            xp,
-                            s,
-                            k * T + s,
-                            pv,
-                            ev_stop,
-                            use_var,
-                            ncol,
-                            nrows,
-                            V,
-                            False,
-                            imp,
-                            0,
-                            False,
-                            traj,
-                            0,
-                        )
-                        if not salt_ok:
-                            li[lane, L_JAC] = 0
-                        if recording and li[lane, L_STAGE] == FINAL:
-                            counts[lane, ev_stop] += 1
-                        li[lane, L_DEFL] = 1
-                        li[lane, L_DEFL_STOP] = ev_stop
-                        if m.sticks[ev_stop]:
-                            dt_acc = chatter_remaining(m, xl, s, pv, ev_stop, speed, chatter_tol * T)
-                            if dt_acc >= 0.0:
-                                s += dt_acc
-                                if periodic and s >= T:
-                                    s -= T
-                                    k += 1
-                                enter_contact(m, xl, s, pv, ev_stop)
-                                li[lane, L_MODE] = 1
-                                li[lane, L_STUCK] = ev_stop
-                                li[lane, L_DEFL] = 0
-                                li[lane, L_JAC] = 0
+                buffers = (xp, V, scratch, logs[lane], xe, gh, gv, fbuf)
+                chatter_time = cfg.chatter_tol * run.T
+                kicked, impact = end_step(
+                    m, run, xl, XT[:, :, lane], pl[lane], nrows, cfg, chatter_time, 0, Tp, buffers, tables
+                )
+                if recording and run.stage == FINAL:
+                    if kicked:
+                        counts[lane, cfg.stop] += 1
+                    if impact:
+                        counts[lane, run.ev_stop] += 1
+                run.n_stick = 0  # (sticking intervals are not recorded)
                 for i in range(ntot):
                     XS[i, lane] = xl[i]
-            li[lane, L_K] = k
-            lf[lane, F_S] = s
-            n_samples = li[lane, L_NSAMP]
-            if li[lane, L_ISAMP] < n_samples:
+            n_samples = ls[lane].n_samples
+            if ls[lane].isamp < n_samples:
                 continue
             # The request is done (Runner.advance returns): on to the next stage of the point.
-            if periodic:
-                li[lane, L_RKS] += n_samples
-            else:
-                lf[lane, F_RSS] += n_samples * T
-            stage = li[lane, L_STAGE]
-            if stage == TRANSIENT:
-                blk = li[lane, L_BLOCK]
-                li[lane, L_USED] += blk
-                used = li[lane, L_USED]
-                nxt = -1
-                if adaptive and blk == ADAPTIVE_BLOCK:
-                    per = repeats_with_period(buf[lane], blk, n, adaptive_tol, ADAPTIVE_MAX_PERIOD)
-                    if per > 0:
-                        extra = (budget - used) % per
-                        if extra:
-                            li[lane, L_USED] += extra
-                            li[lane, L_STAGE] = EXTRA
-                            begin_request(li, lf, lane, extra, 0, False, T, zdms[p])
-                            continue
-                        nxt = 0
-                if nxt < 0 and used < budget:
-                    blk = min(ADAPTIVE_BLOCK, budget - used)
-                    li[lane, L_BLOCK] = blk
-                    begin_request(li, lf, lane, blk, blk if adaptive else 0, False, T, zdms[p])
-                    continue
-                li[lane, L_STAGE] = FINAL
-                final_request(li, lf, XS, n, lane, align, periods, lyapunov, T, sphase[p], periodic, zdms[p])
-                continue
-            if stage == EXTRA:
-                li[lane, L_STAGE] = FINAL
-                final_request(li, lf, XS, n, lane, align, periods, lyapunov, T, sphase[p], periodic, zdms[p])
-                continue
-            # FINAL: the point's results (a state that became non-finite on the last step fails the point).
-            finite = True
-            for i in range(n):
-                finite = finite and math.isfinite(XS[i, lane])
-            for r in range(periods):
-                for c in range(n):
-                    finite = finite and math.isfinite(buf[lane, r, c])
-            if not finite:
-                li[lane, L_STATUS] = STATUS_NONFINITE
-                store_release(out_status, p, STATUS_NONFINITE)
-                li[lane, L_STAGE] = IDLE
+            if end_request(m, cfg, points, out, la, lane, budget, align):
                 active -= 1
-                continue
-            for r in range(periods):
-                for c in range(n):
-                    out_samples[p, r, c] = buf[lane, r, c]
-            for j in range(nstops):
-                out_by_stop[p, j] = counts[lane, j]
-            lyap = math.nan
-            if lyapunov:
-                span = k * T + s - lf[lane, F_LT0] if li[lane, L_LSTART] == 1 else 0.0
-                if li[lane, L_JAC] == 1 and span != 0.0:
-                    lyap = logs[lane, 0] / span
-                    for j in range(1, n):
-                        v = logs[lane, j] / span
-                        if math.isnan(lyap) or math.isnan(v):
-                            lyap = math.nan
-                        elif v > lyap:
-                            lyap = v
-            out_lyap[p] = lyap
-            out_used[p] = li[lane, L_USED] + align
+
+
+@njit(cache=True, inline="always")
+def lane_coefficients(m, la, kinds, use_lanes, coeffs):
+    """The Taylor coefficients of the lanes in free flight into ``XT``, ``OT``; returns how many have ``V``.
+
+    ``kinds[lane]`` becomes 0 (idle or sticking), 1 (free flight) or 2 (with
+    the variational equations); a kind with at least ``VECTOR_MIN_LANES``
+    lanes is computed by the model's lane function (``use_lanes``), the
+    others lane by lane.  ``coeffs`` = ``(XT, OT, SI, Xs, Os, xl)``: the lanes'
+    coefficients, their local times, one lane's coefficients and state.
+    """
+    XT, OT, SI, Xs, Os, xl = coeffs
+    ls, XS, pl, PT = la.ls, la.XS, la.pl, la.PT
+    n = m.nx
+    nstops = m.nstops
+    K = m.order + 1
+    L = ls.shape[0]
+    ntot = n + n * n
+    nfree = 0
+    nvar = 0
+    for lane in range(L):
+        kinds[lane] = 0
+        if ls[lane].stage != IDLE and ls[lane].mode == 0:
+            if ls[lane].use_var:
+                kinds[lane] = 2
+                nvar += 1
+            else:
+                kinds[lane] = 1
+                nfree += 1
+    for lane in range(L):
+        SI[lane] = ls[lane].s
+    for kind in (1, 2):
+        count = nfree if kind == 1 else nvar
+        rows = n if kind == 1 else ntot
+        if count == 0:
+            continue
+        if use_lanes and count >= VECTOR_MIN_LANES:
+            call_model(m.fns[TC_FREE_LANES if kind == 1 else TC_VAR_LANES], XS, 0.0, PT, XT, OT, SI, 0)
+        elif L == 1:  # one lane: the lane arrays are the scalar function's arrays
+            if kind == 1:
+                tc_free(m, XS, SI[0], pl[0], XT, OT)
+            else:
+                tc_var(m, XS, SI[0], pl[0], XT, OT)
+        else:  # lane by lane, into the lanes' columns
+            for lane in range(L):
+                if kinds[lane] == kind:
+                    for i in range(rows):
+                        xl[i] = XS[i, lane]
+                    if kind == 1:
+                        tc_free(m, xl, SI[lane], pl[lane], Xs, Os)
+                    else:
+                        tc_var(m, xl, SI[lane], pl[lane], Xs, Os)
+                    to_lane(Xs, Os, rows, nstops, K, XT, OT, lane)
+    return nvar
+
+
+@njit(cache=True, inline="always")
+def lane_norms(m, XT, OT, kinds, nvar, norms):
+    """The norms of the lanes' step sizes (as ``step_size``, row by row, on vectors) into ``norms``."""
+    nx_, n1_, n2_ = norms
+    n = m.nx
+    order = m.order
+    nstops = m.nstops
+    L = XT.shape[2]
+    ntot = n + n * n
+    for lane in range(L):
+        nx_[lane] = abs(OT[0, 0, lane])
+        n1_[lane] = 0.0
+        n2_[lane] = 0.0
+    for r in range(nstops):
+        for lane in range(L):
+            n1_[lane] = max(n1_[lane], abs(OT[r, order - 1, lane]))
+            n2_[lane] = max(n2_[lane], abs(OT[r, order, lane]))
+    for i in range(ntot if nvar > 0 else n):
+        for lane in range(L):
+            if i < n or kinds[lane] == 2:
+                nx_[lane] = max(nx_[lane], abs(XT[i, 0, lane]))
+                n1_[lane] = max(n1_[lane], abs(XT[i, order - 1, lane]))
+                n2_[lane] = max(n2_[lane], abs(XT[i, order, lane]))
+
+
+@njit(cache=True, inline="always")
+def no_events_certain(m, cfg, OT, hs, plain, certs):
+    """Clear ``plain[lane]`` where an event on the step of size ``hs[lane]`` is not excluded.
+
+    ``event_certificate`` on vectors (the same coefficients as
+    ``event_polynomial``): a lane stays ``plain`` where every guard's
+    polynomial is certainly positive on its step.  A single lane is never
+    plain (its search is as cheap).  ``certs`` = ``(a0, a1, a2, tl, hk)``.
+    """
+    a0, a1, a2, tl, hk = certs
+    nstops = m.nstops
+    K = m.order + 1
+    L = hs.shape[0]
+    for lane in range(L if L == 1 else 0):
+        plain[lane] = 0
+    for r in range(nstops if L > 1 else 0):
+        if cfg.zdm and r == cfg.stop:
+            continue
+        for lane in range(L):
+            hk[lane] = 1.0
+            tl[lane] = 0.0
+            a0[lane] = OT[r, 0, lane] * hk[lane]
+            hk[lane] *= hs[lane]
+            a1[lane] = OT[r, 1, lane] * hk[lane]
+            hk[lane] *= hs[lane]
+            a2[lane] = OT[r, 2, lane] * hk[lane]
+            hk[lane] *= hs[lane]
+        for j in range(3, K):
+            for lane in range(L):
+                tl[lane] += abs(OT[r, j, lane] * hk[lane])
+                hk[lane] *= hs[lane]
+        for lane in range(L):
+            if plain[lane] == 1 and not (
+                a0[lane] > 0.0 and quadratic_bound(a0[lane], a1[lane], a2[lane], tl[lane]) > 0.0
+            ):
+                plain[lane] = 0
+
+
+@njit(cache=True, inline="always")
+def advance_lanes(m, la, XT, dts, todo, kinds, nvar, acc):
+    """Every stepping lane to the end of its accepted part ``dts[lane]`` (``eval_rows`` on vectors).
+
+    The state in all, the variational equations in free flight.
+    """
+    ls, XS = la.ls, la.XS
+    n = m.nx
+    order = m.order
+    L = dts.shape[0]
+    ntot = n + n * n
+    for lane in range(L):
+        if todo[lane] == 0:
+            dts[lane] = 0.0
+    for i in range(ntot if nvar > 0 else n):
+        for lane in range(L):
+            acc[lane] = XT[i, order, lane]
+        for j in range(order - 1, -1, -1):
+            for lane in range(L):
+                acc[lane] = acc[lane] * dts[lane] + XT[i, j, lane]
+        for lane in range(L):
+            if todo[lane] == 1 and (i < n or (kinds[lane] == 2 and ls[lane].mode == 0)):
+                XS[i, lane] = acc[lane]
+
+
+@njit(cache=True, inline="always")
+def plan_steps(m, cfg, la, zdms, norms, coeffs, factor, plan):
+    """Each running lane's step: its size (from ``norms`` in free flight, the scalar sticking function
+    otherwise) and where it ends (:func:`.step.step_end`), or its point's failure.
+
+    ``plan`` = ``(hs, flags, todo, plain)``: the step, how it ends (or
+    ``FAILED``), whether the lane steps, whether it may skip the event search
+    (free flight, no known root at its start: :func:`no_events_certain`).
+    """
+    hs, flags, todo, plain = plan
+    nx_, n1_, n2_ = norms
+    XT, OT, _, Xs, Os, xl = coeffs
+    ls, XS, pl = la.ls, la.XS, la.pl
+    n = m.nx
+    order = m.order
+    nstops = m.nstops
+    K = order + 1
+    L = ls.shape[0]
+    for lane in range(L):
+        todo[lane] = 0
+        flags[lane] = 0
+        plain[lane] = 0
+        if ls[lane].stage == IDLE:
+            continue
+        p = ls[lane].point
+        T = ls[lane].T
+        s = ls[lane].s
+        mode = ls[lane].mode
+        status = STATUS_OK
+        if ls[lane].steps >= ls[lane].max_steps:
+            status = STATUS_STEP_LIMIT
+        for i in range(n):
+            if not math.isfinite(XS[i, lane]):
+                status = STATUS_NONFINITE
+        if status != STATUS_OK:
+            flags[lane] = FAILED
+            ls[lane].status = status
+            continue
+        if mode == 1:
+            stuck = ls[lane].stuck
             for i in range(n):
-                out_x[p, i] = XS[i, lane]
-            out_t[p] = k * T + s
-            store_release(out_status, p, STATUS_OK)  # (after its results: another thread may read them now)
-            li[lane, L_STAGE] = IDLE
-            active -= 1
+                xl[i] = XS[i, lane]
+            tc_stick(m, xl, s, pl[lane], Xs, Os, stuck)
+            to_lane(Xs, Os, n, nstops, K, XT, OT, lane)
+            h = step_size(Xs, n, Os, nstops, stuck, order, T, factor)
+        else:
+            h = step_from_norms(nx_[lane], n1_[lane], n2_[lane], order, T, factor)
+        h, ends = step_end(ls[lane], h, cfg.zdm, zdms[p])
+        flags[lane] = ends
+        hs[lane] = h
+        todo[lane] = 1
+        plain[lane] = 1 if mode == 0 and ls[lane].defl == 0 else 0
 
 
 @njit(cache=True)
-def final_request(li, lf, XS, n, lane, align, periods, lyapunov, T, s_phase, periodic, zdm_s):
+def take_point(m, cfg, work, points, out, la, lane, budget, align, active):
+    """An idle lane takes its job's next point, else the next job's first; returns the points now running.
+
+    ``la`` holds the lanes' arrays (:class:`LaneArrays`); ``active`` counts the
+    points this call is running (a thread with ``control[2]`` jobs running
+    takes no other job).
+    """
+    n = m.nx
+    nstops = m.nstops
+    ls, XS, pl, PT, logs, counts = la.ls, la.XS, la.pl, la.PT, la.logs, la.counts
+    pvs, Ts, sphase, tcarry, zdms = points.pvs, points.Ts, points.sphase, points.tcarry, points.zdms
+    npv = pvs.shape[1]
+    while ls[lane].stage == IDLE and ls[lane].job_end >= 0:
+        p = ls[lane].point + 1
+        carried = ls[lane].status == STATUS_OK and ls[lane].job_end > 0
+        first = False
+        if ls[lane].job_end == 0 or p >= ls[lane].job_end:
+            if work.control[2] > 0 and active >= work.control[2]:
+                break  # (this thread has its share of the jobs running)
+            job = fetch_add(work.control, 0, 1)
+            if job >= work.jobs.shape[0]:
+                ls[lane].job_end = -1  # (no more jobs for this lane)
+                break
+            p = work.jobs[job, 0]
+            ls[lane].job_end = work.jobs[job, 1]
+            ls[lane].job = job
+            carried = False
+            first = True
+        ls[lane].point = p
+        T = Ts[p]
+        ls[lane].T = T
+        ls[lane].wrap = cfg.periodic
+        if first:
+            for i in range(n):
+                XS[i, lane] = work.firsts[ls[lane].job, 1 + i]
+            t0 = work.firsts[ls[lane].job, 0]
+        elif cfg.fresh or not carried:
+            for i in range(n):
+                XS[i, lane] = work.x0[ls[lane].job, i]
+            t0 = 0.0
+        else:
+            t0 = tcarry[p] if cfg.periodic else out.t[p - 1]
+        k0, s0, ks0, ss0 = start_times(t0, T, sphase[p], cfg.periodic)
+        ls[lane].k = k0
+        ls[lane].s = s0
+        ls[lane].req_ks = ks0
+        ls[lane].req_ss = ss0
+        ls[lane].mode = 0
+        ls[lane].stuck = 0
+        ls[lane].status = STATUS_OK
+        ls[lane].used = 0
+        for j in range(npv):
+            pl[lane, j] = pvs[p, j]
+            PT[j, lane] = pvs[p, j]
+        for j in range(nstops):
+            counts[lane, j] = 0
+        for j in range(n):
+            logs[lane, j] = 0.0
+        if budget > 0:
+            blk = min(ADAPTIVE_BLOCK, budget)
+            ls[lane].block = blk
+            ls[lane].stage = TRANSIENT
+            begin_request(ls[lane], blk, blk if cfg.adaptive else 0, False, T, zdms[p])
+        else:
+            ls[lane].stage = FINAL
+            final_request(ls[lane], XS, n, lane, align, cfg, sphase[p], zdms[p])
+        active += 1
+    return active
+
+
+@njit(cache=True)
+def end_request(m, cfg, points, out, la, lane, budget, align):
+    """The lane's request is done (``Runner.advance`` returns): on to its point's next stage.
+
+    Returns True when the point is finished (its results written, or failed).
+    """
+    n = m.nx
+    ls, XS, buf = la.ls, la.XS, la.buf
+    Ts, sphase, zdms = points.Ts, points.sphase, points.zdms
+    p = ls[lane].point
+    T = Ts[p]
+    n_samples = ls[lane].n_samples
+    if cfg.periodic:
+        ls[lane].req_ks += n_samples
+    else:
+        ls[lane].req_ss += n_samples * T
+    stage = ls[lane].stage
+    if stage == TRANSIENT:
+        blk = ls[lane].block
+        ls[lane].used += blk
+        used = ls[lane].used
+        nxt = -1
+        if cfg.adaptive and blk == ADAPTIVE_BLOCK:
+            per = repeats_with_period(buf[lane], blk, n, cfg.adaptive_tol, ADAPTIVE_MAX_PERIOD)
+            if per > 0:
+                extra = (budget - used) % per
+                if extra:
+                    ls[lane].used += extra
+                    ls[lane].stage = EXTRA
+                    begin_request(ls[lane], extra, 0, False, T, zdms[p])
+                    return False
+                nxt = 0
+        if nxt < 0 and used < budget:
+            blk = min(ADAPTIVE_BLOCK, budget - used)
+            ls[lane].block = blk
+            begin_request(ls[lane], blk, blk if cfg.adaptive else 0, False, T, zdms[p])
+            return False
+        ls[lane].stage = FINAL
+        final_request(ls[lane], XS, n, lane, align, cfg, sphase[p], zdms[p])
+        return False
+    if stage == EXTRA:
+        ls[lane].stage = FINAL
+        final_request(ls[lane], XS, n, lane, align, cfg, sphase[p], zdms[p])
+        return False
+    return finish_point(m, cfg, out, la, lane, align)
+
+
+@njit(cache=True)
+def finish_point(m, cfg, out, la, lane, align):
+    """The point of a lane at the end of its last request: its results, or its failure; returns True."""
+    n = m.nx
+    nstops = m.nstops
+    ls, XS, logs, buf, counts = la.ls, la.XS, la.logs, la.buf, la.counts
+    p = ls[lane].point
+    T = ls[lane].T
+    k = ls[lane].k
+    s = ls[lane].s
+    finite = True  # (a state that became non-finite on the last step fails the point)
+    for i in range(n):
+        finite = finite and math.isfinite(XS[i, lane])
+    for r in range(cfg.periods):
+        for c in range(n):
+            finite = finite and math.isfinite(buf[lane, r, c])
+    if not finite:
+        ls[lane].status = STATUS_NONFINITE
+        store_release(out.status, p, STATUS_NONFINITE)
+        ls[lane].stage = IDLE
+        return True
+    for r in range(cfg.periods):
+        for c in range(n):
+            out.samples[p, r, c] = buf[lane, r, c]
+    for j in range(nstops):
+        out.by_stop[p, j] = counts[lane, j]
+    lyap = math.nan
+    if cfg.lyapunov:
+        span = k * T + s - ls[lane].lyap_t0 if ls[lane].lyap_started else 0.0
+        if ls[lane].jac_valid and span != 0.0:
+            lyap = logs[lane, 0] / span
+            for j in range(1, n):
+                v = logs[lane, j] / span
+                if math.isnan(lyap) or math.isnan(v):
+                    lyap = math.nan
+                elif v > lyap:
+                    lyap = v
+    out.lyap[p] = lyap
+    out.used[p] = ls[lane].used + align
+    for i in range(n):
+        out.x[p, i] = XS[i, lane]
+    out.t[p] = k * T + s
+    store_release(out.status, p, STATUS_OK)  # (after its results: another thread may read them now)
+    ls[lane].stage = IDLE
+    return True
+
+
+@njit(cache=True)
+def final_request(st, XS, n, lane, align, cfg, s_phase, zdm_s):
     """The recorded stage of a point: with the variational equations (from the identity) for Lyapunov."""
-    if lyapunov:  # a new Runner at the current time (as run_point's ``var``)
-        t0 = li[lane, L_K] * T + lf[lane, F_S]
-        k0, s0, ks0, ss0 = start_times(t0, T, s_phase, periodic)
-        li[lane, L_K] = k0
-        lf[lane, F_S] = s0
-        li[lane, L_RKS] = ks0
-        lf[lane, F_RSS] = ss0
+    T = st.T
+    if cfg.lyapunov:  # a new Runner at the current time (as run_point's ``var``)
+        t0 = st.k * T + st.s
+        k0, s0, ks0, ss0 = start_times(t0, T, s_phase, cfg.periodic)
+        st.k = k0
+        st.s = s0
+        st.req_ks = ks0
+        st.req_ss = ss0
         for i in range(n):
             for c in range(n):
                 XS[n + i * n + c, lane] = 1.0 if i == c else 0.0
-        begin_request(li, lf, lane, align + periods, periods, True, T, zdm_s)
+        begin_request(st, align + cfg.periods, cfg.periods, True, T, zdm_s)
     else:
-        begin_request(li, lf, lane, periods, periods, False, T, zdm_s)
+        begin_request(st, cfg.periods, cfg.periods, False, T, zdm_s)

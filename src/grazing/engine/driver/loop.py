@@ -17,7 +17,8 @@ vector field is T-periodic in time (``cfg.wrap``), so that the forcing phase
 does not lose precision over long runs.  Samples are taken at local times
 ``(ks, ss)``, ``(ks + 1, ss)``, ... (or ``ss``, ``ss + T``, ... without
 wrapping); the last ``n_keep`` are stored and define the recorded span
-(impacts, trajectory, minimum of the guard, Lyapunov sums).  ``start.mode``
+(impacts, trajectory, minimum of the guard, Lyapunov sums), which starts at
+the sample before the first kept one.  ``start.mode``
 is 0 in free flight, ``1 + j`` when sticking to stop ``j``; the final mode is
 returned so that a run can be continued.  ``cfg.stop`` is the stop a grazing
 analysis looks at: its guard's minimum is tracked, a grazing contact at the
@@ -32,13 +33,25 @@ import math
 import numpy as np
 from numba import njit
 
-from grazing.core.solution import Status
 from grazing.engine.driver.atomics import load_acquire
 from grazing.engine.driver.calls import tc_free, tc_stick, tc_var
 from grazing.engine.driver.events import first_event
-from grazing.engine.driver.impacts import apply_impact, chatter_remaining, close_sticking, enter_contact
-from grazing.engine.driver.recording import finish_guard, take_samples, track_guard, trajectory_points
-from grazing.engine.driver.tangent import discontinuity_map, lyapunov_step, shift_period
+from grazing.engine.driver.impacts import close_sticking
+from grazing.engine.driver.recording import (
+    finish_guard,
+    new_guard_info,
+    take_samples,
+    track_guard,
+    trajectory_points,
+)
+from grazing.engine.driver.state import (
+    STATUS_INTERRUPTED,
+    STATUS_NONFINITE,
+    STATUS_OK,
+    STATUS_STEP_LIMIT,
+    new_state,
+)
+from grazing.engine.driver.step import STEP_LAST, accept_step, end_plain_step, end_step, step_end
 from grazing.engine.polyroots import work_shape
 from grazing.engine.records import Config, Kernels, Start
 from grazing.engine.stepping import (
@@ -52,11 +65,6 @@ from grazing.engine.stepping import (
     unpack_var,
 )
 
-STATUS_OK = int(Status.OK)
-STATUS_STEP_LIMIT = int(Status.STEP_LIMIT)
-STATUS_NONFINITE = int(Status.NONFINITE)
-STATUS_ZENO = int(Status.ZENO)
-STATUS_INTERRUPTED = int(Status.INTERRUPTED)
 ROOT_WORK_ROWS, ROOT_WORK_MIN_COLS = work_shape(0)
 
 
@@ -79,7 +87,6 @@ def integrate(start, pv, cfg, m):
     nstops = m.nstops
     # The settings read on every step, as locals (no record access in the loop).
     T = cfg.T
-    wrap = cfg.wrap
     use_var = cfg.use_var
     max_step = cfg.max_step
     max_steps = cfg.max_steps
@@ -94,9 +101,6 @@ def integrate(start, pv, cfg, m):
     record_impacts = cfg.record_impacts
     Tp = cfg.Tp
     chatter_time = cfg.chatter_time
-    zdm_a = cfg.zdm_a
-    zdm_e = cfg.zdm_e
-    zdm_window = cfg.zdm_window
     watch = cfg.stop
     sigints = cfg.sigints
     sigints_seen = cfg.sigints_seen
@@ -126,228 +130,154 @@ def integrate(start, pv, cfg, m):
     traj = new_table(64 if traj_dt > 0.0 else 1, 1 + n)
     logs = np.zeros(n)
     scratch = np.zeros(n)
-    min_info = np.full((nstops, 2 * (2 + n)), math.inf)  # per stop (see track_guard)
-    slope_end = np.full(nstops, math.nan)  # d guard / dt at the end of the previous free-flight step
-    slope_first = np.full(nstops, math.nan)  # ... at the start of the first recorded one
+    guard_info = new_guard_info(nstops, n)  # per stop: the guard's minimum, closest approach, slopes
+    tables = (imp, sticks, traj)
     fbuf = np.empty(n)
-    shift_sens = use_var and m.nsens > 0 and wrap
     zdm_gh = np.zeros(n)
     zdm_gv = np.zeros(n)
+    buffers = (xp, V, scratch, logs, xe, zdm_gh, zdm_gv, fbuf)  # (step.end_step's)
 
-    k = start.k
-    s = start.s
-    mode = 1 if start.mode > 0 else 0
-    stuck = max(start.mode - 1, 0)  # the stop it sticks to
-    defl = 2 if cfg.touch_start else 0
-    defl_stop = watch  # the stop the known roots at u = 0 belong to
-    ks = cfg.ks
-    ss = cfg.ss
-    isamp = 0
+    runs = new_state(1)  # (read again in the return statement: a record does not keep its array alive)
+    r = runs[0]  # the run's state (see .state)
+    start_run(m, r, start, cfg, x, tables)
     keep_from = n_samples - n_keep
-    recording = keep_from == 0
-    lyap_t0 = k * T + s
-    lyap_started = recording
-    n_imp = 0
-    n_imp_rec = 0
-    n_stick = 0
-    n_traj = 0
-    kt = k
-    st = s
-    kz = k if s < cfg.zdm_s - 1e-9 * T else k + 1
     sz = cfg.zdm_s
-    status = STATUS_OK
-    nsteps = 0
-    zero_events = 0
-    jac_valid = True
-    if recording and traj_dt > 0.0:
-        append_row(traj, 0, k * T + s, x, n)
-        n_traj = 1
-        st += traj_dt
-        while wrap and st >= T:
-            st -= T
-            kt += 1
-    if recording and mode == 1:  # the recorded span starts while sticking
-        append_pair(sticks, n_stick, k * T + s, math.nan)
-        n_stick += 1
 
     while True:
-        if nsteps >= max_steps:
-            status = STATUS_STEP_LIMIT
+        if r.steps >= max_steps:
+            r.status = STATUS_STEP_LIMIT
             break
         if load_acquire(sigints, 0) != sigints_seen:  # Ctrl-C (grazing.engine.interrupts)
-            status = STATUS_INTERRUPTED
+            r.status = STATUS_INTERRUPTED
             break
         for i in range(n):
             if not math.isfinite(x[i]):
-                status = STATUS_NONFINITE
+                r.status = STATUS_NONFINITE
                 break
-        if status != STATUS_OK:
+        if r.status != STATUS_OK:
             break
         # The step: Taylor coefficients of the solution (and of the event function), and the step size.
-        if mode == 0:
+        if r.mode == 0:
             if use_var:
-                tc_var(m, x, s, pv, X, O)
+                tc_var(m, x, r.s, pv, X, O)
             else:
-                tc_free(m, x, s, pv, X, O)
+                tc_free(m, x, r.s, pv, X, O)
             h = step_size(X, ntot, O, nstops, 0, order, max_step, factor)
         else:
-            tc_stick(m, x, s, pv, X, O, stuck)  # the first n rows only
-            h = step_size(X, n, O, nstops, stuck, order, max_step, factor)
-        rem = (ks - k) * T + (ss - s)
-        is_last = False
-        if isamp == n_samples - 1 and h >= rem:
-            h = rem
-            is_last = True
-        zdm_hit = False
-        if zdm_on:
-            rem_z = (kz - k) * T + (sz - s)
-            if rem_z <= h:
-                h = rem_z
-                zdm_hit = True
-                is_last = is_last and rem_z >= rem
+            tc_stick(m, x, r.s, pv, X, O, r.stuck)  # the first n rows only
+            h = step_size(X, n, O, nstops, r.stuck, order, max_step, factor)
+        h, ends = step_end(r, h, zdm_on, sz)  # (at the last sample, at the map's phase)
+        is_last = (ends & STEP_LAST) != 0
 
         # The first event on the step (each guard's polynomial in u in [0, 1]).
         u, ev_stop = first_event(
-            m, O, h, mode, stuck, events, watch if zdm_on else -1, defl, defl_stop,
-            touch_end and is_last and mode == 0, watch, a, work,
-        )  # fmt: skip
-        event = u >= 0.0 and h > 0.0
-        if event and u == 0.0:
-            zero_events += 1
-            if zero_events > 3:
-                status = STATUS_ZENO
-                break
-        else:
-            zero_events = 0
-        h_acc = u * h if event else h
-        if event and is_last and u >= 1.0:
-            event = False
-        nrows = ntot if mode == 0 else n
+            m, r, O, h, events, watch if zdm_on else -1, touch_end and is_last and r.mode == 0, watch, a, work
+        )
+        if not accept_step(r, h, ends, u, ev_stop):  # (events accumulate)
+            break
+        h_acc = r.h_acc
+        event = r.event
+        nrows = ntot if r.mode == 0 else n
 
         # What the step records within (0, h_acc].
-        if (ks - k) * T + (ss - s) <= h_acc:  # a sample is due on this step (about once a period)
-            isamp, ks, ss, recording, n_stick, n_traj, kt, st = take_samples(
-                m, T, wrap, n_samples, n_keep, traj_dt, X, k, s, h_acc, event, is_last, mode, isamp, ks, ss,
-                keep_from, recording, samples, sticks, n_stick, traj, n_traj, kt, st, xe,
-            )  # fmt: skip
-        if recording and traj_dt > 0.0:
-            n_traj, kt, st = trajectory_points(m, T, wrap, traj_dt, X, k, s, h_acc, traj, n_traj, kt, st, xe)
-        if recording and track_min and mode == 0 and h_acc > 0.0:
+        if (r.ks - r.k) * T + (r.ss - r.s) <= h_acc:  # a sample is due on this step (about once a period)
+            take_samples(m, r, X, h_acc, event, is_last, samples, sticks, traj, xe)
+        if r.recording and traj_dt > 0.0:
+            trajectory_points(m, r, X, h_acc, traj, xe, is_last and not event)
+        if r.recording and track_min and r.mode == 0 and h_acc > 0.0:
             for j in range(nstops):  # every stop's closest approach
-                slope_end[j], slope_first[j] = track_guard(
-                    m, O, j, X, x, k * T + s, h, h_acc, defl if defl_stop == j else 0, event, gm, min_info[j],
-                    slope_end[j], slope_first[j], xe,
-                )  # fmt: skip
+                track_guard(m, r, O, j, X, x, h, h_acc, event, gm, guard_info[j], xe)
 
         # Advance to the end of the accepted part of the step.
         eval_rows(X, nrows, order, h_acc, xe)
         for i in range(nrows):
             x[i] = xe[i]
-        s += h_acc
-        if wrap and s >= T:
-            if shift_sens and mode == 0:
-                shift_period(m, x, s, pv, Tp, ncol, fbuf)
-            s -= T
-            k += 1
-        nsteps += 1
-        defl = 0
-        if lyap and use_var and mode == 0:
-            lyap_started, lyap_t0 = lyapunov_step(
-                m, x, V, ncol, recording, lyap_started, lyap_t0, k * T + s, scratch, logs
+        if not end_plain_step(r, lyap, m.nsens > 0):  # (the step's end has work to do)
+            kicked, impact = end_step(
+                m, r, x, X, pv, nrows, cfg, chatter_time, record_impacts, Tp, buffers, tables
             )
-
-        if zdm_hit:
-            kz += 1
-            record = record_impacts == 2 or (record_impacts == 1 and recording)
-            applied, n_imp_rec = discontinuity_map(
-                m,
-                x,
-                s,
-                k * T + s,
-                pv,
-                watch,
-                zdm_a,
-                zdm_e,
-                zdm_window,
-                use_var,
-                ncol,
-                V,
-                zdm_gh,
-                zdm_gv,
-                record,
-                imp,
-                n_imp_rec,
-            )
-            if applied:
-                n_imp += 1
-
-        if event:
-            if mode == 1 and ev_stop == stuck:
-                # Release from sticking: the contact force changes sign.
-                mode = 0
-                defl = 3
-                defl_stop = stuck
-                if recording:
-                    close_sticking(sticks, n_stick, k * T + s)
-            else:
-                if mode == 1:  # sticking to one stop, it hits another: the contact ends
-                    mode = 0
-                    if recording:
-                        close_sticking(sticks, n_stick, k * T + s)
-                # Impact: x holds the state on stop ev_stop, just before its reset.
-                record = record_impacts == 2 or (record_impacts == 1 and recording)
-                traj_on = recording and traj_dt > 0.0
-                speed, n_imp_rec, n_traj, salt_ok = apply_impact(
-                    m, x, xp, s, k * T + s, pv, ev_stop, use_var, ncol, nrows, V, record, imp, n_imp_rec,
-                    traj_on, traj, n_traj,
-                )  # fmt: skip
-                jac_valid = jac_valid and salt_ok  # (an impact at zero normal speed has no Jacobian)
-                n_imp += 1
-                defl = 1
-                defl_stop = ev_stop
-                if m.sticks[ev_stop]:
-                    dt_acc = chatter_remaining(m, x, s, pv, ev_stop, speed, chatter_time)
-                    if dt_acc >= 0.0:  # complete chattering: on to the accumulation point, then sticking
-                        s += dt_acc
-                        if wrap and s >= T:  # (the Jacobian is not valid after sticking)
-                            s -= T
-                            k += 1
-                        enter_contact(m, x, s, pv, ev_stop)
-                        mode = 1
-                        stuck = ev_stop
-                        defl = 0
-                        jac_valid = False
-                        if recording:
-                            append_pair(sticks, n_stick, k * T + s, math.nan)
-                            n_stick += 1
-        if isamp >= n_samples:
+            r.n_imp += int(kicked) + int(impact)
+        if r.isamp >= n_samples:
             break
 
-    if track_min and mode == 0 and recording:
+    if track_min and r.mode == 0 and r.recording:
         for j in range(nstops):
-            finish_guard(m, x, s, pv, j, k * T + s, slope_end[j], slope_first[j], min_info[j])
-    close_sticking(sticks, n_stick, k * T + s)
-    lyap_span = k * T + s - lyap_t0 if (lyap and lyap_started) else 0.0
+            finish_guard(m, r, x, pv, j, guard_info[j])
+    close_sticking(sticks, r.n_stick, r.k * T + r.s)
+    lyap_span = r.k * T + r.s - r.lyap_t0 if (lyap and r.lyap_started) else 0.0
     Vout = np.zeros((n, ncol))
     if use_var:
         unpack_var(x, n, ncol, Vout)
     # A plain tuple (the caller makes the Result): numba's boxing of a named tuple runs Python code
     # (unpickling the class) without checking it for an error, a crash if a Ctrl-C is pending.
     return (
-        status,
+        r.status,
         x[:n].copy(),
         Vout,
-        k,
-        s,
-        0 if mode == 0 else 1 + stuck,
-        nsteps,
-        n_imp,
-        samples[: max(0, min(n_keep, isamp - keep_from))].copy(),
-        table_rows(imp, n_imp_rec),
-        table_rows(sticks, n_stick),
-        table_rows(traj, n_traj),
+        r.k,
+        r.s,
+        0 if r.mode == 0 else 1 + r.stuck,
+        r.steps,
+        r.n_imp,
+        samples[: max(0, min(n_keep, r.isamp - keep_from))].copy(),
+        table_rows(imp, r.n_imp_rec),
+        table_rows(sticks, r.n_stick),
+        table_rows(traj, r.n_traj),
         logs,
         lyap_span,
-        min_info,
-        jac_valid,
+        guard_info[:, : 2 * (2 + n)].copy(),
+        runs[0].jac_valid,  # (the last use of runs: see above)
     )
+
+
+@njit(cache=True)
+def start_run(m, r, start, cfg, x, tables):
+    """Set the state ``r`` of a run from ``start`` with the settings ``cfg`` (its state ``x``).
+
+    A run whose recorded span starts at once records its first trajectory
+    point, and a sticking interval if it starts sticking (``tables`` =
+    ``(impacts, sticking, trajectory)``).
+    """
+    n = m.nx
+    T = cfg.T
+    r.T = T
+    r.wrap = cfg.wrap
+    r.traj_dt = cfg.traj_dt
+    r.n_samples = cfg.n_samples
+    r.n_keep = cfg.n_keep
+    r.use_var = cfg.use_var
+    r.max_steps = cfg.max_steps
+    r.k = start.k
+    r.s = start.s
+    r.mode = 1 if start.mode > 0 else 0
+    r.stuck = max(start.mode - 1, 0)  # the stop it sticks to
+    r.defl = 2 if cfg.touch_start else 0
+    r.defl_stop = cfg.stop  # the stop the known roots at u = 0 belong to
+    r.ks = cfg.ks
+    r.ss = cfg.ss
+    r.isamp = 0
+    r.recording = cfg.n_samples - cfg.n_keep == 0
+    r.lyap_t0 = r.k * T + r.s
+    r.lyap_started = r.recording
+    r.span_dt = math.nan
+    r.n_imp = 0
+    r.n_imp_rec = 0
+    r.n_stick = 0
+    r.n_traj = 0
+    r.kt = r.k
+    r.st = r.s
+    r.kz = r.k if r.s < cfg.zdm_s - 1e-9 * T else r.k + 1
+    r.status = STATUS_OK
+    r.steps = 0
+    r.zero_events = 0
+    r.jac_valid = True
+    if r.recording and r.traj_dt > 0.0:
+        append_row(tables[2], 0, r.k * T + r.s, x, n)
+        r.n_traj = 1
+        r.st += r.traj_dt
+        while r.wrap and r.st >= T:
+            r.st -= T
+            r.kt += 1
+    if r.recording and r.mode == 1:  # the recorded span starts while sticking
+        append_pair(tables[1], r.n_stick, r.k * T + r.s, math.nan)
+        r.n_stick += 1

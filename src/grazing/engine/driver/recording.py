@@ -9,105 +9,121 @@ in free flight), are tracked for grazing analysis.
 
 import math
 
-import numpy as np  # noqa: F401 - the names the pieces share in the generated module
+import numpy as np
 from numba import njit
 
 from grazing.engine.driver.calls import guard
 from grazing.engine.polyroots import horner
 from grazing.engine.stepping import append_pair, append_row, eval_rows, poly_derivative, set_row, set_slice
 
+TRAJECTORY_END_TOL = 1e-9
+"""A trajectory point at most this many spacings past the run's end is its end (rounding)."""
+
 
 @njit(cache=True, inline="always")
-def take_samples(
-    m, T, wrap, n_samples, n_keep, traj_dt, X, k, s, h_acc, event, is_last, mode, isamp, ks, ss, keep_from,
-    recording, samples, sticks, n_stick, traj, n_traj, kt, st, xe,
-):  # fmt: skip
-    """The samples within ``(0, h_acc]`` of the step; returns the updated sampling state.
+def take_samples(m, r, X, h_acc, event, is_last, samples, sticks, traj, xe):
+    """The samples within ``(0, h_acc]`` of the step of run ``r`` (a :data:`.state.RUN_STATE` record).
 
-    Returns ``(isamp, ks, ss, recording, n_stick, n_traj, kt, st)``: samples
-    taken, the next sample's time, whether the recorded span has started, and
-    the sticking-interval and trajectory counters (the span may start while
+    Updates the sampling state of ``r``: samples taken (into ``samples``, the
+    kept ones), the next sample's time, whether the recorded span has started
+    (and where: ``r.span_dt`` into the step, at time ``r.lyap_t0``), and the
+    sticking-interval and trajectory counters (the span may start while
     sticking, and starts the trajectory).
     """
     n = m.nx
     order = m.order
-    while isamp < n_samples:
-        dt = (ks - k) * T + (ss - s)
+    T = r.T
+    keep_from = r.n_samples - r.n_keep
+    while r.isamp < r.n_samples:
+        dt = (r.ks - r.k) * T + (r.ss - r.s)
         if dt > h_acc or (event and dt == h_acc and not is_last):
             break
-        if is_last and isamp == n_samples - 1:
+        if is_last and r.isamp == r.n_samples - 1:
             dt = h_acc
-        if isamp >= keep_from:
+        if r.isamp >= keep_from:
             eval_rows(X, n, order, dt, xe)
-            set_row(samples, isamp - keep_from, 0, xe, n)
-        isamp += 1
-        if wrap:
-            ks += 1
+            set_row(samples, r.isamp - keep_from, 0, xe, n)
+        r.isamp += 1
+        if r.wrap:
+            r.ks += 1
         else:
-            ss += T
-        if isamp == keep_from and not recording and n_keep > 0:
-            recording = True
-            if mode == 1:  # recording starts while sticking: the interval starts here
-                append_pair(sticks, n_stick, k * T + s + dt, math.nan)
-                n_stick += 1
-            if traj_dt > 0.0:
+            r.ss += T
+        if r.isamp == keep_from and not r.recording and r.n_keep > 0:
+            r.recording = True
+            r.span_dt = dt  # (where the Lyapunov sums start: tangent.lyapunov_step)
+            r.lyap_t0 = r.k * T + r.s + dt
+            if r.mode == 1:  # recording starts while sticking: the interval starts here
+                append_pair(sticks, r.n_stick, r.k * T + r.s + dt, math.nan)
+                r.n_stick += 1
+            if r.traj_dt > 0.0:
                 eval_rows(X, n, order, dt, xe)
-                append_row(traj, n_traj, k * T + s + dt, xe, n)
-                n_traj += 1
-                kt = k
-                st = s + dt + traj_dt
-                while wrap and st >= T:
-                    st -= T
-                    kt += 1
-    return isamp, ks, ss, recording, n_stick, n_traj, kt, st
+                append_row(traj, r.n_traj, r.k * T + r.s + dt, xe, n)
+                r.n_traj += 1
+                r.kt = r.k
+                r.st = r.s + dt + r.traj_dt
+                while r.wrap and r.st >= T:
+                    r.st -= T
+                    r.kt += 1
 
 
 @njit(cache=True, inline="always")
-def trajectory_points(m, T, wrap, traj_dt, X, k, s, h_acc, traj, n_traj, kt, st, xe):
-    """Trajectory points within the step, every ``traj_dt``; returns ``(n_traj, kt, st)``."""
+def trajectory_points(m, r, X, h_acc, traj, xe, run_end):
+    """Trajectory points of run ``r`` within the step, every ``r.traj_dt``, from ``(r.kt, r.st)`` on.
+
+    At the run's end (``run_end``: the step ends there, not at an event) a
+    point that the sums of ``traj_dt`` put past it by rounding is the end's
+    (the last row of a trajectory was missing where they came out a hair long).
+    """
     n = m.nx
+    T = r.T
     while True:
-        dt = (kt - k) * T + (st - s)
+        dt = (r.kt - r.k) * T + (r.st - r.s)
         if dt > h_acc:
-            break
+            if not (run_end and dt - h_acc <= TRAJECTORY_END_TOL * r.traj_dt):
+                break
+            dt = h_acc
         eval_rows(X, n, m.order, dt, xe)
-        append_row(traj, n_traj, k * T + s + dt, xe, n)
-        n_traj += 1
-        st += traj_dt
-        while wrap and st >= T:
-            st -= T
-            kt += 1
-    return n_traj, kt, st
+        append_row(traj, r.n_traj, r.k * T + r.s + dt, xe, n)
+        r.n_traj += 1
+        r.st += r.traj_dt
+        while r.wrap and r.st >= T:
+            r.st -= T
+            r.kt += 1
 
 
 @njit(cache=True, inline="always")
-def track_guard(m, O, row, X, x, t, h, h_acc, defl, event, gm, min_info, slope_end, slope_first, xe):
-    """Minimum of event row ``row`` (a guard) over ``[t, t + h_acc)``, closest approach; returns the slopes.
+def track_guard(m, r, O, row, X, x, h, h_acc, event, gm, info, xe):
+    """Minimum of event row ``row`` (a guard) over the step of run ``r`` up to ``h_acc``, closest approach.
 
-    ``min_info[:2 + n]`` holds the smallest value, its time and the state
-    there; ``min_info[2 + n:]`` the same for the smallest local minimum in free
+    ``info`` is the stop's row of the guard's record (:func:`new_guard_info`):
+    ``info[:2 + n]`` holds the smallest value, its time and the state there;
+    ``info[2 + n:4 + 2n]`` the same for the smallest local minimum in free
     flight (where ``L_f h`` turns from negative to positive, inside the step
-    or at its start).  Returns ``(slope_end, slope_first)``: the guard's slope
-    at the end of this step (nan when an event follows) and at the start of
-    the first recorded step.
+    or at its start); the last two, the guard's slope at the end of the
+    previous step (nan when an event followed) and at the start of the
+    first recorded one.  ``x`` is the state at the step's start.
     """
     n = m.nx
     order = m.order
+    t = r.k * r.T + r.s
+    defl = r.defl if r.defl_stop == row else 0
+    slope_end = info[4 + 2 * n]
+    slope_first = info[5 + 2 * n]
     hk = 1.0
     for j in range(order + 1):
         gm[j] = O[row, j] * hk
         hk *= h
-    if gm[0] < min_info[0]:
-        min_info[0] = gm[0]
-        min_info[1] = t
-        set_slice(min_info, 2, x, n)
+    if gm[0] < info[0]:
+        info[0] = gm[0]
+        info[1] = t
+        set_slice(info, 2, x, n)
     if defl == 0:  # not leaving a contact
         if math.isnan(slope_first):
             slope_first = gm[1] / h
-        elif slope_end < 0.0 <= gm[1] and gm[0] < min_info[2 + n]:
-            min_info[2 + n] = gm[0]  # a local minimum exactly at the step boundary
-            min_info[3 + n] = t
-            set_slice(min_info, 4 + n, x, n)
+        elif slope_end < 0.0 <= gm[1] and gm[0] < info[2 + n]:
+            info[2 + n] = gm[0]  # a local minimum exactly at the step boundary
+            info[3 + n] = t
+            set_slice(info, 4 + n, x, n)
     uend = h_acc / h
     slope_end = poly_derivative(gm, order, uend) / h
     if gm[1] < 0.0 and slope_end > 0.0:
@@ -121,29 +137,39 @@ def track_guard(m, O, row, X, x, t, h, h_acc, defl, event, gm, min_info, slope_e
                 hi = mid
         um = 0.5 * (lo + hi)
         gv = horner(gm, order, um)
-        if gv < min_info[0] or gv < min_info[2 + n]:
+        if gv < info[0] or gv < info[2 + n]:
             eval_rows(X, n, order, um * h, xe)
         for base in (0, 2 + n):
-            if gv < min_info[base]:
-                min_info[base] = gv
-                min_info[base + 1] = t + um * h
-                set_slice(min_info, base + 2, xe, n)
+            if gv < info[base]:
+                info[base] = gv
+                info[base + 1] = t + um * h
+                set_slice(info, base + 2, xe, n)
     if event:
         slope_end = math.nan  # an impact or a release follows: no free-flight minimum here
-    return slope_end, slope_first
+    info[4 + 2 * n] = slope_end
+    info[5 + 2 * n] = slope_first
 
 
 @njit(cache=True)
-def finish_guard(m, x, s, pv, j, t, slope_end, slope_first, min_info):
-    """At the end of the run: the final state, and a minimum where the orbit closes."""
+def new_guard_info(nstops, n):
+    """Each stop's guard record (:func:`track_guard`): no minimum yet (inf), no slopes (nan)."""
+    info = np.full((nstops, 2 * (2 + n) + 2), math.inf)
+    info[:, 2 * (2 + n) :] = math.nan
+    return info
+
+
+@njit(cache=True)
+def finish_guard(m, r, x, pv, j, info):
+    """At the end of run ``r``: the final state, and a minimum where the orbit closes (``info`` of stop j)."""
     n = m.nx
-    g_end = guard(m, x, s, pv, j)
-    if g_end < min_info[0]:
-        min_info[0] = g_end
-        min_info[1] = t
-        set_slice(min_info, 2, x, n)
+    t = r.k * r.T + r.s
+    g_end = guard(m, x, r.s, pv, j)
+    if g_end < info[0]:
+        info[0] = g_end
+        info[1] = t
+        set_slice(info, 2, x, n)
     # A run over whole periods of an orbit ends where it started: a minimum there.
-    if slope_end < 0.0 <= slope_first and g_end < min_info[2 + n]:
-        min_info[2 + n] = g_end
-        min_info[3 + n] = t
-        set_slice(min_info, 4 + n, x, n)
+    if info[4 + 2 * n] < 0.0 <= info[5 + 2 * n] and g_end < info[2 + n]:
+        info[2 + n] = g_end
+        info[3 + n] = t
+        set_slice(info, 4 + n, x, n)

@@ -7,10 +7,11 @@ the state in ``x``): columns ``0 .. n-1`` are ``d x / d x0``, the next
 
 import math
 
+import numpy as np
 from numba import njit
 
 from grazing.engine.driver.calls import guard, guard_grad, normal_rate, normal_rate_grad, rhs
-from grazing.engine.stepping import append_record, orthonormalize, pack_var, unpack_var
+from grazing.engine.stepping import append_record, eval_rows, orthonormalize, pack_var, unpack_var
 
 
 @njit(cache=True)
@@ -31,45 +32,71 @@ def shift_period(m, x, s, pv, Tp, ncol, f):
 
 
 @njit(cache=True, inline="always")
-def lyapunov_step(m, x, V, ncol, recording, started, t0, t, scratch, logs):
-    """Gram-Schmidt on the tangent vectors after a step; returns ``(started, t0)``.
+def lyapunov_step(m, r, x, X, V, ncol, t, scratch, logs, xe):
+    """Gram-Schmidt on the tangent vectors of run ``r`` after a step that ends at time ``t``.
 
     Before the recorded span the vectors are only aligned (their growth is
-    discarded); from its start the log norms are summed into ``logs``.
+    discarded); from its start, ``r.lyap_t0``, the log norms are summed into
+    ``logs``.  A span that starts inside the step, ``r.span_dt`` after its
+    start (at a sample, :func:`.recording.take_samples`), counts the growth
+    from there: the log norms of the aligned vectors at the end of the step
+    less those of the vectors at the span's start, evaluated there from the
+    step's polynomials ``X`` (into ``xe``).  The sums are then the same
+    (to rounding) whether or not a step, or a call of the driver, ends at
+    that sample.
     """
     n = m.nx
-    unpack_var(x, n, ncol, V)
-    if recording and not started:
-        started = True
-        t0 = t
-        orthonormalize(V, n, scratch)
-    elif started:
+    if r.recording and not r.lyap_started:
+        r.lyap_started = True
+        if math.isnan(r.span_dt):  # (the span started in an earlier step, while sticking)
+            r.lyap_t0 = t
+            unpack_var(x, n, ncol, V)
+            orthonormalize(V, n, scratch)
+        else:
+            eval_rows(X, n + n * ncol, m.order, r.span_dt, xe)
+            unpack_var(xe, n, ncol, V)
+            before = np.zeros(n)
+            orthonormalize(V, n, before)  # the vectors' growth before the span ...
+            unpack_var(x, n, ncol, V)
+            orthonormalize(V, n, logs)
+            for c in range(n):
+                logs[c] -= before[c]  # ... is not the span's (the diagonal of R1^-1 R: log R - log R1)
+    elif r.lyap_started:
+        unpack_var(x, n, ncol, V)
         orthonormalize(V, n, logs)
     else:
-        orthonormalize(V, n, scratch)  # transient: align V, discard growth
+        unpack_var(x, n, ncol, V)
+        orthonormalize(V, n, scratch)  # before the span: align V, discard growth
     pack_var(V, n, ncol, x)
-    return started, t0
 
 
 @njit(cache=True)
-def discontinuity_map(m, x, s, t, pv, j, a, e, window, use_var, ncol, V, gh, gv, record, imp, n_rec):
-    """Nordmark's discontinuity map at leading order, at the grazing phase; returns ``(applied, n_rec)``.
+def discontinuity_map(m, r, x, pv, cfg, V, gh, gv, record, imp):
+    """Nordmark's discontinuity map at leading order, at the grazing phase; returns whether it applied.
 
-    With ``v = L_f h`` and ``delta = v^2 / (2 a) - h`` (how far the local
-    parabola would reach past the stop, ``a = L_f^2 h`` at the grazing
-    point): if ``delta > 0`` and ``|v| / a < window``, ``x <- x - e sqrt(2 a
-    delta)``, and the
-    variational matrix by ``dD/dx = I - e (grad S)^T``.  The kick is recorded
-    as an impact (time, speed ``S``, state) when ``record``.
+    ``cfg`` holds the map's settings (``stop`` the stop it stands for,
+    ``zdm_a``, ``zdm_e``, ``zdm_window``: the fields of
+    :class:`~grazing.engine.records.Config` and
+    :class:`~grazing.engine.records.LaneSettings`).  With ``v = L_f h`` and
+    ``delta = v^2 / (2 a) - h`` (how far the local parabola would reach past
+    the stop, ``a = L_f^2 h`` at the grazing point): if ``delta > 0`` and
+    ``|v| / a < window``, ``x <- x - e sqrt(2 a delta)``, and the variational
+    matrix by ``dD/dx = I - e (grad S)^T``.  The kick is recorded as an impact
+    (time, speed ``S``, state) in ``imp`` when ``record`` (``r.n_imp_rec``).
     """
     n = m.nx
+    ncol = n + m.nsens
+    j = cfg.stop
+    a = cfg.zdm_a
+    e = cfg.zdm_e
+    s = r.s
     hval = guard(m, x, s, pv, j)
     vn = normal_rate(m, x, s, pv, j)
     dz = vn * vn / (2.0 * a) - hval
-    if not (dz > 0.0 and abs(vn) < window * a):
-        return False, n_rec
+    if not (dz > 0.0 and abs(vn) < cfg.zdm_window * a):
+        return False
     sp_ = math.sqrt(2.0 * a * dz)
-    if use_var:
+    if r.use_var:
         # dD/dx = I - e (grad S)^T, grad S = a grad(delta) / S
         guard_grad(m, x, s, pv, gh, j)
         normal_rate_grad(m, x, s, pv, gv, j)
@@ -83,9 +110,9 @@ def discontinuity_map(m, x, s, t, pv, j, a, e, window, use_var, ncol, V, gh, gv,
                 V[i, c] -= e[i] * gs
         pack_var(V, n, ncol, x)
     if record:
-        append_record(imp, n_rec, t, sp_, x, n)
-        imp[0][n_rec, 2 + n] = j
-        n_rec += 1
+        append_record(imp, r.n_imp_rec, r.k * r.T + s, sp_, x, n)
+        imp[0][r.n_imp_rec, 2 + n] = j
+        r.n_imp_rec += 1
     for i in range(n):
         x[i] -= e[i] * sp_
-    return True, n_rec
+    return True

@@ -1,0 +1,137 @@
+"""Driver piece: the parts of a step that :mod:`.loop` and :mod:`.lanes` share, over a run's record.
+
+Each takes the run's state (a :data:`.state.RUN_STATE` record): the one run
+of :func:`.loop.integrate`, or one lane of :func:`.lanes.sweep_lanes`.
+"""
+
+import math
+
+from numba import njit
+
+from grazing.engine.driver.impacts import at_event
+from grazing.engine.driver.state import STATUS_ZENO
+from grazing.engine.driver.tangent import discontinuity_map, lyapunov_step, shift_period
+
+STEP_EVENT = 1
+"""The step ends at an event."""
+STEP_LAST = 2
+"""The step ends at the run's last sample."""
+STEP_MAP = 4
+"""The step ends at the discontinuity map's phase."""
+
+
+@njit(cache=True, inline="always")
+def step_end(r, h, zdm_on, zdm_s):
+    """The step of run ``r`` from its time on, of size at most ``h``; returns ``(h, ends)``.
+
+    The step is cut at the run's last sample (``ends & STEP_LAST``) and at
+    the discontinuity map's local time ``zdm_s`` (``ends & STEP_MAP``).
+    """
+    T = r.T
+    rem = (r.ks - r.k) * T + (r.ss - r.s)
+    last = False
+    if r.isamp == r.n_samples - 1 and h >= rem:
+        h = rem
+        last = True
+    zdm_hit = False
+    if zdm_on:
+        rem_z = (r.kz - r.k) * T + (zdm_s - r.s)
+        if rem_z <= h:
+            h = rem_z
+            zdm_hit = True
+            last = last and rem_z >= rem
+    return h, (STEP_LAST if last else 0) | (STEP_MAP if zdm_hit else 0)
+
+
+@njit(cache=True, inline="always")
+def accept_step(r, h, ends, u, ev_stop):
+    """The accepted part of the step of run ``r`` (``h``, cut as ``ends`` says) and its event; False: none.
+
+    ``u`` is the first event on the step as a fraction of it (``u < 0``:
+    none), on stop ``ev_stop``.  Sets ``r.h_acc``, ``r.event``, ``r.ev_stop``
+    and ``r.zdm_hit``.  An event at the very end of a step that ends at the
+    run's last sample is left for the next run.  Returns False (``r.status``
+    ``ZENO``) when more than three events in a row come at ``u = 0``.
+    """
+    event = u >= 0.0 and h > 0.0
+    if event and u == 0.0:
+        r.zero_events += 1
+        if r.zero_events > 3:
+            r.status = STATUS_ZENO
+            return False
+    else:
+        r.zero_events = 0
+    r.h_acc = u * h if event else h
+    if event and (ends & STEP_LAST) != 0 and u >= 1.0:
+        event = False
+    r.event = event
+    r.ev_stop = ev_stop
+    r.zdm_hit = (ends & STEP_MAP) != 0
+    return True
+
+
+@njit(cache=True, inline="always")
+def end_plain_step(r, lyapunov, sensitivities):
+    """The end of the step of run ``r`` where only time passes; False (nothing done) where there is more.
+
+    Only time passes at a step without an event, a discontinuity map, the
+    Lyapunov vectors to update (``lyapunov``) or the sensitivities' period
+    term at a period boundary (``sensitivities``): the time, steps and
+    ``defl`` as :func:`end_step` sets them.  It takes no array: numba counts
+    the references to each array a function is given (an atomic increment and
+    decrement), which at every step cost :func:`end_step`'s callers a tenth of
+    their time; :func:`end_step` is called only where it has work to do.
+    """
+    if r.event or r.zdm_hit:
+        return False
+    if r.use_var and r.mode == 0 and (lyapunov or (sensitivities and r.wrap and r.s + r.h_acc >= r.T)):
+        return False
+    r.s += r.h_acc
+    if r.wrap and r.s >= r.T:
+        r.s -= r.T
+        r.k += 1
+    r.steps += 1
+    r.defl = 0
+    r.span_dt = math.nan
+    return True
+
+
+@njit(cache=True, inline="always")
+def end_step(m, r, x, X, pv, nrows, cfg, chatter_time, record_impacts, Tp, work, tables):
+    """The end of the step of run ``r``, whose state ``x`` is already advanced; returns ``(zdm, impact)``.
+
+    The step, its accepted part ``r.h_acc`` and its event (``r.event`` on
+    stop ``r.ev_stop``, ``r.zdm_hit``) are those :func:`step_end` and the
+    event search chose; ``X`` holds its Taylor coefficients, ``nrows`` the
+    rows of ``x`` it advanced.  In order: the time (at a period boundary, the
+    sensitivities' period term, ``Tp`` = dT/dp), the Lyapunov vectors (with
+    ``cfg.lyapunov``), the discontinuity map (``cfg``'s), the event
+    (:func:`.impacts.at_event`, chattering shorter than ``chatter_time``).
+    Impacts (and kicks of the map) are recorded in ``tables`` as
+    ``record_impacts`` says (0 none, 1 in the recorded span, 2 all).
+    ``work`` holds the buffers ``(xp, V, scratch, logs, xe, gh, gv, f)``.
+    Returns whether the map kicked and whether there was an impact.
+    """
+    xp, V, scratch, logs, xe, gh, gv, f = work
+    ncol = m.nx + m.nsens
+    mode = r.mode
+    r.s += r.h_acc
+    if r.wrap and r.s >= r.T:
+        if m.nsens > 0 and r.use_var and mode == 0:
+            shift_period(m, x, r.s, pv, Tp, ncol, f)
+        r.s -= r.T
+        r.k += 1
+    r.steps += 1
+    r.defl = 0
+    if cfg.lyapunov and r.use_var and mode == 0:
+        lyapunov_step(m, r, x, X, V, ncol, r.k * r.T + r.s, scratch, logs, xe)
+    r.span_dt = math.nan
+    record = record_impacts == 2 or (record_impacts == 1 and r.recording)
+    kicked = False
+    if r.zdm_hit:
+        r.kz += 1
+        kicked = discontinuity_map(m, r, x, pv, cfg, V, gh, gv, record, tables[0])
+    impact = False
+    if r.event:
+        impact = at_event(m, r, x, xp, pv, r.ev_stop, nrows, V, chatter_time, record, tables)
+    return kicked, impact
