@@ -212,3 +212,22 @@ def test_random_models(spec: ModelSpec):
     for k in range(0, x.shape[0], 5):
         if found.labels[k] > 0 and found.attractor(int(found.labels[k])).kind in ("periodic", "sticking"):
             assert ends_on(model, found, int(found.labels[k]), x[k], transient=800), k
+
+
+def test_an_orbit_slow_to_settle_is_not_split_into_spurious_periods():
+    """Found by hypothesis (a lightly damped two-mass model, random names): after 200 periods some
+    initial states still spiralled into the period-1 orbit and their samples repeated to the period
+    detector's 1e-6 with periods 2, 7 and 9, each reported as an attractor of its own (the same
+    Lyapunov exponent to 1e-11). Such end states are run on before they are classified."""
+    names = ("x1", "v1", "t_0", "v0", "pi", "T", "J", "t", "t_", "x2", "v2", "E", "I", "e", "S", "N",
+             "lambda", "sin", "cos", "exp", "log", "sqrt", "math", "np", "pv", "s", "x", "out", "h", "k",
+             "c0", "w0", "p0", "xs0_0", "X", "O", "tau", "Dummy")  # fmt: skip
+    spec = ModelSpec(names=names, dof=2, damping=0.03125, stiffness=1.0, amplitude=1.0, omega=2.0,
+                     stop_fraction=0.5, restitution=0.75, coupling=0.25, cubic=0.0, smooth="none")  # fmt: skip
+    model = spec.model()
+    grid = state_grid(model, (-1.5 * spec.stop, 1.2 * spec.stop), (-2.0, 2.0), (6, 6))
+    x = grid.states_array()
+    found = find_attractors(model, x, workers=2, transient=200, periods=32)
+    assert [(a.kind, a.period) for a in found.attractors if a.kind != "invalid"] == [("periodic", 1)]
+    for k in np.flatnonzero(found.labels > 0):
+        assert ends_on(model, found, int(found.labels[k]), x[k], transient=800), k

@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 
 from grazing.core.model import ON_STOP_TOL, HybridModel
-from grazing.core.options import CHAOS_THRESHOLD, MATCH_TOL
+from grazing.core.options import BASIN_ADAPTIVE_TOL, CHAOS_THRESHOLD, MATCH_TOL
 from grazing.core.solution import Status
 from grazing.sweeps.spec import ChunkResult
 from grazing.sweeps.status import reason
@@ -214,7 +214,11 @@ class Catalogue:
 
         With ``defer``, the aperiodic ones are not labelled: their positions in
         ``res`` are returned, to be continued (:func:`grazing.attractors.basins`
-        runs them further before deciding); else an empty array.
+        runs them further before deciding); else an empty array.  So are, with
+        ``defer``, the periodic ones that have not settled (:func:`unsettled`):
+        an orbit slow to converge, sampled on its way, repeats to the period
+        detector's tolerance with a spurious period (a period-1 orbit whose
+        samples spiral in looked like period 7, 2 or 9 after 200 periods).
         """
         index = first + np.arange(res.status.size) if which is None else np.asarray(which)
         status = np.asarray(res.status, dtype=int)
@@ -233,10 +237,11 @@ class Catalogue:
             else:
                 self._outcome_label(int(index[k]), "failed", reason(int(status[k])))
         settled = ok & ~far
-        self._add_periodic(index, res, np.flatnonzero(settled & (period > 0)))
+        slow = unsettled(samples, period) & settled if defer else np.zeros(status.size, dtype=bool)
+        self._add_periodic(index, res, np.flatnonzero(settled & (period > 0) & ~slow))
         aperiodic = np.flatnonzero(settled & (period <= 0))
         if defer:
-            return aperiodic
+            return np.union1d(aperiodic, np.flatnonzero(slow))
         self._add_aperiodic(index, res, aperiodic)
         return np.zeros(0, dtype=np.int64)
 
@@ -402,6 +407,25 @@ class Catalogue:
             if not any(abs(self.model.guard(x, self.t_sample, j)) <= tol for j in range(self.model.n_stops)):
                 return False
         return True
+
+
+def unsettled(samples: np.ndarray, period: np.ndarray, tol: float = BASIN_ADAPTIVE_TOL) -> np.ndarray:
+    """Which periodic end states have not settled: their samples repeat with their period only to more
+    than ``tol`` (an orbit on its attractor repeats to rounding; the period detector accepts 1e-6).
+
+    Examples
+    --------
+    >>> k = np.arange(32.0)
+    >>> spiral = 1e-6 * 0.98**k * np.cos(2 * np.pi * k / 7)     # converging to a point, slowly
+    >>> samples = np.stack([np.stack([spiral, 0 * k], 1), np.stack([0 * k + 1.0, 0 * k], 1)])
+    >>> unsettled(samples, np.array([7, 1])).tolist()
+    [True, False]
+    """
+    out = np.zeros(period.shape, dtype=bool)
+    for i in np.flatnonzero(period > 0):
+        p = int(period[i])
+        out[i] = bool(np.max(np.abs(samples[i, p:] - samples[i, :-p])) > tol)
+    return out
 
 
 def set_distance(a: np.ndarray, b: np.ndarray, cell: np.ndarray) -> float:
