@@ -223,7 +223,8 @@ def test_an_orbit_slow_to_settle_is_not_split_into_spurious_periods():
              "lambda", "sin", "cos", "exp", "log", "sqrt", "math", "np", "pv", "s", "x", "out", "h", "k",
              "c0", "w0", "p0", "xs0_0", "X", "O", "tau", "Dummy")  # fmt: skip
     spec = ModelSpec(names=names, dof=2, damping=0.03125, stiffness=1.0, amplitude=1.0, omega=2.0,
-                     stop_fraction=0.5, restitution=0.75, coupling=0.25, cubic=0.0, smooth="none")  # fmt: skip
+                     stop_fraction=0.5, restitution=0.75, coupling=0.25, cubic=0.0,
+                     smooth="none")  # fmt: skip
     model = spec.model()
     grid = state_grid(model, (-1.5 * spec.stop, 1.2 * spec.stop), (-2.0, 2.0), (6, 6))
     x = grid.states_array()

@@ -272,6 +272,23 @@ def test_forked_children_do_not_keep_the_lock(tmp_path):
         child.join()
 
 
+def test_a_copy_of_the_lock_not_yet_closed_does_not_keep_it(tmp_path):
+    """A child forked a moment before the store is closed may not have run yet (so not closed its
+    copy of the lock): the holder unlocks, not only closes (the test above was flaky under load)."""
+    from grazing.sweeps import lock
+
+    path, spec = tmp_path / "s.zarr", _spec()
+    store = ZarrStore(path, spec)
+    (fd,) = lock._HELD
+    copy = os.dup(fd)  # (what a forked child holds until it runs: the same open file description)
+    try:
+        store.close()
+        with ZarrStore(path, spec):
+            pass
+    finally:
+        os.close(copy)
+
+
 def test_wait_waits_for_the_other_run_and_without_it_the_pid_is_named(tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     out = tmp_path / "w.zarr"

@@ -5,8 +5,9 @@ is written and held until the run ends.  The operating system releases it when
 the holder's process dies, however it dies, so a lock left by a dead process
 is simply taken over.  The holder writes its PID into the file, so that a
 second run can name it.  Forked children (pool workers) close their inherited
-copy at once: the lock belongs to the process that took it, not to its
-workers.
+copy at once, and the holder unlocks before it closes (a child that has not
+run yet still shares the lock): the lock belongs to the process that took it,
+not to its workers.
 
 Where the file system does not support ``flock`` (some network file systems),
 the lock falls back to the PID in the file: it is taken over only when that
@@ -128,6 +129,10 @@ class StoreLock:
         _HELD.discard(self._fd)
         try:
             os.ftruncate(self._fd, 0)
+        except OSError:
+            pass
+        try:  # (unlocked, not only closed: a child forked a moment ago may not yet have closed its copy)
+            fcntl.flock(self._fd, fcntl.LOCK_UN)
         except OSError:
             pass
         os.close(self._fd)
