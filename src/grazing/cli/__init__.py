@@ -12,7 +12,7 @@ from __future__ import annotations
 import click
 
 import grazing
-from grazing.cli import attractors, curves, experiment, normalform, orbits, report, simulate, sweeps
+from grazing.cli import attractors, curves, experiment, explore, normalform, orbits, report, simulate, sweeps
 from grazing.cli.common import EXIT_FAILURE, EXIT_INTERRUPTED, EXIT_USAGE, error_line
 from grazing.cli.limits import MEMORY_ENV
 from grazing.errors import GrazingError
@@ -31,6 +31,7 @@ for _command in (
     simulate.simulate, orbits.orbit, orbits.graze, orbits.graze_curve, orbits.continue_, curves.curve,
     sweeps.sweep_cmd, normalform.normal_form_cmd, sweeps.map_cmd, report.report, *experiment.COMMANDS,
     *attractors.COMMANDS,  # issue 28
+    explore.explore,  # issue 31
 ):  # fmt: skip
     cli.add_command(_command)
 

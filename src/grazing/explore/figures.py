@@ -1,0 +1,315 @@
+"""The explorer's plots (Bokeh): the diagram or period map, the orbit's time series and phase portrait.
+
+The data of each plot is built from the records of :mod:`grazing.explore` by a plain
+function returning the columns of a Bokeh ``ColumnDataSource`` (testable without a
+browser); :class:`Figures` holds the figures and their sources, and is changed only by
+replacing those columns.  Labels come from the parameters' and states' metadata (symbol,
+display unit: degrees for angles).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from grazing.core.model import HybridModel, Parameter
+from grazing.explore.branch import Continued, Grazings, Mark
+from grazing.explore.diagram import Diagram, View
+from grazing.explore.point import PointReport
+
+__all__ = ["PERIOD_COLOURS", "Figures", "branch_columns", "diagram_columns", "mark_columns", "period_label"]
+
+PERIOD_COLOURS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#17becf")
+"""The colours of periods 1 to 8 (longer periods, no period and failed points are grey)."""
+
+OTHER_COLOUR, NONE_COLOUR, FAILED_COLOUR = "#7f7f7f", "#444444", "#ff00ff"
+
+
+def period_label(period: int) -> str:
+    """How a period is shown: ``"5"``, ``"none <= 64"``, ``"failed"``."""
+    if period > 0:
+        return str(int(period))
+    return "none <= 64" if period == 0 else "failed"
+
+
+def period_colour(period: int) -> str:
+    if 0 < period <= len(PERIOD_COLOURS):
+        return PERIOD_COLOURS[period - 1]
+    return OTHER_COLOUR if period > 0 else (NONE_COLOUR if period == 0 else FAILED_COLOUR)
+
+
+def axis_label(par: Parameter) -> str:
+    unit = par.display_unit
+    return f"{par.label} ({unit})" if unit else par.label
+
+
+def state_label(model: HybridModel, i: int) -> str:
+    unit = model.state_units[i] if model.state_units else ""
+    return f"{model.state_labels[i]} ({unit})" if unit else model.state_labels[i]
+
+
+def diagram_columns(diagram: Diagram, component: int) -> dict[str, list[Any]]:
+    """The stroboscopic points of a one-parameter diagram: one per distinct sample of each point.
+
+    A point with period ``p`` contributes its last ``p`` samples, one without a
+    period all of them, a failed point none (its samples are NaN).
+    """
+    par = diagram.view.parameter(0)
+    xs, ys, labels, colours, ipp = [], [], [], [], []
+    assert diagram.samples is not None
+    for i, value in enumerate(diagram.values[0]):
+        p = int(diagram.period[i])
+        s = diagram.samples[i, -p:, component] if p > 0 else diagram.samples[i, :, component]
+        s = s[np.isfinite(s)]
+        xs += [par.to_display(value)] * s.size
+        ys += s.tolist()
+        labels += [period_label(p)] * s.size
+        colours += [period_colour(p)] * s.size
+        ipp += [float(diagram.impacts_per_period[i])] * s.size
+    return {"x": xs, "y": ys, "period": labels, "colour": colours, "impacts": ipp}
+
+
+def map_image(diagram: Diagram) -> dict[str, list[Any]]:
+    """A period map as an image: the period of each cell (NaN where none; -1 failed)."""
+    a, b = diagram.view.axes
+    pa, pb = diagram.view.parameter(0), diagram.view.parameter(1)
+    lo1, hi1, lo2, hi2 = pa.to_display(a.lo), pa.to_display(a.hi), pb.to_display(b.lo), pb.to_display(b.hi)
+    d1, d2 = (hi1 - lo1) / (a.num - 1), (hi2 - lo2) / (b.num - 1)
+    image = np.where(diagram.period > 0, diagram.period, np.nan).astype(float)
+    return {
+        "image": [image],
+        "x": [lo1 - d1 / 2],
+        "y": [lo2 - d2 / 2],
+        "dw": [hi1 - lo1 + d1],
+        "dh": [hi2 - lo2 + d2],
+    }
+
+
+def branch_columns(view: View, continued: Continued, component: int) -> dict[str, list[Any]]:
+    """The continued branch's points at phase 0 (one per forcing period of each orbit), stable or not."""
+    par = view.parameter(0)
+    xs, ys, stable = [], [], []
+    for piece in continued.pieces:
+        for value, states, st in zip(piece.values, piece.states, piece.stable):
+            xs += [par.to_display(value)] * len(states)
+            ys += [float(v) for v in states[:, component]]
+            stable += [bool(st)] * len(states)
+    colour = ["black" if s else "white" for s in stable]
+    return {"x": xs, "y": ys, "stable": ["stable" if s else "unstable" for s in stable], "fill": colour}
+
+
+def mark_columns(view: View, marks: tuple[Mark, ...], component: int) -> dict[str, list[Any]]:
+    """Special points (and grazings) at phase 0, with their text for the hover."""
+    par = view.parameter(0)
+    xs, ys, kinds, texts = [], [], [], []
+    for m in marks:
+        for s in m.states:
+            xs.append(par.to_display(m.value))
+            ys.append(float(s[component]))
+            kinds.append(m.kind)
+            texts.append(m.text)
+    return {"x": xs, "y": ys, "kind": kinds, "text": texts}
+
+
+def empty(columns: dict[str, list[Any]]) -> dict[str, list[Any]]:
+    return {k: [] for k in columns}
+
+
+class Figures:
+    """The explorer's Bokeh figures and their data sources."""
+
+    def __init__(self, view: View) -> None:
+        from bokeh.models import ColumnDataSource, HoverTool, Span
+        from bokeh.plotting import figure
+
+        self.view = view
+        model = view.model
+        par = view.parameter(0)
+        tools = "pan,wheel_zoom,box_zoom,reset,tap,save"
+        self.diagram = figure(
+            height=460,
+            sizing_mode="stretch_width",
+            tools=tools,
+            active_scroll="wheel_zoom",
+            x_axis_label=axis_label(par),
+            name="diagram",
+            output_backend="canvas",
+        )
+        lo, hi = par.to_display(view.axes[0].lo), par.to_display(view.axes[0].hi)
+        self.diagram.x_range.start, self.diagram.x_range.end = lo, hi
+        if len(view.axes) == 1:
+            self.diagram.title.text = (
+                f"bifurcation diagram: stroboscopic {model.state_labels[view.component]}"
+            )
+            self.diagram.yaxis.axis_label = state_label(model, view.component)
+            self.points = ColumnDataSource({"x": [], "y": [], "period": [], "colour": [], "impacts": []})
+            r = self.diagram.scatter("x", "y", source=self.points, size=2, color="colour", alpha=0.8)
+            self.diagram.add_tools(
+                HoverTool(
+                    renderers=[r],
+                    tooltips=[
+                        (par.label, "@x{0.000000}"),
+                        ("period", "@period"),
+                        ("impacts per period", "@impacts{0.[00]}"),
+                    ],
+                )
+            )
+        else:
+            from bokeh.models import LinearColorMapper
+
+            pb = view.parameter(1)
+            self.diagram.title.text = "period map (white: no period <= 64)"
+            self.diagram.yaxis.axis_label = axis_label(pb)
+            self.diagram.y_range.start = pb.to_display(view.axes[1].lo)
+            self.diagram.y_range.end = pb.to_display(view.axes[1].hi)
+            self.image = ColumnDataSource({"image": [], "x": [], "y": [], "dw": [], "dh": []})
+            mapper = LinearColorMapper(palette="Viridis256", low=1, high=12, nan_color="white")
+            r = self.diagram.image(
+                "image", x="x", y="y", dw="dw", dh="dh", source=self.image, color_mapper=mapper
+            )
+            self.diagram.add_tools(
+                HoverTool(
+                    renderers=[r],
+                    tooltips=[
+                        (par.label, "$x{0.000000}"),
+                        (pb.label, "$y{0.000000}"),
+                        ("period", "@image"),
+                    ],
+                )
+            )
+        self.branch = ColumnDataSource({"x": [], "y": [], "stable": [], "fill": []})
+        self.marks = ColumnDataSource({"x": [], "y": [], "kind": [], "text": []})
+        self.grazings = ColumnDataSource({"x": [], "y": [], "kind": [], "text": []})
+        if len(view.axes) == 1:
+            rb = self.diagram.scatter(
+                "x", "y", source=self.branch, size=4, line_color="black", fill_color="fill"
+            )
+            rm = self.diagram.scatter(
+                "x", "y", source=self.marks, size=12, marker="diamond", fill_color="red", line_color="black"
+            )
+            rg = self.diagram.scatter(
+                "x",
+                "y",
+                source=self.grazings,
+                size=12,
+                marker="triangle",
+                fill_color="orange",
+                line_color="black",
+            )
+            self.diagram.add_tools(
+                HoverTool(renderers=[rb], tooltips=[(par.label, "@x{0.000000}"), ("branch", "@stable")])
+            )
+            self.diagram.add_tools(HoverTool(renderers=[rm, rg], tooltips=[("", "@text")]))
+        self.clicked = Span(
+            location=lo, dimension="height", line_color="red", line_dash="dashed", visible=False
+        )
+        self.diagram.add_layout(self.clicked)
+        self.grazing_spans: list[Any] = []
+        # The clicked point: time series and phase portrait.
+        self.series = figure(
+            height=260,
+            sizing_mode="stretch_width",
+            x_axis_label=f"time {model.time_label}",
+            tools="pan,wheel_zoom,box_zoom,reset,save",
+            title="time series",
+        )
+        self.series_sources = []
+        for i, colour in zip(range(model.n_states), PERIOD_COLOURS):
+            src = ColumnDataSource({"t": [], "x": []})
+            self.series.line("t", "x", source=src, color=colour, legend_label=model.state_labels[i])
+            self.series_sources.append(src)
+        self.series_impacts = ColumnDataSource({"t": [], "x": []})
+        self.series.scatter(
+            "t", "x", source=self.series_impacts, marker="x", size=9, color="black", legend_label="impact"
+        )
+        self.series.legend.location = "top_left"
+        self.series.legend.click_policy = "hide"
+        j = 1 if model.n_states > 1 else 0
+        self.phase = figure(
+            height=300,
+            sizing_mode="stretch_width",
+            x_axis_label=state_label(model, 0),
+            y_axis_label=state_label(model, j),
+            tools="pan,wheel_zoom,box_zoom,reset,save",
+            title="phase portrait",
+        )
+        self.phase_line = ColumnDataSource({"x": [], "y": []})
+        self.phase.line("x", "y", source=self.phase_line, color="#1f77b4", legend_label="motion")
+        self.phase_strobe = ColumnDataSource({"x": [], "y": []})
+        self.phase.scatter(
+            "x", "y", source=self.phase_strobe, size=8, color="red", legend_label="stroboscopic (phase 0)"
+        )
+        self.phase_impacts = ColumnDataSource({"x": [], "y": []})
+        self.phase.scatter(
+            "x", "y", source=self.phase_impacts, marker="x", size=10, color="black", legend_label="impacts"
+        )
+        self.phase.legend.location = "top_left"
+        self.stop_spans = []
+        for k, name in enumerate(model.stop_names):
+            level = model.stop_level(0, 0.0, k)
+            if level is not None and np.isfinite(level):
+                span = Span(location=level, dimension="height", line_color="grey", line_width=3)
+                self.phase.add_layout(span)
+                self.stop_spans.append((name, span))
+
+    def show_diagram(self, diagram: Diagram) -> None:
+        if len(diagram.view.axes) == 1:
+            self.points.data = diagram_columns(diagram, self.view.component)
+        else:
+            self.image.data = map_image(diagram)
+
+    def show_refined(self, refined: Diagram) -> None:
+        """A zoomed-in diagram: its points replace the coarse ones over its range."""
+        coarse = self.points.data
+        a = refined.view.axes[0]
+        par = self.view.parameter(0)
+        lo, hi = par.to_display(a.lo), par.to_display(a.hi)
+        keep = [i for i, x in enumerate(coarse["x"]) if not lo <= x <= hi]
+        fine = diagram_columns(refined, self.view.component)
+        self.points.data = {k: [coarse[k][i] for i in keep] + fine[k] for k in fine}
+
+    def show_point(self, rep: PointReport) -> None:
+        par = self.view.parameter(0)
+        self.clicked.location = par.to_display(rep.values[self.view.axes[0].name])
+        self.clicked.visible = len(self.view.axes) == 1
+        x = rep.trajectory
+        for i, src in enumerate(self.series_sources):
+            src.data = {"t": rep.t.tolist(), "x": x[:, i].tolist()}
+        self.series_impacts.data = {"t": rep.impact_t.tolist(), "x": rep.impact_states[:, 0].tolist()}
+        j = 1 if x.shape[1] > 1 else 0
+        self.phase_line.data = {"x": x[:, 0].tolist(), "y": x[:, j].tolist()}
+        strobe = rep.samples[-rep.period :] if rep.period > 0 else rep.samples
+        self.phase_strobe.data = {"x": strobe[:, 0].tolist(), "y": strobe[:, j].tolist()}
+        self.phase_impacts.data = {
+            "x": rep.impact_states[:, 0].tolist(),
+            "y": rep.impact_states[:, j].tolist(),
+        }
+        for k, (_, span) in enumerate(self.stop_spans):
+            level = rep.model.stop_level(0, 0.0, k)
+            if level is not None:
+                span.location = level
+
+    def show_branch(self, continued: Continued) -> None:
+        if len(self.view.axes) == 1:
+            self.branch.data = branch_columns(self.view, continued, self.view.component)
+            self.marks.data = mark_columns(self.view, continued.marks, self.view.component)
+
+    def show_grazings(self, found: Grazings) -> None:
+        from bokeh.models import Span
+
+        par = self.view.parameter(0)
+        for span in self.grazing_spans:
+            span.visible = False
+        for m in found.marks:
+            span = Span(
+                location=par.to_display(m.value),
+                dimension="height",
+                line_color="orange",
+                line_dash="dotted",
+                line_width=2,
+            )
+            self.diagram.add_layout(span)
+            self.grazing_spans.append(span)
+        if len(self.view.axes) == 1:
+            self.grazings.data = mark_columns(self.view, found.marks, self.view.component)
