@@ -104,9 +104,10 @@ class Explorer:
         self.continue_button.on_click(lambda _e: self.continue_orbit())
         self.grazings_button.on_click(lambda _e: self.find_grazings())
         self.code_button.on_click(lambda _e: self.show_code())
-        from bokeh.events import RangesUpdate, Tap
+        from bokeh.events import DoubleTap, RangesUpdate, Tap
 
         self.figures.diagram.on_event(Tap, self._on_tap)
+        self.figures.diagram.on_event(DoubleTap, self._on_tap)  # (two quick clicks: the second is not a Tap)
         if len(view.axes) == 1:
             self.figures.diagram.on_event(RangesUpdate, self._on_ranges)
         self.panel = pn.Column(

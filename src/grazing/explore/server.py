@@ -8,6 +8,7 @@ left behind).  The diagram of each page opened is computed for that page.
 from __future__ import annotations
 
 import errno
+import signal
 import socket
 from collections.abc import Callable
 
@@ -49,7 +50,7 @@ def serve(
     open_browser: bool = True,
     ready: Callable[[str], None] | None = None,
 ) -> None:
-    """Serve the explorer of ``view`` at ``http://address:port/`` until interrupted.
+    """Serve the explorer of ``view`` at ``http://address:port/`` until Ctrl-C (then ``KeyboardInterrupt``).
 
     ``ready(url)`` is called once the server listens (``port`` 0: a free port
     is chosen, and ``url`` says which); ``open_browser`` then opens the page.
@@ -78,6 +79,14 @@ def serve(
         title=f"grazing explore: {view.model.name}",
         websocket_origin=[f"{address}:{port}", f"localhost:{port}"],
     )
+    interrupted: list[int] = []
+    loop = server.io_loop
+
+    def on_sigint(signum: int, _frame: object) -> None:  # Ctrl-C: stop the loop, then say so
+        interrupted.append(signum)
+        loop.add_callback_from_signal(loop.stop)
+
+    previous = signal.signal(signal.SIGINT, on_sigint)  # (Panel's own handler would stop it silently)
     try:
         server.start()
         url = f"http://{address}:{server.port}/"
@@ -87,10 +96,13 @@ def serve(
             import webbrowser
 
             webbrowser.open(url)
-        server.io_loop.start()
+        loop.start()
     finally:
+        signal.signal(signal.SIGINT, previous)
         for explorer in pages:
             explorer.jobs.close(timeout=0)
         server.stop()
         for explorer in pages:
             explorer.jobs.close(timeout=10)
+    if interrupted:
+        raise KeyboardInterrupt
