@@ -43,7 +43,10 @@ _TEXT = """(() => {
 
 _POINT = """(() => {
   const found = [];
-  const walk = (v) => { if (v.model.name === 'diagram') found.push(v); for (const c of (v.child_views ?? [])) walk(c); };
+  const walk = (v) => {
+    if (v.model.name === 'diagram') found.push(v);
+    for (const c of (v.child_views ?? [])) walk(c);
+  };
   for (const r of Bokeh.index.roots) walk(r);
   if (!found.length) return null;
   const pv = found[0], fr = pv.frame.bbox, rect = pv.canvas_view.el.getBoundingClientRect();
@@ -54,7 +57,7 @@ _POINT = """(() => {
 
 
 class ExplorerPage:
-    """``grazing explore ARGS --no-browser --port 0`` and its page in headless Chromium (a context manager)."""
+    """``grazing explore ARGS --no-browser --port 0`` and its page in headless Chromium (context manager)."""
 
     def __init__(self, args: list[str], cwd: Path, width: int = 1400, height: int = 1000) -> None:
         self.args = args
@@ -69,8 +72,14 @@ class ExplorerPage:
         exe = find_chromium()
         assert exe is not None
         cmd = [sys.executable, "-m", "grazing", "explore", *self.args, "--no-browser", "--port", "0"]
-        self.server = subprocess.Popen(cmd, cwd=self.cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                       text=True, start_new_session=True)  # fmt: skip
+        self.server = subprocess.Popen(
+            cmd,
+            cwd=self.cwd,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            start_new_session=True,
+        )
         line = _read_line(self.server, SERVER_START)
         match = re.search(r"http://127\.0\.0\.1:\d+/", line)
         assert match, f"no address in {line!r}"
@@ -78,18 +87,24 @@ class ExplorerPage:
         self._profile = tempfile.TemporaryDirectory(prefix="grazing-explore-chromium-")
         self.dt = _DevTools(exe, self._profile.name, 60.0)
         target = self.dt.send("Target.createTarget", {"url": "about:blank"})["targetId"]
-        self.session = self.dt.send("Target.attachToTarget", {"targetId": target, "flatten": True})["sessionId"]
+        self.session = self.dt.send("Target.attachToTarget", {"targetId": target, "flatten": True})[
+            "sessionId"
+        ]
         self.dt.send("Page.enable", session=self.session)
         self.dt.send("Runtime.enable", session=self.session)
-        self.dt.send("Emulation.setDeviceMetricsOverride", {"width": self.width, "height": self.height,
-                     "deviceScaleFactor": 1, "mobile": False}, session=self.session)  # fmt: skip
+        self.dt.send(
+            "Emulation.setDeviceMetricsOverride",
+            {"width": self.width, "height": self.height, "deviceScaleFactor": 1, "mobile": False},
+            session=self.session,
+        )
         self.dt.send("Page.navigate", {"url": self.url}, session=self.session)
         self.dt.wait_event("Page.loadEventFired")
         return self
 
     def evaluate(self, expression: str) -> Any:
-        res = self.dt.send("Runtime.evaluate", {"expression": expression, "returnByValue": True},
-                           session=self.session)  # fmt: skip
+        res = self.dt.send(
+            "Runtime.evaluate", {"expression": expression, "returnByValue": True}, session=self.session
+        )
         return res.get("result", {}).get("value")
 
     def text(self) -> str:
@@ -116,8 +131,11 @@ class ExplorerPage:
     def click(self, x: float, y: float) -> None:
         """A left click at page pixel ``(x, y)``."""
         for kind in ("mouseMoved", "mousePressed", "mouseReleased"):
-            self.dt.send("Input.dispatchMouseEvent", {"type": kind, "x": x, "y": y, "button": "left",
-                         "clickCount": 1}, session=self.session)  # fmt: skip
+            self.dt.send(
+                "Input.dispatchMouseEvent",
+                {"type": kind, "x": x, "y": y, "button": "left", "clickCount": 1},
+                session=self.session,
+            )
 
     def screenshot(self, path: Path) -> None:
         shot = self.dt.send("Page.captureScreenshot", {"format": "png"}, session=self.session)

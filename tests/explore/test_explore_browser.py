@@ -45,8 +45,11 @@ def test_a_click_outside_the_computed_range_is_a_message_in_the_page(tmp_path):
         page.wait_for(r"Floquet multipliers")
         # zoom out so that the range's end is inside the frame: the reset tool is not enough, so
         # the mouse wheel over the plot (the diagram's active scroll tool)
-        page.dt.send("Input.dispatchMouseEvent", {"type": "mouseWheel", "x": inside["x"], "y": inside["y"],
-                     "deltaX": 0, "deltaY": 600}, session=page.session)  # fmt: skip
+        page.dt.send(
+            "Input.dispatchMouseEvent",
+            {"type": "mouseWheel", "x": inside["x"], "y": inside["y"], "deltaX": 0, "deltaY": 600},
+            session=page.session,
+        )
         outside = None
         for _ in range(50):
             where = page.diagram_pixel(0.495)

@@ -86,19 +86,19 @@ class Explorer:
         self.actions_text = pn.pane.Markdown("", sizing_mode="stretch_width", css_classes=["grazing-actions"])
         self.inputs = [
             pn.widgets.FloatInput(
-                name=f"{p.label} ({p.display_unit})" if p.display_unit else p.label, value=None, width=150
+                label=f"{p.label} ({p.display_unit})" if p.display_unit else p.label, value=None, width=150
             )
             for p in names
         ]
-        self.show_button = pn.widgets.Button(name="Show this point", button_type="primary")
-        self.continue_button = pn.widgets.Button(name="Continue this orbit", disabled=True)
-        self.grazings_button = pn.widgets.Button(name="Find the grazings")
-        self.code_button = pn.widgets.Button(name="Copy as code")
+        self.show_button = pn.widgets.Button(label="Show this point")
+        self.continue_button = pn.widgets.Button(label="Continue this orbit", disabled=True)
+        self.grazings_button = pn.widgets.Button(label="Find the grazings")
+        self.code_button = pn.widgets.Button(label="Copy as code")
         self.code_python = pn.widgets.TextAreaInput(
-            name="Python", height=260, sizing_mode="stretch_width", visible=False
+            label="Python", height=260, sizing_mode="stretch_width", visible=False
         )
         self.code_cli = pn.widgets.TextAreaInput(
-            name="Command line", height=160, sizing_mode="stretch_width", visible=False
+            label="Command line", height=160, sizing_mode="stretch_width", visible=False
         )
         self.show_button.on_click(lambda _e: self.click_values([w.value for w in self.inputs]))
         self.continue_button.on_click(lambda _e: self.continue_orbit())
@@ -183,12 +183,12 @@ class Explorer:
     def _diagram_done(self, diagram: Diagram) -> None:
         from grazing.sweeps.status import failure_text
 
-        self.diagram = diagram
         self.figures.show_diagram(diagram)
         self.progress.value = 100
         self.progress.visible = False
         failed = failure_text(diagram.status)
         self.status.object = f"diagram: {diagram.period.size} points in {diagram.elapsed:.1f} s; {failed}"
+        self.diagram = diagram  # (last: clicks use it from now on)
 
     def _diagram_failed(self, exc: BaseException) -> None:
         self.progress.visible = False
@@ -264,11 +264,11 @@ class Explorer:
         return self.diagram
 
     def _point_done(self, rep: PointReport) -> None:
-        self.point = rep
         self.continued = None
         self.figures.show_point(rep)
         self.orbit.object = "\n\n".join(rep.summary().splitlines())
         self.continue_button.disabled = rep.orbit is None
+        self.point = rep
         if self.code_python.visible:
             self.show_code()
 
@@ -291,9 +291,9 @@ class Explorer:
         def done(c: Continued) -> None:
             if self.point is not point:
                 return  # another point was clicked meanwhile
-            self.continued = c
             self.figures.show_branch(c)
             self.actions_text.object = "\n\n".join(c.lines)
+            self.continued = c
             if self.code_python.visible:
                 self.show_code()
 

@@ -56,6 +56,30 @@ def checkpoint(cancelled: IsSupersededError | None) -> None:
         raise SupersededError("replaced by a newer request")
 
 
+def check_display(par: Parameter, value: float) -> None:
+    """:meth:`Parameter.check` with the message in the display unit (degrees for an angle).
+
+    Examples
+    --------
+    >>> stop = Parameter("theta_hat", 0.7, lower=-math.pi, upper=math.pi, lower_open=True, upper_open=True,
+    ...                  description="stop angle", unit="rad", angle=True)
+    >>> check_display(stop, math.radians(200))
+    Traceback (most recent call last):
+    ...
+    grazing.errors.InvalidParameterError: theta_hat = 200 deg is outside (-180, 180) deg (stop angle)
+    """
+    try:
+        par.check(value)
+    except InvalidParameterError:
+        if not par.angle:
+            raise
+        lo = "(" if par.lower_open or math.isinf(par.lower) else "["
+        hi = ")" if par.upper_open or math.isinf(par.upper) else "]"
+        what = f" ({par.description})" if par.description else ""
+        interval = f"{lo}{par.to_display(par.lower):g}, {par.to_display(par.upper):g}{hi} {par.display_unit}"
+        raise InvalidParameterError(f"{par.show(value, 'g')} is outside {interval}{what}") from None
+
+
 @dataclass(frozen=True)
 class Axis:
     """One explored parameter and the range of its diagram, in the model's units.
@@ -127,7 +151,8 @@ class View:
             if int(a.num) != a.num or a.num < 2:
                 raise InvalidParameterError(f"a diagram needs at least 2 values of {a.name}, got {a.num}")
             for v in (a.lo, a.hi):
-                self.model.with_params(**{a.name: v})  # both ends inside the parameter's interval
+                check_display(par, v)
+                self.model.with_params(**{a.name: v})  # (and the forcing period there is positive)
         if not 0 <= self.component < self.model.n_states:
             raise InvalidParameterError(f"no state {self.component} in model {self.model.name}")
 

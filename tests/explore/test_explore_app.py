@@ -1,0 +1,119 @@
+"""The explorer's page without a browser: its background requests, its answers to clicks, its two hosts."""
+
+from __future__ import annotations
+
+import math
+import threading
+import time
+
+import pytest
+
+import grazing
+from grazing.explore import View
+from grazing.explore.app import CLICK_HINT, Explorer, explorer
+from grazing.explore.jobs import Jobs
+
+
+def wait_until(cond, limit=120.0):
+    end = time.monotonic() + limit
+    while not cond():
+        assert time.monotonic() < end, "timed out"
+        time.sleep(0.02)
+
+
+def test_a_newer_request_supersedes_a_running_one_and_only_its_result_arrives():
+    delivered, started, release = [], threading.Event(), threading.Event()
+    seen_cancelled = []
+    jobs = Jobs(deliver=lambda fn: fn())
+
+    def first(cancelled):
+        started.set()
+        release.wait(10)
+        seen_cancelled.append(cancelled())
+        return "first"
+
+    jobs.submit("point", first, delivered.append, delivered.append)
+    assert started.wait(10)
+    jobs.submit("point", lambda c: "second", delivered.append, delivered.append)
+    jobs.submit("point", lambda c: "third", delivered.append, delivered.append)  # replaces the waiting second
+    release.set()
+    wait_until(lambda: delivered)
+    time.sleep(0.2)
+    assert delivered == ["third"] and seen_cancelled == [True]
+    jobs.close()
+
+
+def test_an_error_in_a_request_is_delivered_as_an_error_and_the_lane_goes_on():
+    got = []
+    jobs = Jobs(deliver=lambda fn: fn())
+    jobs.submit("point", lambda c: 1 / 0, got.append, lambda e: got.append(type(e).__name__))
+    wait_until(lambda: got)
+    jobs.submit("point", lambda c: "next", got.append, got.append)
+    wait_until(lambda: len(got) == 2)
+    assert got == ["ZeroDivisionError", "next"]
+    jobs.close()
+
+
+def test_a_long_diagram_does_not_hold_up_a_click():
+    got, release = [], threading.Event()
+    jobs = Jobs(deliver=lambda fn: fn())
+    jobs.submit("diagram", lambda c: release.wait(10), got.append, got.append)
+    jobs.submit("point", lambda c: "point", got.append, got.append)
+    wait_until(lambda: got == ["point"])
+    release.set()
+    wait_until(lambda: len(got) == 2)
+    jobs.close()
+
+
+@pytest.fixture(scope="module")
+def page():
+    model = grazing.models.pendulum("B", theta_hat=math.radians(40))
+    app = Explorer(View.of(model, {"eta": (0.44, 0.49)}, num=21), deliver=lambda fn: fn())
+    wait_until(lambda: app.diagram is not None or "could not" in app.status.object)
+    yield app
+    app.close()
+
+
+def test_the_page_answers_a_click_continues_and_copies(page):
+    assert page.status.object.startswith("diagram: 21 points in")
+    assert page.orbit.object == CLICK_HINT
+    page.click_values([0.446])
+    wait_until(lambda: page.point is not None)
+    wait_until(lambda: "Floquet" in page.orbit.object)
+    assert page.orbit.object.startswith("period 5 with 1 impact per period (stop: 1, back: 0)")
+    assert not page.continue_button.disabled
+    assert len(page.figures.series_sources[0].data["t"]) > 5 * 200
+    page.continue_orbit()
+    wait_until(lambda: page.continued is not None)
+    assert "grazing at eta = 0.44512118" in page.actions_text.object
+    assert len(page.figures.marks.data["x"]) == 5 * len(page.continued.marks)
+    page.show_code()
+    assert page.code_python.visible and "continue_orbit(point, 'eta', 0.446" in page.code_python.value
+    assert page.code_cli.value.startswith("grazing sweep --model pendulum")
+
+
+def test_bad_clicks_are_messages_in_the_page(page):
+    page.click_values([0.5])
+    wait_until(lambda: "outside" in page.orbit.object)
+    assert page.orbit.object == (
+        "**eta = 0.5 is outside the computed range eta in [0.44, 0.49]: click inside the diagram**"
+    )
+    page.click_values([None])
+    assert page.orbit.object == "give a value for every parameter"
+    page.find_grazings()
+    wait_until(lambda: "grazing at" in page.actions_text.object)
+    assert page.actions_text.object.startswith("grazing at eta = 0.44512118")
+
+
+def test_the_same_component_renders_without_a_server_as_in_a_notebook():
+    """Jupyter displays a Panel component by rendering its Bokeh model with no server: so here."""
+    import panel as pn
+    from bokeh.models import LayoutDOM
+
+    component = explorer(grazing.models.pendulum("B"), {"eta": (0.44, 0.45)}, num=3)
+    assert isinstance(component, pn.viewable.Viewable)
+    root = component.get_root()
+    assert isinstance(root, LayoutDOM)
+    assert any(getattr(m, "name", None) == "diagram" for m in root.references())
+    with pytest.raises(grazing.GrazingError, match="give the ranges"):
+        explorer(grazing.models.impact_oscillator())
