@@ -244,7 +244,7 @@ class Explorer:
             return
         values = [self.view.parameter(i).from_display(float(v)) for i, v in enumerate(shown)]  # type: ignore[arg-type]
         for w, v in zip(self.inputs, shown):
-            w.value = v
+            w.value = float(f"{float(v):.6g}")  # (what a person would type)
         diagram = self._diagram_for(values)
         text = ", ".join(self.view.parameter(i).show(v, ".6g") for i, v in enumerate(values))
         self.orbit.object = f"computing the orbit at {text} ..."

@@ -71,12 +71,12 @@ def diagram_columns(diagram: Diagram, component: int) -> dict[str, list[Any]]:
 
 
 def map_image(diagram: Diagram) -> dict[str, list[Any]]:
-    """A period map as an image: the period of each cell (NaN where none; -1 failed)."""
+    """A period map as an image: the period of each cell (NaN where there is none; -1 where it failed)."""
     a, b = diagram.view.axes
     pa, pb = diagram.view.parameter(0), diagram.view.parameter(1)
     lo1, hi1, lo2, hi2 = pa.to_display(a.lo), pa.to_display(a.hi), pb.to_display(b.lo), pb.to_display(b.hi)
     d1, d2 = (hi1 - lo1) / (a.num - 1), (hi2 - lo2) / (b.num - 1)
-    image = np.where(diagram.period > 0, diagram.period, np.nan).astype(float)
+    image = np.where(diagram.period == 0, np.nan, diagram.period).astype(float)
     return {
         "image": [image],
         "x": [lo1 - d1 / 2],
@@ -159,12 +159,22 @@ class Figures:
             from bokeh.models import LinearColorMapper
 
             pb = view.parameter(1)
-            self.diagram.title.text = "period map (white: no period <= 64)"
+            self.diagram.title.text = (
+                "period map (colours as periods 1 to 8; grey: longer; white: none <= 64)"
+            )
             self.diagram.yaxis.axis_label = axis_label(pb)
             self.diagram.y_range.start = pb.to_display(view.axes[1].lo)
             self.diagram.y_range.end = pb.to_display(view.axes[1].hi)
             self.image = ColumnDataSource({"image": [], "x": [], "y": [], "dw": [], "dh": []})
-            mapper = LinearColorMapper(palette="Viridis256", low=1, high=12, nan_color="white")
+            n = len(PERIOD_COLOURS)  # (periods 1 to 8 in the diagram's colours, longer grey, failed magenta)
+            mapper = LinearColorMapper(
+                palette=list(PERIOD_COLOURS),
+                low=0.5,
+                high=n + 0.5,
+                nan_color="white",
+                high_color=OTHER_COLOUR,
+                low_color=FAILED_COLOUR,
+            )
             r = self.diagram.image(
                 "image", x="x", y="y", dw="dw", dh="dh", source=self.image, color_mapper=mapper
             )
@@ -205,6 +215,17 @@ class Figures:
             location=lo, dimension="height", line_color="red", line_dash="dashed", visible=False
         )
         self.diagram.add_layout(self.clicked)
+        self.clicked_cell = ColumnDataSource({"x": [], "y": []})  # (a map's clicked point)
+        self.diagram.scatter(
+            "x",
+            "y",
+            source=self.clicked_cell,
+            marker="circle_cross",
+            size=14,
+            fill_alpha=0,
+            line_color="red",
+            line_width=2,
+        )
         self.grazing_spans: list[Any] = []
         # The clicked point: time series and phase portrait.
         self.series = figure(
@@ -223,8 +244,8 @@ class Figures:
         self.series.scatter(
             "t", "x", source=self.series_impacts, marker="x", size=9, color="black", legend_label="impact"
         )
-        self.series.legend.location = "top_left"
         self.series.legend.click_policy = "hide"
+        self.series.add_layout(self.series.legend[0], "right")  # (beside the plot: it hides no data)
         j = 1 if model.n_states > 1 else 0
         self.phase = figure(
             height=300,
@@ -244,7 +265,8 @@ class Figures:
         self.phase.scatter(
             "x", "y", source=self.phase_impacts, marker="x", size=10, color="black", legend_label="impacts"
         )
-        self.phase.legend.location = "top_left"
+        self.phase.legend.click_policy = "hide"
+        self.phase.add_layout(self.phase.legend[0], "right")
         self.stop_spans = []
         for k, name in enumerate(model.stop_names):
             level = model.stop_level(0, 0.0, k)
@@ -273,6 +295,12 @@ class Figures:
         par = self.view.parameter(0)
         self.clicked.location = par.to_display(rep.values[self.view.axes[0].name])
         self.clicked.visible = len(self.view.axes) == 1
+        if len(self.view.axes) == 2:
+            second = self.view.parameter(1)
+            self.clicked_cell.data = {
+                "x": [self.clicked.location],
+                "y": [second.to_display(rep.values[self.view.axes[1].name])],
+            }
         x = rep.trajectory
         for i, src in enumerate(self.series_sources):
             src.data = {"t": rep.t.tolist(), "x": x[:, i].tolist()}
