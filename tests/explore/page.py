@@ -123,10 +123,20 @@ class ExplorerPage:
             time.sleep(0.2)
 
     def diagram_pixel(self, value: float) -> dict[str, float]:
-        """Where the diagram's scales put ``value`` (display units): page pixels, and the frame's edges."""
-        found = self.evaluate(_POINT % value)
-        assert found, "no diagram on the page"
-        return json.loads(found)
+        """Where the diagram's scales put ``value`` (display units): page pixels, and the frame's edges.
+
+        Read until two readings 0.2 s apart agree: the frame moves while the page lays itself out
+        (the width of the axis's tick labels changes when the data arrives).
+        """
+        last = None
+        for _ in range(100):
+            found = self.evaluate(_POINT % value)
+            assert found, "no diagram on the page"
+            if found == last:
+                return json.loads(found)
+            last = found
+            time.sleep(0.2)
+        raise AssertionError("the diagram never stopped moving")
 
     def click(self, x: float, y: float) -> None:
         """A left click at page pixel ``(x, y)``."""
@@ -179,3 +189,52 @@ def _read_line(proc: subprocess.Popen[str], limit: float) -> str:
         _, err = proc.communicate()
         raise AssertionError(f"grazing explore ended (status {proc.returncode}): {err.strip()}")
     return line
+
+
+def docs_screenshot(path: Path) -> None:
+    """The screenshot of docs/explore.md: the default view, η = 0.446 clicked, its orbit continued, the
+    grazings found (``python -m tests.explore.page docs/img/explore.png``)."""
+    from grazing.outputs import write_png_bytes
+
+    with ExplorerPage([], Path(tempfile.gettempdir()), width=1400, height=1000) as page:
+        page.wait_for(r"diagram: 200 points")
+        where = page.diagram_pixel(0.446)
+        page.click(where["x"], where["y"])
+        page.wait_for(r"Floquet multipliers")
+        for label, done in (
+            ("Continue this orbit", r"towards eta = 0\.49"),
+            ("Find the grazings", r"stop stop"),
+        ):
+            page.evaluate(_CLICK_BUTTON % label)
+            page.wait_for(done, 120)
+        for _ in range(3):  # zoomed in on the period-adding cascade: the diagram is refined there
+            page.dt.send(
+                "Input.dispatchMouseEvent",
+                {"type": "mouseWheel", "x": where["x"], "y": where["y"], "deltaX": 0, "deltaY": -300},
+                session=page.session,
+            )
+            time.sleep(0.3)
+        page.wait_for(r"refined: 200 points", 120)
+        page.dt.send("Input.dispatchMouseEvent", {"type": "mouseMoved", "x": 5, "y": 5}, session=page.session)
+        time.sleep(1.0)  # (the plots redraw)
+        shot = page.dt.send("Page.captureScreenshot", {"format": "png"}, session=page.session)
+        write_png_bytes(path, base64.b64decode(shot["data"]), overwrite=True)
+
+
+_CLICK_BUTTON = """(() => {
+  const walk = (node) => {
+    if (node.shadowRoot) { const b = walk(node.shadowRoot); if (b) return b; }
+    for (const c of node.children ?? []) {
+      if (c.tagName === 'BUTTON' && c.textContent.trim() === %r) return c;
+      const b = walk(c); if (b) return b;
+    }
+    return null;
+  };
+  const button = walk(document.body);
+  button.click();
+  return true;
+})()"""
+
+
+if __name__ == "__main__":
+    docs_screenshot(Path(sys.argv[1]))

@@ -101,8 +101,8 @@ def test_bad_clicks_are_messages_in_the_page(page):
     page.click_values([None])
     assert page.orbit.object == "give a value for every parameter"
     page.find_grazings()
-    wait_until(lambda: "grazing at" in page.actions_text.object)
-    assert page.actions_text.object.startswith("grazing at eta = 0.44512118")
+    wait_until(lambda: "grazing at" in page.grazings_text.object)
+    assert page.grazings_text.object.startswith("grazing at eta = 0.44512118")
 
 
 def test_the_same_component_renders_without_a_server_as_in_a_notebook():

@@ -83,7 +83,10 @@ class Explorer:
             "computing the diagram ...", sizing_mode="stretch_width", css_classes=["grazing-status"]
         )
         self.orbit = pn.pane.Markdown(CLICK_HINT, sizing_mode="stretch_width", css_classes=["grazing-orbit"])
-        self.actions_text = pn.pane.Markdown("", sizing_mode="stretch_width", css_classes=["grazing-actions"])
+        self.actions_text = pn.pane.Markdown("", sizing_mode="stretch_width", css_classes=["grazing-branch"])
+        self.grazings_text = pn.pane.Markdown(
+            "", sizing_mode="stretch_width", css_classes=["grazing-grazings"]
+        )
         self.inputs = [
             pn.widgets.FloatInput(
                 label=f"{p.label} ({p.display_unit})" if p.display_unit else p.label, value=None, width=150
@@ -124,6 +127,7 @@ class Explorer:
                     self.orbit,
                     pn.Row(self.continue_button, self.grazings_button, self.code_button),
                     self.actions_text,
+                    self.grazings_text,
                     sizing_mode="stretch_width",
                 ),
                 sizing_mode="stretch_width",
@@ -304,21 +308,21 @@ class Explorer:
         fixed = {}
         if len(self.view.axes) == 2:
             if self.point is None:
-                self.actions_text.object = "click a row of the map first: the grazings are sought along it"
+                self.grazings_text.object = "click a row of the map first: the grazings are sought along it"
                 return
             name = self.view.axes[1].name
             fixed = {name: self.point.values[name]}
-        self.actions_text.object = "finding the grazings ..."
+        self.grazings_text.object = "finding the grazings ..."
 
         def work(cancelled: Callable[[], bool]) -> Grazings:
             return grazings_in_view(self.view, fixed, cancelled=cancelled)
 
         def done(g: Grazings) -> None:
             self.figures.show_grazings(g)
-            self.actions_text.object = "\n\n".join(g.lines)
+            self.grazings_text.object = "\n\n".join(g.lines)
 
         self.jobs.submit(
-            "grazings", work, done, lambda e: setattr(self.actions_text, "object", message_of(e))
+            "grazings", work, done, lambda e: setattr(self.grazings_text, "object", message_of(e))
         )
 
     def show_code(self) -> None:

@@ -60,12 +60,17 @@ class Mark:
 
 @dataclass(frozen=True)
 class BranchPiece:
-    """One direction of a continuation: the branch and each point's states at phase 0."""
+    """One direction of a continuation: the branch and each point's states at phase 0.
+
+    ``crossing``: the point's orbit is a virtual one (followed with the stops ignored, as a
+    nonimpacting branch is) that passes through a stop: not a motion of the system.
+    """
 
     branch: Branch
     values: np.ndarray
     states: list[np.ndarray]
     stable: np.ndarray
+    crossing: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -122,11 +127,9 @@ def continue_click(
         for o in branch.orbits:
             checkpoint(cancelled)
             states.append(section_states(o))
-        pieces.append(
-            BranchPiece(
-                branch, np.asarray(branch.values), states, np.array([o.stable for o in branch.orbits])
-            )
-        )
+        crossing = np.array([o.virtual and bool(o.crossed_stops) for o in branch.orbits], dtype=bool)
+        stable = np.array([o.stable for o in branch.orbits], dtype=bool)
+        pieces.append(BranchPiece(branch, np.asarray(branch.values), states, stable, crossing))
         lines.append(
             f"towards {par.show(end, '.6g')}: {len(branch)} points, {branch.status or 'reached the end'}"
         )

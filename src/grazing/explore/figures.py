@@ -87,16 +87,29 @@ def map_image(diagram: Diagram) -> dict[str, list[Any]]:
 
 
 def branch_columns(view: View, continued: Continued, component: int) -> dict[str, list[Any]]:
-    """The continued branch's points at phase 0 (one per forcing period of each orbit), stable or not."""
+    """The continued branch's points at phase 0 (one per forcing period of each orbit).
+
+    Each is ``stable``, ``unstable`` or, for a virtual orbit that passes through a stop (a
+    nonimpacting branch followed past its grazing), ``through a stop``: drawn apart, it is not
+    a motion of the system.
+    """
     par = view.parameter(0)
-    xs, ys, stable = [], [], []
+    xs, ys, kinds = [], [], []
     for piece in continued.pieces:
-        for value, states, st in zip(piece.values, piece.states, piece.stable):
+        for value, states, st, cross in zip(piece.values, piece.states, piece.stable, piece.crossing):
+            kind = "through a stop (not a motion)" if cross else ("stable" if st else "unstable")
             xs += [par.to_display(value)] * len(states)
             ys += [float(v) for v in states[:, component]]
-            stable += [bool(st)] * len(states)
-    colour = ["black" if s else "white" for s in stable]
-    return {"x": xs, "y": ys, "stable": ["stable" if s else "unstable" for s in stable], "fill": colour}
+            kinds += [kind] * len(states)
+    fill = {"stable": "black", "unstable": "white"}
+    line = {"stable": "black", "unstable": "black"}
+    return {
+        "x": xs,
+        "y": ys,
+        "stable": kinds,
+        "fill": [fill.get(k, "#dddddd") for k in kinds],
+        "line": [line.get(k, "#aaaaaa") for k in kinds],
+    }
 
 
 def mark_columns(view: View, marks: tuple[Mark, ...], component: int) -> dict[str, list[Any]]:
@@ -188,12 +201,12 @@ class Figures:
                     ],
                 )
             )
-        self.branch = ColumnDataSource({"x": [], "y": [], "stable": [], "fill": []})
+        self.branch = ColumnDataSource({"x": [], "y": [], "stable": [], "fill": [], "line": []})
         self.marks = ColumnDataSource({"x": [], "y": [], "kind": [], "text": []})
         self.grazings = ColumnDataSource({"x": [], "y": [], "kind": [], "text": []})
         if len(view.axes) == 1:
             rb = self.diagram.scatter(
-                "x", "y", source=self.branch, size=4, line_color="black", fill_color="fill"
+                "x", "y", source=self.branch, size=4, line_color="line", fill_color="fill"
             )
             rm = self.diagram.scatter(
                 "x", "y", source=self.marks, size=12, marker="diamond", fill_color="red", line_color="black"
