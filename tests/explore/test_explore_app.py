@@ -117,3 +117,28 @@ def test_the_same_component_renders_without_a_server_as_in_a_notebook():
     assert any(getattr(m, "name", None) == "diagram" for m in root.references())
     with pytest.raises(grazing.GrazingError, match="give the ranges"):
         explorer(grazing.models.impact_oscillator())
+
+
+def test_a_period_map_marks_the_special_points_on_the_clicked_row():
+    model = grazing.models.pendulum("B")
+    app = Explorer(
+        View.of(model, {"eta": (0.44, 0.46), "theta_hat": (35, 45)}, num=5), deliver=lambda fn: fn()
+    )
+    try:
+        wait_until(lambda: app.diagram is not None)
+        assert app.diagram.period.shape == (5, 5)
+        assert len(app.figures.image.data["image"][0]) == 5
+        app.click_values([0.446, 40])
+        wait_until(lambda: app.point is not None)
+        assert app.orbit.object.startswith("period 5 with 1 impact per period")
+        assert app.figures.clicked_cell.data == {"x": [0.446], "y": [pytest.approx(40.0)]}
+        app.continue_orbit()
+        wait_until(lambda: app.continued is not None)
+        marks = app.figures.marks.data
+        assert marks["kind"] == [m.kind for m in app.continued.marks]
+        assert marks["y"] == pytest.approx([40.0] * len(marks["x"]))
+        app.find_grazings()
+        wait_until(lambda: app.figures.grazings.data["x"] != [])
+        assert app.figures.grazings.data["x"] == [pytest.approx(0.4451211835, abs=1e-9)]
+    finally:
+        app.close()

@@ -295,13 +295,17 @@ class Explorer:
         def done(c: Continued) -> None:
             if self.point is not point:
                 return  # another point was clicked meanwhile
-            self.figures.show_branch(c)
+            self.figures.show_branch(c, self._row(point))
             self.actions_text.object = "\n\n".join(c.lines)
             self.continued = c
             if self.code_python.visible:
                 self.show_code()
 
         self.jobs.submit("branch", work, done, lambda e: setattr(self.actions_text, "object", message_of(e)))
+
+    def _row(self, point: PointReport) -> float | None:
+        """The clicked row of a map (its second parameter's value), else None."""
+        return point.values[self.view.axes[1].name] if len(self.view.axes) == 2 else None
 
     def find_grazings(self) -> None:
         """Find the grazings of the nonimpacting orbit over the range (at the clicked row of a map)."""
@@ -318,7 +322,7 @@ class Explorer:
             return grazings_in_view(self.view, fixed, cancelled=cancelled)
 
         def done(g: Grazings) -> None:
-            self.figures.show_grazings(g)
+            self.figures.show_grazings(g, fixed.get(self.view.axes[-1].name))
             self.grazings_text.object = "\n\n".join(g.lines)
 
         self.jobs.submit(

@@ -9,6 +9,7 @@ display unit: degrees for angles).
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -125,6 +126,14 @@ def mark_columns(view: View, marks: tuple[Mark, ...], component: int) -> dict[st
     return {"x": xs, "y": ys, "kind": kinds, "text": texts}
 
 
+def row_columns(view: View, marks: tuple[Mark, ...], row: float | None) -> dict[str, list[Any]]:
+    """Special points on a map's row ``row`` (the second parameter's value, model units)."""
+    p1, p2 = view.parameter(0), view.parameter(1)
+    y = p2.to_display(row) if row is not None else math.nan
+    return {"x": [p1.to_display(m.value) for m in marks], "y": [y] * len(marks),
+            "kind": [m.kind for m in marks], "text": [m.text for m in marks]}  # fmt: skip
+
+
 def empty(columns: dict[str, list[Any]]) -> dict[str, list[Any]]:
     return {k: [] for k in columns}
 
@@ -204,26 +213,26 @@ class Figures:
         self.branch = ColumnDataSource({"x": [], "y": [], "stable": [], "fill": [], "line": []})
         self.marks = ColumnDataSource({"x": [], "y": [], "kind": [], "text": []})
         self.grazings = ColumnDataSource({"x": [], "y": [], "kind": [], "text": []})
+        rm = self.diagram.scatter(
+            "x", "y", source=self.marks, size=12, marker="diamond", fill_color="red", line_color="black"
+        )
+        rg = self.diagram.scatter(
+            "x",
+            "y",
+            source=self.grazings,
+            size=12,
+            marker="triangle",
+            fill_color="orange",
+            line_color="black",
+        )
+        self.diagram.add_tools(HoverTool(renderers=[rm, rg], tooltips=[("", "@text")]))
         if len(view.axes) == 1:
             rb = self.diagram.scatter(
                 "x", "y", source=self.branch, size=4, line_color="line", fill_color="fill"
             )
-            rm = self.diagram.scatter(
-                "x", "y", source=self.marks, size=12, marker="diamond", fill_color="red", line_color="black"
-            )
-            rg = self.diagram.scatter(
-                "x",
-                "y",
-                source=self.grazings,
-                size=12,
-                marker="triangle",
-                fill_color="orange",
-                line_color="black",
-            )
             self.diagram.add_tools(
                 HoverTool(renderers=[rb], tooltips=[(par.label, "@x{0.000000}"), ("branch", "@stable")])
             )
-            self.diagram.add_tools(HoverTool(renderers=[rm, rg], tooltips=[("", "@text")]))
         self.clicked = Span(
             location=lo, dimension="height", line_color="red", line_dash="dashed", visible=False
         )
@@ -331,17 +340,25 @@ class Figures:
             if level is not None:
                 span.location = level
 
-    def show_branch(self, continued: Continued) -> None:
+    def show_branch(self, continued: Continued, row: float | None = None) -> None:
+        """A continued branch: on a diagram its points and special points; on a map (at the clicked
+        ``row``, model units) its special points."""
         if len(self.view.axes) == 1:
             self.branch.data = branch_columns(self.view, continued, self.view.component)
             self.marks.data = mark_columns(self.view, continued.marks, self.view.component)
+        else:
+            self.marks.data = row_columns(self.view, continued.marks, row)
 
-    def show_grazings(self, found: Grazings) -> None:
+    def show_grazings(self, found: Grazings, row: float | None = None) -> None:
+        """Grazings: on a diagram a dotted line and the grazing orbit's points; on a map a mark on the row."""
         from bokeh.models import Span
 
         par = self.view.parameter(0)
         for span in self.grazing_spans:
             span.visible = False
+        if len(self.view.axes) == 2:
+            self.grazings.data = row_columns(self.view, found.marks, row)
+            return
         for m in found.marks:
             span = Span(
                 location=par.to_display(m.value),
