@@ -68,10 +68,25 @@ def test_a_long_diagram_does_not_hold_up_a_click():
 @pytest.fixture(scope="module")
 def page():
     model = grazing.models.pendulum("B", theta_hat=math.radians(40))
-    app = Explorer(View.of(model, {"eta": (0.44, 0.49)}, num=21), deliver=lambda fn: fn())
+    shown = []
+
+    def deliver(fn):  # (what the page says after each update: the progress of the diagram too)
+        fn()
+        shown.append((app.progress.value, app.status.object))
+
+    app = Explorer(View.of(model, {"eta": (0.44, 0.49)}, num=21), deliver=deliver, compute=False)
+    app.compute()
     wait_until(lambda: app.diagram is not None or "could not" in app.status.object)
+    app.shown = shown
     yield app
     app.close()
+
+
+def test_the_diagram_shows_its_progress(page):
+    # chunks of 25 points: 21 points are one chunk, so the bar goes from 0 to 100 through "21 of 21"
+    assert (0, "computing the diagram: 0 of 21 points") in page.shown
+    assert (100, "computing the diagram: 21 of 21 points") in page.shown
+    assert not page.progress.visible  # (done: hidden)
 
 
 def test_the_page_answers_a_click_continues_and_copies(page):
@@ -142,3 +157,20 @@ def test_a_period_map_marks_the_special_points_on_the_clicked_row():
         assert app.figures.grazings.data["x"] == [pytest.approx(0.4451211835, abs=1e-9)]
     finally:
         app.close()
+
+
+class _Zoom:
+    def __init__(self, x0, x1):
+        self.x0, self.x1 = x0, x1
+
+
+def test_zoomed_in_the_diagram_is_computed_again_there_and_clicks_use_it(page):
+    page._on_ranges(_Zoom(0.4480, 0.4460))  # (either order)
+    wait_until(lambda: page.refined is not None)
+    axis = page.refined.view.axes[0]
+    assert (axis.lo, axis.hi, axis.num) == (pytest.approx(0.446), pytest.approx(0.448), 21)
+    assert page.status.object.startswith("refined: 21 points over eta in [0.446, 0.448]")
+    assert sum(0.446 <= x <= 0.448 for x in page.figures.points.data["x"]) >= 21  # the fine points drawn
+    assert page._diagram_for([0.447]) is page.refined and page._diagram_for([0.47]) is page.diagram
+    page._on_ranges(_Zoom(0.44, 0.47))  # wider than half the range: nothing computed
+    assert page.refined.view.axes[0].lo == pytest.approx(0.446)
