@@ -18,7 +18,7 @@ import numpy as np
 
 from grazing.cli.common import multipliers_text
 from grazing.engine.simulate import simulate
-from grazing.errors import GrazingError, GrazingWarning
+from grazing.errors import GrazingError, GrazingWarning, InvalidParameterError
 from grazing.explore.diagram import IsSupersededError, View, checkpoint
 from grazing.explore.point import PointReport
 from grazing.orbits.continuation import Branch, continue_orbit
@@ -102,8 +102,6 @@ def continue_click(
     InvalidParameterError
         The point has no orbit (:attr:`PointReport.message` says why).
     """
-    from grazing.errors import InvalidParameterError
-
     if point.orbit is None:
         raise InvalidParameterError(f"no orbit to continue: {point.message}")
     axis = view.axes[0]
@@ -173,8 +171,8 @@ def grazings_in_view(
     """
     axis = view.axes[0]
     model = view.model.with_params(**(fixed or {}))
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", GrazingWarning)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", GrazingWarning)  # (said in each grazing's text instead)
         _, branch = find_grazings(
             model, axis.name, axis.lo, axis.hi, period=period, progress=lambda _n, _v: checkpoint(cancelled)
         )
@@ -197,5 +195,4 @@ def grazings_in_view(
         lines.append(marks[-1].text)
     if not marks:
         lines.append(f"no grazing of the nonimpacting period-{period} orbit in the range ({branch.status})")
-    del caught
     return Grazings(axis.name, tuple(marks), tuple(lines))

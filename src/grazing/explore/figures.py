@@ -134,10 +134,6 @@ def row_columns(view: View, marks: tuple[Mark, ...], row: float | None) -> dict[
             "kind": [m.kind for m in marks], "text": [m.text for m in marks]}  # fmt: skip
 
 
-def empty(columns: dict[str, list[Any]]) -> dict[str, list[Any]]:
-    return {k: [] for k in columns}
-
-
 class Figures:
     """The explorer's Bokeh figures and their data sources."""
 

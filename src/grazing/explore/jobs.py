@@ -64,7 +64,6 @@ class Jobs:
         self._lock = threading.Condition()
         self._threads: dict[str, threading.Thread] = {}
         self._closed = False
-        self.running: dict[str, str | None] = dict.fromkeys(self._waiting)
 
     def submit(
         self,
@@ -105,7 +104,6 @@ class Jobs:
                     return
                 kind = next(iter(self._waiting[lane]))
                 job = self._waiting[lane].pop(kind)
-                self.running[lane] = kind
             cancelled = lambda job=job: self.stale(job.kind, job.token)  # noqa: E731
             try:
                 result = job.work(cancelled)
@@ -115,8 +113,6 @@ class Jobs:
                 if not cancelled():
                     self.deliver(lambda job=job, exc=exc: job.failed(exc))
                 continue
-            finally:
-                self.running[lane] = None
             if not cancelled():
                 self.deliver(lambda job=job, result=result: job.done(result))
 
