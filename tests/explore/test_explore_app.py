@@ -121,7 +121,8 @@ def test_bad_clicks_are_messages_in_the_page(page):
 
 
 def test_the_same_component_renders_without_a_server_as_in_a_notebook():
-    """Jupyter displays a Panel component by rendering its Bokeh model with no server: so here."""
+    """Jupyter displays a Panel component by asking for its MIME bundle (the Bokeh document, rendered
+    through the notebook's comms, no server): the same call here."""
     import panel as pn
     from bokeh.models import LayoutDOM
 
@@ -130,6 +131,11 @@ def test_the_same_component_renders_without_a_server_as_in_a_notebook():
     root = component.get_root()
     assert isinstance(root, LayoutDOM)
     assert any(getattr(m, "name", None) == "diagram" for m in root.references())
+    pn.extension()  # (a notebook's first cell)
+    bundle = component._repr_mimebundle_()
+    data = bundle[0] if isinstance(bundle, tuple) else bundle
+    assert "application/vnd.holoviews_exec.v0+json" in data
+    assert '"name":"diagram"' in data["text/html"].replace(" ", "")
     with pytest.raises(grazing.GrazingError, match="give the ranges"):
         explorer(grazing.models.impact_oscillator())
 
