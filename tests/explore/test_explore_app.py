@@ -180,3 +180,30 @@ def test_zoomed_in_the_diagram_is_computed_again_there_and_clicks_use_it(page):
     assert page._diagram_for([0.447]) is page.refined and page._diagram_for([0.47]) is page.diagram
     page._on_ranges(_Zoom(0.44, 0.47))  # wider than half the range: nothing computed
     assert page.refined.view.axes[0].lo == pytest.approx(0.446)
+
+
+def test_on_a_period_map_the_clicked_orbit_s_bifurcation_curves_are_followed():
+    """The period-5 window's period-doubling and grazings, followed in (eta, theta_hat)."""
+    model = grazing.models.pendulum("B")
+    app = Explorer(
+        View.of(model, {"eta": (0.43, 0.46), "theta_hat": (35, 45)}, num=4), deliver=lambda fn: fn()
+    )
+    try:
+        wait_until(lambda: app.diagram is not None)
+        app.click_values([0.446, 40])
+        wait_until(lambda: app.point is not None)
+        app.continue_orbit()
+        wait_until(lambda: app.continued is not None)
+        assert not app.curves_button.disabled
+        app.follow_curves()
+        wait_until(lambda: app.figures.curves.data["kind"] != [] or "curve from" in app.curves_text.object)
+        kinds = app.figures.curves.data["kind"]
+        assert "period-doubling" in kinds and "grazing" in kinds, app.curves_text.object
+        pd = kinds.index("period-doubling")
+        xs, ys = app.figures.curves.data["xs"][pd], app.figures.curves.data["ys"][pd]
+        # it passes through the period-doubling the branch found at theta_hat = 40 deg
+        at = [x for x, y in zip(xs, ys) if abs(y - 40) < 1e-6]
+        assert at == [pytest.approx(0.44539259, abs=1e-8)]
+        assert 35 - 1e-9 <= min(ys) and max(ys) <= 45 + 1e-9  # (inside the map's range)
+    finally:
+        app.close()

@@ -18,7 +18,14 @@ from collections.abc import Callable
 from typing import Any
 
 from grazing.errors import GrazingError
-from grazing.explore.branch import Continued, Grazings, continue_click, grazings_in_view
+from grazing.explore.branch import (
+    Continued,
+    Curves,
+    Grazings,
+    continue_click,
+    follow_click_curves,
+    grazings_in_view,
+)
 from grazing.explore.code import view_code
 from grazing.explore.diagram import Diagram, View, compute_diagram
 from grazing.explore.figures import Figures
@@ -97,6 +104,10 @@ class Explorer:
         self.continue_button = pn.widgets.Button(label="Continue this orbit", disabled=True)
         self.grazings_button = pn.widgets.Button(label="Find the grazings")
         self.code_button = pn.widgets.Button(label="Copy as code")
+        self.curves_button = pn.widgets.Button(
+            label="Follow the bifurcation curves", disabled=True, visible=len(view.axes) == 2
+        )
+        self.curves_text = pn.pane.Markdown("", sizing_mode="stretch_width", css_classes=["grazing-curves"])
         self.code_python = pn.widgets.TextAreaInput(
             label="Python", height=260, sizing_mode="stretch_width", visible=False
         )
@@ -107,6 +118,7 @@ class Explorer:
         self.continue_button.on_click(lambda _e: self.continue_orbit())
         self.grazings_button.on_click(lambda _e: self.find_grazings())
         self.code_button.on_click(lambda _e: self.show_code())
+        self.curves_button.on_click(lambda _e: self.follow_curves())
         from bokeh.events import DoubleTap, RangesUpdate, Tap
 
         self.figures.diagram.on_event(Tap, self._on_tap)
@@ -126,8 +138,10 @@ class Explorer:
                     pn.pane.Markdown("#### Orbit"),
                     self.orbit,
                     pn.Row(self.continue_button, self.grazings_button, self.code_button),
+                    self.curves_button,
                     self.actions_text,
                     self.grazings_text,
+                    self.curves_text,
                     sizing_mode="stretch_width",
                 ),
                 sizing_mode="stretch_width",
@@ -269,6 +283,7 @@ class Explorer:
 
     def _point_done(self, rep: PointReport) -> None:
         self.continued = None
+        self.curves_button.disabled = True
         self.figures.show_point(rep)
         self.orbit.object = "\n\n".join(rep.summary().splitlines())
         self.continue_button.disabled = rep.orbit is None
@@ -297,11 +312,29 @@ class Explorer:
                 return  # another point was clicked meanwhile
             self.figures.show_branch(c, self._row(point))
             self.actions_text.object = "\n\n".join(c.lines)
+            self.curves_button.disabled = False
             self.continued = c
             if self.code_python.visible:
                 self.show_code()
 
         self.jobs.submit("branch", work, done, lambda e: setattr(self.actions_text, "object", message_of(e)))
+
+    def follow_curves(self) -> None:
+        """On a period map: follow the continued orbit's special points in the map's two parameters."""
+        point, continued = self.point, self.continued
+        if point is None or continued is None:
+            self.curves_text.object = "continue a clicked orbit first: its special points are followed"
+            return
+        self.curves_text.object = "following the bifurcation curves ..."
+
+        def work(cancelled: Callable[[], bool]) -> Curves:
+            return follow_click_curves(self.view, point, continued, cancelled=cancelled)
+
+        def done(found: Curves) -> None:
+            self.figures.show_curves(found)
+            self.curves_text.object = "\n\n".join(found.lines)
+
+        self.jobs.submit("curves", work, done, lambda e: setattr(self.curves_text, "object", message_of(e)))
 
     def _row(self, point: PointReport) -> float | None:
         """The clicked row of a map (its second parameter's value), else None."""

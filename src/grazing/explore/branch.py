@@ -19,7 +19,7 @@ import numpy as np
 from grazing.cli.common import multipliers_text
 from grazing.engine.simulate import simulate
 from grazing.errors import GrazingError, GrazingWarning, InvalidParameterError
-from grazing.explore.diagram import IsSupersededError, View, checkpoint
+from grazing.explore.diagram import IsCancelled, SupersededError, View, checkpoint
 from grazing.explore.point import PointReport
 from grazing.orbits.continuation import Branch, continue_orbit
 from grazing.orbits.grazing import find_grazings
@@ -28,9 +28,12 @@ from grazing.orbits.shooting import PeriodicOrbit
 __all__ = [
     "BranchPiece",
     "Continued",
+    "CurveView",
+    "Curves",
     "Grazings",
     "Mark",
     "continue_click",
+    "follow_click_curves",
     "grazings_in_view",
     "section_states",
 ]
@@ -71,6 +74,7 @@ class BranchPiece:
     states: list[np.ndarray]
     stable: np.ndarray
     crossing: np.ndarray
+    end: float
 
 
 @dataclass(frozen=True)
@@ -92,9 +96,7 @@ def _special_text(view: View, kind: str, value: float, mu: np.ndarray, note: str
     return f"{text} ({note})" if note else text
 
 
-def continue_click(
-    view: View, point: PointReport, *, cancelled: IsSupersededError | None = None
-) -> Continued:
+def continue_click(view: View, point: PointReport, *, cancelled: IsCancelled | None = None) -> Continued:
     """Continue the orbit of ``point`` in the view's first parameter, both ways to the ends of its range.
 
     Raises
@@ -127,7 +129,7 @@ def continue_click(
             states.append(section_states(o))
         crossing = np.array([o.virtual and bool(o.crossed_stops) for o in branch.orbits], dtype=bool)
         stable = np.array([o.stable for o in branch.orbits], dtype=bool)
-        pieces.append(BranchPiece(branch, np.asarray(branch.values), states, stable, crossing))
+        pieces.append(BranchPiece(branch, np.asarray(branch.values), states, stable, crossing, end))
         lines.append(
             f"towards {par.show(end, '.6g')}: {len(branch)} points, {branch.status or 'reached the end'}"
         )
@@ -161,7 +163,7 @@ def grazings_in_view(
     fixed: dict[str, float] | None = None,
     *,
     period: int = 1,
-    cancelled: IsSupersededError | None = None,
+    cancelled: IsCancelled | None = None,
 ) -> Grazings:
     """Every stop's grazings of the nonimpacting period-``period`` orbit over the view's first range.
 
@@ -196,3 +198,90 @@ def grazings_in_view(
     if not marks:
         lines.append(f"no grazing of the nonimpacting period-{period} orbit in the range ({branch.status})")
     return Grazings(axis.name, tuple(marks), tuple(lines))
+
+
+CURVE_OF = {
+    "fold": "fold",
+    "period-doubling": "period-doubling",
+    "neimark-sacker": "neimark-sacker",
+    "branch point": "branch-point",
+    "grazing": "grazing",
+}
+"""The curve (:data:`grazing.orbits.curves.CURVE_KINDS`) that follows each kind of special point."""
+
+
+@dataclass(frozen=True)
+class CurveView:
+    """A bifurcation curve drawn on a period map: its kind, its two parameters' values (model units)."""
+
+    kind: str
+    first: np.ndarray
+    second: np.ndarray
+    text: str
+
+
+@dataclass(frozen=True)
+class Curves:
+    """The bifurcation curves through the special points of a continued orbit, and one line each."""
+
+    curves: tuple[CurveView, ...]
+    lines: tuple[str, ...]
+
+
+def follow_click_curves(
+    view: View, point: PointReport, continued: Continued, *, cancelled: IsCancelled | None = None
+) -> Curves:
+    """Follow each special point of the clicked orbit's branch (the first of each kind, each way) in
+    the map's two parameters over the map's range (:func:`grazing.orbits.follow_curve`).
+
+    Raises
+    ------
+    InvalidParameterError
+        A view with one parameter (a curve needs two), or a point without an orbit.
+    """
+    from grazing.orbits.curves import follow_curve
+
+    if len(view.axes) != 2:
+        raise InvalidParameterError(
+            "a bifurcation curve needs two parameters: explore a period map (--params)"
+        )
+    if point.orbit is None:
+        raise InvalidParameterError(f"no orbit to follow: {point.message}")
+    a, b = view.axes
+    par = view.model.parameter(a.name)
+    start = point.values[a.name]
+    curves, lines = [], []
+    for piece in continued.pieces:
+        done = set()
+        for sp in piece.branch.special:
+            kind = CURVE_OF.get(sp.kind)
+            if kind is None or kind in done:
+                continue
+            done.add(kind)
+            checkpoint(cancelled)
+            try:
+                curve = follow_curve(
+                    point.model,
+                    kind,
+                    a.name,
+                    start,
+                    piece.end,
+                    b.name,
+                    (b.lo, b.hi),
+                    x0=point.orbit.state,
+                    period=point.orbit.period,
+                    progress=lambda *_: checkpoint(cancelled),
+                )
+            except GrazingError as exc:
+                if isinstance(exc, SupersededError):
+                    raise
+                lines.append(f"{kind} curve from {par.show(sp.param, '.8g')}: {exc}")
+                continue
+            text = (
+                f"{kind} curve from {par.show(sp.param, '.8g')}: {len(curve.points)} points; {curve.status}"
+            )
+            curves.append(CurveView(kind, curve.values(a.name), curve.values(b.name), text))
+            lines.append(text)
+    if not lines:
+        lines.append("no special point on the branch to follow")
+    return Curves(tuple(curves), tuple(lines))

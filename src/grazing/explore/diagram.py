@@ -47,10 +47,10 @@ class SupersededError(GrazingError):
 
 
 Progress = Callable[[int, int], None]
-IsSupersededError = Callable[[], bool]
+IsCancelled = Callable[[], bool]
 
 
-def checkpoint(cancelled: IsSupersededError | None) -> None:
+def checkpoint(cancelled: IsCancelled | None) -> None:
     """Raise :class:`SupersededError` when ``cancelled()`` says so."""
     if cancelled is not None and cancelled():
         raise SupersededError("replaced by a newer request")
@@ -259,7 +259,7 @@ def compute_diagram(
     view: View,
     *,
     progress: Progress | None = None,
-    cancelled: IsSupersededError | None = None,
+    cancelled: IsCancelled | None = None,
     workers: int | None = None,
 ) -> Diagram:
     """Compute a view's diagram with :func:`grazing.sweeps.sweep` or :func:`~grazing.sweeps.parameter_map`.

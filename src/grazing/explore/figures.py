@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from grazing.core.model import HybridModel, Parameter
-from grazing.explore.branch import Continued, Grazings, Mark
+from grazing.explore.branch import Continued, Curves, Grazings, Mark
 from grazing.explore.diagram import Diagram, View
 from grazing.explore.point import PointReport
 
@@ -130,8 +130,12 @@ def row_columns(view: View, marks: tuple[Mark, ...], row: float | None) -> dict[
     """Special points on a map's row ``row`` (the second parameter's value, model units)."""
     p1, p2 = view.parameter(0), view.parameter(1)
     y = p2.to_display(row) if row is not None else math.nan
-    return {"x": [p1.to_display(m.value) for m in marks], "y": [y] * len(marks),
-            "kind": [m.kind for m in marks], "text": [m.text for m in marks]}  # fmt: skip
+    return {
+        "x": [p1.to_display(m.value) for m in marks],
+        "y": [y] * len(marks),
+        "kind": [m.kind for m in marks],
+        "text": [m.text for m in marks],
+    }
 
 
 class Figures:
@@ -209,6 +213,10 @@ class Figures:
         self.branch = ColumnDataSource({"x": [], "y": [], "stable": [], "fill": [], "line": []})
         self.marks = ColumnDataSource({"x": [], "y": [], "kind": [], "text": []})
         self.grazings = ColumnDataSource({"x": [], "y": [], "kind": [], "text": []})
+        self.curves = ColumnDataSource({"xs": [], "ys": [], "kind": [], "text": [], "colour": []})
+        if len(view.axes) == 2:
+            rc = self.diagram.multi_line("xs", "ys", source=self.curves, line_color="colour", line_width=3)
+            self.diagram.add_tools(HoverTool(renderers=[rc], tooltips=[("", "@text")]))
         rm = self.diagram.scatter(
             "x", "y", source=self.marks, size=12, marker="diamond", fill_color="red", line_color="black"
         )
@@ -344,6 +352,24 @@ class Figures:
             self.marks.data = mark_columns(self.view, continued.marks, self.view.component)
         else:
             self.marks.data = row_columns(self.view, continued.marks, row)
+
+    def show_curves(self, found: Curves) -> None:
+        """Bifurcation curves on a period map, in display units."""
+        p1, p2 = self.view.parameter(0), self.view.parameter(1)
+        colours = {
+            "fold": "black",
+            "period-doubling": "red",
+            "neimark-sacker": "purple",
+            "branch-point": "brown",
+            "grazing": "orange",
+        }
+        self.curves.data = {
+            "xs": [[p1.to_display(v) for v in c.first] for c in found.curves],
+            "ys": [[p2.to_display(v) for v in c.second] for c in found.curves],
+            "kind": [c.kind for c in found.curves],
+            "text": [c.text for c in found.curves],
+            "colour": [colours.get(c.kind, "black") for c in found.curves],
+        }
 
     def show_grazings(self, found: Grazings, row: float | None = None) -> None:
         """Grazings: on a diagram a dotted line and the grazing orbit's points; on a map a mark on the row."""

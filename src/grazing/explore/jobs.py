@@ -32,7 +32,14 @@ from grazing.explore.diagram import SupersededError
 
 __all__ = ["LANES", "Jobs"]
 
-LANES = {"diagram": "diagram", "refine": "diagram", "point": "point", "branch": "point", "grazings": "point"}
+LANES = {
+    "diagram": "diagram",
+    "refine": "diagram",
+    "point": "point",
+    "branch": "point",
+    "grazings": "point",
+    "curves": "point",
+}
 """The lane (worker thread) of each kind of request: a long diagram does not hold up a click."""
 
 

@@ -22,7 +22,7 @@ from grazing.core.model import HybridModel
 from grazing.core.options import MAX_PERIOD
 from grazing.engine.simulate import simulate
 from grazing.errors import GrazingError
-from grazing.explore.diagram import Diagram, IsSupersededError, View, checkpoint
+from grazing.explore.diagram import Diagram, IsCancelled, View, checkpoint
 from grazing.orbits.shooting import PeriodicOrbit, find_orbit
 
 __all__ = ["INSPECT_SETTINGS", "InspectSettings", "PointReport", "inspect_click", "inspect_point"]
@@ -148,7 +148,7 @@ def inspect_point(
     x0: Sequence[float] | np.ndarray,
     *,
     settings: InspectSettings = INSPECT_SETTINGS,
-    cancelled: IsSupersededError | None = None,
+    cancelled: IsCancelled | None = None,
 ) -> PointReport:
     """Simulate ``model`` at the parameters ``values`` from ``x0``; its period, impacts and orbit.
 
@@ -214,7 +214,7 @@ def inspect_click(
     values: Sequence[float],
     *,
     settings: InspectSettings = INSPECT_SETTINGS,
-    cancelled: IsSupersededError | None = None,
+    cancelled: IsCancelled | None = None,
 ) -> PointReport:
     """:func:`inspect_point` at a point of a diagram (model units, one value per explored parameter).
 
