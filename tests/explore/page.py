@@ -236,5 +236,30 @@ _CLICK_BUTTON = """(() => {
 })()"""
 
 
+def docs_map_screenshot(path: Path) -> None:
+    """The period map of docs/explore.md: (η, θ̂) over [0.42, 0.48] x [30, 50] deg, η = 0.446 and
+    θ̂ = 40° clicked, its orbit continued, its bifurcation curves followed, the grazings found."""
+    from grazing.outputs import write_png_bytes
+
+    args = ["--params", "eta,theta-hat", "--range", "0.42,0.48", "--range", "30,50", "--num", "40"]
+    with ExplorerPage(args, Path(tempfile.gettempdir()), width=1400, height=1000) as page:
+        page.wait_for(r"diagram: 1600 points")
+        where = page.diagram_pixel(0.446)  # (at the frame's middle height: 40 deg)
+        page.click(where["x"], where["y"])
+        page.wait_for(r"Floquet multipliers")
+        steps = (
+            ("Continue this orbit", r"towards eta = 0\.48"),
+            ("Follow the bifurcation curves", r"curve from"),
+            ("Find the grazings", r"stop stop"),
+        )
+        for label, done in steps:
+            page.evaluate(_CLICK_BUTTON % label)
+            page.wait_for(done, 120)
+        page.dt.send("Input.dispatchMouseEvent", {"type": "mouseMoved", "x": 5, "y": 5}, session=page.session)
+        time.sleep(1.0)  # (the plots redraw)
+        shot = page.dt.send("Page.captureScreenshot", {"format": "png"}, session=page.session)
+        write_png_bytes(path, base64.b64decode(shot["data"]), overwrite=True)
+
+
 if __name__ == "__main__":
-    docs_screenshot(Path(sys.argv[1]))
+    (docs_map_screenshot if "map" in Path(sys.argv[1]).name else docs_screenshot)(Path(sys.argv[1]))

@@ -3,18 +3,26 @@
 The computations are plain Python, testable without a browser: :mod:`.diagram` (what is
 explored, :class:`View`, and its sweep, :class:`Diagram`), :mod:`.point` (a clicked point:
 simulation, period, impacts, Newton's method and Floquet multipliers), :mod:`.branch`
-(continuing the clicked orbit, the grazings in the range), :mod:`.code` ("copy as code": the
-Python and the command lines that reproduce the view), :mod:`.jobs` (the page's requests in
-the background, newer ones superseding older).  The page itself (:mod:`.app`, Panel and
-Bokeh, the ``explore`` extra) is one component that ``grazing explore`` serves
-(:mod:`.server`) and that a Jupyter notebook displays (:func:`explorer`).
+(continuing the clicked orbit, its bifurcation curves on a period map, the grazings in the
+range), :mod:`.code` ("copy as code": the Python and the command lines that reproduce the
+view), :mod:`.jobs` (the page's requests in the background, newer ones superseding older).
+The page itself (:mod:`.app`, Panel and Bokeh, the ``explore`` extra) is one component that
+``grazing explore`` serves (:mod:`.server`) and that a Jupyter notebook displays
+(:func:`explorer`).
 """
 
 from __future__ import annotations
 
 from typing import Any
 
-from grazing.explore.branch import Continued, Grazings, continue_click, grazings_in_view
+from grazing.explore.branch import (
+    Continued,
+    Curves,
+    Grazings,
+    continue_click,
+    follow_click_curves,
+    grazings_in_view,
+)
 from grazing.explore.code import Code, view_code
 from grazing.explore.diagram import Axis, Diagram, SupersededError, View, compute_diagram
 from grazing.explore.point import InspectSettings, PointReport, inspect_click, inspect_point
@@ -24,6 +32,7 @@ __all__ = [
     "Axis",
     "Code",
     "Continued",
+    "Curves",
     "Diagram",
     "Grazings",
     "InspectSettings",
@@ -34,6 +43,7 @@ __all__ = [
     "compute_diagram",
     "continue_click",
     "explorer",
+    "follow_click_curves",
     "grazings_in_view",
     "inspect_click",
     "inspect_point",
