@@ -6,6 +6,7 @@ import math
 import threading
 import time
 
+import numpy as np
 import pytest
 
 import grazing
@@ -207,3 +208,21 @@ def test_on_a_period_map_the_clicked_orbit_s_bifurcation_curves_are_followed():
         assert 35 - 1e-9 <= min(ys) and max(ys) <= 45 + 1e-9  # (inside the map's range)
     finally:
         app.close()
+
+
+def test_the_basins_at_the_clicked_point_hold_its_attractor(page):
+    """At eta = 0.446 the period-5 orbit attracts most of the plane (the diagram's chain found it too)."""
+    page.click_values([0.446])
+    wait_until(lambda: page.point is not None and page.point.values["eta"] == 0.446)
+    assert not page.basins_button.disabled
+    page.find_basins()
+    wait_until(lambda: "of the grid" in page.basins_text.object or "error" in page.basins_text.object)
+    text = page.basins_text.object
+    assert "periodic, period 5 with 1 impacts per period" in text, text
+    assert page.figures.basins.visible
+    label = page.figures.basin_image.data["image"][0]
+    assert label.shape == (40, 40) and set(np.unique(label)) <= {0.0, 1.0, 2.0, 3.0, 4.0, 5.0}
+    # the attractor's points drawn are those of the clicked orbit (the same 5 points at phase 0)
+    pts = np.column_stack([page.figures.basin_points.data["x"], page.figures.basin_points.data["y"]])
+    orbit = page.point.samples[-5:]
+    assert all(np.min(np.abs(pts - p).sum(axis=1)) < 1e-5 for p in orbit)

@@ -18,6 +18,7 @@ from collections.abc import Callable
 from typing import Any
 
 from grazing.errors import GrazingError
+from grazing.explore.basins import BasinView, basins_at
 from grazing.explore.branch import (
     Continued,
     Curves,
@@ -104,6 +105,8 @@ class Explorer:
         self.continue_button = pn.widgets.Button(label="Continue this orbit", disabled=True)
         self.grazings_button = pn.widgets.Button(label="Find the grazings")
         self.code_button = pn.widgets.Button(label="Copy as code")
+        self.basins_button = pn.widgets.Button(label="Basins of attraction", disabled=True)
+        self.basins_text = pn.pane.Markdown("", sizing_mode="stretch_width", css_classes=["grazing-basins"])
         self.curves_button = pn.widgets.Button(
             label="Follow the bifurcation curves", disabled=True, visible=len(view.axes) == 2
         )
@@ -119,6 +122,7 @@ class Explorer:
         self.grazings_button.on_click(lambda _e: self.find_grazings())
         self.code_button.on_click(lambda _e: self.show_code())
         self.curves_button.on_click(lambda _e: self.follow_curves())
+        self.basins_button.on_click(lambda _e: self.find_basins())
         from bokeh.events import DoubleTap, RangesUpdate, Tap
 
         self.figures.diagram.on_event(Tap, self._on_tap)
@@ -138,10 +142,11 @@ class Explorer:
                     pn.pane.Markdown("#### Orbit"),
                     self.orbit,
                     pn.Row(self.continue_button, self.grazings_button, self.code_button),
-                    self.curves_button,
+                    pn.Row(self.curves_button, self.basins_button),
                     self.actions_text,
                     self.grazings_text,
                     self.curves_text,
+                    self.basins_text,
                     sizing_mode="stretch_width",
                 ),
                 sizing_mode="stretch_width",
@@ -151,6 +156,7 @@ class Explorer:
                 pn.pane.Bokeh(self.figures.phase, sizing_mode="stretch_width"),
                 sizing_mode="stretch_width",
             ),
+            pn.pane.Bokeh(self.figures.basins, sizing_mode="stretch_width"),
             self.code_python,
             self.code_cli,
             sizing_mode="stretch_width",
@@ -284,6 +290,7 @@ class Explorer:
     def _point_done(self, rep: PointReport) -> None:
         self.continued = None
         self.curves_button.disabled = True
+        self.basins_button.disabled = False
         self.figures.show_point(rep)
         self.orbit.object = "\n\n".join(rep.summary().splitlines())
         self.continue_button.disabled = rep.orbit is None
@@ -335,6 +342,25 @@ class Explorer:
             self.curves_text.object = "\n\n".join(found.lines)
 
         self.jobs.submit("curves", work, done, lambda e: setattr(self.curves_text, "object", message_of(e)))
+
+    def find_basins(self) -> None:
+        """The basins of attraction at the clicked parameters, around its motion."""
+        point = self.point
+        if point is None:
+            self.basins_text.object = "click a point first"
+            return
+        self.basins_text.object = "finding the attractors and their basins ..."
+
+        def done(found: BasinView) -> None:
+            self.figures.show_basins(found)
+            self.basins_text.object = "\n\n".join(found.lines)
+
+        self.jobs.submit(
+            "basins",
+            lambda _c: basins_at(point),
+            done,
+            lambda e: setattr(self.basins_text, "object", message_of(e)),
+        )
 
     def _row(self, point: PointReport) -> float | None:
         """The clicked row of a map (its second parameter's value), else None."""

@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from grazing.core.model import HybridModel, Parameter
+from grazing.explore.basins import BasinView
 from grazing.explore.branch import Continued, Curves, Grazings, Mark
 from grazing.explore.diagram import Diagram, View
 from grazing.explore.point import PointReport
@@ -293,6 +294,7 @@ class Figures:
         )
         self.phase.legend.click_policy = "hide"
         self.phase.add_layout(self.phase.legend[0], "right")
+        self._basins_figure(model)
         self.stop_spans = []
         for k, name in enumerate(model.stop_names):
             level = model.stop_level(0, 0.0, k)
@@ -301,11 +303,58 @@ class Figures:
                 self.phase.add_layout(span)
                 self.stop_spans.append((name, span))
 
+    def _basins_figure(self, model: HybridModel) -> None:
+        from bokeh.models import ColumnDataSource, HoverTool, LinearColorMapper
+        from bokeh.plotting import figure
+
+        self.basins = figure(
+            height=300,
+            sizing_mode="stretch_width",
+            x_axis_label=state_label(model, 0),
+            y_axis_label=state_label(model, 1),
+            tools="pan,wheel_zoom,box_zoom,reset,save",
+            title="basins of attraction (initial states at phase 0; white: beyond a stop)",
+            visible=False,
+        )
+        self.basin_image = ColumnDataSource({"image": [], "x": [], "y": [], "dw": [], "dh": []})
+        palette = ["#aec7e8", "#ffbb78", "#98df8a", "#ff9896", "#c5b0d5", "#c49c94", "#f7b6d2", "#dbdb8d"]
+        mapper = LinearColorMapper(
+            palette=palette, low=0.5, high=len(palette) + 0.5, low_color="white", high_color="#cccccc"
+        )
+        self.basins.image(
+            "image", x="x", y="y", dw="dw", dh="dh", source=self.basin_image, color_mapper=mapper
+        )
+        self.basin_points = ColumnDataSource({"x": [], "y": [], "text": []})
+        r = self.basins.scatter("x", "y", source=self.basin_points, size=7, color="black")
+        self.basins.add_tools(HoverTool(renderers=[r], tooltips=[("", "@text")]))
+
     def show_diagram(self, diagram: Diagram) -> None:
         if len(diagram.view.axes) == 1:
             self.points.data = diagram_columns(diagram, self.view.component)
         else:
             self.image.data = map_image(diagram)
+
+    def show_basins(self, found: BasinView) -> None:
+        """The basins: each initial state coloured by its attractor, the attractors' points on top."""
+        (x0, x1), (y0, y1) = found.x_range, found.y_range
+        nx, ny = found.label.shape[1], found.label.shape[0]
+        dx, dy = (x1 - x0) / max(nx - 1, 1), (y1 - y0) / max(ny - 1, 1)
+        self.basin_image.data = {
+            "image": [found.label.astype(float)],
+            "x": [x0 - dx / 2],
+            "y": [y0 - dy / 2],
+            "dw": [x1 - x0 + dx],
+            "dh": [y1 - y0 + dy],
+        }
+        xs, ys, texts = [], [], []
+        for k, pts in enumerate(found.points):
+            if found.kinds[k] == "invalid" or not len(pts):
+                continue
+            xs += pts[:, 0].tolist()
+            ys += pts[:, 1].tolist()
+            texts += [found.lines[k]] * len(pts)
+        self.basin_points.data = {"x": xs, "y": ys, "text": texts}
+        self.basins.visible = True
 
     def show_refined(self, refined: Diagram) -> None:
         """A zoomed-in diagram: its points replace the coarse ones over its range."""

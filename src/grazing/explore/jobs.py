@@ -39,6 +39,7 @@ LANES = {
     "branch": "point",
     "grazings": "point",
     "curves": "point",
+    "basins": "point",
 }
 """The lane (worker thread) of each kind of request: a long diagram does not hold up a click."""
 
