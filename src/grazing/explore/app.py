@@ -244,13 +244,13 @@ class Explorer:
         self.jobs.submit("refine", work, self._refined_done, self._diagram_failed)
 
     def _refined_done(self, diagram: Diagram) -> None:
-        self.refined = diagram
         self.figures.show_refined(diagram)
         par = self.view.parameter(0)
         a = diagram.view.axes[0]
         self.status.object = (
             f"refined: {a.num} points over {par.show_range(a.lo, a.hi, '.6g')} in {diagram.elapsed:.1f} s"
         )
+        self.refined = diagram  # (last: clicks use it from now on)
 
     # -- a click ------------------------------------------------------------------------------
 
