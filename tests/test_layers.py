@@ -37,6 +37,7 @@ LAYERS = {
     "grazing.plotting": 8,
     "grazing.report": 9,
     "grazing.cli": 10,
+    "grazing.explore": 10,
 }
 """The layer of every part of the package (the facade ``grazing/__init__`` is above them all)."""
 

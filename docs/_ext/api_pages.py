@@ -26,6 +26,7 @@ API_MODULES = (
     ("grazing.errors", "Errors and warnings"),
     ("grazing.outputs", "Output files"),
     ("grazing.report", "The report"),
+    ("grazing.explore", "The explorer (grazing explore)"),
 )
 """Every module of the public API, in the order of the reference, with its page's title."""
 

@@ -274,6 +274,30 @@ ACCEPTED_BUT_WRONG = [
     ([*ATTRACTORS, "--out", "b.zarr"], "--out must end in .nc, got 'b.zarr'"),
     ([*ATTRACTORS[:4], "r", *ATTRACTORS[5:8], "2", *ATTRACTORS[9:]], "r = 2 is outside [0, 1]"),
     ([*ATTRACTORS[:-1], "0,2"], "--num-grid must be at least 1 along each state (an empty grid)"),
+    # issue 31: explore
+    (["explore", "--param", "r", "--range", "0.5,2"], "--range: r = 2 is outside [0, 1]"),
+    (
+        ["explore", "--model", "impact-oscillator"],
+        "explore needs --param NAME --range LO,HI (or --params P1,P2 with a --range for each) for model "
+        "impact-oscillator",
+    ),
+    (["explore", "--range", "0.44,0.49"], "explore needs --param NAME --range LO,HI"),
+    (["explore", "--param", "eta", "--range", "0.49,0.44"], "--range: LO must be below HI, got 0.49,0.44"),
+    (["explore", "--param", "eta", "--range", "0.44,nan"], "--range must be finite numbers, got '0.44,nan'"),
+    (["explore", "--param", "eta"], "give one --range LO,HI for each explored parameter (1), got 0"),
+    (["explore", "--params", "eta", "--range", "0.44,0.49"], "--params must be P1,P2 (two parameters)"),
+    (["explore", "--params", "eta,eta", "--range", "0.4,0.5", "--range", "0.4,0.5"], "must differ"),
+    (["explore", "--param", "omega", "--range", "1,2"], "--param: unknown parameter 'omega'"),
+    (
+        ["explore", "--param", "eta", "--range", "0.44,0.49", "--component", "x"],
+        "--component: model pendulum has no state 'x' (states: theta, dtheta)",
+    ),
+    (
+        ["explore", "--param", "eta", "--range", "0.44,0.49", "--num", "100000"],
+        "--num 100000 is more than the page can show: at most 20000 for a diagram",
+    ),
+    (["explore", "--port", "70000"], "70000 is not in the range 0<=x<=65535"),
+    (["explore", "--param", "theta-hat", "--range", "30,200"], "theta_hat = 200 deg is outside"),
 ]
 
 IGNORED_OPTIONS = [
@@ -446,6 +470,25 @@ IGNORED_OPTIONS = [
         "--eta is not used with --param eta",
     ),
     ([*ATTRACTORS[:10], "1", *ATTRACTORS[11:]], "--stop is not used with --num 1 (its one value is --start"),
+    # issue 31: explore
+    (["explore", "--eta", "0.45"], "--eta is not used by explore: it shows eta in [0.44, 0.49]"),
+    (["explore", "--set", "eta=0.45"], "--set eta=0.45 is not used by explore: it shows eta in [0.44, 0.49]"),
+    (
+        ["explore", "--param", "eta", "--range", "0.44,0.49", "--set", "eta=0.45"],
+        "--set eta=0.45 is not used with --param/--params: the explored values replace it",
+    ),
+    (
+        ["explore", "--param", "theta-hat", "--range", "30,40", "--theta-hat", "35"],
+        "--theta-hat is not used with --param/--params",
+    ),
+    (
+        ["explore", "--param", "eta", "--params", "eta,r", "--range", "0.44,0.49"],
+        "--params is not used with --param (give one of them)",
+    ),
+    (
+        "explore --params eta,theta-hat --range 0.44,0.49 --range 30,40 --component theta".split(),
+        "--component is not used with a period map (--params)",
+    ),
 ]
 
 MEMORY = [
@@ -689,6 +732,7 @@ WORK = [
     ("grazing.orbits", "follow_curve"),  # issue 27: curves
     ("grazing.attractors.basins", "find_attractors"),  # issue 28: attractors
     ("grazing.attractors.continuation", "continue_attractors"),
+    ("grazing.explore.server", "serve"),  # issue 31: explore
 ]
 
 
@@ -932,6 +976,17 @@ COMMANDS["curve"] = {
 }
 REQUIRED += ["--kind", "--range"]
 REQUIRED += ["--x-range", "--y-range", "--num-grid"]  # issue 28: attractors
+# issue 31: explore
+COMMANDS["explore"] = {
+    **MODEL,
+    "--param": PARAMS,
+    "--params": ["eta,theta-hat", "eta", "eta,eta", "r,alpha", "theta-hat,gamma"],
+    "--range": ["0.44,0.49", "30,50", "0.49,0.44", "0.1,0.9", "1", "0,nan"],
+    "--num": ["2", "3", "100000"],
+    "--component": ["theta", "dtheta", "x"],
+    "--port": ["0", "5006", "70000"],
+    "--no-browser": None,
+}
 REAL_WORK = ("simulate", "sweep", "map", "damping", "synthesize", "analyze")
 
 
@@ -993,7 +1048,7 @@ def ignored(argv: list[str]) -> list[str]:
     bad = []
     sets = _sets(argv)  # issue 26: models (a parameter given by --set counts as its option)
     if cmd in ("simulate", "orbit", "graze", "graze-curve", "continue", "sweep", "map", "normal-form",
-               "curve"):  # fmt: skip
+               "curve", "explore"):  # fmt: skip
         if all(o in g or o in sets for o in ("--alpha", "--beta", "--r")) and "--case" in g:
             bad.append("--case")
         bad += [o for o in sets if o in g]  # the option and --set of one parameter
@@ -1057,6 +1112,16 @@ def ignored(argv: list[str]) -> list[str]:
         bad += [f"--{g['--param']}"] if f"--{g.get('--param')}" in g else []
         if g.get("--num") == "1" and "--stop" in g and _number(g.get("--stop")) != _number(g.get("--start")):
             bad.append("--stop")
+    # issue 31: explore
+    if cmd == "explore":
+        if "--param" in g:
+            bad += ["--params"] if "--params" in g else []
+            explored = [str(g["--param"])]
+        else:
+            explored = str(g.get("--params", "eta")).split(",")  # (without either: the pendulum's eta)
+        bad += [f"--{p}" for p in explored if f"--{p}" in g]
+        if "--component" in g and "--params" in g and "--param" not in g:
+            bad.append("--component")
     return bad
 
 

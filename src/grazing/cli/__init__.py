@@ -38,6 +38,7 @@ COMMANDS: dict[str, str] = {
     "synthesize": "experiment:synthesize_cmd",
     "basins": "attractors:basins_cmd",  # issue 28
     "attractors": "attractors:attractors_cmd",
+    "explore": "explore:explore",  # issue 31
 }
 """Every command: its name and where it is (``module of grazing.cli:object``), imported when it is used.
 

@@ -1,0 +1,287 @@
+"""Actions on a clicked orbit: continue it over the diagram's range; find the grazings there.
+
+:func:`continue_click` follows the clicked point's orbit both ways to the ends of the
+diagram's first parameter with :func:`grazing.orbits.continue_orbit` (special points
+located: folds, branch points, period-doublings, Neimark-Sacker points, grazings, where
+an impacting branch ends).  :func:`grazings_in_view` follows the nonimpacting period-1
+orbit over that range with the stops ignored (:func:`grazing.orbits.find_grazings`)
+and returns every stop's grazings.  Both give what the diagram draws: each orbit by its
+points at forcing phase 0, the diagram's stroboscopic section.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from grazing.cli.common import multipliers_text
+from grazing.engine.simulate import simulate
+from grazing.errors import GrazingError, GrazingWarning, InvalidParameterError
+from grazing.explore.diagram import IsCancelled, SupersededError, View, checkpoint
+from grazing.explore.point import PointReport
+from grazing.orbits.continuation import Branch, continue_orbit
+from grazing.orbits.grazing import find_grazings
+from grazing.orbits.shooting import PeriodicOrbit
+
+__all__ = [
+    "BranchPiece",
+    "Continued",
+    "CurveView",
+    "Curves",
+    "Grazings",
+    "Mark",
+    "continue_click",
+    "follow_click_curves",
+    "grazings_in_view",
+    "section_states",
+]
+
+
+def section_states(orbit: PeriodicOrbit) -> np.ndarray:
+    """The orbit's states at forcing phase 0, one per forcing period of its period: ``(period, n_states)``.
+
+    A branch's orbits are solved on sections chosen away from their impacts; the
+    diagram samples at phase 0, so each is simulated over one period from its section.
+    """
+    sol = simulate(
+        orbit.model, orbit.state, t0=orbit.t0, periods=orbit.period, impacts="none", events=not orbit.virtual
+    )
+    return sol.samples
+
+
+@dataclass(frozen=True)
+class Mark:
+    """A special point drawn on the diagram: its kind, parameter value (model units), states at phase 0."""
+
+    kind: str
+    value: float
+    states: np.ndarray
+    text: str
+
+
+@dataclass(frozen=True)
+class BranchPiece:
+    """One direction of a continuation: the branch and each point's states at phase 0.
+
+    ``crossing``: the point's orbit is a virtual one (followed with the stops ignored, as a
+    nonimpacting branch is) that passes through a stop: not a motion of the system.
+    """
+
+    branch: Branch
+    values: np.ndarray
+    states: list[np.ndarray]
+    stable: np.ndarray
+    crossing: np.ndarray
+    end: float
+
+
+@dataclass(frozen=True)
+class Continued:
+    """The clicked orbit continued both ways: pieces (one per direction), special points, summary."""
+
+    param: str
+    pieces: tuple[BranchPiece, ...]
+    marks: tuple[Mark, ...]
+    lines: tuple[str, ...] = field(default=())
+
+    def summary(self) -> str:
+        return "\n".join(self.lines)
+
+
+def _special_text(view: View, kind: str, value: float, mu: np.ndarray, note: str = "") -> str:
+    par = view.model.parameter(view.axes[0].name)
+    text = f"{kind} at {par.show(value, '.8g')}, multipliers {multipliers_text(mu)}"
+    return f"{text} ({note})" if note else text
+
+
+def continue_click(view: View, point: PointReport, *, cancelled: IsCancelled | None = None) -> Continued:
+    """Continue the orbit of ``point`` in the view's first parameter, both ways to the ends of its range.
+
+    Raises
+    ------
+    InvalidParameterError
+        The point has no orbit (:attr:`PointReport.message` says why).
+    """
+    if point.orbit is None:
+        raise InvalidParameterError(f"no orbit to continue: {point.message}")
+    axis = view.axes[0]
+    par = view.model.parameter(axis.name)
+    start = point.values[axis.name]
+    pieces, marks, lines = [], [], []
+    for end in (axis.lo, axis.hi):
+        if abs(end - start) <= 1e-12 * max(1.0, abs(start)):
+            continue
+        checkpoint(cancelled)
+        branch = continue_orbit(
+            point.model,
+            axis.name,
+            start,
+            end,
+            x0=point.orbit.state,
+            period=point.orbit.period,
+            progress=lambda _n, _v: checkpoint(cancelled),
+        )
+        states = []
+        for o in branch.orbits:
+            checkpoint(cancelled)
+            states.append(section_states(o))
+        crossing = np.array([o.virtual and bool(o.crossed_stops) for o in branch.orbits], dtype=bool)
+        stable = np.array([o.stable for o in branch.orbits], dtype=bool)
+        pieces.append(BranchPiece(branch, np.asarray(branch.values), states, stable, crossing, end))
+        lines.append(
+            f"towards {par.show(end, '.6g')}: {len(branch)} points, {branch.status or 'reached the end'}"
+        )
+        for sp in branch.special:
+            marks.append(
+                Mark(
+                    sp.kind,
+                    sp.param,
+                    section_states(sp.orbit),
+                    _special_text(view, sp.kind, sp.param, sp.multipliers, sp.note),
+                )
+            )
+            lines.append("  " + marks[-1].text)
+    return Continued(axis.name, tuple(pieces), tuple(marks), tuple(lines))
+
+
+@dataclass(frozen=True)
+class Grazings:
+    """The grazings of the nonimpacting orbit in the view's range: marks and one line each."""
+
+    param: str
+    marks: tuple[Mark, ...]
+    lines: tuple[str, ...]
+
+    def summary(self) -> str:
+        return "\n".join(self.lines)
+
+
+def grazings_in_view(
+    view: View,
+    fixed: dict[str, float] | None = None,
+    *,
+    period: int = 1,
+    cancelled: IsCancelled | None = None,
+) -> Grazings:
+    """Every stop's grazings of the nonimpacting period-``period`` orbit over the view's first range.
+
+    ``fixed``: the other explored parameter's value (a period map: the clicked row).
+    The orbit is followed with the stops ignored from the range's start (its guess:
+    a simulation from rest with the stops ignored), through folds.
+    """
+    axis = view.axes[0]
+    model = view.model.with_params(**(fixed or {}))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", GrazingWarning)  # (said in each grazing's text instead)
+        _, branch = find_grazings(
+            model, axis.name, axis.lo, axis.hi, period=period, progress=lambda _n, _v: checkpoint(cancelled)
+        )
+    marks, lines = [], []
+    for sp in branch.special:
+        if sp.kind != "grazing" or sp.grazing is None:
+            continue
+        checkpoint(cancelled)
+        g = sp.grazing
+        note = f"stop {g.stop_name}"
+        if g.crossed:
+            note += f"; passes through stop(s) {', '.join(g.crossed)}: not a motion of the system"
+        try:
+            states = section_states(sp.orbit)
+        except GrazingError:
+            states = np.empty((0, view.model.n_states))
+        marks.append(
+            Mark("grazing", sp.param, states, _special_text(view, "grazing", sp.param, g.multipliers, note))
+        )
+        lines.append(marks[-1].text)
+    if not marks:
+        lines.append(f"no grazing of the nonimpacting period-{period} orbit in the range ({branch.status})")
+    return Grazings(axis.name, tuple(marks), tuple(lines))
+
+
+CURVE_OF = {
+    "fold": "fold",
+    "period-doubling": "period-doubling",
+    "neimark-sacker": "neimark-sacker",
+    "branch point": "branch-point",
+    "grazing": "grazing",
+}
+"""The curve (:data:`grazing.orbits.curves.CURVE_KINDS`) that follows each kind of special point."""
+
+
+@dataclass(frozen=True)
+class CurveView:
+    """A bifurcation curve drawn on a period map: its kind, its two parameters' values (model units)."""
+
+    kind: str
+    first: np.ndarray
+    second: np.ndarray
+    text: str
+
+
+@dataclass(frozen=True)
+class Curves:
+    """The bifurcation curves through the special points of a continued orbit, and one line each."""
+
+    curves: tuple[CurveView, ...]
+    lines: tuple[str, ...]
+
+
+def follow_click_curves(
+    view: View, point: PointReport, continued: Continued, *, cancelled: IsCancelled | None = None
+) -> Curves:
+    """Follow each special point of the clicked orbit's branch (the first of each kind, each way) in
+    the map's two parameters over the map's range (:func:`grazing.orbits.follow_curve`).
+
+    Raises
+    ------
+    InvalidParameterError
+        A view with one parameter (a curve needs two), or a point without an orbit.
+    """
+    from grazing.orbits.curves import follow_curve
+
+    if len(view.axes) != 2:
+        raise InvalidParameterError(
+            "a bifurcation curve needs two parameters: explore a period map (--params)"
+        )
+    if point.orbit is None:
+        raise InvalidParameterError(f"no orbit to follow: {point.message}")
+    a, b = view.axes
+    par = view.model.parameter(a.name)
+    start = point.values[a.name]
+    curves, lines = [], []
+    for piece in continued.pieces:
+        done = set()
+        for sp in piece.branch.special:
+            kind = CURVE_OF.get(sp.kind)
+            if kind is None or kind in done:
+                continue
+            done.add(kind)
+            checkpoint(cancelled)
+            try:
+                curve = follow_curve(
+                    point.model,
+                    kind,
+                    a.name,
+                    start,
+                    piece.end,
+                    b.name,
+                    (b.lo, b.hi),
+                    x0=point.orbit.state,
+                    period=point.orbit.period,
+                    progress=lambda *_: checkpoint(cancelled),
+                )
+            except GrazingError as exc:
+                if isinstance(exc, SupersededError):
+                    raise
+                lines.append(f"{kind} curve from {par.show(sp.param, '.8g')}: {exc}")
+                continue
+            text = (
+                f"{kind} curve from {par.show(sp.param, '.8g')}: {len(curve.points)} points; {curve.status}"
+            )
+            curves.append(CurveView(kind, curve.values(a.name), curve.values(b.name), text))
+            lines.append(text)
+    if not lines:
+        lines.append("no special point on the branch to follow")
+    return Curves(tuple(curves), tuple(lines))

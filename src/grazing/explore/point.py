@@ -1,0 +1,236 @@
+"""A clicked point: its motion simulated, its period and impacts, its orbit by Newton's method.
+
+:func:`inspect_point` answers a click on a diagram: from the state the diagram's
+chain reached nearest to the click, it simulates the model at the clicked
+parameters (a transient, then samples), detects the period, records one period
+of the motion densely (time series, phase portrait, impacts), and runs Newton's
+method on the stroboscopic map (:func:`grazing.orbits.find_orbit`) from the
+last sample for the orbit's Floquet multipliers.  Where there is no period or
+Newton's method fails, :attr:`PointReport.message` says so; the simulation is
+still shown.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from grazing.cli.common import multipliers_text
+from grazing.core.model import HybridModel
+from grazing.core.options import MAX_PERIOD
+from grazing.engine.simulate import simulate
+from grazing.errors import GrazingError
+from grazing.explore.diagram import Diagram, IsCancelled, View, checkpoint
+from grazing.orbits.shooting import PeriodicOrbit, find_orbit
+
+__all__ = ["INSPECT_SETTINGS", "InspectSettings", "PointReport", "inspect_click", "inspect_point"]
+
+
+@dataclass(frozen=True)
+class InspectSettings:
+    """How a clicked point is simulated.
+
+    Attributes
+    ----------
+    transient
+        Forcing periods run first from the diagram's state (it is on the attractor
+        already, but at a slightly different parameter).
+    periods
+        Forcing periods sampled to detect the period (twice the largest period detected).
+    points_per_period
+        Points per forcing period of the dense trajectory shown.
+    shown_periods
+        Forcing periods shown of a motion without a period.
+    """
+
+    transient: int = 200
+    periods: int = 2 * MAX_PERIOD
+    points_per_period: int = 200
+    shown_periods: int = 20
+
+
+INSPECT_SETTINGS = InspectSettings()
+"""The defaults of :class:`InspectSettings`."""
+
+
+@dataclass(frozen=True)
+class PointReport:
+    """What the explorer shows of a clicked point.
+
+    Attributes
+    ----------
+    values
+        The explored parameters at the point (model units), by name.
+    model
+        The model there.
+    x0
+        The state the simulation started from (at time 0).
+    period
+        The detected period in forcing periods (0: none <= 64).
+    impacts_per_period
+        Impacts in one period of the motion (per forcing period without a period),
+        in all and by stop.
+    samples
+        The stroboscopic samples (phase 0) of the detection run.
+    t, trajectory
+        The dense trajectory of one period of the motion (:attr:`shown_periods` forcing periods).
+    impact_t, impact_states, impact_stops
+        Its impacts: times, states just before, stop index.
+    orbit
+        The periodic orbit from Newton's method, or None.
+    orbit_guess
+        Where Newton's method started (the state at the end of the shown period, at time 0 mod
+        the forcing period), or None.
+    message
+        Why there is no orbit (no period, Newton's method failed), else "".
+    """
+
+    values: dict[str, float]
+    model: HybridModel
+    x0: np.ndarray
+    period: int
+    impacts_per_period: float
+    impacts_by_stop: dict[str, float]
+    samples: np.ndarray
+    shown_periods: int
+    t: np.ndarray
+    trajectory: np.ndarray
+    impact_t: np.ndarray
+    impact_states: np.ndarray
+    impact_stops: np.ndarray
+    orbit: PeriodicOrbit | None
+    message: str
+    orbit_guess: np.ndarray | None = None
+    settings: InspectSettings = INSPECT_SETTINGS
+
+    def summary(self) -> str:
+        """The point in a few lines of text (what the orbit panel says).
+
+        The first line is ``period 5 with 1 impact per period`` (by stop, for several stops).
+        """
+        shown = ", ".join(f"{self.model.parameter(n).show(v, '.6g')}" for n, v in self.values.items())
+        by_stop = ""
+        if len(self.impacts_by_stop) > 1:
+            by_stop = " (" + ", ".join(f"{k}: {_count(v)}" for k, v in self.impacts_by_stop.items()) + ")"
+        if self.period > 0:
+            k = self.impacts_per_period
+            first = f"period {self.period} with {_count(k)} impact{'s' * (k != 1)} per period{by_stop}"
+        else:
+            first = (
+                f"no period <= {MAX_PERIOD} in {self.samples.shape[0]} sampled forcing periods (chaotic, "
+                f"quasi-periodic or not settled); {_count(self.impacts_per_period)} impacts per forcing "
+                f"period{by_stop}"
+            )
+        lines = [first, shown]
+        if self.orbit is not None:
+            o = self.orbit
+            state = ", ".join(f"{n} = {x:.6g}" for n, x in zip(self.model.state_names, o.state))
+            lines += [
+                f"Newton: period-{o.period} orbit with {o.impacts} impact{'s' * (o.impacts != 1)}, "
+                f"{'stable' if o.stable else 'unstable'}, max |multiplier| = {o.abs_lambda:.4f}",
+                f"Floquet multipliers: {multipliers_text(o.multipliers)}",
+                f"state at time 0: {state}",
+            ]
+        if self.message:
+            lines.append(self.message)
+        return "\n".join(lines)
+
+
+def _count(v: float) -> str:
+    return f"{v:g}" if float(v).is_integer() else f"{v:.3g}"
+
+
+def inspect_point(
+    model: HybridModel,
+    values: dict[str, float],
+    x0: Sequence[float] | np.ndarray,
+    *,
+    settings: InspectSettings = INSPECT_SETTINGS,
+    cancelled: IsCancelled | None = None,
+) -> PointReport:
+    """Simulate ``model`` at the parameters ``values`` from ``x0``; its period, impacts and orbit.
+
+    Raises
+    ------
+    InvalidParameterError
+        A parameter value outside its interval.
+    SimulationError, InvalidStateError
+        The simulation failed (see :func:`grazing.simulate`).
+    SupersededError
+        ``cancelled()`` became true (looked at between the steps).
+
+    Examples
+    --------
+    >>> import math, grazing
+    >>> m = grazing.models.pendulum("B", theta_hat=math.radians(40))
+    >>> rep = inspect_point(m, {"eta": 0.446}, [0.0, 0.0], settings=InspectSettings(transient=500))
+    >>> print(rep.summary().splitlines()[0])
+    period 5 with 1 impact per period (stop: 1, back: 0)
+    """
+    here = model.with_params(**values)
+    x0 = np.array(x0, dtype=float)
+    s = settings
+    sol = simulate(here, x0, transient=s.transient, periods=s.periods, impacts="none")
+    period = sol.period()
+    checkpoint(cancelled)
+    shown = period if period > 0 else s.shown_periods
+    run = simulate(here, sol.x_final, t0=sol.t_final, periods=shown, trajectory=s.points_per_period)
+    per_stop = run.impacts.per_stop()
+    scale = 1.0 if period > 0 else 1.0 / shown
+    orbit, message = None, ""
+    if period > 0:
+        checkpoint(cancelled)
+        try:
+            orbit = find_orbit(here, run.x_final, period=period, t0=0.0)
+        except GrazingError as exc:
+            message = f"Newton's method on the period-{period} orbit failed: {exc}"
+    else:
+        message = "no periodic orbit to solve for: Newton's method not run"
+    return PointReport(
+        values={k: float(v) for k, v in values.items()},
+        model=here,
+        x0=x0,
+        period=period,
+        impacts_per_period=len(run.impacts) * scale,
+        impacts_by_stop={k: v * scale for k, v in per_stop.items()},
+        samples=sol.samples,
+        shown_periods=shown,
+        t=run.trajectory_t - sol.t_final,
+        trajectory=run.trajectory,
+        impact_t=run.impacts.t - sol.t_final,
+        impact_states=run.impacts.state,
+        impact_stops=run.impacts.stop,
+        orbit=orbit,
+        message=message,
+        orbit_guess=run.x_final.copy() if period > 0 else None,
+        settings=settings,
+    )
+
+
+def inspect_click(
+    diagram: Diagram,
+    values: Sequence[float],
+    *,
+    settings: InspectSettings = INSPECT_SETTINGS,
+    cancelled: IsCancelled | None = None,
+) -> PointReport:
+    """:func:`inspect_point` at a point of a diagram (model units, one value per explored parameter).
+
+    The simulation starts from the state the diagram reached at the nearest
+    point, so it shows the attractor the diagram shows there.
+
+    Raises
+    ------
+    InvalidParameterError
+        A point outside the computed range, or a value outside a parameter's interval.
+    """
+    view: View = diagram.view
+    if len(values) != len(view.axes):
+        raise ValueError(f"one value per explored parameter ({len(view.axes)}), got {len(values)}")
+    diagram.check_inside(values)
+    named = dict(zip(view.names, (float(v) for v in values)))
+    view.model.with_params(**named)  # (a value outside its interval: one line)
+    x0 = diagram.start_state(values)
+    return inspect_point(view.model, named, x0, settings=settings, cancelled=cancelled)

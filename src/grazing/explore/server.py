@@ -1,0 +1,108 @@
+"""Serve the explorer: a Bokeh server (through Panel) on 127.0.0.1, one :class:`~.app.Explorer` per page.
+
+:func:`serve` blocks until Ctrl-C (``KeyboardInterrupt``, which it lets pass after
+stopping the server and every page's background work: no thread or process is
+left behind).  The diagram of each page opened is computed for that page.
+"""
+
+from __future__ import annotations
+
+import errno
+import signal
+import socket
+from collections.abc import Callable
+
+from grazing.errors import GrazingError
+from grazing.explore.diagram import View
+
+__all__ = ["DEFAULT_ADDRESS", "DEFAULT_PORT", "PortInUseError", "serve"]
+
+DEFAULT_PORT = 5006
+"""The port ``grazing explore`` listens on (Bokeh's own default)."""
+
+DEFAULT_ADDRESS = "127.0.0.1"
+"""Where it listens: this machine only."""
+
+
+class PortInUseError(GrazingError):
+    """The port asked for is taken."""
+
+
+def check_port(address: str, port: int) -> int:
+    """The port to listen on: ``port``, or a free one for 0; :class:`PortInUseError` when it is taken."""
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        try:
+            s.bind((address, port))
+            return int(s.getsockname()[1])
+        except OSError as exc:
+            if exc.errno == errno.EADDRINUSE:
+                raise PortInUseError(
+                    f"port {port} is in use: give another with --port (0: any free port)"
+                ) from None
+            raise GrazingError(f"cannot listen on {address}:{port}: {exc.strerror or exc}") from None
+
+
+def serve(
+    view: View,
+    *,
+    port: int = DEFAULT_PORT,
+    address: str = DEFAULT_ADDRESS,
+    open_browser: bool = True,
+    ready: Callable[[str], None] | None = None,
+) -> None:
+    """Serve the explorer of ``view`` at ``http://address:port/`` until Ctrl-C (then ``KeyboardInterrupt``).
+
+    ``ready(url)`` is called once the server listens (``port`` 0: a free port
+    is chosen, and ``url`` says which); ``open_browser`` then opens the page.
+    Only pages served from that address and port may open the server's websocket.
+    """
+    import panel as pn
+
+    from grazing.explore.app import Explorer
+
+    port = check_port(address, port)
+    pages: list[Explorer] = []
+
+    def page() -> object:
+        explorer = Explorer(view)
+        pages.append(explorer)
+        pn.state.on_session_destroyed(lambda _ctx: explorer.close())
+        return explorer.panel
+
+    server = pn.serve(
+        {"/": page},
+        port=port,
+        address=address,
+        show=False,
+        start=False,
+        verbose=False,
+        title=f"grazing explore: {view.model.name}",
+        websocket_origin=[f"{address}:{port}", f"localhost:{port}"],
+    )
+    interrupted: list[int] = []
+    loop = server.io_loop
+
+    def on_sigint(signum: int, _frame: object) -> None:  # Ctrl-C: stop the loop, then say so
+        interrupted.append(signum)
+        loop.add_callback_from_signal(loop.stop)
+
+    previous = signal.signal(signal.SIGINT, on_sigint)  # (Panel's own handler would stop it silently)
+    try:
+        server.start()
+        url = f"http://{address}:{server.port}/"
+        if ready is not None:
+            ready(url)
+        if open_browser:
+            import webbrowser
+
+            webbrowser.open(url)
+        loop.start()
+    finally:
+        signal.signal(signal.SIGINT, previous)
+        for explorer in pages:
+            explorer.jobs.close(timeout=0)
+        server.stop()
+        for explorer in pages:
+            explorer.jobs.close(timeout=10)
+    if interrupted:
+        raise KeyboardInterrupt
