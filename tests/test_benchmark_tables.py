@@ -36,7 +36,7 @@ def test_the_saved_run_names_its_date_machine_and_vector_width(record):
     assert machine["cpu"] and machine["cores"] >= 1
     assert machine["vector_isa"] in ("AVX-512", "AVX2", "AVX", "SSE2", "unknown")
     assert machine["heyoka_simd_size"] >= 1 and machine["grazing_lanes"] >= 1
-    assert set(record["parts"]) == {"equal-work", "sweep", "simulate", "grazing-curve", "curves"}
+    assert set(record["parts"]) == {"equal-work", "sweep", "simulate", "grazing-curve", "curves", "scaling"}
 
 
 def test_every_timing_of_the_equal_work_comparison_is_a_median_with_its_spread(record):
