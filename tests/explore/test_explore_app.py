@@ -183,6 +183,38 @@ def test_zoomed_in_the_diagram_is_computed_again_there_and_clicks_use_it(page):
     assert page.refined.view.axes[0].lo == pytest.approx(0.446)
 
 
+class _MapZoom(_Zoom):
+    def __init__(self, x0, x1, y0, y1):
+        super().__init__(x0, x1)
+        self.y0, self.y1 = y0, y1
+
+
+def test_zoomed_in_a_period_map_is_computed_again_there_and_clicks_use_it():
+    model = grazing.models.pendulum("B")
+    view = View.of(model, {"eta": (0.43, 0.47), "theta_hat": (30, 50)}, num=4)
+    app = Explorer(view, deliver=lambda fn: fn())
+    try:
+        wait_until(lambda: app.diagram is not None)
+        app._on_ranges(_MapZoom(0.44, 0.47, 30, 50))  # (not zoomed in far enough: nothing computed)
+        assert app.refined is None and app.status.object.startswith("diagram:")
+        app._on_ranges(_MapZoom(0.44, 0.455, 30, 50))  # (eta narrower than half its range: refined)
+        wait_until(lambda: app.refined is not None)
+        a, b = app.refined.view.axes
+        assert (a.lo, a.hi, a.num) == (pytest.approx(0.44), pytest.approx(0.455), 4)
+        assert (b.lo, b.hi, b.num) == (pytest.approx(math.radians(30)), pytest.approx(math.radians(50)), 4)
+        assert app.status.object.startswith("refined: 4 x 4 cells over eta in [0.44, 0.455], ")
+        fine = app.figures.fine_image.data
+        assert fine["x"][0] < 0.44 < fine["x"][0] + fine["dw"][0] and fine["image"][0].shape == (4, 4)
+        assert app._diagram_for([0.446, math.radians(40)]) is app.refined
+        assert app._diagram_for([0.46, math.radians(40)]) is app.diagram
+        assert app.refined.period.shape == (4, 4) and (app.refined.period > 0).any()
+        app.click_values([0.446, 40])
+        wait_until(lambda: app.point is not None)
+        assert app.orbit.object.startswith("period 5 with 1 impact per period")
+    finally:
+        app.close()
+
+
 def test_on_a_period_map_the_clicked_orbit_s_bifurcation_curves_are_followed():
     """The period-5 window's period-doubling and grazings, followed in (eta, theta_hat)."""
     model = grazing.models.pendulum("B")

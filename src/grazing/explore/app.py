@@ -127,8 +127,7 @@ class Explorer:
 
         self.figures.diagram.on_event(Tap, self._on_tap)
         self.figures.diagram.on_event(DoubleTap, self._on_tap)  # (two quick clicks: the second is not a Tap)
-        if len(view.axes) == 1:
-            self.figures.diagram.on_event(RangesUpdate, self._on_ranges)
+        self.figures.diagram.on_event(RangesUpdate, self._on_ranges)
         self.panel = pn.Column(
             self.header,
             pn.Row(self.progress, self.status, sizing_mode="stretch_width"),
@@ -218,25 +217,40 @@ class Explorer:
         self.progress.visible = False
         self.status.object = f"**the diagram could not be computed:** {message_of(exc)}"
 
+    def _visible(self, i: int, a: float | None, b: float | None) -> tuple[float, float] | None:
+        """The visible part ``[lo, hi]`` (model units) of explored parameter ``i``, or None."""
+        if a is None or b is None:
+            return None
+        par, axis = self.view.parameter(i), self.view.axes[i]
+        lo = max(axis.lo, par.from_display(min(a, b)))
+        hi = min(axis.hi, par.from_display(max(a, b)))
+        return (lo, hi) if lo < hi else None
+
     def _on_ranges(self, event: Any) -> None:
-        """Zoomed in far enough: compute the diagram again over the visible range (same number of points)."""
-        if self.diagram is None or event.x0 is None or event.x1 is None:
+        """Zoomed in far enough: compute the diagram (or map) again over the visible range (as many
+        points or cells).  On a map, far enough in either parameter."""
+        if self.diagram is None:
             return
-        par, axis = self.view.parameter(0), self.view.axes[0]
-        lo = max(axis.lo, par.from_display(min(event.x0, event.x1)))
-        hi = min(axis.hi, par.from_display(max(event.x0, event.x1)))
-        if not lo < hi or (hi - lo) > REFINE_BELOW * (axis.hi - axis.lo):
+        ranges = [self._visible(0, event.x0, event.x1)]
+        if len(self.view.axes) == 2:
+            ranges.append(self._visible(1, getattr(event, "y0", None), getattr(event, "y1", None)))
+        if any(r is None for r in ranges):
             return
-        current = self.refined.view.axes[0] if self.refined is not None else None
-        if (
-            current is not None
-            and current.lo <= lo
-            and hi <= current.hi
-            and (hi - lo) > 0.5 * (current.hi - current.lo)
+        full = [a.hi - a.lo for a in self.view.axes]
+        if all((hi - lo) > REFINE_BELOW * w for (lo, hi), w in zip(ranges, full)):  # type: ignore[misc]
+            return
+        current = self.refined.view.axes if self.refined is not None else None
+        if current is not None and all(
+            c.lo <= lo and hi <= c.hi and (hi - lo) > 0.5 * (c.hi - c.lo)
+            for (lo, hi), c in zip(ranges, current)  # type: ignore[misc]
         ):
             return
-        zoomed = self.view.zoomed(lo, hi)
-        self.status.object = f"refining the diagram over {par.show_range(lo, hi, '.6g')} ..."
+        zoomed = self.view.zoomed(*[v for r in ranges for v in r])  # type: ignore[union-attr]
+        shown = ", ".join(
+            self.view.parameter(i).show_range(lo, hi, ".6g")
+            for i, (lo, hi) in enumerate(ranges)  # type: ignore[misc]
+        )
+        self.status.object = f"refining the diagram over {shown} ..."
 
         def work(cancelled: Callable[[], bool]) -> Diagram:
             return compute_diagram(zoomed, cancelled=cancelled)
@@ -245,11 +259,10 @@ class Explorer:
 
     def _refined_done(self, diagram: Diagram) -> None:
         self.figures.show_refined(diagram)
-        par = self.view.parameter(0)
-        a = diagram.view.axes[0]
-        self.status.object = (
-            f"refined: {a.num} points over {par.show_range(a.lo, a.hi, '.6g')} in {diagram.elapsed:.1f} s"
-        )
+        axes = diagram.view.axes
+        count = " x ".join(str(a.num) for a in axes) + (" points" if len(axes) == 1 else " cells")
+        shown = ", ".join(self.view.parameter(i).show_range(a.lo, a.hi, ".6g") for i, a in enumerate(axes))
+        self.status.object = f"refined: {count} over {shown} in {diagram.elapsed:.1f} s"
         self.refined = diagram  # (last: clicks use it from now on)
 
     # -- a click ------------------------------------------------------------------------------
@@ -283,7 +296,7 @@ class Explorer:
         """The finest computed diagram containing the point (the refined one when zoomed)."""
         assert self.diagram is not None
         r = self.refined
-        if r is not None and r.view.axes[0].contains(values[0]):
+        if r is not None and all(a.contains(v) for a, v in zip(r.view.axes, values)):
             return r
         return self.diagram
 

@@ -182,10 +182,15 @@ class View:
     def names(self) -> tuple[str, ...]:
         return tuple(a.name for a in self.axes)
 
-    def zoomed(self, lo: float, hi: float) -> View:
-        """The same view with the first parameter over ``[lo, hi]`` (model units), as many points."""
+    def zoomed(self, lo: float, hi: float, lo2: float | None = None, hi2: float | None = None) -> View:
+        """The same view with the first parameter over ``[lo, hi]`` (model units), as many points;
+        on a map also the second over ``[lo2, hi2]`` (given)."""
         a = self.axes[0]
-        return dataclasses.replace(self, axes=(Axis(a.name, lo, hi, a.num), *self.axes[1:]))
+        axes = [Axis(a.name, lo, hi, a.num), *self.axes[1:]]
+        if lo2 is not None and hi2 is not None and len(axes) == 2:
+            b = self.axes[1]
+            axes[1] = Axis(b.name, lo2, hi2, b.num)
+        return dataclasses.replace(self, axes=tuple(axes))
 
     def at(self, values: Sequence[float]) -> HybridModel:
         """The model at the explored parameters' ``values`` (model units), each checked."""

@@ -201,9 +201,13 @@ class Figures:
             r = self.diagram.image(
                 "image", x="x", y="y", dw="dw", dh="dh", source=self.image, color_mapper=mapper
             )
+            self.fine_image = ColumnDataSource({"image": [], "x": [], "y": [], "dw": [], "dh": []})
+            fine = self.diagram.image(  # (a zoomed-in map, drawn over the coarse one where it is)
+                "image", x="x", y="y", dw="dw", dh="dh", source=self.fine_image, color_mapper=mapper
+            )
             self.diagram.add_tools(
                 HoverTool(
-                    renderers=[r],
+                    renderers=[r, fine],
                     tooltips=[
                         (par.label, "$x{0.000000}"),
                         (pb.label, "$y{0.000000}"),
@@ -357,7 +361,11 @@ class Figures:
         self.basins.visible = True
 
     def show_refined(self, refined: Diagram) -> None:
-        """A zoomed-in diagram: its points replace the coarse ones over its range."""
+        """A zoomed-in diagram: its points replace the coarse ones over its range; a zoomed-in map
+        is drawn over the coarse one."""
+        if len(refined.view.axes) == 2:
+            self.fine_image.data = map_image(refined)
+            return
         coarse = self.points.data
         a = refined.view.axes[0]
         par = self.view.parameter(0)
