@@ -336,16 +336,20 @@ def _png_chunk(kind: bytes, payload: bytes) -> bytes:
     return struct.pack(">I", len(payload)) + kind + payload + struct.pack(">I", zlib.crc32(kind + payload))
 
 
-def mark_png(data: bytes) -> bytes:
-    """A PNG file's bytes with grazing's mark (a ``Software`` text chunk right after the header)."""
-    chunks = [c for c in _png_chunks(data) if not _is_png_mark(*c)]
-    text = f"{PNG_MARK_KEY}\0{mark_text('the image', _png_digest(chunks))}".encode("latin-1")
+def _with_text(chunks: list[tuple[bytes, bytes]], key: str, text: str) -> bytes:
+    """The PNG file of ``chunks`` with a text chunk ``key`` right after the header."""
     out = [PNG_SIGNATURE]
     for kind, payload in chunks:
         out.append(_png_chunk(kind, payload))
         if kind == b"IHDR":
-            out.append(_png_chunk(b"tEXt", text))
+            out.append(_png_chunk(b"tEXt", f"{key}\0{text}".encode("latin-1")))
     return b"".join(out)
+
+
+def mark_png(data: bytes) -> bytes:
+    """A PNG file's bytes with grazing's mark (a ``Software`` text chunk right after the header)."""
+    chunks = [c for c in _png_chunks(data) if not _is_png_mark(*c)]
+    return _with_text(chunks, PNG_MARK_KEY, mark_text("the image", _png_digest(chunks)))
 
 
 def _png_is_ours(data: bytes) -> bool:
@@ -381,12 +385,7 @@ def add_png_text(data: bytes, key: str, text: str) -> bytes:
     """
     same_key = key.encode("latin-1") + b"\0"
     chunks = [(k, p) for k, p in _png_chunks(data) if not (k == b"tEXt" and p.startswith(same_key))]
-    out = [PNG_SIGNATURE]
-    for kind, payload in chunks:
-        out.append(_png_chunk(kind, payload))
-        if kind == b"IHDR":
-            out.append(_png_chunk(b"tEXt", key.encode("latin-1") + b"\0" + text.encode("latin-1")))
-    return b"".join(out)
+    return _with_text(chunks, key, text)
 
 
 def png_text(data: bytes, key: str) -> str | None:
