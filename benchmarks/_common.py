@@ -17,6 +17,12 @@ from dataclasses import dataclass
 from importlib.metadata import PackageNotFoundError, version
 from typing import Any
 
+EQUAL_WORK_TOL = 1e-10
+"""The tolerance of the equal-work sweep (grazing's sweep tolerance; the heyoka peer's too)."""
+
+EQUAL_WORK = ["--fresh", "--no-lyapunov", "--no-adaptive", "--tol", str(EQUAL_WORK_TOL)]
+"""grazing's options for the peer's work: every point from rest, full transients, no Lyapunov exponents."""
+
 PACKAGES = ("numpy", "scipy", "numba", "llvmlite", "heyoka", "grazing")
 VECTOR_ISAS = (("avx512f", "AVX-512", 8), ("avx2", "AVX2", 4), ("avx", "AVX", 4), ("sse2", "SSE2", 2))
 """(/proc/cpuinfo flag, name, doubles per register), widest first."""

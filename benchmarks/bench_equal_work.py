@@ -42,18 +42,28 @@ import numpy as np
 
 import grazing
 import heyoka_batch_sweep as peer
-from _common import Meter, Spread, bench_parser, emit, loadavg, log, machine_info, versions_line, wait_quiet
+from _common import (
+    EQUAL_WORK,
+    EQUAL_WORK_TOL,
+    Meter,
+    Spread,
+    bench_parser,
+    emit,
+    loadavg,
+    log,
+    machine_info,
+    versions_line,
+    wait_quiet,
+)
 from grazing.sweeps import sweep
 
 ETA_START, ETA_STOP = 0.44, 0.49
 N_POINTS, QUICK_POINTS = 1000, 200
-TRANSIENT, PERIODS, TOL = 500, 100, 1e-10
+TRANSIENT, PERIODS, TOL = 500, 100, EQUAL_WORK_TOL
 LANES = (4, 8, 16)
 REPEATS = 5
 QUIET_WAIT = 10.0
 PEER = Path(__file__).with_name("heyoka_batch_sweep.py")
-EQUAL_WORK = ["--fresh", "--no-lyapunov", "--no-adaptive", "--tol", str(TOL)]
-"""grazing's options for the peer's work: every point from rest, full transients, no Lyapunov exponents."""
 
 
 def grazing_exe() -> str:

@@ -40,10 +40,7 @@ from pathlib import Path
 from typing import Any
 
 sys.path.insert(0, os.path.dirname(__file__))
-from _common import bench_parser, emit, loadavg, log, machine_info
-
-EQUAL_WORK = ["--fresh", "--no-lyapunov", "--no-adaptive", "--tol", "1e-10"]
-"""The options of the equal-work sweep (as in bench_sweep.py's heyoka comparison)."""
+from _common import EQUAL_WORK, EQUAL_WORK_TOL, bench_parser, emit, loadavg, log, machine_info
 
 CORES = (2, 4, 8, 16, 32, 64)
 """Core counts of the projection."""
@@ -191,7 +188,7 @@ def dask_against_threads(points: int, runs: int) -> dict[str, Any]:
     ncores = os.cpu_count() or 1
     model = grazing.models.pendulum("B")
     values = np.linspace(0.44, 0.49, points)
-    settings = SweepSettings(fresh=True, lyapunov=False, adaptive=False, tol=1e-10)
+    settings = SweepSettings(fresh=True, lyapunov=False, adaptive=False, tol=EQUAL_WORK_TOL)  # (EQUAL_WORK)
     log(f"Dask against threads, {points} points: {ncores} one-thread workers, {runs} interleaved runs")
     with LocalCluster(n_workers=ncores, threads_per_worker=1, dashboard_address=None) as cluster:
         with Client(cluster) as client:
