@@ -11,22 +11,38 @@ the chain's, chunk by chunk:
   chain; a chunk after a failed point, from where the chain starts again) is
   the chain's, bit for bit;
 - otherwise its first point is run again from the previous chunk's final
-  state (one point: a *check*); when both end on the same periodic orbit, at
-  the same point of it (samples and final state equal to
-  :data:`~grazing.core.options.CHAIN_TOL`), or fail alike, the chunk is
-  kept: from its first point on it is the chain's to that tolerance;
-- otherwise (another attractor: the hysteresis the guess misses; an
-  aperiodic point, which no tolerance makes equal) the chunk is run again
-  from that final state, so it is the chain's, and the chunks after it are
-  checked against its new end.
+  state (one point: a *check*); when both runs end alike (:func:`same_outcome`),
+  the chunk is kept: from its first point on it is the chain's.  Alike is:
+  on one periodic orbit at the same point of it (samples and final state
+  equal to :data:`~grazing.core.options.CHAIN_TOL`); both aperiodic on one
+  attractor (their samples share a cell of a grid of
+  :data:`~grazing.core.options.CHAIN_CELLS` cells along their joint box, as
+  the basins' classifier groups aperiodic end states:
+  :func:`grazing.core.cells.one_attractor`); or failed alike;
+- otherwise (another attractor: the hysteresis the guess misses, periodic
+  against aperiodic, disjoint chaotic sets; another point of one periodic
+  orbit) the chunk is run again from that final state, so it is the chain's,
+  and the chunks after it are checked against its new end.
+
+Why the attractor, not the samples, at an aperiodic point: on a chaotic
+attractor the chain's samples are not reproducible anyway.  Any rounding
+difference (another processor, fused multiply-adds, another lane width)
+moves them after a few periods, and with them what the chain lands on after
+the chaos where attractors coexist (a relative change of 1e-15 in the
+pendulum's state entering a chaotic band at 40 deg moves its samples by the
+band's size and lands it on a period-6 orbit instead of a period-3 one a few
+points later).  Only the attractor is reproducible, so "the chain's answer"
+at an aperiodic point means the chain's attractor.  Periodic points keep
+their guarantee: the same orbit, at the same point of it.
 
 A chunk is *settled* once it and every chunk before it in its chain are the
 chain's; then it is written to the store.  The checks and the runs of a
 round are computed together on the lanes, so a sweep whose chunks agree
-costs one point per chunk more than the chunks; a sweep through chaos, where
-no chunk can be kept, costs a chain's time.  A store holds settled chunks
-only: resumed, a chunk continues from the final state stored for the chunk
-before it.
+costs one point per chunk more than the chunks; what is left of a chain's
+time is the chunks run again, one after the other (in a periodic window a
+guess ends at a random point of the orbit: of period p, the chain's point
+one time in p).  A store holds settled chunks only: resumed, a chunk
+continues from the final state stored for the chunk before it.
 """
 
 from __future__ import annotations
@@ -38,7 +54,8 @@ from typing import Any
 
 import numpy as np
 
-from grazing.core.options import CHAIN_TOL
+from grazing.core.cells import one_attractor
+from grazing.core.options import CHAIN_CELLS, CHAIN_TOL
 from grazing.core.solution import Status
 from grazing.sweeps.spec import ChunkResult, SweepSpec
 
@@ -93,13 +110,17 @@ def from_start(spec: SweepSpec, index: int, start: ChainStart, points: int | Non
 def same_outcome(a: ChunkResult, i: int, b: ChunkResult, j: int, tol: float = CHAIN_TOL) -> bool:
     """Whether point ``i`` of ``a`` and point ``j`` of ``b`` end alike: the chain goes on the same from both.
 
-    Both failed for the same reason, or both on one periodic orbit at one point of it: the same
-    period, samples and final state equal to ``tol``.
+    Both failed for the same reason; or both on one periodic orbit at one point of it: the same
+    period, samples and final state equal to ``tol``; or both aperiodic on one attractor: their
+    samples share a cell of the grid of :data:`~grazing.core.options.CHAIN_CELLS` cells along their
+    joint box (:func:`~grazing.core.cells.one_attractor`, the basins' rule).
     """
     sa, sb = int(a.status[i]), int(b.status[j])
     if sa != Status.OK or sb != Status.OK:
         return sa == sb
     p = int(a.period[i])
+    if p <= 0 and int(b.period[j]) <= 0:
+        return one_attractor(a.samples[i], b.samples[j], CHAIN_CELLS)
     if p <= 0 or p != int(b.period[j]):
         return False
     close = np.max(np.abs(a.samples[i] - b.samples[j])) <= tol
@@ -132,17 +153,29 @@ class _Chunk:
 
     line: int
     index: int
-    result: ChunkResult | None = None
-    start: Any = _UNSET  # the start its result was computed from
-    passed: list[Any] = field(default_factory=list)  # starts its first point was checked against and agreed
-    failed: dict[Any, bool] = field(default_factory=dict)  # ... disagreed: start -> the check ended periodic
+    guess: ChunkResult | None = None  # computed from x0 at time 0
+    result: ChunkResult | None = None  # what the chain goes on from: the guess, or the run from ``start``
+    start: Any = _UNSET  # the start ``result`` was computed from (None: the guess)
+    passed: list[Any] = field(default_factory=list)  # starts the guess's first point agreed with (checked)
+    failed: dict[Any, bool] = field(default_factory=dict)  # ... disagreed with: start -> the check ended OK
     settled: bool = False
 
+    def keep_guess(self, start: Any) -> None:
+        """Its guess's first point ends alike from ``start``: from there, the guess is the chain's."""
+        self.passed.append(start)
+        self.result, self.start = self.guess, None
+
+    def take_run(self, start: Any, res: ChunkResult) -> None:
+        """``res``, computed from ``start``, is what the chain goes on from (it is the chain's from there)."""
+        self.result, self.start = res, start
+        if start is None:
+            self.guess = res
+
     @property
-    def aperiodic(self) -> bool:
-        """Whether its first point ended on no periodic orbit (no check can agree with it)."""
-        res = self.result
-        return res is not None and int(res.status[0]) == Status.OK and int(res.period[0]) <= 0
+    def unlike_its_chain(self) -> bool:
+        """Whether its guess's first point was checked and never agreed (a run from its chain's start is
+        likely to be needed: the guess is on another attractor than the chain's)."""
+        return bool(self.failed) and not self.passed
 
 
 @dataclass
@@ -157,12 +190,14 @@ class _Round:
 
     def ask(self, c: _Chunk, what: str, start: Any, extend: bool = False) -> None:
         """Check ``c``'s first point from ``start``, or run ``c`` from there; ``extend``-ed, with the chunks
-        after it that only a run from the chain's start can settle (their first point aperiodic), as one
-        job (the same numbers as runs of each from the end of the one before)."""
+        after it whose guess disagreed with every start it was checked against, as one job (the same
+        numbers as runs of each from the end of the one before; each of them is also its check)."""
         group = [c]
         while extend:
             nxt = self.active.get((c.line, group[-1].index + 1))
-            if nxt is None or nxt.result is None or nxt.settled or not nxt.aperiodic:
+            if nxt is None or nxt.guess is None or nxt.settled or not nxt.unlike_its_chain:
+                break
+            if (nxt.line, nxt.index) in self.claimed:
                 break
             group.append(nxt)
         self.claimed.update((g.line, g.index) for g in group)
@@ -173,6 +208,28 @@ class _Round:
             points = spec.chunk(group[-1].index).stop - spec.chunk(c.index).start
             self.parts.append(from_start(spec, c.index, start, points if len(group) > 1 else None))
         self.jobs.append((group, what, start))
+
+    def take(self, results: Sequence[ChunkResult]) -> None:
+        """Record the results of the round's jobs (``results[k]`` of ``jobs[k]``) in their chunks."""
+        for (group, what, start), res in zip(self.jobs, results):
+            c = group[0]
+            if what == "check":
+                if same_outcome(c.guess, 0, res, 0):
+                    c.keep_guess(start)
+                else:
+                    c.failed[start] = int(res.status[0]) == Status.OK
+                continue
+            spec = self.lines[c.line].spec  # (a run: a part of its own, of index 0; its result the chunks')
+            pieces = split_result(spec, res, [g.index for g in group])
+            for n, (g, piece) in enumerate(zip(group, pieces)):
+                if n > 0:  # (a chunk run on from the one before: its first point is its check from there)
+                    if same_outcome(g.guess, 0, piece, 0):
+                        g.keep_guess(start)
+                        break  # (the chunks after it went on from the run's end, not the guess's)
+                    g.failed[start] = int(piece.status[0]) == Status.OK
+                g.take_run(start, piece)
+                if n + 1 < len(group):  # (the next one started where this one ended)
+                    start = next_start(spec, piece, g.index)
 
 
 @dataclass
@@ -199,17 +256,18 @@ def settle(
 
     In each round, a chunk whose chain's start is final (the chunk before it
     settled) is settled when its result started there or its check there
-    agreed; else it is checked there, or run again there when its first point
-    is aperiodic or its check disagreed.  A chunk whose chain's start may still
-    change is checked there, and run again there only when the check ended on
-    another periodic orbit (hysteresis: likely to stay so); an aperiodic one
-    waits for the start to be final.
+    agreed; else it is checked there, or run again there when its check
+    disagreed (with the chunks after it whose guesses disagreed with every
+    start they were checked against, as one job: the first point of each is
+    its check from there).  A chunk whose chain's start may still change is
+    checked there, and run again there when the check ended on another
+    attractor (hysteresis: likely to stay so).
 
     Every chunk is computed first from ``x0`` at time 0 (the guess), whatever
     is known of its chain's start: its result is then a function of that
-    guess and the final start alone (the guess's when it started there or its
-    check there agrees, else the run from there), so the results are the same
-    whatever the window, the rounds, the threads or an interruption.
+    guess and the final start alone (the guess when its check from there
+    agrees, else the run from there), so the results are the same whatever
+    the window, the rounds, the threads or an interruption.
     """
     waiting = iter([_Chunk(k, i) for k, line in enumerate(lines) for i in line.todo])
     pending = sum(len(line.todo) for line in lines)
@@ -237,13 +295,11 @@ def settle(
             if start is _UNSET or c.start == start or start in c.passed:
                 continue
             if final:
-                if c.aperiodic or start in c.failed:
-                    work.ask(c, "run", start, extend=True)
-                else:
-                    work.ask(c, "check", start)
+                rerun = start in c.failed
+                work.ask(c, "run" if rerun else "check", start, extend=rerun)
             elif c.failed.get(start, False):
-                work.ask(c, "run", start)
-            elif not c.aperiodic and start not in c.failed:
+                work.ask(c, "run", start, extend=True)
+            elif start not in c.failed:
                 work.ask(c, "check", start)
         while len(active) < window:  # new chunks, from x0 (see above: whatever the window, the same results)
             c = next(waiting, None)
@@ -256,19 +312,7 @@ def settle(
             results: dict[int, ChunkResult] = {}
             for part, res in compute(work.parts):
                 results[position[id(part)]] = res
-            for k, (group, what, start) in enumerate(work.jobs):
-                res, c = results[k], group[0]
-                if what == "run":  # (a part of its own, of index 0: its result is the chunks')
-                    spec = lines[c.line].spec
-                    pieces = split_result(spec, res, [g.index for g in group])
-                    for n, (g, piece) in enumerate(zip(group, pieces)):
-                        g.result, g.start, g.passed, g.failed = piece, start, [], {}
-                        if n + 1 < len(group):  # (the next one started where this one ended)
-                            start = next_start(spec, piece, g.index)
-                elif c.result is not None and same_outcome(c.result, 0, res, 0):
-                    c.passed.append(start)
-                else:
-                    c.failed[start] = int(res.status[0]) == Status.OK and int(res.period[0]) > 0
+            work.take([results[k] for k in range(len(work.parts))])
         progressed = False
         for key in sorted(active):
             c = active[key]
@@ -277,7 +321,7 @@ def settle(
             final, start = chain_start(c)
             if final and (c.start == start or start in c.passed):
                 c.settled = True
-                on_settled(c.line, c.result)
+                on_settled(c.line, c.result if c.start == start else c.guess)
                 del active[key]
                 pending -= 1
                 progressed = True
