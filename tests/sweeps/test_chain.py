@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from grazing.core.cells import one_attractor
-from grazing.core.options import CHAIN_CELLS, CHAIN_TOL
+from grazing.core.options import CHAIN_CELLS, CHAIN_SHIFTS, CHAIN_TOL
 from grazing.models import pendulum, two_sided_oscillator
 from grazing.sweeps import run_sweep, run_sweeps, sweep
 from grazing.sweeps.chain import ChainLine, same_outcome, settle
@@ -220,11 +220,14 @@ def chunked_spec(model, param, values, chunk_size, **settings):
 
 def runs_of(spec, parts_log):
     """The parts of ``parts_log`` by kind: guesses (chunks of ``spec`` from x0), checks (one point from a
-    chain's start) and runs from a chain's start."""
+    chain's start), shifts (a chunk from a point of its guess's orbit) and runs from a chain's start."""
     guesses = [(p, r) for p, r in parts_log if p[0] is spec]
+    orbits = {tuple(map(float, x)) for _, r in guesses for x in r.samples[0]}
     checks = [(p, r) for p, r in parts_log if p[0] is not spec and len(p[0].points) == 1]
-    runs = [(p, r) for p, r in parts_log if p[0] is not spec and len(p[0].points) > 1]
-    return guesses, checks, runs
+    longer = [(p, r) for p, r in parts_log if p[0] is not spec and len(p[0].points) > 1]
+    shifts = [(p, r) for p, r in longer if p[0].resume[1] in orbits]
+    runs = [(p, r) for p, r in longer if p[0].resume[1] not in orbits]
+    return guesses, checks, shifts, runs
 
 
 BANDS = {  # chaotic bands: every point of the chain aperiodic, with a positive Lyapunov exponent
@@ -246,8 +249,8 @@ def test_a_chaotic_band_chunked_is_on_the_chains_attractor_at_every_point(name):
         assert int(chunked.period.values[i]) <= 0
         assert one_attractor(chain.samples.values[i], chunked.samples.values[i], CHAIN_CELLS), i
     # not a chain run point after point: every chunk from its guess, checked once, none run again
-    guesses, checks, runs = runs_of(spec, log)
-    assert len(guesses) == spec.n_chunks and len(checks) == spec.n_chunks - 1 and runs == []
+    guesses, checks, shifts, runs = runs_of(spec, log)
+    assert len(guesses) == spec.n_chunks and len(checks) == spec.n_chunks - 1 and shifts == runs == []
     # (and its samples are not the chain's: the chain check did not compare them)
     assert np.abs(chunked.samples.values[4:] - chain.samples.values[4:]).max() > 1e-2
 
@@ -264,7 +267,7 @@ def test_a_chaotic_guess_where_the_chain_is_periodic_is_run_again():
     chunked = settled(spec, log)
     assert_same_chain(chain, chunked)
     np.testing.assert_array_equal(chunked.period.values, chain.period.values)
-    runs = runs_of(spec, log)[2]
+    runs = runs_of(spec, log)[3]
     again = {point for p, _ in runs for point in p[0].points}
     assert set(spec.points[8:16]) <= again  # (the chunks from eta[8] and eta[12]: checks ended periodic)
 
@@ -295,18 +298,22 @@ def test_the_default_sweep_through_chaos_computes_its_points_about_once():
     spec = chunked_spec(M40, "eta", values, 20)
     log: list = []
     ds = settled(spec, log)
-    guesses, checks, runs = runs_of(spec, log)
+    guesses, checks, shifts, runs = runs_of(spec, log)
     firsts = {spec.points[spec.chunk(i).start]: i for i in range(spec.n_chunks)}
+    guess_of = {p[1]: r for p, r in guesses}
     aperiodic_firsts = [i for i in range(spec.n_chunks) if ds.period.values[spec.chunk(i).start] <= 0]
     assert len(aperiodic_firsts) >= 2  # (the chunks from eta[40] and eta[80])
-    assert len(guesses) == spec.n_chunks and len(checks) <= spec.n_chunks - 1 + len(runs)
-    for part, res in runs:  # run again only where a check found another orbit or another point of one
-        i = firsts[part[0].points[0]]
-        guess = next(r for p, r in guesses if p[1] == i)
-        assert int(guess.period[0]) > 0 or int(res.period[0]) > 0, i
+    assert len(guesses) == spec.n_chunks
+    for part, res in runs:  # run again only where a check found another attractor than the guess's
+        guess = guess_of[firsts[part[0].points[0]]]
+        assert int(guess.period[0]) != int(res.period[0]) or int(res.period[0]) > 0
+    shifted = [firsts[part[0].points[0]] for part, _ in shifts]
+    for i in set(shifted):  # from each point of a periodic guess's orbit
+        assert shifted.count(i) == int(guess_of[i].period[0]) in range(2, CHAIN_SHIFTS + 1)
     points = sum(len(p[0].points) if p[0] is not spec else 20 for p, _ in log)
-    assert points == 200 + len(checks) + sum(len(p[0].points) for p, _ in runs)
-    assert points <= 200 + 2 * len(checks) + 40
+    assert points == 200 + len(checks) + sum(len(p[0].points) for p, _ in shifts + runs)
+    # none run again from its chain's start, one after the other: every round after the shifts is checks
+    assert runs == [] and len(checks) <= 3 * spec.n_chunks
 
 
 def test_a_chain_through_chaos_is_not_reproducible():
@@ -335,3 +342,20 @@ def test_a_chain_through_chaos_is_not_reproducible():
         other_period = ds.period.values != chain.period.values[after]
         moved_later += bool((periodic & (gap > 1e-3)).any() or other_period.any())
     assert moved_later >= 1  # (measured: 4 of these 6 land at another point of the period-2 orbit after it)
+
+
+@pytest.mark.parametrize(("window", "period"), [(slice(62, 86), 3), (slice(130, 170), 2)])
+def test_a_guess_at_another_point_of_the_chains_orbit_is_kept_shifted(window, period):
+    # In a periodic window the guesses from rest end at any point of the orbit, the chain's one time in p:
+    # each such chunk is computed from every point of its guess's orbit (in parallel, from the guess alone)
+    # and the one whose first point ends as the chain's is kept; none is run again after the one before.
+    values = PENDULUM_ETAS[window]
+    chain = sweep(M40, "eta", values, chunk_size=0, workers=2)
+    assert (chain.period.values == period).all()
+    spec = chunked_spec(M40, "eta", values, 4)
+    log: list = []
+    chunked = settled(spec, log)
+    _guesses, _checks, shifts, runs = runs_of(spec, log)
+    assert shifts and not runs
+    np.testing.assert_array_equal(chunked.period.values, chain.period.values)
+    assert np.abs(chunked.samples.values - chain.samples.values).max() <= 10 * CHAIN_TOL

@@ -87,6 +87,12 @@ extent are told apart.  Two runs on one chaotic attractor share tens of cells (t
 40 deg, 100 samples each: 14 or more); too few samples to share one make the check fail, and the chunk
 is run again: a slower answer, not another one."""
 
+CHAIN_SHIFTS = 8
+"""A chunk of a sweep whose guess's first point ends on a periodic orbit of period 2 to this, and from
+the chain's state on that orbit at another point of it, is computed from each point of the orbit (in
+parallel, from the guess alone); the one that ends its first point as the chain's state does is kept
+(a guess ends at the chain's point of a period-p orbit only one time in p)."""
+
 CHAOS_THRESHOLD = 1e-3
 """Largest Lyapunov exponent (per unit time) above which an aperiodic run counts as chaotic; within
 it of zero, quasi-periodic."""

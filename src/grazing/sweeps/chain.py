@@ -19,10 +19,16 @@ the chain's, chunk by chunk:
   :data:`~grazing.core.options.CHAIN_CELLS` cells along their joint box, as
   the basins' classifier groups aperiodic end states:
   :func:`grazing.core.cells.one_attractor`); or failed alike;
+- when both end on one periodic orbit (of period 2 to
+  :data:`~grazing.core.options.CHAIN_SHIFTS`) at different points of it (a
+  guess ends at the chain's point of a period-p orbit one time in p), the
+  chunk is computed from each point of its guess's orbit (its *shifts*: from
+  the guess alone, so in parallel, before the chain reaches it) and the one
+  whose first point ends as the check does is kept;
 - otherwise (another attractor: the hysteresis the guess misses, periodic
-  against aperiodic, disjoint chaotic sets; another point of one periodic
-  orbit) the chunk is run again from that final state, so it is the chain's,
-  and the chunks after it are checked against its new end.
+  against aperiodic, disjoint chaotic sets) the chunk is run again from that
+  final state, so it is the chain's, and the chunks after it are checked
+  against its new end.
 
 Why the attractor, not the samples, at an aperiodic point: on a chaotic
 attractor the chain's samples are not reproducible anyway.  Any rounding
@@ -36,12 +42,11 @@ at an aperiodic point means the chain's attractor.  Periodic points keep
 their guarantee: the same orbit, at the same point of it.
 
 A chunk is *settled* once it and every chunk before it in its chain are the
-chain's; then it is written to the store.  The checks and the runs of a
+chain's; then it is written to the store.  The checks, shifts and runs of a
 round are computed together on the lanes, so a sweep whose chunks agree
 costs one point per chunk more than the chunks; what is left of a chain's
-time is the chunks run again, one after the other (in a periodic window a
-guess ends at a random point of the orbit: of period p, the chain's point
-one time in p).  A store holds settled chunks only: resumed, a chunk
+time is the chunks run again, one after the other, where the guesses miss
+the chain's attractor.  A store holds settled chunks only: resumed, a chunk
 continues from the final state stored for the chunk before it.
 """
 
@@ -55,7 +60,7 @@ from typing import Any
 import numpy as np
 
 from grazing.core.cells import one_attractor
-from grazing.core.options import CHAIN_CELLS, CHAIN_TOL
+from grazing.core.options import CHAIN_CELLS, CHAIN_SHIFTS, CHAIN_TOL
 from grazing.core.solution import Status
 from grazing.sweeps.spec import ChunkResult, SweepSpec
 
@@ -154,28 +159,66 @@ class _Chunk:
     line: int
     index: int
     guess: ChunkResult | None = None  # computed from x0 at time 0
-    result: ChunkResult | None = None  # what the chain goes on from: the guess, or the run from ``start``
-    start: Any = _UNSET  # the start ``result`` was computed from (None: the guess)
-    passed: list[Any] = field(default_factory=list)  # starts the guess's first point agreed with (checked)
-    failed: dict[Any, bool] = field(default_factory=dict)  # ... disagreed with: start -> the check ended OK
+    result: ChunkResult | None = None  # what the chain goes on from, from ``start``
+    start: Any = _UNSET  # the start ``result`` stands for (None: the guess's own, x0 at time 0)
+    checks: dict[Any, ChunkResult] = field(default_factory=dict)  # its first point run from each start
+    shifts: list[ChunkResult] | None = None  # the guess from each point of its orbit (:func:`shifted_starts`)
+    kept: dict[Any, ChunkResult | None] = field(default_factory=dict)  # start -> the candidate kept there
+    shifting: bool = False  # (its shifts asked)
     settled: bool = False
 
-    def keep_guess(self, start: Any) -> None:
-        """Its guess's first point ends alike from ``start``: from there, the guess is the chain's."""
-        self.passed.append(start)
-        self.result, self.start = self.guess, None
+    def candidates(self) -> list[ChunkResult]:
+        """The results it may keep where its check ends on its guess's orbit: the guess, then its shifts."""
+        assert self.guess is not None
+        return [self.guess, *(self.shifts or [])]  # (not needed when the guess agrees: see verdict)
+
+    def verdict(self, start: Any, spec: SweepSpec) -> str:
+        """From ``start``: ``"keep"`` (``kept[start]`` is the chain's), ``"check"`` (its first point from
+        there is not known), ``"shift"`` (the guess's shifts are needed to decide) or ``"run"``."""
+        if start in self.kept:
+            return "keep" if self.kept[start] is not None else "run"
+        check = self.checks.get(start)
+        if check is None:
+            return "check"
+        p = orbit_period(spec, self.guess)
+        on_its_orbit = p > 0 and int(check.status[0]) == Status.OK and int(check.period[0]) == p
+        if on_its_orbit and self.shifts is None and not same_outcome(self.guess, 0, check, 0):
+            return "shift"
+        candidates = self.candidates() if on_its_orbit else [self.guess]  # (whatever was computed)
+        self.kept[start] = next((r for r in candidates if same_outcome(r, 0, check, 0)), None)
+        return self.verdict(start, spec)
 
     def take_run(self, start: Any, res: ChunkResult) -> None:
         """``res``, computed from ``start``, is what the chain goes on from (it is the chain's from there)."""
         self.result, self.start = res, start
+        self.kept[start] = None if start is not None else res
         if start is None:
             self.guess = res
 
     @property
     def unlike_its_chain(self) -> bool:
-        """Whether its guess's first point was checked and never agreed (a run from its chain's start is
+        """Whether its first point was checked and no candidate agreed (a run from its chain's start is
         likely to be needed: the guess is on another attractor than the chain's)."""
-        return bool(self.failed) and not self.passed
+        return bool(self.kept) and all(v is None for v in self.kept.values())
+
+
+def orbit_period(spec: SweepSpec, res: ChunkResult | None) -> int:
+    """The period of the orbit the first point of ``res`` ends on when a chunk may keep it shifted along
+    that orbit (:func:`shifted_starts`): 2 to :data:`~grazing.core.options.CHAIN_SHIFTS`, a periodic model;
+    else 0."""
+    if res is None or not spec.model.periodic or int(res.status[0]) != Status.OK:
+        return 0
+    p = int(res.period[0])
+    return p if 2 <= p <= CHAIN_SHIFTS else 0
+
+
+def shifted_starts(spec: SweepSpec, index: int, res: ChunkResult) -> list[ChainStart]:
+    """Each point of the orbit that the first point of chunk ``index``'s guess ``res`` ends on, as a start
+    of that chunk (at the sampling phase: its samples are the orbit's points there)."""
+    p = orbit_period(spec, res)
+    T = float(spec.model_at(spec.points[spec.chunk(index).start]).period)
+    t = (spec.phase / (2 * math.pi)) % 1.0 * T
+    return [(t, tuple(float(v) for v in res.samples[0][-p + j])) for j in range(p)]
 
 
 @dataclass
@@ -189,9 +232,10 @@ class _Round:
     claimed: set[tuple[int, int]] = field(default_factory=set)
 
     def ask(self, c: _Chunk, what: str, start: Any, extend: bool = False) -> None:
-        """Check ``c``'s first point from ``start``, or run ``c`` from there; ``extend``-ed, with the chunks
-        after it whose guess disagreed with every start it was checked against, as one job (the same
-        numbers as runs of each from the end of the one before; each of them is also its check)."""
+        """Check ``c``'s first point from ``start``, run ``c`` from there, or run it from each point of its
+        guess's orbit (``"shift"``); a run ``extend``-ed with the chunks after it whose candidates
+        disagreed with every start they were checked against, as one job (the same numbers as runs of
+        each from the end of the one before; the first point of each is its check from there)."""
         group = [c]
         while extend:
             nxt = self.active.get((c.line, group[-1].index + 1))
@@ -202,6 +246,12 @@ class _Round:
             group.append(nxt)
         self.claimed.update((g.line, g.index) for g in group)
         spec = self.lines[c.line].spec
+        if what == "shift":
+            c.shifting = True
+            for shifted in shifted_starts(spec, c.index, c.guess):
+                self.parts.append(from_start(spec, c.index, shifted))
+                self.jobs.append((group, what, shifted))
+            return
         if what == "check":
             self.parts.append(from_start(spec, c.index, start, 1))
         else:
@@ -211,25 +261,27 @@ class _Round:
 
     def take(self, results: Sequence[ChunkResult]) -> None:
         """Record the results of the round's jobs (``results[k]`` of ``jobs[k]``) in their chunks."""
+        shifted: dict[int, tuple[_Chunk, list[ChunkResult]]] = {}
         for (group, what, start), res in zip(self.jobs, results):
             c = group[0]
             if what == "check":
-                if same_outcome(c.guess, 0, res, 0):
-                    c.keep_guess(start)
-                else:
-                    c.failed[start] = int(res.status[0]) == Status.OK
+                c.checks[start] = res
+                continue
+            if what == "shift":  # (the shifts of a chunk come in the order asked, all in one round)
+                shifted.setdefault(id(c), (c, []))[1].append(replace(res, index=c.index))
                 continue
             spec = self.lines[c.line].spec  # (a run: a part of its own, of index 0; its result the chunks')
             pieces = split_result(spec, res, [g.index for g in group])
             for n, (g, piece) in enumerate(zip(group, pieces)):
                 if n > 0:  # (a chunk run on from the one before: its first point is its check from there)
-                    if same_outcome(g.guess, 0, piece, 0):
-                        g.keep_guess(start)
-                        break  # (the chunks after it went on from the run's end, not the guess's)
-                    g.failed[start] = int(piece.status[0]) == Status.OK
+                    g.checks[start] = piece
+                    if g.verdict(start, spec) != "run":
+                        break  # (kept from its candidates, or to decide: the run's later chunks are not its)
                 g.take_run(start, piece)
                 if n + 1 < len(group):  # (the next one started where this one ended)
                     start = next_start(spec, piece, g.index)
+        for c, shifts in shifted.values():  # (all of them at once: a chunk decides on all its shifts)
+            c.shifts = shifts
 
 
 @dataclass
@@ -255,18 +307,21 @@ def settle(
     exception (Ctrl-C) leaves the chunks settled before it written.
 
     In each round, a chunk whose chain's start is final (the chunk before it
-    settled) is settled when its result started there or its check there
-    agreed; else it is checked there, or run again there when its check
-    disagreed (with the chunks after it whose guesses disagreed with every
-    start they were checked against, as one job: the first point of each is
-    its check from there).  A chunk whose chain's start may still change is
-    checked there, and run again there when the check ended on another
-    attractor (hysteresis: likely to stay so).
+    settled) is settled when its result stands for that start; else it is
+    checked there, computed from its shifts when the check ended on its
+    guess's orbit at another point, or run again there (with the chunks after
+    it whose checks never agreed, as one job: the first point of each is its
+    check from there).  A chunk whose chain's start may still change is
+    treated alike, but run again only when its check ended on an attractor
+    (hysteresis: likely to stay so); and when the chunk before it moves (its
+    result is not its guess), its shifts are computed at once (its start
+    will move along the orbit too).
 
     Every chunk is computed first from ``x0`` at time 0 (the guess), whatever
     is known of its chain's start: its result is then a function of that
     guess and the final start alone (the guess when its check from there
-    agrees, else the run from there), so the results are the same whatever
+    agrees; else, when the check ended on the guess's orbit, the shift that
+    agrees; else the run from there), so the results are the same whatever
     the window, the rounds, the threads or an interruption.
     """
     waiting = iter([_Chunk(k, i) for k, line in enumerate(lines) for i in line.todo])
@@ -287,20 +342,30 @@ def settle(
 
     while pending:
         work = _Round(lines, active)
+        moving: set[tuple[int, int]] = set()  # (chunks whose result is not, or will not be, their guess)
         for key in sorted(active):
             c = active[key]
             if c.result is None or key in work.claimed:
                 continue
             final, start = chain_start(c)
-            if start is _UNSET or c.start == start or start in c.passed:
+            if start is _UNSET:
                 continue
-            if final:
-                rerun = start in c.failed
-                work.ask(c, "run" if rerun else "check", start, extend=rerun)
-            elif c.failed.get(start, False):
+            spec = lines[c.line].spec
+            what = "keep" if c.start == start else c.verdict(start, spec)
+            if c.start == start:
+                pass
+            elif what == "keep":  # (the chunks after it see its new end in this same loop)
+                c.result, c.start = c.kept[start], start
+            elif what != "run":
+                work.ask(c, what, start)
+            elif final or int(c.checks[start].status[0]) == Status.OK:  # (hysteresis: likely to stay so)
                 work.ask(c, "run", start, extend=True)
-            elif start not in c.failed:
-                work.ask(c, "check", start)
+            ahead = (c.line, c.index - 1) in moving and what != "shift" and not c.shifting
+            if ahead and orbit_period(spec, c.guess):  # (the chunk before it moves: its start will too)
+                work.ask(c, "shift", start)
+                what = "shift"
+            if what in ("shift", "run") or c.result is not c.guess:
+                moving.add(key)
         while len(active) < window:  # new chunks, from x0 (see above: whatever the window, the same results)
             c = next(waiting, None)
             if c is None:
@@ -319,9 +384,9 @@ def settle(
             if c.result is None:
                 continue
             final, start = chain_start(c)
-            if final and (c.start == start or start in c.passed):
+            if final and c.start == start:
                 c.settled = True
-                on_settled(c.line, c.result if c.start == start else c.guess)
+                on_settled(c.line, c.result)
                 del active[key]
                 pending -= 1
                 progressed = True
