@@ -199,7 +199,8 @@ class _Chunk:
     def unlike_its_chain(self) -> bool:
         """Whether its first point was checked and no candidate agreed (a run from its chain's start is
         likely to be needed: the guess is on another attractor than the chain's)."""
-        return bool(self.kept) and all(v is None for v in self.kept.values())
+        decided = [v for start, v in self.kept.items() if start is not None]  # (None: the guess's own start)
+        return bool(decided) and all(v is None for v in decided)
 
 
 def orbit_period(spec: SweepSpec, res: ChunkResult | None) -> int:
