@@ -132,9 +132,14 @@ def test_the_result_does_not_depend_on_threads_window_or_store(tmp_path, make):
         np.testing.assert_array_equal(other.period.values, one.period.values)
 
 
-def test_a_store_resumes_from_the_end_stored_before(tmp_path):
+def two_stops_up():
     spec = sweep_spec(TWO_STOPS, "omega", OMEGAS[::2], direction="up")
-    spec = type(spec)(**{**spec.__dict__, "chunk_size": 8, "transient": 200, "periods": 24})
+    return type(spec)(**{**spec.__dict__, "chunk_size": 8, "transient": 200, "periods": 24})
+
+
+@pytest.mark.parametrize("make", [two_stops_up, pendulum_through_chaos])
+def test_a_store_resumes_from_the_end_stored_before(tmp_path, make):
+    spec = make()
     whole = run_sweep(spec, workers=2)
     path = tmp_path / "r.zarr"
     with ZarrStore(path, spec) as store:  # the first chunks only, as a run stopped after them
@@ -359,3 +364,15 @@ def test_a_guess_at_another_point_of_the_chains_orbit_is_kept_shifted(window, pe
     assert shifts and not runs
     np.testing.assert_array_equal(chunked.period.values, chain.period.values)
     assert np.abs(chunked.samples.values - chain.samples.values).max() <= 10 * CHAIN_TOL
+
+
+def test_a_dask_cluster_settles_the_same_chain_through_chaos():
+    from distributed import Client, LocalCluster
+
+    spec = pendulum_through_chaos()
+    local = run_sweep(spec, workers=2)
+    with LocalCluster(n_workers=2, threads_per_worker=1, host="127.0.0.1", processes=True,
+                      dashboard_address=":0") as cluster, Client(cluster) as client:  # fmt: skip
+        remote = run_sweep(spec, client=client)
+    np.testing.assert_array_equal(remote.samples.values, local.samples.values)
+    np.testing.assert_array_equal(remote.period.values, local.period.values)
