@@ -19,12 +19,13 @@ the chain's, chunk by chunk:
   :data:`~grazing.core.options.CHAIN_CELLS` cells along their joint box, as
   the basins' classifier groups aperiodic end states:
   :func:`grazing.core.cells.one_attractor`); or failed alike;
-- when both end on one periodic orbit (of period 2 to
-  :data:`~grazing.core.options.CHAIN_SHIFTS`) at different points of it (a
-  guess ends at the chain's point of a period-p orbit one time in p), the
-  chunk is computed from each point of its guess's orbit (its *shifts*: from
-  the guess alone, so in parallel, before the chain reaches it) and the one
-  whose first point ends as the check does is kept;
+- when both end periodic with one period (2 to
+  :data:`~grazing.core.options.CHAIN_SHIFTS`) but not alike (mostly at
+  another point of one orbit: a guess ends at the chain's point of a
+  period-p orbit one time in p), the chunk is computed from each point of its
+  guess's orbit (its *shifts*: from the guess alone, so in parallel, before
+  the chain reaches it) and the first whose first point ends as the check
+  does is kept;
 - otherwise (another attractor: the hysteresis the guess misses, periodic
   against aperiodic, disjoint chaotic sets) the chunk is run again from that
   final state, so it is the chain's, and the chunks after it are checked
@@ -168,7 +169,8 @@ class _Chunk:
     settled: bool = False
 
     def candidates(self) -> list[ChunkResult]:
-        """The results it may keep where its check ends on its guess's orbit: the guess, then its shifts."""
+        """The results it may keep where its check ends periodic with its guess's period: the guess, then
+        its shifts."""
         assert self.guess is not None
         return [self.guess, *(self.shifts or [])]  # (not needed when the guess agrees: see verdict)
 
@@ -181,10 +183,10 @@ class _Chunk:
         if check is None:
             return "check"
         p = orbit_period(spec, self.guess)
-        on_its_orbit = p > 0 and int(check.status[0]) == Status.OK and int(check.period[0]) == p
-        if on_its_orbit and self.shifts is None and not same_outcome(self.guess, 0, check, 0):
+        its_period = p > 0 and int(check.status[0]) == Status.OK and int(check.period[0]) == p
+        if its_period and self.shifts is None and not same_outcome(self.guess, 0, check, 0):
             return "shift"
-        candidates = self.candidates() if on_its_orbit else [self.guess]  # (whatever was computed)
+        candidates = self.candidates() if its_period else [self.guess]  # (whatever was computed)
         self.kept[start] = next((r for r in candidates if same_outcome(r, 0, check, 0)), None)
         return self.verdict(start, spec)
 
@@ -309,21 +311,21 @@ def settle(
 
     In each round, a chunk whose chain's start is final (the chunk before it
     settled) is settled when its result stands for that start; else it is
-    checked there, computed from its shifts when the check ended on its
-    guess's orbit at another point, or run again there (with the chunks after
-    it whose checks never agreed, as one job: the first point of each is its
-    check from there).  A chunk whose chain's start may still change is
+    checked there, computed from its shifts when the check ended periodic with
+    its guess's period but not alike, or run again there (with the chunks
+    after it whose checks never agreed, as one job: the first point of each is
+    its check from there).  A chunk whose chain's start may still change is
     treated alike, but run again only when its check ended on an attractor
     (hysteresis: likely to stay so); and when the chunk before it moves (its
-    result is not its guess), its shifts are computed at once (its start
-    will move along the orbit too).
+    result is not its guess), its shifts are computed at once (its start will
+    move along the orbit too).
 
     Every chunk is computed first from ``x0`` at time 0 (the guess), whatever
     is known of its chain's start: its result is then a function of that
     guess and the final start alone (the guess when its check from there
-    agrees; else, when the check ended on the guess's orbit, the shift that
-    agrees; else the run from there), so the results are the same whatever
-    the window, the rounds, the threads or an interruption.
+    agrees; else, when the check ended with the guess's period, the first
+    shift that agrees; else the run from there), so the results are the same
+    whatever the window, the rounds, the threads or an interruption.
     """
     waiting = iter([_Chunk(k, i) for k, line in enumerate(lines) for i in line.todo])
     pending = sum(len(line.todo) for line in lines)
