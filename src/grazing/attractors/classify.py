@@ -33,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from grazing.core.cells import group_by_cells
 from grazing.core.model import ON_STOP_TOL, HybridModel
 from grazing.core.options import BASIN_ADAPTIVE_TOL, CHAOS_THRESHOLD, MATCH_TOL
 from grazing.core.solution import Status
@@ -293,23 +294,15 @@ class Catalogue:
         found before that share one."""
         if rows.size == 0:
             return
-        from scipy.sparse import coo_matrix
-        from scipy.sparse.csgraph import connected_components
-
         samples = np.asarray(res.samples, dtype=float)[rows]  # (states, periods, n)
         m, P, n = samples.shape
-        q = np.floor((samples.reshape(-1, n) - self.origin) / self.cell).astype(np.int64)
-        keys = np.ascontiguousarray(q).view(np.dtype((np.void, 8 * n))).ravel()
-        ukeys, cell_of = np.unique(keys, return_inverse=True)
-        cell_of = cell_of.ravel()
         owner = np.repeat(np.arange(m), P)
-        graph = coo_matrix((np.ones(m * P), (owner, m + cell_of)), shape=(m + ukeys.size, m + ukeys.size))
-        _, comp = connected_components(graph, directed=False)
+        groups = group_by_cells(samples.reshape(-1, n), owner, m, self.origin, self.cell)
         lyap = np.asarray(res.lyapunov, dtype=float)[rows]
         impacts = np.asarray(res.impacts, dtype=float)[rows] / self.periods
-        for c in np.unique(comp[:m]):
-            members = np.flatnonzero(comp[:m] == c)
-            cells = {bytes(ukeys[u]) for u in np.unique(cell_of[np.isin(owner, members)])}
+        for c in np.unique(groups.group):
+            members = np.flatnonzero(groups.group == c)
+            cells = groups.cells_of(owner, members)
             first = int(index[rows[members[0]]])
             pts = samples[members].reshape(-1, n)[:MAX_POINTS]
             mean_impacts = float(np.mean(impacts[members]))

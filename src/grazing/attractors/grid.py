@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from grazing.core.cells import box_cell
 from grazing.core.model import ON_STOP_TOL, HybridModel
 from grazing.errors import InvalidParameterError
 
@@ -223,9 +224,7 @@ def default_cell(states: np.ndarray) -> np.ndarray:
     """
     from grazing.core.options import CELLS
 
-    span = np.ptp(np.asarray(states, dtype=float), axis=0) / CELLS
-    fallback = float(span.max()) if span.max() > 0 else 1.0 / CELLS
-    return np.where(span > 0, span, fallback)
+    return box_cell(states, CELLS)
 
 
 def as_states(model: HybridModel, states: Any) -> np.ndarray:

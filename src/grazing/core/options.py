@@ -69,9 +69,29 @@ BASIN_ADAPTIVE_TOL = 1e-7
 """The same for the initial states of a basin: their orbits are told apart to 1e-3 cells, and recognised
 periodic to 1e-6."""
 
+CELLS = 64
+"""Cells along each side of the grid box on which the points of aperiodic attractors are recorded
+(the size of a cell is the box's extent over this)."""
+
 CHAIN_TOL = PERIOD_TOL
 """A chunk of a sweep computed from a guess is kept when its first point ends on the periodic orbit,
 at the same point of it, as from the chain's state: samples and final state equal to this."""
+
+CHAIN_CELLS = CELLS
+"""A chunk of a sweep computed from a guess is kept when its first point ends aperiodic, on the attractor
+it ends on from the chain's state: both runs' samples share a cell of a grid of this many cells along
+each side of their joint box (:func:`grazing.core.cells.one_attractor`).  On a chaotic attractor only
+the attractor is reproducible, not the samples (any rounding difference moves them after a few periods),
+so the basins' rule decides, on their default grid: two sets farther apart than 1/64 of their joint
+extent are told apart.  Two runs on one chaotic attractor share tens of cells (the pendulum's band at
+40 deg, 100 samples each: 14 or more); too few samples to share one make the check fail, and the chunk
+is run again: a slower answer, not another one."""
+
+CHAIN_SHIFTS = 8
+"""A chunk of a sweep whose guess's first point ends on a periodic orbit of period 2 to this, and from
+the chain's state on that orbit at another point of it, is computed from each point of the orbit (in
+parallel, from the guess alone); the one that ends its first point as the chain's state does is kept
+(a guess ends at the chain's point of a period-p orbit only one time in p)."""
 
 CHAOS_THRESHOLD = 1e-3
 """Largest Lyapunov exponent (per unit time) above which an aperiodic run counts as chaotic; within
@@ -85,10 +105,6 @@ BASIN_PERIODS = 50
 
 BASIN_CHUNK = 512
 """Initial states per chunk of a basin computation: the unit of parallel work and of saving."""
-
-CELLS = 64
-"""Cells along each side of the grid box on which the points of aperiodic attractors are recorded
-(the size of a cell is the box's extent over this)."""
 
 MATCH_TOL = 1e-3
 """Two periodic orbits are one attractor when each point of one is within this many cells of a point

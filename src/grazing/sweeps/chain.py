@@ -11,22 +11,44 @@ the chain's, chunk by chunk:
   chain; a chunk after a failed point, from where the chain starts again) is
   the chain's, bit for bit;
 - otherwise its first point is run again from the previous chunk's final
-  state (one point: a *check*); when both end on the same periodic orbit, at
-  the same point of it (samples and final state equal to
-  :data:`~grazing.core.options.CHAIN_TOL`), or fail alike, the chunk is
-  kept: from its first point on it is the chain's to that tolerance;
-- otherwise (another attractor: the hysteresis the guess misses; an
-  aperiodic point, which no tolerance makes equal) the chunk is run again
-  from that final state, so it is the chain's, and the chunks after it are
-  checked against its new end.
+  state (one point: a *check*); when both runs end alike (:func:`same_outcome`),
+  the chunk is kept: from its first point on it is the chain's.  Alike is:
+  on one periodic orbit at the same point of it (samples and final state
+  equal to :data:`~grazing.core.options.CHAIN_TOL`); both aperiodic on one
+  attractor (their samples share a cell of a grid of
+  :data:`~grazing.core.options.CHAIN_CELLS` cells along their joint box, as
+  the basins' classifier groups aperiodic end states:
+  :func:`grazing.core.cells.one_attractor`); or failed alike;
+- when both end periodic with one period (2 to
+  :data:`~grazing.core.options.CHAIN_SHIFTS`) but not alike (mostly at
+  another point of one orbit: a guess ends at the chain's point of a
+  period-p orbit one time in p), the chunk is computed from each point of its
+  guess's orbit (its *shifts*: from the guess alone, so in parallel, before
+  the chain reaches it) and the first whose first point ends as the check
+  does is kept;
+- otherwise (another attractor: the hysteresis the guess misses, periodic
+  against aperiodic, disjoint chaotic sets) the chunk is run again from that
+  final state, so it is the chain's, and the chunks after it are checked
+  against its new end.
+
+Why the attractor, not the samples, at an aperiodic point: on a chaotic
+attractor the chain's samples are not reproducible anyway.  Any rounding
+difference (another processor, fused multiply-adds, another lane width)
+moves them after a few periods, and with them what the chain lands on after
+the chaos where attractors coexist (a relative change of 1e-15 in the
+pendulum's state entering a chaotic band at 40 deg moves its samples by the
+band's size and lands it on a period-6 orbit instead of a period-3 one a few
+points later).  Only the attractor is reproducible, so "the chain's answer"
+at an aperiodic point means the chain's attractor.  Periodic points keep
+their guarantee: the same orbit, at the same point of it.
 
 A chunk is *settled* once it and every chunk before it in its chain are the
-chain's; then it is written to the store.  The checks and the runs of a
+chain's; then it is written to the store.  The checks, shifts and runs of a
 round are computed together on the lanes, so a sweep whose chunks agree
-costs one point per chunk more than the chunks; a sweep through chaos, where
-no chunk can be kept, costs a chain's time.  A store holds settled chunks
-only: resumed, a chunk continues from the final state stored for the chunk
-before it.
+costs one point per chunk more than the chunks; what is left of a chain's
+time is the chunks run again, one after the other, where the guesses miss
+the chain's attractor.  A store holds settled chunks only: resumed, a chunk
+continues from the final state stored for the chunk before it.
 """
 
 from __future__ import annotations
@@ -38,7 +60,8 @@ from typing import Any
 
 import numpy as np
 
-from grazing.core.options import CHAIN_TOL
+from grazing.core.cells import one_attractor
+from grazing.core.options import CHAIN_CELLS, CHAIN_SHIFTS, CHAIN_TOL
 from grazing.core.solution import Status
 from grazing.sweeps.spec import ChunkResult, SweepSpec
 
@@ -93,13 +116,17 @@ def from_start(spec: SweepSpec, index: int, start: ChainStart, points: int | Non
 def same_outcome(a: ChunkResult, i: int, b: ChunkResult, j: int, tol: float = CHAIN_TOL) -> bool:
     """Whether point ``i`` of ``a`` and point ``j`` of ``b`` end alike: the chain goes on the same from both.
 
-    Both failed for the same reason, or both on one periodic orbit at one point of it: the same
-    period, samples and final state equal to ``tol``.
+    Both failed for the same reason; or both on one periodic orbit at one point of it: the same
+    period, samples and final state equal to ``tol``; or both aperiodic on one attractor: their
+    samples share a cell of the grid of :data:`~grazing.core.options.CHAIN_CELLS` cells along their
+    joint box (:func:`~grazing.core.cells.one_attractor`, the basins' rule).
     """
     sa, sb = int(a.status[i]), int(b.status[j])
     if sa != Status.OK or sb != Status.OK:
         return sa == sb
     p = int(a.period[i])
+    if p <= 0 and int(b.period[j]) <= 0:
+        return one_attractor(a.samples[i], b.samples[j], CHAIN_CELLS)
     if p <= 0 or p != int(b.period[j]):
         return False
     close = np.max(np.abs(a.samples[i] - b.samples[j])) <= tol
@@ -132,17 +159,69 @@ class _Chunk:
 
     line: int
     index: int
-    result: ChunkResult | None = None
-    start: Any = _UNSET  # the start its result was computed from
-    passed: list[Any] = field(default_factory=list)  # starts its first point was checked against and agreed
-    failed: dict[Any, bool] = field(default_factory=dict)  # ... disagreed: start -> the check ended periodic
+    guess: ChunkResult | None = None  # computed from x0 at time 0
+    result: ChunkResult | None = None  # what the chain goes on from, from ``start``
+    start: Any = _UNSET  # the start ``result`` stands for (None: the guess's own, x0 at time 0)
+    checks: dict[Any, ChunkResult] = field(default_factory=dict)  # its first point run from each start
+    shifts: list[ChunkResult] | None = None  # the guess from each point of its orbit (:func:`shifted_starts`)
+    kept: dict[Any, ChunkResult | None] = field(default_factory=dict)  # start -> the candidate kept there
+    shifting: bool = False  # (its shifts asked)
     settled: bool = False
 
+    def candidates(self) -> list[ChunkResult]:
+        """The results it may keep where its check ends periodic with its guess's period: the guess, then
+        its shifts."""
+        assert self.guess is not None
+        return [self.guess, *(self.shifts or [])]  # (not needed when the guess agrees: see verdict)
+
+    def verdict(self, start: Any, spec: SweepSpec) -> str:
+        """From ``start``: ``"keep"`` (``kept[start]`` is the chain's), ``"check"`` (its first point from
+        there is not known), ``"shift"`` (the guess's shifts are needed to decide) or ``"run"``."""
+        if start in self.kept:
+            return "keep" if self.kept[start] is not None else "run"
+        check = self.checks.get(start)
+        if check is None:
+            return "check"
+        p = orbit_period(spec, self.guess)
+        its_period = p > 0 and int(check.status[0]) == Status.OK and int(check.period[0]) == p
+        if its_period and self.shifts is None and not same_outcome(self.guess, 0, check, 0):
+            return "shift"
+        candidates = self.candidates() if its_period else [self.guess]  # (whatever was computed)
+        self.kept[start] = next((r for r in candidates if same_outcome(r, 0, check, 0)), None)
+        return self.verdict(start, spec)
+
+    def take_run(self, start: Any, res: ChunkResult) -> None:
+        """``res``, computed from ``start``, is what the chain goes on from (it is the chain's from there)."""
+        self.result, self.start = res, start
+        self.kept[start] = None if start is not None else res
+        if start is None:
+            self.guess = res
+
     @property
-    def aperiodic(self) -> bool:
-        """Whether its first point ended on no periodic orbit (no check can agree with it)."""
-        res = self.result
-        return res is not None and int(res.status[0]) == Status.OK and int(res.period[0]) <= 0
+    def unlike_its_chain(self) -> bool:
+        """Whether its first point was checked and no candidate agreed (a run from its chain's start is
+        likely to be needed: the guess is on another attractor than the chain's)."""
+        decided = [v for start, v in self.kept.items() if start is not None]  # (None: the guess's own start)
+        return bool(decided) and all(v is None for v in decided)
+
+
+def orbit_period(spec: SweepSpec, res: ChunkResult | None) -> int:
+    """The period of the orbit the first point of ``res`` ends on when a chunk may keep it shifted along
+    that orbit (:func:`shifted_starts`): 2 to :data:`~grazing.core.options.CHAIN_SHIFTS`, a periodic model;
+    else 0."""
+    if res is None or not spec.model.periodic or int(res.status[0]) != Status.OK:
+        return 0
+    p = int(res.period[0])
+    return p if 2 <= p <= CHAIN_SHIFTS else 0
+
+
+def shifted_starts(spec: SweepSpec, index: int, res: ChunkResult) -> list[ChainStart]:
+    """Each point of the orbit that the first point of chunk ``index``'s guess ``res`` ends on, as a start
+    of that chunk (at the sampling phase: its samples are the orbit's points there)."""
+    p = orbit_period(spec, res)
+    T = float(spec.model_at(spec.points[spec.chunk(index).start]).period)
+    t = (spec.phase / (2 * math.pi)) % 1.0 * T
+    return [(t, tuple(float(v) for v in res.samples[0][-p + j])) for j in range(p)]
 
 
 @dataclass
@@ -156,23 +235,56 @@ class _Round:
     claimed: set[tuple[int, int]] = field(default_factory=set)
 
     def ask(self, c: _Chunk, what: str, start: Any, extend: bool = False) -> None:
-        """Check ``c``'s first point from ``start``, or run ``c`` from there; ``extend``-ed, with the chunks
-        after it that only a run from the chain's start can settle (their first point aperiodic), as one
-        job (the same numbers as runs of each from the end of the one before)."""
+        """Check ``c``'s first point from ``start``, run ``c`` from there, or run it from each point of its
+        guess's orbit (``"shift"``); a run ``extend``-ed with the chunks after it whose candidates
+        disagreed with every start they were checked against, as one job (the same numbers as runs of
+        each from the end of the one before; the first point of each is its check from there)."""
         group = [c]
         while extend:
             nxt = self.active.get((c.line, group[-1].index + 1))
-            if nxt is None or nxt.result is None or nxt.settled or not nxt.aperiodic:
+            if nxt is None or nxt.guess is None or nxt.settled or not nxt.unlike_its_chain:
+                break
+            if (nxt.line, nxt.index) in self.claimed:
                 break
             group.append(nxt)
         self.claimed.update((g.line, g.index) for g in group)
         spec = self.lines[c.line].spec
+        if what == "shift":
+            c.shifting = True
+            for shifted in shifted_starts(spec, c.index, c.guess):
+                self.parts.append(from_start(spec, c.index, shifted))
+                self.jobs.append((group, what, shifted))
+            return
         if what == "check":
             self.parts.append(from_start(spec, c.index, start, 1))
         else:
             points = spec.chunk(group[-1].index).stop - spec.chunk(c.index).start
             self.parts.append(from_start(spec, c.index, start, points if len(group) > 1 else None))
         self.jobs.append((group, what, start))
+
+    def take(self, results: Sequence[ChunkResult]) -> None:
+        """Record the results of the round's jobs (``results[k]`` of ``jobs[k]``) in their chunks."""
+        shifted: dict[int, tuple[_Chunk, list[ChunkResult]]] = {}
+        for (group, what, start), res in zip(self.jobs, results):
+            c = group[0]
+            if what == "check":
+                c.checks[start] = res
+                continue
+            if what == "shift":  # (the shifts of a chunk come in the order asked, all in one round)
+                shifted.setdefault(id(c), (c, []))[1].append(replace(res, index=c.index))
+                continue
+            spec = self.lines[c.line].spec  # (a run: a part of its own, of index 0; its result the chunks')
+            pieces = split_result(spec, res, [g.index for g in group])
+            for n, (g, piece) in enumerate(zip(group, pieces)):
+                if n > 0:  # (a chunk run on from the one before: its first point is its check from there)
+                    g.checks[start] = piece
+                    if g.verdict(start, spec) != "run":
+                        break  # (kept from its candidates, or to decide: the run's later chunks are not its)
+                g.take_run(start, piece)
+                if n + 1 < len(group):  # (the next one started where this one ended)
+                    start = next_start(spec, piece, g.index)
+        for c, shifts in shifted.values():  # (all of them at once: a chunk decides on all its shifts)
+            c.shifts = shifts
 
 
 @dataclass
@@ -198,17 +310,21 @@ def settle(
     exception (Ctrl-C) leaves the chunks settled before it written.
 
     In each round, a chunk whose chain's start is final (the chunk before it
-    settled) is settled when its result started there or its check there
-    agreed; else it is checked there, or run again there when its first point
-    is aperiodic or its check disagreed.  A chunk whose chain's start may still
-    change is checked there, and run again there only when the check ended on
-    another periodic orbit (hysteresis: likely to stay so); an aperiodic one
-    waits for the start to be final.
+    settled) is settled when its result stands for that start; else it is
+    checked there, computed from its shifts when the check ended periodic with
+    its guess's period but not alike, or run again there (with the chunks
+    after it whose checks never agreed, as one job: the first point of each is
+    its check from there).  A chunk whose chain's start may still change is
+    treated alike, but run again only when its check ended on an attractor
+    (hysteresis: likely to stay so); and when the chunk before it moves (its
+    result is not its guess), its shifts are computed at once (its start will
+    move along the orbit too).
 
     Every chunk is computed first from ``x0`` at time 0 (the guess), whatever
     is known of its chain's start: its result is then a function of that
-    guess and the final start alone (the guess's when it started there or its
-    check there agrees, else the run from there), so the results are the same
+    guess and the final start alone (the guess when its check from there
+    agrees; else, when the check ended with the guess's period, the first
+    shift that agrees; else the run from there), so the results are the same
     whatever the window, the rounds, the threads or an interruption.
     """
     waiting = iter([_Chunk(k, i) for k, line in enumerate(lines) for i in line.todo])
@@ -229,22 +345,30 @@ def settle(
 
     while pending:
         work = _Round(lines, active)
+        moving: set[tuple[int, int]] = set()  # (chunks whose result is not, or will not be, their guess)
         for key in sorted(active):
             c = active[key]
             if c.result is None or key in work.claimed:
                 continue
             final, start = chain_start(c)
-            if start is _UNSET or c.start == start or start in c.passed:
+            if start is _UNSET:
                 continue
-            if final:
-                if c.aperiodic or start in c.failed:
-                    work.ask(c, "run", start, extend=True)
-                else:
-                    work.ask(c, "check", start)
-            elif c.failed.get(start, False):
-                work.ask(c, "run", start)
-            elif not c.aperiodic and start not in c.failed:
-                work.ask(c, "check", start)
+            spec = lines[c.line].spec
+            what = "keep" if c.start == start else c.verdict(start, spec)
+            if c.start == start:
+                pass
+            elif what == "keep":  # (the chunks after it see its new end in this same loop)
+                c.result, c.start = c.kept[start], start
+            elif what != "run":
+                work.ask(c, what, start)
+            elif final or int(c.checks[start].status[0]) == Status.OK:  # (hysteresis: likely to stay so)
+                work.ask(c, "run", start, extend=True)
+            ahead = (c.line, c.index - 1) in moving and what != "shift" and not c.shifting
+            if ahead and orbit_period(spec, c.guess):  # (the chunk before it moves: its start will too)
+                work.ask(c, "shift", start)
+                what = "shift"
+            if what in ("shift", "run") or c.result is not c.guess:
+                moving.add(key)
         while len(active) < window:  # new chunks, from x0 (see above: whatever the window, the same results)
             c = next(waiting, None)
             if c is None:
@@ -256,26 +380,14 @@ def settle(
             results: dict[int, ChunkResult] = {}
             for part, res in compute(work.parts):
                 results[position[id(part)]] = res
-            for k, (group, what, start) in enumerate(work.jobs):
-                res, c = results[k], group[0]
-                if what == "run":  # (a part of its own, of index 0: its result is the chunks')
-                    spec = lines[c.line].spec
-                    pieces = split_result(spec, res, [g.index for g in group])
-                    for n, (g, piece) in enumerate(zip(group, pieces)):
-                        g.result, g.start, g.passed, g.failed = piece, start, [], {}
-                        if n + 1 < len(group):  # (the next one started where this one ended)
-                            start = next_start(spec, piece, g.index)
-                elif c.result is not None and same_outcome(c.result, 0, res, 0):
-                    c.passed.append(start)
-                else:
-                    c.failed[start] = int(res.status[0]) == Status.OK and int(res.period[0]) > 0
+            work.take([results[k] for k in range(len(work.parts))])
         progressed = False
         for key in sorted(active):
             c = active[key]
             if c.result is None:
                 continue
             final, start = chain_start(c)
-            if final and (c.start == start or start in c.passed):
+            if final and c.start == start:
                 c.settled = True
                 on_settled(c.line, c.result)
                 del active[key]
