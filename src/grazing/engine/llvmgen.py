@@ -11,10 +11,22 @@ is compiled in a fraction of a second: numba's front end (typing, reference
 counting, exception paths for every division) is what cost the time.
 
 The translation keeps the arithmetic exactly: the same operations in the same
-order, no fast-math flags, and the same LLVM intrinsics or C library functions
-that numba calls for ``math.sin``, ``math.exp``, ``**`` and the others, so the
-results are bit-identical to numba's.  One difference: a division by zero
-gives an infinity or a NaN (IEEE) where numba raised ``ZeroDivisionError``.
+order, no fast-math flags (so no fused multiply-adds), and for ``math.exp``,
+``**`` and the other functions the same LLVM intrinsics or C library functions
+that numba calls, so the results are bit-identical to numba's compiling the
+same text, with two exceptions.  ``math.sin`` and ``math.cos``, in every
+generated function, are grazing's own (:mod:`grazing.engine.sincos`: within
+one ulp, not always the C library's bits): straight-line arithmetic
+translated in place, the same operations on a scalar and on SIMD lanes, so
+that a lane function gives its scalar twin's bits while its vectors stay
+vectors (the C library's ``sin`` would take one call per lane).  Using them
+in every function (the vector field, guards, resets), not only in the Taylor
+kernels and their lane twins, keeps one definition of ``sin`` and ``cos`` for
+the whole model.  And a division by zero gives an infinity or a NaN
+(IEEE) where numba raised ``ZeroDivisionError``.  The reference for the
+compiled code is CPython running the same text with
+:func:`grazing.engine.sincos.sin` and :func:`~grazing.engine.sincos.cos` as
+``math.sin`` and ``math.cos`` (``tests/engine/test_llvmgen.py``).
 
 Examples
 --------
