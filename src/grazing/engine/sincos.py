@@ -99,17 +99,13 @@ def sincos_fast(x: float) -> tuple[float, float]:
     t = x * INVPIO2 + TOINT
     n = t - TOINT
     m = n - 4.0 * ((n * 0.25 + TOINT) - TOINT)
-    # r = x - n pi/2 = hi + lo
+    # r = x - n pi/2 = hi + lo (lo, below one ulp of hi, is off the critical path)
     t1 = x - n * PIO2_1
     p2 = n * PIO2_2
     s2 = t1 - p2
-    e2 = (t1 - s2) - p2
     p3 = n * PIO2_3
-    s3 = s2 - p3
-    e3 = (s2 - s3) - p3
-    ntail = n * PIO2_3T - (e2 + e3)
-    hi = s3 - ntail
-    lo = (s3 - hi) - ntail
+    hi = s2 - p3
+    lo = (((t1 - s2) - p2) + ((s2 - hi) - p3)) - n * PIO2_3T
     # sin(hi + lo) and cos(hi + lo) on [-pi/4, pi/4]
     z = hi * hi
     w = z * z
