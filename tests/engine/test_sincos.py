@@ -208,3 +208,52 @@ def test_ir_calls_the_c_library_only_on_the_slow_path() -> None:
             calls.append(block)
     # sin and cos: once in the scalar function, once per lane in the lane function, all on the slow path
     assert len(calls) == 2 * (1 + L) and all(b.startswith("sincos_slow") for b in calls), calls
+
+
+# ----------------------------------------------------------------------------- a model with sin of its states
+
+MODEL_FILE = """
+import sympy as sp
+from grazing import HybridModel, Parameter, Stop
+
+phi, w_dot, t = sp.symbols("phi_1 w_dot t")
+k, c, a, gap, r = sp.symbols("k c a_2t gap r")
+MODEL = HybridModel(
+    "trig rotor",
+    [phi, w_dot],
+    t,
+    [Parameter("k", 1.0), Parameter("c", 0.1, lower=0), Parameter("a_2t", 0.9),
+     Parameter("gap", 0.3), Parameter("r", 0.8, lower=0, upper=1)],
+    vector_field=[w_dot, -k * sp.sin(phi) - c * w_dot + a * sp.cos(2 * t) + sp.sin(phi) * sp.cos(3 * phi)],
+    stops=[
+        Stop("Upper_Wall2", gap - sp.sin(phi), [phi, -r * w_dot], [0, 1]),
+        Stop("lower_wall", phi + 1.2 + sp.cos(phi) / 10, [phi, -r * w_dot], [0, 1]),
+    ],
+    period=sp.pi,
+)
+"""
+"""``sin`` and ``cos`` of the state (in the field and in a guard) and of ``2 t``; two stops, unusual names."""
+
+
+@pytest.fixture(scope="module")
+def trig_model(tmp_path_factory):
+    from grazing.cli.common import load_model
+
+    path = tmp_path_factory.mktemp("models") / "trig_rotor.py"
+    path.write_text(MODEL_FILE)
+    return load_model(f"{path}:MODEL")
+
+
+def test_a_model_with_sin_of_its_states_on_lanes_equals_the_scalar_path(trig_model) -> None:
+    from grazing.core.options import SweepSettings
+    from grazing.sweeps.run import run_chunks
+    from grazing.sweeps.spec import sweep_spec
+    from tests.engine.test_lanes import assert_chunks_equal, check_lane_functions
+
+    check_lane_functions(trig_model, np.random.default_rng(17))
+    settings_ = SweepSettings(transient=40, periods=16, chunk_size=3, lyapunov=False)
+    spec = sweep_spec(trig_model, "a_2t", np.linspace(0.8, 2.0, 9), settings=settings_)
+    results = run_chunks(spec, list(range(spec.n_chunks)))
+    by_stop = sum(np.asarray(res.impacts_by_stop).sum(axis=0) for res in results)
+    assert by_stop.min() > 0  # both stops are hit (their guards and resets run)
+    assert_chunks_equal(spec, results, "trig rotor")
