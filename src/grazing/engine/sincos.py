@@ -17,8 +17,12 @@ fast path:
    ``pio2_3``) have at most 32 significant bits, so for ``|n| <= 2^20`` their
    products with ``n`` are exact, and each subtraction's rounding error is
    recovered exactly (Dekker's Fast2Sum; where its ordering condition fails
-   the subtraction itself is exact).  The remaining error of ``hi + lo`` is
-   below ``2^-100 |r|`` for ``|x| <`` :data:`LIMIT`.
+   the subtraction itself is exact); these errors and the fourth part make
+   ``lo`` (below one ulp of ``hi``), computed beside the kernels' first
+   steps rather than before them.  No double with ``|x| <`` :data:`LIMIT` is
+   closer to a multiple of ``pi/2`` than ``2^-72.6 |x|`` (an exact scan of
+   every multiple: ``tests/engine/test_sincos.py``), and the error of
+   ``hi + lo`` stays below ``2^-80 |r|``.
 2. **Kernels** on ``[-pi/4, pi/4]``: fdlibm's minimax polynomials for
    ``sin`` (degree 13) and ``cos`` (degree 14) with the correction for the
    tail ``lo``, as FreeBSD's ``k_sin.c`` and ``k_cos.c`` (Bruce Evans'
