@@ -18,8 +18,9 @@ fast path:
    products with ``n`` are exact, and each subtraction's rounding error is
    recovered exactly (Dekker's Fast2Sum; where its ordering condition fails
    the subtraction itself is exact); these errors and the fourth part make
-   ``lo`` (below one ulp of ``hi``), computed beside the kernels' first
-   steps rather than before them.  No double with ``|x| <`` :data:`LIMIT` is
+   ``lo``, computed beside the kernels' first steps rather than before them
+   (``|lo|`` is below one ulp of ``hi``, or below ``2^-31 |hi|`` where
+   ``|hi| < 1e-12``: the kernels' first-order correction for ``lo`` holds).  No double with ``|x| <`` :data:`LIMIT` is
    closer to a multiple of ``pi/2`` than ``2^-72.6 |x|`` (an exact scan of
    every multiple: ``tests/engine/test_sincos.py``), and the error of
    ``hi + lo`` stays below ``2^-80 |r|``.
@@ -105,7 +106,7 @@ def sincos_fast(x: float) -> tuple[float, float]:
     t = x * INVPIO2 + TOINT
     n = t - TOINT
     m = n - 4.0 * ((n * 0.25 + TOINT) - TOINT)
-    # r = x - n pi/2 = hi + lo (lo, below one ulp of hi, is off the critical path)
+    # r = x - n pi/2 = hi + lo (lo, tiny beside hi, is off the critical path)
     t1 = x - n * PIO2_1
     p2 = n * PIO2_2
     s2 = t1 - p2
