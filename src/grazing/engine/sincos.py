@@ -20,10 +20,11 @@ fast path:
    the subtraction itself is exact); these errors and the fourth part make
    ``lo``, computed beside the kernels' first steps rather than before them
    (``|lo|`` is below one ulp of ``hi``, or below ``2^-31 |hi|`` where
-   ``|hi| < 1e-12``: the kernels' first-order correction for ``lo`` holds).  No double with ``|x| <`` :data:`LIMIT` is
-   closer to a multiple of ``pi/2`` than ``2^-72.6 |x|`` (an exact scan of
-   every multiple: ``tests/engine/test_sincos.py``), and the error of
-   ``hi + lo`` stays below ``2^-80 |r|``.
+   ``|hi| < 1e-12``: the kernels' first-order correction for ``lo`` holds).
+   No double with ``|x| <`` :data:`LIMIT` is closer to a multiple of
+   ``pi/2`` than ``2^-72.6 |x|`` (an exact scan of every multiple:
+   ``tests/engine/test_sincos.py``), and the error of ``hi + lo`` stays
+   below ``2^-80 |r|``.
 2. **Kernels** on ``[-pi/4, pi/4]``: fdlibm's minimax polynomials for
    ``sin`` (degree 13) and ``cos`` (degree 14) with the correction for the
    tail ``lo``, as FreeBSD's ``k_sin.c`` and ``k_cos.c`` (Bruce Evans'
