@@ -362,7 +362,9 @@ def kernel_key(identity: str, directions: int, order: int = DEFAULT_ORDER) -> st
     import llvmlite
 
     here = Path(__file__).parent
-    deps = "".join((here / f).read_text() for f in ("taylor.py", "codegen.py", "llvmgen.py", "abi.py"))
+    deps = "".join(
+        (here / f).read_text() for f in ("taylor.py", "codegen.py", "llvmgen.py", "sincos.py", "abi.py")
+    )
     versions = (_CODEGEN_VERSION, llvmlite.__version__, sys.version)
     return _key(identity, int(directions), order, versions, deps)
 

@@ -11,10 +11,22 @@ is compiled in a fraction of a second: numba's front end (typing, reference
 counting, exception paths for every division) is what cost the time.
 
 The translation keeps the arithmetic exactly: the same operations in the same
-order, no fast-math flags, and the same LLVM intrinsics or C library functions
-that numba calls for ``math.sin``, ``math.exp``, ``**`` and the others, so the
-results are bit-identical to numba's.  One difference: a division by zero
-gives an infinity or a NaN (IEEE) where numba raised ``ZeroDivisionError``.
+order, no fast-math flags (so no fused multiply-adds), and for ``math.exp``,
+``**`` and the other functions the same LLVM intrinsics or C library functions
+that numba calls, so the results are bit-identical to numba's compiling the
+same text, with two exceptions.  ``math.sin`` and ``math.cos``, in every
+generated function, are grazing's own (:mod:`grazing.engine.sincos`: within
+one ulp, not always the C library's bits): straight-line arithmetic
+translated in place, the same operations on a scalar and on SIMD lanes, so
+that a lane function gives its scalar twin's bits while its vectors stay
+vectors (the C library's ``sin`` would take one call per lane).  Using them
+in every function (the vector field, guards, resets), not only in the Taylor
+kernels and their lane twins, keeps one definition of ``sin`` and ``cos`` for
+the whole model.  And a division by zero gives an infinity or a NaN
+(IEEE) where numba raised ``ZeroDivisionError``.  The reference for the
+compiled code is CPython running the same text with
+:func:`grazing.engine.sincos.sin` and :func:`~grazing.engine.sincos.cos` as
+``math.sin`` and ``math.cos`` (``tests/engine/test_llvmgen.py``).
 
 Examples
 --------
@@ -30,7 +42,9 @@ from __future__ import annotations
 
 import ast
 import ctypes
+import inspect
 import math
+import textwrap
 import threading
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -40,6 +54,7 @@ import llvmlite.binding as llvm
 import llvmlite.ir as ir
 import numpy as np
 
+from grazing.engine import sincos
 from grazing.engine.abi import ARITY, C_SIGNATURE
 
 _DOUBLE = ir.DoubleType()
@@ -50,7 +65,7 @@ _FNTY = ir.FunctionType(_DOUBLE, [_PTR, _DOUBLE, _PTR, _PTR, _PTR, _PTR, _I64])
 """The common signature (:mod:`grazing.engine.abi`)."""
 
 # math functions as numba lowers them: LLVM intrinsics for these ...
-_INTRINSICS = {"sin", "cos", "exp", "log", "log10", "log2", "fabs", "exp2", "copysign", "pow"}
+_INTRINSICS = {"exp", "log", "log10", "log2", "fabs", "exp2", "copysign", "pow"}
 # ... and C library calls for the rest.
 _EXTERNS = {
     "tan": "tan", "asin": "asin", "acos": "acos", "atan": "atan", "atan2": "atan2", "sinh": "sinh",
@@ -60,6 +75,19 @@ _EXTERNS = {
     "ceil": "ceil", "trunc": "trunc",
 }  # fmt: skip
 _CONSTANTS = {"pi": math.pi, "e": math.e, "inf": math.inf, "nan": math.nan}
+
+
+def _sincos_body() -> tuple[list[ast.stmt], tuple[str, str]]:
+    """The statements of :func:`grazing.engine.sincos.sincos_fast` and the names it returns."""
+    fdef = ast.parse(textwrap.dedent(inspect.getsource(sincos.sincos_fast))).body[0]
+    assert isinstance(fdef, ast.FunctionDef)
+    *body, ret = fdef.body
+    assert isinstance(ret, ast.Return) and isinstance(ret.value, ast.Tuple)
+    names = [e.id for e in ret.value.elts if isinstance(e, ast.Name)]
+    return body, (names[0], names[1])
+
+
+_SINCOS_BODY, _SINCOS_RESULTS = _sincos_body()
 
 
 class UntranslatableCodeError(ValueError):
@@ -77,6 +105,8 @@ class _Function:
     columns: Mapping[str, int]
     lanes: int = 0  # 0: scalars; L: every value a vector of L lanes (see translate)
     env: dict[str, ir.Value] = field(default_factory=dict)
+    trig: dict[int, tuple[ir.Value, ir.Value, ir.Value]] = field(default_factory=dict)
+    # id of an argument -> (the argument, its sin, its cos): sin and cos of one value computed once
 
     def _declare(self, name: str, nargs: int, intrinsic: bool) -> ir.Function:
         ty = ir.VectorType(_DOUBLE, self.lanes) if self.lanes and intrinsic else _DOUBLE
@@ -100,6 +130,52 @@ class _Function:
             i = ir.Constant(ir.IntType(32), lane)
             out = b.insert_element(out, b.call(callee, [b.extract_element(a, i) for a in args]), i)
         return out
+
+    def _sincos(self, x: ir.Value) -> tuple[ir.Value, ir.Value]:
+        """``sin x`` and ``cos x`` by :func:`grazing.engine.sincos.sincos` (scalar or lanes alike).
+
+        The fast path is the text of :func:`~grazing.engine.sincos.sincos_fast`
+        translated in place; if a lane is beyond :data:`~grazing.engine.sincos.LIMIT`
+        (or NaN, infinite), a branch computes the C library's ``sin`` and
+        ``cos`` of every lane and keeps them for those lanes.
+        """
+        known = self.trig.get(id(x))
+        if known is not None:
+            return known[1], known[2]
+        b = self.builder
+        env = {"x": x, **{k: self._constant(_DOUBLE, v) for k, v in sincos.CONSTANTS.items()}}
+        fast = _Function(self.module, self.fn, b, {}, {}, self.lanes, env)
+        for stmt in _SINCOS_BODY:
+            fast.statement(stmt)
+        s_fast, c_fast = (fast.env[name] for name in _SINCOS_RESULTS)
+        inside = b.fcmp_ordered(
+            "<", b.call(self._declare("fabs", 1, True), [x]), self._constant(_DOUBLE, sincos.LIMIT)
+        )
+        every = inside
+        if self.lanes:  # every lane inside: the L bits of the mask all set
+            mask = ir.IntType(self.lanes)
+            every = b.icmp_unsigned("==", b.bitcast(inside, mask), ir.Constant(mask, -1))
+        entry = b.block
+        slow, done = self.fn.append_basic_block("sincos_slow"), self.fn.append_basic_block("sincos_done")
+        b.cbranch(every, done, slow).set_weights([1000, 1])
+        b.position_at_end(slow)
+        libm = [self._declare(name, 1, False) for name in ("sin", "cos")]
+        if self.lanes:
+            s_slow, c_slow = (
+                b.select(inside, v, self._scalarised(f, [x])) for v, f in zip((s_fast, c_fast), libm)
+            )
+        else:
+            s_slow, c_slow = (b.call(f, [x]) for f in libm)
+        b.branch(done)
+        b.position_at_end(done)
+        out = []
+        for v_fast, v_slow in ((s_fast, s_slow), (c_fast, c_slow)):
+            phi = b.phi(x.type)
+            phi.add_incoming(v_fast, entry)
+            phi.add_incoming(v_slow, slow)
+            out.append(phi)
+        self.trig[id(x)] = (x, out[0], out[1])
+        return out[0], out[1]
 
     def _element(self, node: ast.Subscript) -> ir.Value:
         """Pointer to ``arr[i]`` or ``arr[i, k]`` (C order; the columns of 2-D arrays are known)."""
@@ -186,6 +262,8 @@ class _Function:
                 return b.select(beyond, args[1], args[0])
         if isinstance(f, ast.Attribute) and isinstance(f.value, ast.Name) and f.value.id == "math":
             name = f.attr
+            if name in ("sin", "cos") and len(args) == 1:
+                return self._sincos(args[0])[name == "cos"]
             if name in _INTRINSICS:
                 return b.call(self._declare(name, len(args), True), args)
             if name in _EXTERNS:

@@ -434,6 +434,7 @@ class _Continuation:
         self.detect, self.switch, self.progress = detect, switch, progress
         self.virtual = branch.virtual
         self.switched_smooth = False  # switched at a period-doubling or branch point (done once)
+        self.toward = 1.0  # the parameter's direction from the request's start to its stop
 
     # -- acceptance of a step -------------------------------------------------------------
 
@@ -632,6 +633,8 @@ class _Continuation:
             u_star = np.append(at.orbit.state, at.param)
             for orbit, direction in crossing_starts(evaluate, u_star, at.tangent, self.s):
                 starts.append(Start(orbit, math.copysign(1.0, direction[-1] or 1.0), direction, i))
+            # first the direction of the request (the null vector's sign, and so their order, is arbitrary)
+            starts.sort(key=lambda st: st.sign != self.toward)
             missing = "not switched: no other branch was found through it"
             what = "the other branch through it" + (" (both directions)" if len(starts) == 2 else "")
         if not starts:
@@ -767,7 +770,8 @@ def continue_orbit(
     run = _Continuation(
         model, param, branch, s, (min(start, stop), max(start, stop)), tuple(detect), switch, progress
     )
-    pending = [Start(orbit, math.copysign(1.0, stop - start))]  # (a stack: each chain to its end first)
+    run.toward = math.copysign(1.0, stop - start)
+    pending = [Start(orbit, run.toward)]  # (a stack: each chain to its end first)
     while pending:
         if len(branch) >= s.max_points:
             left = len(pending)

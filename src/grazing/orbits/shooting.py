@@ -403,16 +403,20 @@ def find_orbit(
         return move_section(orbit, quiet_section(orbit), tol=tol)
     stop = model.stop_index(stop_name)
     guess: InitialGuess | None = None
+    note = ""  # why the default guess's period was not used, if it was not
     if x0 is None:
         advice = "try another period (--period), an initial guess x0 (--initial) or a longer transient"
         guess = initial_guess(model, t0=t0, transient=transient, virtual=virtual)
         x, detected = guess.state, guess.period
         n = int(period or detected or 1)
         if not (period or detected):
-            advice = (
+            note = (
                 f"simulation from rest showed no period <= 64 after {transient} periods (chaos, or a "
-                "transient not yet settled), so a period-1 orbit was tried; give the period (--period) or "
-                "an initial guess x0 (--initial), or a longer transient (--transient)"
+                "transient not yet settled), so a period-1 orbit was tried"
+            )
+            advice = (
+                f"{note}; give the period (--period) or an initial guess x0 (--initial), or a longer "
+                "transient (--transient)"
             )
     else:
         advice = "try another initial guess or another period"
@@ -420,7 +424,7 @@ def find_orbit(
         n = int(period or 1)
     newton = _Newton(model, t0, n, stop, tol, max_iter)
     try:
-        return newton.solve(x, virtual, advice, guess)
+        return newton.solve(x, virtual, advice, guess, note)
     except ConvergenceError:
         inside = None if virtual else newton.nonimpacting(x)
         if inside is None:
@@ -439,8 +443,11 @@ class _Newton:
     tol: float
     max_iter: int
 
-    def solve(self, x: np.ndarray, virtual: bool, advice: str, guess: InitialGuess | None) -> PeriodicOrbit:
-        """The orbit from ``x``, or :class:`ConvergenceError` saying why not and ``advice``."""
+    def solve(
+        self, x: np.ndarray, virtual: bool, advice: str, guess: InitialGuess | None, note: str = ""
+    ) -> PeriodicOrbit:
+        """The orbit from ``x``, or :class:`ConvergenceError` saying why not and ``advice`` (with
+        ``note``, how the guess was made, where the motion sticks)."""
         model, t0, n, stop, tol = self.model, self.t0, self.n, self.stop, self.tol
         residuals: list[float] = []
         why = ""
@@ -457,7 +464,9 @@ class _Newton:
                     f"beyond the stop); {advice}"
                 ) from None
             if not fm.solution.jacobian_valid:
-                raise ConvergenceError(_sticking_message(model, n, it, fm, guess))
+                raise ConvergenceError(
+                    _sticking_message(model, n, it, fm, guess) + (f"; {note}" if note else "")
+                )
             F = fm.image - x
             res = float(np.max(np.abs(F)))
             residuals.append(res)
