@@ -43,7 +43,7 @@ from grazing.engine.driver.state import STATUS_NONFINITE, STATUS_OK, STATUS_STEP
 from grazing.engine.driver.step import STEP_LAST, accept_step, end_plain_step, end_step, step_end
 from grazing.engine.polyroots import quadratic_bound, work_shape
 from grazing.engine.records import Kernels, LaneJobs, LanePoints, LaneResults, LaneSettings
-from grazing.engine.stepping import new_table, step_factor, step_from_norms, step_size
+from grazing.engine.stepping import new_table, step_factor, step_size, steps_from_norms
 
 LANE_ROOT_ROWS, LANE_ROOT_MIN_COLS = work_shape(0)
 ADAPTIVE_BLOCK = 32  # (grazing.sweeps.run.ADAPTIVE_BLOCK)
@@ -202,7 +202,7 @@ def sweep_lanes(m, cfg, work, points, out):
     dts = np.zeros(L)  # accepted part of it
     flags = np.zeros(L, dtype=np.int64)  # how it ends (step.STEP_LAST, STEP_MAP), or FAILED
     todo = np.zeros(L, dtype=np.int64)  # 1: the lane steps this round
-    norms = (np.zeros(L), np.zeros(L), np.zeros(L))  # of the step sizes (lane_norms)
+    norms = (np.zeros(L), np.zeros(L), np.zeros(L), np.zeros(L), np.zeros(L))  # (lane_norms)
     certs = (np.zeros(L), np.zeros(L), np.zeros(L), np.zeros(L), np.zeros(L))  # (no_events_certain)
     plain = np.zeros(L, dtype=np.int64)  # 1: no event on the step is certain so far
     acc = np.zeros(L)
@@ -225,7 +225,7 @@ def sweep_lanes(m, cfg, work, points, out):
         # The Taylor coefficients: lanes in free flight by kind, on vectors where there are enough of them;
         # the norms of their step sizes.
         nvar = lane_coefficients(m, la, kinds, use_lanes, coeffs)
-        lane_norms(m, XT, OT, kinds, nvar, norms)
+        lane_norms(m, ls, XT, OT, kinds, nvar, factor, norms)
 
         # Pass A, lane by lane: the step, its events and its samples.
         plan_steps(m, cfg, la, zdms, norms, coeffs, factor, (hs, flags, todo, plain))
@@ -352,9 +352,10 @@ def lane_coefficients(m, la, kinds, use_lanes, coeffs):
 
 
 @njit(cache=True, inline="always")
-def lane_norms(m, XT, OT, kinds, nvar, norms):
-    """The norms of the lanes' step sizes (as ``step_size``, row by row, on vectors) into ``norms``."""
-    nx_, n1_, n2_ = norms
+def lane_norms(m, ls, XT, OT, kinds, nvar, factor, norms):
+    """The norms of the lanes' step sizes (as ``step_size``, row by row, on vectors) into ``norms``, and
+    the steps in free flight from them (on vectors too: ``step_from_norms`` calls no C function)."""
+    nx_, n1_, n2_, hfree, Tl = norms
     n = m.nx
     order = m.order
     nstops = m.nstops
@@ -374,6 +375,9 @@ def lane_norms(m, XT, OT, kinds, nvar, norms):
                 nx_[lane] = max(nx_[lane], abs(XT[i, 0, lane]))
                 n1_[lane] = max(n1_[lane], abs(XT[i, order - 1, lane]))
                 n2_[lane] = max(n2_[lane], abs(XT[i, order, lane]))
+    for lane in range(L):
+        Tl[lane] = ls[lane].T
+    steps_from_norms(nx_, n1_, n2_, order, Tl, factor, hfree)
 
 
 @njit(cache=True, inline="always")
@@ -385,33 +389,32 @@ def no_events_certain(m, cfg, OT, hs, plain, certs):
     polynomial is certainly positive on its step.  A single lane is never
     plain (its search is as cheap).  ``certs`` = ``(a0, a1, a2, tl, hk)``.
     """
-    a0, a1, a2, tl, hk = certs
     nstops = m.nstops
     K = m.order + 1
     L = hs.shape[0]
-    for lane in range(L if L == 1 else 0):
-        plain[lane] = 0
-    for r in range(nstops if L > 1 else 0):
-        if cfg.zdm and r == cfg.stop:
+    for lane in range(L):  # (lane by lane: the sums stay in registers)
+        if L == 1:
+            plain[lane] = 0
+        if plain[lane] == 0:
             continue
-        for lane in range(L):
-            hk[lane] = 1.0
-            tl[lane] = 0.0
-            a0[lane] = OT[r, 0, lane] * hk[lane]
-            hk[lane] *= hs[lane]
-            a1[lane] = OT[r, 1, lane] * hk[lane]
-            hk[lane] *= hs[lane]
-            a2[lane] = OT[r, 2, lane] * hk[lane]
-            hk[lane] *= hs[lane]
-        for j in range(3, K):
-            for lane in range(L):
-                tl[lane] += abs(OT[r, j, lane] * hk[lane])
-                hk[lane] *= hs[lane]
-        for lane in range(L):
-            if plain[lane] == 1 and not (
-                a0[lane] > 0.0 and quadratic_bound(a0[lane], a1[lane], a2[lane], tl[lane]) > 0.0
-            ):
+        h = hs[lane]
+        for r in range(nstops):
+            if cfg.zdm and r == cfg.stop:
+                continue
+            hk = 1.0
+            a0 = OT[r, 0, lane] * hk
+            hk *= h
+            a1 = OT[r, 1, lane] * hk
+            hk *= h
+            a2 = OT[r, 2, lane] * hk
+            hk *= h
+            tl = 0.0
+            for j in range(3, K):
+                tl += abs(OT[r, j, lane] * hk)
+                hk *= h
+            if not (a0 > 0.0 and quadratic_bound(a0, a1, a2, tl) > 0.0):
                 plain[lane] = 0
+                break
 
 
 @njit(cache=True, inline="always")
@@ -425,18 +428,16 @@ def advance_lanes(m, la, XT, dts, todo, kinds, nvar, acc):
     order = m.order
     L = dts.shape[0]
     ntot = n + n * n
-    for lane in range(L):
+    for lane in range(L):  # (lane by lane: the sums stay in registers, several lanes' chains overlap)
         if todo[lane] == 0:
-            dts[lane] = 0.0
-    for i in range(ntot if nvar > 0 else n):
-        for lane in range(L):
-            acc[lane] = XT[i, order, lane]
-        for j in range(order - 1, -1, -1):
-            for lane in range(L):
-                acc[lane] = acc[lane] * dts[lane] + XT[i, j, lane]
-        for lane in range(L):
-            if todo[lane] == 1 and (i < n or (kinds[lane] == 2 and ls[lane].mode == 0)):
-                XS[i, lane] = acc[lane]
+            continue
+        dt = dts[lane]
+        rows = ntot if (nvar > 0 and kinds[lane] == 2 and ls[lane].mode == 0) else n
+        for i in range(rows):
+            v = XT[i, order, lane]
+            for j in range(order - 1, -1, -1):
+                v = v * dt + XT[i, j, lane]
+            XS[i, lane] = v
 
 
 @njit(cache=True, inline="always")
@@ -449,7 +450,7 @@ def plan_steps(m, cfg, la, zdms, norms, coeffs, factor, plan):
     (free flight, no known root at its start: :func:`no_events_certain`).
     """
     hs, flags, todo, plain = plan
-    nx_, n1_, n2_ = norms
+    hfree = norms[3]
     XT, OT, _, Xs, Os, xl = coeffs
     ls, XS, pl = la.ls, la.XS, la.pl
     n = m.nx
@@ -485,7 +486,7 @@ def plan_steps(m, cfg, la, zdms, norms, coeffs, factor, plan):
             to_lane(Xs, Os, n, nstops, K, XT, OT, lane)
             h = step_size(Xs, n, Os, nstops, stuck, order, T, factor)
         else:
-            h = step_from_norms(nx_[lane], n1_[lane], n2_[lane], order, T, factor)
+            h = hfree[lane]
         h, ends = step_end(ls[lane], h, cfg.zdm, zdms[p])
         flags[lane] = ends
         hs[lane] = h
