@@ -122,7 +122,7 @@ def _polish(a, n, lo, hi, p_lo, p_hi):
     return hi
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def quadratic_bound(a0, a1, a2, tail):
     """A lower bound on [0, 1] of ``a0 + a1 u + a2 u^2 + r(u)`` where ``|r| <= tail``.
 

@@ -41,6 +41,7 @@ from grazing.engine.driver.events import first_event
 from grazing.engine.driver.recording import take_samples
 from grazing.engine.driver.state import STATUS_NONFINITE, STATUS_OK, STATUS_STEP_LIMIT, new_state
 from grazing.engine.driver.step import STEP_LAST, accept_step, end_plain_step, end_step, step_end
+from grazing.engine.llvmgen import lane_width
 from grazing.engine.polyroots import quadratic_bound, work_shape
 from grazing.engine.records import Kernels, LaneJobs, LanePoints, LaneResults, LaneSettings
 from grazing.engine.stepping import new_table, step_factor, step_size, steps_from_norms
@@ -50,6 +51,9 @@ ADAPTIVE_BLOCK = 32  # (grazing.sweeps.run.ADAPTIVE_BLOCK)
 ADAPTIVE_MAX_PERIOD = 16
 LYAPUNOV_ALIGN = 16
 VECTOR_MIN_LANES = 3
+LANE_WIDTH = lane_width()
+"""This processor's lane width (the model's lane functions'): loops over that many lanes have a constant
+trip count, which lets the compiler keep their values in vector registers."""
 """Fewest lanes of a kind for which the lane function is called (else the scalar one, lane by lane)."""
 
 
@@ -202,8 +206,8 @@ def sweep_lanes(m, cfg, work, points, out):
     dts = np.zeros(L)  # accepted part of it
     flags = np.zeros(L, dtype=np.int64)  # how it ends (step.STEP_LAST, STEP_MAP), or FAILED
     todo = np.zeros(L, dtype=np.int64)  # 1: the lane steps this round
-    norms = (np.zeros(L), np.zeros(L), np.zeros(L), np.zeros(L), np.zeros(L))  # (lane_norms)
-    certs = (np.zeros(L), np.zeros(L), np.zeros(L), np.zeros(L), np.zeros(L))  # (no_events_certain)
+    norms = np.zeros(5 * L)  # the norms of the steps, the steps in free flight, the periods (lane_norms)
+    certs = np.zeros(5 * L)  # (no_events_certain)
     plain = np.zeros(L, dtype=np.int64)  # 1: no event on the step is certain so far
     acc = np.zeros(L)
 
@@ -353,31 +357,44 @@ def lane_coefficients(m, la, kinds, use_lanes, coeffs):
 
 @njit(cache=True, inline="always")
 def lane_norms(m, ls, XT, OT, kinds, nvar, factor, norms):
-    """The norms of the lanes' step sizes (as ``step_size``, row by row, on vectors) into ``norms``, and
-    the steps in free flight from them (on vectors too: ``step_from_norms`` calls no C function)."""
-    nx_, n1_, n2_, hfree, Tl = norms
+    """The norms of the lanes' steps (as ``step_size``, row by row, on vectors) and the steps in free flight.
+
+    ``norms`` holds five rows of ``L`` lanes, one after the other: the norms
+    ``nx``, ``n1``, ``n2`` of :func:`~grazing.engine.stepping.step_from_norms`,
+    the step (on vectors too: it calls no C function) and the lane's period.
+    """
+    L = XT.shape[2]
+    if L == LANE_WIDTH:
+        _lane_norms(m, ls, XT, OT, kinds, nvar, factor, norms, LANE_WIDTH)
+    else:
+        _lane_norms(m, ls, XT, OT, kinds, nvar, factor, norms, L)
+
+
+@njit(cache=True, inline="always")
+def _lane_norms(m, ls, XT, OT, kinds, nvar, factor, norms, nl):
+    """:func:`lane_norms` over ``nl`` lanes (a constant: the rows' values stay in vector registers)."""
     n = m.nx
     order = m.order
     nstops = m.nstops
-    L = XT.shape[2]
     ntot = n + n * n
-    for lane in range(L):
-        nx_[lane] = abs(OT[0, 0, lane])
-        n1_[lane] = 0.0
-        n2_[lane] = 0.0
+    for lane in range(nl):
+        norms[lane] = abs(OT[0, 0, lane])
+        norms[nl + lane] = 0.0
+        norms[2 * nl + lane] = 0.0
     for r in range(nstops):
-        for lane in range(L):
-            n1_[lane] = max(n1_[lane], abs(OT[r, order - 1, lane]))
-            n2_[lane] = max(n2_[lane], abs(OT[r, order, lane]))
+        for lane in range(nl):
+            norms[nl + lane] = max(norms[nl + lane], abs(OT[r, order - 1, lane]))
+            norms[2 * nl + lane] = max(norms[2 * nl + lane], abs(OT[r, order, lane]))
     for i in range(ntot if nvar > 0 else n):
-        for lane in range(L):
+        for lane in range(nl):
             if i < n or kinds[lane] == 2:
-                nx_[lane] = max(nx_[lane], abs(XT[i, 0, lane]))
-                n1_[lane] = max(n1_[lane], abs(XT[i, order - 1, lane]))
-                n2_[lane] = max(n2_[lane], abs(XT[i, order, lane]))
-    for lane in range(L):
-        Tl[lane] = ls[lane].T
-    steps_from_norms(nx_, n1_, n2_, order, Tl, factor, hfree)
+                norms[lane] = max(norms[lane], abs(XT[i, 0, lane]))
+                norms[nl + lane] = max(norms[nl + lane], abs(XT[i, order - 1, lane]))
+                norms[2 * nl + lane] = max(norms[2 * nl + lane], abs(XT[i, order, lane]))
+    for lane in range(nl):
+        norms[4 * nl + lane] = ls[lane].T
+    steps_from_norms(norms[:nl], norms[nl : 2 * nl], norms[2 * nl : 3 * nl], order, norms[4 * nl :],
+                     factor, norms[3 * nl : 4 * nl])  # fmt: skip
 
 
 @njit(cache=True, inline="always")
@@ -387,34 +404,44 @@ def no_events_certain(m, cfg, OT, hs, plain, certs):
     ``event_certificate`` on vectors (the same coefficients as
     ``event_polynomial``): a lane stays ``plain`` where every guard's
     polynomial is certainly positive on its step.  A single lane is never
-    plain (its search is as cheap).  ``certs`` = ``(a0, a1, a2, tl, hk)``.
+    plain (its search is as cheap).  ``certs`` holds five rows of ``L`` lanes
+    (``a0, a1, a2``, the tail, the power of the step).
     """
+    L = hs.shape[0]
+    if L == 1:
+        plain[0] = 0
+    elif L == LANE_WIDTH:
+        _no_events_certain(m, cfg, OT, hs, plain, certs, LANE_WIDTH)
+    else:
+        _no_events_certain(m, cfg, OT, hs, plain, certs, L)
+
+
+@njit(cache=True, inline="always")
+def _no_events_certain(m, cfg, OT, hs, plain, certs, nl):
+    """:func:`no_events_certain` over ``nl`` lanes (a constant: the rows stay in vector registers)."""
     nstops = m.nstops
     K = m.order + 1
-    L = hs.shape[0]
-    for lane in range(L):  # (lane by lane: the sums stay in registers)
-        if L == 1:
-            plain[lane] = 0
-        if plain[lane] == 0:
+    a1, a2, tl, hk = nl, 2 * nl, 3 * nl, 4 * nl
+    for r in range(nstops):
+        if cfg.zdm and r == cfg.stop:
             continue
-        h = hs[lane]
-        for r in range(nstops):
-            if cfg.zdm and r == cfg.stop:
-                continue
-            hk = 1.0
-            a0 = OT[r, 0, lane] * hk
-            hk *= h
-            a1 = OT[r, 1, lane] * hk
-            hk *= h
-            a2 = OT[r, 2, lane] * hk
-            hk *= h
-            tl = 0.0
-            for j in range(3, K):
-                tl += abs(OT[r, j, lane] * hk)
-                hk *= h
-            if not (a0 > 0.0 and quadratic_bound(a0, a1, a2, tl) > 0.0):
+        for lane in range(nl):
+            certs[hk + lane] = 1.0
+            certs[tl + lane] = 0.0
+            certs[lane] = OT[r, 0, lane] * certs[hk + lane]
+            certs[hk + lane] *= hs[lane]
+            certs[a1 + lane] = OT[r, 1, lane] * certs[hk + lane]
+            certs[hk + lane] *= hs[lane]
+            certs[a2 + lane] = OT[r, 2, lane] * certs[hk + lane]
+            certs[hk + lane] *= hs[lane]
+        for j in range(3, K):
+            for lane in range(nl):
+                certs[tl + lane] += abs(OT[r, j, lane] * certs[hk + lane])
+                certs[hk + lane] *= hs[lane]
+        for lane in range(nl):
+            bound = quadratic_bound(certs[lane], certs[a1 + lane], certs[a2 + lane], certs[tl + lane])
+            if plain[lane] == 1 and not (certs[lane] > 0.0 and bound > 0.0):
                 plain[lane] = 0
-                break
 
 
 @njit(cache=True, inline="always")
@@ -428,6 +455,20 @@ def advance_lanes(m, la, XT, dts, todo, kinds, nvar, acc):
     order = m.order
     L = dts.shape[0]
     ntot = n + n * n
+    if L == LANE_WIDTH:  # (a constant number of lanes: the sums stay in vector registers)
+        for lane in range(LANE_WIDTH):
+            if todo[lane] == 0:
+                dts[lane] = 0.0
+        for i in range(ntot if nvar > 0 else n):
+            for lane in range(LANE_WIDTH):
+                acc[lane] = XT[i, order, lane]
+            for j in range(order - 1, -1, -1):
+                for lane in range(LANE_WIDTH):
+                    acc[lane] = acc[lane] * dts[lane] + XT[i, j, lane]
+            for lane in range(LANE_WIDTH):
+                if todo[lane] == 1 and (i < n or (kinds[lane] == 2 and ls[lane].mode == 0)):
+                    XS[i, lane] = acc[lane]
+        return
     for lane in range(L):  # (lane by lane: the sums stay in registers, several lanes' chains overlap)
         if todo[lane] == 0:
             continue
@@ -450,7 +491,6 @@ def plan_steps(m, cfg, la, zdms, norms, coeffs, factor, plan):
     (free flight, no known root at its start: :func:`no_events_certain`).
     """
     hs, flags, todo, plain = plan
-    hfree = norms[3]
     XT, OT, _, Xs, Os, xl = coeffs
     ls, XS, pl = la.ls, la.XS, la.pl
     n = m.nx
@@ -458,6 +498,7 @@ def plan_steps(m, cfg, la, zdms, norms, coeffs, factor, plan):
     nstops = m.nstops
     K = order + 1
     L = ls.shape[0]
+    hfree = norms[3 * L : 4 * L]
     for lane in range(L):
         todo[lane] = 0
         flags[lane] = 0
