@@ -26,6 +26,8 @@ _MAX_DEGREE = 64
 _QUOTIENTS = np.array([[i / j if j else 0.0 for j in range(_MAX_DEGREE + 2)] for i in range(_MAX_DEGREE + 2)])
 """``_QUOTIENTS[i, j]`` = ``i / j``: :func:`to_bernstein`'s quotients of small integers, divided once here
 (the same doubles as dividing on every call; a division costs several multiplications' time)."""
+
+
 @njit(cache=True)
 def horner(a, n, u):
     """Value of ``sum(a[k] * u**k for k <= n)``."""

@@ -68,7 +68,8 @@ def fast_log(x):
     m = m * 0.5 if up else m
     t = (m - 1.0) / (m + 1.0)
     t2 = t * t
-    s = t2 * (1.0 / 3.0 + t2 * (1.0 / 5.0 + t2 * (1.0 / 7.0 + t2 * (1.0 / 9.0 + t2 * (1.0 / 11.0)))))
+    t4 = t2 * t2
+    s = t2 * ((1.0 / 3.0 + t2 * (1.0 / 5.0)) + t4 * ((1.0 / 7.0 + t2 * (1.0 / 9.0)) + t4 * (1.0 / 11.0)))
     return e * _LN2_HI + (2.0 * t + (2.0 * t * s + e * _LN2_LO))
 
 
@@ -76,14 +77,21 @@ def fast_log(x):
 def fast_exp(y):
     """``exp(y)`` for ``|y| <= 700`` to a relative 1e-14 (see :func:`fast_log`: no call, no branch).
 
-    ``y = k ln 2 + r`` with ``|r| <= ln(2)/2``; ``e^r`` by its series to the 11th power, times ``2^k``
-    made from its bits.
+    ``y = k ln 2 + r`` with ``|r| <= ln(2)/2``; ``e^r`` by its series to the 11th power (Estrin's
+    scheme), times ``2^k`` made from its bits.
     """
     k = math.floor(y * _LOG2E + 0.5)
     r = (y - k * _LN2_HI) - k * _LN2_LO
-    p = 1.0 + r * (1.0 + r * (1.0 / 2.0 + r * (1.0 / 6.0 + r * (1.0 / 24.0 + r * (1.0 / 120.0 + r * (
-        1.0 / 720.0 + r * (1.0 / 5040.0 + r * (1.0 / 40320.0 + r * (1.0 / 362880.0 + r * (
-            1.0 / 3628800.0 + r * (1.0 / 39916800.0)))))))))))  # fmt: skip
+    # the series to r^11 in Estrin's scheme (pairs, then powers of r^2: a short chain of dependent operations)
+    r2 = r * r
+    r4 = r2 * r2
+    p01 = 1.0 + r
+    p23 = 1.0 / 2.0 + r * (1.0 / 6.0)
+    p45 = 1.0 / 24.0 + r * (1.0 / 120.0)
+    p67 = 1.0 / 720.0 + r * (1.0 / 5040.0)
+    p89 = 1.0 / 40320.0 + r * (1.0 / 362880.0)
+    pab = 1.0 / 3628800.0 + r * (1.0 / 39916800.0)
+    p = (p01 + r2 * p23) + r4 * ((p45 + r2 * p67) + r4 * (p89 + r2 * pab))
     return p * _double_of((int(k) + 1023) << 52)
 
 
@@ -134,7 +142,7 @@ def step_from_norms(nx, n1, n2, order, max_step, factor):
     r1 = r1 if r1 > _RATIO_MIN else _RATIO_MIN
     r2 = sc / (n2 if n2 > low else low)
     r2 = r2 if r2 > _RATIO_MIN else _RATIO_MIN
-    log_rho = min(fast_log(r1) / (order - 1), fast_log(r2) / order)
+    log_rho = min(fast_log(r1) * (1.0 / (order - 1)), fast_log(r2) * (1.0 / order))  # (no division per lane)
     h = fast_exp(log_rho) * factor
     return h if h < max_step else max_step
 
