@@ -41,7 +41,7 @@ from grazing.engine.driver.events import first_event
 from grazing.engine.driver.recording import take_samples
 from grazing.engine.driver.state import STATUS_NONFINITE, STATUS_OK, STATUS_STEP_LIMIT, new_state
 from grazing.engine.driver.step import STEP_LAST, accept_step, end_plain_step, end_step, step_end
-from grazing.engine.llvmgen import lane_width
+from grazing.engine.lanevec import LANE_WIDTH, certify_stop
 from grazing.engine.polyroots import quadratic_bound, work_shape
 from grazing.engine.records import Kernels, LaneJobs, LanePoints, LaneResults, LaneSettings
 from grazing.engine.stepping import new_table, step_factor, step_size, steps_from_norms
@@ -51,9 +51,6 @@ ADAPTIVE_BLOCK = 32  # (grazing.sweeps.run.ADAPTIVE_BLOCK)
 ADAPTIVE_MAX_PERIOD = 16
 LYAPUNOV_ALIGN = 16
 VECTOR_MIN_LANES = 3
-LANE_WIDTH = lane_width()
-"""This processor's lane width (the model's lane functions'): loops over that many lanes have a constant
-trip count, which lets the compiler keep their values in vector registers."""
 """Fewest lanes of a kind for which the lane function is called (else the scalar one, lane by lane)."""
 
 
@@ -410,8 +407,10 @@ def no_events_certain(m, cfg, OT, hs, plain, certs):
     L = hs.shape[0]
     if L == 1:
         plain[0] = 0
-    elif L == LANE_WIDTH:
-        _no_events_certain(m, cfg, OT, hs, plain, certs, LANE_WIDTH)
+    elif L == LANE_WIDTH:  # (on vectors: the loop over the coefficients keeps the lanes in registers)
+        for r in range(m.nstops):
+            if not (cfg.zdm and r == cfg.stop):
+                certify_stop(OT, r, m.order + 1, hs, plain)
     else:
         _no_events_certain(m, cfg, OT, hs, plain, certs, L)
 
