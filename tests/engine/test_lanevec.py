@@ -6,7 +6,7 @@ import numpy as np
 from numba import njit
 
 from grazing.engine.driver.events import event_certificate, event_polynomial
-from grazing.engine.lanevec import LANE_WIDTH, certify_stop
+from grazing.engine.lanevec import LANE_WIDTH, advance_rows, certify_stop
 
 
 @njit(cache=False)
@@ -46,3 +46,27 @@ def test_every_lane_decides_as_the_scalar_path():
                 assert plain[lane] == (before[lane] if certain else 0)
                 decided[bool(certain)] += 1
     assert min(decided.values()) > 100  # (both decisions are taken often)
+
+
+@njit(cache=False)
+def _advance(X, first, last, order, dt, mask, out):
+    advance_rows(X, first, last, order, dt, mask, out)
+
+
+def test_advancing_rows_is_the_scalar_evaluation_on_the_lanes_it_should():
+    from grazing.engine.stepping import eval_rows
+
+    rng = np.random.default_rng(6)
+    order, rows = 13, 6
+    X = rng.normal(size=(rows, order + 1, LANE_WIDTH))
+    dt = rng.uniform(0.0, 2.0, LANE_WIDTH)
+    mask = rng.integers(0, 2, LANE_WIDTH).astype(np.int64)
+    out = rng.normal(size=(rows, LANE_WIDTH))
+    before = out.copy()
+    _advance(X, 1, 5, order, dt, mask, out)
+    for lane in range(LANE_WIDTH):
+        want = np.zeros(rows)
+        eval_rows(np.ascontiguousarray(X[:, :, lane]), rows, order, dt[lane], want)
+        for i in range(rows):
+            expected = want[i] if (mask[lane] and 1 <= i < 5) else before[i, lane]
+            assert out[i, lane] == expected  # (bit for bit)

@@ -123,3 +123,45 @@ def certify_stop(typingctx, O, row, K, hs, plain):
         return context.get_dummy_value()
 
     return sig, codegen
+
+
+@intrinsic
+def advance_rows(typingctx, X, first, last, order, dt, mask, out):
+    """``out[i, lane]`` = the polynomial ``X[i, :order + 1, lane]`` at ``dt[lane]``, for ``first <= i < last``
+    and the lanes where ``mask[lane]`` is not 0 (the others keep their value).
+
+    ``X`` is ``(rows, K, LANE_WIDTH)``, ``out`` ``(rows, LANE_WIDTH)``; Horner's
+    rule from the highest coefficient, as :func:`grazing.engine.stepping.eval_rows`.
+    """
+    sig = types.void(X, first, last, order, dt, mask, out)
+
+    def codegen(context, builder, signature, args):
+        x_ty, f_ty, l_ty, o_ty, d_ty, m_ty, out_ty = signature.args
+        x_arr, first_v, last_v, order_v, d_arr, m_arr, out_arr = args
+        i64 = ir.IntType(64)
+        x_data = context.make_array(x_ty)(context, builder, x_arr).data
+        d_data = context.make_array(d_ty)(context, builder, d_arr).data
+        m_data = context.make_array(m_ty)(context, builder, m_arr).data
+        out_data = context.make_array(out_ty)(context, builder, out_arr).data
+        first_v = context.cast(builder, first_v, f_ty, types.int64)
+        last_v = context.cast(builder, last_v, l_ty, types.int64)
+        order_v = context.cast(builder, order_v, o_ty, types.int64)
+        width = ir.Constant(i64, LANE_WIDTH)
+        K = builder.add(order_v, ir.Constant(i64, 1))
+        dt = _load(builder, d_data, ir.Constant(i64, 0))
+        keep = builder.icmp_signed("!=", _load(builder, m_data, ir.Constant(i64, 0), _I64VEC),
+                                   ir.Constant(_I64VEC, [0] * LANE_WIDTH))  # fmt: skip
+        acc_slot = cgutils.alloca_once(builder, _VEC)
+        with cgutils.for_range(builder, last_v, start=first_v) as row:
+            base = builder.mul(builder.mul(row.index, K), width)  # element of X[i, 0, 0]
+            builder.store(_load(builder, x_data, builder.add(base, builder.mul(order_v, width))), acc_slot)
+            with cgutils.for_range(builder, order_v) as step:
+                j = builder.sub(builder.sub(order_v, ir.Constant(i64, 1)), step.index)  # order - 1 down to 0
+                c = _load(builder, x_data, builder.add(base, builder.mul(j, width)))
+                builder.store(builder.fadd(builder.fmul(builder.load(acc_slot), dt), c), acc_slot)
+            ptr = builder.bitcast(builder.gep(out_data, [builder.mul(row.index, width)]), _VEC.as_pointer())
+            old = builder.load(ptr, align=8)
+            builder.store(builder.select(keep, builder.load(acc_slot), old), ptr, align=8)
+        return context.get_dummy_value()
+
+    return sig, codegen

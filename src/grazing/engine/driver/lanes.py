@@ -41,7 +41,7 @@ from grazing.engine.driver.events import first_event
 from grazing.engine.driver.recording import take_samples
 from grazing.engine.driver.state import STATUS_NONFINITE, STATUS_OK, STATUS_STEP_LIMIT, new_state
 from grazing.engine.driver.step import STEP_LAST, accept_step, end_plain_step, end_step, step_end
-from grazing.engine.lanevec import LANE_WIDTH, certify_stop
+from grazing.engine.lanevec import LANE_WIDTH, advance_rows, certify_stop
 from grazing.engine.polyroots import quadratic_bound, work_shape
 from grazing.engine.records import Kernels, LaneJobs, LanePoints, LaneResults, LaneSettings
 from grazing.engine.stepping import new_table, step_factor, step_size, steps_from_norms
@@ -206,7 +206,7 @@ def sweep_lanes(m, cfg, work, points, out):
     norms = np.zeros(5 * L)  # the norms of the steps, the steps in free flight, the periods (lane_norms)
     certs = np.zeros(5 * L)  # (no_events_certain)
     plain = np.zeros(L, dtype=np.int64)  # 1: no event on the step is certain so far
-    acc = np.zeros(L)
+    acc = np.zeros(L, dtype=np.int64)  # (advance_lanes: which lanes advance)
 
     la = LaneArrays(ls, XS, pl, PT, logs, buf, counts)
     coeffs = (XT, OT, SI, Xs, Os, xl)
@@ -454,19 +454,14 @@ def advance_lanes(m, la, XT, dts, todo, kinds, nvar, acc):
     order = m.order
     L = dts.shape[0]
     ntot = n + n * n
-    if L == LANE_WIDTH:  # (a constant number of lanes: the sums stay in vector registers)
+    if L == LANE_WIDTH:  # (on vectors: the sums stay in vector registers)
         for lane in range(LANE_WIDTH):
-            if todo[lane] == 0:
-                dts[lane] = 0.0
-        for i in range(ntot if nvar > 0 else n):
-            for lane in range(LANE_WIDTH):
-                acc[lane] = XT[i, order, lane]
-            for j in range(order - 1, -1, -1):
-                for lane in range(LANE_WIDTH):
-                    acc[lane] = acc[lane] * dts[lane] + XT[i, j, lane]
-            for lane in range(LANE_WIDTH):
-                if todo[lane] == 1 and (i < n or (kinds[lane] == 2 and ls[lane].mode == 0)):
-                    XS[i, lane] = acc[lane]
+            acc[lane] = todo[lane]  # (the lanes whose state advances)
+        advance_rows(XT, 0, n, order, dts, acc, XS)
+        if nvar > 0:
+            for lane in range(LANE_WIDTH):  # (... and their variational equations, in free flight)
+                acc[lane] = 1 if todo[lane] == 1 and kinds[lane] == 2 and ls[lane].mode == 0 else 0
+            advance_rows(XT, n, ntot, order, dts, acc, XS)
         return
     for lane in range(L):  # (lane by lane: the sums stay in registers, several lanes' chains overlap)
         if todo[lane] == 0:
