@@ -181,8 +181,21 @@ def first_root(a, n, work):
 def isolate_first_root(a, n, work):
     """:func:`first_root` without its O(n) certificate, for callers that ran it already.
 
-    Requires ``a[0] > 0``.  Bernstein subdivision and Newton polishing.
+    Requires ``a[0] > 0``.  Bernstein subdivision and Newton polishing; a
+    polynomial that certainly decreases on the whole of [0, 1] (the common
+    event: a guard crossing zero) goes to Newton's method at once, its one
+    root bracketed by the ends.
     """
+    if n >= 2:
+        # p'(u) <= a1 + max(0, 2 a2) + sum_{k>=3} k |a_k| on [0, 1]; below zero: p decreases, one root
+        # at most, there iff p(1) <= 0
+        slope = a[1] + max(0.0, 2.0 * a[2])
+        end = a[0] + a[1] + a[2]
+        for k in range(3, n + 1):
+            slope += k * abs(a[k])
+            end += a[k]
+        if slope < 0.0:
+            return -1.0 if end > 0.0 else _polish(a, n, 0.0, 1.0, a[0], end)
     # Bernstein coefficients all positive => no root (convex hull property).
     b = work[0]
     to_bernstein(a, n, b)
