@@ -25,7 +25,10 @@ benchmarks/README.md):
   cooldown left from the previous batch has expired long before (heyoka resets nothing
   when the state is set by hand; here nothing needs resetting);
 * the values split over ``--processes`` processes (a process pool: heyoka's Python
-  callbacks need the interpreter, so threads would serialise on it).
+  callbacks need the interpreter, so threads would serialise on it);
+* one OpenBLAS thread (``OPENBLAS_NUM_THREADS=1`` unless set, before numpy is imported), as
+  ``grazing``'s command line has: the BLAS threads numpy starts spin for about 0.1 s of a
+  core each, beside the processes' work, and nothing here is BLAS.
 
 Prints a JSON record (``--json``: the periods, the lanes, heyoka's recommended SIMD width,
 the elapsed time) or a summary.  Run as a whole process to time it (``run_all.py`` does,
@@ -39,10 +42,13 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import sys
 import time
 from concurrent.futures import ProcessPoolExecutor
 from typing import Any
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # (before numpy: see above)
 
 import numpy as np
 

@@ -9,13 +9,22 @@ the rest).
 
 from __future__ import annotations
 
+import os
 import sys
 
 EXIT_INTERRUPTED = 130  # grazing.cli.common.EXIT_INTERRUPTED (not imported: that is the point)
 
 
+BLAS_THREADS = "1"
+"""OpenBLAS threads of a command, unless ``OPENBLAS_NUM_THREADS`` says otherwise: grazing computes in
+threads of its own, and the BLAS library's threads, started when numpy is imported, spin for about
+0.1 s of a core each before they sleep (measured: 0.08-0.1 s of CPU time per command); nothing a
+command does is large linear algebra."""
+
+
 def main() -> int:
     """Import the command line and run it; a Ctrl-C while importing is one line."""
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", BLAS_THREADS)  # (before numpy is imported)
     try:
         from grazing.cli import main as run
     except KeyboardInterrupt:

@@ -93,3 +93,19 @@ def test_ctrl_c_while_the_command_line_is_imported(monkeypatch, capsys):
     monkeypatch.setattr(builtins, "__import__", interrupted)
     assert _grazing_entry.main() == 130
     assert capsys.readouterr().err == "grazing: interrupted\n"
+
+
+def test_the_command_runs_one_blas_thread_unless_told_otherwise():
+    # OpenBLAS's threads would spin beside the command's own (issue 29: 0.1 s of CPU per command); the
+    # setting must be made before numpy is imported, which the command line imports.
+    script = (
+        "import os, sys; from _grazing_entry import main; sys.argv = ['grazing', '--help']\n"
+        "try:\n    main()\nexcept SystemExit:\n    pass\n"
+        "print(os.environ['OPENBLAS_NUM_THREADS'], 'numpy' in sys.modules)"
+    )
+    env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_NUM_THREADS"}
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env, check=True)
+    assert out.stdout.splitlines()[-1] == "1 True"
+    env["OPENBLAS_NUM_THREADS"] = "2"  # (a user's setting stays)
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env, check=True)
+    assert out.stdout.splitlines()[-1] == "2 True"

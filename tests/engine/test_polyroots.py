@@ -74,3 +74,65 @@ def test_quadratic_lower_bound_is_a_lower_bound(coeffs):
     a = np.asarray(coeffs, dtype=float)
     u = np.linspace(0.0, 1.0, 2001)
     assert quadratic_lower_bound(a, a.size - 1) <= P.polyval(u, a).min() + 1e-12
+
+
+def _polish_cases(count: int, seed: int) -> np.ndarray:
+    """Guard polynomials of a step: nearly straight, one root in (0.05, 0.95), decaying Taylor terms."""
+    rng = np.random.default_rng(seed)
+    out = []
+    while len(out) < count:
+        c = rng.normal(size=14) * 0.4 ** np.arange(14)
+        c[1] -= 1.0
+        c[0] = 0.0
+        c[0] = -P.polyval(rng.uniform(0.05, 0.95), c)
+        if c[0] > 0.0:
+            out.append(c)
+    return np.array(out)
+
+
+def test_the_root_is_certified_and_as_close_as_rounding_allows():
+    # Newton's polishing stops once its step is below rounding; the root it returns is certified
+    # (Horner's p <= 0 there) and within the rounding of p's evaluation (eps sum|a_k| / |p'|) of the
+    # exact root (mpmath, 30 digits).
+    import mpmath as mp
+
+    from grazing.engine.polyroots import horner
+
+    for a in _polish_cases(300, seed=3):
+        u = _first_root(a)
+        assert horner(a, a.size - 1, u) <= 0.0
+        with mp.workdps(30):
+            coeffs = [mp.mpf(float(c)) for c in a[::-1]]
+            exact = mp.findroot(lambda v, c=coeffs: mp.polyval(c, v), mp.mpf(float(u)))
+            slope = abs(float(mp.polyval([c * k for c, k in zip(coeffs, range(a.size - 1, 0, -1))], exact)))
+        noise = 4 * np.finfo(float).eps * np.sum(np.abs(a)) / slope
+        assert abs(u - float(exact)) <= 2 * np.spacing(u) + noise
+
+
+def test_polishing_takes_few_newton_steps():
+    # It used to bisect when Newton's last step was below rounding (the root ~50 times halved): count
+    # the evaluations by a polynomial whose evaluations are counted.
+    from grazing.engine import polyroots
+
+    calls = []
+    original = polyroots.horner_with_derivative.py_func
+
+    def counted(a, n, u):
+        calls.append(u)
+        return original(a, n, u)
+
+    polish = polyroots._polish.py_func
+    polyroots_globals = polish.__globals__
+    saved = polyroots_globals["horner_with_derivative"]
+    polyroots_globals["horner_with_derivative"] = counted
+    try:
+        counts = []
+        for a in _polish_cases(300, seed=4):
+            calls.clear()
+            b = np.zeros(a.size)
+            to_bernstein(a, a.size - 1, b)
+            polish(a, a.size - 1, 0.0, 1.0, b[0], b[-1])
+            counts.append(len(calls))
+    finally:
+        polyroots_globals["horner_with_derivative"] = saved
+    assert np.median(counts) <= 6 and max(counts) <= 12, (np.median(counts), max(counts))

@@ -144,7 +144,11 @@ def test_switching_at_the_branch_point_gives_the_mirror_image_pair(name):
             continue
         near = a[int(np.argmin(np.abs(values_a - o.model.params[param])))]
         other = find_orbit(o.model, move_section(near, o.t0).state, period=1, t0=o.t0)
-        np.testing.assert_allclose(image, other.state, atol=1e-9)
+        # Near the branch point a multiplier is near 1: Newton's residual leaves the state uncertain by
+        # about residual / |1 - mu| (1.7e-11 / 3e-4 at 5e-6 from it: measured differences 1.5e-7)
+        conditioning = min(abs(1 - o.multipliers))
+        atol = 1e-9 + 10 * (o.residual + other.residual) / conditioning
+        np.testing.assert_allclose(image, other.state, rtol=0, atol=atol)
         np.testing.assert_allclose(np.sort(o.impact_speeds), np.sort(other.impact_speeds), atol=1e-9)
         checked += 1
     assert checked >= 3

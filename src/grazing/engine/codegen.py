@@ -384,7 +384,8 @@ def driver_key() -> str:
     from grazing.core.solution import Status
 
     here = Path(__file__).parent
-    files = [here / f for f in ("polyroots.py", "stepping.py", "records.py", "abi.py", "timebase.py")]
+    helpers = ("polyroots.py", "stepping.py", "records.py", "abi.py", "timebase.py", "lanevec.py")
+    files = [here / f for f in helpers]
     deps = "".join(path.read_text() for path in [*files, *driver.template_files()])
     constants = (STEPS_PER_PERIOD, STEPS_EXTRA, [(s.name, int(s)) for s in Status])  # (from core)
     return _key(_CODEGEN_VERSION, version("numba"), sys.version, deps, constants)  # (numba's, not imported)

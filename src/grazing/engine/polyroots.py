@@ -17,9 +17,15 @@ All functions are numba-compiled and see only arrays.
 
 from __future__ import annotations
 
+import numpy as np
 from numba import njit
 
 _MAX_DEPTH = 60
+_MAX_DEGREE = 64
+"""Highest degree :func:`to_bernstein` takes (the Taylor order is at most 60)."""
+_QUOTIENTS = np.array([[i / j if j else 0.0 for j in range(_MAX_DEGREE + 2)] for i in range(_MAX_DEGREE + 2)])
+"""``_QUOTIENTS[i, j]`` = ``i / j``: :func:`to_bernstein`'s quotients of small integers, divided once here
+(the same doubles as dividing on every call; a division costs several multiplications' time)."""
 
 
 @njit(cache=True)
@@ -44,18 +50,18 @@ def horner_with_derivative(a, n, u):
 
 @njit(cache=True)
 def to_bernstein(a, n, b):
-    """Bernstein coefficients on [0, 1] of the power-basis polynomial ``a[:n+1]``."""
+    """Bernstein coefficients on [0, 1] of the power-basis polynomial ``a[:n+1]`` (``n <= 64``)."""
     for i in range(n + 1):
         b[i] = 0.0
     # b_i = sum_{k<=i} C(i,k)/C(n,k) a_k; ratio(i,k) = ratio(i-1,k) * i/(i-k).
     inv_cnk = 1.0  # 1/C(n, k), updated with k
     for k in range(n + 1):
         if k > 0:
-            inv_cnk *= k / (n - k + 1.0)
+            inv_cnk *= _QUOTIENTS[k, n - k + 1]
         ratio = inv_cnk
         b[k] += ratio * a[k]
         for i in range(k + 1, n + 1):
-            ratio *= i / (i - k)
+            ratio *= _QUOTIENTS[i, i - k]
             b[i] += ratio * a[k]
 
 
@@ -74,9 +80,19 @@ def split_half(c, n, left, right, tmp):
 
 
 @njit(cache=True)
-def _polish(a, n, lo, hi):
-    """Root of the polynomial in [lo, hi], given value(lo) > 0 >= value(hi)."""
-    x = 0.5 * (lo + hi)
+def _polish(a, n, lo, hi, p_lo, p_hi):
+    """The left-most point of [lo, hi] where the polynomial is <= 0, to about an ulp.
+
+    Given value(lo) = p_lo > 0 >= value(hi) = p_hi and one root in between.
+    Safeguarded Newton iteration from the chord's root (closer than the middle
+    where the polynomial is nearly straight, as it is on a step), stopped once
+    its step is below rounding; if the polynomial is still above zero there
+    (rounding), the root is the next few doubles up.
+    """
+    x = lo + (hi - lo) * (p_lo / (p_lo - p_hi))
+    if not (lo < x < hi):
+        x = 0.5 * (lo + hi)
+    p = p_lo
     for _ in range(200):
         p, dp = horner_with_derivative(a, n, x)
         if p > 0.0:
@@ -86,19 +102,29 @@ def _polish(a, n, lo, hi):
         if hi - lo <= 4e-16 * max(1.0, abs(hi)):
             break
         xn = x - p / dp if dp != 0.0 else 0.5 * (lo + hi)
+        if xn == x:  # (a step below rounding: before the bracket's test, which would bisect)
+            break
         if not (lo < xn < hi):
             xn = 0.5 * (lo + hi)
-        if xn == x:
-            break
         x = xn
-    # Return the left-most point that is certified non-positive to ~1 ulp.
-    p = horner(a, n, x)
-    if p > 0.0:
-        return hi
-    return x
+    if p <= 0.0:
+        return x
+    for _ in range(8):  # p(x) > 0 by rounding: the root is a few doubles on
+        x = np.nextafter(x, hi)
+        if x >= hi:
+            return hi
+        if horner(a, n, x) <= 0.0:
+            return x
+    while hi - lo > 4e-16 * max(1.0, abs(hi)):  # (rare: a flat polynomial) bisection
+        mid = 0.5 * (lo + hi)
+        if horner(a, n, mid) > 0.0:
+            lo = mid
+        else:
+            hi = mid
+    return hi
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def quadratic_bound(a0, a1, a2, tail):
     """A lower bound on [0, 1] of ``a0 + a1 u + a2 u^2 + r(u)`` where ``|r| <= tail``.
 
@@ -155,8 +181,21 @@ def first_root(a, n, work):
 def isolate_first_root(a, n, work):
     """:func:`first_root` without its O(n) certificate, for callers that ran it already.
 
-    Requires ``a[0] > 0``.  Bernstein subdivision and Newton polishing.
+    Requires ``a[0] > 0``.  Bernstein subdivision and Newton polishing; a
+    polynomial that certainly decreases on the whole of [0, 1] (the common
+    event: a guard crossing zero) goes to Newton's method at once, its one
+    root bracketed by the ends.
     """
+    if n >= 2:
+        # p'(u) <= a1 + max(0, 2 a2) + sum_{k>=3} k |a_k| on [0, 1]; below zero: p decreases, one root
+        # at most, there iff p(1) <= 0
+        slope = a[1] + max(0.0, 2.0 * a[2])
+        end = a[0] + a[1] + a[2]
+        for k in range(3, n + 1):
+            slope += k * abs(a[k])
+            end += a[k]
+        if slope < 0.0:
+            return -1.0 if end > 0.0 else _polish(a, n, 0.0, 1.0, a[0], end)
     # Bernstein coefficients all positive => no root (convex hull property).
     b = work[0]
     to_bernstein(a, n, b)
@@ -201,8 +240,8 @@ def isolate_first_root(a, n, work):
                 last = v
         if allpos:
             continue
-        if nvar == 1 and c[n] <= 0.0:
-            return _polish(a, n, lo, hi)
+        if nvar == 1 and c[n] <= 0.0:  # (a Bernstein polynomial's end coefficients are its end values)
+            return _polish(a, n, lo, hi, c[0], c[n])
         if nvar == 0:
             # Coefficients >= 0 with zeros: the polynomial touches zero at most
             # at an endpoint; hi is checked by the next interval.

@@ -41,9 +41,10 @@ from grazing.engine.driver.events import first_event
 from grazing.engine.driver.recording import take_samples
 from grazing.engine.driver.state import STATUS_NONFINITE, STATUS_OK, STATUS_STEP_LIMIT, new_state
 from grazing.engine.driver.step import STEP_LAST, accept_step, end_plain_step, end_step, step_end
+from grazing.engine.lanevec import LANE_WIDTH, advance_rows, certify_stop
 from grazing.engine.polyroots import quadratic_bound, work_shape
 from grazing.engine.records import Kernels, LaneJobs, LanePoints, LaneResults, LaneSettings
-from grazing.engine.stepping import new_table, step_factor, step_from_norms, step_size
+from grazing.engine.stepping import new_table, step_factor, step_size, steps_from_norms
 
 LANE_ROOT_ROWS, LANE_ROOT_MIN_COLS = work_shape(0)
 ADAPTIVE_BLOCK = 32  # (grazing.sweeps.run.ADAPTIVE_BLOCK)
@@ -202,10 +203,10 @@ def sweep_lanes(m, cfg, work, points, out):
     dts = np.zeros(L)  # accepted part of it
     flags = np.zeros(L, dtype=np.int64)  # how it ends (step.STEP_LAST, STEP_MAP), or FAILED
     todo = np.zeros(L, dtype=np.int64)  # 1: the lane steps this round
-    norms = (np.zeros(L), np.zeros(L), np.zeros(L))  # of the step sizes (lane_norms)
-    certs = (np.zeros(L), np.zeros(L), np.zeros(L), np.zeros(L), np.zeros(L))  # (no_events_certain)
+    norms = np.zeros(5 * L)  # the norms of the steps, the steps in free flight, the periods (lane_norms)
+    certs = np.zeros(5 * L)  # (no_events_certain)
     plain = np.zeros(L, dtype=np.int64)  # 1: no event on the step is certain so far
-    acc = np.zeros(L)
+    acc = np.zeros(L, dtype=np.int64)  # (advance_lanes: which lanes advance)
 
     la = LaneArrays(ls, XS, pl, PT, logs, buf, counts)
     coeffs = (XT, OT, SI, Xs, Os, xl)
@@ -225,7 +226,7 @@ def sweep_lanes(m, cfg, work, points, out):
         # The Taylor coefficients: lanes in free flight by kind, on vectors where there are enough of them;
         # the norms of their step sizes.
         nvar = lane_coefficients(m, la, kinds, use_lanes, coeffs)
-        lane_norms(m, XT, OT, kinds, nvar, norms)
+        lane_norms(m, ls, XT, OT, kinds, nvar, factor, norms)
 
         # Pass A, lane by lane: the step, its events and its samples.
         plan_steps(m, cfg, la, zdms, norms, coeffs, factor, (hs, flags, todo, plain))
@@ -352,28 +353,45 @@ def lane_coefficients(m, la, kinds, use_lanes, coeffs):
 
 
 @njit(cache=True, inline="always")
-def lane_norms(m, XT, OT, kinds, nvar, norms):
-    """The norms of the lanes' step sizes (as ``step_size``, row by row, on vectors) into ``norms``."""
-    nx_, n1_, n2_ = norms
+def lane_norms(m, ls, XT, OT, kinds, nvar, factor, norms):
+    """The norms of the lanes' steps (as ``step_size``, row by row, on vectors) and the steps in free flight.
+
+    ``norms`` holds five rows of ``L`` lanes, one after the other: the norms
+    ``nx``, ``n1``, ``n2`` of :func:`~grazing.engine.stepping.step_from_norms`,
+    the step (on vectors too: it calls no C function) and the lane's period.
+    """
+    L = XT.shape[2]
+    if L == LANE_WIDTH:
+        _lane_norms(m, ls, XT, OT, kinds, nvar, factor, norms, LANE_WIDTH)
+    else:
+        _lane_norms(m, ls, XT, OT, kinds, nvar, factor, norms, L)
+
+
+@njit(cache=True, inline="always")
+def _lane_norms(m, ls, XT, OT, kinds, nvar, factor, norms, nl):
+    """:func:`lane_norms` over ``nl`` lanes (a constant: the rows' values stay in vector registers)."""
     n = m.nx
     order = m.order
     nstops = m.nstops
-    L = XT.shape[2]
     ntot = n + n * n
-    for lane in range(L):
-        nx_[lane] = abs(OT[0, 0, lane])
-        n1_[lane] = 0.0
-        n2_[lane] = 0.0
+    for lane in range(nl):
+        norms[lane] = abs(OT[0, 0, lane])
+        norms[nl + lane] = 0.0
+        norms[2 * nl + lane] = 0.0
     for r in range(nstops):
-        for lane in range(L):
-            n1_[lane] = max(n1_[lane], abs(OT[r, order - 1, lane]))
-            n2_[lane] = max(n2_[lane], abs(OT[r, order, lane]))
+        for lane in range(nl):
+            norms[nl + lane] = max(norms[nl + lane], abs(OT[r, order - 1, lane]))
+            norms[2 * nl + lane] = max(norms[2 * nl + lane], abs(OT[r, order, lane]))
     for i in range(ntot if nvar > 0 else n):
-        for lane in range(L):
+        for lane in range(nl):
             if i < n or kinds[lane] == 2:
-                nx_[lane] = max(nx_[lane], abs(XT[i, 0, lane]))
-                n1_[lane] = max(n1_[lane], abs(XT[i, order - 1, lane]))
-                n2_[lane] = max(n2_[lane], abs(XT[i, order, lane]))
+                norms[lane] = max(norms[lane], abs(XT[i, 0, lane]))
+                norms[nl + lane] = max(norms[nl + lane], abs(XT[i, order - 1, lane]))
+                norms[2 * nl + lane] = max(norms[2 * nl + lane], abs(XT[i, order, lane]))
+    for lane in range(nl):
+        norms[4 * nl + lane] = ls[lane].T
+    steps_from_norms(norms[:nl], norms[nl : 2 * nl], norms[2 * nl : 3 * nl], order, norms[4 * nl :],
+                     factor, norms[3 * nl : 4 * nl])  # fmt: skip
 
 
 @njit(cache=True, inline="always")
@@ -383,34 +401,45 @@ def no_events_certain(m, cfg, OT, hs, plain, certs):
     ``event_certificate`` on vectors (the same coefficients as
     ``event_polynomial``): a lane stays ``plain`` where every guard's
     polynomial is certainly positive on its step.  A single lane is never
-    plain (its search is as cheap).  ``certs`` = ``(a0, a1, a2, tl, hk)``.
+    plain (its search is as cheap).  ``certs`` holds five rows of ``L`` lanes
+    (``a0, a1, a2``, the tail, the power of the step).
     """
-    a0, a1, a2, tl, hk = certs
+    L = hs.shape[0]
+    if L == 1:
+        plain[0] = 0
+    elif L == LANE_WIDTH:  # (on vectors: the loop over the coefficients keeps the lanes in registers)
+        for r in range(m.nstops):
+            if not (cfg.zdm and r == cfg.stop):
+                certify_stop(OT, r, m.order + 1, hs, plain)
+    else:
+        _no_events_certain(m, cfg, OT, hs, plain, certs, L)
+
+
+@njit(cache=True, inline="always")
+def _no_events_certain(m, cfg, OT, hs, plain, certs, nl):
+    """:func:`no_events_certain` over ``nl`` lanes (a constant: the rows stay in vector registers)."""
     nstops = m.nstops
     K = m.order + 1
-    L = hs.shape[0]
-    for lane in range(L if L == 1 else 0):
-        plain[lane] = 0
-    for r in range(nstops if L > 1 else 0):
+    a1, a2, tl, hk = nl, 2 * nl, 3 * nl, 4 * nl
+    for r in range(nstops):
         if cfg.zdm and r == cfg.stop:
             continue
-        for lane in range(L):
-            hk[lane] = 1.0
-            tl[lane] = 0.0
-            a0[lane] = OT[r, 0, lane] * hk[lane]
-            hk[lane] *= hs[lane]
-            a1[lane] = OT[r, 1, lane] * hk[lane]
-            hk[lane] *= hs[lane]
-            a2[lane] = OT[r, 2, lane] * hk[lane]
-            hk[lane] *= hs[lane]
+        for lane in range(nl):
+            certs[hk + lane] = 1.0
+            certs[tl + lane] = 0.0
+            certs[lane] = OT[r, 0, lane] * certs[hk + lane]
+            certs[hk + lane] *= hs[lane]
+            certs[a1 + lane] = OT[r, 1, lane] * certs[hk + lane]
+            certs[hk + lane] *= hs[lane]
+            certs[a2 + lane] = OT[r, 2, lane] * certs[hk + lane]
+            certs[hk + lane] *= hs[lane]
         for j in range(3, K):
-            for lane in range(L):
-                tl[lane] += abs(OT[r, j, lane] * hk[lane])
-                hk[lane] *= hs[lane]
-        for lane in range(L):
-            if plain[lane] == 1 and not (
-                a0[lane] > 0.0 and quadratic_bound(a0[lane], a1[lane], a2[lane], tl[lane]) > 0.0
-            ):
+            for lane in range(nl):
+                certs[tl + lane] += abs(OT[r, j, lane] * certs[hk + lane])
+                certs[hk + lane] *= hs[lane]
+        for lane in range(nl):
+            bound = quadratic_bound(certs[lane], certs[a1 + lane], certs[a2 + lane], certs[tl + lane])
+            if plain[lane] == 1 and not (certs[lane] > 0.0 and bound > 0.0):
                 plain[lane] = 0
 
 
@@ -425,18 +454,25 @@ def advance_lanes(m, la, XT, dts, todo, kinds, nvar, acc):
     order = m.order
     L = dts.shape[0]
     ntot = n + n * n
-    for lane in range(L):
+    if L == LANE_WIDTH:  # (on vectors: the sums stay in vector registers)
+        for lane in range(LANE_WIDTH):
+            acc[lane] = todo[lane]  # (the lanes whose state advances)
+        advance_rows(XT, 0, n, order, dts, acc, XS)
+        if nvar > 0:
+            for lane in range(LANE_WIDTH):  # (... and their variational equations, in free flight)
+                acc[lane] = 1 if todo[lane] == 1 and kinds[lane] == 2 and ls[lane].mode == 0 else 0
+            advance_rows(XT, n, ntot, order, dts, acc, XS)
+        return
+    for lane in range(L):  # (lane by lane: the sums stay in registers, several lanes' chains overlap)
         if todo[lane] == 0:
-            dts[lane] = 0.0
-    for i in range(ntot if nvar > 0 else n):
-        for lane in range(L):
-            acc[lane] = XT[i, order, lane]
-        for j in range(order - 1, -1, -1):
-            for lane in range(L):
-                acc[lane] = acc[lane] * dts[lane] + XT[i, j, lane]
-        for lane in range(L):
-            if todo[lane] == 1 and (i < n or (kinds[lane] == 2 and ls[lane].mode == 0)):
-                XS[i, lane] = acc[lane]
+            continue
+        dt = dts[lane]
+        rows = ntot if (nvar > 0 and kinds[lane] == 2 and ls[lane].mode == 0) else n
+        for i in range(rows):
+            v = XT[i, order, lane]
+            for j in range(order - 1, -1, -1):
+                v = v * dt + XT[i, j, lane]
+            XS[i, lane] = v
 
 
 @njit(cache=True, inline="always")
@@ -449,7 +485,6 @@ def plan_steps(m, cfg, la, zdms, norms, coeffs, factor, plan):
     (free flight, no known root at its start: :func:`no_events_certain`).
     """
     hs, flags, todo, plain = plan
-    nx_, n1_, n2_ = norms
     XT, OT, _, Xs, Os, xl = coeffs
     ls, XS, pl = la.ls, la.XS, la.pl
     n = m.nx
@@ -457,6 +492,7 @@ def plan_steps(m, cfg, la, zdms, norms, coeffs, factor, plan):
     nstops = m.nstops
     K = order + 1
     L = ls.shape[0]
+    hfree = norms[3 * L : 4 * L]
     for lane in range(L):
         todo[lane] = 0
         flags[lane] = 0
@@ -485,7 +521,7 @@ def plan_steps(m, cfg, la, zdms, norms, coeffs, factor, plan):
             to_lane(Xs, Os, n, nstops, K, XT, OT, lane)
             h = step_size(Xs, n, Os, nstops, stuck, order, T, factor)
         else:
-            h = step_from_norms(nx_[lane], n1_[lane], n2_[lane], order, T, factor)
+            h = hfree[lane]
         h, ends = step_end(ls[lane], h, cfg.zdm, zdms[p])
         flags[lane] = ends
         hs[lane] = h
