@@ -12,6 +12,7 @@ import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import pytest
 
@@ -103,7 +104,13 @@ def test_the_command_runs_one_blas_thread_unless_told_otherwise():
         "try:\n    main()\nexcept SystemExit:\n    pass\n"
         "print(os.environ['OPENBLAS_NUM_THREADS'], 'numpy' in sys.modules)"
     )
+    import grazing
+
     env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_NUM_THREADS"}
+    # (this tree's entry module: an editable install keeps a copy of it, made when it was installed)
+    env["PYTHONPATH"] = os.pathsep.join(
+        [str(Path(grazing.__file__).resolve().parents[1]), env.get("PYTHONPATH", "")]
+    )
     out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env, check=True)
     assert out.stdout.splitlines()[-1] == "1 True"
     env["OPENBLAS_NUM_THREADS"] = "2"  # (a user's setting stays)

@@ -266,7 +266,11 @@ def test_a_chaotic_guess_where_the_chain_is_periodic_is_run_again():
     values = PENDULUM_ETAS[80:100]
     fresh = sweep(M40, "eta", values, fresh=True, workers=2)
     chain = sweep(M40, "eta", values, chunk_size=0, workers=2)
-    assert (fresh.period.values[8:16] == 0).all() and (chain.period.values[8:16] == 3).all()
+    assert (chain.period.values[8:16] == 3).all()
+    # the chunks (of 4) whose first point, from rest (the guess), ends chaotic (which of them do is a
+    # matter of rounding: chaotic transients)
+    starts = [i for i in range(8, 16, 4) if fresh.period.values[i] == 0]
+    assert starts
     spec = chunked_spec(M40, "eta", values, 4)
     log: list = []
     chunked = settled(spec, log)
@@ -274,7 +278,8 @@ def test_a_chaotic_guess_where_the_chain_is_periodic_is_run_again():
     np.testing.assert_array_equal(chunked.period.values, chain.period.values)
     runs = runs_of(spec, log)[3]
     again = {point for p, _ in runs for point in p[0].points}
-    assert set(spec.points[8:16]) <= again  # (the chunks from eta[8] and eta[12]: checks ended periodic)
+    for i in starts:  # (their checks ended periodic)
+        assert set(spec.points[i : i + 4]) <= again
 
 
 def _result(samples, period, status=0):
