@@ -10,8 +10,9 @@ samples (grazing's rule; 0: none).
 
 Sweeps timed:
 
-* ``grazing`` -- ``sweep(model, "eta", etas)``: all cores, chunks of 50 points (each chunk
-  starts from (0, 0)), adaptive transients, Lyapunov exponents, tol 1e-10;
+* ``grazing`` -- ``sweep(model, "eta", etas)``: all cores, chunks of 50 points computed in
+  parallel and made one chain (issue 28: each chunk checked against the chain's end, run again
+  where it lands on another attractor), adaptive transients, Lyapunov exponents, tol 1e-10;
 * the same with ``lyapunov=False``; with ``workers=1``; with ``adaptive=False``; and with all
   four switched off (``workers=1, chunk_size=0, adaptive=False, lyapunov=False``: one strictly
   sequential sweep doing exactly the work of the loops below);
@@ -559,8 +560,9 @@ def markdown(res: Results) -> str:
         f"θ̂ = {THETA_HAT_DEG:g}°, η = `np.linspace({ETA_START}, {ETA_STOP}, {n})`; {TRANSIENT} transient + "
         f"{PERIODS} sampled forcing periods per point, samples at τ = 2πk; each point starts from the "
         "previous point's final state "
-        f"(grazing: within chunks of {CHUNK} points, each chunk from (0, 0); the sequential plain variant "
-        "and the loops: throughout).",
+        f"(grazing: chunks of {CHUNK} points computed in parallel and made one chain — each checked "
+        "against the chain's end and run again where it lands on another attractor; the sequential plain "
+        "variant and the loops: one chain point after point).",
         "- Period: smallest p ≤ min(64, M/2) with max |s[i+p] − s[i]| ≤ 1e-6 over the M = 100 samples "
         '(grazing\'s rule, reimplemented for the loops). "Locally constant": interior points whose period '
         f"in the default sweep equals both neighbours' ({sc.stable} of the scipy points).",
