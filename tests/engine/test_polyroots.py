@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from numpy.polynomial import polynomial as P  # noqa: N812
 
@@ -51,6 +51,8 @@ def test_bernstein_conversion_exact_for_monomials():
     roots=st.lists(st.floats(0.01, 0.99), min_size=1, max_size=6),
     extra=st.lists(st.floats(-3.0, 3.0), min_size=0, max_size=6),
 )
+@example(roots=[0.5, 0.8125, 0.9080984134446282, 0.390625], extra=[])  # (a root at the halving point:
+# Newton's method from the chord's root converged to it, not to the first)
 def test_matches_smallest_simple_root(roots, extra):
     """Random polynomials with known simple roots in (0, 1) and complex/outside ones."""
     roots = sorted(roots)
