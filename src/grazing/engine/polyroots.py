@@ -80,43 +80,19 @@ def split_half(c, n, left, right, tmp):
 
 
 @njit(cache=True)
-def _crossing_near(a, n, x, p, lo, hi):
-    """The crossing (a double where the polynomial is <= 0, the one before it > 0) within 16 doubles of
-    ``x``, where Newton's method converged (``p`` = its value there, ``lo < x < hi`` or at an end); -1.0
-    if there is none (``x`` is another root: one of even order, or not the bracket's first)."""
-    if p <= 0.0:  # walk down to the last double above zero
-        for _ in range(16):
-            y = np.nextafter(x, -np.inf)
-            if y <= lo or horner(a, n, y) > 0.0:
-                return x
-            x = y
-        return -1.0
-    for _ in range(16):  # walk up to the first double at or below zero
-        y = np.nextafter(x, np.inf)
-        if y >= hi:
-            return hi
-        if horner(a, n, y) <= 0.0:
-            return y
-        x = y
-    return -1.0
-
-
-@njit(cache=True)
 def _polish(a, n, lo, hi, p_lo, p_hi):
     """The left-most point of [lo, hi] where the polynomial is <= 0, to about an ulp.
 
-    Given value(lo) = p_lo > 0 >= value(hi) = p_hi and one sign change in between.
+    Given value(lo) = p_lo > 0 >= value(hi) = p_hi and one root in between.
     Safeguarded Newton iteration from the chord's root (closer than the middle
     where the polynomial is nearly straight, as it is on a step; the middle where
-    the chord's root is near an end); once its step
-    is below rounding, the crossing is looked for among the doubles next to it
-    (:func:`_crossing_near`), and where there is none (Newton's method found
-    another root) the bracket is halved and the search goes on.
+    the value at ``hi`` is zero but for rounding), stopped once
+    its step is below rounding; if the polynomial is still above zero there
+    (rounding), the root is the next few doubles up.
     """
     x = lo + (hi - lo) * (p_lo / (p_lo - p_hi))
-    margin = 0.0625 * (hi - lo)
-    if not (lo + margin < x < hi - margin):  # (near an end, where the value may be zero by rounding: another
-        x = 0.5 * (lo + hi)  # root there would take the bracket; the middle, as bisection would)
+    if not (lo < x < hi) or -p_hi <= 1e-12 * p_lo:  # (the value at hi zero but for rounding: a root there,
+        x = 0.5 * (lo + hi)  # the next one, would take the chord's root and then the bracket; the middle)
     p = p_lo
     for _ in range(200):
         p, dp = horner_with_derivative(a, n, x)
@@ -128,14 +104,25 @@ def _polish(a, n, lo, hi, p_lo, p_hi):
             break
         xn = x - p / dp if dp != 0.0 else 0.5 * (lo + hi)
         if xn == x:  # (a step below rounding: before the bracket's test, which would bisect)
-            crossing = _crossing_near(a, n, x, p, lo, hi)
-            if crossing >= 0.0:
-                return crossing
-            xn = 0.5 * (lo + hi)
+            break
         if not (lo < xn < hi):
             xn = 0.5 * (lo + hi)
         x = xn
-    return x if p <= 0.0 else hi
+    if p <= 0.0:
+        return x
+    for _ in range(8):  # p(x) > 0 by rounding: the root is a few doubles on
+        x = np.nextafter(x, hi)
+        if x >= hi:
+            return hi
+        if horner(a, n, x) <= 0.0:
+            return x
+    while hi - lo > 4e-16 * max(1.0, abs(hi)):  # (rare: a flat polynomial) bisection
+        mid = 0.5 * (lo + hi)
+        if horner(a, n, mid) > 0.0:
+            lo = mid
+        else:
+            hi = mid
+    return hi
 
 
 @njit(cache=True, inline="always")
