@@ -16,6 +16,7 @@ from grazing.sweeps.chain import ChainLine, same_outcome, settle
 from grazing.sweeps.executor import compute_parts
 from grazing.sweeps.spec import ChunkResult, sweep_spec
 from grazing.sweeps.store import MemoryStore, ZarrStore
+from tests.sweeps.dask_cluster import loopback_client
 
 M40 = pendulum("B", theta_hat=math.radians(40))
 # The paper's pendulum where its windows end in coexisting attractors (case B, 40 deg): the issue's
@@ -372,12 +373,9 @@ def test_a_guess_at_another_point_of_the_chains_orbit_is_kept_shifted(window, pe
 
 
 def test_a_dask_cluster_settles_the_same_chain_through_chaos():
-    from distributed import Client, LocalCluster
-
     spec = pendulum_through_chaos()
     local = run_sweep(spec, workers=2)
-    with LocalCluster(n_workers=2, threads_per_worker=1, host="127.0.0.1", processes=True,
-                      dashboard_address=":0") as cluster, Client(cluster) as client:  # fmt: skip
+    with loopback_client(2) as client:
         remote = run_sweep(spec, client=client)
     np.testing.assert_array_equal(remote.samples.values, local.samples.values)
     np.testing.assert_array_equal(remote.period.values, local.period.values)

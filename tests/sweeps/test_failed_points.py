@@ -33,6 +33,7 @@ from grazing.sweeps.run import run_chunk
 from grazing.sweeps.spec import sweep_spec
 from grazing.sweeps.status import failure_text
 from grazing.sweeps.store import ZarrStore
+from tests.sweeps.dask_cluster import loopback_client
 
 OK, STEPS, NONFINITE, ZENO = (int(s) for s in (Status.OK, Status.STEP_LIMIT, Status.NONFINITE, Status.ZENO))
 QUICK = {"transient": 20, "periods": 10, "workers": 1}
@@ -237,12 +238,9 @@ def test_failure_text_counts_most_frequent_first():
 
 
 def test_the_dask_path_gives_the_same_status():
-    from distributed import Client, LocalCluster
-
     spec = sweep_spec(pendulum("B"), "alpha", [0.2, 1e300, 0.2254, 1e299], settings=SMALL(chunk_size=2))
     local = run_sweep(spec, workers=1)
-    with LocalCluster(n_workers=1, threads_per_worker=1, host="127.0.0.1", processes=True,
-                      dashboard_address=":0") as cluster, Client(cluster) as client:  # fmt: skip
+    with loopback_client(1) as client:
         remote = run_sweep(spec, client=client)
     assert local.status.values.tolist() == [OK, OK, NONFINITE, NONFINITE]
     assert remote.status.values.tolist() == local.status.values.tolist()

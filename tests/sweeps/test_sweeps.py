@@ -22,6 +22,7 @@ from grazing.sweeps import parameter_map, sweep
 from grazing.sweeps.run import run_chunk
 from grazing.sweeps.spec import SweepSpec
 from grazing.sweeps.store import StoreMismatchError, ZarrStore
+from tests.sweeps.dask_cluster import loopback_client
 
 DEG = math.pi / 180
 M40 = pendulum("B", theta_hat=40 * DEG)
@@ -259,17 +260,14 @@ def test_netcdf_export(tmp_path, capsys):
 
 
 def test_dask_cluster_gives_identical_results():
-    from distributed import Client, LocalCluster
-
     from grazing.sweeps import run_sweep
 
     spec = _spec()
     local = run_sweep(spec, workers=2)
-    with LocalCluster(n_workers=2, threads_per_worker=1, host="127.0.0.1", processes=True,
-                      dashboard_address=":0") as cluster, Client(cluster) as client:  # fmt: skip
+    with loopback_client(2) as client:
         remote = run_sweep(spec, client=client)
         args = "sweep --param eta --start 0.44 --stop 0.46 --num 12 --chunk-size 4 --transient 200"
-        args += f" --periods 30 --scheduler {cluster.scheduler_address} --json"
+        args += f" --periods 30 --scheduler {client.scheduler.address} --json"
         cli_out = subprocess.run(
             [sys.executable, "-m", "grazing.cli", *args.split()], capture_output=True, text=True
         )
