@@ -412,14 +412,15 @@ def no_events_certain(m, cfg, OT, hs, plain, certs):
             if not (cfg.zdm and r == cfg.stop):
                 certify_stop(OT, r, m.order + 1, hs, plain)
     else:
-        _no_events_certain(m, cfg, OT, hs, plain, certs, L)
+        _no_events_certain(m, cfg, OT, hs, plain, certs)
 
 
 @njit(cache=True, inline="always")
-def _no_events_certain(m, cfg, OT, hs, plain, certs, nl):
-    """:func:`no_events_certain` over ``nl`` lanes (a constant: the rows stay in vector registers)."""
+def _no_events_certain(m, cfg, OT, hs, plain, certs):
+    """:func:`no_events_certain` lane by lane in numba, for a lane count other than ``LANE_WIDTH``."""
     nstops = m.nstops
     K = m.order + 1
+    nl = hs.shape[0]
     a1, a2, tl, hk = nl, 2 * nl, 3 * nl, 4 * nl
     for r in range(nstops):
         if cfg.zdm and r == cfg.stop:
