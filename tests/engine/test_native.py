@@ -1,11 +1,13 @@
-"""The sweep driver's machine code loaded without numba (:mod:`grazing.engine.native`).
+"""The driver's machine code loaded without numba (:mod:`grazing.engine.native`).
 
-The sweeps of tests/engine/test_lanes.py run through it and equal an oracle
-over numba's ``integrate``; here: it is numba's ``sweep_lanes`` bit for bit
-(slow: numba compiles that function anew, it is not in numba's cache), a
-sweep in a new process does not import numba, wrong arrays are refused
-before any machine code runs, an error inside the code is reported, and a
-damaged cache file is built again.
+Both entry points, the sweep's ``sweep_lanes`` and the scalar ``integrate``:
+the sweeps of tests/engine/test_lanes.py run through the first and equal an
+oracle over the second; here: each is numba's function bit for bit (slow:
+numba compiles them anew, they are not in numba's cache), a sweep and a
+simulation in a new process do not import numba, wrong arrays are refused
+before any machine code runs, an error inside the code is reported, a
+damaged cache file is built again, and a run whose tables were too short is
+run again, the same.
 """
 
 from __future__ import annotations
@@ -19,10 +21,10 @@ import numpy as np
 import pytest
 
 from grazing.core.options import SweepSettings
-from grazing.engine import codegen, native
+from grazing.engine import codegen, interrupts, native, outputs
 from grazing.engine.codegen import load_driver, taylor_order
-from grazing.engine.records import LaneJobs, LanePoints, LaneResults, LaneSettings
-from grazing.models import bouncing_ball, pendulum
+from grazing.engine.records import Config, LaneJobs, LanePoints, LaneResults, LaneSettings
+from grazing.models import bouncing_ball, impact_oscillator, pendulum
 from grazing.sweeps import run
 from grazing.sweeps.spec import sweep_spec
 
@@ -147,7 +149,7 @@ def test_a_damaged_cache_file_is_built_again(tmp_path, monkeypatch) -> None:
     source = (codegen.cache_dir() / f"grazing_native_{key}.bin").read_bytes()
     built = []
 
-    def build() -> bytes:
+    def build(entry=None) -> bytes:
         built.append(1)
         return source
 
@@ -229,3 +231,120 @@ def test_reference_counts_are_plain_adds_and_every_array_is_freed() -> None:
             _nrt_python.memsys_disable_stats()
     allocated, freed = after.alloc - before.alloc, after.free - before.free
     assert allocated >= 200 and freed == allocated  # (two arrays per call, every one freed)
+
+
+# -- the scalar integrator's entry point (integrate)
+
+
+def run_arguments(model, x0, periods=3, keep=3, variational=False, impacts="all", trajectory=0) -> list:
+    """The arguments of ``integrate`` for a run of ``model`` from ``x0`` (by a Runner), its output last."""
+    from grazing.engine.runner import RECORD_IMPACTS, Runner
+
+    r = Runner(model, np.asarray(x0, dtype=float), variational=variational)
+    call = dict(
+        max_steps=100_000, n_samples=periods, ks=r.ks, ss=float(r.ss), n_keep=keep, lyapunov=variational,
+        traj_dt=r.T / trajectory if trajectory else 0.0, track_min=True,
+        record_impacts=RECORD_IMPACTS[impacts], touch_start=False, touch_end=False,
+    )  # fmt: skip
+    cfg = Config(*(call[name] for name in Config._fields[: len(call)]), *r._static, interrupts.SIGINTS, 0)
+    rows = outputs.TableRows.guess(cfg)
+    out = outputs.allocate(model.n_states, r.V.shape[1], model.n_stops, keep, rows)
+    return [(r.x, r.V, r.k, r.s, r.mode), r.pv, cfg, r.kern.table, out]
+
+
+RUNS = [
+    pytest.param(
+        lambda: bouncing_ball(amplitude=1.2),
+        {"x0": [0.5, 0.0], "trajectory": 40},
+        id="bouncing-ball-trajectory",
+    ),
+    pytest.param(
+        lambda: pendulum("B", theta_hat=math.radians(40)),
+        {"x0": [0.1, 0.0], "periods": 30, "variational": True},
+        id="pendulum-jacobian",
+    ),
+    pytest.param(
+        lambda: impact_oscillator(),
+        {"x0": [0.0, 0.0], "periods": 20, "keep": 5, "impacts": "sampled"},
+        id="oscillator",
+    ),
+]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("make", "options"), RUNS)
+def test_native_integrate_equals_numbas_function(make, options) -> None:
+    ours = run_arguments(make(), **options)
+    native.load_integrate()(*ours)
+    theirs = run_arguments(make(), **options)
+    load_driver().integrate(*theirs)
+    a, b = (outputs.result(out, outputs.Totals.of(out)) for out in (ours[4], theirs[4]))
+    for field, x, y in zip(a._fields, a, b, strict=True):
+        assert np.asarray(x).tobytes() == np.asarray(y).tobytes(), field  # (what the run wrote, bit for bit)
+
+
+@pytest.mark.parametrize(("make", "options"), RUNS)
+def test_a_run_whose_tables_were_too_short_runs_again_the_same(make, options) -> None:
+    """Tables of one row: the run counts the rows it needs, runs again with them, and equals a roomy run."""
+    arguments = run_arguments(make(), **options)
+    cfg = arguments[2]
+    integrate = native.load_integrate()
+
+    def call(out):
+        integrate(*arguments[:4], out)
+
+    n, ncol, nstops = arguments[0][0].size, arguments[0][1].shape[1], arguments[3][3]
+    short, need = outputs.run(call, n, ncol, nstops, cfg, outputs.TableRows(1, 1, 1))
+    roomy, need_roomy = outputs.run(call, n, ncol, nstops, cfg, outputs.TableRows(10_000, 10_000, 10_000))
+    assert need == need_roomy and short.status == 0
+    assert max(need) > 1  # (the case needs a second run)
+    for field, a, b in zip(short._fields, short, roomy, strict=True):
+        assert np.asarray(a).tobytes() == np.asarray(b).tobytes(), field
+    assert short.impacts.shape[0] == need.impacts and short.trajectory.shape[0] == need.trajectory
+
+
+def test_the_integrate_entry_refuses_wrong_arrays() -> None:
+    arguments = run_arguments(bouncing_ball(), [0.5, 0.0])
+    native.load_integrate()(*arguments)
+    assert outputs.Totals.of(arguments[4]).status == 0
+    start_x, out_V, out_samples, impacts = (0, 0), (4, 2), (4, 3), (4, 4)
+    wrong_arrays = (
+        (start_x, np.zeros(3)),  # the state of the wrong size
+        (start_x, np.zeros((2, 1))),  # dimensions
+        (out_V, np.zeros((2, 2), dtype=np.float32)),  # dtype
+        (out_samples, np.zeros((3, 4))[:, ::2]),  # not contiguous
+        (impacts, np.zeros((4, 2))),  # a row of impacts without its time and speed
+        ((4, 0), np.zeros(1)),  # the totals as plain numbers
+    )
+    for (record, field), bad in wrong_arrays:
+        wrong = [list(r) if isinstance(r, tuple) else r for r in arguments]
+        wrong[record][field] = bad
+        with pytest.raises(TypeError, match="must be a C-contiguous"):
+            native.load_integrate()(*(tuple(r) if isinstance(r, list) else r for r in wrong))
+    read_only = [list(r) if isinstance(r, tuple) else r for r in arguments]
+    read_only[4][1] = np.zeros(2)
+    read_only[4][1].flags.writeable = False
+    with pytest.raises(TypeError, match=r"RunOutput\.x must be writeable"):
+        native.load_integrate()(*(tuple(r) if isinstance(r, list) else r for r in read_only))
+    with pytest.raises(TypeError, match="5 arguments expected"):
+        native.load_integrate()(*arguments[:4])
+    with pytest.raises(TypeError, match=rf"a Config \({len(Config._fields)} fields\) expected"):
+        native.load_integrate()(arguments[0], arguments[1], tuple(arguments[2])[:-1], *arguments[3:])
+
+
+def test_numpys_array_objects_hold_their_fields_where_the_entry_reads_them() -> None:
+    assert native.numpy_layout_holds()
+
+
+def test_a_simulation_in_a_new_process_does_not_import_numba() -> None:
+    native.load_integrate()  # (the cache file exists)
+    code = (
+        "import sys, math, grazing\n"
+        "from grazing.models import pendulum\n"
+        "sol = grazing.simulate(pendulum('B', theta_hat=math.radians(40)), periods=20)\n"
+        "assert len(sol.samples) == 20\n"
+        "print('numba' in sys.modules)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "False"

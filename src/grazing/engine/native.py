@@ -37,72 +37,179 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 from types import ModuleType
-from typing import Annotated, Any
+from typing import Annotated, Any, NamedTuple
 
 import numpy as np
 
 _PREFIX = "grazing_native"
-_ENTRY = "sweep_lanes"
 _RETURNED = (0, -2)
 """numba's status codes of a function that returned (OK, None); the others report an exception."""
 
 
-def _layout() -> list[tuple[str, str, Any]]:
-    """The sweep driver's arguments, field by field: ``(record.field, kind, dtype and dimensions)``.
+class Entry(NamedTuple):
+    """A driver function compiled into an object file of its own."""
 
-    Derived from the annotations of :data:`grazing.engine.records.SWEEP_RECORDS`:
-    an array field is annotated with its dtype and dimensions, the others are
-    ``int``, ``float`` or ``bool``.
+    name: str  # the function, in grazing.engine.driver
+    arguments: tuple[Any, ...]  # its arguments: records (passed as plain tuples) or (name, annotated array)
+    shapes: Callable[[dict[str, Any]], dict[str, tuple[int, ...]]]  # each array's shape, from the others
+
+
+def _parts(argument: Any) -> tuple[str, list[tuple[str, Any]]]:
+    """An argument's name and its fields' ``(label, type hint)``: a record's fields, or the array itself."""
+    from typing import get_type_hints
+
+    if isinstance(argument, tuple):
+        name, hint = argument
+        return name, [(name, hint)]
+    hints = get_type_hints(argument, include_extras=True)
+    return argument.__name__, [(f"{argument.__name__}.{field}", hints[field]) for field in argument._fields]
+
+
+def _layout(entry: Entry | None = None) -> list[tuple[str, str, Any]]:
+    """A driver function's arguments, field by field: ``(record.field, kind, dtype and dimensions)``.
+
+    Derived from the annotations of its records (:data:`ENTRIES`; the sweep
+    driver's by default): an array field is annotated with its dtype and
+    dimensions, the others are ``int``, ``float`` or ``bool``.
     """
-    from typing import get_args, get_origin, get_type_hints
-
-    from grazing.engine.records import SWEEP_RECORDS
+    from typing import get_args, get_origin
 
     fields = []
-    for record in SWEEP_RECORDS:
-        for name, hint in get_type_hints(record, include_extras=True).items():
-            label = f"{record.__name__}.{name}"
+    for argument in (entry or ENTRIES["sweep_lanes"]).arguments:
+        for label, hint in _parts(argument)[1]:
             if get_origin(hint) is Annotated:
                 fields.append((label, "array", get_args(hint)[1]))
             elif hint in (int, float, bool):
                 fields.append((label, hint.__name__, None))
             else:  # pragma: no cover - a record field the driver cannot take
-                raise TypeError(f"sweep driver: {label} has a type the machine code cannot take: {hint}")
+                raise TypeError(f"driver: {label} has a type the machine code cannot take: {hint}")
     return fields
 
 
-def _signature() -> Any:
-    """The numba signature of ``sweep_lanes``: a tuple of its fields' types per record."""
+def _signature(entry: Entry) -> Any:
+    """The numba signature of a driver function: a tuple of its fields' types per record, or an array."""
     from numba import types
+    from numba.np.numpy_support import from_dtype
 
-    from grazing.engine.records import SWEEP_RECORDS
-
-    scalar = {"i8": types.int64, "f8": types.float64, "?": types.boolean}
     kinds = {"int": types.int64, "float": types.float64, "bool": types.boolean}
     of = {
-        label: types.Array(scalar[spec[0]], spec[1], "C") if kind == "array" else kinds[kind]
-        for label, kind, spec in _layout()
+        label: types.Array(from_dtype(np.dtype(spec[0])), spec[1], "C") if kind == "array" else kinds[kind]
+        for label, kind, spec in _layout(entry)
     }
-    return tuple(
-        types.Tuple([of[f"{record.__name__}.{name}"] for name in record._fields]) for record in SWEEP_RECORDS
-    )
+    signature = []
+    for argument in entry.arguments:
+        labels = [label for label, _hint in _parts(argument)[1]]
+        signature.append(
+            of[labels[0]] if isinstance(argument, tuple) else types.Tuple([of[x] for x in labels])
+        )
+    return tuple(signature)
+
+
+def _slot_load(i: int, ty: str) -> tuple[list[str], str]:
+    """LLVM IR lines loading an argument of type ``ty`` from slot ``i`` of ``%slots``; and the argument."""
+    lines = [f"  %p{i} = getelementptr inbounds i64, ptr %slots, i64 {i}"]
+    lines.append(f"  %s{i} = load i64, ptr %p{i}, align 8")
+    if ty == "i64":
+        return lines, f"i64 %s{i}"
+    cast = {"ptr": "inttoptr", "double": "bitcast", "i8": "trunc", "i32": "trunc", "i1": "trunc"}.get(ty)
+    if cast is None:
+        raise TypeError(f"an argument of type {ty} cannot come from a 64-bit slot")
+    return [*lines, f"  %a{i} = {cast} i64 %s{i} to {ty}"], f"{ty} %a{i}"
 
 
 def _slot_loads(types_: list[str]) -> tuple[list[str], list[str]]:
     """LLVM IR lines loading one argument of each type in ``types_`` from ``%slots``; and the arguments."""
     lines, args = [], []
     for i, ty in enumerate(types_):
-        lines.append(f"  %p{i} = getelementptr inbounds i64, ptr %slots, i64 {i}")
-        lines.append(f"  %s{i} = load i64, ptr %p{i}, align 8")
-        if ty == "i64":
-            args.append(f"i64 %s{i}")
-            continue
-        cast = {"ptr": "inttoptr", "double": "bitcast", "i8": "trunc", "i32": "trunc", "i1": "trunc"}.get(ty)
-        if cast is None:
-            raise TypeError(f"an argument of type {ty} cannot come from a 64-bit slot")
-        lines.append(f"  %a{i} = {cast} i64 %s{i} to {ty}")
-        args.append(f"{ty} %a{i}")
+        more, arg = _slot_load(i, ty)
+        lines += more
+        args.append(arg)
     return lines, args
+
+
+NUMPY_ARRAY_FIELDS = {"data": 16, "nd": 24, "dimensions": 32, "strides": 40}
+"""Byte offsets in numpy's array object (``PyArrayObject_fields``, the same in numpy 1 and 2) of the
+fields the entry functions read; :func:`numpy_layout_holds` checks them in the running numpy."""
+
+
+def _array_loads(i: int, ndim: int, itemsize: int) -> tuple[list[str], list[str]]:
+    """LLVM IR lines reading the numpy array object in slot ``i`` as numba's array arguments; and those.
+
+    numba passes an array as its memory manager (none here), parent (none),
+    size, item size, data pointer, shape and strides; here the data pointer,
+    shape and strides are read from the array object (:data:`NUMPY_ARRAY_FIELDS`),
+    the size is the product of the shape, the item size is ``itemsize``.
+    """
+    f = NUMPY_ARRAY_FIELDS
+    lines = [
+        f"  %p{i} = getelementptr inbounds i64, ptr %slots, i64 {i}",
+        f"  %o{i} = load ptr, ptr %p{i}, align 8",
+        f"  %dp{i} = getelementptr inbounds i8, ptr %o{i}, i64 {f['data']}",
+        f"  %data{i} = load ptr, ptr %dp{i}, align 8",
+        f"  %shp{i} = getelementptr inbounds i8, ptr %o{i}, i64 {f['dimensions']}",
+        f"  %sh{i} = load ptr, ptr %shp{i}, align 8",
+        f"  %stp{i} = getelementptr inbounds i8, ptr %o{i}, i64 {f['strides']}",
+        f"  %st{i} = load ptr, ptr %stp{i}, align 8",
+    ]
+    size = "1"
+    for d in range(ndim):
+        lines += [
+            f"  %shq{i}.{d} = getelementptr inbounds i64, ptr %sh{i}, i64 {d}",
+            f"  %dim{i}.{d} = load i64, ptr %shq{i}.{d}, align 8",
+            f"  %stq{i}.{d} = getelementptr inbounds i64, ptr %st{i}, i64 {d}",
+            f"  %str{i}.{d} = load i64, ptr %stq{i}.{d}, align 8",
+            f"  %size{i}.{d} = mul i64 {size}, %dim{i}.{d}",
+        ]
+        size = f"%size{i}.{d}"
+    dims = [f"i64 %dim{i}.{d}" for d in range(ndim)] + [f"i64 %str{i}.{d}" for d in range(ndim)]
+    return lines, ["ptr null", "ptr null", f"i64 {size}", f"i64 {itemsize}", f"ptr %data{i}", *dims]
+
+
+def _field_loads(
+    params: list[str], fields: list[tuple[int, int] | None]
+) -> tuple[list[str], list[str], list[str]]:
+    """The entry's loads when each of ``fields`` (``(ndim, itemsize)`` of an array, or None) takes one slot.
+
+    Returns the IR lines, the call's arguments and the slots' kinds (an
+    array's ``"array<ndim>"``, else its LLVM type).
+    """
+    lines, args, kinds = [], [], []
+    at = 0
+    for i, field in enumerate(fields):
+        if field is None:
+            more, arg = _slot_load(i, params[at])
+            lines += more
+            args.append(arg)
+            kinds.append(params[at])
+            at += 1
+            continue
+        ndim, itemsize = field
+        expected = ["ptr", "ptr", "i64", "i64", "ptr", *["i64"] * (2 * ndim)]
+        if params[at : at + len(expected)] != expected:  # pragma: no cover - numba passes arrays otherwise
+            raise TypeError(f"argument {i}: numba's array arguments are {params[at : at + len(expected)]}")
+        more, array_args = _array_loads(i, ndim, itemsize)
+        lines += more
+        args += array_args
+        kinds.append(f"array{ndim}")
+        at += len(expected)
+    if at != len(params):  # pragma: no cover
+        raise TypeError(f"{len(params)} arguments, {at} described")
+    return lines, args, kinds
+
+
+def numpy_layout_holds() -> bool:
+    """Whether numpy's array objects have their fields where :data:`NUMPY_ARRAY_FIELDS` says."""
+    a = np.empty((3, 4))[:, ::2]
+    at = id(a)
+
+    def word(offset: int) -> int:
+        return ctypes.c_void_p.from_address(at + offset).value or 0
+
+    shape = (ctypes.c_int64 * 2).from_address(word(NUMPY_ARRAY_FIELDS["dimensions"]))
+    strides = (ctypes.c_int64 * 2).from_address(word(NUMPY_ARRAY_FIELDS["strides"]))
+    nd = ctypes.c_int.from_address(at + NUMPY_ARRAY_FIELDS["nd"]).value
+    found = (word(NUMPY_ARRAY_FIELDS["data"]), nd, tuple(shape), tuple(strides))
+    return found == (a.ctypes.data, a.ndim, a.shape, a.strides)
 
 
 _REFCOUNTS = {
@@ -147,15 +254,20 @@ def plain_reference_counts(text: str) -> str:
     return text
 
 
-def object_file(dispatcher: Any, signature: tuple[Any, ...], name: str) -> bytes:
+def object_file(
+    dispatcher: Any, signature: tuple[Any, ...], name: str, fields: list[tuple[int, int] | None] | None = None
+) -> bytes:
     """The cache file of a numba function compiled for ``signature``: a JSON line, then an object file.
 
     The object file holds numba's LLVM IR of the function (and of everything it
     calls, as numba optimised it, not optimised again) and an entry function
     ``{_PREFIX}_{name}(int64 *slots) -> int64``: numba's status code, the
-    function's flattened arguments read from ``slots``.  ``dispatcher`` must
+    function's flattened arguments read from ``slots``: one slot per LLVM
+    argument, or, with ``fields`` (per field of the arguments, in order, an
+    array's ``(ndim, itemsize)`` or None), one per field, an array's slot
+    holding numpy's array object (:func:`_array_loads`).  ``dispatcher`` must
     not come from numba's on-disk cache (whose IR numba does not keep).  The
-    JSON line lists the C symbols the code needs and the arguments' LLVM types.
+    JSON line lists the C symbols the code needs and the slots' kinds.
     """
     import llvmlite.binding as llvm
 
@@ -164,7 +276,11 @@ def object_file(dispatcher: Any, signature: tuple[Any, ...], name: str) -> bytes
     module = llvm.parse_assembly(text)
     target = module.get_function(dispatcher.overloads[signature].fndesc.llvm_func_name)
     params = [str(a.type) for a in target.arguments][2:]  # (after the return slot and the exception info)
-    lines, args = _slot_loads(params)
+    if fields is None:
+        lines, args = _slot_loads(params)
+        kinds = params
+    else:
+        lines, args, kinds = _field_loads(params, fields)
     entry = "\n".join(
         [
             f"define i64 @{_PREFIX}_{name}(ptr %slots) {{",
@@ -192,7 +308,7 @@ def object_file(dispatcher: Any, signature: tuple[Any, ...], name: str) -> bytes
         {f.name for f in module.functions if f.is_declaration and not f.name.startswith("llvm.")}
         | {g.name for g in module.global_variables if g.is_declaration}
     )
-    header = json.dumps({"symbols": needs, "params": params}).encode()
+    header = json.dumps({"symbols": needs, "params": kinds}).encode()
     return header + b"\n" + _jit_target_machine().emit_object(module)
 
 
@@ -209,15 +325,18 @@ def _jit_target_machine() -> Any:
     )  # fmt: skip
 
 
-def build() -> bytes:
-    """The cache file of the sweep driver (numba compiles ``sweep_lanes``, which it does not cache)."""
+def build(entry: Entry | None = None) -> bytes:
+    """The cache file of a driver function (the sweep's by default; numba compiles it, uncached)."""
     from grazing.engine.codegen import load_driver
 
-    return object_file(load_driver().sweep_lanes, _signature(), _ENTRY)
+    entry = entry or ENTRIES["sweep_lanes"]
+    layout = _plan(entry).layout
+    fields = [None if kind != "array" else (spec[1], spec[0].itemsize) for _label, kind, spec in layout]
+    return object_file(getattr(load_driver(), entry.name), _signature(entry), entry.name, fields)
 
 
-def cache_key() -> str:
-    """Key of the entry point's cache file: the driver's key, this module, llvmlite's version and this CPU."""
+def cache_key(entry: Entry | None = None) -> str:
+    """Key of an entry point's cache file: the function, the driver, this module, llvmlite, the CPU."""
     import llvmlite
     import llvmlite.binding as llvm
 
@@ -226,7 +345,8 @@ def cache_key() -> str:
 
     _target_machine()  # (initialises LLVM's native target)
     cpu = (llvm.get_host_cpu_name(), llvm.get_host_cpu_features().flatten())
-    return _key(driver_key(), Path(__file__).read_text(), llvmlite.__version__, cpu)
+    name = (entry or ENTRIES["sweep_lanes"]).name
+    return _key(name, driver_key(), Path(__file__).read_text(), llvmlite.__version__, cpu)
 
 
 def _numba_extension(name: str) -> ModuleType:
@@ -291,8 +411,8 @@ def _resolvable(name: str) -> bool:
     return True
 
 
-def _shapes(values: dict[str, Any]) -> dict[str, tuple[int, ...]]:
-    """The shape each array field must have, from the sizes the others give (the driver does not check)."""
+def _sweep_shapes(values: dict[str, Any]) -> dict[str, tuple[int, ...]]:
+    """The shape each array of ``sweep_lanes`` must have, from the sizes the others give (it checks none)."""
     nx, nstops = values["Kernels.nx"], values["Kernels.nstops"]
     npts, njobs = values["LanePoints.pvs"].shape[0], values["LaneJobs.jobs"].shape[0]
     per_point = ("LanePoints.Ts", "LanePoints.sphase", "LanePoints.tcarry", "LanePoints.zdms")
@@ -307,96 +427,216 @@ def _shapes(values: dict[str, Any]) -> dict[str, tuple[int, ...]]:
     }  # fmt: skip
 
 
-def flatten(arguments: tuple[Any, ...]) -> tuple[np.ndarray, list[str]]:
-    """``sweep_lanes``'s arguments as numba passes them: 64-bit slots and their LLVM types.
+def _run_shapes(values: dict[str, Any]) -> dict[str, tuple[int, ...]]:
+    """The shape each array of ``integrate`` must have (its tables' rows are the caller's to choose)."""
+    nx, nstops = values["Kernels.nx"], values["Kernels.nstops"]
+    ncol = nx + values["Kernels.nsens"]
+    rows = {name: values[f"RunOutput.{name}"].shape[:1] for name in ("impacts", "sticking", "trajectory")}
+    return {
+        "Start.x": (nx,), "Start.V": (nx, ncol), "pv": values["pv"].shape, "Config.zdm_e": (nx,),
+        "Config.Tp": (ncol - nx,), "Config.sigints": (1,), "Kernels.fns": values["Kernels.fns"].shape,
+        "Kernels.sticks": (nstops,), "RunOutput.totals": (1,), "RunOutput.x": (nx,),
+        "RunOutput.V": (nx, ncol),
+        "RunOutput.samples": (values["Config.n_keep"], nx), "RunOutput.impacts": (*rows["impacts"], 3 + nx),
+        "RunOutput.sticking": (*rows["sticking"], 2), "RunOutput.trajectory": (*rows["trajectory"], 1 + nx),
+        "RunOutput.log_sums": (nx,), "RunOutput.guard_min": (nstops, 2 * (2 + nx)),
+    }  # fmt: skip
 
-    The arguments are the records of :data:`grazing.engine.records.SWEEP_RECORDS`
-    (or plain tuples of their fields), each passed field by field: an array as
-    its memory manager (none), parent (none), size, item size, data pointer,
-    shape and strides; a boolean as a byte.  Arrays of another dtype,
-    dimension, shape or layout than the driver takes are refused
-    (``TypeError``).
-    """
-    from grazing.engine.records import SWEEP_RECORDS
 
-    if len(arguments) != len(SWEEP_RECORDS):
-        raise TypeError(f"sweep driver: {len(SWEEP_RECORDS)} arguments expected, got {len(arguments)}")
-    values: dict[str, Any] = {}
-    for record, value in zip(SWEEP_RECORDS, arguments, strict=True):
-        if not isinstance(value, tuple) or len(value) != len(record._fields):
-            raise TypeError(f"sweep driver: a {record.__name__} ({len(record._fields)} fields) expected")
-        values.update((f"{record.__name__}.{name}", v) for name, v in zip(record._fields, value, strict=True))
-    shapes = _shapes(values)
-    slots: list[int] = []
-    kinds: list[str] = []
-    for label, kind, spec in _layout():
-        value = values[label]
-        if kind == "array":
-            dtype, ndim = spec
-            a = value
-            ok = isinstance(a, np.ndarray) and a.dtype == np.dtype(dtype) and a.ndim == ndim
-            if not (ok and a.flags.c_contiguous and a.shape == shapes[label]):
-                want = f"a C-contiguous {np.dtype(dtype)} array of shape {shapes[label]}"
-                raise TypeError(f"sweep driver: {label} must be {want}")
-            if label.startswith("LaneResults.") and not a.flags.writeable:
-                raise TypeError(f"sweep driver: {label} must be writeable")
-            slots += [0, 0, a.size, a.itemsize, a.ctypes.data, *a.shape, *a.strides]
-            kinds += ["ptr", "ptr", "i64", "i64", "ptr", *["i64"] * (2 * ndim)]
-        elif kind == "bool":
-            slots.append(1 if value else 0)
-            kinds.append("i8")
-        elif kind == "float":
-            slots.append(int(np.float64(value).view(np.int64)))
-            kinds.append("double")
+def _entries() -> dict[str, Entry]:
+    from grazing.engine.records import INTEGRATE_ARGUMENTS, SWEEP_RECORDS
+
+    return {
+        "sweep_lanes": Entry("sweep_lanes", SWEEP_RECORDS, _sweep_shapes),
+        "integrate": Entry("integrate", INTEGRATE_ARGUMENTS, _run_shapes),
+    }
+
+
+ENTRIES = _entries()
+"""The driver's functions that run as machine code of their own: the sweep's and the scalar integrator."""
+
+
+class _Plan(NamedTuple):
+    """How :func:`flatten` reads a driver function's arguments."""
+
+    arguments: list[tuple[str, list[str] | None]]  # name and its fields' labels (None: an array of its own)
+    layout: list[tuple[str, str, Any]]  # (label, kind, (numpy dtype, dimensions) of an array)
+    written: str  # the prefix of the labels of the arrays the function writes (its last argument's)
+    kinds: list[str]  # the slots' LLVM types
+    format: str  # the slots' struct format (64-bit integers, doubles)
+
+
+_SLOT_TYPES = {"int": ("i64", "q"), "float": ("double", "d"), "bool": ("i8", "q")}
+
+
+@functools.cache
+def _plan(entry: Entry) -> _Plan:
+    """The :class:`_Plan` of ``entry``."""
+    arguments = []
+    for argument in entry.arguments:
+        name, fields = _parts(argument)
+        arguments.append((name, None if isinstance(argument, tuple) else [label for label, _hint in fields]))
+    layout, kinds, format_ = [], [], "="
+    for label, kind, spec in _layout(entry):
+        if kind == "array":  # (one slot: numpy's array object, read by the entry function)
+            layout.append((label, kind, (np.dtype(spec[0]), spec[1])))
+            kinds.append(f"array{spec[1]}")
+            format_ += "q"
         else:
-            slots.append(int(value))
-            kinds.append("i64")
-    return np.array(slots, dtype=np.int64), kinds
+            layout.append((label, kind, None))
+            kinds.append(_SLOT_TYPES[kind][0])
+            format_ += _SLOT_TYPES[kind][1]
+    return _Plan(arguments, layout, _parts(entry.arguments[-1])[0] + ".", kinds, format_)
 
 
-def _caller(address: int, params: list[str], keep: Any) -> Callable[..., None]:
-    """A Python function with the arguments of ``driver.lanes.sweep_lanes``, calling its machine code."""
-    entry = ctypes.CFUNCTYPE(ctypes.c_int64, ctypes.c_void_p)(address)
+def _refuse(entry: Entry, label: str, dtype: np.dtype, shapes: dict[str, Any], value: Any) -> None:
+    """Raise the ``TypeError`` of an array argument that the driver cannot take."""
+    if isinstance(value, np.ndarray) and value.dtype == dtype and value.flags.c_contiguous:
+        if value.shape == shapes[label]:
+            raise TypeError(f"{entry.name}: {label} must be writeable")
+    raise TypeError(f"{entry.name}: {label} must be a C-contiguous {dtype} array of shape {shapes[label]}")
 
-    def sweep_lanes(*arguments: Any) -> None:
-        slots, kinds = flatten(arguments)
-        if kinds != params:  # pragma: no cover - a driver whose arguments changed without its cache key
-            raise TypeError("sweep driver: the compiled code takes other arguments; clear the kernel cache")
-        if entry(slots.ctypes.data) not in _RETURNED:  # pragma: no cover - the driver raised
-            from grazing.engine.codegen import load_driver
 
-            m, cfg, work, points, out = arguments
-            work[1][1] = 1  # (the other threads of the call stop: LaneJobs.control)
-            again = (work[0], np.zeros(3, dtype=np.int64), *work[2:])  # every job again, in this thread:
-            load_driver().sweep_lanes(m, cfg, again, points, out)  # numba's function raises the error
-            raise RuntimeError("the compiled sweep driver failed where numba's function did not")
+@functools.cache
+def _flattener(entry: Entry) -> Callable[[tuple[Any, ...]], bytes]:
+    """A function from the arguments of ``entry`` to its slots (as bytes), written for its layout.
 
-    sweep_lanes.library = keep  # type: ignore[attr-defined]  # (the machine code lives as long as this)
-    return sweep_lanes
+    Python code with a line per field (no loop over the layout): the driver's
+    arguments are flattened on every call of the scalar integrator, about as
+    often as numba's dispatcher would take them.
+    """
+    import struct
+
+    plan = _plan(entry)
+    lines = [
+        "def flatten(arguments):",
+        f"    if len(arguments) != {len(plan.arguments)}:",
+        f"        raise TypeError(f'{entry.name}: {len(plan.arguments)} arguments expected, "
+        "got {len(arguments)}')",
+        f"    {', '.join(f'a{i}' for i in range(len(plan.arguments)))}, = arguments",
+    ]
+    names = {label: f"v{j}" for j, (label, _kind, _spec) in enumerate(plan.layout)}
+    for i, (name, labels) in enumerate(plan.arguments):
+        if labels is None:
+            lines.append(f"    {names[name]} = a{i}")
+            continue
+        lines += [
+            f"    if not (isinstance(a{i}, tuple) and len(a{i}) == {len(labels)}):",
+            f"        raise TypeError('{entry.name}: a {name} ({len(labels)} fields) expected')",
+            f"    {', '.join(names[label] for label in labels)}, = a{i}",
+        ]
+    lines.append("    s = shapes({" + ", ".join(f"{label!r}: {v}" for label, v in names.items()) + "})")
+    items = []
+    dtypes = {}
+    for label, kind, spec in plan.layout:
+        v = names[label]
+        if kind != "array":
+            items.append({"bool": f"1 if {v} else 0", "float": f"float({v})", "int": f"int({v})"}[kind])
+            continue
+        dtypes[f"D_{v}"] = spec[0]
+        written = label.startswith(plan.written)
+        lines += [
+            f"    if not (isinstance({v}, ndarray) and {v}.dtype == D_{v} and {v}.flags.c_contiguous"
+            f"{f' and {v}.flags.writeable' if written else ''} and {v}.shape == s[{label!r}]):",
+            f"        refuse(entry, {label!r}, D_{v}, s, {v})",
+        ]
+        items.append(f"id({v})")
+    lines.append(f"    return pack({plan.format!r}, {', '.join(items)})")
+    scope = {
+        "ndarray": np.ndarray, "pack": struct.pack, "shapes": entry.shapes, "refuse": _refuse, "entry": entry,
+        **dtypes,
+    }  # fmt: skip
+    exec(compile("\n".join(lines) + "\n", f"<grazing.engine.native: flatten {entry.name}>", "exec"), scope)
+    return scope["flatten"]
+
+
+def flatten(arguments: tuple[Any, ...], entry: Entry | None = None) -> tuple[np.ndarray, list[str]]:
+    """A driver function's arguments as its entry function reads them: 64-bit slots and their kinds.
+
+    The arguments are those of ``entry`` (the sweep driver's by default): its
+    records (or plain tuples of their fields), each passed field by field, and
+    its arrays: a slot per field, an array's holding the address of its numpy
+    object (which must live as long as the slots are used; the entry function
+    reads its data pointer, shape and strides), a boolean's 0 or 1.  Arrays of
+    another dtype, dimension, shape or layout than the driver takes are
+    refused (``TypeError``), and so are read-only arrays the driver writes.
+    """
+    entry = entry or ENTRIES["sweep_lanes"]
+    return np.frombuffer(_flattener(entry)(arguments), dtype=np.int64), _plan(entry).kinds
+
+
+def _raise_numbas_error(entry: Entry, arguments: tuple[Any, ...]) -> None:
+    """Call numba's function of ``entry`` with ``arguments``, after its machine code reported an exception.
+
+    numba's function raises the exception.  The sweep driver's other threads
+    are stopped first, and its jobs run again in this thread.
+    """
+    from grazing.engine.codegen import load_driver
+
+    function = getattr(load_driver(), entry.name)
+    if entry.name == "sweep_lanes":
+        m, cfg, work, points, out = arguments
+        work[1][1] = 1  # (the other threads of the call stop: LaneJobs.control)
+        again = (work[0], np.zeros(3, dtype=np.int64), *work[2:])  # every job again, in this thread:
+        arguments = (m, cfg, again, points, out)
+    function(*arguments)
+
+
+def _caller(entry: Entry, address: int, params: list[str], keep: Any) -> Callable[..., None]:
+    """A Python function with the arguments of the driver's function ``entry``, calling its machine code."""
+    if _plan(entry).kinds != params:  # pragma: no cover - arguments changed without the cache key
+        raise TypeError(f"{entry.name}: the compiled code takes other arguments; clear the kernel cache")
+    call = ctypes.CFUNCTYPE(ctypes.c_int64, ctypes.c_char_p)(address)
+    flatten_ = _flattener(entry)
+
+    def driver_function(*arguments: Any) -> None:
+        if call(flatten_(arguments)) not in _RETURNED:  # pragma: no cover - the driver raised
+            _raise_numbas_error(entry, arguments)
+            raise RuntimeError(f"the compiled {entry.name} failed where numba's function did not")
+
+    driver_function.__name__ = entry.name
+    driver_function.library = keep  # type: ignore[attr-defined]  # (the machine code lives as long as this)
+    return driver_function
+
+
+def _load(entry: Entry) -> Callable[..., None]:
+    """A driver function's entry point, loaded from the kernel cache (compiled by numba the first time).
+
+    If numba's runtime cannot be given to the machine code (a numba that no
+    longer provides a C helper), numba's own compiled function is returned.
+    """
+    from grazing.engine.codegen import _cached_file, load_driver
+
+    name = f"grazing_native_{cache_key(entry)}.bin"
+    path = _cached_file(name, lambda: build(entry))
+    try:
+        loaded = load_object(path.read_bytes(), entry.name)
+    except (ValueError, KeyError, OSError, RuntimeError):  # a damaged cache file (ours): build it again
+        path.unlink(missing_ok=True)
+        loaded = load_object(_cached_file(name, lambda: build(entry)).read_bytes(), entry.name)
+    if loaded is None or not numpy_layout_holds():  # pragma: no cover - a numba or numpy we do not know
+        return getattr(load_driver(), entry.name)
+    return _caller(entry, *loaded)
 
 
 @functools.cache
 def load_sweep_lanes() -> Callable[..., None]:
-    """The sweep driver's entry point, loaded from the kernel cache (compiled by numba the first time).
+    """The sweep driver's entry point: the arguments of :func:`grazing.engine.driver.lanes.sweep_lanes`.
 
-    The returned function takes the arguments of
-    :func:`grazing.engine.driver.lanes.sweep_lanes` (the records of
-    :data:`grazing.engine.records.SWEEP_RECORDS`).  If numba's runtime
-    cannot be given to the machine code (a numba that no longer provides a
-    C helper), numba's own compiled function is returned instead.
+    They are the records of :data:`grazing.engine.records.SWEEP_RECORDS`; it
+    writes the results into the last.
     """
-    from grazing.engine.codegen import _cached_file, load_driver
+    return _load(ENTRIES["sweep_lanes"])
 
-    name = f"grazing_native_{cache_key()}.bin"
-    path = _cached_file(name, build)
-    try:
-        loaded = load_object(path.read_bytes(), _ENTRY)
-    except (ValueError, KeyError, OSError, RuntimeError):  # a damaged cache file (ours): build it again
-        path.unlink(missing_ok=True)
-        loaded = load_object(_cached_file(name, build).read_bytes(), _ENTRY)
-    if loaded is None:  # pragma: no cover - a numba whose C helpers we do not know
-        return load_driver().sweep_lanes
-    return _caller(*loaded)
+
+@functools.cache
+def load_integrate() -> Callable[..., None]:
+    """The scalar integrator's entry point: the arguments of :func:`grazing.engine.driver.loop.integrate`.
+
+    They are :data:`grazing.engine.records.INTEGRATE_ARGUMENTS`; it writes the
+    run into the last, a :class:`~grazing.engine.records.RunOutput`.
+    """
+    return _load(ENTRIES["integrate"])
 
 
 def load_object(data: bytes, name: str) -> tuple[int, list[str], Any] | None:

@@ -1,17 +1,19 @@
-"""The records the compiled driver takes and returns: :class:`Start`, :class:`Config`, :class:`Kernels`,
-:class:`Result`; and the sweep driver's :class:`LaneSettings`, :class:`LaneJobs`, :class:`LanePoints`,
-:class:`LaneResults`.
+"""The records the compiled driver takes and returns: :class:`Start`, :class:`Config`,
+:class:`Kernels`, :class:`RunOutput`, :class:`Result`; and the sweep driver's :class:`LaneSettings`,
+:class:`LaneJobs`, :class:`LanePoints`, :class:`LaneResults`.
 
 Named tuples, which numba compiles as structs: the driver,
-``integrate(start, pv, config, kernels) -> result``, reads its settings by name (no
-positional argument lists) and returns one record that the runner reads by
-name.  Built by :class:`grazing.engine.runner.Runner` (the kernels by
-:mod:`grazing.engine.codegen`).  The sweep driver,
+``integrate(start, pv, config, kernels, output)``, reads its settings by name
+(no positional argument lists) and writes its run into one record,
+:class:`RunOutput`, of arrays the caller allocates, from which the runner
+reads a :class:`Result` by name.  Built by :class:`grazing.engine.runner.Runner`
+(the kernels by :mod:`grazing.engine.codegen`, the outputs by
+:mod:`grazing.engine.outputs`).  The sweep driver,
 ``sweep_lanes(kernels, settings, jobs, points, results)``, takes the records
-of a sweep (built by :class:`grazing.sweeps.run.LaneBatch`); their arrays are
-annotated with their dtype and dimensions (:data:`SWEEP_RECORDS`), from which
-:mod:`grazing.engine.native` derives the machine code's argument layout and
-its checks.
+of a sweep (built by :class:`grazing.sweeps.run.LaneBatch`).  The records'
+arrays are annotated with their dtype and dimensions (:data:`SWEEP_RECORDS`,
+:data:`INTEGRATE_ARGUMENTS`), from which :mod:`grazing.engine.native` derives
+the machine code's argument layout and its checks, for both.
 """
 
 from __future__ import annotations
@@ -26,14 +28,35 @@ F8_1 = Annotated[np.ndarray, ("f8", 1)]
 F8_2 = Annotated[np.ndarray, ("f8", 2)]
 F8_3 = Annotated[np.ndarray, ("f8", 3)]
 BOOL_1 = Annotated[np.ndarray, ("?", 1)]
-"""C-contiguous arrays of a dtype (numpy's code) and number of dimensions, as the sweep driver takes them."""
+
+RUN_TOTALS = np.dtype(
+    [
+        ("status", "i8"),  # a grazing.core.solution.Status code
+        ("k", "i8"),  # the end: whole periods ...
+        ("s", "f8"),  # ... and local time
+        ("mode", "i8"),  # the contact mode at the end
+        ("steps", "i8"),
+        ("n_impacts", "i8"),  # over the whole run
+        ("samples_kept", "i8"),  # rows of RunOutput.samples written
+        ("impact_rows", "i8"),  # rows the tables need (they hold them if they have room) ...
+        ("sticking_rows", "i8"),
+        ("trajectory_rows", "i8"),
+        ("lyap_span", "f8"),  # the time the Lyapunov sums are over
+        ("jacobian_valid", "?"),
+    ],
+    align=True,
+)
+"""The single values a run writes (:attr:`RunOutput.totals`, a structured array of one element)."""
+
+TOTALS_1 = Annotated[np.ndarray, (RUN_TOTALS, 1)]
+"""C-contiguous arrays of a dtype (numpy's) and number of dimensions, as the driver takes them."""
 
 
 class Start(NamedTuple):
     """Where a run starts: state, variational matrix, time ``k T + s`` and contact mode."""
 
-    x: np.ndarray  # state, (n,)
-    V: np.ndarray  # variational matrix, (n, n + directions)
+    x: F8_1  # state, (n,)
+    V: F8_2  # variational matrix, (n, n + directions)
     k: int  # whole periods
     s: float  # local time in [0, T) (periodic models) or the time
     mode: int  # 0 free flight, 1 + j sticking to stop j
@@ -73,12 +96,12 @@ class Config(NamedTuple):
     zdm: bool  # apply the discontinuity map once per period instead of the impacts
     zdm_s: float  # its local time
     zdm_a: float  # L_f^2 h at the grazing point
-    zdm_e: np.ndarray  # its direction e
+    zdm_e: F8_1  # its direction e
     zdm_window: float  # largest |L_f h| / a for which it is applied
-    Tp: np.ndarray  # dT/dp along each sensitivity direction
+    Tp: F8_1  # dT/dp along each sensitivity direction
     stop: int  # the stop a grazing analysis looks at (tracked guard, grazing contacts, discontinuity map)
     # -- Ctrl-C (appended by grazing.engine.codegen.ModelKernels.integrate, see grazing.engine.interrupts)
-    sigints: np.ndarray  # int64 (1,): SIGINTs counted by the machine-code handler
+    sigints: I8_1  # (1,): SIGINTs counted by the machine-code handler
     sigints_seen: int  # the count when the call started: the driver stops when it changes
 
 
@@ -105,7 +128,7 @@ class Kernels(NamedTuple):
 
 
 class Result(NamedTuple):
-    """What a run returns."""
+    """What a run returns (read from its :class:`RunOutput`)."""
 
     status: int  # a grazing.core.solution.Status code
     x: np.ndarray
@@ -123,6 +146,31 @@ class Result(NamedTuple):
     lyap_span: float
     guard_min: np.ndarray  # per stop (rows): [h, t, state..., h_approach, t_approach, state...]
     jacobian_valid: bool
+
+
+class RunOutput(NamedTuple):
+    """What a run writes (the caller allocates it; :class:`Result` is read from it).
+
+    A table (impacts, sticking intervals, trajectory) holds its rows if it has
+    room for them: the rows a run needs are counted in :attr:`totals` all the
+    same, so that a caller whose table was too short runs it again with room
+    for them all (the run is the same, bit for bit).
+    """
+
+    totals: TOTALS_1  # (1,): status, the end, counts (RUN_TOTALS)
+    x: F8_1  # (n,): the final state
+    V: F8_2  # (n, n + directions): the variational matrix at the end (zero without it)
+    samples: F8_2  # (n_keep, n): the kept samples, the first totals.samples_kept rows
+    impacts: F8_2  # (rows, 3 + n): [t, speed, state..., stop]
+    sticking: F8_2  # (rows, 2): [start, end]
+    trajectory: F8_2  # (rows, 1 + n): [t, state...]
+    log_sums: F8_1  # (n,): Lyapunov sums
+    guard_min: F8_2  # (stops, 2 (2 + n)): per stop [h, t, state..., h_approach, t_approach, state...]
+
+
+INTEGRATE_ARGUMENTS = (Start, ("pv", F8_1), Config, Kernels, RunOutput)
+"""The arguments of :func:`grazing.engine.driver.loop.integrate`, in order: records (as plain
+tuples) and the parameter vector, an array of its own (see :class:`Config`)."""
 
 
 class LaneSettings(NamedTuple):

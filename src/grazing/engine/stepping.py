@@ -259,9 +259,12 @@ def append_pair(table, count, a, b):
 
 
 @njit(cache=True)
-def table_rows(table, count):
-    """A copy of the first ``count`` rows."""
-    return table[0][:count].copy()
+def copy_rows(table, count, into):
+    """The first ``count`` rows of ``table`` into ``into``, as many as it has room for."""
+    buf = table[0]
+    for i in range(min(count, into.shape[0])):
+        for j in range(into.shape[1]):
+            into[i, j] = buf[i, j]
 
 
 @njit(cache=True)

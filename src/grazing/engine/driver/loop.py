@@ -53,35 +53,39 @@ from grazing.engine.driver.state import (
 )
 from grazing.engine.driver.step import STEP_LAST, accept_step, end_plain_step, end_step, step_end
 from grazing.engine.polyroots import work_shape
-from grazing.engine.records import Config, Kernels, Start
+from grazing.engine.records import Config, Kernels, RunOutput, Start
 from grazing.engine.stepping import (
     append_pair,
     append_row,
+    copy_rows,
     eval_rows,
     new_table,
     step_factor,
     step_size,
-    table_rows,
     unpack_var,
 )
 
 ROOT_WORK_ROWS, ROOT_WORK_MIN_COLS = work_shape(0)
 
 
-@njit(cache=True, nogil=True)
-def integrate(start, pv, cfg, m):
+@njit(cache=False, nogil=True)  # (compiled once per machine into its own object file, grazing.engine.native)
+def integrate(start, pv, cfg, m, out):
     """Integrate from ``start`` until the ``cfg.n_samples``-th stroboscopic sample (see the module).
 
-    The GIL is released while it runs: other Python threads go on meanwhile.
+    Writes the run's end, samples and tables into ``out`` (a
+    :class:`~grazing.engine.records.RunOutput` whose arrays the caller
+    allocated).  The GIL is released while it runs: other Python threads go
+    on meanwhile.
 
-    ``start``, ``cfg`` and ``m`` arrive as plain tuples in the field order of their
-    records (numba types a plain tuple in C, a named tuple field by field in
-    Python: 3x faster per call) and are named again here.  Every setting used
-    in the loop is read from the record once, into a local.
+    ``start``, ``cfg``, ``m`` and ``out`` arrive as plain tuples in the field
+    order of their records (numba types a plain tuple in C, a named tuple
+    field by field in Python: 3x faster per call) and are named again here.
+    Every setting used in the loop is read from the record once, into a local.
     """
     start = Start(*start)
     cfg = Config(*cfg)
     m = Kernels(*m)
+    out = RunOutput(*out)
     n = m.nx
     order = m.order
     nstops = m.nstops
@@ -91,7 +95,6 @@ def integrate(start, pv, cfg, m):
     max_step = cfg.max_step
     max_steps = cfg.max_steps
     n_samples = cfg.n_samples
-    n_keep = cfg.n_keep
     events = cfg.events
     touch_end = cfg.touch_end
     zdm_on = cfg.zdm
@@ -124,11 +127,12 @@ def integrate(start, pv, cfg, m):
     xp = np.empty(ntot)
     V = np.empty((n, ncol))
 
-    samples = np.empty((n_keep, n))
+    samples = out.samples  # (n_keep, n)
     imp = new_table(16, 3 + n)
     sticks = new_table(4, 2)
     traj = new_table(64 if traj_dt > 0.0 else 1, 1 + n)
-    logs = np.zeros(n)
+    logs = out.log_sums
+    logs[:] = 0.0
     scratch = np.zeros(n)
     guard_info = new_guard_info(nstops, n)  # per stop: the guard's minimum, closest approach, slopes
     tables = (imp, sticks, traj)
@@ -140,7 +144,6 @@ def integrate(start, pv, cfg, m):
     runs = new_state(1)  # (read again in the return statement: a record does not keep its array alive)
     r = runs[0]  # the run's state (see .state)
     start_run(m, r, start, cfg, x, tables)
-    keep_from = n_samples - n_keep
     sz = cfg.zdm_s
 
     while True:
@@ -200,34 +203,45 @@ def integrate(start, pv, cfg, m):
         if r.isamp >= n_samples:
             break
 
-    if track_min and r.mode == 0 and r.recording:
-        for j in range(nstops):
+    finish_run(m, runs, cfg, x, pv, guard_info, tables, out)  # (the last use of runs: see above)
+
+
+@njit(cache=True)
+def finish_run(m, runs, cfg, x, pv, guard_info, tables, out):
+    """Write the end of the run ``runs[0]`` (its state ``x``) into ``out``, a :class:`RunOutput`.
+
+    The tables (``(impacts, sticking, trajectory)``) are copied as far as
+    ``out``'s have room; ``out.totals`` counts the rows they need.
+    """
+    r = runs[0]
+    n = m.nx
+    T = cfg.T
+    if cfg.track_min and r.mode == 0 and r.recording:
+        for j in range(m.nstops):
             finish_guard(m, r, x, pv, j, guard_info[j])
-    close_sticking(sticks, r.n_stick, r.k * T + r.s)
-    lyap_span = r.k * T + r.s - r.lyap_t0 if (lyap and r.lyap_started) else 0.0
-    Vout = np.zeros((n, ncol))
-    if use_var:
-        unpack_var(x, n, ncol, Vout)
-    # A plain tuple (the caller makes the Result): numba's boxing of a named tuple runs Python code
-    # (unpickling the class) without checking it for an error, a crash if a Ctrl-C is pending.
-    return (
-        r.status,
-        x[:n].copy(),
-        Vout,
-        r.k,
-        r.s,
-        0 if r.mode == 0 else 1 + r.stuck,
-        r.steps,
-        r.n_imp,
-        samples[: max(0, min(n_keep, r.isamp - keep_from))].copy(),
-        table_rows(imp, r.n_imp_rec),
-        table_rows(sticks, r.n_stick),
-        table_rows(traj, r.n_traj),
-        logs,
-        lyap_span,
-        guard_info[:, : 2 * (2 + n)].copy(),
-        runs[0].jac_valid,  # (the last use of runs: see above)
-    )
+    close_sticking(tables[1], r.n_stick, r.k * T + r.s)
+    tot = out.totals[0]
+    tot.status = r.status
+    tot.k = r.k
+    tot.s = r.s
+    tot.mode = 0 if r.mode == 0 else 1 + r.stuck
+    tot.steps = r.steps
+    tot.n_impacts = r.n_imp
+    tot.samples_kept = max(0, min(cfg.n_keep, r.isamp - (cfg.n_samples - cfg.n_keep)))
+    tot.impact_rows = r.n_imp_rec
+    tot.sticking_rows = r.n_stick
+    tot.trajectory_rows = r.n_traj
+    tot.lyap_span = r.k * T + r.s - r.lyap_t0 if (cfg.lyapunov and r.lyap_started) else 0.0
+    tot.jacobian_valid = r.jac_valid
+    for i in range(n):
+        out.x[i] = x[i]
+    out.V[:, :] = 0.0
+    if cfg.use_var:
+        unpack_var(x, n, out.V.shape[1], out.V)
+    copy_rows(tables[0], r.n_imp_rec, out.impacts)
+    copy_rows(tables[1], r.n_stick, out.sticking)
+    copy_rows(tables[2], r.n_traj, out.trajectory)
+    out.guard_min[:, :] = guard_info[:, : out.guard_min.shape[1]]
 
 
 @njit(cache=True)
