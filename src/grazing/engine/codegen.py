@@ -45,9 +45,8 @@ from grazing.atomic import write_bytes_atomic
 from grazing.core.model import set_kernel_loader
 from grazing.core.options import MACHINE_EPSILON
 from grazing.core.symbolic import SymbolicSystem
-from grazing.engine import driver, interrupts, outputs
+from grazing.engine import driver, outputs
 from grazing.engine.abi import LANE_SLOTS, SLOTS
-from grazing.engine.records import Config, Result, RunOutput
 from grazing.errors import WriteError
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -475,7 +474,8 @@ class ModelKernels:
     ``STICKS`` give the sizes; every name of :data:`grazing.engine.abi.SLOTS`
     is a Python caller (``model.kernels().guard(x, t, pv, j)``); arrays must
     be C-contiguous float64, outputs are written in place.  ``table`` is the
-    :class:`~grazing.engine.records.Kernels` record the driver takes.
+    :class:`~grazing.engine.records.Kernels` record the driver takes
+    (:func:`grazing.engine.runner.integrate`).
     """
 
     def __init__(self, library: Any, sizes: dict[str, Any]) -> None:
@@ -495,38 +495,7 @@ class ModelKernels:
         self.table = (fns, self.NX, self.NSENS, self.NSTOPS, self.ORDER, sticks, self.LANES)
         for name in SLOTS:
             setattr(self, name, library.function(name))
-        self._integrate: Callable[..., Any] | None = None
-        self._impacts_per_period = (
-            outputs.IMPACTS_PER_PERIOD
-        )  # (of the last run: the next one's tables are made for as many)
-
-    def integrate(self, start: tuple[Any, ...], pv: np.ndarray, cfg: tuple[Any, ...]) -> Result:
-        """Run the driver on this model (see :mod:`grazing.engine.driver.loop`).
-
-        ``cfg`` holds the fields of :class:`~grazing.engine.records.Config` but
-        the last ones (:data:`~grazing.engine.records.INTERRUPT`), added here: a
-        Ctrl-C during the run stops the driver at its next step and raises
-        :class:`KeyboardInterrupt` (:mod:`grazing.engine.interrupts`).  The
-        driver's machine code is loaded without numba
-        (:func:`grazing.engine.native.load_integrate`); it writes into arrays
-        allocated here (:mod:`grazing.engine.outputs`).
-        """
-        from grazing.engine.native import load_integrate
-
-        if self._integrate is None:
-            self._integrate = load_integrate()
-        integrate = self._integrate
-
-        def call(out: RunOutput) -> None:
-            with interrupts.counting_sigint() as seen:
-                integrate(start, pv, (*cfg, interrupts.SIGINTS, seen), self.table, out)
-            interrupts.raise_if_interrupted(seen)
-
-        config = Config(*cfg, interrupts.SIGINTS, 0)  # (its settings by name, here)
-        rows = outputs.TableRows.guess(config, self._impacts_per_period)
-        result, need = outputs.run(call, self.NX, start[1].shape[1], self.NSTOPS, config, rows)
-        self._impacts_per_period = outputs.impacts_per_period(need, config)
-        return result
+        self.impacts_per_period = outputs.IMPACTS_PER_PERIOD  # (the last run's: see runner.integrate)
 
 
 _loaded: dict[str, ModelKernels] = {}

@@ -19,12 +19,41 @@ import numpy as np
 from grazing.core.model import HybridModel
 from grazing.core.options import CHATTER_TOL, MACHINE_EPSILON, step_limit
 from grazing.core.solution import Status
-from grazing.engine.codegen import direction_columns, taylor_order
-from grazing.engine.records import CALL, STATIC
+from grazing.engine import interrupts, outputs
+from grazing.engine.codegen import ModelKernels, direction_columns, taylor_order
+from grazing.engine.native import load_integrate
+from grazing.engine.records import CALL, STATIC, Config, Result, RunOutput
 from grazing.engine.timebase import start_times
 from grazing.errors import SimulationError
 
 RECORD_IMPACTS = {"none": 0, "sampled": 1, "all": 2}
+
+
+def integrate(kern: ModelKernels, start: tuple[Any, ...], pv: np.ndarray, cfg: tuple[Any, ...]) -> Result:
+    """Run the driver on the model of ``kern`` (see :mod:`grazing.engine.driver.loop`).
+
+    ``start`` holds the fields of :class:`~grazing.engine.records.Start`, ``cfg``
+    those of :class:`~grazing.engine.records.Config` but the last ones
+    (:data:`~grazing.engine.records.INTERRUPT`), added here: a Ctrl-C during
+    the run stops the driver at its next step and raises
+    :class:`KeyboardInterrupt` (:mod:`grazing.engine.interrupts`).  The
+    driver's machine code is loaded without numba
+    (:func:`grazing.engine.native.load_integrate`); it writes into arrays
+    allocated here, with tables for as many impacts per period as the last
+    run of these kernels made (:mod:`grazing.engine.outputs`).
+    """
+    driver = load_integrate()
+
+    def call(out: RunOutput) -> None:
+        with interrupts.counting_sigint() as seen:
+            driver(start, pv, (*cfg, interrupts.SIGINTS, seen), kern.table, out)
+        interrupts.raise_if_interrupted(seen)
+
+    config = Config(*cfg, interrupts.SIGINTS, 0)  # (its settings by name, here)
+    rows = outputs.TableRows.guess(config, kern.impacts_per_period)
+    result, need = outputs.run(call, kern.NX, start[1].shape[1], kern.NSTOPS, config, rows)
+    kern.impacts_per_period = outputs.impacts_per_period(need, config)
+    return result
 
 
 @dataclass(frozen=True)
@@ -254,7 +283,7 @@ class Runner:
         )  # fmt: skip
         # A records.Config but its INTERRUPT fields, as a plain tuple (see the driver's integrate).
         cfg = (*(call[name] for name in CALL), *self._static)
-        out = self.kern.integrate(start, self.pv, cfg)
+        out = integrate(self.kern, start, self.pv, cfg)
         if out.status != Status.OK:
             raise SimulationError(
                 Status(int(out.status)).message(out.k * T + out.s, max_steps, self.model, out.x)
