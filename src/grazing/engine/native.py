@@ -37,7 +37,7 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 from types import ModuleType
-from typing import Annotated, Any, NamedTuple
+from typing import Annotated, Any, NamedTuple, NoReturn
 
 import numpy as np
 
@@ -47,11 +47,17 @@ _RETURNED = (0, -2)
 
 
 class Entry(NamedTuple):
-    """A driver function compiled into an object file of its own."""
+    """A driver function compiled into an object file of its own, and the shapes of its arrays.
+
+    The shapes are Python expressions over the arguments' fields, each named
+    ``Record_field`` (``Kernels_nx``; an array of its own by its name) and
+    over the sizes, which are such expressions themselves, in order.
+    """
 
     name: str  # the function, in grazing.engine.driver
     arguments: tuple[Any, ...]  # its arguments: records (passed as plain tuples) or (name, annotated array)
-    shapes: Callable[[dict[str, Any]], dict[str, tuple[int, ...]]]  # each array's shape, from the others
+    sizes: tuple[tuple[str, str], ...]  # (size, expression), e.g. ("nx", "Kernels_nx")
+    shapes: tuple[tuple[str, str], ...]  # (array field, its shape), e.g. ("Start.x", "(nx,)"); unlisted: any
 
 
 def _parts(argument: Any) -> tuple[str, list[tuple[str, Any]]]:
@@ -411,44 +417,41 @@ def _resolvable(name: str) -> bool:
     return True
 
 
-def _sweep_shapes(values: dict[str, Any]) -> dict[str, tuple[int, ...]]:
-    """The shape each array of ``sweep_lanes`` must have, from the sizes the others give (it checks none)."""
-    nx, nstops = values["Kernels.nx"], values["Kernels.nstops"]
-    npts, njobs = values["LanePoints.pvs"].shape[0], values["LaneJobs.jobs"].shape[0]
-    per_point = ("LanePoints.Ts", "LanePoints.sphase", "LanePoints.tcarry", "LanePoints.zdms")
-    per_point += ("LaneResults.lyap", "LaneResults.used", "LaneResults.t", "LaneResults.status")
-    return {
-        **{name: (npts,) for name in per_point}, "Kernels.fns": values["Kernels.fns"].shape,
-        "Kernels.sticks": (nstops,), "LaneJobs.jobs": (njobs, 2), "LaneJobs.control": (3,),
-        "LaneJobs.x0": (njobs, nx), "LaneJobs.firsts": (njobs, nx + 1),
-        "LanePoints.pvs": values["LanePoints.pvs"].shape,
-        "LaneSettings.zdm_e": (nx,), "LaneResults.samples": (npts, values["LaneSettings.periods"], nx),
-        "LaneResults.by_stop": (npts, nstops), "LaneResults.x": (npts, nx),
-    }  # fmt: skip
+_PER_POINT = ("LanePoints.Ts", "LanePoints.sphase", "LanePoints.tcarry", "LanePoints.zdms")
+_PER_POINT += ("LaneResults.lyap", "LaneResults.used", "LaneResults.t", "LaneResults.status")
 
+SWEEP_LANES = (
+    (("nx", "Kernels_nx"), ("nstops", "Kernels_nstops"), ("points", "LanePoints_pvs.shape[0]"),
+     ("jobs", "LaneJobs_jobs.shape[0]"), ("periods", "LaneSettings_periods")),
+    (*((name, "(points,)") for name in _PER_POINT), ("Kernels.sticks", "(nstops,)"),
+     ("LaneJobs.jobs", "(jobs, 2)"), ("LaneJobs.control", "(3,)"), ("LaneJobs.x0", "(jobs, nx)"),
+     ("LaneJobs.firsts", "(jobs, nx + 1)"), ("LaneSettings.zdm_e", "(nx,)"),
+     ("LaneResults.samples", "(points, periods, nx)"), ("LaneResults.by_stop", "(points, nstops)"),
+     ("LaneResults.x", "(points, nx)")),
+)  # fmt: skip
+"""The sizes and shapes of the arrays of ``sweep_lanes`` (it checks none)."""
 
-def _run_shapes(values: dict[str, Any]) -> dict[str, tuple[int, ...]]:
-    """The shape each array of ``integrate`` must have (its tables' rows are the caller's to choose)."""
-    nx, nstops = values["Kernels.nx"], values["Kernels.nstops"]
-    ncol = nx + values["Kernels.nsens"]
-    rows = {name: values[f"RunOutput.{name}"].shape[:1] for name in ("impacts", "sticking", "trajectory")}
-    return {
-        "Start.x": (nx,), "Start.V": (nx, ncol), "pv": values["pv"].shape, "Config.zdm_e": (nx,),
-        "Config.Tp": (ncol - nx,), "Config.sigints": (1,), "Kernels.fns": values["Kernels.fns"].shape,
-        "Kernels.sticks": (nstops,), "RunOutput.totals": (1,), "RunOutput.x": (nx,),
-        "RunOutput.V": (nx, ncol),
-        "RunOutput.samples": (values["Config.n_keep"], nx), "RunOutput.impacts": (*rows["impacts"], 3 + nx),
-        "RunOutput.sticking": (*rows["sticking"], 2), "RunOutput.trajectory": (*rows["trajectory"], 1 + nx),
-        "RunOutput.log_sums": (nx,), "RunOutput.guard_min": (nstops, 2 * (2 + nx)),
-    }  # fmt: skip
+INTEGRATE = (
+    (("nx", "Kernels_nx"), ("nstops", "Kernels_nstops"), ("ncol", "Kernels_nx + Kernels_nsens"),
+     ("keep", "Config_n_keep")),
+    (("Start.x", "(nx,)"), ("Start.V", "(nx, ncol)"), ("Config.zdm_e", "(nx,)"),
+     ("Config.Tp", "(ncol - nx,)"), ("Config.sigints", "(1,)"), ("Kernels.sticks", "(nstops,)"),
+     ("RunOutput.totals", "(1,)"),
+     ("RunOutput.x", "(nx,)"), ("RunOutput.V", "(nx, ncol)"), ("RunOutput.samples", "(keep, nx)"),
+     ("RunOutput.impacts", "(RunOutput_impacts.shape[0], 3 + nx)"),
+     ("RunOutput.sticking", "(RunOutput_sticking.shape[0], 2)"),
+     ("RunOutput.trajectory", "(RunOutput_trajectory.shape[0], 1 + nx)"), ("RunOutput.log_sums", "(nx,)"),
+     ("RunOutput.guard_min", "(nstops, 2 * (2 + nx))")),
+)  # fmt: skip
+"""The sizes and shapes of the arrays of ``integrate`` (its tables' rows are the caller's to choose)."""
 
 
 def _entries() -> dict[str, Entry]:
     from grazing.engine.records import INTEGRATE_ARGUMENTS, SWEEP_RECORDS
 
     return {
-        "sweep_lanes": Entry("sweep_lanes", SWEEP_RECORDS, _sweep_shapes),
-        "integrate": Entry("integrate", INTEGRATE_ARGUMENTS, _run_shapes),
+        "sweep_lanes": Entry("sweep_lanes", SWEEP_RECORDS, *SWEEP_LANES),
+        "integrate": Entry("integrate", INTEGRATE_ARGUMENTS, *INTEGRATE),
     }
 
 
@@ -489,21 +492,42 @@ def _plan(entry: Entry) -> _Plan:
     return _Plan(arguments, layout, _parts(entry.arguments[-1])[0] + ".", kinds, format_)
 
 
-def _refuse(entry: Entry, label: str, dtype: np.dtype, shapes: dict[str, Any], value: Any) -> None:
-    """Raise the ``TypeError`` of an array argument that the driver cannot take."""
-    if isinstance(value, np.ndarray) and value.dtype == dtype and value.flags.c_contiguous:
-        if value.shape == shapes[label]:
+def _name(label: str) -> str:
+    """The Python name of a field in the expressions of an :class:`Entry` (``Kernels.nx``: ``Kernels_nx``)."""
+    return label.replace(".", "_")
+
+
+def _refuse(entry: Entry, fields: dict[str, Any]) -> NoReturn:
+    """Raise the ``TypeError`` saying which array of ``fields`` (by :func:`_name`) the driver cannot take."""
+    plan = _plan(entry)
+    arrays = [(label, spec) for label, kind, spec in plan.layout if kind == "array"]
+    for label, (dtype, ndim) in arrays:
+        a = fields[_name(label)]
+        if not (isinstance(a, np.ndarray) and a.dtype == dtype and a.ndim == ndim and a.flags.c_contiguous):
+            raise TypeError(
+                f"{entry.name}: {label} must be a C-contiguous {dtype} array of {ndim} dimension(s)"
+            )
+    values = dict(fields)
+    for size, expression in entry.sizes:
+        values[size] = eval(expression, {}, values)  # (the entry's own expressions)
+    for label, (dtype, _ndim) in arrays:
+        a = fields[_name(label)]
+        want = eval(dict(entry.shapes).get(label, "None"), {}, values)
+        if want is not None and a.shape != want:
+            raise TypeError(f"{entry.name}: {label} must be a C-contiguous {dtype} array of shape {want}")
+        if label.startswith(plan.written) and not a.flags.writeable:
             raise TypeError(f"{entry.name}: {label} must be writeable")
-    raise TypeError(f"{entry.name}: {label} must be a C-contiguous {dtype} array of shape {shapes[label]}")
+    raise TypeError(f"{entry.name}: arguments the driver cannot take")  # pragma: no cover - a size not an int
 
 
 @functools.cache
 def _flattener(entry: Entry) -> Callable[[tuple[Any, ...]], bytes]:
     """A function from the arguments of ``entry`` to its slots (as bytes), written for its layout.
 
-    Python code with a line per field (no loop over the layout): the driver's
-    arguments are flattened on every call of the scalar integrator, about as
-    often as numba's dispatcher would take them.
+    Python code with a line per field (no loop over the layout, no table of
+    values): the driver's arguments are flattened on every call of the scalar
+    integrator, about as often as numba's dispatcher would take them.  Should
+    any check fail, :func:`_refuse` finds which.
     """
     import struct
 
@@ -515,39 +539,49 @@ def _flattener(entry: Entry) -> Callable[[tuple[Any, ...]], bytes]:
         "got {len(arguments)}')",
         f"    {', '.join(f'a{i}' for i in range(len(plan.arguments)))}, = arguments",
     ]
-    names = {label: f"v{j}" for j, (label, _kind, _spec) in enumerate(plan.layout)}
     for i, (name, labels) in enumerate(plan.arguments):
         if labels is None:
-            lines.append(f"    {names[name]} = a{i}")
+            lines.append(f"    {_name(name)} = a{i}")
             continue
         lines += [
             f"    if not (isinstance(a{i}, tuple) and len(a{i}) == {len(labels)}):",
             f"        raise TypeError('{entry.name}: a {name} ({len(labels)} fields) expected')",
-            f"    {', '.join(names[label] for label in labels)}, = a{i}",
+            f"    {', '.join(_name(label) for label in labels)}, = a{i}",
         ]
-    lines.append("    s = shapes({" + ", ".join(f"{label!r}: {v}" for label, v in names.items()) + "})")
+    lines.append("    try:")
+    lines += [f"        {size} = {expression}" for size, expression in entry.sizes]
+    shapes = dict(entry.shapes)
     items = []
     dtypes = {}
     for label, kind, spec in plan.layout:
-        v = names[label]
+        v = _name(label)
         if kind != "array":
             items.append({"bool": f"1 if {v} else 0", "float": f"float({v})", "int": f"int({v})"}[kind])
             continue
         dtypes[f"D_{v}"] = spec[0]
-        written = label.startswith(plan.written)
+        shape = f"{v}.shape == {shapes[label]}" if label in shapes else f"{v}.ndim == {spec[1]}"
+        written = f" and {v}.flags.writeable" if label.startswith(plan.written) else ""
         lines += [
-            f"    if not (isinstance({v}, ndarray) and {v}.dtype == D_{v} and {v}.flags.c_contiguous"
-            f"{f' and {v}.flags.writeable' if written else ''} and {v}.shape == s[{label!r}]):",
-            f"        refuse(entry, {label!r}, D_{v}, s, {v})",
+            f"        if not (isinstance({v}, ndarray) and {v}.dtype == D_{v} and {v}.flags.c_contiguous"
+            f"{written} and {shape}):",
+            "            raise RefusedError",
         ]
         items.append(f"id({v})")
-    lines.append(f"    return pack({plan.format!r}, {', '.join(items)})")
+    lines += [
+        "    except Exception:",
+        "        refuse(entry, locals())",
+        f"    return pack({plan.format!r}, {', '.join(items)})",
+    ]
     scope = {
-        "ndarray": np.ndarray, "pack": struct.pack, "shapes": entry.shapes, "refuse": _refuse, "entry": entry,
-        **dtypes,
+        "ndarray": np.ndarray, "pack": struct.pack, "refuse": _refuse, "entry": entry,
+        "RefusedError": _RefusedError, **dtypes,
     }  # fmt: skip
     exec(compile("\n".join(lines) + "\n", f"<grazing.engine.native: flatten {entry.name}>", "exec"), scope)
     return scope["flatten"]
+
+
+class _RefusedError(Exception):
+    """An argument a driver function cannot take (the generated checks' signal to :func:`_refuse`)."""
 
 
 def flatten(arguments: tuple[Any, ...], entry: Entry | None = None) -> tuple[np.ndarray, list[str]]:
