@@ -1,16 +1,22 @@
-"""The sweep driver as machine code of its own, loaded without importing numba.
+"""The driver as machine code of its own, loaded without importing numba: the one compile pipeline.
 
-numba compiles the driver (:mod:`grazing.engine.driver`) once per machine and
-caches it, but a process that uses it pays about half a second to import
-numba and have it load that cache -- in every worker of every sweep, more
-than the work of a small sweep.  So the sweep's entry point,
-:func:`~grazing.engine.driver.lanes.sweep_lanes`, is compiled by numba once
-per machine and its LLVM IR (the function and everything it calls, as numba
+numba compiles the driver (:mod:`grazing.engine.driver`), but a process that
+uses numba's compiled functions pays about half a second to import numba and
+have it load its cache -- in every command, and in every worker of every
+sweep.  So each entry point of the driver (:data:`ENTRIES`: the sweep's
+:func:`~grazing.engine.driver.lanes.sweep_lanes` and the scalar integrator
+:func:`~grazing.engine.driver.loop.integrate`) is compiled by numba once per
+machine and its LLVM IR (the function and everything it calls, as numba
 optimised it) becomes an object file in the kernel cache, with a small entry
 function added that takes the function's arguments from an array of 64-bit
-slots.  A sweep loads that file with llvmlite, as it loads a model's
-functions (:mod:`grazing.engine.llvmgen`), and calls it through ctypes: the
-machine code numba would run, the same numbers bit for bit.
+slots, one per field of its records (an array's slot holds numpy's array
+object, whose data pointer, shape and strides the entry function reads).  A
+run loads that file with llvmlite, as it loads a model's functions
+(:mod:`grazing.engine.llvmgen`), and calls it through ctypes: the machine
+code numba would run, the same numbers bit for bit.  The argument layout
+comes from the records' annotations (:mod:`grazing.engine.records`), and the
+arguments are checked (dtype, dimensions, shape, layout) before any machine
+code runs.
 
 numba's code calls a few C functions of numba's own: its memory allocator
 (NRT, for the driver's work arrays) and, on the error path only, its
@@ -24,6 +30,8 @@ Examples
 >>> sweep = load_sweep_lanes()  # the driver's arguments (records.SWEEP_RECORDS); it writes the results
 >>> [label for label, kind, spec in _layout()][:3]
 ['Kernels.fns', 'Kernels.nx', 'Kernels.nsens']
+>>> [label for label, kind, spec in _layout(ENTRIES["integrate"])][:3]
+['Start.x', 'Start.V', 'Start.k']
 """
 
 from __future__ import annotations
