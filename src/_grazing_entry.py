@@ -28,7 +28,9 @@ def main() -> int:
     try:
         from grazing.cli import main as run
     except KeyboardInterrupt:
-        print("grazing: interrupted", file=sys.stderr)
+        print(
+            ("\n" if sys.stderr.isatty() else "") + "grazing: interrupted", file=sys.stderr
+        )  # (cli.interrupted_line)
         return EXIT_INTERRUPTED
     return run()
 

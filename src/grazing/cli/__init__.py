@@ -68,6 +68,13 @@ def cli() -> None:
     Piiroinen, Virgin & Champneys 2004 by default)."""
 
 
+def interrupted_line() -> None:
+    """Say on stderr that the command was interrupted, in one line (after a terminal's ``^C``, its own)."""
+    import sys
+
+    click.echo(("\n" if sys.stderr.isatty() else "") + "grazing: interrupted", err=True)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI; every error becomes one line on stderr and an exit status.
 
@@ -75,17 +82,15 @@ def main(argv: list[str] | None = None) -> int:
     """
     import sys
 
-    if not (sys.argv[1:] if argv is None else argv):
-        argv = ["--help"]
+    args = list(sys.argv[1:] if argv is None else argv) or ["--help"]
     try:
-        cli.main(args=argv, prog_name="grazing", standalone_mode=False)
+        # (not cli.main: on Ctrl-C it writes an empty line to stderr, whatever stderr is)
+        with cli.make_context("grazing", args) as ctx:
+            cli.invoke(ctx)
     except click.exceptions.Exit as exc:
         return int(exc.exit_code)
-    except click.exceptions.Abort:
-        click.echo("grazing: interrupted", err=True)
-        return EXIT_INTERRUPTED
-    except KeyboardInterrupt:
-        click.echo("grazing: interrupted", err=True)
+    except (click.exceptions.Abort, KeyboardInterrupt, EOFError):
+        interrupted_line()
         return EXIT_INTERRUPTED
     except click.ClickException as exc:
         error_line(exc.format_message())
