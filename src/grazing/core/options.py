@@ -46,6 +46,11 @@ STEPS_EXTRA = 100_000
 NEWTON_TOL = 1e-11
 """Periodic orbits: Newton's method stops when ``max |P^n(x) - x|`` is below this."""
 
+UNIT_CIRCLE_TOL = 1e-9
+"""A Floquet multiplier within this of the unit circle is on it (neither stable nor unstable): the
+multipliers of an area-preserving map (a conservative model: no damping, elastic impacts) lie on the
+circle up to rounding (measured: 2e-16), which would make such an orbit stable or unstable by chance."""
+
 NEWTON_MAX_ITER = 30
 """Periodic orbits: the largest number of Newton iterations."""
 

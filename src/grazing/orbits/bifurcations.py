@@ -28,7 +28,10 @@ its defining condition.
 The account: the number of multipliers outside the unit circle changes by one
 at a fold, at a branch point where the parameter does not turn and at a
 period-doubling, by none at a branch point where it turns, and by two at a
-Neimark-Sacker point.  A change between two points that the located points do
+Neimark-Sacker point; a multiplier within ``core.options.UNIT_CIRCLE_TOL`` of the
+circle is on it, not outside (an area-preserving map, of a conservative model,
+keeps its complex pairs there, and ``det(P_x) - 1`` is then no test function:
+:data:`AREA_PRESERVING_TOL`).  A change between two points that the located points do
 not explain, or a test function that changed sign where no point could be
 located, is an *unlocated* stability change, reported as such: never silent.
 """
@@ -40,6 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from grazing.core.options import UNIT_CIRCLE_TOL
 from grazing.orbits.branch_equations import BranchEquations
 from grazing.orbits.palc import PalcPoint, PalcSettings, locate, locate_by_interpolation, sign_changed
 from grazing.orbits.shooting import PeriodicOrbit
@@ -50,6 +54,10 @@ SMOOTH_KINDS = ("fold", "branch point", "period-doubling", "neimark-sacker")
 CROSSINGS = {"fold": 1, "branch point": 1, "period-doubling": 1, "neimark-sacker": 2}
 """How many multipliers cross the unit circle at each kind (a branch point where the parameter
 turns: none)."""
+
+AREA_PRESERVING_TOL = 2 * UNIT_CIRCLE_TOL
+"""Where ``|det(P_x) - 1|`` is below this the map preserves area (a conservative model) and the
+Neimark-Sacker test function ``det(P_x) - 1`` says nothing (a pair on the unit circle stays on it)."""
 
 VERIFY_TOL = 1e-5
 """A located point's multiplier must lie this close to its defining value (+1, -1, the unit circle)."""
@@ -65,7 +73,9 @@ def orbit_test(kind: str, orbit: PeriodicOrbit) -> float:
         return float(np.linalg.det(J + eye))
     if kind == "neimark-sacker":
         complex_pair = bool(np.any(np.abs(orbit.multipliers.imag) > 1e-12))
-        return float(np.linalg.det(J) - 1.0) if complex_pair else math.nan
+        area = float(np.linalg.det(J) - 1.0)
+        # (an area-preserving map keeps a complex pair on the circle: det - 1 is rounding, no test)
+        return area if complex_pair and abs(area) > AREA_PRESERVING_TOL else math.nan
     raise ValueError(f"unknown special point kind {kind!r}")
 
 
@@ -89,8 +99,8 @@ def verified(kind: str, orbit: PeriodicOrbit) -> bool:
 
 
 def unstable_count(orbit: PeriodicOrbit) -> int:
-    """The number of multipliers outside the unit circle (0: the orbit is stable)."""
-    return int(np.sum(np.abs(orbit.multipliers) > 1.0))
+    """The number of multipliers outside the unit circle (0: the orbit is stable; see ``UNIT_CIRCLE_TOL``)."""
+    return orbit.unstable_count
 
 
 @dataclass(frozen=True)

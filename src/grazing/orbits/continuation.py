@@ -450,7 +450,7 @@ class _Continuation:
             )
         if not self.virtual and b.section_clearance() < RESECTION_MARGIN:
             return STOP, _RESECTION
-        if np.sum(np.abs(a.multipliers) > 1.0) != np.sum(np.abs(b.multipliers) > 1.0):
+        if a.unstable_count != b.unstable_count:
             return REFINE, "stability changes"
         return ACCEPT, ""
 

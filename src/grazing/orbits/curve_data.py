@@ -15,7 +15,7 @@ import numpy as np
 from grazing.core.model import HybridModel
 from grazing.orbits.contact import GrazingPoint
 from grazing.orbits.continuation import Branch, SpecialPoint
-from grazing.orbits.shooting import PeriodicOrbit
+from grazing.orbits.shooting import PeriodicOrbit, unstable_count
 
 ACCURACY_NOTE = 1e-6
 """Points whose multipliers are known less well than this (:attr:`CurvePoint.accuracy`) are named
@@ -67,7 +67,8 @@ class CurvePoint:
 
     @property
     def stable(self) -> bool:
-        return bool(np.max(np.abs(self.multipliers)) < 1.0)
+        """No multiplier outside the unit circle (see ``core.options.UNIT_CIRCLE_TOL``)."""
+        return unstable_count(self.multipliers) == 0
 
 
 @dataclass(frozen=True)

@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from grazing.core.model import HybridModel
-from grazing.core.options import NEWTON_MAX_ITER, NEWTON_TOL
+from grazing.core.options import NEWTON_MAX_ITER, NEWTON_TOL, UNIT_CIRCLE_TOL
 from grazing.core.period import detect_period
 from grazing.core.solution import Solution
 from grazing.engine.simulate import simulate
@@ -36,6 +36,17 @@ stroboscopic section, an automatic section (``t0=None``) moves to a quiet phase.
 
 CROSSING_TOL = 1e-9
 """A virtual orbit whose guard goes below ``-CROSSING_TOL`` passes through that stop."""
+
+
+def unstable_count(multipliers: np.ndarray) -> int:
+    """The number of ``multipliers`` outside the unit circle by more than ``core.options.UNIT_CIRCLE_TOL``.
+
+    Examples
+    --------
+    >>> unstable_count(np.array([1.5, 0.2])), unstable_count(np.exp(1j * np.array([0.3, -0.3]) + 1e-15))
+    (1, 0)
+    """
+    return int(np.sum(np.abs(multipliers) > 1.0 + UNIT_CIRCLE_TOL))
 
 
 @dataclass(frozen=True)
@@ -134,9 +145,14 @@ class PeriodicOrbit:
         return float(np.min(np.minimum(d, 1.0 - d)))
 
     @property
+    def unstable_count(self) -> int:
+        """How many multipliers lie outside the unit circle (by more than ``options.UNIT_CIRCLE_TOL``)."""
+        return unstable_count(self.multipliers)
+
+    @property
     def stable(self) -> bool:
-        """Linearly stable: every multiplier inside the unit circle."""
-        return bool(np.max(np.abs(self.multipliers)) < 1.0)
+        """Linearly stable: no multiplier outside the unit circle (one on it, to rounding, is not outside)."""
+        return self.unstable_count == 0
 
     @property
     def abs_lambda(self) -> float:
