@@ -55,9 +55,8 @@ def test_native_entry_equals_numbas_function(make, param, values, fresh, monkeyp
     assert np.isfinite(np.concatenate([r.samples for r in ours])).all()
 
 
-def test_a_sweep_in_a_new_process_does_not_import_numba() -> None:
-    native.load_sweep_lanes()  # (the cache file exists)
-    code = (
+NEW_PROCESS = {
+    "sweep": (
         "import sys, numpy as np, grazing\n"
         "from grazing.sweeps.spec import sweep_spec\n"
         "from grazing.core.options import SweepSettings\n"
@@ -66,8 +65,20 @@ def test_a_sweep_in_a_new_process_does_not_import_numba() -> None:
         "                  settings=SweepSettings(transient=20, periods=4, chunk_size=2))\n"
         "res = run_chunks(spec, [0, 1])\n"
         "assert np.isfinite(res[0].samples).all()\n"
-        "print('numba' in sys.modules)\n"
-    )
+    ),
+    "simulation": (
+        "import sys, math, grazing\n"
+        "from grazing.models import pendulum\n"
+        "sol = grazing.simulate(pendulum('B', theta_hat=math.radians(40)), periods=20)\n"
+        "assert len(sol.samples) == 20\n"
+    ),
+}
+
+
+@pytest.mark.parametrize("what", list(NEW_PROCESS))
+def test_a_run_in_a_new_process_does_not_import_numba(what) -> None:
+    native.load_sweep_lanes(), native.load_integrate()  # (the cache files exist)
+    code = NEW_PROCESS[what] + "print('numba' in sys.modules)\n"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == "False"
@@ -334,17 +345,3 @@ def test_the_integrate_entry_refuses_wrong_arrays() -> None:
 
 def test_numpys_array_objects_hold_their_fields_where_the_entry_reads_them() -> None:
     assert native.numpy_layout_holds()
-
-
-def test_a_simulation_in_a_new_process_does_not_import_numba() -> None:
-    native.load_integrate()  # (the cache file exists)
-    code = (
-        "import sys, math, grazing\n"
-        "from grazing.models import pendulum\n"
-        "sol = grazing.simulate(pendulum('B', theta_hat=math.radians(40)), periods=20)\n"
-        "assert len(sol.samples) == 20\n"
-        "print('numba' in sys.modules)\n"
-    )
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
-    assert out.returncode == 0, out.stderr
-    assert out.stdout.strip() == "False"
