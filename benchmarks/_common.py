@@ -28,6 +28,15 @@ VECTOR_ISAS = (("avx512f", "AVX-512", 8), ("avx2", "AVX2", 4), ("avx", "AVX", 4)
 """(/proc/cpuinfo flag, name, doubles per register), widest first."""
 
 
+def grazing_exe() -> str:
+    """The ``grazing`` command of this interpreter's environment (else the one on PATH)."""
+    import shutil
+    from pathlib import Path
+
+    exe = Path(sys.executable).with_name("grazing")
+    return str(exe) if exe.exists() else (shutil.which("grazing") or "grazing")
+
+
 def bench_parser(doc: str, quiet_wait: float | None = None) -> argparse.ArgumentParser:
     """The options every benchmark has (``--markdown``, ``--json``; ``--quiet-wait`` given its default)."""
     parser = argparse.ArgumentParser(description=doc.splitlines()[0])

@@ -25,11 +25,9 @@ from __future__ import annotations
 
 import json
 import math
-import shutil
 import subprocess
 import sys
 import time
-from pathlib import Path
 from typing import Any
 
 import grazing
@@ -38,6 +36,7 @@ from _common import (
     Spread,
     bench_parser,
     emit,
+    grazing_exe,
     log,
     machine_info,
     metered_command,
@@ -73,9 +72,8 @@ def run_curve(stages: dict[str, float] | None = None) -> BifurcationCurve:
 
 
 def cli_command() -> list[str]:
-    exe = Path(sys.executable).with_name("grazing")
     return [
-        str(exe) if exe.exists() else (shutil.which("grazing") or "grazing"),
+        grazing_exe(),
         *f"curve --case {CASE} --theta-hat {THETA_HAT_DEG:g} --kind period-doubling --param eta "
         f"--start {START} --stop {STOP} --param2 theta-hat --range {RANGE_DEG[0]:g},{RANGE_DEG[1]:g} "
         f"--max-step {DS_MAX} --json".split(),

@@ -49,6 +49,7 @@ from _common import (
     Spread,
     bench_parser,
     emit,
+    grazing_exe,
     loadavg,
     log,
     machine_info,
@@ -64,11 +65,6 @@ LANES = (4, 8, 16)
 REPEATS = 5
 QUIET_WAIT = 10.0
 PEER = Path(__file__).with_name("heyoka_batch_sweep.py")
-
-
-def grazing_exe() -> str:
-    exe = Path(sys.executable).with_name("grazing")
-    return str(exe) if exe.exists() else "grazing"
 
 
 def grazing_command(n: int, processes: int) -> list[str]:

@@ -35,7 +35,6 @@ from __future__ import annotations
 
 import json
 import math
-import shutil
 import subprocess
 import sys
 import time
@@ -50,6 +49,7 @@ from _common import (
     Spread,
     bench_parser,
     emit,
+    grazing_exe,
     loadavg,
     log,
     machine_info,
@@ -90,11 +90,6 @@ def run_curve() -> GrazingCurve:
         model(), ("eta", "theta_hat"), math.radians(START_DEG), search=SEARCH,
         settings=PalcSettings(ds=DS, ds_max=DS_MAX),
     )  # fmt: skip
-
-
-def grazing_exe() -> str:
-    exe = Path(sys.executable).with_name("grazing")
-    return str(exe) if exe.exists() else (shutil.which("grazing") or "grazing")
 
 
 def cli_command() -> list[str]:

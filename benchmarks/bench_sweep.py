@@ -50,13 +50,11 @@ from __future__ import annotations
 
 import math
 import os
-import shutil
 import subprocess
 import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import heyoka as hy
@@ -70,6 +68,7 @@ from _common import (
     bench_parser,
     command_seconds,
     emit,
+    grazing_exe,
     loadavg,
     log,
     machine_info,
@@ -139,6 +138,15 @@ class Timing:
     agree_stable: int = 0
     seconds_min: float = math.nan  # the spread of the repeated runs (extrapolated like `seconds`)
     seconds_max: float = math.nan
+
+    @classmethod
+    def of_runs(cls, key: str, spread: Spread, others: float, repeats: int, periods: list[int]) -> Timing:
+        """The timing of ``repeats`` runs over every point (``len(periods)``), their spread ``spread``."""
+        n = len(periods)
+        return cls(
+            key, n, spread.median, others, repeats, n, list(range(n)), periods,
+            seconds_min=spread.min, seconds_max=spread.max,
+        )  # fmt: skip
 
     @property
     def extrapolated(self) -> bool:
@@ -323,20 +331,7 @@ def time_grazing(res: Results, etas: np.ndarray, quiet: float) -> np.ndarray:
     for key, (sec, others, runs, ds) in round_robin(runners, REPEATS, quiet).items():
         per = ds.period.values.astype(int)
         assert [detect_period(s) for s in ds.samples.values] == per.tolist(), "period rules differ"
-        res.timings.append(
-            Timing(
-                key,
-                n,
-                sec.median,
-                others,
-                runs,
-                n,
-                list(range(n)),
-                per.tolist(),
-                seconds_min=sec.min,
-                seconds_max=sec.max,
-            )
-        )
+        res.timings.append(Timing.of_runs(key, sec, others, runs, per.tolist()))
         if key == "grazing":
             res.grazing_periods = per.tolist()
             x_final = ds.x_final.values
@@ -358,21 +353,7 @@ def time_heyoka(res: Results, etas: np.ndarray, quiet: float) -> None:
         runners[key] = lambda t=ta, d=three_d: heyoka_sweep(t, etas, d)
     log(f"heyoka loops: {n} points, median of {REPEATS} ...")
     for key, (sec, others, runs, samples) in round_robin(runners, REPEATS, quiet).items():
-        periods = [detect_period(s) for s in samples]
-        res.timings.append(
-            Timing(
-                key,
-                n,
-                sec.median,
-                others,
-                runs,
-                n,
-                list(range(n)),
-                periods,
-                seconds_min=sec.min,
-                seconds_max=sec.max,
-            )
-        )
+        res.timings.append(Timing.of_runs(key, sec, others, runs, [detect_period(s) for s in samples]))
 
 
 def time_scipy(res: Results, etas: np.ndarray, x_final: np.ndarray, quiet: float) -> None:
@@ -388,11 +369,6 @@ def time_scipy(res: Results, etas: np.ndarray, x_final: np.ndarray, quiet: float
         periods.append(detect_period(samples))
     n = len(etas)
     res.timings.append(Timing("scipy", n, total / len(idx) * n, other / total, 1, len(idx), idx, periods))
-
-
-def grazing_exe() -> str:
-    exe = Path(sys.executable).with_name("grazing")
-    return str(exe) if exe.exists() else (shutil.which("grazing") or "grazing")
 
 
 def cli_command(n: int) -> list[str]:
