@@ -364,8 +364,10 @@ def kernel_key(identity: str, directions: int, order: int = DEFAULT_ORDER) -> st
     deps = "".join(
         (here / f).read_text() for f in ("taylor.py", "codegen.py", "llvmgen.py", "sincos.py", "abi.py")
     )
+    from grazing.engine.llvmgen import lane_width
+
     versions = (_CODEGEN_VERSION, llvmlite.__version__, sys.version)
-    return _key(identity, int(directions), order, versions, deps)
+    return _key(identity, int(directions), order, versions, deps, lane_width())
 
 
 @functools.cache
@@ -386,8 +388,11 @@ def driver_key() -> str:
     helpers = ("polyroots.py", "stepping.py", "records.py", "abi.py", "timebase.py", "lanevec.py")
     files = [here / f for f in helpers]
     deps = "".join(path.read_text() for path in [*files, *driver.template_files()])
+    from grazing.engine.llvmgen import lane_width
+
     constants = (STEPS_PER_PERIOD, STEPS_EXTRA, [(s.name, int(s)) for s in Status])  # (from core)
-    return _key(_CODEGEN_VERSION, version("numba"), sys.version, deps, constants)  # (numba's, not imported)
+    versions = (_CODEGEN_VERSION, version("numba"), sys.version)  # (numba's, not imported)
+    return _key(*versions, deps, constants, lane_width())  # (lanevec's vectors are lane_width() wide)
 
 
 def _init_numba_without_blas_probe() -> None:

@@ -42,8 +42,10 @@ from __future__ import annotations
 
 import ast
 import ctypes
+import functools
 import inspect
 import math
+import os
 import textwrap
 import threading
 from collections.abc import Callable, Mapping
@@ -390,8 +392,17 @@ def _target_machine() -> Any:
     )
 
 
+LANE_WIDTH_ENV = "GRAZING_LANE_WIDTH"
+"""An environment variable that narrows the lanes (2 or 4 doubles where the processor has more): the
+vector code a processor with narrower registers runs, tested on this one."""
+
+
+@functools.cache
 def lane_width() -> int:
     """Doubles in this CPU's widest vector registers: 8 with AVX-512, 4 with AVX, else 2.
+
+    ``GRAZING_LANE_WIDTH`` (:data:`LANE_WIDTH_ENV`) asks for fewer: 2, 4 or 8, at most the
+    processor's; any other value is refused (a :class:`~grazing.errors.GrazingError`).
 
     Examples
     --------
@@ -400,11 +411,17 @@ def lane_width() -> int:
     """
     _target_machine()  # (initialises LLVM)
     features = llvm.get_host_cpu_features()
-    if features.get("avx512f"):
-        return 8
-    if features.get("avx"):
-        return 4
-    return 2
+    widest = 8 if features.get("avx512f") else 4 if features.get("avx") else 2
+    asked = os.environ.get(LANE_WIDTH_ENV, "").strip()
+    if not asked:
+        return widest
+    allowed = [w for w in (2, 4, 8) if w <= widest]
+    if asked not in [str(w) for w in allowed]:
+        from grazing.errors import GrazingError
+
+        lanes = " or ".join(map(str, allowed))
+        raise GrazingError(f"{LANE_WIDTH_ENV}={asked!r}: this processor's lanes are {lanes} doubles wide")
+    return int(asked)
 
 
 def compile_object(module: ir.Module) -> bytes:
