@@ -55,7 +55,11 @@ class TableRows(NamedTuple):
 
     def fit(self, needed: TableRows) -> bool:
         """Whether tables of these rows hold ``needed`` rows."""
-        return all(have >= need for have, need in zip(self, needed, strict=True))
+        return (
+            self.impacts >= needed.impacts
+            and self.sticking >= needed.sticking
+            and self.trajectory >= needed.trajectory
+        )
 
 
 def allocate(nx: int, ncol: int, nstops: int, n_keep: int, rows: TableRows) -> RunOutput:
