@@ -31,6 +31,7 @@ True
 
 from __future__ import annotations
 
+import _signal
 import ctypes
 import os
 import signal
@@ -92,7 +93,8 @@ def _sigaction() -> Any:
 def _counting_applies() -> bool:
     return (
         threading.current_thread() is threading.main_thread()
-        and signal.getsignal(signal.SIGINT) is signal.default_int_handler
+        # (signal.getsignal's value, without its 2 us of trying the handler as an enum member)
+        and _signal.getsignal(signal.SIGINT) is signal.default_int_handler
         and _sigaction() is not None
     )
 
