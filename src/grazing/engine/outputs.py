@@ -30,8 +30,9 @@ from grazing.engine.records import RUN_TOTALS, Config, Result, RunOutput
 IMPACTS_PER_PERIOD = 4.0
 """The impacts per recorded period a first run makes room for (then: what the runs before needed)."""
 
-MAX_GUESSED_ROWS = 1 << 20
-"""At most this many rows per table are allocated before a run has shown it needs them."""
+MAX_GUESSED_ROWS = 1 << 22
+"""At most this many rows of guessed impacts or sticking intervals per table (an array not written is
+not in memory: numpy's ``empty`` leaves its pages to the first write)."""
 
 
 class TableRows(NamedTuple):
@@ -45,13 +46,13 @@ class TableRows(NamedTuple):
     def guess(cls, cfg: Config, impacts_per_period: float = IMPACTS_PER_PERIOD) -> TableRows:
         """Rows for a run with settings ``cfg``, at ``impacts_per_period`` impacts per recorded period."""
         span = (0, cfg.n_keep, cfg.n_samples)[cfg.record_impacts]  # (periods whose impacts are recorded)
-        impacts = 16 + math.ceil(impacts_per_period * span) if span else 0
-        sticking = 4 + math.ceil(impacts_per_period * cfg.n_keep / 4)
+        impacts = min(16 + math.ceil(impacts_per_period * span), MAX_GUESSED_ROWS) if span else 0
+        sticking = min(4 + math.ceil(impacts_per_period * cfg.n_keep / 4), MAX_GUESSED_ROWS)
         trajectory = 0
-        if cfg.traj_dt > 0.0:  # a point per traj_dt, two per impact and one per end of sticking
-            points = cfg.n_keep * cfg.T / cfg.traj_dt
-            trajectory = 8 + math.ceil(points + impacts_per_period * cfg.n_keep * 2 + sticking)
-        return cls(*(min(rows, MAX_GUESSED_ROWS) for rows in (impacts, sticking, trajectory)))
+        if cfg.traj_dt > 0.0:  # a point per traj_dt (known), two per impact and one per end of sticking
+            around = min(math.ceil(impacts_per_period * cfg.n_keep * 2) + sticking, MAX_GUESSED_ROWS)
+            trajectory = 8 + math.ceil(cfg.n_keep * cfg.T / cfg.traj_dt) + around
+        return cls(impacts, sticking, trajectory)
 
     def fit(self, needed: TableRows) -> bool:
         """Whether tables of these rows hold ``needed`` rows."""
