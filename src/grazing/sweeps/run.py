@@ -39,7 +39,6 @@ from typing import Any
 
 import numpy as np
 
-from grazing.core.model import HybridModel
 from grazing.core.period import DEFAULT_MAX_PERIOD, DEFAULT_PERIOD_TOL, detect_periods
 from grazing.core.solution import Status
 from grazing.engine.codegen import taylor_order
@@ -94,67 +93,52 @@ class LaneBatch:
         spec0 = parts[0][0]
         model = spec0.model
         n, m, nstops = model.n_states, spec0.periods, model.n_stops
+        slices = [spec.chunk(i) for spec, i in parts]
+        sizes = np.array([sl.stop - sl.start for sl in slices], dtype=np.int64)
+        ends = np.cumsum(sizes)
+        bounds = [(int(e - k), int(e)) for k, e in zip(sizes, ends)]
+        npts = int(ends[-1])
+        pvs, Ts = _point_table(parts, slices, npts)
         two_pi = 2 * math.pi
-        cache: dict[tuple[Any, ...], tuple[HybridModel, float]] = {}  # (a grid of starts shares its point)
-
-        def at(spec: SweepSpec, base: tuple[Any, ...], pt: tuple[float, ...]) -> tuple[HybridModel, float]:
-            key = (*base, pt)
-            if key not in cache:
-                mm = spec.model_at(pt)
-                cache[key] = (mm, float(mm.period))
-            return cache[key]
-
-        pv_list, t_list, phases, tcarry, zdms = [], [], [], [], []
-        jobs: list[tuple[int, int]] = []
-        x0s: list[tuple[float, ...]] = []
-        firsts: list[np.ndarray] = []
-        bounds = []
-        first = 0
-        for spec, i in parts:
-            sl = spec.chunk(i)
-            size = sl.stop - sl.start
-            base = (id(spec.model._def), tuple(spec.model.param_vector), spec.params)
-            here = [at(spec, base, pt) for pt in spec.points[sl]]
-            Ts = np.array([T for _, T in here])
-            pv_list += [mm.param_vector for mm, _ in here]
-            t_list.append(Ts)
-            phases.append((spec.phase % two_pi) / two_pi * Ts)
-            carry = (spec.phase / two_pi) % 1.0 * Ts
-            tcarry.append(carry)
-            zdms.append(np.array([float(spec.zdm.phase) % T for T in Ts]) if spec.zdm is not None else 0 * Ts)
+        sphase, tcarry, zdms = np.empty(npts), np.empty(npts), np.zeros(npts)
+        jobs, x0s, firsts = [], [], []
+        for (spec, i), sl, (a, b) in zip(parts, slices, bounds):
+            size, T = b - a, Ts[a:b]
+            sphase[a:b] = (spec.phase % two_pi) / two_pi * T
+            carry = (spec.phase / two_pi) % 1.0 * T
+            tcarry[a:b] = carry
+            if spec.zdm is not None:
+                zdms[a:b] = [float(spec.zdm.phase) % t for t in T]
             x0 = np.asarray(spec.x0, dtype=float)
             # Jobs: runs of points, each continuing from the previous (a chunk; every point when fresh).
             if spec.fresh:
-                jobs += [(j, j + 1) for j in range(first, first + size)]
-                x0s += [spec.x0] * size
+                jobs.append(np.column_stack([np.arange(a, b), np.arange(a + 1, b + 1)]))
+                x0s.append(np.broadcast_to(x0, (size, n)))
                 if spec.starts is not None:  # (each from its own state, at its sampling phase)
                     firsts.append(np.column_stack([carry, spec.starts[sl]]))
                 else:
-                    firsts.append(np.tile(np.concatenate([[0.0], x0]), (size, 1)))
+                    firsts.append(np.broadcast_to(np.concatenate([[0.0], x0]), (size, n + 1)))
             else:
-                jobs.append((first, first + size))
-                x0s.append(spec.x0)
+                jobs.append(np.array([[a, b]]))
+                x0s.append(x0[None])
                 if i == 0 and spec.resume is not None:  # (continuing a chain: grazing.sweeps.chain)
                     t, x = spec.resume
                     firsts.append(np.array([[float(t), *x]]))
                 else:
                     firsts.append(np.concatenate([[0.0], x0])[None])
-            bounds.append((first, first + size))
-            first += size
-        npts = first
         self._bounds = bounds
         order = taylor_order(spec0.tol)
         self._kern = model.kernels(0, order)
         self._order = order
         self._spec0 = spec0
-        self.jobs = np.array(jobs, dtype=np.int64).reshape(-1, 2)
-        self.x0 = np.array(x0s, dtype=float).reshape(-1, n)
+        self.jobs = np.ascontiguousarray(np.concatenate(jobs), dtype=np.int64).reshape(-1, 2)
+        self.x0 = np.ascontiguousarray(np.concatenate(x0s), dtype=float).reshape(-1, n)
         self.firsts = np.ascontiguousarray(np.concatenate(firsts), dtype=float).reshape(-1, n + 1)
-        self.pvs = np.array(pv_list, dtype=float).reshape(npts, -1)
-        self.Ts = np.concatenate(t_list)
-        self.sphase = np.concatenate(phases)
-        self.tcarry = np.concatenate(tcarry)
-        self.zdms = np.concatenate(zdms).astype(float)
+        self.pvs = pvs
+        self.Ts = Ts
+        self.sphase = sphase
+        self.tcarry = tcarry
+        self.zdms = zdms
         self.fresh = all(spec.fresh for spec, _ in parts)  # (a fresh spec's jobs are single points anyway)
         self.control = np.zeros(3, dtype=np.int64)  # [next job, stop, most jobs at a time per thread]
         self.samples = np.full((npts, m, n), np.nan)
@@ -229,6 +213,33 @@ class LaneBatch:
             status=status.astype(STATUS_DTYPE),
             t_final=np.where(good, self.t_final[part], np.nan),
         )
+
+
+def _point_table(
+    parts: Sequence[tuple[SweepSpec, int]], slices: Sequence[slice], npts: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """The parameter vectors and forcing periods of the points of ``parts`` (chunks ``slices``), in order.
+
+    Each spec's points at once (:meth:`~grazing.core.model.HybridModel.parameter_table`: the
+    numbers of a model made per point, without making one).
+    """
+    by_spec: dict[int, tuple[SweepSpec, list[slice], list[np.ndarray]]] = {}
+    at = 0
+    for (spec, _), sl in zip(parts, slices):
+        size = sl.stop - sl.start
+        by_spec.setdefault(id(spec), (spec, [], []))
+        by_spec[id(spec)][1].append(sl)
+        by_spec[id(spec)][2].append(np.arange(at, at + size))
+        at += size
+    pvs = np.empty((npts, len(parts[0][0].model.parameters)))
+    Ts = np.empty(npts)
+    for spec, chunks, rows in by_spec.values():
+        points = np.concatenate([np.asarray(spec.points[sl], dtype=float) for sl in chunks])
+        table = spec.model.parameter_table(spec.params, points)
+        where = np.concatenate(rows)
+        pvs[where] = table.vectors
+        Ts[where] = table.periods
+    return pvs, Ts
 
 
 def run_chunks(spec: SweepSpec, indices: Sequence[int]) -> list[ChunkResult]:
