@@ -34,7 +34,7 @@ from __future__ import annotations
 import math
 import threading
 import time
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from typing import Any
 
 import numpy as np
@@ -129,6 +129,7 @@ class LaneBatch:
         self._bounds = bounds
         order = taylor_order(spec0.tol)
         self._kern = model.kernels(0, order)
+        self._driver = load_sweep_lanes()  # (loaded once, with the first table: not by each thread)
         self._order = order
         self._spec0 = spec0
         self.jobs = np.ascontiguousarray(np.concatenate(jobs), dtype=np.int64).reshape(-1, 2)
@@ -179,7 +180,7 @@ class LaneBatch:
         out = LaneResults(
             self.samples, self.by_stop, self.lyap, self.used, self.x_final, self.t_final, self.status
         )
-        load_sweep_lanes()(kern.table, tuple(settings), tuple(work), tuple(points), tuple(out))
+        self._driver(kern.table, tuple(settings), tuple(work), tuple(points), tuple(out))
 
     def stop(self) -> None:
         """Have the threads running the batch return at their next step (unfinished points stay so)."""
@@ -191,6 +192,10 @@ class LaneBatch:
         done = [int(k) for k in np.flatnonzero(complete & ~self._taken)]
         self._taken[done] = True
         return done
+
+    def all_taken(self) -> bool:
+        """Whether :meth:`finished` has given every chunk of the batch."""
+        return bool(self._taken.all())
 
     def result(self, k: int) -> ChunkResult:
         """The result of chunk ``parts[k]`` (once finished)."""
@@ -270,23 +275,93 @@ def stream_chunks(
 
     The chunks are computed as one :class:`LaneBatch` (``parts``, or a batch
     already built of them) by ``threads`` threads sharing its jobs (the
-    compiled driver runs without the GIL).  When the consumer stops early
+    compiled driver runs without the GIL): :func:`stream_batches` of one batch.
+    """
+    batch = parts if isinstance(parts, LaneBatch) else LaneBatch(parts)
+    for _, k, res in stream_batches([lambda: batch], threads):
+        yield k, res
+
+
+def stream_batches(
+    batches: Sequence[Callable[[], LaneBatch]], threads: int
+) -> Iterator[tuple[int, int, ChunkResult]]:
+    """``(batch, position in its parts, result)`` of each chunk of the batches, as soon as it is finished.
+
+    ``batches[k]()`` builds batch ``k`` (a :class:`LaneBatch`): a thread of its
+    own builds each batch while the cores compute the one before (a table of
+    points, Python work: not a serial part of the sweep, issue 29).
+    ``threads`` threads run the batches in order, sharing each batch's jobs
+    (the compiled driver runs without the GIL); a thread with no job left in
+    a batch goes on to the next one at once, so that no thread waits for the
+    others' last points at a batch's end.  When the consumer stops early
     (Ctrl-C, an error, ``close()``) the threads are told to stop and have
     returned, at their next step, before this returns.
     """
-    batch = parts if isinstance(parts, LaneBatch) else LaneBatch(parts)
-    batch.control[2] = math.ceil(len(batch.jobs) / threads)  # (a few chains: as many on each thread)
+    if not batches:
+        return
+    from concurrent.futures import Future, ThreadPoolExecutor
+
     errors: list[BaseException] = []
     finished = threading.Semaphore(0)
+    stopping = threading.Event()
+    lock = threading.Lock()
+    built: dict[int, Future[LaneBatch]] = {}  # (batches built or being built, not yet all reported)
+    reported: set[int] = set()  # (batches all reported: let go)
+    builder = ThreadPoolExecutor(1, thread_name_prefix="grazing-batch")
+
+    def build(k: int) -> LaneBatch:
+        batch = batches[k]()
+        batch.control[2] = math.ceil(len(batch.jobs) / threads)  # (a few chains: as many on each thread)
+        return batch
+
+    def batch_at(k: int) -> Future[LaneBatch] | None:
+        """Batch ``k`` (built, or being built, once), or None if it is all reported."""
+        with lock:
+            if k in reported:
+                return None
+            if k not in built:
+                built[k] = builder.submit(build, k)
+            return built[k]
 
     def work() -> None:
         try:
-            batch.run()
+            for k in range(len(batches)):
+                future = batch_at(k)
+                if k + 1 < len(batches):
+                    batch_at(k + 1)  # (built while this one runs)
+                if future is None:  # (the other threads ran it)
+                    continue
+                batch = future.result()
+                if stopping.is_set():
+                    break
+                batch.run()
         except BaseException as exc:  # (reported by the consumer's thread)
             errors.append(exc)
-            batch.stop()
+            stop()
         finally:
             finished.release()
+
+    def stop() -> None:
+        stopping.set()
+        with lock:
+            futures = list(built.values())
+        for future in futures:
+            if future.done() and future.exception() is None:
+                future.result().stop()
+
+    def report() -> list[tuple[int, int, LaneBatch]]:
+        """The chunks finished since the last look, in the batches built so far."""
+        with lock:
+            ready = sorted((k, f) for k, f in built.items() if f.done() and f.exception() is None)
+        done = []
+        for k, future in ready:
+            batch = future.result()
+            done += [(k, i, batch) for i in batch.finished()]
+            if batch.all_taken():
+                with lock:
+                    reported.add(k)
+                    del built[k]
+        return done
 
     workers = [threading.Thread(target=work, name=f"grazing-sweep-{i}", daemon=True) for i in range(threads)]
     for w in workers:
@@ -298,19 +373,21 @@ def stream_chunks(
                 running -= 1
             if errors:
                 raise errors[0]
-            done = batch.finished()
+            done = report()
             now = time.perf_counter()
-            for k in done:
-                res = batch.result(k)
+            for k, i, batch in done:
+                res = batch.result(i)
                 res.seconds = (now - last) * threads / len(done)
-                yield k, res
+                yield k, i, res
             last = now if done else last
-        for k in batch.finished():
-            yield k, batch.result(k)
+        for k, i, batch in report():
+            yield k, i, batch.result(i)
     finally:
-        batch.stop()
+        stop()
+        builder.shutdown(wait=False, cancel_futures=True)  # (a thread waiting for a batch not begun returns)
         for w in workers:
             w.join()
+        builder.shutdown(wait=True)
 
 
 def run_chunk(spec: SweepSpec, index: int) -> ChunkResult:
