@@ -100,4 +100,4 @@ class JsonMemoryStore(MemoryStore):
 
     def write(self, res: ChunkResult) -> None:
         super().write(res)
-        self.rows.add(res.index, self.arrays["samples"][self.spec.chunk(res.index)])
+        self.rows.add(res.index, res.samples)  # (what the store now holds: not self.arrays, which fills)
