@@ -53,17 +53,22 @@ class SampleRows:
 
     def __init__(self, spec: SweepSpec) -> None:
         self.spec = spec
-        n = spec.segment_points
-        first = np.asarray(spec.points, dtype=float)[:, 0]
-        self._rank = np.empty(spec.n_points, dtype=np.int64)  # (each point's place in the JSON's lists)
-        for s in range(spec.segments):
-            by_value = np.argsort(first[s * n : (s + 1) * n], kind="stable")  # (as the JSON sorts them)
-            self._rank[s * n + by_value] = s * n + np.arange(n)
+        self._rank: np.ndarray | None = None  # (each point's place in the JSON's lists: at the first chunk)
         self._runs: dict[int, _Run] = {}
+
+    def _places(self) -> np.ndarray:
+        if self._rank is None:
+            spec, n = self.spec, self.spec.segment_points
+            first = np.asarray(spec.points, dtype=float)[:, 0]
+            self._rank = np.empty(spec.n_points, dtype=np.int64)
+            for s in range(spec.segments):
+                by_value = np.argsort(first[s * n : (s + 1) * n], kind="stable")  # (as the JSON sorts them)
+                self._rank[s * n + by_value] = s * n + np.arange(n)
+        return self._rank
 
     def add(self, index: int, samples: np.ndarray) -> None:
         """Encode the samples (points x periods x states) of chunk ``index`` (again: replaced)."""
-        place = self._rank[self.spec.chunk(index)]
+        place = self._places()[self.spec.chunk(index)]
         step = int(place[1] - place[0]) if place.size > 1 else 1
         if abs(step) != 1 or np.any(np.diff(place) != step):  # (not one run of the sorted points)
             self._runs.pop(index, None)
