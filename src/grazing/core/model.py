@@ -699,17 +699,23 @@ class HybridModel:
         >>> table = impact_oscillator().parameter_table(["omega"], [[1.0], [2.0], [1.0]])
         >>> table.periods.tolist() == [2 * math.pi, math.pi, 2 * math.pi]
         True
+        >>> impact_oscillator(omega=3.0).parameter_table([], [(), ()]).periods.tolist()  # (the model's own)
+        [2.0943951023931953, 2.0943951023931953]
         >>> impact_oscillator().parameter_table(["omega"], [[1.0], [-2.0]])
         Traceback (most recent call last):
         ...
         grazing.errors.InvalidParameterError: omega = -2 is outside (0, inf) (forcing frequency)
         """
-        pts = np.asarray(points, dtype=float).reshape(-1, len(names))
+        pts = np.asarray(points, dtype=float)
+        pts = pts.reshape(len(pts), len(names))  # (no names: every point is the model's own)
         params = self._def.parameters
         columns = [[p.name for p in params].index(name) if name in self._values else -1 for name in names]
         admitted = all(k >= 0 and params[k].admits(pts[:, j]).all() for j, k in enumerate(columns))
-        if admitted:
-            _, first, inverse = np.unique(pts, axis=0, return_index=True, return_inverse=True)
+        if admitted and len(pts):
+            if names:
+                _, first, inverse = np.unique(pts, axis=0, return_index=True, return_inverse=True)
+            else:
+                first, inverse = np.zeros(1, dtype=np.int64), np.zeros(len(pts), dtype=np.int64)
             vectors = np.tile(self.param_vector, (len(first), 1))
             vectors[:, columns] = pts[first]
             try:
