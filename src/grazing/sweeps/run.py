@@ -24,7 +24,9 @@ own point with its own steps and events; in a continuation sweep a lane
 follows one chunk, in a fresh sweep it takes any point.  Several threads can
 share one call's jobs (:func:`stream_chunks`): each takes the next job when
 one of its lanes is free, so the cores stay busy until the last chains, and
-the chunks are handed out as soon as they are finished.  The results do not
+the chunks are handed out as soon as they are finished; through several
+batches (:func:`stream_batches`) a thread with no job left in one goes on to
+the next.  The results do not
 depend on the lanes or the threads (each lane does the scalar path's
 arithmetic; a chain of points stays on one lane).
 """
