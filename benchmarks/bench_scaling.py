@@ -12,7 +12,9 @@ Two ways to find ``S``, printed side by side:
 
 - *measured*: one whole ``grazing sweep ... --json`` process, with the times of its phases
   taken in the process itself (the driver's calls on each thread, the JSON text) and the
-  start-up measured as a process that stops right before the sweep;
+  start-up measured as a process that stops right before the sweep; also printed, the main
+  thread's CPU time while the threads compute (it takes each chunk's results, stores them and
+  encodes their JSON: Python holding the GIL, which the threads' compiled driver does not need);
 - *fitted*: the same command on 1 and on 2 threads, ``T1 = S + P``, ``T2 = S + P / 2``
   (each a median of several runs; noisy where other processes share the cores).
 
@@ -78,12 +80,22 @@ def timed_text(*args, **kwargs):
     encode.append(time.perf_counter() - start)
     return out
 setattr(common, name, timed_text)
+from grazing.sweeps import executor
+consumer = []
+original_local = executor.local_results
+def timed_local(*args, **kwargs):
+    start = time.thread_time()  # (the main thread's CPU, while the threads compute the chunks it takes)
+    try:
+        yield from original_local(*args, **kwargs)
+    finally:
+        consumer.append(time.thread_time() - start)
+executor.local_results = timed_local
 t_main = time.perf_counter()
 code = grazing.cli.main(sys.argv[2:])
 t_end = time.perf_counter()
 with open(sys.argv[1], "w") as fh:
     json.dump({"enter": t_enter, "main": t_main, "end": t_end, "calls": calls, "encode": encode,
-               "code": code}, fh)
+               "consumer": consumer, "code": code}, fh)
 """
 
 
@@ -130,6 +142,7 @@ def phases(args: list[str]) -> dict[str, float]:
         / max(threads, 1),  # (the threads' idle tail, per thread)
         "after_driver": rec["end"] - last,  # assembly, summary, JSON text and its writing
         "json": sum(rec["encode"]),
+        "consumer_cpu": sum(rec["consumer"]),  # (the main thread's work on the chunks, overlapped)
         "threads": threads,
         "rounds": len(calls) / max(threads, 1),
     }
@@ -244,7 +257,9 @@ def report(results: list[dict[str, Any]], dask: dict[str, Any] | None = None) ->
             f"  phases (median of {len(r['phases_runs'])}): start-up {m['startup']:.3f} s, before the driver "
             f"{m['before_driver']:.3f} s, driver {m['driver_span']:.3f} s on {m['threads']:.0f} threads "
             f"({m['rounds']:.0f} rounds, idle {m['idle_in_span']:.3f} s per thread), after it "
-            f"{m['after_driver']:.3f} s (JSON text {m['json']:.3f} s)"
+            f"{m['after_driver']:.3f} s (JSON text {m['json']:.3f} s); the main thread's CPU while the "
+            f"threads compute {m['consumer_cpu']:.3f} s (each chunk's results, storing, JSON: work shared "
+            "with the threads' cores, not serial)"
         )
         for how in ("measured", "fitted"):
             a = r[how]
