@@ -16,7 +16,9 @@ Two ways to find ``S``, printed side by side:
   thread's CPU time while the threads compute (it takes each chunk's results, stores them and
   encodes their JSON: Python holding the GIL, which the threads' compiled driver does not need);
 - *fitted*: the same command on 1 and on 2 threads, ``T1 = S + P``, ``T2 = S + P / 2``
-  (each a median of several runs; noisy where other processes share the cores).
+  (each a median of several runs; noisy where other processes share the cores; the main
+  thread's work while the threads compute counts as serial here: with one thread it has the
+  other core to itself, with two it shares them).
 
 The sweep is the equal-work sweep of the heyoka comparison (every point from rest, no
 Lyapunov exponents, no adaptive transients, tol 1e-10) and, with ``--default``, the default
