@@ -201,13 +201,31 @@ class LaneBatch:
 
     def result(self, k: int) -> ChunkResult:
         """The result of chunk ``parts[k]`` (once finished)."""
+        return self.results([k])[0]
+
+    def results(self, ks: Sequence[int]) -> list[ChunkResult]:
+        """:meth:`result` of each chunk ``parts[k]`` of ``ks`` (once finished), their periods found at once
+        (one call per chunk was most of the Python work on a sweep's chunks)."""
+        if not ks:
+            return []
+        rows = np.concatenate([np.arange(*self._bounds[k]) for k in ks])
+        good = self.status[rows] == Status.OK
+        periods = np.full(rows.size, -1, dtype=np.int32)
+        periods[good] = detect_periods(self.samples[rows[good]], DEFAULT_PERIOD_TOL, DEFAULT_MAX_PERIOD)
+        out, at = [], 0
+        for k in ks:
+            a, b = self._bounds[k]
+            out.append(self._result(k, periods[at : at + b - a]))
+            at += b - a
+        return out
+
+    def _result(self, k: int, period: np.ndarray) -> ChunkResult:
+        """The result of chunk ``parts[k]`` (once finished), its points' periods given."""
         a, b = self._bounds[k]
         part = slice(a, b)
         status = self.status[part]
         good = status == Status.OK
         samples = self.samples[part]
-        period = np.full(b - a, -1, dtype=np.int32)
-        period[good] = detect_periods(samples[good], DEFAULT_PERIOD_TOL, DEFAULT_MAX_PERIOD)
         return ChunkResult(
             index=self.parts[k][1],
             samples=np.where(good[:, None, None], samples, np.nan),
@@ -351,14 +369,15 @@ def stream_batches(
             if future.done() and future.exception() is None:
                 future.result().stop()
 
-    def report() -> list[tuple[int, int, LaneBatch]]:
-        """The chunks finished since the last look, in the batches built so far."""
+    def report() -> list[tuple[int, int, ChunkResult]]:
+        """The chunks finished since the last look, in the batches built so far, with their results."""
         with lock:
             ready = sorted((k, f) for k, f in built.items() if f.done() and f.exception() is None)
         done = []
         for k, future in ready:
             batch = future.result()
-            done += [(k, i, batch) for i in batch.finished()]
+            chunks = batch.finished()
+            done += [(k, i, res) for i, res in zip(chunks, batch.results(chunks))]
             if batch.all_taken():
                 with lock:
                     reported.add(k)
@@ -377,13 +396,11 @@ def stream_batches(
                 raise errors[0]
             done = report()
             now = time.perf_counter()
-            for k, i, batch in done:
-                res = batch.result(i)
+            for k, i, res in done:
                 res.seconds = (now - last) * threads / len(done)
                 yield k, i, res
             last = now if done else last
-        for k, i, batch in report():
-            yield k, i, batch.result(i)
+        yield from report()
     finally:
         stop()
         builder.shutdown(wait=False, cancel_futures=True)  # (a thread waiting for a batch not begun returns)
