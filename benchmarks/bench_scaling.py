@@ -12,14 +12,24 @@ Two ways to find ``S``, printed side by side:
 
 - *measured*: one whole ``grazing sweep ... --json`` process, with the times of its phases
   taken in the process itself (the driver's calls on each thread, the JSON text) and the
-  start-up measured as a process that stops right before the sweep;
+  start-up measured as a process that stops right before the sweep; also printed, the main
+  thread's CPU time while the threads compute (it takes each chunk's results, stores them and
+  encodes their JSON: Python holding the GIL, which the threads' compiled driver does not need);
 - *fitted*: the same command on 1 and on 2 threads, ``T1 = S + P``, ``T2 = S + P / 2``
-  (each a median of several runs; noisy where other processes share the cores).
+  (each a median of several runs; noisy where other processes share the cores; the main
+  thread's work while the threads compute counts as serial here: with one thread it has the
+  other core to itself, with two it shares them).
 
 The sweep is the equal-work sweep of the heyoka comparison (every point from rest, no
 Lyapunov exponents, no adaptive transients, tol 1e-10) and, with ``--default``, the default
 sweep (one chain of points: chunks checked against the previous chunk's end and run again
 where they differ; its rounds wait for their slowest chunk).
+
+The processes import grazing from compiled bytecode, as an installed package does: where the
+environment says not to write it (``PYTHONDONTWRITEBYTECODE``, set in some sandboxes and CI
+jobs), every module was compiled from its source in every process, 0.06 s of the start-up; the
+script then keeps the bytecode in a temporary directory of its own (``PYTHONPYCACHEPREFIX``)
+unless ``--no-bytecode-cache`` is given.
 
 Usage::
 
@@ -29,6 +39,8 @@ Usage::
 
 from __future__ import annotations
 
+import argparse
+import contextlib
 import json
 import os
 import statistics
@@ -36,6 +48,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -61,19 +74,30 @@ def timed_run(self):
         calls.append((threading.get_ident(), start, time.perf_counter()))
 run_module.LaneBatch.run = timed_run
 encode = []
-original_text = common.json_text
-def timed_text(obj):
+name = "json_pieces" if hasattr(common, "json_pieces") else "json_text"  # (the encoder emit_json calls)
+original_text = getattr(common, name)
+def timed_text(*args, **kwargs):
     start = time.perf_counter()
-    out = original_text(obj)
+    out = original_text(*args, **kwargs)
     encode.append(time.perf_counter() - start)
     return out
-common.json_text = timed_text
+setattr(common, name, timed_text)
+from grazing.sweeps import executor
+consumer = []
+original_local = executor.local_results
+def timed_local(*args, **kwargs):
+    start = time.thread_time()  # (the main thread's CPU, while the threads compute the chunks it takes)
+    try:
+        yield from original_local(*args, **kwargs)
+    finally:
+        consumer.append(time.thread_time() - start)
+executor.local_results = timed_local
 t_main = time.perf_counter()
 code = grazing.cli.main(sys.argv[2:])
 t_end = time.perf_counter()
 with open(sys.argv[1], "w") as fh:
     json.dump({"enter": t_enter, "main": t_main, "end": t_end, "calls": calls, "encode": encode,
-               "code": code}, fh)
+               "consumer": consumer, "code": code}, fh)
 """
 
 
@@ -120,6 +144,7 @@ def phases(args: list[str]) -> dict[str, float]:
         / max(threads, 1),  # (the threads' idle tail, per thread)
         "after_driver": rec["end"] - last,  # assembly, summary, JSON text and its writing
         "json": sum(rec["encode"]),
+        "consumer_cpu": sum(rec["consumer"]),  # (the main thread's work on the chunks, overlapped)
         "threads": threads,
         "rounds": len(calls) / max(threads, 1),
     }
@@ -234,7 +259,9 @@ def report(results: list[dict[str, Any]], dask: dict[str, Any] | None = None) ->
             f"  phases (median of {len(r['phases_runs'])}): start-up {m['startup']:.3f} s, before the driver "
             f"{m['before_driver']:.3f} s, driver {m['driver_span']:.3f} s on {m['threads']:.0f} threads "
             f"({m['rounds']:.0f} rounds, idle {m['idle_in_span']:.3f} s per thread), after it "
-            f"{m['after_driver']:.3f} s (JSON text {m['json']:.3f} s)"
+            f"{m['after_driver']:.3f} s (JSON text {m['json']:.3f} s); the main thread's CPU while the "
+            f"threads compute {m['consumer_cpu']:.3f} s (each chunk's results, storing, JSON: work shared "
+            "with the threads' cores, not serial)"
         )
         for how in ("measured", "fitted"):
             a = r[how]
@@ -274,13 +301,46 @@ def markdown(results: list[dict[str, Any]], dask: dict[str, Any] | None = None) 
     return "\n".join(rows)
 
 
+@contextlib.contextmanager
+def bytecode_cache(enabled: bool) -> Iterator[str]:
+    """The measured processes import compiled bytecode (see the module); yields what they do."""
+    if not (enabled and sys.flags.dont_write_bytecode):
+        written = "" if not sys.flags.dont_write_bytecode else " (from source: no bytecode written)"
+        yield f"as the environment has it{written}"
+        return
+    saved = {k: os.environ.get(k) for k in ("PYTHONDONTWRITEBYTECODE", "PYTHONPYCACHEPREFIX")}
+    with tempfile.TemporaryDirectory(prefix="bench-scaling-pyc-") as cache:
+        os.environ.pop("PYTHONDONTWRITEBYTECODE", None)
+        os.environ["PYTHONPYCACHEPREFIX"] = cache
+        try:
+            yield "compiled bytecode, kept in a temporary directory (PYTHONDONTWRITEBYTECODE was set)"
+        finally:
+            for k, v in saved.items():
+                if v is None:
+                    os.environ.pop(k, None)
+                else:
+                    os.environ[k] = v
+
+
 def main() -> None:
     parser = bench_parser(__doc__)
     parser.add_argument("--points", type=int, default=4000, help="points of the sweep (default 4000)")
     parser.add_argument("--runs", type=int, default=3, help="runs of each measurement (default 3)")
     parser.add_argument("--default", action="store_true", help="also the default sweep (one chain)")
     parser.add_argument("--dask", action="store_true", help="also a local Dask cluster against threads")
+    parser.add_argument(
+        "--no-bytecode-cache",
+        action="store_true",
+        help="import grazing as the environment says (with PYTHONDONTWRITEBYTECODE: from source)",
+    )
     args = parser.parse_args()
+    with bytecode_cache(not args.no_bytecode_cache) as imports:
+        log(f"the processes import grazing: {imports}")
+        measured(args, imports)
+
+
+def measured(args: argparse.Namespace, imports: str) -> None:
+    """Everything :func:`main` measures and prints."""
     load_start = loadavg()
     subprocess.run(
         [sys.executable, "-m", "grazing", *sweep_args(8, 1, False)], stdout=subprocess.DEVNULL, check=True
@@ -291,13 +351,14 @@ def main() -> None:
     dask = dask_against_threads(args.points, args.runs) if args.dask else None
     machine = machine_info()
     machine["load_average"] = [load_start, loadavg()]
+    machine["imports"] = imports
     emit(
         args,
         lambda: report(results, dask),
         lambda: markdown(results, dask),
         lambda: {"machine": machine, "results": results, "dask": dask},
     )
-    print(f"\nload average {load_start} (start), {loadavg()} (end)")
+    print(f"\nload average {load_start} (start), {loadavg()} (end); the processes imported {imports}")
 
 
 if __name__ == "__main__":

@@ -264,3 +264,57 @@ def test_states_that_are_views_of_other_arrays_are_accepted():
     assert m.guard(view) == m.guard(copy) and m.normal_accel(view) == m.normal_accel(copy)
     assert np.array_equal(m.vector_field(view), m.vector_field(copy))
     assert np.array_equal(m.reset(view), m.reset(copy))
+
+
+def _tables_by_model(model, names, points):
+    """What ``parameter_table`` must give: a model per point (the first of equal points', as sweeps had)."""
+    vectors, periods, seen = [], [], {}
+    for pt in points:
+        m = seen.setdefault(tuple(pt), model.with_params(**dict(zip(names, pt))))
+        vectors.append(m.param_vector)
+        periods.append(m.period)
+    return np.array(vectors), np.array(periods)
+
+
+def _raised(call):
+    try:
+        call()
+    except Exception as exc:  # (compared by type and text)
+        return type(exc), str(exc)
+    return None
+
+
+@pytest.mark.parametrize("name", ["pendulum", "oscillator", "ball"])
+@settings(max_examples=40, deadline=None)
+@given(data=st.data())
+def test_parameter_table_is_a_model_per_point(name, data):
+    """Every point's parameter vector and period are those of its own model, bit for bit; a point
+    with_params refuses raises with_params' error (the first such point's)."""
+    model = MODELS[name]
+    names = data.draw(st.lists(st.sampled_from(list(model.params)), min_size=0, max_size=2, unique=True))
+    value = st.one_of(
+        st.sampled_from([0.0, -0.0, 0.3, 0.3, 1.0, 2.5, -1.0, math.inf, math.nan]),
+        st.floats(-3, 3, allow_nan=False),
+    )
+    points = data.draw(st.lists(st.tuples(*[value] * len(names)), min_size=1, max_size=12))
+    expected = _raised(lambda: _tables_by_model(model, names, points))
+    got = _raised(lambda: model.parameter_table(names, points))
+    assert got == expected
+    if expected is None:
+        vectors, periods = _tables_by_model(model, names, points)
+        table = model.parameter_table(names, points)
+        assert table.vectors.tobytes() == vectors.tobytes() and table.periods.tobytes() == periods.tobytes()
+
+
+def test_parameter_table_refuses_a_period_not_positive_between_good_points():
+    """A user model whose period is negative for a parameter value between two good ones."""
+    x, v, t, w = sp.symbols("x v t w")
+    model = HybridModel(
+        "shifted", [x, v], t, [Parameter("w", 2.0, lower=0.0, lower_open=True)], vector_field=[v, -x],
+        guard=1 - x, reset=[x, -v], period=2 * sp.pi / (w - 1),
+    )  # fmt: skip
+    assert model.parameter_table(["w"], [[2.0], [3.0]]).periods.tolist() == [2 * math.pi, math.pi]
+    with pytest.raises(InvalidParameterError, match="the forcing period must be positive"):
+        model.parameter_table(["w"], [[2.0], [0.5], [3.0]])
+    with pytest.raises(ZeroDivisionError):  # (as with_params: the period's own error)
+        model.parameter_table(["w"], [[2.0], [1.0]])

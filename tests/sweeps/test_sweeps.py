@@ -338,3 +338,27 @@ def test_sweep_chatter_tol_is_a_setting_of_the_spec():
     # The ball is thrown off the table and chatters back to rest on it, period after period: summed,
     # a chattering sequence counts as the impacts before its tail; unsummed, every impact of it.
     assert unsummed.impacts[0] > default.impacts[0] > 0
+
+
+def test_a_memory_store_reads_its_chunks_not_written_as_not_computed():
+    """The arrays are filled only when read: a chunk written keeps its values, the others read as before
+    computing (NaN, -1, the status not computed), also after a chunk is written once they were read."""
+    from grazing.sweeps.run import run_chunk
+    from grazing.sweeps.status import NOT_COMPUTED
+    from grazing.sweeps.store import MemoryStore
+
+    spec = _spec()
+    store = MemoryStore(spec)
+    one = run_chunk(spec, 1)
+    store.write(one)
+    a = store.arrays
+    sl, other = spec.chunk(1), spec.chunk(0)
+    np.testing.assert_array_equal(a["samples"][sl], one.samples)
+    assert np.isnan(a["samples"][other]).all() and np.isnan(a["lyapunov"][other]).all()
+    assert (a["period"][other] == -1).all() and (a["impacts_by_stop"][other] == -1).all()
+    assert (a["status"][other] == NOT_COMPUTED).all()
+    zero = run_chunk(spec, 0)
+    store.write(zero)
+    np.testing.assert_array_equal(store.arrays["period"][other], zero.period)
+    ds = store.dataset()
+    assert ds.period.values.tolist() == [*zero.period, *one.period, *[-1] * (spec.n_points - sl.stop)]

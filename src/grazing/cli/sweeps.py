@@ -122,13 +122,14 @@ class _SweepRun:
 
     def __init__(
         self, ds: Any, period: np.ndarray, status: np.ndarray, arrays: dict[str, np.ndarray] | None = None,
-        impacts: np.ndarray | None = None,
+        impacts: np.ndarray | None = None, rows: Any = None,
     ):  # fmt: skip
         self.ds = ds
         self.period = period
         self.status = status
         self.arrays = arrays
         self.impacts = impacts
+        self.rows = rows  # (arrays and --json: the samples' JSON text, grazing.cli.sweep_json.SampleRows)
 
 
 def _run_sweep_spec(
@@ -169,6 +170,10 @@ def _run_sweep_spec(
                     + (f" (PID {pid})" if pid is not None else "") + "; waiting", err=True
                 ),
             )  # fmt: skip
+        elif memory and as_json:  # (the samples' JSON text made as the chunks arrive)
+            from grazing.cli.sweep_json import JsonMemoryStore
+
+            store = JsonMemoryStore(spec)
         elif memory:
             from grazing.sweeps.store import MemoryStore
 
@@ -187,7 +192,8 @@ def _run_sweep_spec(
     if memory:
         if out is not None:
             save_dataset(store.dataset(), out, overwrite)
-        return _SweepRun(None, store.arrays["period"], store.arrays["status"], store.arrays)
+        rows = getattr(store, "rows", None)
+        return _SweepRun(None, store.arrays["period"], store.arrays["status"], store.arrays, rows=rows)
     if out is not None and out.suffix.lower() == ".nc":
         save_dataset(ds, out, overwrite)
     if flat is None:  # (the dataset's points, flattened: in visiting order, as the spec lists them)
@@ -222,16 +228,24 @@ def _sweep_json(spec: Any, run: _SweepRun, param: str, shown: np.ndarray) -> dic
         half = [{k: v[sl] for k, v in a.items()} for sl in halves]
         parts = [
             _point_keys(type(spec)(**{**spec.__dict__, "points": spec.points[sl], "segments": 1}), h, ipp[sl],
-                        ipp_stop[sl])
-            for sl, h in zip(halves, half)
+                        ipp_stop[sl], _rows_text(run, k))
+            for k, (sl, h) in enumerate(zip(halves, half))
         ]  # fmt: skip
         return {"param": param, "values": np.sort(shown),
                 **{key: {"up": parts[0][key], "down": parts[1][key]} for key in parts[0]}}  # fmt: skip
-    return {"param": param, "values": np.sort(shown), **_point_keys(spec, a, ipp, ipp_stop)}
+    keys = _point_keys(spec, a, ipp, ipp_stop, _rows_text(run, 0))
+    return {"param": param, "values": np.sort(shown), **keys}
 
 
-def _point_keys(spec: Any, a: dict[str, np.ndarray], ipp: np.ndarray, ipp_stop: np.ndarray) -> dict[str, Any]:
-    """The per-point keys of a sweep's ``--json``, sorted by value."""
+def _rows_text(run: _SweepRun, segment: int) -> Any:
+    """The samples of chain ``segment`` as JSON text made while the sweep ran, or None."""
+    return run.rows.text(segment) if run.rows is not None else None
+
+
+def _point_keys(
+    spec: Any, a: dict[str, np.ndarray], ipp: np.ndarray, ipp_stop: np.ndarray, samples_text: Any = None
+) -> dict[str, Any]:
+    """The per-point keys of a sweep's ``--json``, sorted by value (``samples_text``: the samples' JSON)."""
     from grazing.sweeps.status import reasons
 
     by_value = np.argsort(np.asarray(spec.points, dtype=float)[:, 0], kind="stable")
@@ -239,7 +253,7 @@ def _point_keys(spec: Any, a: dict[str, np.ndarray], ipp: np.ndarray, ipp_stop: 
         "period": a["period"][by_value],
         "impacts_per_period": ipp[by_value],
         "lyapunov": a["lyapunov"][by_value],
-        "samples": a["samples"][by_value][..., 0],
+        "samples": samples_text if samples_text is not None else a["samples"][by_value, :, 0],
         "transient_used": a["transient_used"][by_value],
         "impacts_per_period_by_stop": {
             str(name): ipp_stop[by_value, j] for j, name in enumerate(spec.model.stop_names)

@@ -173,6 +173,19 @@ class Parameter:
             raise InvalidParameterError(f"{self.name} = {v:g} is outside {self.interval()}{what}")
         return v
 
+    def admits(self, values: np.ndarray) -> np.ndarray:
+        """Which of the float ``values`` :meth:`check` accepts (a boolean array, at once).
+
+        Examples
+        --------
+        >>> r = Parameter("r", 0.5, lower=0.0, upper=1.0, lower_open=True)
+        >>> r.admits(np.array([0.0, 0.5, 1.0, np.nan]))
+        array([False,  True,  True, False])
+        """
+        below = (values < self.lower) | (self.lower_open & (values == self.lower))
+        above = (values > self.upper) | (self.upper_open & (values == self.upper))
+        return np.isfinite(values) & ~below & ~above
+
 
 class _Definition:
     """The parameter-independent part of a model, shared by all its copies.
@@ -440,6 +453,16 @@ def _srepr(obj: Any) -> str:
 _DEFINITIONS: dict[str, _Definition] = {}
 
 
+@dataclass(frozen=True)
+class ParameterTable:
+    """Parameter vectors and forcing periods of many points (:meth:`HybridModel.parameter_table`)."""
+
+    vectors: np.ndarray
+    """One row per point: every parameter's value in the model's order (:attr:`HybridModel.param_vector`)."""
+    periods: np.ndarray
+    """Each point's forcing period (as :attr:`HybridModel.period`)."""
+
+
 def _rebuild(args: dict[str, Any], values: dict[str, float]) -> HybridModel:
     """Unpickle a model: reuse (or build) its definition, then set the values."""
     return HybridModel._from(_Definition.get(args), dict(values))
@@ -659,6 +682,53 @@ class HybridModel:
     def with_params(self, **changes: float) -> HybridModel:
         """A copy of this model with some parameter values changed (validated)."""
         return HybridModel._from(self._def, self._checked(self._values, changes))
+
+    def parameter_table(self, names: Sequence[str], points: Any) -> ParameterTable:
+        """The parameter vectors and forcing periods of ``with_params(**dict(zip(names, point)))`` for
+        each row of ``points``, without making a model per point.
+
+        The same numbers (the period by the same function of the same values) and
+        the same validation: a point :meth:`with_params` refuses raises its error
+        (the first such point's, in order).  Points equal as numbers (0.0 and
+        -0.0 too) are one point: the first of them.  A sweep's table of points
+        (:class:`grazing.sweeps.run.LaneBatch`) is built so.
+
+        Examples
+        --------
+        >>> from grazing.models import impact_oscillator
+        >>> table = impact_oscillator().parameter_table(["omega"], [[1.0], [2.0], [1.0]])
+        >>> table.periods.tolist() == [2 * math.pi, math.pi, 2 * math.pi]
+        True
+        >>> impact_oscillator(omega=3.0).parameter_table([], [(), ()]).periods.tolist()  # (the model's own)
+        [2.0943951023931953, 2.0943951023931953]
+        >>> impact_oscillator().parameter_table(["omega"], [[1.0], [-2.0]])
+        Traceback (most recent call last):
+        ...
+        grazing.errors.InvalidParameterError: omega = -2 is outside (0, inf) (forcing frequency)
+        """
+        pts = np.asarray(points, dtype=float)
+        pts = pts.reshape(len(pts), len(names))  # (no names: every point is the model's own)
+        params = self._def.parameters
+        columns = [[p.name for p in params].index(name) if name in self._values else -1 for name in names]
+        admitted = all(k >= 0 and params[k].admits(pts[:, j]).all() for j, k in enumerate(columns))
+        if admitted and len(pts):
+            if names:
+                _, first, inverse = np.unique(pts, axis=0, return_index=True, return_inverse=True)
+            else:
+                first, inverse = np.zeros(1, dtype=np.int64), np.zeros(len(pts), dtype=np.int64)
+            vectors = np.tile(self.param_vector, (len(first), 1))
+            vectors[:, columns] = pts[first]
+            try:
+                distinct = np.array([self._def.period(v) for v in vectors.tolist()], dtype=float)
+            except Exception:  # (raised again below, by the point that raises it)
+                distinct = np.array([np.nan])
+            if np.all(np.isfinite(distinct) & (distinct > 0)):
+                return ParameterTable(vectors[inverse.reshape(-1)], distinct[inverse.reshape(-1)])
+        models = [self.with_params(**dict(zip(names, pt))) for pt in pts.tolist()]  # (raises the error)
+        return ParameterTable(  # pragma: no cover - (every point with_params accepts is accepted above)
+            np.array([m.param_vector for m in models]).reshape(len(pts), -1),
+            np.array([m.period for m in models], dtype=float),
+        )
 
     # -- description ----------------------------------------------------------
     @property

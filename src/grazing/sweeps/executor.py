@@ -3,7 +3,7 @@
 Locally, the chunks (of one sweep, or of several: :func:`local_results`)
 are computed in batches (:func:`local_batches`) by one
 thread per core sharing each batch's jobs
-(:func:`grazing.sweeps.run.stream_chunks`: the compiled driver runs without
+(:func:`grazing.sweeps.run.stream_batches`: the compiled driver runs without
 the GIL), and handed to the caller as each one finishes.  No worker process
 is started, so there is none to leave behind, and a small sweep costs little
 more than its work; Ctrl-C (or an error while storing a result) stops the
@@ -17,6 +17,7 @@ is told, and given up on after a timeout.
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 import time
@@ -25,7 +26,7 @@ from typing import Any
 
 from grazing.errors import GrazingError
 from grazing.parallel import in_flight
-from grazing.sweeps.run import LaneBatch, batch_key, run_parts, stream_chunks
+from grazing.sweeps.run import LaneBatch, batch_key, run_parts, stream_batches
 from grazing.sweeps.spec import ChunkResult, SweepSpec
 
 
@@ -47,6 +48,10 @@ TASKS_PER_WORKER = 8
 
 BATCH_VALUES = 1 << 21
 """Most sample values (points x periods x states) of a local batch, beyond what filling the lanes takes."""
+
+BATCH_GROWTH = 4
+"""A fresh sweep's local batches grow by this factor up to :data:`BATCH_VALUES`, the first one filling the
+lanes only: the threads start after building a small table, the next ones are built while they compute."""
 
 
 def chunk_groups(spec: SweepSpec, todo: Sequence[int], workers: int) -> list[list[int]]:
@@ -97,15 +102,28 @@ def local_batches(parts: Sequence[Part], threads: int) -> list[list[Part]]:
     lanes twice over (two chains of a continuation sweep per lane, four
     points per lane) and holds at least :data:`BATCH_VALUES` sample values
     (points x periods x states) when there are that many: a batch's chunks
-    reach the caller as they finish, but its lanes run idle at its end.
+    reach the caller as they finish, but its lanes run idle at its end.  A
+    fresh sweep's first batch only fills the lanes, and the next ones grow by
+    :data:`BATCH_GROWTH` up to that size: the threads wait only for the first
+    batch's table of points (:func:`local_results` builds the next ones while
+    they compute), and a fresh sweep's lanes are idle at a batch's end for
+    less than a point's time (a chain's, for its slowest chain: not so grown).
 
     Examples
     --------
     >>> import grazing
+    >>> from grazing.core.options import SweepSettings
+    >>> from grazing.engine.llvmgen import lane_width
     >>> from grazing.sweeps.spec import sweep_spec
     >>> spec = sweep_spec(grazing.models.pendulum("B"), "eta", [0.4 + 0.001 * i for i in range(1000)])
     >>> [len(b) for b in local_batches([(spec, i) for i in range(spec.n_chunks)], threads=2)]
     [20]
+    >>> values = [0.4 + 1e-6 * i for i in range(32000)]
+    >>> fresh = sweep_spec(grazing.models.pendulum("B"), "eta", values, settings=SweepSettings(fresh=True))
+    >>> batches = local_batches([(fresh, i) for i in range(fresh.n_chunks)], threads=2)
+    >>> points = [sum(fresh.chunk(i).stop - fresh.chunk(i).start for _, i in b) for b in batches]
+    >>> points[0] >= 4 * 2 * lane_width(), points[1] >= 4 * points[0], max(points) * 200 < 2 * 2**21
+    (True, True, True)
     """
     from grazing.engine.llvmgen import lane_width
 
@@ -117,6 +135,8 @@ def local_batches(parts: Sequence[Part], threads: int) -> list[list[Part]]:
     for group in groups.values():
         batch: list[Part] = []
         jobs = points = values = 0
+        fresh = all(spec.fresh for spec, _ in group)
+        least = 0 if fresh else BATCH_VALUES  # (the sample values the next batch needs)
         for part in group:
             spec, i = part
             sl = spec.chunk(i)
@@ -125,8 +145,9 @@ def local_batches(parts: Sequence[Part], threads: int) -> list[list[Part]]:
             jobs += size if spec.fresh else 1
             points += size
             values += size * spec.periods * spec.model.n_states
-            if jobs >= 2 * lanes and points >= 4 * lanes and values >= BATCH_VALUES:
+            if jobs >= 2 * lanes and points >= 4 * lanes and values >= least:
                 out.append(batch)
+                least = min(BATCH_VALUES, BATCH_GROWTH * values) if fresh else BATCH_VALUES
                 batch, jobs, points, values = [], 0, 0, 0
         if batch:
             out.append(batch)
@@ -136,25 +157,18 @@ def local_batches(parts: Sequence[Part], threads: int) -> list[list[Part]]:
 def local_results(parts: Sequence[Part], threads: int | None) -> Iterator[tuple[Part, ChunkResult]]:
     """Each chunk of ``parts`` with its result as it finishes, by ``threads`` threads (None: one per core).
 
-    The batches run one after the other; the next one's table of points
-    (:class:`~grazing.sweeps.run.LaneBatch`: a model per point, Python work) is
-    built by a thread of its own while the cores compute the one before, so
-    that they do not wait for it (a serial part of the sweep, issue 29).
+    The batches (:func:`local_batches`) run one after the other, a thread
+    going on to the next batch as soon as it has no job left in its batch;
+    the next batch's table of points (:class:`~grazing.sweeps.run.LaneBatch`)
+    is built by a thread of its own while the cores compute the one before
+    (:func:`~grazing.sweeps.run.stream_batches`), so that they do not wait for
+    it (a serial part of the sweep, issue 29).
     """
-    from concurrent.futures import ThreadPoolExecutor
-
     threads = max(1, threads or os.cpu_count() or 1)
     batches = local_batches(parts, threads)
-    if not batches:
-        return
-    with ThreadPoolExecutor(1, thread_name_prefix="grazing-batch") as pool:
-        upcoming = pool.submit(LaneBatch, batches[0])
-        for k, group in enumerate(batches):
-            batch = upcoming.result()
-            if k + 1 < len(batches):
-                upcoming = pool.submit(LaneBatch, batches[k + 1])
-            for i, result in stream_chunks(batch, threads):
-                yield group[i], result
+    makers = [functools.partial(LaneBatch, group) for group in batches]
+    for k, i, result in stream_batches(makers, threads):
+        yield batches[k][i], result
 
 
 def _same(value: Any) -> Any:

@@ -24,7 +24,9 @@ own point with its own steps and events; in a continuation sweep a lane
 follows one chunk, in a fresh sweep it takes any point.  Several threads can
 share one call's jobs (:func:`stream_chunks`): each takes the next job when
 one of its lanes is free, so the cores stay busy until the last chains, and
-the chunks are handed out as soon as they are finished.  The results do not
+the chunks are handed out as soon as they are finished; through several
+batches (:func:`stream_batches`) a thread with no job left in one goes on to
+the next.  The results do not
 depend on the lanes or the threads (each lane does the scalar path's
 arithmetic; a chain of points stays on one lane).
 """
@@ -34,12 +36,11 @@ from __future__ import annotations
 import math
 import threading
 import time
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from typing import Any
 
 import numpy as np
 
-from grazing.core.model import HybridModel
 from grazing.core.period import DEFAULT_MAX_PERIOD, DEFAULT_PERIOD_TOL, detect_periods
 from grazing.core.solution import Status
 from grazing.engine.codegen import taylor_order
@@ -94,67 +95,53 @@ class LaneBatch:
         spec0 = parts[0][0]
         model = spec0.model
         n, m, nstops = model.n_states, spec0.periods, model.n_stops
+        slices = [spec.chunk(i) for spec, i in parts]
+        sizes = np.array([sl.stop - sl.start for sl in slices], dtype=np.int64)
+        ends = np.cumsum(sizes)
+        bounds = [(int(e - k), int(e)) for k, e in zip(sizes, ends)]
+        npts = int(ends[-1])
+        pvs, Ts = _point_table(parts, slices, npts)
         two_pi = 2 * math.pi
-        cache: dict[tuple[Any, ...], tuple[HybridModel, float]] = {}  # (a grid of starts shares its point)
-
-        def at(spec: SweepSpec, base: tuple[Any, ...], pt: tuple[float, ...]) -> tuple[HybridModel, float]:
-            key = (*base, pt)
-            if key not in cache:
-                mm = spec.model_at(pt)
-                cache[key] = (mm, float(mm.period))
-            return cache[key]
-
-        pv_list, t_list, phases, tcarry, zdms = [], [], [], [], []
-        jobs: list[tuple[int, int]] = []
-        x0s: list[tuple[float, ...]] = []
-        firsts: list[np.ndarray] = []
-        bounds = []
-        first = 0
-        for spec, i in parts:
-            sl = spec.chunk(i)
-            size = sl.stop - sl.start
-            base = (id(spec.model._def), tuple(spec.model.param_vector), spec.params)
-            here = [at(spec, base, pt) for pt in spec.points[sl]]
-            Ts = np.array([T for _, T in here])
-            pv_list += [mm.param_vector for mm, _ in here]
-            t_list.append(Ts)
-            phases.append((spec.phase % two_pi) / two_pi * Ts)
-            carry = (spec.phase / two_pi) % 1.0 * Ts
-            tcarry.append(carry)
-            zdms.append(np.array([float(spec.zdm.phase) % T for T in Ts]) if spec.zdm is not None else 0 * Ts)
+        sphase, tcarry, zdms = np.empty(npts), np.empty(npts), np.zeros(npts)
+        jobs, x0s, firsts = [], [], []
+        for (spec, i), sl, (a, b) in zip(parts, slices, bounds):
+            size, T = b - a, Ts[a:b]
+            sphase[a:b] = (spec.phase % two_pi) / two_pi * T
+            carry = (spec.phase / two_pi) % 1.0 * T
+            tcarry[a:b] = carry
+            if spec.zdm is not None:
+                zdms[a:b] = [float(spec.zdm.phase) % t for t in T]
             x0 = np.asarray(spec.x0, dtype=float)
             # Jobs: runs of points, each continuing from the previous (a chunk; every point when fresh).
             if spec.fresh:
-                jobs += [(j, j + 1) for j in range(first, first + size)]
-                x0s += [spec.x0] * size
+                jobs.append(np.column_stack([np.arange(a, b), np.arange(a + 1, b + 1)]))
+                x0s.append(np.broadcast_to(x0, (size, n)))
                 if spec.starts is not None:  # (each from its own state, at its sampling phase)
                     firsts.append(np.column_stack([carry, spec.starts[sl]]))
                 else:
-                    firsts.append(np.tile(np.concatenate([[0.0], x0]), (size, 1)))
+                    firsts.append(np.broadcast_to(np.concatenate([[0.0], x0]), (size, n + 1)))
             else:
-                jobs.append((first, first + size))
-                x0s.append(spec.x0)
+                jobs.append(np.array([[a, b]]))
+                x0s.append(x0[None])
                 if i == 0 and spec.resume is not None:  # (continuing a chain: grazing.sweeps.chain)
                     t, x = spec.resume
                     firsts.append(np.array([[float(t), *x]]))
                 else:
                     firsts.append(np.concatenate([[0.0], x0])[None])
-            bounds.append((first, first + size))
-            first += size
-        npts = first
         self._bounds = bounds
         order = taylor_order(spec0.tol)
         self._kern = model.kernels(0, order)
+        self._driver = load_sweep_lanes()  # (loaded once, with the first table: not by each thread)
         self._order = order
         self._spec0 = spec0
-        self.jobs = np.array(jobs, dtype=np.int64).reshape(-1, 2)
-        self.x0 = np.array(x0s, dtype=float).reshape(-1, n)
+        self.jobs = np.ascontiguousarray(np.concatenate(jobs), dtype=np.int64).reshape(-1, 2)
+        self.x0 = np.ascontiguousarray(np.concatenate(x0s), dtype=float).reshape(-1, n)
         self.firsts = np.ascontiguousarray(np.concatenate(firsts), dtype=float).reshape(-1, n + 1)
-        self.pvs = np.array(pv_list, dtype=float).reshape(npts, -1)
-        self.Ts = np.concatenate(t_list)
-        self.sphase = np.concatenate(phases)
-        self.tcarry = np.concatenate(tcarry)
-        self.zdms = np.concatenate(zdms).astype(float)
+        self.pvs = pvs
+        self.Ts = Ts
+        self.sphase = sphase
+        self.tcarry = tcarry
+        self.zdms = zdms
         self.fresh = all(spec.fresh for spec, _ in parts)  # (a fresh spec's jobs are single points anyway)
         self.control = np.zeros(3, dtype=np.int64)  # [next job, stop, most jobs at a time per thread]
         self.samples = np.full((npts, m, n), np.nan)
@@ -195,7 +182,7 @@ class LaneBatch:
         out = LaneResults(
             self.samples, self.by_stop, self.lyap, self.used, self.x_final, self.t_final, self.status
         )
-        load_sweep_lanes()(kern.table, tuple(settings), tuple(work), tuple(points), tuple(out))
+        self._driver(kern.table, tuple(settings), tuple(work), tuple(points), tuple(out))
 
     def stop(self) -> None:
         """Have the threads running the batch return at their next step (unfinished points stay so)."""
@@ -208,15 +195,37 @@ class LaneBatch:
         self._taken[done] = True
         return done
 
+    def all_taken(self) -> bool:
+        """Whether :meth:`finished` has given every chunk of the batch."""
+        return bool(self._taken.all())
+
     def result(self, k: int) -> ChunkResult:
         """The result of chunk ``parts[k]`` (once finished)."""
+        return self.results([k])[0]
+
+    def results(self, ks: Sequence[int]) -> list[ChunkResult]:
+        """:meth:`result` of each chunk ``parts[k]`` of ``ks`` (once finished), their periods found at once
+        (one call per chunk was most of the Python work on a sweep's chunks)."""
+        if not ks:
+            return []
+        rows = np.concatenate([np.arange(*self._bounds[k]) for k in ks])
+        good = self.status[rows] == Status.OK
+        periods = np.full(rows.size, -1, dtype=np.int32)
+        periods[good] = detect_periods(self.samples[rows[good]], DEFAULT_PERIOD_TOL, DEFAULT_MAX_PERIOD)
+        out, at = [], 0
+        for k in ks:
+            a, b = self._bounds[k]
+            out.append(self._result(k, periods[at : at + b - a]))
+            at += b - a
+        return out
+
+    def _result(self, k: int, period: np.ndarray) -> ChunkResult:
+        """The result of chunk ``parts[k]`` (once finished), its points' periods given."""
         a, b = self._bounds[k]
         part = slice(a, b)
         status = self.status[part]
         good = status == Status.OK
         samples = self.samples[part]
-        period = np.full(b - a, -1, dtype=np.int32)
-        period[good] = detect_periods(samples[good], DEFAULT_PERIOD_TOL, DEFAULT_MAX_PERIOD)
         return ChunkResult(
             index=self.parts[k][1],
             samples=np.where(good[:, None, None], samples, np.nan),
@@ -229,6 +238,33 @@ class LaneBatch:
             status=status.astype(STATUS_DTYPE),
             t_final=np.where(good, self.t_final[part], np.nan),
         )
+
+
+def _point_table(
+    parts: Sequence[tuple[SweepSpec, int]], slices: Sequence[slice], npts: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """The parameter vectors and forcing periods of the points of ``parts`` (chunks ``slices``), in order.
+
+    Each spec's points at once (:meth:`~grazing.core.model.HybridModel.parameter_table`: the
+    numbers of a model made per point, without making one).
+    """
+    by_spec: dict[int, tuple[SweepSpec, list[slice], list[np.ndarray]]] = {}
+    at = 0
+    for (spec, _), sl in zip(parts, slices):
+        size = sl.stop - sl.start
+        by_spec.setdefault(id(spec), (spec, [], []))
+        by_spec[id(spec)][1].append(sl)
+        by_spec[id(spec)][2].append(np.arange(at, at + size))
+        at += size
+    pvs = np.empty((npts, len(parts[0][0].model.parameters)))
+    Ts = np.empty(npts)
+    for spec, chunks, rows in by_spec.values():
+        points = np.concatenate([np.asarray(spec.points[sl], dtype=float) for sl in chunks])
+        table = spec.model.parameter_table(spec.params, points)
+        where = np.concatenate(rows)
+        pvs[where] = table.vectors
+        Ts[where] = table.periods
+    return pvs, Ts
 
 
 def run_chunks(spec: SweepSpec, indices: Sequence[int]) -> list[ChunkResult]:
@@ -259,23 +295,94 @@ def stream_chunks(
 
     The chunks are computed as one :class:`LaneBatch` (``parts``, or a batch
     already built of them) by ``threads`` threads sharing its jobs (the
-    compiled driver runs without the GIL).  When the consumer stops early
+    compiled driver runs without the GIL): :func:`stream_batches` of one batch.
+    """
+    batch = parts if isinstance(parts, LaneBatch) else LaneBatch(parts)
+    for _, k, res in stream_batches([lambda: batch], threads):
+        yield k, res
+
+
+def stream_batches(
+    batches: Sequence[Callable[[], LaneBatch]], threads: int
+) -> Iterator[tuple[int, int, ChunkResult]]:
+    """``(batch, position in its parts, result)`` of each chunk of the batches, as soon as it is finished.
+
+    ``batches[k]()`` builds batch ``k`` (a :class:`LaneBatch`): a thread of its
+    own builds each batch while the cores compute the one before (a table of
+    points, Python work: not a serial part of the sweep, issue 29).
+    ``threads`` threads run the batches in order, sharing each batch's jobs
+    (the compiled driver runs without the GIL); a thread with no job left in
+    a batch goes on to the next one at once, so that no thread waits for the
+    others' last points at a batch's end.  When the consumer stops early
     (Ctrl-C, an error, ``close()``) the threads are told to stop and have
     returned, at their next step, before this returns.
     """
-    batch = parts if isinstance(parts, LaneBatch) else LaneBatch(parts)
-    batch.control[2] = math.ceil(len(batch.jobs) / threads)  # (a few chains: as many on each thread)
+    if not batches:
+        return
+    from concurrent.futures import Future, ThreadPoolExecutor
+
     errors: list[BaseException] = []
     finished = threading.Semaphore(0)
+    stopping = threading.Event()
+    lock = threading.Lock()
+    built: dict[int, Future[LaneBatch]] = {}  # (batches built or being built, not yet all reported)
+    reported: set[int] = set()  # (batches all reported: let go)
+    builder = ThreadPoolExecutor(1, thread_name_prefix="grazing-batch")
+
+    def build(k: int) -> LaneBatch:
+        batch = batches[k]()
+        batch.control[2] = math.ceil(len(batch.jobs) / threads)  # (a few chains: as many on each thread)
+        return batch
+
+    def batch_at(k: int) -> Future[LaneBatch] | None:
+        """Batch ``k`` (built, or being built, once), or None if it is all reported."""
+        with lock:
+            if k in reported:
+                return None
+            if k not in built:
+                built[k] = builder.submit(build, k)
+            return built[k]
 
     def work() -> None:
         try:
-            batch.run()
+            for k in range(len(batches)):
+                future = batch_at(k)
+                if k + 1 < len(batches):
+                    batch_at(k + 1)  # (built while this one runs)
+                if future is None:  # (the other threads ran it)
+                    continue
+                batch = future.result()
+                if stopping.is_set():
+                    break
+                batch.run()
         except BaseException as exc:  # (reported by the consumer's thread)
             errors.append(exc)
-            batch.stop()
+            stop()
         finally:
             finished.release()
+
+    def stop() -> None:
+        stopping.set()
+        with lock:
+            futures = list(built.values())
+        for future in futures:
+            if future.done() and future.exception() is None:
+                future.result().stop()
+
+    def report() -> list[tuple[int, int, ChunkResult]]:
+        """The chunks finished since the last look, in the batches built so far, with their results."""
+        with lock:
+            ready = sorted((k, f) for k, f in built.items() if f.done() and f.exception() is None)
+        done = []
+        for k, future in ready:
+            batch = future.result()
+            chunks = batch.finished()
+            done += [(k, i, res) for i, res in zip(chunks, batch.results(chunks))]
+            if batch.all_taken():
+                with lock:
+                    reported.add(k)
+                    del built[k]
+        return done
 
     workers = [threading.Thread(target=work, name=f"grazing-sweep-{i}", daemon=True) for i in range(threads)]
     for w in workers:
@@ -287,19 +394,19 @@ def stream_chunks(
                 running -= 1
             if errors:
                 raise errors[0]
-            done = batch.finished()
+            done = report()
             now = time.perf_counter()
-            for k in done:
-                res = batch.result(k)
+            for k, i, res in done:
                 res.seconds = (now - last) * threads / len(done)
-                yield k, res
+                yield k, i, res
             last = now if done else last
-        for k in batch.finished():
-            yield k, batch.result(k)
+        yield from report()
     finally:
-        batch.stop()
+        stop()
+        builder.shutdown(wait=False, cancel_futures=True)  # (a thread waiting for a batch not begun returns)
         for w in workers:
             w.join()
+        builder.shutdown(wait=True)
 
 
 def run_chunk(spec: SweepSpec, index: int) -> ChunkResult:

@@ -86,13 +86,6 @@ def _shapes(spec: SweepSpec) -> dict[str, tuple[int, ...]]:
     return {name: tuple(size[d] for d in var.dims) for name, var in _STORED.items()}
 
 
-def _empty_arrays(spec: SweepSpec) -> dict[str, np.ndarray]:
-    return {
-        name: np.full(shape, _STORED[name].fill, dtype=_STORED[name].dtype)
-        for name, shape in _shapes(spec).items()
-    }
-
-
 def _flat(arrays: dict[str, np.ndarray]) -> Any:
     """The stored variables (``arrays``, or a chunk's part of them) as a Dataset along ``point``."""
     import xarray as xr
@@ -234,23 +227,45 @@ def _label_parameters(ds: Any, spec: SweepSpec) -> None:
 
 
 class MemoryStore:
-    """Results kept in memory."""
+    """Results kept in memory.
+
+    The arrays are taken from the system untouched and each chunk's part is
+    written when the chunk is (while the threads compute the next ones); the
+    chunks not written are given their values before computing (NaN, -1...)
+    only when :attr:`arrays` is read.  (Filling 50 MB of samples at once, a
+    32000-point sweep's, took 0.01 to 0.15 s before the threads started.)
+    """
 
     def __init__(self, spec: SweepSpec, attrs: dict[str, Any] | None = None):
         self.spec = spec
-        self.arrays = _empty_arrays(spec)
+        self._arrays = {
+            name: np.empty(shape, dtype=_STORED[name].dtype) for name, shape in _shapes(spec).items()
+        }
+        self._set = np.zeros(spec.n_chunks, dtype=bool)  # (the chunks whose part of the arrays holds values)
         self.done = np.zeros(spec.n_chunks, dtype=bool)
         self.end_time = np.full(spec.n_chunks, np.nan)
         self.attrs = attrs or {}
+
+    @property
+    def arrays(self) -> dict[str, np.ndarray]:
+        """The stored variables, flat along the points (a chunk not written: its values before computing)."""
+        if not self._set.all():
+            for i in np.flatnonzero(~self._set):
+                sl = self.spec.chunk(int(i))
+                for name, array in self._arrays.items():
+                    array[sl] = _STORED[name].fill
+            self._set[:] = True
+        return self._arrays
 
     def is_done(self, i: int) -> bool:
         return bool(self.done[i])
 
     def write(self, res: ChunkResult) -> None:
         sl = self.spec.chunk(res.index)
-        for key in self.arrays:
-            self.arrays[key][sl] = getattr(res, key)
+        for key, array in self._arrays.items():
+            array[sl] = getattr(res, key)
         self.end_time[res.index] = _end_time(res)
+        self._set[res.index] = True
         self.done[res.index] = True
 
     def chain_start(self, i: int) -> ChainStart:

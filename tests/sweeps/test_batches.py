@@ -1,0 +1,75 @@
+"""Local batches run one after the other by threads that do not wait at a batch's end (grazing.sweeps.run)."""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import threading
+
+import numpy as np
+import pytest
+
+from grazing.core.options import SweepSettings
+from grazing.engine.llvmgen import lane_width
+from grazing.models import impact_oscillator, pendulum
+from grazing.sweeps import executor
+from grazing.sweeps.run import LaneBatch, run_chunks, stream_batches
+from grazing.sweeps.spec import sweep_spec
+
+FIELDS = [f.name for f in dataclasses.fields(executor.ChunkResult) if f.name not in ("index", "seconds")]
+
+
+def _same(a, b) -> bool:
+    return all(np.array_equal(getattr(a, f), getattr(b, f), equal_nan=True) for f in FIELDS)
+
+
+@pytest.mark.parametrize("fresh", [True, False])
+def test_batches_give_each_chunk_once_as_computed_alone(fresh):
+    """Chunks in batches of several sizes, three threads: every chunk once, with the results of the chunk
+    computed alone (a chunk's result does not depend on the chunks computed with it)."""
+    model = impact_oscillator(sigma=0.1)
+    spec = sweep_spec(model, "omega", np.linspace(1.5, 3.0, 41), settings=SweepSettings(
+        fresh=fresh, chunk_size=3, transient=40, periods=12))  # fmt: skip
+    groups = [[0], [1, 2, 3], [4], list(range(5, 12)), [12, 13]]
+    assert sorted(i for g in groups for i in g) == list(range(spec.n_chunks))
+    makers = [functools.partial(LaneBatch, [(spec, i) for i in g]) for g in groups]
+    got = {}
+    for k, i, res in stream_batches(makers, 3):
+        assert (k, i) not in got
+        got[k, i] = res
+        assert res.index == groups[k][i]
+    assert sorted(got) == [(k, i) for k, g in enumerate(groups) for i in range(len(g))]
+    alone = {res.index: res for res in run_chunks(spec, range(spec.n_chunks))}
+    for res in got.values():
+        assert _same(res, alone[res.index]), res.index
+
+
+def test_local_results_of_a_fresh_sweep_in_growing_batches(monkeypatch):
+    """A fresh sweep's batches grow from one that fills the lanes; the results are those of one batch."""
+    n = 4 * 2 * lane_width() * 6  # (the first batch fills two threads' lanes: 4 points each)
+    spec = sweep_spec(pendulum("B"), "eta", np.linspace(0.44, 0.49, n), settings=SweepSettings(
+        fresh=True, chunk_size=2, transient=20, periods=6))  # fmt: skip
+    monkeypatch.setattr(executor, "BATCH_VALUES", 4 * 4 * (n // 6) * 6 * 2)  # (so that they grow)
+    parts = [(spec, i) for i in range(spec.n_chunks)]
+    sizes = [len(b) for b in executor.local_batches(parts, 2)]
+    assert len(sizes) > 2 and sizes[1] > sizes[0]
+    got = {part[1]: res for part, res in executor.local_results(parts, 2)}
+    alone = {res.index: res for res in run_chunks(spec, range(spec.n_chunks))}
+    assert sorted(got) == sorted(alone)
+    assert all(_same(got[i], alone[i]) for i in alone)
+
+
+def test_a_batch_that_cannot_be_built_stops_the_threads():
+    """An error building a later batch reaches the consumer; every thread has returned."""
+    spec = sweep_spec(pendulum("B"), "eta", np.linspace(0.44, 0.49, 8), settings=SweepSettings(
+        fresh=True, chunk_size=2, transient=20, periods=6))  # fmt: skip
+
+    def broken() -> LaneBatch:
+        raise ValueError("no table")
+
+    makers = [functools.partial(LaneBatch, [(spec, 0), (spec, 1)]), broken,
+              functools.partial(LaneBatch, [(spec, 2)])]  # fmt: skip
+    with pytest.raises(ValueError, match="no table"):
+        list(stream_batches(makers, 2))
+    alive = [t.name for t in threading.enumerate() if t.name.startswith(("grazing-sweep", "grazing-batch"))]
+    assert alive == []
