@@ -354,6 +354,13 @@ class _Definition:
             self._kernels[directions, order] = _kernel_loader(self, directions, order)
         return self._kernels[directions, order]
 
+    def scalar_kernels(self) -> Any:
+        """Kernels for the scalar functions (vector field, guard, reset, ...), which every module has:
+        one already loaded (a sweep's, say: no second module to load), else the default one."""
+        if self._kernels:
+            return next(iter(self._kernels.values()))
+        return self.kernels()
+
     def numeric(self, what: str, stop: int = 0) -> Callable[..., Any]:
         """numpy function of ``(x, t, p)`` for f, h, g or a Jacobian at a stop (built on first use)."""
         fn = self._numeric.get((what, stop))
@@ -906,14 +913,16 @@ class HybridModel:
     def vector_field(self, x: Any, t: float = 0.0) -> np.ndarray:
         """``f(x, t)`` (evaluated by the compiled kernels)."""
         out = np.empty(self.n_states)
-        self.kernels().rhs(np.ascontiguousarray(x, dtype=float), float(t), self.param_vector, out)
+        self._def.scalar_kernels().rhs(np.ascontiguousarray(x, dtype=float), float(t), self.param_vector, out)
         return out
 
     def guard(self, x: Any, t: float = 0.0, stop: int | str | None = None) -> float:
         """``h(x, t)`` of a stop (the first by default): positive in the allowed region."""
         j = self.stop_index(stop)
         return float(
-            self.kernels().guard(np.ascontiguousarray(x, dtype=float), float(t), self.param_vector, j)
+            self._def.scalar_kernels().guard(
+                np.ascontiguousarray(x, dtype=float), float(t), self.param_vector, j
+            )
         )
 
     def guards(self, x: Any, t: float = 0.0) -> np.ndarray:
@@ -924,14 +933,18 @@ class HybridModel:
         """``g(x, t)`` of a stop: the state just after an impact at ``x``."""
         out = np.empty(self.n_states)
         j = self.stop_index(stop)
-        self.kernels().reset(np.ascontiguousarray(x, dtype=float), float(t), self.param_vector, out, j)
+        self._def.scalar_kernels().reset(
+            np.ascontiguousarray(x, dtype=float), float(t), self.param_vector, out, j
+        )
         return out
 
     def normal_accel(self, x: Any, t: float = 0.0, stop: int | str | None = None) -> float:
         """``L_f^2 h`` at ``(x, t)``: a guard's acceleration along the flow (compiled)."""
         j = self.stop_index(stop)
         return float(
-            self.kernels().normal_accel(np.ascontiguousarray(x, dtype=float), float(t), self.param_vector, j)
+            self._def.scalar_kernels().normal_accel(
+                np.ascontiguousarray(x, dtype=float), float(t), self.param_vector, j
+            )
         )
 
     def jacobians(
