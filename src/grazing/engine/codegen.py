@@ -370,6 +370,21 @@ def kernel_key(identity: str, directions: int, order: int = DEFAULT_ORDER) -> st
     return _key(identity, int(directions), order, versions, deps, lane_width())
 
 
+def _numba_version() -> str:
+    """numba's version, without importing numba: its ``_version.py`` as text (else its metadata's).
+
+    (``importlib.metadata`` costs 20-50 ms to import, in every process that runs the driver.)
+    """
+    spec = importlib.util.find_spec("numba")
+    if spec is not None and spec.origin is not None:
+        path = Path(spec.origin).parent / "_version.py"
+        if path.exists():
+            return path.read_text()
+    from importlib.metadata import version  # pragma: no cover - a numba without versioneer's file
+
+    return version("numba")  # pragma: no cover
+
+
 @functools.cache
 def driver_key() -> str:
     """Cache key of the compiled driver: its sources and those of everything it inlines.
@@ -379,8 +394,6 @@ def driver_key() -> str:
     are the values of the constants the driver takes from :mod:`grazing.core`
     (the step limit, the status codes).
     """
-    from importlib.metadata import version
-
     from grazing.core.options import STEPS_EXTRA, STEPS_PER_PERIOD
     from grazing.core.solution import Status
 
@@ -391,7 +404,7 @@ def driver_key() -> str:
     from grazing.engine.llvmgen import lane_width
 
     constants = (STEPS_PER_PERIOD, STEPS_EXTRA, [(s.name, int(s)) for s in Status])  # (from core)
-    versions = (_CODEGEN_VERSION, version("numba"), sys.version)  # (numba's, not imported)
+    versions = (_CODEGEN_VERSION, _numba_version(), sys.version)
     return _key(*versions, deps, constants, lane_width())  # (lanevec's vectors are lane_width() wide)
 
 
