@@ -224,7 +224,7 @@ class Catalogue:
         index = first + np.arange(res.status.size) if which is None else np.asarray(which)
         status = np.asarray(res.status, dtype=int)
         samples = np.asarray(res.samples, dtype=float)
-        period = np.asarray(res.period, dtype=int)
+        period = np.array(res.period, dtype=int)
         ok = status == Status.OK
         far = np.zeros(status.size, dtype=bool)
         if ok.any():
@@ -239,7 +239,12 @@ class Catalogue:
                 self._outcome_label(int(index[k]), "failed", reason(int(status[k])))
         settled = ok & ~far
         slow = unsettled(samples, period) & settled if defer else np.zeros(status.size, dtype=bool)
-        self._add_periodic(index, res, np.flatnonzero(settled & (period > 0) & ~slow))
+        if not defer:  # (the last look: an orbit closing in on a shorter period, within a match, has it)
+            for k in np.flatnonzero(settled & (period > 0)):
+                d, off = closing_period(samples[k], int(period[k]))
+                if off <= MATCH_TOL * float(np.min(self.cell)):
+                    period[k] = d
+        self._add_periodic(index, res, period, np.flatnonzero(settled & (period > 0) & ~slow))
         aperiodic = np.flatnonzero(settled & (period <= 0))
         if defer:
             return np.union1d(aperiodic, np.flatnonzero(slow))
@@ -254,10 +259,11 @@ class Catalogue:
         self.entries[k].count += 1
         self.labels[i] = k
 
-    def _add_periodic(self, index: np.ndarray, res: ChunkResult, rows: np.ndarray) -> None:
+    def _add_periodic(
+        self, index: np.ndarray, res: ChunkResult, period: np.ndarray, rows: np.ndarray
+    ) -> None:
         if rows.size == 0:
             return
-        period = np.asarray(res.period, dtype=int)
         tol = MATCH_TOL * self.cell
         for p in np.unique(period[rows]):
             sel = rows[period[rows] == p]
@@ -404,21 +410,49 @@ class Catalogue:
 
 def unsettled(samples: np.ndarray, period: np.ndarray, tol: float = BASIN_ADAPTIVE_TOL) -> np.ndarray:
     """Which periodic end states have not settled: their samples repeat with their period only to more
-    than ``tol`` (an orbit on its attractor repeats to rounding; the period detector accepts 1e-6).
+    than ``tol`` (an orbit on its attractor repeats to rounding; the period detector accepts 1e-6), or
+    they are closing in on a shorter period (a divisor's differences shrink over the samples).
+
+    The second: an orbit slow to settle on a period-1 orbit with a multiplier near -1 (-0.94) repeats
+    with period 2 to 7e-8 after 200 periods, with period 1 to only 1e-6 (found by hypothesis).
 
     Examples
     --------
     >>> k = np.arange(32.0)
     >>> spiral = 1e-6 * 0.98**k * np.cos(2 * np.pi * k / 7)     # converging to a point, slowly
-    >>> samples = np.stack([np.stack([spiral, 0 * k], 1), np.stack([0 * k + 1.0, 0 * k], 1)])
-    >>> unsettled(samples, np.array([7, 1])).tolist()
-    [True, False]
+    >>> flip = 1e-6 * (-0.94) ** k                                  # the same, alternating
+    >>> two = np.where(k % 2 == 0, 1.0, -1.0)                       # a period-2 orbit
+    >>> samples = np.stack([np.stack([v, 0 * k], 1) for v in (spiral, 0 * k + 1.0, flip, two)])
+    >>> unsettled(samples, np.array([7, 1, 2, 2])).tolist()
+    [True, False, True, False]
     """
     out = np.zeros(period.shape, dtype=bool)
     for i in np.flatnonzero(period > 0):
         p = int(period[i])
-        out[i] = bool(np.max(np.abs(samples[i, p:] - samples[i, :-p])) > tol)
+        repeats = np.max(np.abs(samples[i, p:] - samples[i, :-p]))
+        out[i] = bool(repeats > tol) or closing_period(samples[i], p)[0] != p
     return out
+
+
+def closing_period(samples: np.ndarray, p: int) -> tuple[int, float]:
+    """The least divisor ``d`` of ``p`` that p-periodic ``samples`` are converging to, else ``p``; and
+    how far their last samples are from period ``d`` (0 for ``p``).
+
+    They converge to period ``d`` where the differences ``|x[k + d] - x[k]|`` of their last ``p``
+    samples are under half those of their first ``p`` (on a p-periodic orbit they are the same).
+
+    Examples
+    --------
+    >>> k = np.arange(32.0)[:, None]
+    >>> d, off = closing_period(1e-5 * (-0.97) ** k, 2)
+    >>> d, bool(off < 1e-5), closing_period(np.where(k % 2 == 0, 1.0, -1.0), 2)
+    (1, True, (2, 0.0))
+    """
+    for d in (d for d in range(1, p) if p % d == 0):
+        diff = np.max(np.abs(samples[d:] - samples[:-d]), axis=1)
+        if diff.size >= 2 * p and np.max(diff[-p:]) < 0.5 * np.max(diff[:p]):
+            return d, float(np.max(diff[-p:]))
+    return p, 0.0
 
 
 def set_distance(a: np.ndarray, b: np.ndarray, cell: np.ndarray) -> float:
