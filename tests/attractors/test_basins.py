@@ -214,6 +214,26 @@ def test_random_models(spec: ModelSpec):
             assert ends_on(model, found, int(found.labels[k]), x[k], transient=800), k
 
 
+CLASHING_NAMES = ("x1", "v1", "t_0", "v0", "pi", "T", "J", "t", "t_", "x2", "v2", "E", "I", "e", "S", "N",
+                  "lambda", "sin", "cos", "exp", "log", "sqrt", "math", "np", "pv", "s", "x", "out", "h", "k",
+                  "c0", "w0", "p0", "xs0_0", "X", "O", "tau", "Dummy")  # fmt: skip
+"""The names of the two-mass models hypothesis found (tests.random_models draws such clashes)."""
+
+
+def only_period_one(every: int, transient: int, **values: float) -> None:
+    """A lightly damped two-mass model with clashing names whose only attractor is a period-1 orbit:
+    so the basins of a 6 x 6 grid find, and every ``every``-th state run on its own ends there."""
+    spec = ModelSpec(names=CLASHING_NAMES, dof=2, amplitude=1.0, stop_fraction=0.5, coupling=0.25,
+                     cubic=0.0, smooth="none", **values)  # type: ignore[arg-type]  # fmt: skip
+    model = spec.model()
+    grid = state_grid(model, (-1.5 * spec.stop, 1.2 * spec.stop), (-2.0, 2.0), (6, 6))
+    x = grid.states_array()
+    found = find_attractors(model, x, workers=2, transient=200, periods=32)
+    assert [(a.kind, a.period) for a in found.attractors if a.kind != "invalid"] == [("periodic", 1)]
+    for k in np.flatnonzero(found.labels > 0)[::every]:
+        assert ends_on(model, found, int(found.labels[k]), x[k], transient=transient), k
+
+
 def test_an_orbit_closing_in_on_a_shorter_period_is_not_an_attractor_of_its_own():
     """Found by hypothesis: the period-1 orbit of this model has a multiplier near -1 (-0.94), and
     initial states on their way to it repeated with period 2 to 7e-8 (settled, by the 1e-7 of the
@@ -222,19 +242,7 @@ def test_an_orbit_closing_in_on_a_shorter_period_is_not_an_attractor_of_its_own(
     are given the period they close in on where they are within a match of it.  (With damping
     0.03125, a multiplier near -0.97, some are still 3e-5 from it after 400 periods, and a period-2
     attractor is still reported: left, see the session note.)"""
-    names = ("x1", "v1", "t_0", "v0", "pi", "T", "J", "t", "t_", "x2", "v2", "E", "I", "e", "S", "N",
-             "lambda", "sin", "cos", "exp", "log", "sqrt", "math", "np", "pv", "s", "x", "out", "h", "k",
-             "c0", "w0", "p0", "xs0_0", "X", "O", "tau", "Dummy")  # fmt: skip
-    spec = ModelSpec(names=names, dof=2, damping=0.0625, stiffness=1.1875, amplitude=1.0, omega=2.375,
-                     stop_fraction=0.5, restitution=0.5, coupling=0.25, cubic=0.0,
-                     smooth="none")  # fmt: skip
-    model = spec.model()
-    grid = state_grid(model, (-1.5 * spec.stop, 1.2 * spec.stop), (-2.0, 2.0), (6, 6))
-    x = grid.states_array()
-    found = find_attractors(model, x, workers=2, transient=200, periods=32)
-    assert [(a.kind, a.period) for a in found.attractors if a.kind != "invalid"] == [("periodic", 1)]
-    for k in np.flatnonzero(found.labels > 0)[::5]:
-        assert ends_on(model, found, int(found.labels[k]), x[k], transient=1600), k
+    only_period_one(5, 1600, damping=0.0625, stiffness=1.1875, omega=2.375, restitution=0.5)
 
 
 def test_an_orbit_slow_to_settle_is_not_split_into_spurious_periods():
@@ -242,16 +250,4 @@ def test_an_orbit_slow_to_settle_is_not_split_into_spurious_periods():
     initial states still spiralled into the period-1 orbit and their samples repeated to the period
     detector's 1e-6 with periods 2, 7 and 9, each reported as an attractor of its own (the same
     Lyapunov exponent to 1e-11). Such end states are run on before they are classified."""
-    names = ("x1", "v1", "t_0", "v0", "pi", "T", "J", "t", "t_", "x2", "v2", "E", "I", "e", "S", "N",
-             "lambda", "sin", "cos", "exp", "log", "sqrt", "math", "np", "pv", "s", "x", "out", "h", "k",
-             "c0", "w0", "p0", "xs0_0", "X", "O", "tau", "Dummy")  # fmt: skip
-    spec = ModelSpec(names=names, dof=2, damping=0.03125, stiffness=1.0, amplitude=1.0, omega=2.0,
-                     stop_fraction=0.5, restitution=0.75, coupling=0.25, cubic=0.0,
-                     smooth="none")  # fmt: skip
-    model = spec.model()
-    grid = state_grid(model, (-1.5 * spec.stop, 1.2 * spec.stop), (-2.0, 2.0), (6, 6))
-    x = grid.states_array()
-    found = find_attractors(model, x, workers=2, transient=200, periods=32)
-    assert [(a.kind, a.period) for a in found.attractors if a.kind != "invalid"] == [("periodic", 1)]
-    for k in np.flatnonzero(found.labels > 0):
-        assert ends_on(model, found, int(found.labels[k]), x[k], transient=800), k
+    only_period_one(1, 800, damping=0.03125, stiffness=1.0, omega=2.0, restitution=0.75)
