@@ -55,3 +55,9 @@ def test_a_run_is_made_again_only_when_its_tables_were_short() -> None:
     assert made == [need] and need_again == need
     assert all(np.array_equal(a, b) for a, b in zip(result, again, strict=True) if isinstance(a, np.ndarray))
     assert math.isclose(result.s, again.s)
+
+
+def test_the_totals_are_read_by_the_names_the_driver_writes() -> None:
+    from grazing.engine.records import RUN_TOTALS
+
+    assert outputs.Totals._fields == RUN_TOTALS.names

@@ -250,7 +250,7 @@ def plain_reference_counts(text: str) -> str:
     array it is given: the sweep driver's pieces, given the lanes' arrays,
     spent a fifth of its time on them.  In the driver's machine code no
     count is shared between threads: the arrays it is given come without a
-    memory manager (:func:`flatten`: a null pointer, whose count is never
+    memory manager (:func:`_array_loads`: a null pointer, whose count is never
     touched) and those it allocates are its own thread's, so plain adds count
     the same.  They are inlined where they are called (:func:`object_file`
     runs LLVM's always-inliner, which touches nothing else).  The text is
@@ -468,12 +468,12 @@ ENTRIES = _entries()
 
 
 class _Plan(NamedTuple):
-    """How :func:`flatten` reads a driver function's arguments."""
+    """How :func:`_flattener`'s function reads a driver function's arguments."""
 
     arguments: list[tuple[str, list[str] | None]]  # name and its fields' labels (None: an array of its own)
     layout: list[tuple[str, str, Any]]  # (label, kind, (numpy dtype, dimensions) of an array)
     written: str  # the prefix of the labels of the arrays the function writes (its last argument's)
-    kinds: list[str]  # the slots' LLVM types
+    kinds: list[str]  # the slots' kinds: an array's "array<ndim>", else its LLVM type
     format: str  # the slots' struct format (64-bit integers, doubles)
 
 
@@ -530,9 +530,15 @@ def _refuse(entry: Entry, fields: dict[str, Any]) -> NoReturn:
 
 @functools.cache
 def _flattener(entry: Entry) -> Callable[[tuple[Any, ...]], bytes]:
-    """A function from the arguments of ``entry`` to its slots (as bytes), written for its layout.
+    """A function from the arguments of ``entry`` to the 64-bit slots its entry function reads (as bytes).
 
-    Python code with a line per field (no loop over the layout, no table of
+    The arguments are its records (or plain tuples of their fields) and its
+    arrays; a slot per field, an array's holding the address of its numpy
+    object (which must live as long as the slots are used; the entry function
+    reads its data pointer, shape and strides, :func:`_array_loads`), a
+    boolean's 0 or 1.  Arrays of another dtype, dimension, shape or layout
+    than the driver takes are refused (``TypeError``), and so are read-only
+    arrays the driver writes.  Python code with a line per field (no loop over the layout, no table of
     values): the driver's arguments are flattened on every call of the scalar
     integrator, about as often as numba's dispatcher would take them.  Should
     any check fail, :func:`_refuse` finds which.
@@ -590,21 +596,6 @@ def _flattener(entry: Entry) -> Callable[[tuple[Any, ...]], bytes]:
 
 class _RefusedError(Exception):
     """An argument a driver function cannot take (the generated checks' signal to :func:`_refuse`)."""
-
-
-def flatten(arguments: tuple[Any, ...], entry: Entry | None = None) -> tuple[np.ndarray, list[str]]:
-    """A driver function's arguments as its entry function reads them: 64-bit slots and their kinds.
-
-    The arguments are those of ``entry`` (the sweep driver's by default): its
-    records (or plain tuples of their fields), each passed field by field, and
-    its arrays: a slot per field, an array's holding the address of its numpy
-    object (which must live as long as the slots are used; the entry function
-    reads its data pointer, shape and strides), a boolean's 0 or 1.  Arrays of
-    another dtype, dimension, shape or layout than the driver takes are
-    refused (``TypeError``), and so are read-only arrays the driver writes.
-    """
-    entry = entry or ENTRIES["sweep_lanes"]
-    return np.frombuffer(_flattener(entry)(arguments), dtype=np.int64), _plan(entry).kinds
 
 
 def _raise_numbas_error(entry: Entry, arguments: tuple[Any, ...]) -> None:

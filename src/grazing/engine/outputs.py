@@ -25,6 +25,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from grazing.core.solution import Status
 from grazing.engine.records import RUN_TOTALS, Config, Result, RunOutput
 
 IMPACTS_PER_PERIOD = 4.0
@@ -33,6 +34,11 @@ IMPACTS_PER_PERIOD = 4.0
 MAX_GUESSED_ROWS = 1 << 22
 """At most this many rows of guessed impacts or sticking intervals per table (an array not written is
 not in memory: numpy's ``empty`` leaves its pages to the first write)."""
+
+
+def _recorded_periods(cfg: Config) -> int:
+    """The periods whose impacts a run with settings ``cfg`` records (none, the kept ones, all)."""
+    return (0, cfg.n_keep, cfg.n_samples)[cfg.record_impacts]
 
 
 class TableRows(NamedTuple):
@@ -45,7 +51,7 @@ class TableRows(NamedTuple):
     @classmethod
     def guess(cls, cfg: Config, impacts_per_period: float = IMPACTS_PER_PERIOD) -> TableRows:
         """Rows for a run with settings ``cfg``, at ``impacts_per_period`` impacts per recorded period."""
-        span = (0, cfg.n_keep, cfg.n_samples)[cfg.record_impacts]  # (periods whose impacts are recorded)
+        span = _recorded_periods(cfg)
         impacts = min(16 + math.ceil(impacts_per_period * span), MAX_GUESSED_ROWS) if span else 0
         sticking = min(4 + math.ceil(impacts_per_period * cfg.n_keep / 4), MAX_GUESSED_ROWS)
         trajectory = 0
@@ -123,12 +129,12 @@ def run(
     """``call(out)`` with outputs of ``rows`` (a run with settings ``cfg``); again if it needs more rows.
 
     Returns the run's result and the rows it needed.  A run that failed
-    (its status is not 0) is not run again: its tables hold the rows that fit.
+    (its status is not OK) is not run again: its tables hold the rows that fit.
     """
     out = allocate(nx, ncol, nstops, cfg.n_keep, rows)
     call(out)
     totals = Totals.of(out)
-    if totals.status == 0 and not rows.fit(totals.rows):
+    if totals.status == Status.OK and not rows.fit(totals.rows):
         out = allocate(nx, ncol, nstops, cfg.n_keep, totals.rows)
         call(out)
         totals = Totals.of(out)
@@ -140,7 +146,7 @@ def impacts_per_period(need: TableRows, cfg: Config) -> float:
 
     At least :data:`IMPACTS_PER_PERIOD`; sticking intervals count as a quarter of that.
     """
-    span = (0, cfg.n_keep, cfg.n_samples)[cfg.record_impacts]
+    span = _recorded_periods(cfg)
     return max(
         IMPACTS_PER_PERIOD, need.impacts / span if span else 0.0, need.sticking * 4 / max(cfg.n_keep, 1)
     )
