@@ -257,7 +257,8 @@ def run_arguments(model, x0, periods=3, keep=3, variational=False, impacts="all"
         traj_dt=r.T / trajectory if trajectory else 0.0, track_min=True,
         record_impacts=RECORD_IMPACTS[impacts], touch_start=False, touch_end=False,
     )  # fmt: skip
-    cfg = Config(*(call[name] for name in Config._fields[: len(call)]), *r._static, interrupts.SIGINTS, 0)
+    seen = int(interrupts.SIGINTS[0])  # (SIGINTs counted by earlier tests in this process)
+    cfg = Config(*(call[name] for name in Config._fields[: len(call)]), *r._static, interrupts.SIGINTS, seen)
     rows = outputs.TableRows.guess(cfg)
     out = outputs.allocate(model.n_states, r.V.shape[1], model.n_stops, keep, rows)
     return [(r.x, r.V, r.k, r.s, r.mode), r.pv, cfg, r.kern.table, out]
