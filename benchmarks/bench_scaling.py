@@ -53,14 +53,15 @@ from pathlib import Path
 from typing import Any
 
 sys.path.insert(0, os.path.dirname(__file__))
-from _common import EQUAL_WORK, EQUAL_WORK_TOL, bench_parser, emit, loadavg, log, machine_info
+from _common import EQUAL_WORK, EQUAL_WORK_TOL, bench_parser, emit, grazing_exe, loadavg, log, machine_info
 
 CORES = (2, 4, 8, 16, 32, 64)
 """Core counts of the projection."""
 
 _PROBE = r"""
-import json, sys, threading, time
+import json, os, sys, threading, time
 t_enter = time.perf_counter()
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # (as the grazing console script: _grazing_entry)
 import grazing.cli
 from grazing.cli import common
 from grazing.sweeps import run as run_module
@@ -98,6 +99,8 @@ t_end = time.perf_counter()
 with open(sys.argv[1], "w") as fh:
     json.dump({"enter": t_enter, "main": t_main, "end": t_end, "calls": calls, "encode": encode,
                "consumer": consumer, "code": code}, fh)
+from grazing.cli.quick_exit import quick_exit  # (as the console script ends)
+quick_exit(code)
 """
 
 
@@ -108,10 +111,11 @@ def sweep_args(points: int, workers: int, default: bool) -> list[str]:
 
 
 def whole(args: list[str]) -> tuple[float, float]:
-    """Wall and CPU seconds (user + system) of ``python -m grazing ARGS > /dev/null`` as a whole process."""
+    """Wall and CPU seconds (user + system) of ``grazing ARGS > /dev/null`` (the console script) as a whole
+    process."""
     before = os.times()
     start = time.perf_counter()
-    subprocess.run([sys.executable, "-m", "grazing", *args], stdout=subprocess.DEVNULL, check=True)
+    subprocess.run([grazing_exe(), *args], stdout=subprocess.DEVNULL, check=True)
     wall = time.perf_counter() - start
     after = os.times()
     return wall, (after.children_user - before.children_user) + (
@@ -119,8 +123,11 @@ def whole(args: list[str]) -> tuple[float, float]:
     )
 
 
-def phases(args: list[str]) -> dict[str, float]:
-    """One whole process, its phases timed inside it (see the module)."""
+def phases(args: list[str], threads: int) -> dict[str, float]:
+    """One whole process of a sweep on ``threads`` threads, its phases timed inside it (see the module).
+
+    The threads' idle time is counted against ``threads``, not against the threads that ran the driver
+    (a sweep that settles a chain in rounds starts new threads each round)."""
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "phases.json"
         script = Path(tmp) / "probe.py"
@@ -132,7 +139,6 @@ def phases(args: list[str]) -> dict[str, float]:
     calls = rec["calls"]
     first = min(c[1] for c in calls)
     last = max(c[2] for c in calls)
-    threads = len({c[0] for c in calls})
     busy = sum(c[2] - c[1] for c in calls)
     span = last - first
     return {
@@ -146,7 +152,7 @@ def phases(args: list[str]) -> dict[str, float]:
         "json": sum(rec["encode"]),
         "consumer_cpu": sum(rec["consumer"]),  # (the main thread's work on the chunks, overlapped)
         "threads": threads,
-        "rounds": len(calls) / max(threads, 1),
+        "rounds": len(calls) / max(threads, 1),  # (driver calls per thread)
     }
 
 
@@ -166,7 +172,7 @@ def measure(points: int, runs: int, default: bool) -> dict[str, Any]:
     ncores = os.cpu_count() or 1
     name = "default sweep" if default else "equal-work sweep"
     log(f"{name}, {points} points: {runs} runs with the phases timed, then 1 and {ncores} threads")
-    runs_phases = [phases(sweep_args(points, ncores, default)) for _ in range(runs)]
+    runs_phases = [phases(sweep_args(points, ncores, default), ncores) for _ in range(runs)]
     med = {k: statistics.median(r[k] for r in runs_phases) for k in runs_phases[0]}
     t1 = [whole(sweep_args(points, 1, default)) for _ in range(runs)]
     tc = [whole(sweep_args(points, ncores, default)) for _ in range(runs)]

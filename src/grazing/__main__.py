@@ -1,7 +1,6 @@
 """``python -m grazing``: the command line."""
 
-import sys
-
 from grazing.cli import main
+from grazing.cli.quick_exit import quick_exit
 
-sys.exit(main())
+quick_exit(main())

@@ -20,17 +20,16 @@ in a hidden folder of it instead, removed as a whole at the end.
 from __future__ import annotations
 
 import ctypes
-import ctypes.util
 import errno
 import os
 import shutil
-import sys
 import tempfile
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager, suppress
 from pathlib import Path
 from typing import Any
 
+from grazing.clib import libc
 from grazing.errors import GrazingError, WriteError
 
 
@@ -230,12 +229,8 @@ def rename_noreplace(src: str | Path, dst: str | Path) -> None:
 
 
 def _renameat2() -> Any:
-    if not sys.platform.startswith("linux"):
-        return None
-    try:
-        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
-        fn = libc.renameat2
-    except (OSError, AttributeError):
+    fn = getattr(libc(), "renameat2", None)  # (None: not Linux, or a C library without it)
+    if fn is None:
         return None
     fn.argtypes = [ctypes.c_int, ctypes.c_char_p, ctypes.c_int, ctypes.c_char_p, ctypes.c_uint]
     fn.restype = ctypes.c_int

@@ -20,16 +20,14 @@ worker runs :func:`init_worker`, and then
 
 from __future__ import annotations
 
-import ctypes
-import ctypes.util
 import os
 import signal
-import sys
 import threading
 import time
 from collections.abc import Callable, Iterator, Sequence
 from typing import Any
 
+from grazing.clib import libc
 from grazing.errors import SimulationError
 
 PR_SET_PDEATHSIG = 1
@@ -64,12 +62,10 @@ def set_parent_death_signal(sig: int = signal.SIGKILL) -> bool:
     bool
         True if the request was accepted (False elsewhere than Linux).
     """
-    if not sys.platform.startswith("linux"):
-        return False
+    lib = libc()
     try:
-        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
-        return libc.prctl(PR_SET_PDEATHSIG, int(sig), 0, 0, 0) == 0
-    except (OSError, AttributeError):
+        return lib is not None and lib.prctl(PR_SET_PDEATHSIG, int(sig), 0, 0, 0) == 0
+    except AttributeError:  # pragma: no cover - a C library without prctl
         return False
 
 

@@ -1140,7 +1140,8 @@ def _check_run(argv: list[str], capsys, template: Path) -> None:
         out, err = capsys.readouterr()
         if code == 0 or code is None:  # passed every check: nothing it was given may be ignored
             assert not ignored(argv), (argv, ignored(argv))
-            if code == 0 and "--json" in argv and out:  # issue 26: strict JSON (no NaN, no Infinity)
+            # issue 26: strict JSON (no NaN, no Infinity); --json as given (not the value of an option)
+            if code == 0 and "--json" in _given(argv) and out:
                 _strict_json(out)
             return
         assert err.startswith("grazing: error: ") and err.count("\n") == 1, (argv, err)
@@ -1209,3 +1210,15 @@ def test_a_memory_bound_beyond_floats_is_one_line(monkeypatch, capsys, inputs):
     monkeypatch.setenv(MEMORY_ENV, "1e400")
     err = _one_line_error(["simulate", "--periods", "10"], capsys, inputs)
     assert err == "grazing: error: GRAZING_MAX_MEMORY='1e400' is not a size such as 8G or 512M"
+
+
+# --------------------------------------------------------------------------
+# issue 29: the fuzz test's own reading of --json
+
+
+def test_json_given_as_an_options_value_asks_for_no_json(capsys, inputs):
+    """``--amplitude --json --amplitude 28``: "--json" is the first amplitude (then replaced), the output text
+    (hypothesis found it; the check of strict JSON read any "--json" in the list as the flag)."""
+    argv = ["damping", "--amplitude", "--json", "--amplitude", "28"]
+    assert "--json" not in _given(argv)
+    _check_run(argv, capsys, inputs)
