@@ -34,7 +34,7 @@ unless ``--no-bytecode-cache`` is given.
 Usage::
 
     python benchmarks/bench_scaling.py                 # 4000 points, 3 runs each (about 1-2 minutes)
-    python benchmarks/bench_scaling.py --points 16000 --default --json scaling.json
+    python benchmarks/bench_scaling.py --points 8000 32000 --default --default-points 8000 --json scaling.json
 """
 
 from __future__ import annotations
@@ -330,7 +330,16 @@ def bytecode_cache(enabled: bool) -> Iterator[str]:
 
 def main() -> None:
     parser = bench_parser(__doc__)
-    parser.add_argument("--points", type=int, default=4000, help="points of the sweep (default 4000)")
+    parser.add_argument(
+        "--points",
+        type=int,
+        nargs="+",
+        default=[4000],
+        help="points of the sweep, one or more (default 4000)",
+    )
+    parser.add_argument(
+        "--default-points", type=int, default=None, help="points of the default sweep (default: the first)"
+    )
     parser.add_argument("--runs", type=int, default=3, help="runs of each measurement (default 3)")
     parser.add_argument("--default", action="store_true", help="also the default sweep (one chain)")
     parser.add_argument("--dask", action="store_true", help="also a local Dask cluster against threads")
@@ -351,10 +360,10 @@ def measured(args: argparse.Namespace, imports: str) -> None:
     subprocess.run(
         [sys.executable, "-m", "grazing", *sweep_args(8, 1, False)], stdout=subprocess.DEVNULL, check=True
     )
-    results = [measure(args.points, args.runs, default=False)]
+    results = [measure(points, args.runs, default=False) for points in args.points]
     if args.default:
-        results.append(measure(args.points, args.runs, default=True))
-    dask = dask_against_threads(args.points, args.runs) if args.dask else None
+        results.append(measure(args.default_points or args.points[0], args.runs, default=True))
+    dask = dask_against_threads(args.points[0], args.runs) if args.dask else None
     machine = machine_info()
     machine["load_average"] = [load_start, loadavg()]
     machine["imports"] = imports

@@ -46,7 +46,7 @@ PARTS: dict[str, tuple[str, list[str], list[str]]] = {
     "curves": ("bench_curves.py", [], []),
     "scaling": (
         "bench_scaling.py",
-        ["--points", "8000", "--dask"],
+        ["--points", "8000", "32000", "--default", "--default-points", "8000", "--dask"],
         ["--points", "1000", "--runs", "2", "--dask"],
     ),
 }
