@@ -239,10 +239,11 @@ def test_an_orbit_closing_in_on_a_shorter_period_is_not_an_attractor_of_its_own(
     initial states on their way to it repeated with period 2 to 7e-8 (settled, by the 1e-7 of the
     check for an orbit slow to settle) and with period 1 to 1e-6 only: a period-2 "attractor".
     Their period-1 differences shrink over the samples: they are run on, and at the last look they
-    are given the period they close in on where they are within a match of it.  (With damping
-    0.03125, a multiplier near -0.97, some are still 3e-5 from it after 400 periods, and a period-2
-    attractor is still reported: left, see the session note.)"""
+    are given the period they close in on where they are within a match of it.  With damping
+    0.03125 (a multiplier near -0.97) some were still 3e-5 from it after 400 periods, beyond a match,
+    and a period-2 attractor was reported: such end states are run on (BASIN_CLOSING_ROUNDS)."""
     only_period_one(5, 1600, damping=0.0625, stiffness=1.1875, omega=2.375, restitution=0.5)
+    only_period_one(5, 3200, damping=0.03125, stiffness=1.1875, omega=2.375, restitution=0.5)
 
 
 def test_an_orbit_slow_to_settle_is_not_split_into_spurious_periods():

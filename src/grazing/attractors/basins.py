@@ -28,6 +28,7 @@ from grazing.attractors.grid import StateGrid, as_states, beyond_stops, default_
 from grazing.core.model import HybridModel
 from grazing.core.options import (
     BASIN_ADAPTIVE_TOL,
+    BASIN_CLOSING_ROUNDS,
     ESCAPE_FACTOR,
     BasinSettings,
     refuse_unknown,
@@ -185,10 +186,10 @@ def find_attractors(
     if valid.size:
         run = _Run(workers, client, store, progress)
         spec = basin_spec(model, x[valid], s, s.lyapunov and s.refine == 0)
-        deferred = _run(spec, valid, catalogue, s.refine > 0, run, x.shape[0] - valid.size, x.shape[0])
-        for n in range(s.refine):
-            last = n == s.refine - 1
-            deferred = _refine(model, catalogue, deferred, s, last, replace(run, store=None, progress=None))
+        looks = _looks(s.refine)
+        deferred = _run(spec, valid, catalogue, looks[0], run, x.shape[0] - valid.size, x.shape[0])
+        for look in looks[1:]:
+            deferred = _refine(model, catalogue, deferred, s, look, replace(run, store=None, progress=None))
         if s.lyapunov:
             _orbit_exponents(model, catalogue, s, workers, client)
     attractors, labels = catalogue.attractors(int(invalid.sum()))
@@ -211,6 +212,32 @@ def _orbit_exponents(model: HybridModel, catalogue: Catalogue, s: BasinSettings,
         catalogue.entries[k].exponents = [float(value)]
 
 
+@dataclass(frozen=True)
+class _Look:
+    """How the end states of one run are classified (:meth:`Catalogue.add`): ``defer`` the aperiodic and
+    unsettled ones (to run them on), or label them; at a last look, ``hold`` those still closing in on a
+    shorter period beyond a match of it (to run them on)."""
+
+    defer: bool
+    hold: bool = False
+
+
+def _looks(refine: int) -> list[_Look]:
+    """The runs of an initial state, at most: the first, ``refine`` runs on, then up to
+    :data:`~grazing.core.options.BASIN_CLOSING_ROUNDS` for the end states closing in on a shorter
+    period (none without ``refine``: a run on was not asked for).
+
+    Examples
+    --------
+    >>> [(look.defer, look.hold) for look in _looks(1)][:3], len(_looks(1)), _looks(0)
+    ([(True, False), (False, True), (False, True)], 6, [_Look(defer=False, hold=False)])
+    """
+    if refine == 0:
+        return [_Look(defer=False)]
+    closing = [_Look(defer=False, hold=n < BASIN_CLOSING_ROUNDS) for n in range(1, BASIN_CLOSING_ROUNDS + 1)]
+    return [*([_Look(defer=True)] * refine), _Look(defer=False, hold=True), *closing]
+
+
 @dataclass
 class _Deferred:
     """Initial states (their indices) whose end state was aperiodic, and those end states."""
@@ -222,9 +249,9 @@ class _Deferred:
 class _InOrder:
     """Classifies the chunks of a spec in their order, as they arrive (or are read from the store)."""
 
-    def __init__(self, spec: SweepSpec, which: np.ndarray, catalogue: Catalogue, defer: bool, store: Any,
+    def __init__(self, spec: SweepSpec, which: np.ndarray, catalogue: Catalogue, look: _Look, store: Any,
                  done: set[int]) -> None:  # fmt: skip
-        self.spec, self.which, self.catalogue, self.defer = spec, which, catalogue, defer
+        self.spec, self.which, self.catalogue, self.look = spec, which, catalogue, look
         self.store, self.done = store, done
         self.pending: dict[int, ChunkResult] = {}
         self.next = 0
@@ -240,7 +267,8 @@ class _InOrder:
             i = self.next
             part = self.pending.pop(i) if i in self.pending else self.store.read_chunk(i)
             sl = self.spec.chunk(i)
-            later = self.catalogue.add(0, part, which=self.which[sl], defer=self.defer)
+            look = self.look
+            later = self.catalogue.add(0, part, which=self.which[sl], defer=look.defer, hold=look.hold)
             if later.size:
                 self.index.append(self.which[sl][later])
                 self.states.append(np.asarray(part.x_final, dtype=float)[later])
@@ -255,7 +283,7 @@ class _InOrder:
         )
 
 
-def _run(spec: SweepSpec, which: np.ndarray, catalogue: Catalogue, defer: bool, run: _Run, offset: int,
+def _run(spec: SweepSpec, which: np.ndarray, catalogue: Catalogue, look: _Look, run: _Run, offset: int,
          total: int) -> _Deferred:  # fmt: skip
     """Run (or read from the store) every chunk of ``spec`` and classify them (initial states ``which``)."""
     from grazing.sweeps.executor import chunk_results
@@ -264,11 +292,11 @@ def _run(spec: SweepSpec, which: np.ndarray, catalogue: Catalogue, defer: bool, 
         from grazing.sweeps.store import open_store
 
         with open_store(run.store, spec) as opened:
-            return _run(spec, which, catalogue, defer, replace(run, store=opened), offset, total)
+            return _run(spec, which, catalogue, look, replace(run, store=opened), offset, total)
     store = run.store
     done = {i for i in range(spec.n_chunks) if store is not None and store.is_done(i)}
     todo = [i for i in range(spec.n_chunks) if i not in done]
-    order = _InOrder(spec, which, catalogue, defer, store, done)
+    order = _InOrder(spec, which, catalogue, look, store, done)
     order.take()
     if run.progress is not None:
         run.progress(offset + order.counted, total)
@@ -286,13 +314,13 @@ def _run(spec: SweepSpec, which: np.ndarray, catalogue: Catalogue, defer: bool, 
     return order.deferred()
 
 
-def _refine(model: HybridModel, catalogue: Catalogue, deferred: _Deferred, s: BasinSettings, last: bool,
+def _refine(model: HybridModel, catalogue: Catalogue, deferred: _Deferred, s: BasinSettings, look: _Look,
             run: _Run) -> _Deferred:  # fmt: skip
     """Run the deferred end states on for another transient, from where they ended; classify them."""
     if deferred.index.size == 0:
         return deferred
-    spec = basin_spec(model, deferred.states, s, s.lyapunov and last)
-    return _run(spec, deferred.index, catalogue, not last, run, 0, 0)
+    spec = basin_spec(model, deferred.states, s, s.lyapunov and not look.defer)
+    return _run(spec, deferred.index, catalogue, look, run, 0, 0)
 
 
 def basins(

@@ -209,7 +209,12 @@ class Catalogue:
     # ------------------------------------------------------------------ adding end states
 
     def add(
-        self, first: int, res: ChunkResult, which: np.ndarray | None = None, defer: bool = False
+        self,
+        first: int,
+        res: ChunkResult,
+        which: np.ndarray | None = None,
+        defer: bool = False,
+        hold: bool = False,
     ) -> np.ndarray:
         """Classify the end states of ``res`` (initial states ``first + k``, or ``which[k]``) and label them.
 
@@ -220,6 +225,10 @@ class Catalogue:
         an orbit slow to converge, sampled on its way, repeats to the period
         detector's tolerance with a spurious period (a period-1 orbit whose
         samples spiral in looked like period 7, 2 or 9 after 200 periods).
+        Without ``defer`` (the last look), an end state closing in on a shorter
+        period (:func:`closing_period`) within a match of it has that period;
+        beyond a match, with ``hold``, it is not labelled either but returned
+        to be run on (else it keeps the period it repeats with).
         """
         index = first + np.arange(res.status.size) if which is None else np.asarray(which)
         status = np.asarray(res.status, dtype=int)
@@ -244,12 +253,14 @@ class Catalogue:
                 d, off = closing_period(samples[k], int(period[k]))
                 if off <= MATCH_TOL * float(np.min(self.cell)):
                     period[k] = d
+                elif hold:  # (beyond a match of it: run on)
+                    slow[k] = True
         self._add_periodic(index, res, period, np.flatnonzero(settled & (period > 0) & ~slow))
         aperiodic = np.flatnonzero(settled & (period <= 0))
         if defer:
             return np.union1d(aperiodic, np.flatnonzero(slow))
         self._add_aperiodic(index, res, aperiodic)
-        return np.zeros(0, dtype=np.int64)
+        return np.flatnonzero(slow)
 
     def _outcome_label(self, i: int, family: str, why: str) -> None:
         key = (family, why)

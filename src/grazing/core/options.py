@@ -119,6 +119,12 @@ BASIN_REFINE = 1
 """Times an initial state whose end state is aperiodic is run on for another transient before it is
 classified (a chaotic transient, or one slow to settle, then ends on its attractor)."""
 
+BASIN_CLOSING_ROUNDS = 4
+"""Times, after the ``refine`` runs, an end state still closing in on a shorter period than the one it
+repeats with (a period-1 orbit with a multiplier near -1 looks period-2 long before it is period 1),
+yet beyond a match of it, is run on for another transient before it is classified (then, still so,
+it keeps the period it repeats with)."""
+
 ESCAPE_FACTOR = 1e6
 """A state farther than this many times the grid box's extent from the box has escaped."""
 
