@@ -164,3 +164,24 @@ def test_impact_oscillator_continuation_in_omega_through_the_fold():
     for value, o in zip(branch.values[::20], branch.orbits[::20]):
         t_imp = o.impact_times[0] % (2 * math.pi / value)
         np.testing.assert_allclose(residual(o.impact_speeds[0], value, t_imp * value), 0.0, atol=1e-10)
+
+
+def test_an_orbit_that_is_not_isolated_is_refused_and_one_that_is_continues():
+    """The undamped oscillator forced at omega = 2.8 = 14/5: 14 forcing periods are 5 of its own
+    (14 T = 10 pi), so its period-14 map is the identity (every state is periodic) and no branch
+    goes through such an orbit: refused in one line (it stalled at 5 points among hundreds of
+    branch points before).  Its period-1 orbit (M: a rotation by T = 2 pi / 2.8, not the identity)
+    is isolated and is followed through omega = 2.8 with the closed-form multipliers."""
+    m = impact_oscillator(zeta=0.0, omega=2.8, sigma=2.0, r=REST)
+    every = find_orbit(m, period=14, virtual=True)
+    np.testing.assert_allclose(every.monodromy, np.eye(2), atol=1e-9)  # (P^14 = I: the closed form)
+    with pytest.raises(grazing.ConvergenceError, match="period-14 orbit is not isolated"):
+        continue_orbit(m, "omega", 2.8, 2.9, orbit=every)
+    branch = continue_orbit(m, "omega", 2.7, 2.9, period=1, virtual=True)
+    assert branch.status.startswith("reached") and branch.period == 1
+    assert min(branch.values) <= 2.7 + 1e-12 and max(branch.values) >= 2.9 - 1e-12
+    assert not [s for s in branch.special if s.kind != "grazing"]
+    for w, orbit in zip(branch.values, branch.orbits):
+        T = 2 * math.pi / w
+        expected = np.exp(1j * T * np.array([1, -1]))
+        np.testing.assert_allclose(np.sort_complex(orbit.multipliers), np.sort_complex(expected), atol=1e-9)

@@ -51,6 +51,12 @@ UNIT_CIRCLE_TOL = 1e-9
 multipliers of an area-preserving map (a conservative model: no damping, elastic impacts) lie on the
 circle up to rounding (measured: 2e-16), which would make such an orbit stable or unstable by chance."""
 
+NOT_ISOLATED_TOL = 1e-8
+"""A periodic orbit is not isolated where its monodromy matrix ``M`` keeps two or more directions:
+``M - I`` has two or more singular values below this (relative to ``1 + |M|``).  Every state near it
+is then periodic too (the undamped linear oscillator forced at a rational multiple of its own
+frequency: ``M = I``), and no curve of orbits through it can be followed."""
+
 NEWTON_MAX_ITER = 30
 """Periodic orbits: the largest number of Newton iterations."""
 

@@ -84,6 +84,7 @@ from grazing.orbits.shooting import (
     SECTION_MARGIN,
     PeriodicOrbit,
     find_orbit,
+    kept_directions,
     move_section,
     quiet_section,
 )
@@ -510,6 +511,12 @@ class _Continuation:
             u0 = np.append(orbit.state, orbit.model.params[self.param])
             try:
                 F, DF, orb = evaluate(u0)
+                kept = kept_directions(orb.monodromy)
+                if kept >= 2:
+                    raise ConvergenceError(
+                        f"the period-{n} orbit is not isolated (its monodromy keeps {kept} directions: every "
+                        "state near it is periodic too), so no branch of orbits goes through it"
+                    )
             except GrazingError as exc:
                 if seg == 0 and prev is None:
                     raise ConvergenceError(f"cannot start the continuation: {exc}") from None

@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from grazing.core.model import HybridModel
-from grazing.core.options import NEWTON_MAX_ITER, NEWTON_TOL, UNIT_CIRCLE_TOL
+from grazing.core.options import NEWTON_MAX_ITER, NEWTON_TOL, NOT_ISOLATED_TOL, UNIT_CIRCLE_TOL
 from grazing.core.period import detect_period
 from grazing.core.solution import Solution
 from grazing.engine.simulate import simulate
@@ -47,6 +47,20 @@ def unstable_count(multipliers: np.ndarray) -> int:
     (1, 0)
     """
     return int(np.sum(np.abs(multipliers) > 1.0 + UNIT_CIRCLE_TOL))
+
+
+def kept_directions(monodromy: np.ndarray) -> int:
+    """How many directions the monodromy matrix ``M`` keeps: the singular values of ``M - I`` below
+    ``core.options.NOT_ISOLATED_TOL`` (relative to ``1 + |M|``).  Two or more: the orbit is not isolated.
+
+    Examples
+    --------
+    >>> kept_directions(np.eye(2)), kept_directions(np.diag([1.0, 0.5])), kept_directions(np.diag([0.3, 0.5]))
+    (2, 1, 0)
+    """
+    m = np.asarray(monodromy, dtype=float)
+    sv = np.linalg.svd(m - np.eye(m.shape[0]), compute_uv=False)
+    return int(np.sum(sv <= NOT_ISOLATED_TOL * (1.0 + np.linalg.norm(m, 2))))
 
 
 @dataclass(frozen=True)
