@@ -25,6 +25,7 @@ LAYERS = {
     "grazing.outputs": 0,
     "grazing.plot_areas": 0,
     "grazing.parallel": 0,
+    "grazing.clib": 0,
     "grazing.core": 1,
     "grazing.models": 2,
     "grazing.engine": 3,
