@@ -36,6 +36,7 @@ INTERNAL = {
     "grazing.cli": "the command line, documented by `grazing --help` and the README",
     "grazing.atomic": "files written all at once (used by outputs)",
     "grazing.parallel": "the pool of worker processes",
+    "grazing.clib": "the C library, for the calls Python does not offer (used by atomic and parallel)",
     "grazing.plot_areas": "the record of a saved figure's plot areas, read by make check-report",
 }
 """Modules of ``grazing`` left out of the reference, with the reason."""

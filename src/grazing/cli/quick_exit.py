@@ -31,8 +31,11 @@ def others_running() -> bool:
 
     Examples
     --------
-    >>> others_running()
-    False
+    >>> import time
+    >>> worker = threading.Thread(target=time.sleep, args=(0.2,))
+    >>> worker.start(); others_running()
+    True
+    >>> worker.join()
     """
     me = threading.current_thread()
     return any(t is not me and t.is_alive() and not t.daemon for t in threading.enumerate())
