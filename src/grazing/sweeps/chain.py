@@ -233,6 +233,28 @@ class _Round:
     parts: list[Part] = field(default_factory=list)
     jobs: list[tuple[list[_Chunk], str, Any]] = field(default_factory=list)
     claimed: set[tuple[int, int]] = field(default_factory=set)
+    checking: set[tuple[int, int, Any]] = field(default_factory=set)  # (line, index, start) of its checks
+
+    def check(self, c: _Chunk, start: Any) -> None:
+        """Check ``c``'s first point from ``start`` (once a round; unlike :meth:`ask`, ``c`` is not claimed:
+        its own verdict is still asked for in this round)."""
+        if start in c.checks or (c.line, c.index, start) in self.checking:
+            return
+        self.checking.add((c.line, c.index, start))
+        self.parts.append(from_start(self.lines[c.line].spec, c.index, start, 1))
+        self.jobs.append(([c], "check", start))
+
+    def check_after(self, c: _Chunk) -> None:
+        """Check the first point of the chunk after ``c`` from the end of each of ``c``'s candidates (the
+        ends it may go on from, its guess's orbit computed from each of its points): however ``c`` is
+        decided, the chunk after it is decided in the same pass, not a round later (a ripple through a
+        periodic window, each chunk kept at another point of its orbit, took a round a chunk)."""
+        nxt = self.active.get((c.line, c.index + 1))
+        if nxt is None or nxt.guess is None or nxt.settled or c.shifts is None:
+            return
+        spec = self.lines[c.line].spec
+        for r in c.candidates():
+            self.check(nxt, next_start(spec, r, c.index))
 
     def ask(self, c: _Chunk, what: str, start: Any, extend: bool = False) -> None:
         """Check ``c``'s first point from ``start``, run ``c`` from there, or run it from each point of its
@@ -256,10 +278,10 @@ class _Round:
                 self.jobs.append((group, what, shifted))
             return
         if what == "check":
-            self.parts.append(from_start(spec, c.index, start, 1))
-        else:
-            points = spec.chunk(group[-1].index).stop - spec.chunk(c.index).start
-            self.parts.append(from_start(spec, c.index, start, points if len(group) > 1 else None))
+            self.check(c, start)
+            return
+        points = spec.chunk(group[-1].index).stop - spec.chunk(c.index).start
+        self.parts.append(from_start(spec, c.index, start, points if len(group) > 1 else None))
         self.jobs.append((group, what, start))
 
     def take(self, results: Sequence[ChunkResult]) -> None:
@@ -363,6 +385,8 @@ def settle(
                 work.ask(c, what, start)
             elif final or int(c.checks[start].status[0]) == Status.OK:  # (hysteresis: likely to stay so)
                 work.ask(c, "run", start, extend=True)
+            if not final or what not in ("keep", "run"):  # (undecided: which of its candidates it keeps)
+                work.check_after(c)
             ahead = (c.line, c.index - 1) in moving and what != "shift" and not c.shifting
             if ahead and orbit_period(spec, c.guess):  # (the chunk before it moves: its start will too)
                 work.ask(c, "shift", start)
