@@ -422,3 +422,18 @@ def test_a_ripple_through_a_periodic_window_is_decided_at_once():
     assert len(rounds) <= 4
     chain = sweep(M40, "eta", PENDULUM_ETAS[120:200], chunk_size=0, workers=2)
     np.testing.assert_array_equal(ds.period.values, chain.period.values)
+
+
+def test_chunks_run_again_one_after_the_other_are_run_each_alone():
+    # Through chaos down to a periodic window: chunks whose guesses miss the chain's attractor one after the
+    # other.  Each is run again as a part of its own: run on over the next ones as one part (as it was), it
+    # made its round as long as all of them while the other chains' chunks waited.
+    spec = pendulum_through_chaos()
+    log: list = []
+    ds = settled(spec, log)
+    runs = runs_of(spec, log)[3]
+    firsts = {spec.points[spec.chunk(i).start]: i for i in range(spec.n_chunks)}
+    run_again = sorted({firsts[p[0].points[0]] for p, _ in runs})
+    assert any(b == a + 1 for a, b in zip(run_again, run_again[1:]))  # (a cascade: one run after the other)
+    assert all(len(p[0].points) <= spec.chunk_size for p, _ in log if p[0] is not spec)
+    assert_identical(ds, run_sweep(spec, workers=1))
