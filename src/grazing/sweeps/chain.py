@@ -150,6 +150,15 @@ class _Chunk:
     kept: dict[Any, ChunkResult | None] = field(default_factory=dict)  # start -> the candidate kept there
     shifting: bool = False  # (its shifts asked)
     settled: bool = False
+    ends: dict[int, tuple[ChunkResult, ChainStart]] = field(default_factory=dict)  # id -> (result, its end)
+
+    def end(self, spec: SweepSpec, res: ChunkResult) -> ChainStart:
+        """Where the chain goes on after it from ``res`` (:func:`next_start`, worked out once a result: a
+        chunk's end is asked for in every round, and twice more for each candidate whose end is checked)."""
+        known = self.ends.get(id(res))
+        if known is None or known[0] is not res:  # (kept with its result: its id is not another's)
+            known = self.ends[id(res)] = (res, next_start(spec, res, self.index))
+        return known[1]
 
     def candidates(self) -> list[ChunkResult]:
         """The results it may keep where its check ends periodic with its guess's period: the guess, then
@@ -230,7 +239,7 @@ class _Round:
             return
         spec = self.lines[c.line].spec
         for r in c.candidates():
-            self.check(nxt, next_start(spec, r, c.index))
+            self.check(nxt, c.end(spec, r))
 
     def ask(self, c: _Chunk, what: str, start: Any) -> None:
         """Check ``c``'s first point from ``start``, run ``c`` from there, or run it from each point of its
@@ -323,7 +332,7 @@ def settle(
             return True, line.sink.chain_start(c.index - 1)
         if prev.result is None:
             return False, _UNSET
-        return prev.settled, next_start(line.spec, prev.result, prev.index)
+        return prev.settled, prev.end(line.spec, prev.result)
 
     while pending:
         work = _Round(lines, active)
