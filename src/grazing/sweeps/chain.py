@@ -153,8 +153,9 @@ class _Chunk:
     ends: dict[int, tuple[ChunkResult, ChainStart]] = field(default_factory=dict)  # id -> (result, its end)
 
     def end(self, spec: SweepSpec, res: ChunkResult) -> ChainStart:
-        """Where the chain goes on after it from ``res`` (:func:`next_start`, worked out once a result: a
-        chunk's end is asked for in every round, and twice more for each candidate whose end is checked)."""
+        """Where the chain goes on after it from ``res`` (:func:`next_start`), worked out once a result (a
+        chunk's end is asked for in every round, its candidates' ends whenever the chunk after it is
+        checked from them)."""
         known = self.ends.get(id(res))
         if known is None or known[0] is not res:  # (kept with its result: its id is not another's)
             known = self.ends[id(res)] = (res, next_start(spec, res, self.index))
