@@ -379,3 +379,81 @@ def test_a_dask_cluster_settles_the_same_chain_through_chaos():
         remote = run_sweep(spec, client=client)
     np.testing.assert_array_equal(remote.samples.values, local.samples.values)
     np.testing.assert_array_equal(remote.period.values, local.period.values)
+
+
+# issue 29: the rounds after the guesses, checks and shifts are few, the results the same.
+
+
+def settled_by_rounds(spec, monkeypatch=None, **patches):
+    """The dataset of ``spec`` settled (every chunk held at once) and the parts of each round (its calls of
+    compute), with ``_Round``'s methods ``patches`` replaced for the run."""
+    from grazing.sweeps import chain
+
+    with pytest.MonkeyPatch.context() as mp:
+        for name, method in patches.items():
+            mp.setattr(chain._Round, name, method)
+        inner, rounds = compute_parts(2, None), []
+
+        def compute(parts):
+            rounds.append(list(parts))
+            yield from inner(parts)
+
+        sink = MemoryStore(spec)
+        settle([ChainLine(spec, sink, list(range(spec.n_chunks)))], compute, lambda _k, res: sink.write(res),
+               window=1 << 40)  # fmt: skip
+    return sink.dataset(), rounds
+
+
+def assert_identical(a, b) -> None:
+    for name in a.data_vars:
+        assert np.array_equal(a[name].values, b[name].values, equal_nan=True), name
+
+
+def test_a_ripple_through_a_periodic_window_is_decided_at_once():
+    # A period-2 window in chunks of 4: each guess (from rest) ends at either point of the orbit, so a chunk
+    # kept at the other point moves the start of the chunk after it, which is kept shifted too, and so on.
+    # The chunk after a chunk with shifts is checked from the end of each of its candidates: the whole
+    # ripple is decided in one round (it took a round a chunk: 13 rounds here).
+    spec = chunked_spec(M40, "eta", PENDULUM_ETAS[120:200], 4)
+    ds, rounds = settled_by_rounds(spec)
+    one_by_one, before = settled_by_rounds(spec, check_after=lambda self, c: None)
+    assert_identical(ds, one_by_one)
+    assert len(before) >= 3 + spec.n_chunks // 3  # (guesses, checks, shifts, then a round a chunk)
+    assert len(rounds) <= 4
+    chain = sweep(M40, "eta", PENDULUM_ETAS[120:200], chunk_size=0, workers=2)
+    np.testing.assert_array_equal(ds.period.values, chain.period.values)
+
+
+def test_chunks_run_again_one_after_the_other_are_run_each_alone():
+    # Through chaos down to a periodic window: chunks whose guesses miss the chain's attractor one after the
+    # other.  Each is run again as a part of its own: run on over the next ones as one part (as it was), it
+    # made its round as long as all of them while the other chains' chunks waited.
+    spec = pendulum_through_chaos()
+    log: list = []
+    ds = settled(spec, log)
+    runs = runs_of(spec, log)[3]
+    firsts = {spec.points[spec.chunk(i).start]: i for i in range(spec.n_chunks)}
+    run_again = {firsts[p[0].points[0]] for p, _ in runs}
+    assert any(i + 1 in run_again for i in run_again)  # (a cascade: one run after the other)
+    assert all(len(p[0].points) <= spec.chunk_size for p, _ in log if p[0] is not spec)
+    assert_identical(ds, run_sweep(spec, workers=1))
+
+
+def test_the_end_of_each_result_is_worked_out_once(monkeypatch):
+    # (a chunk's end, asked for in every round and for each candidate whose end is checked, was worked out
+    # each time: 17629 times for the default 16000-point sweep's 1000-odd results, a part of its serial time)
+    from grazing.sweeps import chain
+
+    calls: list = []
+    inner = chain.next_start
+
+    def counted_next_start(spec, res, index):
+        calls.append(id(res))
+        return inner(spec, res, index)
+
+    monkeypatch.setattr(chain, "next_start", counted_next_start)
+    spec = chunked_spec(M40, "eta", PENDULUM_ETAS[120:200], 4)
+    log: list = []
+    settled(spec, log)
+    results = [r for p, r in log if p[0] is spec or len(p[0].points) > 1]  # (guesses, shifts and runs)
+    assert len(calls) == len(set(calls)) <= len(results)
