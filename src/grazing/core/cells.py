@@ -59,15 +59,27 @@ def group_by_cells(
     from scipy.sparse.csgraph import connected_components
 
     points = np.asarray(points, dtype=float)
-    n = points.shape[1]
-    q = np.floor((points - origin) / cell).astype(np.int64)
-    keys = np.ascontiguousarray(q).view(np.dtype((np.void, 8 * n))).ravel()
+    keys = cell_keys(points, origin, cell)
     ukeys, cell_of = np.unique(keys, return_inverse=True)
     cell_of = cell_of.ravel()
     size = n_sets + ukeys.size
     graph = coo_matrix((np.ones(points.shape[0]), (np.asarray(owner), n_sets + cell_of)), shape=(size, size))
     _, comp = connected_components(graph, directed=False)
     return CellGroups(ukeys, cell_of, comp[:n_sets])
+
+
+def cell_keys(points: np.ndarray, origin: np.ndarray, cell: np.ndarray) -> np.ndarray:
+    """The key of the cell each point (row) of ``points`` falls in, on the grid of boxes of size ``cell`` with
+    a corner at ``origin``: the bytes of its integer coordinates (one value per point, comparable).
+
+    Examples
+    --------
+    >>> k = cell_keys(np.array([[0.1, 0.1], [0.9, 0.2], [1.1, 0.1]]), np.zeros(2), np.ones(2))
+    >>> bool(k[0] == k[1]), bool(k[0] == k[2])
+    (True, False)
+    """
+    q = np.floor((np.asarray(points, dtype=float) - origin) / cell).astype(np.int64)
+    return np.ascontiguousarray(q).view(np.dtype((np.void, 8 * q.shape[1]))).ravel()
 
 
 def box_cell(points: np.ndarray, cells: int) -> np.ndarray:
@@ -100,6 +112,5 @@ def one_attractor(a: np.ndarray, b: np.ndarray, cells: int) -> bool:
     if a.size == 0 or b.size == 0 or not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
         return False
     points = np.concatenate([a, b])
-    owner = np.repeat([0, 1], [a.shape[0], b.shape[0]])
-    groups = group_by_cells(points, owner, 2, points.min(axis=0), box_cell(points, cells))
-    return bool(groups.group[0] == groups.group[1])
+    keys = cell_keys(points, points.min(axis=0), box_cell(points, cells))
+    return bool(np.intersect1d(keys[: a.shape[0]], keys[a.shape[0] :]).size)  # (two sets: one shared cell)
