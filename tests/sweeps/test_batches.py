@@ -73,3 +73,37 @@ def test_a_batch_that_cannot_be_built_stops_the_threads():
         list(stream_batches(makers, 2))
     alive = [t.name for t in threading.enumerate() if t.name.startswith(("grazing-sweep", "grazing-batch"))]
     assert alive == []
+
+
+@pytest.mark.parametrize("fresh", [True, False])
+def test_the_dataset_is_prepared_while_the_cores_compute(fresh, monkeypatch):
+    """issue 29: what a sweep's dataset needs besides its results (xarray, the dask it asks about, the
+    stops' levels: about 1 s of a process's first sweep) is done once the first chunk is in, while the
+    other chunks compute (a fresh sweep: after its first chunk is written; a chain: in its first
+    round, before any chunk is settled), not after the last one; the dataset is the same."""
+    from grazing.sweeps.api import run_sweep
+    from grazing.sweeps.store import MemoryStore, _stop_levels
+
+    settings = SweepSettings(fresh=fresh, chunk_size=8, transient=50, periods=16)
+    spec = sweep_spec(impact_oscillator(), "omega", np.linspace(2.5, 3.0, 240), settings=settings)
+    written: list[int] = []
+    prepared_after: list[int] = []
+    write, prepare = MemoryStore.write, MemoryStore.prepare
+
+    def counted_write(store, res):
+        written.append(res.index)
+        write(store, res)
+
+    def counted_prepare(store):
+        prepared_after.append(len(written))
+        prepare(store)
+
+    monkeypatch.setattr(MemoryStore, "write", counted_write)
+    monkeypatch.setattr(MemoryStore, "prepare", counted_prepare)
+    ds = run_sweep(spec, workers=2)
+    assert prepared_after[0] == (1 if fresh else 0) and len(written) == spec.n_chunks
+    np.testing.assert_array_equal(ds.stop_level.values, _stop_levels(spec))  # (as built without preparing)
+    assert np.all(ds.stop_level.values[:, 0] == impact_oscillator().stop_level(0))
+    if fresh:
+        alone = run_chunks(spec, range(spec.n_chunks))
+        np.testing.assert_array_equal(ds.period.values, np.concatenate([r.period for r in alone]))

@@ -10,14 +10,14 @@ same sweep computes only the chunks that are missing.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
 from grazing.core.model import HybridModel
 from grazing.core.options import SweepSettings, refuse_unknown, with_shorthands
 from grazing.errors import InvalidParameterError
-from grazing.sweeps.chain import ChainLine, settle
+from grazing.sweeps.chain import ChainLine, Compute, Part, settle
 from grazing.sweeps.executor import (
     DASK_NOTICE_AFTER,
     chain_window,
@@ -25,7 +25,7 @@ from grazing.sweeps.executor import (
     compute_parts,
     local_results,
 )
-from grazing.sweeps.spec import DiscontinuityMapLike, SweepSpec, map_spec, sweep_spec
+from grazing.sweeps.spec import ChunkResult, DiscontinuityMapLike, SweepSpec, map_spec, sweep_spec
 
 __all__ = ["DASK_NOTICE_AFTER", "parameter_map", "run_sweep", "run_sweeps", "sweep"]
 
@@ -97,12 +97,15 @@ def run_sweep(
                 progress(counted[0], spec.n_points)
 
         window = chain_window(workers, memory=isinstance(sink, MemoryStore) and client is None)
-        settle([ChainLine(spec, sink, todo)], compute_parts(workers, client, timeout, notice), write, window)
+        compute = preparing(compute_parts(workers, client, timeout, notice), sink if load else None)
+        settle([ChainLine(spec, sink, todo)], compute, write, window)
         return sink.dataset() if load else None
     results = chunk_results(spec, todo, workers, client, timeout, notice)
     try:
-        for res in results:
+        for k, res in enumerate(results):
             sink.write(res)
+            if k == 0 and load and isinstance(sink, MemoryStore):
+                sink.prepare()  # (while the cores compute the other chunks; only for a dataset asked for)
             done_points += res.period.size
             if progress is not None:
                 progress(done_points, spec.n_points)
@@ -143,6 +146,25 @@ def run_sweeps(specs: Sequence[SweepSpec], *, workers: int | None = None) -> lis
         write = lambda k, res: lines[k].sink.write(res)  # noqa: E731
         settle(lines, compute_parts(workers, None), write, chain_window(0, True))
     return [sinks[id(spec)].dataset() for spec in specs]
+
+
+def preparing(compute: Compute, sink: Any) -> Compute:
+    """``compute``, which prepares the dataset of a :class:`~grazing.sweeps.store.MemoryStore` ``sink``
+    (:meth:`~grazing.sweeps.store.MemoryStore.prepare`; None: no dataset is asked for) once its first
+    result is in, while the cores compute the others (a chain's first round: every chunk from its
+    guess)."""
+    from grazing.sweeps.store import MemoryStore
+
+    if not isinstance(sink, MemoryStore):
+        return compute
+
+    def run(parts: list[Part]) -> Iterator[tuple[Part, ChunkResult]]:
+        for k, item in enumerate(compute(parts)):
+            yield item
+            if k == 0:
+                sink.prepare()
+
+    return run
 
 
 def is_chained(spec: SweepSpec) -> bool:

@@ -127,8 +127,13 @@ def impacts_per_period(spec: SweepSpec, arrays: dict[str, np.ndarray]) -> tuple[
     return ipp, ipp_stop
 
 
-def build_dataset(spec: SweepSpec, arrays: dict[str, np.ndarray], attrs: dict[str, Any] | None = None) -> Any:
-    """The xarray Dataset of a sweep from its flat per-point arrays."""
+def build_dataset(
+    spec: SweepSpec,
+    arrays: dict[str, np.ndarray],
+    attrs: dict[str, Any] | None = None,
+    levels: np.ndarray | None = None,
+) -> Any:
+    """The xarray Dataset of a sweep from its flat per-point arrays (``levels``: its stop levels if known)."""
     import xarray as xr
 
     pts = np.asarray(spec.points, dtype=float)
@@ -157,7 +162,7 @@ def build_dataset(spec: SweepSpec, arrays: dict[str, np.ndarray], attrs: dict[st
         coords[name] = ("point", pts[:, j])
     if len(spec.params) == 1:
         coords["value"] = ("point", pts[:, 0])
-    data["stop_level"] = (("point", "component"), _stop_levels(spec))
+    data["stop_level"] = (("point", "component"), _stop_levels(spec) if levels is None else levels)
     ds = xr.Dataset(data, coords=coords)
     ds["stop_level"].attrs["description"] = (
         "the state component's value on the stop, where the guard depends on that component alone (else nan)"
@@ -245,6 +250,7 @@ class MemoryStore:
         self.done = np.zeros(spec.n_chunks, dtype=bool)
         self.end_time = np.full(spec.n_chunks, np.nan)
         self.attrs = attrs or {}
+        self._levels: np.ndarray | None = None  # (the stop levels, once prepared)
 
     @property
     def arrays(self) -> dict[str, np.ndarray]:
@@ -274,8 +280,21 @@ class MemoryStore:
         x, status = self.arrays["x_final"][last], int(self.arrays["status"][last])
         return start_after(self.spec, i, status, x, float(self.end_time[i]))
 
+    def prepare(self) -> None:
+        """Do, once, what :meth:`dataset` needs that the results do not: import xarray and make its first
+        array (xarray then imports dask.array, to ask whether an array is one), and find the stops' levels
+        (for a built-in model, importing sympy).  :func:`~grazing.sweeps.api.run_sweep` calls it once the
+        first chunk is in, while the cores compute the others: done after the last one, it was about 1 s
+        of a process's first sweep in which the cores waited (issue 29)."""
+        if self._levels is not None:
+            return
+        import xarray as xr
+
+        xr.Variable(("point",), np.zeros(1))
+        self._levels = _stop_levels(self.spec)
+
     def dataset(self) -> Any:
-        return build_dataset(self.spec, self.arrays, self.attrs)
+        return build_dataset(self.spec, self.arrays, self.attrs, self._levels)
 
 
 class ZarrStore:
