@@ -234,8 +234,8 @@ def _looks(refine: int) -> list[_Look]:
     """
     if refine == 0:
         return [_Look(defer=False)]
-    closing = [_Look(defer=False, hold=n < BASIN_CLOSING_ROUNDS) for n in range(1, BASIN_CLOSING_ROUNDS + 1)]
-    return [*([_Look(defer=True)] * refine), _Look(defer=False, hold=True), *closing]
+    held = [_Look(defer=False, hold=True)] * BASIN_CLOSING_ROUNDS  # (the last run on, then all but one)
+    return [*([_Look(defer=True)] * refine), *held, _Look(defer=False)]
 
 
 @dataclass

@@ -10,14 +10,14 @@ same sweep computes only the chunks that are missing.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 from grazing.core.model import HybridModel
 from grazing.core.options import SweepSettings, refuse_unknown, with_shorthands
 from grazing.errors import InvalidParameterError
-from grazing.sweeps.chain import ChainLine, Compute, Part, settle
+from grazing.sweeps.chain import ChainLine, settle
 from grazing.sweeps.executor import (
     DASK_NOTICE_AFTER,
     chain_window,
@@ -25,9 +25,11 @@ from grazing.sweeps.executor import (
     compute_parts,
     local_results,
 )
-from grazing.sweeps.spec import ChunkResult, DiscontinuityMapLike, SweepSpec, map_spec, sweep_spec
+from grazing.sweeps.spec import DiscontinuityMapLike, SweepSpec, map_spec, sweep_spec
 
 __all__ = ["DASK_NOTICE_AFTER", "parameter_map", "run_sweep", "run_sweeps", "sweep"]
+
+T = TypeVar("T")
 
 
 def run_sweep(
@@ -87,6 +89,8 @@ def run_sweep(
     done_points = spec.n_points - sum(spec.chunk(i).stop - spec.chunk(i).start for i in todo)
     if progress is not None:
         progress(done_points, spec.n_points)
+    # (what the dataset needs besides the results, done while the cores compute: MemoryStore.prepare)
+    prepare = sink.prepare if load and isinstance(sink, MemoryStore) else None
     if is_chained(spec):  # (the chunks of a chain: settled into the one chain's results)
         counted = [done_points]
 
@@ -97,15 +101,13 @@ def run_sweep(
                 progress(counted[0], spec.n_points)
 
         window = chain_window(workers, memory=isinstance(sink, MemoryStore) and client is None)
-        compute = preparing(compute_parts(workers, client, timeout, notice), sink if load else None)
-        settle([ChainLine(spec, sink, todo)], compute, write, window)
+        compute = compute_parts(workers, client, timeout, notice)
+        settle([ChainLine(spec, sink, todo)], lambda parts: then(compute(parts), prepare), write, window)
         return sink.dataset() if load else None
     results = chunk_results(spec, todo, workers, client, timeout, notice)
     try:
-        for k, res in enumerate(results):
+        for res in then(results, prepare):
             sink.write(res)
-            if k == 0 and load and isinstance(sink, MemoryStore):
-                sink.prepare()  # (while the cores compute the other chunks; only for a dataset asked for)
             done_points += res.period.size
             if progress is not None:
                 progress(done_points, spec.n_points)
@@ -148,23 +150,21 @@ def run_sweeps(specs: Sequence[SweepSpec], *, workers: int | None = None) -> lis
     return [sinks[id(spec)].dataset() for spec in specs]
 
 
-def preparing(compute: Compute, sink: Any) -> Compute:
-    """``compute``, which prepares the dataset of a :class:`~grazing.sweeps.store.MemoryStore` ``sink``
-    (:meth:`~grazing.sweeps.store.MemoryStore.prepare`; None: no dataset is asked for) once its first
-    result is in, while the cores compute the others (a chain's first round: every chunk from its
-    guess)."""
-    from grazing.sweeps.store import MemoryStore
+def then(items: Iterable[T], action: Callable[[], None] | None) -> Iterator[T]:
+    """``items``, with ``action`` done once, when the first has been dealt with (before the second is asked
+    for): a sweep's dataset is prepared once its first chunk is in, while the cores compute the others
+    (a chain's first round: every chunk from its guess).
 
-    if not isinstance(sink, MemoryStore):
-        return compute
-
-    def run(parts: list[Part]) -> Iterator[tuple[Part, ChunkResult]]:
-        for k, item in enumerate(compute(parts)):
-            yield item
-            if k == 0:
-                sink.prepare()
-
-    return run
+    Examples
+    --------
+    >>> done = []
+    >>> [(k, list(done)) for k in then(range(3), lambda: done.append("prepared"))]
+    [(0, []), (1, ['prepared']), (2, ['prepared'])]
+    """
+    for k, item in enumerate(items):
+        yield item
+        if k == 0 and action is not None:
+            action()
 
 
 def is_chained(spec: SweepSpec) -> bool:
