@@ -14,7 +14,15 @@ import importlib
 import click
 
 import grazing
-from grazing.cli.common import EXIT_FAILURE, EXIT_INTERRUPTED, EXIT_USAGE, error_line
+from grazing.cli.common import (
+    EXIT_CLOSED_PIPE,
+    EXIT_FAILURE,
+    EXIT_INTERRUPTED,
+    EXIT_USAGE,
+    discard_output,
+    error_line,
+    output_closed,
+)
 from grazing.cli.limits import MEMORY_ENV
 from grazing.errors import GrazingError
 
@@ -89,6 +97,10 @@ def interrupted_line() -> None:
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI; every error becomes one line on stderr and an exit status.
 
+    Output to a pipe whose reader has gone (``grazing sweep --json | head``)
+    ends the command without a message, with status 141
+    (:data:`~grazing.cli.common.EXIT_CLOSED_PIPE`), as a Unix tool ends.
+
     Without arguments it prints the help, as ``grazing --help`` does.
     """
     import sys
@@ -108,6 +120,12 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_USAGE
     except GrazingError as exc:
         error_line(str(exc))
+        return EXIT_FAILURE
+    except BrokenPipeError as exc:
+        if output_closed():  # (``grazing sweep --json | head``: the reader has what it wanted)
+            discard_output()
+            return EXIT_CLOSED_PIPE
+        error_line(f"{exc.strerror or exc}: {exc.filename or ''}".rstrip(": "))
         return EXIT_FAILURE
     except OSError as exc:
         error_line(f"{exc.strerror or exc}: {exc.filename or ''}".rstrip(": "))

@@ -13,9 +13,11 @@ given.
 from __future__ import annotations
 
 import dataclasses
+import errno
 import functools
 import json
 import math
+import os
 import sys
 import time
 from collections.abc import Callable
@@ -43,6 +45,9 @@ PENDULUM_UNFOLDING = ("eta", "theta_hat")
 EXIT_USAGE = 2
 EXIT_FAILURE = 1
 EXIT_INTERRUPTED = 130
+EXIT_CLOSED_PIPE = 141
+"""A command whose output's reader went away (``grazing sweep --json | head``): 128 + SIGPIPE, the status
+of a Unix tool ended by that signal, and no message (nothing failed that the user asked for)."""
 
 
 InputError = InputError
@@ -617,6 +622,55 @@ def save_dataset(ds: Any, out: Path, overwrite: bool = False) -> None:
     from grazing.outputs import write_netcdf
 
     write_netcdf(out, ds, overwrite=overwrite, hint=OVERWRITE_HINT)
+
+
+def output_closed(fd: int = 1) -> bool:
+    """Whether the reader of the pipe ``fd`` writes to has gone (``poll`` reports an error on it).
+
+    Examples
+    --------
+    >>> import os
+    >>> r, w = os.pipe()
+    >>> output_closed(w)
+    False
+    >>> os.close(r); output_closed(w)
+    True
+    >>> os.close(w)
+    """
+    import select
+
+    if not hasattr(select, "poll"):  # pragma: no cover - not on Linux or macOS
+        return False
+    poller = select.poll()
+    poller.register(fd, 0)  # (no events asked: errors and hang-ups are reported anyway)
+    return any(event & (select.POLLERR | select.POLLHUP | select.POLLNVAL) for _, event in poller.poll(0))
+
+
+def discard_output() -> None:
+    """Send what is left of the standard output to ``/dev/null``: its reader has gone, and the flush at the
+    process's end must not fail again (Python would print an "Exception ignored" message)."""
+    import os
+    import sys
+
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(devnull, sys.stdout.fileno())
+    finally:
+        os.close(devnull)
+
+
+def stdout_console(**options: Any) -> Any:
+    """A :class:`rich.console.Console` on the standard output whose closed pipe ends the command as any
+    other's does (:data:`EXIT_CLOSED_PIPE`, by :func:`grazing.cli.main`; rich's own ends it with status 1).
+    """
+    from rich.console import Console
+
+    class _Console(Console):
+        def on_broken_pipe(self) -> None:
+            self.quiet = True
+            raise BrokenPipeError(errno.EPIPE, os.strerror(errno.EPIPE))
+
+    return _Console(**options)
 
 
 def error_line(message: str) -> None:

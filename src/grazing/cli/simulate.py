@@ -20,6 +20,7 @@ from grazing.cli.common import (
     model_params_json,
     overwrite_option,
     parse_state,
+    stdout_console,
     write_table,
 )
 from grazing.cli.limits import check_memory, count_text, simulate_bytes
@@ -121,10 +122,9 @@ def _write_trajectory_csv(sol: grazing.Solution, fh: Any) -> None:
 def _print_simulation(
     model: grazing.HybridModel, sol: grazing.Solution, period: int, elapsed: float, trajectory: Path | None
 ) -> None:
-    from rich.console import Console
     from rich.table import Table
 
-    con = Console(soft_wrap=True)  # a line is never cut at the terminal's width (the table keeps its own)
+    con = stdout_console(soft_wrap=True)  # (no line cut at the terminal's width; a table keeps its own)
     values = "  ".join(
         f"{p.name}={p.to_display(model.params[p.name]):g}{' deg' if p.angle else ''}"
         for p in model.parameters
