@@ -13,6 +13,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 import grazing
 from grazing.cli import main
@@ -21,7 +23,7 @@ from grazing.orbits import find_orbit
 from grazing.sweeps import parameter_map, sweep
 from grazing.sweeps.run import run_chunk
 from grazing.sweeps.spec import SweepSpec
-from grazing.sweeps.store import StoreMismatchError, ZarrStore
+from grazing.sweeps.store import StoreMismatchError, ZarrStore, orbit_impacts
 from tests.sweeps.dask_cluster import loopback_client
 
 DEG = math.pi / 180
@@ -73,6 +75,45 @@ def test_windows_agree_with_shooting(window_sweep):
         assert orbit.stable and orbit.abs_lambda < 0.75  # well inside the window: |mu| <= 0.70 here
         assert orbit.impacts == (0 if eta < 0.445 else 1)
         assert np.min(np.max(np.abs(samples[-p:] - orbit.state), axis=1)) < 1e-8
+
+
+def test_impacts_per_period_is_the_orbits_over_a_window_of_no_whole_cycles():
+    """100 sampled periods hold no whole number of cycles of the period-3, 6... orbits: the count of impacts
+    in them is off by up to one cycle's, and the dataset's impacts per period is still the orbit's, exact
+    (it was 0.99 for the period-3 orbit, 1.02 or 0.98 for a period-6 one)."""
+    etas = np.array(list(WINDOWS))
+    ds = sweep(M40, "eta", etas, fresh=True, workers=1, transient=800, periods=100)
+    partial = [p for p in ds.period.values if p > 0 and 100 % p]
+    assert sorted(set(partial)) == [3, 6]  # (what the test is about)
+    for eta, p, ipp, count, samples in zip(
+        etas, ds.period.values, ds.impacts_per_period.values, ds.impacts.values, ds.samples.values
+    ):
+        if p <= 0:  # (aperiodic: per forcing period, the count's ratio)
+            assert ipp == count / 100
+            continue
+        orbit = find_orbit(M40.with_params(eta=float(eta)), samples[-1], period=int(p))
+        assert ipp == orbit.impacts, eta
+
+
+@given(
+    period=st.integers(1, 12),
+    pattern=st.lists(st.integers(0, 3), min_size=12, max_size=12),
+    offset=st.integers(0, 11),
+    periods=st.integers(1, 150),
+)
+def test_orbit_impacts_of_any_periodic_pattern(period, pattern, offset, periods):
+    """A period-p orbit with pattern[j] impacts in its j-th forcing period, seen through a window of
+    ``periods`` forcing periods starting anywhere: the orbit's impacts per period, exact where the count
+    allows only one whole number, else the count's ratio -- and exact whenever the window holds more
+    whole cycles than the orbit has impacts."""
+    pattern = pattern[:period]
+    k = sum(pattern)
+    count = sum(pattern[(offset + i) % period] for i in range(periods))
+    got = float(orbit_impacts(np.array([count]), np.array([period]), periods)[0])
+    q = periods // period
+    assert got == k or got == pytest.approx(count / periods * period)
+    if q > k:
+        assert got == k
 
 
 def test_lyapunov_exponents(window_sweep):
