@@ -1,4 +1,4 @@
-"""A command whose output's reader has gone (``grazing sweep --json | head``) ends quietly, with status 141."""
+"""A command whose output's reader has gone (``grazing sweep --json | head``) ends quietly: status 141."""
 
 from __future__ import annotations
 
@@ -18,8 +18,8 @@ CONSOLE = [sys.executable, "-c", "from _grazing_entry import console; console()"
 MODULE = [sys.executable, "-m", "grazing"]
 
 COMMANDS = {
-    "sweep --json": ["sweep", "--param", "eta", "--start", "0.44", "--stop", "0.45", "--num", "3", "--periods",
-                     "5", "--json"],
+    "sweep --json": ["sweep", "--param", "eta", "--start", "0.44", "--stop", "0.45", "--num", "3",
+                     "--periods", "5", "--json"],
     "simulate (a rich table)": ["simulate", "--transient", "3", "--periods", "4"],
     "orbit --json": ["orbit", "--json"],
 }  # fmt: skip
@@ -44,7 +44,8 @@ def test_output_into_a_closed_pipe_ends_quietly_with_status_141(entry, name):
 
 
 def test_output_read_to_its_end_is_whole_and_ends_with_status_0():
-    done = subprocess.run([*CONSOLE, *COMMANDS["orbit --json"]], capture_output=True, timeout=300, check=False)
+    argv = [*CONSOLE, *COMMANDS["orbit --json"]]
+    done = subprocess.run(argv, capture_output=True, timeout=300, check=False)
     assert done.returncode == 0 and done.stderr == b""
     assert done.stdout.rstrip().endswith(b"}")
 
