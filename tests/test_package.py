@@ -23,3 +23,12 @@ def test_dir_lists_every_public_name_and_nothing_used_only_to_write_the_module()
 
     for name in names:
         getattr(grazing, name)  # everything listed is there
+
+
+def test_the_version_is_the_installed_packages_looked_up_once() -> None:
+    from importlib.metadata import version
+
+    import grazing
+
+    assert grazing.__version__ == version("grazing")
+    assert "__version__" in vars(grazing)  # (kept: not looked up again, 2 ms a time)

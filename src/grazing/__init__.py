@@ -52,9 +52,11 @@ def __getattr__(name: str) -> Any:
         from importlib.metadata import PackageNotFoundError, version
 
         try:
-            return version("grazing")
+            found = version("grazing")
         except PackageNotFoundError:  # pragma: no cover - running from a source tree
-            return "0.0.0"
+            found = "0.0.0"
+        globals()["__version__"] = found  # (looked up once: 2 ms a time, and a sweep's spec asks often)
+        return found
     raise AttributeError(f"module 'grazing' has no attribute {name!r}")
 
 
