@@ -119,6 +119,10 @@ def test_bad_clicks_are_messages_in_the_page(page):
     page.find_grazings()
     wait_until(lambda: "grazing at" in page.grazings_text.object)
     assert page.grazings_text.object.startswith("grazing at eta = 0.44512118")
+    wait_until(lambda: page.grazings is not None)
+    page.show_code()
+    assert "_, branch = find_grazings(model, 'eta', 0.44, 0.49, period=1)" in page.code_python.value
+    assert "\ngrazing graze --model pendulum" in page.code_cli.value
 
 
 def test_the_same_component_renders_without_a_server_as_in_a_notebook():
@@ -244,8 +248,9 @@ def test_on_a_period_map_the_clicked_orbit_s_bifurcation_curves_are_followed():
 
 def test_the_basins_at_the_clicked_point_hold_its_attractor(page):
     """At eta = 0.446 the period-5 orbit attracts most of the plane (the diagram's chain found it too)."""
+    before = page.point  # (another test's click may have left one at 0.446 too)
     page.click_values([0.446])
-    wait_until(lambda: page.point is not None and page.point.values["eta"] == 0.446)
+    wait_until(lambda: page.point is not before and page.point.values["eta"] == 0.446)
     assert not page.basins_button.disabled
     page.find_basins()
     wait_until(lambda: "of the grid" in page.basins_text.object or "error" in page.basins_text.object)
@@ -258,3 +263,8 @@ def test_the_basins_at_the_clicked_point_hold_its_attractor(page):
     pts = np.column_stack([page.figures.basin_points.data["x"], page.figures.basin_points.data["y"]])
     orbit = page.point.samples[-5:]
     assert all(np.min(np.abs(pts - p).sum(axis=1)) < 1e-5 for p in orbit)
+    # copy as code gives the basins shown (tests/explore/test_explore_code.py runs such code)
+    wait_until(lambda: page.basins is not None)
+    page.show_code()
+    assert "found = basins(point, " in page.code_python.value and "(40, 40)" in page.code_python.value
+    assert "\ngrazing basins --model pendulum" in page.code_cli.value

@@ -16,6 +16,8 @@ import pytest
 import grazing
 from grazing.cli import main
 from grazing.explore import ModelSource, View, compute_diagram, continue_click, inspect_click, view_code
+from grazing.explore.basins import basins_at
+from grazing.explore.branch import grazings_in_view
 
 SYMMETRIC = Path(__file__).resolve().parents[1] / "orbits" / "symmetric_models.py"
 
@@ -79,6 +81,58 @@ def test_the_command_lines_compute_the_same_diagram_point_orbit_and_branch(pendu
         assert [s["value"] for s in branch["special"]] == pytest.approx(
             [s.param for s in piece.branch.special], abs=1e-9
         )
+
+
+@pytest.fixture(scope="module")
+def basins_and_grazings(pendulum_view):
+    view, _diagram, point, _continued = pendulum_view
+    return basins_at(point, num=(12, 10)), grazings_in_view(view)
+
+
+def test_the_basins_and_grazings_code_prints_what_the_page_shows(
+    pendulum_view, basins_and_grazings, tmp_path
+):
+    view, _diagram, point, _continued = pendulum_view
+    found, grazings = basins_and_grazings
+    assert grazings.marks and len(found.kinds) >= 1  # (what the test is about)
+    code = view_code(view, point, continued=True, basins=found, grazings=grazings)
+    out = run_python(code.python, tmp_path).splitlines()
+    shown = [line.split() for line in out if line.startswith("attractor ")]
+    assert [(k, int(p)) for _, k, p, _ in shown] == list(zip(found.kinds, found.periods))
+    fractions = [np.mean(found.label == k) for k in range(len(found.kinds))]
+    assert [float(f) for *_, f in shown] == pytest.approx(fractions, abs=1e-6)
+    (line,) = [line for line in out if line.startswith("grazings ")]
+    assert eval(line[len("grazings ") :]) == pytest.approx([m.value for m in grazings.marks], abs=1e-8)
+
+
+def test_the_basins_and_graze_command_lines_compute_the_same(pendulum_view, basins_and_grazings, capsys):
+    view, _diagram, point, _continued = pendulum_view
+    found, grazings = basins_and_grazings
+    lines = view_code(view, point, basins=found, grazings=grazings).cli.strip().splitlines()
+    # (the command looks at one stop: a line for each of the pendulum's, "stop" and "back")
+    commands = [shlex.split(line)[1] for line in lines]
+    assert commands == ["sweep", "simulate", "orbit", "basins", "graze", "graze"]
+    res = run_cli(lines[3], capsys)
+    labels = np.array(res["labels"])
+    assert found.label.tolist() in (labels.tolist(), labels.T.tolist())
+    got = [g["value"] for line in lines[4:] for g in run_cli(line, capsys)["grazings"]]
+    assert sorted(got) == pytest.approx(sorted(m.value for m in grazings.marks), abs=1e-9)
+
+
+def test_a_map_s_grazings_are_sought_along_its_clicked_row(capsys, tmp_path):
+    model = grazing.models.pendulum("B")
+    view = View.of(model, {"eta": (0.44, 0.45), "theta_hat": (39.0, 40.0)}, num=3)
+    row = math.radians(39.5)
+    grazings = grazings_in_view(view, {"theta_hat": row})
+    assert len(grazings.marks) == 1
+    code = view_code(view, grazings=grazings)
+    assert f"model.with_params(theta_hat={row!r})" in code.python
+    (line,) = [line for line in run_python(code.python, tmp_path).splitlines() if line.startswith("grazings")]
+    assert eval(line[len("grazings ") :]) == pytest.approx([grazings.marks[0].value], abs=1e-8)
+    grazes = [line for line in code.cli.strip().splitlines() if shlex.split(line)[1] == "graze"]
+    assert all("theta_hat=39.5" in line or "--theta-hat 39.5" in line for line in grazes)
+    got = [g["value"] for line in grazes for g in run_cli(line, capsys)["grazings"]]
+    assert got == pytest.approx([grazings.marks[0].value], abs=1e-9)
 
 
 def test_a_model_file_is_loaded_by_its_path_in_both(tmp_path, capsys):

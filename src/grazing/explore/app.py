@@ -74,6 +74,8 @@ class Explorer:
         self.refined: Diagram | None = None
         self.point: PointReport | None = None
         self.continued: Continued | None = None
+        self.basins: BasinView | None = None  # (found at the clicked point, for copy as code)
+        self.grazings: Grazings | None = None  # (sought over the range, for copy as code)
         self.figures = Figures(view)
         model = view.model
         names = [view.parameter(i) for i in range(len(view.axes))]
@@ -302,6 +304,7 @@ class Explorer:
 
     def _point_done(self, rep: PointReport) -> None:
         self.continued = None
+        self.basins = None
         self.curves_button.disabled = True
         self.basins_button.disabled = False
         self.figures.show_point(rep)
@@ -367,6 +370,10 @@ class Explorer:
         def done(found: BasinView) -> None:
             self.figures.show_basins(found)
             self.basins_text.object = "\n\n".join(found.lines)
+            if self.point is point:  # (else another point was clicked meanwhile)
+                self.basins = found
+                if self.code_python.visible:
+                    self.show_code()
 
         self.jobs.submit(
             "basins",
@@ -396,6 +403,9 @@ class Explorer:
         def done(g: Grazings) -> None:
             self.figures.show_grazings(g, fixed.get(self.view.axes[-1].name))
             self.grazings_text.object = "\n\n".join(g.lines)
+            self.grazings = g
+            if self.code_python.visible:
+                self.show_code()
 
         self.jobs.submit(
             "grazings", work, done, lambda e: setattr(self.grazings_text, "object", message_of(e))
@@ -404,7 +414,9 @@ class Explorer:
     def show_code(self) -> None:
         """Show the Python and the command lines that reproduce the view."""
         view = self.view if self.point is None else self._diagram_for(list(self.point.values.values())).view
-        code = view_code(view, self.point, continued=self.continued is not None)
+        code = view_code(
+            view, self.point, continued=self.continued is not None, basins=self.basins, grazings=self.grazings
+        )
         self.code_python.value = code.python
         self.code_cli.value = code.cli
         self.code_python.visible = self.code_cli.visible = True

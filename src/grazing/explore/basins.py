@@ -23,11 +23,13 @@ BASIN_GRID = (40, 40)
 
 @dataclass(frozen=True)
 class BasinView:
-    """Basins on a grid: its ranges (model units), each initial state's attractor label (0: beyond a
-    stop), each attractor's kind, period and points, and one line per attractor."""
+    """Basins on a grid: its ranges (model units) and initial states along each, each initial state's
+    attractor label (0: beyond a stop), each attractor's kind, period and points, and one line per
+    attractor."""
 
     x_range: tuple[float, float]
     y_range: tuple[float, float]
+    num: tuple[int, int]
     label: np.ndarray
     kinds: tuple[str, ...]
     periods: tuple[int, ...]
@@ -69,6 +71,7 @@ def basins_at(point: PointReport, num: tuple[int, int] = BASIN_GRID) -> BasinVie
     return BasinView(
         x_range=ranges[0],
         y_range=ranges[1],
+        num=(int(num[0]), int(num[1])),
         label=ds.label.values,
         kinds=tuple(ds.kind.values.tolist()),
         periods=tuple(int(p) for p in ds.period.values),

@@ -11,6 +11,7 @@ points at forcing phase 0, the diagram's stroboscopic section.
 
 from __future__ import annotations
 
+import math
 import warnings
 from dataclasses import dataclass, field
 
@@ -148,11 +149,14 @@ def continue_click(view: View, point: PointReport, *, cancelled: IsCancelled | N
 
 @dataclass(frozen=True)
 class Grazings:
-    """The grazings of the nonimpacting orbit in the view's range: marks and one line each."""
+    """The grazings of the nonimpacting orbit in the view's range: marks and one line each; where they
+    were sought (the parameter, its range, the other explored parameter's value held: ``fixed``)."""
 
     param: str
     marks: tuple[Mark, ...]
     lines: tuple[str, ...]
+    range: tuple[float, float] = (math.nan, math.nan)
+    fixed: dict[str, float] = field(default_factory=dict)
 
     def summary(self) -> str:
         return "\n".join(self.lines)
@@ -197,7 +201,7 @@ def grazings_in_view(
         lines.append(marks[-1].text)
     if not marks:
         lines.append(f"no grazing of the nonimpacting period-{period} orbit in the range ({branch.status})")
-    return Grazings(axis.name, tuple(marks), tuple(lines))
+    return Grazings(axis.name, tuple(marks), tuple(lines), (axis.lo, axis.hi), dict(fixed or {}))
 
 
 CURVE_OF = {

@@ -17,6 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from grazing.explore.basins import BasinView
+from grazing.explore.branch import Grazings
 from grazing.explore.diagram import View
 from grazing.explore.point import PointReport
 from grazing.explore.source import command_line
@@ -44,20 +46,53 @@ def _linspace(lo: float, hi: float, num: int) -> str:
     return f"np.linspace({lo!r}, {hi!r}, {num})"
 
 
-def view_code(view: View, point: PointReport | None = None, *, continued: bool = False) -> Code:
-    """The code of the diagram, of the clicked ``point`` and (``continued``) of its continuation.
+def view_code(
+    view: View,
+    point: PointReport | None = None,
+    *,
+    continued: bool = False,
+    basins: BasinView | None = None,
+    grazings: Grazings | None = None,
+) -> Code:
+    """The code of the diagram, of the clicked ``point``, of its continuation (``continued``), of the
+    ``basins`` found at it and of the ``grazings`` sought over the range (the other explored parameter's
+    value held there: :func:`~grazing.explore.branch.grazings_in_view`).
 
     The Python text imports what it uses and prints, for the point, ``period P
     impacts K`` (impacts per period of the motion) and then ``orbit P K`` (Newton's
-    orbit); for the branch, one line per direction with its special points.
-    Command lines need a model given by ``--model`` (a built-in name or a file):
-    for a model object given in Python, :attr:`Code.cli` says so instead.
+    orbit); for the branch, one line per direction with its special points; for the
+    basins, one line per attractor (``attractor KIND PERIOD FRACTION``); for the
+    grazings, ``grazings [VALUE, ...]``.  Command lines need a model given by
+    ``--model`` (a built-in name or a file): for a model object given in Python,
+    :attr:`Code.cli` says so instead.
     """
-    s = view.settings
+    orbits = ["continue_orbit", "find_orbit"] if point is not None else []
+    orbits += ["find_grazings"] if grazings is not None else []
     py = ["import numpy as np", *view.source.python_imports, "", "import grazing"]
-    py += ["from grazing.orbits import continue_orbit, find_orbit"] if point is not None else []
+    py += ["from grazing.attractors import basins"] if basins is not None and point is not None else []
+    py += [f"from grazing.orbits import {', '.join(sorted(orbits))}"] if orbits else []
     py += [f"from grazing.sweeps import {'sweep' if len(view.axes) == 1 else 'parameter_map'}", ""]
     py += view.source.python_lines(view.model)
+    cli: list[str] = []
+    try:
+        model_args: list[str] | None = view.source.cli_args(view.model, varied=view.names)
+    except ValueError as exc:
+        model_args = None
+        cli.append(f"# {exc} (--model FILE.py:OBJECT)")
+    _diagram_code(view, model_args, py, cli)
+    if point is not None:
+        point_args = None if model_args is None else view.source.cli_args(point.model, varied=())
+        _point_code(view, point, continued, point_args, py, cli)
+        if basins is not None:
+            _basins_code(basins, point_args, py, cli)
+    if grazings is not None:
+        _grazings_code(view, grazings, model_args is not None, py, cli)
+    return Code("\n".join(py) + "\n", "\n".join(cli) + "\n")
+
+
+def _diagram_code(view: View, model_args: list[str] | None, py: list[str], cli: list[str]) -> None:
+    """The diagram (or the period map): its Python, and its command line where ``model_args``."""
+    s = view.settings
     common = f"transient={s.transient}, periods={s.periods}, lyapunov={s.lyapunov}"
     a = view.axes[0]
     if len(view.axes) == 1:
@@ -73,71 +108,77 @@ def view_code(view: View, point: PointReport | None = None, *, continued: bool =
             f"ds = parameter_map(model, {a.name!r}, {_linspace(a.lo, a.hi, a.num)}, {b.name!r}, "
             f"{_linspace(b.lo, b.hi, b.num)}, {common}, chunk_size={a.num})",
         ]
-    cli: list[str] = []
-    try:
-        model_args = view.source.cli_args(view.model, varied=view.names)
-    except ValueError as exc:
-        model_args = None
-        cli.append(f"# {exc} (--model FILE.py:OBJECT)")
-    if model_args is not None:
-        shown = [view.parameter(i).to_display for i in range(len(view.axes))]
-        if len(view.axes) == 1:
-            cli.append(
-                command_line(
-                    [
-                        "sweep",
-                        *model_args,
-                        "--param",
-                        a.name,
-                        "--start",
-                        repr(shown[0](a.lo)),
-                        "--stop",
-                        repr(shown[0](a.hi)),
-                        "--num",
-                        str(a.num),
-                        "--transient",
-                        str(s.transient),
-                        "--periods",
-                        str(s.periods),
-                        "--chunk-size",
-                        str(s.chunk_size),
-                    ]
-                    + ([] if s.lyapunov else ["--no-lyapunov"])
-                )
+    if model_args is None:
+        return
+    shown = [view.parameter(i).to_display for i in range(len(view.axes))]
+    if len(view.axes) == 1:
+        cli.append(
+            command_line(
+                [
+                    "sweep",
+                    *model_args,
+                    "--param",
+                    a.name,
+                    "--start",
+                    repr(shown[0](a.lo)),
+                    "--stop",
+                    repr(shown[0](a.hi)),
+                    "--num",
+                    str(a.num),
+                    "--transient",
+                    str(s.transient),
+                    "--periods",
+                    str(s.periods),
+                    "--chunk-size",
+                    str(s.chunk_size),
+                ]
+                + ([] if s.lyapunov else ["--no-lyapunov"])
             )
-        else:
-            b = view.axes[1]
-            cli.append(
-                command_line(
-                    [
-                        "map",
-                        *model_args,
-                        "--param1",
-                        a.name,
-                        "--start1",
-                        repr(shown[0](a.lo)),
-                        "--stop1",
-                        repr(shown[0](a.hi)),
-                        "--num1",
-                        str(a.num),
-                        "--param2",
-                        b.name,
-                        "--start2",
-                        repr(shown[1](b.lo)),
-                        "--stop2",
-                        repr(shown[1](b.hi)),
-                        "--num2",
-                        str(b.num),
-                        "--transient",
-                        str(s.transient),
-                        "--periods",
-                        str(s.periods),
-                    ]
-                    + ([] if s.lyapunov else ["--no-lyapunov"])
-                )
+        )
+    else:
+        b = view.axes[1]
+        cli.append(
+            command_line(
+                [
+                    "map",
+                    *model_args,
+                    "--param1",
+                    a.name,
+                    "--start1",
+                    repr(shown[0](a.lo)),
+                    "--stop1",
+                    repr(shown[0](a.hi)),
+                    "--num1",
+                    str(a.num),
+                    "--param2",
+                    b.name,
+                    "--start2",
+                    repr(shown[1](b.lo)),
+                    "--stop2",
+                    repr(shown[1](b.hi)),
+                    "--num2",
+                    str(b.num),
+                    "--transient",
+                    str(s.transient),
+                    "--periods",
+                    str(s.periods),
+                ]
+                + ([] if s.lyapunov else ["--no-lyapunov"])
             )
-    if point is None:
-        return Code("\n".join(py) + "\n", "\n".join(cli) + "\n")
+        )
+
+
+def _point_code(
+    view: View,
+    point: PointReport,
+    continued: bool,
+    point_args: list[str] | None,
+    py: list[str],
+    cli: list[str],
+) -> None:
+    """The clicked point, its orbit and (``continued``) its branch: Python, and command lines where
+    ``point_args``."""
+    a = view.axes[0]
     p = point.settings
     values = ", ".join(f"{k}={v!r}" for k, v in point.values.items())
     py += [
@@ -152,9 +193,7 @@ def view_code(view: View, point: PointReport | None = None, *, continued: bool =
         f"trajectory={p.points_per_period})",
         'print("period", period, "impacts", len(run.impacts) / (1 if period > 0 else shown))',
     ]
-    point_args = None
-    if model_args is not None:
-        point_args = view.source.cli_args(point.model, varied=())
+    if point_args is not None:
         cli.append(
             command_line(
                 [
@@ -170,7 +209,7 @@ def view_code(view: View, point: PointReport | None = None, *, continued: bool =
             )
         )
     if point.orbit_guess is None:
-        return Code("\n".join(py) + "\n", "\n".join(cli) + "\n")
+        return
     py += [
         "orbit = find_orbit(point, run.x_final, period=period, t0=0.0)",
         'print("orbit", orbit.period, orbit.impacts, orbit.multipliers)',
@@ -189,7 +228,7 @@ def view_code(view: View, point: PointReport | None = None, *, continued: bool =
             )
         )
     if not continued or point.orbit is None:
-        return Code("\n".join(py) + "\n", "\n".join(cli) + "\n")
+        return
     start = point.values[a.name]
     ends = [e for e in (a.lo, a.hi) if abs(e - start) > 1e-12 * max(1.0, abs(start))]
     py += [
@@ -200,7 +239,7 @@ def view_code(view: View, point: PointReport | None = None, *, continued: bool =
         "period=orbit.period)",
         '    print("branch", len(branch), [(s.kind, round(s.param, 8)) for s in branch.special])',
     ]
-    if model_args is not None:
+    if point_args is not None:
         par = view.parameter(0)
         branch_args = view.source.cli_args(point.model, varied=(a.name,))
         for end in ends:
@@ -222,4 +261,54 @@ def view_code(view: View, point: PointReport | None = None, *, continued: bool =
                     ]
                 )
             )
-    return Code("\n".join(py) + "\n", "\n".join(cli) + "\n")
+
+
+def _basins_code(found: BasinView, point_args: list[str] | None, py: list[str], cli: list[str]) -> None:
+    """The basins found at the clicked point (:func:`~grazing.explore.basins.basins_at`)."""
+    py += [
+        "",
+        "# the basins of attraction at the clicked parameters",
+        f"found = basins(point, {found.x_range!r}, {found.y_range!r}, {found.num!r})",
+        "for kind, p, fraction in zip(found.kind.values, found.period.values, found.fraction.values):",
+        '    print("attractor", kind, int(p), round(float(fraction), 6))',
+    ]
+    if point_args is not None:
+        pair = lambda r: f"{r[0]!r},{r[1]!r}"  # noqa: E731
+        cli.append(
+            command_line(
+                [
+                    "basins",
+                    *point_args,
+                    f"--x-range={pair(found.x_range)}",
+                    f"--y-range={pair(found.y_range)}",
+                    "--num",
+                    f"{found.num[0]},{found.num[1]}",
+                ]
+            )
+        )
+
+
+def _grazings_code(view: View, found: Grazings, with_cli: bool, py: list[str], cli: list[str]) -> None:
+    """The grazings of the nonimpacting period-1 orbit over the range they were sought in, the other
+    explored parameter held (:func:`~grazing.explore.branch.grazings_in_view`)."""
+    lo, hi = found.range
+    held = ", ".join(f"{k}={v!r}" for k, v in found.fixed.items())
+    py += [
+        "",
+        "# the grazings of the nonimpacting period-1 orbit over the range (every stop's)",
+        f"_, branch = find_grazings(model{f'.with_params({held})' if held else ''}, {found.param!r}, {lo!r}, "
+        f"{hi!r}, period=1)",
+        'print("grazings", [round(s.param, 8) for s in branch.special if s.kind == "grazing"])',
+    ]
+    if not with_cli:
+        return
+    model = view.model.with_params(**found.fixed)
+    args = view.source.cli_args(model, varied=(found.param,))
+    shown = model.parameter(found.param).to_display
+    for stop in model.stop_names:  # (the command looks at one stop: a line each)
+        cli.append(
+            command_line(
+                ["graze", *args, "--param", found.param, f"--range={shown(lo)!r},{shown(hi)!r}"]
+                + (["--stop-name", stop] if len(model.stop_names) > 1 else [])
+            )
+        )
