@@ -242,6 +242,11 @@ def test_on_a_period_map_the_clicked_orbit_s_bifurcation_curves_are_followed():
         at = [x for x, y in zip(xs, ys) if abs(y - 40) < 1e-6]
         assert at == [pytest.approx(0.44539259, abs=1e-8)]
         assert 35 - 1e-9 <= min(ys) and max(ys) <= 45 + 1e-9  # (inside the map's range)
+        # copy as code follows them too (tests/explore/test_explore_code.py runs such code)
+        wait_until(lambda: app.curves is not None)
+        app.show_code()
+        assert "curve = follow_curve(point, kind, 'eta', 0.446, stop, 'theta_hat'" in app.code_python.value
+        assert "\ngrazing curve --model pendulum" in app.code_cli.value
     finally:
         app.close()
 

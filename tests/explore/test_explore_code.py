@@ -17,7 +17,7 @@ import grazing
 from grazing.cli import main
 from grazing.explore import ModelSource, View, compute_diagram, continue_click, inspect_click, view_code
 from grazing.explore.basins import basins_at
-from grazing.explore.branch import grazings_in_view
+from grazing.explore.branch import follow_click_curves, grazings_in_view
 
 SYMMETRIC = Path(__file__).resolve().parents[1] / "orbits" / "symmetric_models.py"
 
@@ -133,6 +133,29 @@ def test_a_map_s_grazings_are_sought_along_its_clicked_row(capsys, tmp_path):
     assert all("theta_hat=39.5" in line or "--theta-hat 39.5" in line for line in grazes)
     got = [g["value"] for line in grazes for g in run_cli(line, capsys)["grazings"]]
     assert got == pytest.approx([grazings.marks[0].value], abs=1e-9)
+
+
+def test_the_curves_of_a_map_s_clicked_orbit_are_followed_the_same_in_both(tmp_path, capsys):
+    """The period-5 window's special points followed in (eta, theta_hat), as on the page
+    (tests/explore/test_explore_app.py): the same curves, point for point, in Python and on the command
+    line."""
+    model = grazing.models.pendulum("B")
+    view = View.of(model, {"eta": (0.43, 0.46), "theta_hat": (35.0, 45.0)}, num=4)
+    point = inspect_click(compute_diagram(view), [0.446, math.radians(40)])
+    found = follow_click_curves(view, point, continue_click(view, point))
+    assert {c.kind for c in found.curves} >= {"period-doubling", "grazing"}  # (what the test is about)
+    code = view_code(view, point, continued=True, curves=found)
+    printed = run_python(code.python, tmp_path).splitlines()
+    out = [line.split(" ", 3) for line in printed if line.startswith("curve ")]
+    assert [(k, int(n)) for _, k, n, _ in out] == [(c.kind, c.first.size) for c in found.curves]
+    lines = [line for line in code.cli.strip().splitlines() if shlex.split(line)[1] == "curve"]
+    assert len(lines) == len(found.curves)
+    for line, c in zip(lines, found.curves):
+        res = run_cli(line, capsys)
+        assert res["kind"] == c.kind and len(res["points"]) == c.first.size
+        got = np.array([[p["eta"], p["theta_hat"]] for p in res["points"]])  # (theta_hat in degrees)
+        assert got[:, 0] == pytest.approx(c.first, abs=1e-8)
+        assert np.radians(got[:, 1]) == pytest.approx(c.second, abs=1e-8)
 
 
 def test_a_model_file_is_loaded_by_its_path_in_both(tmp_path, capsys):

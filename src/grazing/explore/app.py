@@ -76,6 +76,7 @@ class Explorer:
         self.continued: Continued | None = None
         self.basins: BasinView | None = None  # (found at the clicked point, for copy as code)
         self.grazings: Grazings | None = None  # (sought over the range, for copy as code)
+        self.curves: Curves | None = None  # (followed from the continued point, for copy as code)
         self.figures = Figures(view)
         model = view.model
         names = [view.parameter(i) for i in range(len(view.axes))]
@@ -304,7 +305,7 @@ class Explorer:
 
     def _point_done(self, rep: PointReport) -> None:
         self.continued = None
-        self.basins = None
+        self.basins = self.curves = None
         self.curves_button.disabled = True
         self.basins_button.disabled = False
         self.figures.show_point(rep)
@@ -336,7 +337,7 @@ class Explorer:
             self.figures.show_branch(c, self._row(point))
             self.actions_text.object = "\n\n".join(c.lines)
             self.curves_button.disabled = False
-            self.continued = c
+            self.continued, self.curves = c, None
             if self.code_python.visible:
                 self.show_code()
 
@@ -356,6 +357,10 @@ class Explorer:
         def done(found: Curves) -> None:
             self.figures.show_curves(found)
             self.curves_text.object = "\n\n".join(found.lines)
+            if self.point is point and self.continued is continued:  # (else superseded meanwhile)
+                self.curves = found
+                if self.code_python.visible:
+                    self.show_code()
 
         self.jobs.submit("curves", work, done, lambda e: setattr(self.curves_text, "object", message_of(e)))
 
@@ -415,7 +420,12 @@ class Explorer:
         """Show the Python and the command lines that reproduce the view."""
         view = self.view if self.point is None else self._diagram_for(list(self.point.values.values())).view
         code = view_code(
-            view, self.point, continued=self.continued is not None, basins=self.basins, grazings=self.grazings
+            view,
+            self.point,
+            continued=self.continued is not None,
+            basins=self.basins,
+            grazings=self.grazings,
+            curves=self.curves,
         )
         self.code_python.value = code.python
         self.code_cli.value = code.cli

@@ -216,12 +216,14 @@ CURVE_OF = {
 
 @dataclass(frozen=True)
 class CurveView:
-    """A bifurcation curve drawn on a period map: its kind, its two parameters' values (model units)."""
+    """A bifurcation curve drawn on a period map: its kind, its two parameters' values (model units);
+    the continuation it was found on (from the clicked value towards ``stop``), for copy as code."""
 
     kind: str
     first: np.ndarray
     second: np.ndarray
     text: str
+    stop: float = math.nan
 
 
 @dataclass(frozen=True)
@@ -230,6 +232,7 @@ class Curves:
 
     curves: tuple[CurveView, ...]
     lines: tuple[str, ...]
+    view: View | None = None  # (the map they were followed over, for copy as code)
 
 
 def follow_click_curves(
@@ -284,8 +287,8 @@ def follow_click_curves(
             text = (
                 f"{kind} curve from {par.show(sp.param, '.8g')}: {len(curve.points)} points; {curve.status}"
             )
-            curves.append(CurveView(kind, curve.values(a.name), curve.values(b.name), text))
+            curves.append(CurveView(kind, curve.values(a.name), curve.values(b.name), text, piece.end))
             lines.append(text)
     if not lines:
         lines.append("no special point on the branch to follow")
-    return Curves(tuple(curves), tuple(lines))
+    return Curves(tuple(curves), tuple(lines), view)

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from grazing.explore.basins import BasinView
-from grazing.explore.branch import Grazings
+from grazing.explore.branch import Curves, Grazings
 from grazing.explore.diagram import View
 from grazing.explore.point import PointReport
 from grazing.explore.source import command_line
@@ -53,21 +53,24 @@ def view_code(
     continued: bool = False,
     basins: BasinView | None = None,
     grazings: Grazings | None = None,
+    curves: Curves | None = None,
 ) -> Code:
     """The code of the diagram, of the clicked ``point``, of its continuation (``continued``), of the
     ``basins`` found at it and of the ``grazings`` sought over the range (the other explored parameter's
-    value held there: :func:`~grazing.explore.branch.grazings_in_view`).
+    value held there: :func:`~grazing.explore.branch.grazings_in_view`) and of the bifurcation ``curves``
+    followed from the clicked point on a period map (:func:`~grazing.explore.branch.follow_click_curves`).
 
     The Python text imports what it uses and prints, for the point, ``period P
     impacts K`` (impacts per period of the motion) and then ``orbit P K`` (Newton's
     orbit); for the branch, one line per direction with its special points; for the
     basins, one line per attractor (``attractor KIND PERIOD FRACTION``); for the
-    grazings, ``grazings [VALUE, ...]``.  Command lines need a model given by
-    ``--model`` (a built-in name or a file): for a model object given in Python,
-    :attr:`Code.cli` says so instead.
+    grazings, ``grazings [VALUE, ...]``; for each curve, ``curve KIND POINTS STATUS``.
+    Command lines need a model given by ``--model`` (a built-in name or a file): for a
+    model object given in Python, :attr:`Code.cli` says so instead.
     """
     orbits = ["continue_orbit", "find_orbit"] if point is not None else []
     orbits += ["find_grazings"] if grazings is not None else []
+    orbits += ["follow_curve"] if curves is not None and point is not None and point.orbit is not None else []
     py = ["import numpy as np", *view.source.python_imports, "", "import grazing"]
     py += ["from grazing.attractors import basins"] if basins is not None and point is not None else []
     py += [f"from grazing.orbits import {', '.join(sorted(orbits))}"] if orbits else []
@@ -85,6 +88,8 @@ def view_code(
         _point_code(view, point, continued, point_args, py, cli)
         if basins is not None:
             _basins_code(basins, point_args, py, cli)
+        if curves is not None and point.orbit is not None:
+            _curves_code(view, point, curves, model_args is not None, py, cli)
     if grazings is not None:
         _grazings_code(view, grazings, model_args is not None, py, cli)
     return Code("\n".join(py) + "\n", "\n".join(cli) + "\n")
@@ -310,5 +315,54 @@ def _grazings_code(view: View, found: Grazings, with_cli: bool, py: list[str], c
             command_line(
                 ["graze", *args, "--param", found.param, f"--range={shown(lo)!r},{shown(hi)!r}"]
                 + (["--stop-name", stop] if len(model.stop_names) > 1 else [])
+            )
+        )
+
+
+def _curves_code(
+    view: View, point: PointReport, found: Curves, with_cli: bool, py: list[str], cli: list[str]
+) -> None:
+    """The bifurcation curves followed from the clicked point's branch on a period map
+    (:func:`~grazing.explore.branch.follow_click_curves`): from its orbit, as the page followed them."""
+    assert point.orbit is not None
+    view = found.view or view  # (the map they were followed over, not a zoomed part of it)
+    a, b = view.axes
+    start, period = point.values[a.name], point.orbit.period
+    asked = [(c.kind, c.stop) for c in found.curves]
+    py += [
+        "",
+        f"# the bifurcation curves through the branch's special points, in ({a.name}, {b.name})",
+        f"x0 = {_floats(point.orbit.state)}",
+        f"for kind, stop in {asked!r}:",
+        f"    curve = follow_curve(point, kind, {a.name!r}, {start!r}, stop, {b.name!r}, {(b.lo, b.hi)!r}, "
+        f"x0=x0, period={period})",
+        '    print("curve", kind, len(curve.points), curve.status)',
+    ]
+    if not with_cli:
+        return
+    args = view.source.cli_args(point.model, varied=(a.name,))
+    shown_a, shown_b = view.parameter(0).to_display, view.parameter(1).to_display
+    for kind, stop in asked:
+        cli.append(
+            command_line(
+                [
+                    "curve",
+                    *args,
+                    "--kind",
+                    kind,
+                    "--param",
+                    a.name,
+                    "--start",
+                    repr(shown_a(start)),
+                    "--stop",
+                    repr(shown_a(stop)),
+                    "--param2",
+                    b.name,
+                    f"--range={shown_b(b.lo)!r},{shown_b(b.hi)!r}",
+                    "--period",
+                    str(period),
+                    "--initial",
+                    _state_arg(point.orbit.state),
+                ]
             )
         )
