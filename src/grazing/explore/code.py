@@ -13,6 +13,7 @@ simulate``) from the diagram's state there, and its orbit with
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -115,62 +116,30 @@ def _diagram_code(view: View, model_args: list[str] | None, py: list[str], cli: 
         ]
     if model_args is None:
         return
-    shown = [view.parameter(i).to_display for i in range(len(view.axes))]
+    axes = [(view.parameter(i).to_display, axis) for i, axis in enumerate(view.axes)]
+    runs = ["--transient", str(s.transient), "--periods", str(s.periods)]
+    no_lyapunov = [] if s.lyapunov else ["--no-lyapunov"]
     if len(view.axes) == 1:
-        cli.append(
-            command_line(
-                [
-                    "sweep",
-                    *model_args,
-                    "--param",
-                    a.name,
-                    "--start",
-                    repr(shown[0](a.lo)),
-                    "--stop",
-                    repr(shown[0](a.hi)),
-                    "--num",
-                    str(a.num),
-                    "--transient",
-                    str(s.transient),
-                    "--periods",
-                    str(s.periods),
-                    "--chunk-size",
-                    str(s.chunk_size),
-                ]
-                + ([] if s.lyapunov else ["--no-lyapunov"])
-            )
-        )
+        shown, _ = axes[0]
+        ranges = _range_args("", shown, a.name, a.lo, a.hi, a.num)
+        chunks = ["--chunk-size", str(s.chunk_size)]
+        cli.append(command_line(["sweep", *model_args, *ranges, *runs, *chunks, *no_lyapunov]))
     else:
-        b = view.axes[1]
-        cli.append(
-            command_line(
-                [
-                    "map",
-                    *model_args,
-                    "--param1",
-                    a.name,
-                    "--start1",
-                    repr(shown[0](a.lo)),
-                    "--stop1",
-                    repr(shown[0](a.hi)),
-                    "--num1",
-                    str(a.num),
-                    "--param2",
-                    b.name,
-                    "--start2",
-                    repr(shown[1](b.lo)),
-                    "--stop2",
-                    repr(shown[1](b.hi)),
-                    "--num2",
-                    str(b.num),
-                    "--transient",
-                    str(s.transient),
-                    "--periods",
-                    str(s.periods),
-                ]
-                + ([] if s.lyapunov else ["--no-lyapunov"])
-            )
-        )
+        ranges = [
+            arg
+            for k, (shown, ax) in enumerate(axes, 1)
+            for arg in _range_args(str(k), shown, ax.name, ax.lo, ax.hi, ax.num)
+        ]
+        cli.append(command_line(["map", *model_args, *ranges, *runs, *no_lyapunov]))
+
+
+def _range_args(
+    suffix: str, shown: Callable[[float], float], name: str, lo: float, hi: float, num: int
+) -> list[str]:
+    """``--param NAME --start LO --stop HI --num N``, each option's name ending in ``suffix`` (display
+    units)."""
+    return [f"--param{suffix}", name, f"--start{suffix}", repr(shown(lo)), f"--stop{suffix}", repr(shown(hi)),
+            f"--num{suffix}", str(num)]  # fmt: skip
 
 
 def _point_code(
