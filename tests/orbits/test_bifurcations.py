@@ -80,6 +80,7 @@ def test_the_unstable_symmetric_branch_reaches_its_grazing(symmetric):
     assert not br.orbits[-1].stable and br.orbits[-1].min_impact_speed < 0.05
     g = graze.grazing
     assert g is not None and graze.param == g.model.params[br.param]
+    assert graze.stop == g.stop == 0  # (both stops at once: the first is named, not rounding's pick)
     # The grazing conditions at the contact, to Newton tolerance: on the stop, zero normal speed,
     # turning back, and periodic from the contact.
     cd = g.model.contact_derivatives(g.contact, g.t_graze, g.stop)
@@ -96,6 +97,20 @@ def test_the_unstable_symmetric_branch_reaches_its_grazing(symmetric):
     else:  # the nonimpacting symmetric orbit there touches both walls
         free = find_orbit(g.model, g.contact, t0=g.t_graze, virtual=True)
         assert free.guard_mins == pytest.approx([0.0, 0.0], abs=1e-9)
+
+
+@pytest.mark.parametrize("wall", [0.9, 1.1, 1.2])
+def test_a_symmetric_orbit_losing_both_impacts_at_once_names_the_first_wall(wall):
+    """Its impact speeds vanish on both walls at once (to rounding, which named "west" at these walls
+    before): the first stop, "east", is named, and the grazing is the one of both."""
+    m = walled_pendulum(A=0.9, wall=wall)
+    orbit = find_orbit(m, grazing.simulate(m, [0.0, 0.0], transient=600, periods=4).x_final, period=1, t0=0.0)
+    assert orbit.impacts == 2
+    br = continue_orbit(m, "A", 0.9, 0.05, x0=orbit.state, period=1)
+    graze = br.special[-1]
+    assert graze.kind == "grazing" and graze.grazing.stop_name == "east" and "with stop 'east'" in br.status
+    free = find_orbit(graze.grazing.model, graze.grazing.contact, t0=graze.grazing.t_graze, virtual=True)
+    assert free.guard_mins == pytest.approx([0.0, 0.0], abs=1e-9)
 
 
 def test_a_grazing_ahead_is_accepted_only_within_the_extrapolated_distance(symmetric):

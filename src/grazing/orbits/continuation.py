@@ -345,6 +345,12 @@ def _detect_grazing(
     return SpecialPoint("grazing", -1, value, lo, point, stop)
 
 
+GRAZING_TIE = 1e-6
+"""Margins (:func:`grazing_margin`) of two stops within this relative difference are one simultaneous
+grazing (a symmetric orbit touching both walls at once): the stop with the lower index is named, not
+whichever rounding makes the smaller."""
+
+
 def grazing_margin(orbit: PeriodicOrbit) -> tuple[float, np.ndarray | None, float, str, int]:
     """How far ``orbit`` is from grazing, and where: ``(delta, contact guess, time, what, stop)``.
 
@@ -355,21 +361,26 @@ def grazing_margin(orbit: PeriodicOrbit) -> tuple[float, np.ndarray | None, floa
     linearly in the parameter as the orbit approaches a grazing from its side
     (``v^2 / (2 a)`` may also tend to zero quadratically, where ``v`` does linearly).
     ``stop`` is the index of the stop concerned (closest approaches and
-    impacts on every stop are considered).
+    impacts on every stop are considered; of stops whose margins are equal to
+    :data:`GRAZING_TIE`, the first, then the earliest contact).
     """
-    best: tuple[float, np.ndarray | None, float, str, int] = (math.inf, None, math.nan, "", orbit.stop)
+    found: list[tuple[float, np.ndarray | None, float, str, int]] = []
     for j, ap in enumerate(orbit.approach_by_stop):  # a new impact on any stop
-        if ap is not None and ap[0] < best[0]:
-            best = (ap[0], ap[2], ap[1], "gains an impact", j)
+        if ap is not None:
+            found.append((ap[0], ap[2], ap[1], "gains an impact", j))
     if orbit.impact_states is not None:
         stops = orbit.impact_stops if orbit.impact_stops.size == orbit.impact_times.size else None
         for i, (t, v, x) in enumerate(zip(orbit.impact_times, orbit.impact_speeds, orbit.impact_states)):
             j = int(stops[i]) if stops is not None else 0
             a = abs(orbit.model.normal_accel(x, t, j))
-            delta = v * v / (2 * a) if a > 0 else math.inf
-            if delta < best[0]:
-                best = (delta, x, float(t), "loses an impact", j)
-    return best
+            found.append((v * v / (2 * a) if a > 0 else math.inf, x, float(t), "loses an impact", j))
+    least = min((f[0] for f in found), default=math.inf)
+    if not math.isfinite(least):
+        return (math.inf, None, math.nan, "", orbit.stop)
+    _, x, t, what, stop = min(
+        (f for f in found if f[0] <= least * (1 + GRAZING_TIE)), key=lambda f: (f[4], f[2])
+    )
+    return (least, x, t, what, stop)
 
 
 AHEAD_FACTOR = 2.0
