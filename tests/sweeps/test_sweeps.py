@@ -18,12 +18,13 @@ from hypothesis import strategies as st
 
 import grazing
 from grazing.cli import main
+from grazing.core.period import orbit_impacts
 from grazing.models import pendulum
 from grazing.orbits import find_orbit
 from grazing.sweeps import parameter_map, sweep
 from grazing.sweeps.run import run_chunk
 from grazing.sweeps.spec import SweepSpec
-from grazing.sweeps.store import StoreMismatchError, ZarrStore, orbit_impacts
+from grazing.sweeps.store import StoreMismatchError, ZarrStore
 from tests.sweeps.dask_cluster import loopback_client
 
 DEG = math.pi / 180

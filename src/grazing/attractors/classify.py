@@ -36,6 +36,7 @@ import numpy as np
 from grazing.core.cells import group_by_cells
 from grazing.core.model import ON_STOP_TOL, HybridModel
 from grazing.core.options import BASIN_ADAPTIVE_TOL, CHAOS_THRESHOLD, MATCH_TOL
+from grazing.core.period import orbit_impacts
 from grazing.core.solution import Status
 from grazing.sweeps.spec import ChunkResult
 from grazing.sweeps.status import reason
@@ -301,7 +302,7 @@ class Catalogue:
             k = self.root(k)
             if set_distance(self.entries[k].points, points, self.cell) <= MATCH_TOL:
                 return k
-        impacts = float(res.impacts[row]) / self.periods * p if res.impacts[row] >= 0 else math.nan
+        impacts = float(orbit_impacts(np.array([res.impacts[row]]), np.array([p]), self.periods)[0])
         k = self._new(_Entry("periodic", first, period=p, points=points.copy(), impacts=impacts))
         self._by_period.setdefault(p, []).append(k)
         return k
