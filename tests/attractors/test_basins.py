@@ -10,7 +10,7 @@ from hypothesis import HealthCheck, given, settings
 
 import grazing
 from grazing.attractors import basins, find_attractors, state_grid
-from grazing.attractors.classify import set_distance
+from grazing.attractors.classify import closing_period, set_distance
 from grazing.attractors.grid import start_time
 from grazing.core.options import SWEEP_TOL
 from grazing.core.period import detect_period
@@ -195,6 +195,37 @@ def test_bad_initial_states_are_refused():
         find_attractors(BALL, [[0.0, 1.0]], transients=3)
 
 
+CLASHING_NAMES = ("x1", "v1", "t_0", "v0", "pi", "T", "J", "t", "t_", "x2", "v2", "E", "I", "e", "S", "N",
+                  "lambda", "sin", "cos", "exp", "log", "sqrt", "math", "np", "pv", "s", "x", "out", "h", "k",
+                  "c0", "w0", "p0", "xs0_0", "X", "O", "tau", "Dummy")  # fmt: skip
+"""The names of the two-mass models hypothesis found (tests.random_models draws such clashes)."""
+
+
+def test_a_period_two_orbit_closing_in_slowly_is_not_period_four():
+    """Hypothesis's example: a two-mass model whose period-2 orbit has complex multipliers of modulus
+    about 0.975. After 200 periods its samples repeated with period 4 to the detector's tolerance and
+    closed in on period 2 by only half over 32 samples: 23 of the grid's states were a period-4
+    attractor beside the period-2 one (CLOSING_RATIO)."""
+    spec = ModelSpec(names=CLASHING_NAMES, dof=2, damping=0.15625, stiffness=1.5, amplitude=0.375,
+                     omega=2.875, stop_fraction=0.75, restitution=0.625, coupling=1.0, cubic=0.0,
+                     smooth="erfc")  # fmt: skip
+    model = spec.model()
+    grid = state_grid(model, (-1.5 * spec.stop, 1.2 * spec.stop), (-2.0, 2.0), (6, 6))
+    found = find_attractors(model, grid.states_array(), workers=2, transient=200, periods=32)
+    assert sorted((a.kind, a.period) for a in found.attractors) == [("invalid", -1), ("periodic", 2)]
+    orbit = next(a for a in found.attractors if a.kind == "periodic")
+    x0 = grid.states_array()[int(np.flatnonzero(found.labels == orbit.id)[0])]
+    assert ends_on(model, found, orbit.id, x0, transient=800)
+
+
+def test_closing_period_sees_a_slow_rotation_in_on_a_shorter_period():
+    k = np.arange(32.0)[:, None]
+    two = np.where(k % 2 == 0, 1.0, -1.0)
+    rotating = two + 1e-7 * 0.98**k * np.cos(np.pi * k / 2)  # (repeats with period 4, closes in on 2)
+    assert closing_period(rotating, 4)[0] == 2
+    assert closing_period(two, 2) == (2, 0.0)  # (a period-2 orbit is not closing in on period 1)
+
+
 @settings(max_examples=3, deadline=None, suppress_health_check=list(HealthCheck))
 @given(spec=model_specs())
 def test_random_models(spec: ModelSpec):
@@ -212,12 +243,6 @@ def test_random_models(spec: ModelSpec):
     for k in range(0, x.shape[0], 5):
         if found.labels[k] > 0 and found.attractor(int(found.labels[k])).kind in ("periodic", "sticking"):
             assert ends_on(model, found, int(found.labels[k]), x[k], transient=800), k
-
-
-CLASHING_NAMES = ("x1", "v1", "t_0", "v0", "pi", "T", "J", "t", "t_", "x2", "v2", "E", "I", "e", "S", "N",
-                  "lambda", "sin", "cos", "exp", "log", "sqrt", "math", "np", "pv", "s", "x", "out", "h", "k",
-                  "c0", "w0", "p0", "xs0_0", "X", "O", "tau", "Dummy")  # fmt: skip
-"""The names of the two-mass models hypothesis found (tests.random_models draws such clashes)."""
 
 
 def only_period_one(every: int, transient: int, **values: float) -> None:

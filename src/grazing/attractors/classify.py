@@ -35,7 +35,7 @@ import numpy as np
 
 from grazing.core.cells import group_by_cells
 from grazing.core.model import ON_STOP_TOL, HybridModel
-from grazing.core.options import BASIN_ADAPTIVE_TOL, CHAOS_THRESHOLD, MATCH_TOL
+from grazing.core.options import BASIN_ADAPTIVE_TOL, CHAOS_THRESHOLD, CLOSING_RATIO, MATCH_TOL
 from grazing.core.period import orbit_impacts
 from grazing.core.solution import Status
 from grazing.sweeps.spec import ChunkResult
@@ -451,7 +451,8 @@ def closing_period(samples: np.ndarray, p: int) -> tuple[int, float]:
     how far their last samples are from period ``d`` (0 for ``p``).
 
     They converge to period ``d`` where the differences ``|x[k + d] - x[k]|`` of their last ``p``
-    samples are under half those of their first ``p`` (on a p-periodic orbit they are the same).
+    samples are under :data:`~grazing.core.options.CLOSING_RATIO` of those of their first ``p`` (on a
+    p-periodic orbit they are the same).
 
     Examples
     --------
@@ -462,7 +463,7 @@ def closing_period(samples: np.ndarray, p: int) -> tuple[int, float]:
     """
     for d in (d for d in range(1, p) if p % d == 0):
         diff = np.max(np.abs(samples[d:] - samples[:-d]), axis=1)
-        if diff.size >= 2 * p and np.max(diff[-p:]) < 0.5 * np.max(diff[:p]):
+        if diff.size >= 2 * p and np.max(diff[-p:]) < CLOSING_RATIO * np.max(diff[:p]):
             return d, float(np.max(diff[-p:]))
     return p, 0.0
 
