@@ -53,17 +53,28 @@ def taylor():
     st.floats(-2, 2), st.floats(-2, 2), st.floats(0, 7), st.floats(0.1, 3), st.floats(-1, 1)
 )  # fmt: skip
 def test_taylor_kernel_agrees_with_the_python_text(taylor, x0, y0, s0, w0, c0):
-    """To one ulp: LLVM (here as in numba) rewrites ``x ** 0.5`` (``sqrt(1 + y**2)`` in RHS) as the
-    correctly rounded ``sqrt(x)``, where CPython calls ``pow``, which can be one ulp off (found
-    by hypothesis at x0 = s0 = c0 = 0, y0 = 1.3153: 1.6522626223201962 against 1.652262622320196)."""
+    """To rounding, at the scale of each series: LLVM (here as in numba) rewrites ``x ** 0.5``
+    (``sqrt(1 + y**2)`` in RHS) as the correctly rounded ``sqrt(x)``, where CPython calls ``pow``,
+    which can be one ulp off (found by hypothesis at x0 = s0 = c0 = 0, y0 = 1.3153:
+    1.6522626223201962 against 1.652262622320196).  That ulp goes through the recurrence to the
+    higher coefficients, where sums of terms larger than the coefficient make it several ulps of
+    the coefficient (9 at y0 = 1.8352, also found by hypothesis): each coefficient must agree to
+    :data:`SERIES_EPS` of its series' largest (measured: 2.4)."""
     py, compiled = taylor
     pv = np.array([w0, c0])
     Xp, Op = np.zeros((2, ORDER + 1)), np.zeros((2, ORDER + 1))
     Xc, Oc = np.zeros((2, ORDER + 1)), np.zeros((2, ORDER + 1))
     py(np.array([x0, y0]), s0, pv, Xp, Op)
     compiled(np.array([x0, y0]), s0, pv, Xc, Oc)
-    np.testing.assert_array_max_ulp(Xp, Xc, maxulp=1)
-    np.testing.assert_array_max_ulp(Op, Oc, maxulp=1)
+    for a, b in ((Xp, Xc), (Op, Oc)):
+        scale = np.max(np.abs(a), axis=1, keepdims=True)
+        assert np.all(np.abs(a - b) <= SERIES_EPS * np.finfo(float).eps * scale), (a, b)
+        np.testing.assert_array_max_ulp(a[:, 0], b[:, 0], maxulp=1)  # (the values themselves)
+
+
+SERIES_EPS = 16
+"""Rounding units, of a series' largest coefficient, within which two evaluations of the same
+Taylor recurrence agree when their inputs differ by an ulp."""
 
 
 SCALAR = """
