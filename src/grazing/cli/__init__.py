@@ -121,13 +121,10 @@ def main(argv: list[str] | None = None) -> int:
     except GrazingError as exc:
         error_line(str(exc))
         return EXIT_FAILURE
-    except BrokenPipeError as exc:
-        if output_closed():  # (``grazing sweep --json | head``: the reader has what it wanted)
+    except OSError as exc:
+        if isinstance(exc, BrokenPipeError) and output_closed():  # (``sweep --json | head``: read enough)
             discard_output()
             return EXIT_CLOSED_PIPE
-        error_line(f"{exc.strerror or exc}: {exc.filename or ''}".rstrip(": "))
-        return EXIT_FAILURE
-    except OSError as exc:
         error_line(f"{exc.strerror or exc}: {exc.filename or ''}".rstrip(": "))
         return EXIT_FAILURE
     except MemoryError:
