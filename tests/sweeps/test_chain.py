@@ -12,8 +12,9 @@ from grazing.core.cells import one_attractor
 from grazing.core.options import CHAIN_CELLS, CHAIN_SHIFTS, CHAIN_TOL
 from grazing.models import pendulum, two_sided_oscillator
 from grazing.sweeps import run_sweep, run_sweeps, sweep
-from grazing.sweeps.chain import ChainLine, same_outcome, settle
+from grazing.sweeps.chain import ChainLine, orbit_advance, same_outcome, settle, shifted_start
 from grazing.sweeps.executor import compute_parts
+from grazing.sweeps.run import run_parts
 from grazing.sweeps.spec import ChunkResult, sweep_spec
 from grazing.sweeps.store import MemoryStore, ZarrStore
 from tests.sweeps.dask_cluster import loopback_client
@@ -319,8 +320,9 @@ def test_the_default_sweep_through_chaos_computes_its_points_about_once():
         guess = guess_of[firsts[part[0].points[0]]]
         assert int(guess.period[0]) != int(res.period[0]) or int(res.period[0]) > 0
     shifted = [firsts[part[0].points[0]] for part, _ in shifts]
-    for i in set(shifted):  # from each point of a periodic guess's orbit
-        assert shifted.count(i) == int(guess_of[i].period[0]) in range(2, CHAIN_SHIFTS + 1)
+    for i in set(shifted):  # from points of a periodic guess's orbit, each once
+        starts = [part[0].resume for part, _ in shifts if firsts[part[0].points[0]] == i]
+        assert len(set(starts)) == len(starts) <= int(guess_of[i].period[0]) in range(2, CHAIN_SHIFTS + 1)
     points = sum(len(p[0].points) if p[0] is not spec else 20 for p, _ in log)
     assert points == 200 + len(checks) + sum(len(p[0].points) for p, _ in shifts + runs)
     # none run again from its chain's start, one after the other: every round after the shifts is checks
@@ -457,3 +459,74 @@ def test_the_end_of_each_result_is_worked_out_once(monkeypatch):
     settled(spec, log)
     results = [r for p, r in log if p[0] is spec or len(p[0].points) > 1]  # (guesses, shifts and runs)
     assert len(calls) == len(set(calls)) <= len(results)
+
+
+# Only the shifts a chunk keeps are computed (the default sweep computed 9700 shifts to keep 50 of them).
+
+
+def test_orbit_advance_is_how_far_along_its_orbit_a_point_ends():
+    orbit = np.array([[0.0, 1.0], [1.0, 0.0], [0.5, -0.5]])
+    samples = np.tile(orbit, (10, 1))  # (30 samples of a period-3 orbit, ending at its last point)
+    guess = _result(samples, 3)
+    for m in range(3):
+        assert orbit_advance(guess, _result(np.roll(samples, -m, axis=0), 3), 3) == m
+        nudged = np.roll(samples, -m, axis=0) + 1e-4  # (nearer to that turn of the orbit than to another)
+        assert orbit_advance(guess, _result(nudged, 3), 3) == m
+    assert orbit_advance(guess, _result(samples + 5.0, 3), 3) is None  # (on another orbit)
+    # a period-4 orbit within rounding of a period-2 one: turned by 2 it is itself, which turn is not known
+    twice = np.tile(np.array([[0.0, 1.0], [1.0, 0.0], [0.0, 1.0 + 1e-7], [1.0, 0.0]]), (10, 1))
+    assert orbit_advance(_result(twice, 4), _result(np.roll(twice, -1, axis=0), 4), 4) is None
+    assert orbit_advance(_result(twice, 4), _result(twice, 4), 4) is None
+
+
+TWO_STOPS_3 = (two_sided_oscillator(amp=4.0, r=0.8, zeta=0.02), "omega", np.linspace(1.450, 1.458, 3))
+PENDULUM_3 = (M40, "eta", PENDULUM_ETAS[62:65])
+PENDULUM_2 = (M40, "eta", PENDULUM_ETAS[140:143])
+
+
+@pytest.mark.parametrize(("case", "period"), [(TWO_STOPS_3, 3), (PENDULUM_3, 3), (PENDULUM_2, 2)])
+@pytest.mark.parametrize("settings", [
+    {"transient": 300, "periods": 100}, {"transient": 301, "periods": 100},
+    {"transient": 302, "periods": 64}, {"transient": 301, "periods": 100, "adaptive": False},
+    {"transient": 302, "periods": 100, "lyapunov": True},
+])  # fmt: skip
+def test_a_shift_ends_its_first_point_as_far_along_the_orbit_as_asked(case, period, settings):
+    # A point runs transient + periods periods (an adaptive transient: a number congruent to it modulo the
+    # period; with Lyapunov exponents, the last of them aligning the tangent vectors): from the orbit's
+    # point j its samples are j + transient + periods + 1 points along the orbit from the guess's.
+    model, param, values = case
+    spec = chunked_spec(model, param, values, 3, **settings)
+    guess = run_parts([(spec, 0)])[0]
+    assert int(guess.period[0]) == period
+    for m in range(period):
+        part = (replace_resume(spec, shifted_start(spec, 0, guess, m)), 0)
+        shifted = run_parts([part])[0]
+        assert orbit_advance(guess, shifted, period) == m
+        ahead = guess.samples[0][m:]  # (the guess's samples m periods on)
+        assert np.abs(shifted.samples[0][: len(ahead)] - ahead).max() <= 10 * CHAIN_TOL
+
+
+def replace_resume(spec, start):
+    return type(spec)(**{**spec.__dict__, "resume": start, "chunk_size": 0})
+
+
+@pytest.mark.parametrize("window", [slice(62, 86), slice(120, 200), slice(40, 120)])
+def test_the_shifts_computed_are_those_kept_with_the_same_results(window):
+    # The result a chunk keeps is the one candidate whose first point ends as its check does: computing
+    # only the shift as far along the orbit as the check (and, where the chunk before it moves, as far as
+    # it will be) gives the results of computing every shift, with fewer points.
+    from grazing.sweeps import chain
+
+    spec = chunked_spec(M40, "eta", PENDULUM_ETAS[window], 4)
+    lazy, rounds = settled_by_rounds(spec)
+    every = lambda self, check, p: [k for k in range(p) if k not in self.shifts]  # noqa: E731
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(chain._Chunk, "shifts_wanted", every)
+        eager, eager_rounds = settled_by_rounds(spec)
+    assert_identical(lazy, eager)
+    assert computed(spec, rounds) < computed(spec, eager_rounds)
+
+
+def computed(spec, rounds) -> int:
+    """The points computed in ``rounds`` besides the guesses (of ``spec``'s chunks)."""
+    return sum(len(part[0].points) for parts in rounds for part in parts if part[0] is not spec)

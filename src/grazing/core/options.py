@@ -100,9 +100,9 @@ is run again: a slower answer, not another one."""
 
 CHAIN_SHIFTS = 8
 """A chunk of a sweep whose guess's first point ends on a periodic orbit of period 2 to this, and from
-the chain's state on that orbit at another point of it, is computed from each point of the orbit (in
-parallel, from the guess alone); the one that ends its first point as the chain's state does is kept
-(a guess ends at the chain's point of a period-p orbit only one time in p)."""
+the chain's state on that orbit at another point of it, is computed from the point of the orbit from
+which its first point ends where the chain's state does (from the guess alone: it stands for any start
+that leads there), and kept (a guess ends at the chain's point of a period-p orbit only one time in p)."""
 
 CHAOS_THRESHOLD = 1e-3
 """Largest Lyapunov exponent (per unit time) above which an aperiodic run counts as chaotic; within
