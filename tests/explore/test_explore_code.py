@@ -99,7 +99,7 @@ def test_the_basins_and_grazings_code_prints_what_the_page_shows(
     out = run_python(code.python, tmp_path).splitlines()
     shown = [line.split() for line in out if line.startswith("attractor ")]
     assert [(k, int(p)) for _, k, p, _ in shown] == list(zip(found.kinds, found.periods))
-    fractions = [np.mean(found.label == k) for k in range(len(found.kinds))]
+    fractions = [np.mean(found.label == k) for k in found.ids]
     assert [float(f) for *_, f in shown] == pytest.approx(fractions, abs=1e-6)
     (line,) = [line for line in out if line.startswith("grazings ")]
     assert eval(line[len("grazings ") :]) == pytest.approx([m.value for m in grazings.marks], abs=1e-8)
