@@ -510,14 +510,23 @@ def replace_resume(spec, start):
     return type(spec)(**{**spec.__dict__, "resume": start, "chunk_size": 0})
 
 
-@pytest.mark.parametrize("window", [slice(62, 86), slice(120, 200), slice(40, 120)])
-def test_the_shifts_computed_are_those_kept_with_the_same_results(window):
+SHIFTED = {  # sweeps whose chunks keep shifts: the pendulum's windows, the two-stop oscillator's period 3
+    "pendulum 62-86": (M40, "eta", PENDULUM_ETAS[62:86], {}),
+    "pendulum 120-200": (M40, "eta", PENDULUM_ETAS[120:200], {}),
+    "pendulum 40-120": (M40, "eta", PENDULUM_ETAS[40:120], {}),
+    "two stops": (TWO_STOPS_3[0], "omega", np.linspace(1.445, 1.462, 36), {"transient": 301, "periods": 97}),
+}
+
+
+@pytest.mark.parametrize("name", sorted(SHIFTED))
+def test_the_shifts_computed_are_those_kept_with_the_same_results(name):
     # The result a chunk keeps is the one candidate whose first point ends as its check does: computing
     # only the shift as far along the orbit as the check (and, where the chunk before it moves, as far as
     # it will be) gives the results of computing every shift, with fewer points.
     from grazing.sweeps import chain
 
-    spec = chunked_spec(M40, "eta", PENDULUM_ETAS[window], 4)
+    model, param, values, settings = SHIFTED[name]
+    spec = chunked_spec(model, param, values, 4, **settings)
     lazy, rounds = settled_by_rounds(spec)
     every = lambda self, check, p: [k for k in range(p) if k not in self.shifts]  # noqa: E731
     with pytest.MonkeyPatch.context() as mp:
