@@ -256,7 +256,9 @@ def sweep_lanes(m, cfg, work, points, out):
             dts[lane] = h_acc
             if (run.ks - run.k) * run.T + (run.ss - run.s) <= h_acc:
                 run.n_stick = 0  # (sticking intervals are not recorded)
-                take_samples(m, run, XT[:, :, lane], h_acc, event, is_last, buf[lane], sticks, traj, xe)
+                take_samples(
+                    m, run, XT[:, :, lane], pl[lane], h_acc, event, is_last, buf[lane], sticks, traj, xe
+                )
 
         # The advance of every stepping lane to the end of its accepted part (eval_rows on vectors).
         advance_lanes(m, la, XT, dts, todo, kinds, nvar, acc)

@@ -184,7 +184,7 @@ def integrate(start, pv, cfg, m, out):
 
         # What the step records within (0, h_acc].
         if (r.ks - r.k) * T + (r.ss - r.s) <= h_acc:  # a sample is due on this step (about once a period)
-            take_samples(m, r, X, h_acc, event, is_last, samples, sticks, traj, xe)
+            take_samples(m, r, X, pv, h_acc, event, is_last, samples, sticks, traj, xe)
         if r.recording and traj_dt > 0.0:
             trajectory_points(m, r, X, h_acc, traj, xe, is_last and not event)
         if r.recording and track_min and r.mode == 0 and h_acc > 0.0:

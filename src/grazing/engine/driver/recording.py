@@ -13,6 +13,7 @@ import numpy as np
 from numba import njit
 
 from grazing.engine.driver.calls import guard
+from grazing.engine.driver.impacts import enter_contact
 from grazing.engine.polyroots import horner
 from grazing.engine.stepping import append_pair, append_row, eval_rows, poly_derivative, set_row, set_slice
 
@@ -21,8 +22,12 @@ TRAJECTORY_END_TOL = 1e-9
 
 
 @njit(cache=True, inline="always")
-def take_samples(m, r, X, h_acc, event, is_last, samples, sticks, traj, xe):
+def take_samples(m, r, X, pv, h_acc, event, is_last, samples, sticks, traj, xe):
     """The samples within ``(0, h_acc]`` of the step of run ``r`` (a :data:`.state.RUN_STATE` record).
+
+    A sample taken while sticking is put on the stop's contact manifold
+    (:func:`.impacts.enter_contact`, as the step's end is): the step's
+    polynomial leaves it by its local error.
 
     Updates the sampling state of ``r``: samples taken (into ``samples``, the
     kept ones), the next sample's time, whether the recorded span has started
@@ -42,6 +47,11 @@ def take_samples(m, r, X, h_acc, event, is_last, samples, sticks, traj, xe):
             dt = h_acc
         if r.isamp >= keep_from:
             eval_rows(X, n, order, dt, xe)
+            if r.mode == 1:
+                s = r.s + dt
+                if r.wrap and s >= T:
+                    s -= T
+                enter_contact(m, xe, s, pv, r.stuck)
             set_row(samples, r.isamp - keep_from, 0, xe, n)
         r.isamp += 1
         if r.wrap:

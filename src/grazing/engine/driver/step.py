@@ -8,7 +8,7 @@ import math
 
 from numba import njit
 
-from grazing.engine.driver.impacts import at_event
+from grazing.engine.driver.impacts import at_event, enter_contact
 from grazing.engine.driver.state import STATUS_ZENO
 from grazing.engine.driver.tangent import discontinuity_map, lyapunov_step, shift_period
 
@@ -74,7 +74,7 @@ def accept_step(r, h, ends, u, ev_stop):
 def end_plain_step(r, lyapunov, sensitivities):
     """The end of the step of run ``r`` where only time passes; False (nothing done) where there is more.
 
-    Only time passes at a step without an event, a discontinuity map, the
+    Only time passes at a step without an event, sticking, a discontinuity map, the
     Lyapunov vectors to update (``lyapunov``) or the sensitivities' period
     term at a period boundary (``sensitivities``): the time, steps and
     ``defl`` as :func:`end_step` sets them.  It takes no array: numba counts
@@ -82,7 +82,7 @@ def end_plain_step(r, lyapunov, sensitivities):
     decrement), which at every step cost :func:`end_step`'s callers a tenth of
     their time; :func:`end_step` is called only where it has work to do.
     """
-    if r.event or r.zdm_hit:
+    if r.event or r.zdm_hit or r.mode == 1:  # (sticking: the state is put back on its stop)
         return False
     if r.use_var and r.mode == 0 and (lyapunov or (sensitivities and r.wrap and r.s + r.h_acc >= r.T)):
         return False
@@ -106,7 +106,10 @@ def end_step(m, r, x, X, pv, nrows, cfg, chatter_time, record_impacts, Tp, work,
     rows of ``x`` it advanced.  In order: the time (at a period boundary, the
     sensitivities' period term, ``Tp`` = dT/dp), the Lyapunov vectors (with
     ``cfg.lyapunov``), the discontinuity map (``cfg``'s), the event
-    (:func:`.impacts.at_event`, chattering shorter than ``chatter_time``).
+    (:func:`.impacts.at_event`, chattering shorter than ``chatter_time``) or,
+    sticking without an event, the state put back on the stop's contact
+    manifold (:func:`.impacts.enter_contact`: the integrated state drifts off it
+    by the integrator's error, 4e-9 in a sticking interval of the bouncing ball).
     Impacts (and kicks of the map) are recorded in ``tables`` as
     ``record_impacts`` says (0 none, 1 in the recorded span, 2 all).
     ``work`` holds the buffers ``(xp, V, scratch, logs, xe, gh, gv, f)``.
@@ -134,4 +137,6 @@ def end_step(m, r, x, X, pv, nrows, cfg, chatter_time, record_impacts, Tp, work,
     impact = False
     if r.event:
         impact = at_event(m, r, x, xp, pv, r.ev_stop, nrows, V, chatter_time, record, tables)
+    elif mode == 1:  # sticking: back onto the stop, off which the integration drifts (1e-9 in a period)
+        enter_contact(m, x, r.s, pv, r.stuck)
     return kicked, impact
