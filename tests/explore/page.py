@@ -125,16 +125,17 @@ class ExplorerPage:
     def diagram_pixel(self, value: float) -> dict[str, float]:
         """Where the diagram's scales put ``value`` (display units): page pixels, and the frame's edges.
 
-        Read until two readings 0.2 s apart agree: the frame moves while the page lays itself out
-        (the width of the axis's tick labels changes when the data arrives).
+        Read until three readings 0.2 s apart agree: the frame moves while the page lays itself out
+        (the width of the axis's tick labels changes when the data arrives), and on a loaded
+        machine two readings may agree before it has.
         """
-        last = None
-        for _ in range(100):
+        readings: list[str] = []
+        for _ in range(150):
             found = self.evaluate(_POINT % value)
             assert found, "no diagram on the page"
-            if found == last:
+            readings = [*readings[-2:], found]
+            if len(readings) == 3 and len(set(readings)) == 1:
                 return json.loads(found)
-            last = found
             time.sleep(0.2)
         raise AssertionError("the diagram never stopped moving")
 

@@ -29,10 +29,10 @@ def test_a_click_at_eta_0446_shows_the_period_5_orbit_with_one_impact(tmp_path):
         page.click(where["x"], where["y"])
         text = page.wait_for(r"Floquet multipliers|Newton's method .* failed")
         assert re.search(r"\bperiod 5 with 1 impact per period\b", text), text
-        assert "period-5 orbit with 1 impact, stable" in text
+        assert "period-5 orbit with 1 impact, stable" in text, text
         # the η of the click: within a pixel of 0.446 (the frame is ~600 px wide for 0.05)
         shown = float(re.search(r"(?<![a-z])eta = (0\.\d+)", text).group(1))
-        assert abs(shown - 0.446) < 0.05 / 400
+        assert abs(shown - 0.446) < 0.05 / 400, (shown, where)
     assert page.exit_code == 130
     assert page.stderr.strip() == "grazing: interrupted"
 
