@@ -12,7 +12,7 @@ from grazing.core.cells import one_attractor
 from grazing.core.options import CHAIN_CELLS, CHAIN_SHIFTS, CHAIN_TOL
 from grazing.models import pendulum, two_sided_oscillator
 from grazing.sweeps import run_sweep, run_sweeps, sweep
-from grazing.sweeps.chain import ChainLine, orbit_advance, same_outcome, settle, shifted_start
+from grazing.sweeps.chain import ChainLine, from_start, orbit_advance, same_outcome, settle, shifted_start
 from grazing.sweeps.executor import compute_parts
 from grazing.sweeps.run import run_parts
 from grazing.sweeps.spec import ChunkResult, sweep_spec
@@ -499,15 +499,10 @@ def test_a_shift_ends_its_first_point_as_far_along_the_orbit_as_asked(case, peri
     guess = run_parts([(spec, 0)])[0]
     assert int(guess.period[0]) == period
     for m in range(period):
-        part = (replace_resume(spec, shifted_start(spec, 0, guess, m)), 0)
-        shifted = run_parts([part])[0]
+        shifted = run_parts([from_start(spec, 0, shifted_start(spec, 0, guess, m))])[0]
         assert orbit_advance(guess, shifted, period) == m
         ahead = guess.samples[0][m:]  # (the guess's samples m periods on)
         assert np.abs(shifted.samples[0][: len(ahead)] - ahead).max() <= 10 * CHAIN_TOL
-
-
-def replace_resume(spec, start):
-    return type(spec)(**{**spec.__dict__, "resume": start, "chunk_size": 0})
 
 
 SHIFTED = {  # sweeps whose chunks keep shifts: the pendulum's windows, the two-stop oscillator's period 3

@@ -108,8 +108,8 @@ def end_step(m, r, x, X, pv, nrows, cfg, chatter_time, record_impacts, Tp, work,
     ``cfg.lyapunov``), the discontinuity map (``cfg``'s), the event
     (:func:`.impacts.at_event`, chattering shorter than ``chatter_time``) or,
     sticking without an event, the state put back on the stop's contact
-    manifold (:func:`.impacts.enter_contact`: the integrated state drifts off it
-    by the integrator's error, 4e-9 in a sticking interval of the bouncing ball).
+    manifold (:func:`.impacts.enter_contact`: the integrated state drifted off it
+    step after step, the ball on a table by 3.6e-11 in 300 periods).
     Impacts (and kicks of the map) are recorded in ``tables`` as
     ``record_impacts`` says (0 none, 1 in the recorded span, 2 all).
     ``work`` holds the buffers ``(xp, V, scratch, logs, xe, gh, gv, f)``.
@@ -137,6 +137,6 @@ def end_step(m, r, x, X, pv, nrows, cfg, chatter_time, record_impacts, Tp, work,
     impact = False
     if r.event:
         impact = at_event(m, r, x, xp, pv, r.ev_stop, nrows, V, chatter_time, record, tables)
-    elif mode == 1:  # sticking: back onto the stop, off which the integration drifts (1e-9 in a period)
+    elif mode == 1:  # sticking: back onto the stop, off which the integration drifts
         enter_contact(m, x, r.s, pv, r.stuck)
     return kicked, impact
