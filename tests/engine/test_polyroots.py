@@ -8,7 +8,7 @@ from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from numpy.polynomial import polynomial as P  # noqa: N812
 
-from grazing.engine.polyroots import first_root, to_bernstein, work_shape
+from grazing.engine.polyroots import confirm_first_root, first_root, isolate_first_root, to_bernstein, work_shape
 
 
 def _first_root(coeffs):
@@ -53,6 +53,8 @@ def test_bernstein_conversion_exact_for_monomials():
 )
 @example(roots=[0.5, 0.8125, 0.9080984134446282, 0.390625], extra=[])  # (a root at the halving point:
 # Newton's method from the chord's root converged to it, not to the first)
+@example(roots=[0.4765625, 0.484375, 0.5, 0.75], extra=[])  # (issue 42: two roots 0.008 apart, both on
+# halving points; the interval [0.46875, 0.484375] ended at the second with -7e-18 for 0 and went to Newton)
 def test_matches_smallest_simple_root(roots, extra):
     """Random polynomials with known simple roots in (0, 1) and complex/outside ones."""
     roots = sorted(roots)
@@ -138,3 +140,93 @@ def test_polishing_takes_few_newton_steps():
     finally:
         polyroots_globals["horner_with_derivative"] = saved
     assert np.median(counts) <= 6 and max(counts) <= 12, (np.median(counts), max(counts))
+
+
+@st.composite
+def roots_hard_for_subdivision(draw):
+    """Roots in (0, 1) placed where subdivision finds them hardest, with the first one known.
+
+    One of: a pair whose second root is a halving point (``j / 2**L``) and whose first lies
+    within the same halving interval before it (the interval's end coefficient is 0 but for
+    rounding); roots all on halving points; a close pair (1e-4 to 1e-2 apart); plain random
+    roots; each with up to three more roots on halving points or at random.
+    """
+    kind = draw(st.sampled_from(["halving-pair", "dyadic", "close-pair", "random"]))
+    if kind == "halving-pair":
+        level = draw(st.integers(1, 9))
+        second = draw(st.integers(1, 2**level - 1)) / 2**level
+        fraction = draw(st.one_of(st.integers(1, 63).map(lambda k: k / 64), st.floats(0.02, 0.98)))
+        roots = [second - fraction / 2**level, second]
+    elif kind == "dyadic":
+        level = draw(st.integers(1, 10))
+        roots = [k / 2**level for k in draw(st.lists(st.integers(1, 2**level - 1), min_size=1, max_size=4))]
+    elif kind == "close-pair":
+        first = draw(st.floats(0.01, 0.9))
+        roots = [first, first + draw(st.floats(1e-4, 1e-2))]
+    else:
+        roots = draw(st.lists(st.floats(0.01, 0.99), min_size=1, max_size=4))
+    more = draw(
+        st.lists(
+            st.one_of(st.integers(1, 255).map(lambda k: k / 256), st.floats(0.01, 0.99)), max_size=3
+        )
+    )
+    roots = np.unique(np.array(roots + more, dtype=float))
+    return roots[(roots > 0.0) & (roots < 1.0)]
+
+
+def _check_first_root(roots):
+    """The first root found is the smallest of ``roots`` to its conditioning (and never the second)."""
+    if roots.size == 0 or np.min(np.diff(roots), initial=1.0) < 1e-4:
+        return
+    a = P.polyfromroots(roots)
+    if a[0] < 0:
+        a = -a
+    u = _first_root(a)
+    # A root's error from rounding the coefficients: eps sum|a_k| / |p'(root)| (times a margin).
+    slope = abs(P.polyval(roots[0], P.polyder(a)))
+    tol = max(1e-9, 1e4 * np.finfo(float).eps * np.abs(a).sum() / slope)
+    assert abs(u - roots[0]) <= tol, (list(roots), u)
+    if roots.size > 1:
+        assert u < 0.5 * (roots[0] + roots[1])
+
+
+@settings(max_examples=300, deadline=None)
+@given(roots=roots_hard_for_subdivision())
+@example(roots=np.array([0.6378135456416711, 0.640625, 0.734375, 0.9921875]))  # (found at random by the
+# strategy against the code before issue 42's fix, as were the next two)
+@example(roots=np.array([0.70458984375, 0.7109375, 0.75]))
+@example(roots=np.array([0.47072647987476957, 0.4765625, 0.5, 0.75]))
+def test_first_root_whatever_the_roots_positions(roots):
+    _check_first_root(roots)
+
+
+@pytest.mark.slow
+@settings(max_examples=100_000, deadline=None)
+@given(roots=roots_hard_for_subdivision())
+def test_first_root_never_misses_in_100000_polynomials(roots):
+    _check_first_root(roots)
+
+
+def test_the_search_alone_finds_the_first_of_two_roots_on_halving_points():
+    # Without the confirmation: the subdivision itself halves an interval whose end value is zero
+    # but for rounding instead of polishing across two roots.
+    a = P.polyfromroots([0.4765625, 0.484375, 0.5, 0.75])
+    u = isolate_first_root(a, a.size - 1, np.zeros(work_shape(a.size - 1)))
+    assert u == pytest.approx(0.4765625, abs=1e-12)
+
+
+@pytest.mark.parametrize("later", [0.484375, 0.5, 0.75, 0.999])
+def test_the_confirmation_returns_an_earlier_root(later):
+    # The engine's check of a located event: handed a later root (as the search returned before the
+    # fix), it finds the earlier sign change on the step and returns that.
+    a = P.polyfromroots([0.4765625, 0.484375, 0.5, 0.75])
+    work = np.zeros(work_shape(a.size - 1))
+    assert confirm_first_root(a, a.size - 1, later, work) == pytest.approx(0.4765625, abs=1e-11)
+
+
+def test_the_confirmation_keeps_a_first_root_and_no_root():
+    a = P.polyfromroots([0.3, 0.7])
+    work = np.zeros(work_shape(a.size - 1))
+    assert confirm_first_root(a, a.size - 1, 0.3, work) == 0.3
+    assert confirm_first_root(a, a.size - 1, -1.0, work) == -1.0
+    assert confirm_first_root(a, a.size - 1, 0.0, work) == 0.0

@@ -175,7 +175,37 @@ def first_root(a, n, work):
     # Cheap certificate: on [0, 1], p(u) >= min(quadratic part) - sum_{k>=3} |a_k|.
     if quadratic_lower_bound(a, n) > 0.0:
         return -1.0
-    return isolate_first_root(a, n, work)
+    return confirm_first_root(a, n, isolate_first_root(a, n, work), work)
+
+
+ROUNDING_SLACK = 2.0
+"""Bernstein coefficients within ``ROUNDING_SLACK * (n + 1) * eps`` of the largest of the whole step's are
+of unknown sign: to_bernstein's sums and de Casteljau's halvings round them by about that much (a root on
+a halving point, as 0.5 or 0.4765625, leaves ``-7e-18`` where 0 is exact)."""
+
+_EPS = float(np.finfo(np.float64).eps)
+
+
+@njit(cache=True)
+def _most_sign_changes(c, n, tol):
+    """The most sign changes ``c[:n+1]`` can have when each coefficient within ``tol`` of 0 takes either sign.
+
+    ``c[0] > 0`` is taken as positive.  Dynamic programming over the two
+    signs the sequence can end with (-1: impossible).
+    """
+    pos = 0  # most changes of a sequence ending positive
+    neg = -1  # ... ending negative
+    for i in range(1, n + 1):
+        v = c[i]
+        best_pos = max(pos, neg + 1 if neg >= 0 else -1)
+        best_neg = max(neg, pos + 1 if pos >= 0 else -1)
+        if abs(v) <= tol:  # (either sign)
+            pos, neg = best_pos, best_neg
+        elif v > 0.0:
+            pos, neg = best_pos, -1
+        else:
+            pos, neg = -1, best_neg
+    return max(pos, neg)
 
 
 @njit(cache=True)
@@ -185,7 +215,12 @@ def isolate_first_root(a, n, work):
     Requires ``a[0] > 0``.  Bernstein subdivision and Newton polishing; a
     polynomial that certainly decreases on the whole of [0, 1] (the common
     event: a guard crossing zero) goes to Newton's method at once, its one
-    root bracketed by the ends.
+    root bracketed by the ends.  An interval goes to Newton's method only when
+    its one root is certain whatever the rounding of its coefficients
+    (:data:`ROUNDING_SLACK`): its end value clearly below zero and one sign
+    change at most with each near-zero coefficient of either sign.  Otherwise
+    it is halved, so that a root on a halving point (its end value zero but for
+    rounding) with another just before it gives the first, not the second.
     """
     if n >= 2:
         # p'(u) <= a1 + max(0, 2 a2) + sum_{k>=3} k |a_k| on [0, 1]; below zero: p decreases, one root
@@ -201,12 +236,14 @@ def isolate_first_root(a, n, work):
     b = work[0]
     to_bernstein(a, n, b)
     allpos = True
+    scale = 0.0
     for i in range(n + 1):
         if b[i] <= 0.0:
             allpos = False
-            break
+        scale = max(scale, abs(b[i]))
     if allpos:
         return -1.0
+    tol = ROUNDING_SLACK * (n + 1) * _EPS * scale
     # Depth-first search, left half first.  Stack rows hold Bernstein
     # coefficients; intervals are kept in parallel arrays.
     stack_lo = work[_MAX_DEPTH + 5]
@@ -230,19 +267,25 @@ def isolate_first_root(a, n, work):
         # Sign variations and positivity.
         nvar = 0
         allpos = True
+        inner_clear = True  # c[1..n-1] clearly positive
         last = 1.0
         for i in range(n + 1):
             v = c[i]
             if v <= 0.0:
                 allpos = False
+            if 0 < i < n and v <= tol:
+                inner_clear = False
             if v != 0.0:
                 if (v > 0.0) != (last > 0.0):
                     nvar += 1
                 last = v
         if allpos:
             continue
-        if nvar == 1 and c[n] <= 0.0:  # (a Bernstein polynomial's end coefficients are its end values)
+        if c[n] < -tol and _most_sign_changes(c, n, tol) == 1:
+            # (a Bernstein polynomial's end coefficients are its end values: one root, bracketed)
             return _polish(a, n, lo, hi, c[0], c[n])
+        if c[n] <= 0.0 and inner_clear:  # positive up to hi, zero there but for rounding
+            return hi
         if nvar == 0:
             # Coefficients >= 0 with zeros: the polynomial touches zero at most
             # at an endpoint; hi is checked by the next interval.
@@ -270,6 +313,40 @@ def isolate_first_root(a, n, work):
     return -1.0
 
 
+CONFIRM_GAP = 1e-12
+""":func:`confirm_first_root` looks for an earlier root on ``[0, u (1 - CONFIRM_GAP)]``: one closer to the
+root found than that is the same event to the engine's accuracy of event times."""
+
+
+@njit(cache=True)
+def confirm_first_root(a, n, u, work):
+    """``u``, or the polynomial's first root before it: the check that a located root is the first.
+
+    Given ``u``, the first root :func:`isolate_first_root` found of ``a[:n+1]``
+    (``a[0] > 0``), the polynomial is rescaled to ``[0, u (1 - CONFIRM_GAP)]``
+    and searched again.  A root there means the search returned a later one
+    (a crossing and its return within one step located at the return); the
+    earlier one is returned.  ``u < 0`` (no root) is returned as it is.  The
+    rescaled copy lives in the last row of ``work``.
+    """
+    if u <= 0.0:
+        return u
+    for _ in range(4):  # (each pass either confirms or moves to an earlier root)
+        s = u * (1.0 - CONFIRM_GAP)
+        q = work[_MAX_DEPTH + 7]
+        sk = 1.0
+        for k in range(n + 1):
+            q[k] = a[k] * sk
+            sk *= s
+        if quadratic_lower_bound(q, n) > 0.0:
+            return u
+        v = isolate_first_root(q, n, work)
+        if v < 0.0 or v >= 1.0:
+            return u
+        u = s * v
+    return u
+
+
 def work_shape(n: int) -> tuple[int, int]:
     """Shape of the ``work`` array needed by :func:`first_root` for degree ``n``."""
-    return (_MAX_DEPTH + 7, max(n + 1, _MAX_DEPTH + 2))
+    return (_MAX_DEPTH + 8, max(n + 1, _MAX_DEPTH + 2))

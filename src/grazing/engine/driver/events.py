@@ -15,7 +15,7 @@ import math  # noqa: F401 - the names the pieces share in the generated module
 import numpy as np  # noqa: F401
 from numba import njit
 
-from grazing.engine.polyroots import isolate_first_root, quadratic_bound
+from grazing.engine.polyroots import confirm_first_root, isolate_first_root, quadratic_bound
 from grazing.engine.stepping import divide_double_root_at_one
 
 
@@ -69,7 +69,8 @@ def event_certificate(a, tail):
 
     A quadratic lower bound on scalars (``tail`` bounds the terms of degree 3
     and more) clears most steps; the rest (1) need Bernstein subdivision
-    (``isolate_first_root``), which the loop calls.
+    (``isolate_first_root``), which the loop calls, and the root it finds is checked to be the first
+    (``confirm_first_root``: no earlier sign change of the guard on the step).
     """
     if a[0] <= 0.0:
         return 0.0
@@ -104,7 +105,7 @@ def first_event(m, run, O, h, events, skip, end_contact, end_stop, a, work):
         deg, tail = event_polynomial(O, r, h, 1 if force else 0, defl_r, end_r, a, m.order)
         ur = event_certificate(a, tail)
         if ur > 0.0:  # rarely: the certificate cannot exclude a root on the step
-            ur = isolate_first_root(a, deg, work)
+            ur = confirm_first_root(a, deg, isolate_first_root(a, deg, work), work)
         if ur >= 0.0 and (u < 0.0 or ur < u):
             u = ur
             stop = r
