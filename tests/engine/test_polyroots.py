@@ -8,7 +8,13 @@ from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from numpy.polynomial import polynomial as P  # noqa: N812
 
-from grazing.engine.polyroots import confirm_first_root, first_root, isolate_first_root, to_bernstein, work_shape
+from grazing.engine.polyroots import (
+    confirm_first_root,
+    first_root,
+    isolate_first_root,
+    to_bernstein,
+    work_shape,
+)
 
 
 def _first_root(coeffs):
@@ -166,9 +172,7 @@ def roots_hard_for_subdivision(draw):
     else:
         roots = draw(st.lists(st.floats(0.01, 0.99), min_size=1, max_size=4))
     more = draw(
-        st.lists(
-            st.one_of(st.integers(1, 255).map(lambda k: k / 256), st.floats(0.01, 0.99)), max_size=3
-        )
+        st.lists(st.one_of(st.integers(1, 255).map(lambda k: k / 256), st.floats(0.01, 0.99)), max_size=3)
     )
     roots = np.unique(np.array(roots + more, dtype=float))
     return roots[(roots > 0.0) & (roots < 1.0)]
