@@ -407,6 +407,7 @@ def continue_(
                 **({"stop": model.stop_names[sp_.stop]} if sp_.kind == "grazing" else {}),
                 **({"between": [back(v) for v in sp_.between]} if sp_.between is not None else {}),
                 **({"note": sp_.note} if sp_.note else {}),
+                **({"angle": sp_.angle} if sp_.kind == "neimark-sacker" else {}),
                 "index": sp_.index,
                 "multipliers": complex_list(sp_.multipliers),
                 "state": sp_.orbit.state,
@@ -439,7 +440,10 @@ def continue_(
         mu = multipliers_text(sp_["multipliers"])
         on = f" (stop {sp_['stop']})" if sp_.get("stop", "stop") != "stop" else ""  # as graze prints it
         switched = "   (switched here)" if point.switched else (f"   ({point.note})" if point.note else "")
-        click.echo(f"  {sp_['kind']:16s} {par.show(point.param, '.8g')}   multipliers {mu}{on}{switched}")
+        angle = f"   angle {point.angle:.6g} rad" if "angle" in sp_ else ""
+        click.echo(
+            f"  {sp_['kind']:16s} {par.show(point.param, '.8g')}   multipliers {mu}{angle}{on}{switched}"
+        )
     if segs > 1:
         for i, (origin, status) in enumerate(zip(branch.segment_origin, branch.segment_status)):
             at = branch.special[origin] if origin >= 0 else None

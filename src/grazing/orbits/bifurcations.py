@@ -14,8 +14,14 @@ between them:
   transcritical); it does not change sign at a fold (Keller 1977; Kuznetsov,
   *Elements of Applied Bifurcation Theory*, sec. 10.2);
 * ``det(P_x + I)``: a multiplier passes through -1 (period-doubling);
-* ``det(P_x) - 1`` with a complex pair: a pair crosses the unit circle
-  (Neimark-Sacker; 2-D maps).
+* ``det(P_x (.) P_x - I)``, the bialternate product's (its eigenvalues are the
+  products ``mu_i mu_j``, ``i < j``; for two states ``det(P_x) - 1``), as
+  ``prod (mu_i mu_j - 1) / (1 + |mu_i mu_j|)``: a complex pair crosses the unit
+  circle (Neimark-Sacker), in any dimension.  It also changes sign where two
+  real multipliers' product passes through 1 (a *neutral saddle*, ``mu`` and
+  ``1/mu``: no multiplier crosses the circle there); a point located where the
+  pair is real is that, and neither reported nor missed (Kuznetsov, sec. 10.3;
+  MatCont does the same).
 
 A multiplier through +1 where the parameter turns is a fold; where the
 pseudo-arclength determinant changes sign it is a branch point (the parameter
@@ -30,8 +36,8 @@ at a fold, at a branch point where the parameter does not turn and at a
 period-doubling, by none at a branch point where it turns, and by two at a
 Neimark-Sacker point; a multiplier within ``core.options.UNIT_CIRCLE_TOL`` of the
 circle is on it, not outside (an area-preserving map, of a conservative model,
-keeps its complex pairs there, and ``det(P_x) - 1`` is then no test function:
-:data:`AREA_PRESERVING_TOL`).  A change between two points that the located points do
+keeps its complex pairs there, a pair's product is 1 all along, and the
+Neimark-Sacker test function is then no test: :data:`AREA_PRESERVING_TOL`).  A change between two points that the located points do
 not explain, or a test function that changed sign where no point could be
 located, is an *unlocated* stability change, reported as such: never silent.
 """
@@ -56,11 +62,103 @@ CROSSINGS = {"fold": 1, "branch point": 1, "period-doubling": 1, "neimark-sacker
 turns: none)."""
 
 AREA_PRESERVING_TOL = 2 * UNIT_CIRCLE_TOL
-"""Where ``|det(P_x) - 1|`` is below this the map preserves area (a conservative model) and the
-Neimark-Sacker test function ``det(P_x) - 1`` says nothing (a pair on the unit circle stays on it)."""
+"""Where some product of two multipliers ``mu_i mu_j`` is within this of 1 at both ends of a step the
+map preserves area there (a conservative model, or a conservative part of one: ``det(P_x) = 1`` for two
+states) and the Neimark-Sacker test function says nothing (a pair on the unit circle stays on it)."""
 
 VERIFY_TOL = 1e-5
 """A located point's multiplier must lie this close to its defining value (+1, -1, the unit circle)."""
+
+
+def pair_products(multipliers: np.ndarray) -> tuple[np.ndarray, list[tuple[int, int]]]:
+    """The products ``mu_i mu_j`` (``i < j``) of the multipliers, and their index pairs.
+
+    They are the eigenvalues of the bialternate product ``P_x (.) P_x``.
+
+    Examples
+    --------
+    >>> prods, pairs = pair_products(np.array([2.0, 0.5, 0.25]))
+    >>> prods.real.tolist(), pairs
+    ([1.0, 0.5, 0.125], [(0, 1), (0, 2), (1, 2)])
+    """
+    mu = np.asarray(multipliers, dtype=complex)
+    pairs = [(i, j) for i in range(mu.size) for j in range(i + 1, mu.size)]
+    prods = np.array([mu[i] * mu[j] for i, j in pairs], dtype=complex)
+    return prods, pairs
+
+
+def neimark_sacker_test(multipliers: np.ndarray) -> float:
+    """Zero where two multipliers' product is 1, of the sign of ``det(P_x (.) P_x - I)``.
+
+    With the factors ``q_ij = (mu_i mu_j - 1) / (1 + |mu_i mu_j|)`` (``i < j``; the eigenvalues of
+    ``P_x (.) P_x - I``, each scaled into the unit disc): the sign of ``prod q_ij`` (the
+    determinant's), times ``min |q_ij|``.  Continuous (where the smallest factor changes, the
+    product's sign does not), equal to ``+-q`` of the critical pair near a crossing, so that a
+    tolerance on it is one on ``|mu|^2 - 1`` whatever the dimension (the product itself shrinks with
+    every factor: 15 for six states).  Its sign changes where a complex pair crosses the unit circle
+    (and where a real pair's product passes through 1, a neutral saddle).  For two states
+    ``(det P_x - 1) / (1 + |det P_x|)``.  1 for a single multiplier.
+
+    Examples
+    --------
+    >>> inside = np.array([0.9 * np.exp(0.5j), 0.9 * np.exp(-0.5j), 0.3, -0.2])
+    >>> outside = np.array([1.1 * np.exp(0.5j), 1.1 * np.exp(-0.5j), 0.3, -0.2])
+    >>> neimark_sacker_test(inside) * neimark_sacker_test(outside) < 0
+    True
+    >>> round(neimark_sacker_test(np.array([np.exp(1j), np.exp(-1j), 0.5, 0.4]) * (1 + 1e-6)), 9)
+    1e-06
+    """
+    prods, _ = pair_products(multipliers)
+    if not prods.size:
+        return 1.0
+    q = (prods - 1.0) / (1.0 + np.abs(prods))
+    return math.copysign(float(np.min(np.abs(q))), float(np.prod(q).real))
+
+
+def critical_pair(multipliers: np.ndarray) -> tuple[int, int]:
+    """The two multipliers whose product is closest to 1 (a Neimark-Sacker point's pair)."""
+    prods, pairs = pair_products(multipliers)
+    return pairs[int(np.argmin(np.abs(prods - 1.0)))]
+
+
+def neimark_sacker_angle(multipliers: np.ndarray) -> float:
+    """The angle ``arg mu`` in ``(0, pi)`` of the complex pair whose product is closest to 1 (nan: none).
+
+    At a Neimark-Sacker point the pair is ``exp(+-i angle)``; the rotation number of the torus born
+    there is near ``angle / (2 pi)`` (strong resonances at ``2 pi / k``, ``k <= 4``).
+
+    Examples
+    --------
+    >>> round(neimark_sacker_angle(np.array([np.exp(0.7j), np.exp(-0.7j), 0.2])), 12)
+    0.7
+    """
+    mu = np.asarray(multipliers, dtype=complex)
+    i, j = critical_pair(mu)
+    if not _conjugate_pair(mu[i], mu[j]):
+        return math.nan
+    return float(abs(np.angle(mu[i])))
+
+
+def _conjugate_pair(a: complex, b: complex) -> bool:
+    """``a`` and ``b`` are a complex-conjugate pair (not two real multipliers)."""
+    return abs(a.imag) > COMPLEX_TOL * max(1.0, abs(a)) and abs(a - b.conjugate()) <= 1e-6 * max(1.0, abs(a))
+
+
+COMPLEX_TOL = 1e-9
+"""A multiplier whose imaginary part is below this (relative to ``max(1, |mu|)``) is real."""
+
+
+def area_preserving(orbit: PeriodicOrbit) -> bool:
+    """Some product of two multipliers is 1 to :data:`AREA_PRESERVING_TOL` (no Neimark-Sacker test there)."""
+    prods, _ = pair_products(orbit.multipliers)
+    return bool(prods.size and np.min(np.abs(prods - 1.0)) <= AREA_PRESERVING_TOL)
+
+
+def neutral_saddle(orbit: PeriodicOrbit) -> bool:
+    """The multipliers' product closest to 1 is of two real ones (``mu``, ``1/mu``): not a bifurcation."""
+    mu = orbit.multipliers
+    i, j = critical_pair(mu)
+    return not _conjugate_pair(mu[i], mu[j]) and abs(mu[i] * mu[j] - 1.0) < VERIFY_TOL
 
 
 def orbit_test(kind: str, orbit: PeriodicOrbit) -> float:
@@ -72,10 +170,7 @@ def orbit_test(kind: str, orbit: PeriodicOrbit) -> float:
     if kind == "period-doubling":
         return float(np.linalg.det(J + eye))
     if kind == "neimark-sacker":
-        complex_pair = bool(np.any(np.abs(orbit.multipliers.imag) > 1e-12))
-        area = float(np.linalg.det(J) - 1.0)
-        # (an area-preserving map keeps a complex pair on the circle: det - 1 is rounding, no test)
-        return area if complex_pair and abs(area) > AREA_PRESERVING_TOL else math.nan
+        return neimark_sacker_test(orbit.multipliers)
     raise ValueError(f"unknown special point kind {kind!r}")
 
 
@@ -93,8 +188,10 @@ def verified(kind: str, orbit: PeriodicOrbit) -> bool:
     if kind == "period-doubling":
         return bool(np.min(np.abs(mu + 1.0)) < VERIFY_TOL)
     if kind == "neimark-sacker":
-        pair = mu[np.abs(mu.imag) > 1e-12]
-        return bool(pair.size and np.min(np.abs(np.abs(pair) - 1.0)) < VERIFY_TOL)
+        if mu.size < 2:
+            return False
+        i, j = critical_pair(mu)
+        return _conjugate_pair(mu[i], mu[j]) and abs(abs(mu[i]) - 1.0) < VERIFY_TOL
     return True
 
 
@@ -179,7 +276,7 @@ _MISSED = {
     "fold or branch point": "a multiplier passes through +1 (det(P_x - I) changes sign) where the parameter "
     "does not turn and no branch point is detected",
     "period-doubling": "a multiplier passes through -1 (det(P_x + I) changes sign)",
-    "neimark-sacker": "a complex pair crosses the unit circle (det(P_x) - 1 changes sign)",
+    "neimark-sacker": "a complex pair crosses the unit circle (det(P_x (.) P_x - I) changes sign)",
 }
 
 
@@ -219,9 +316,13 @@ def between(evaluate: BranchEquations, a: PalcPoint, b: PalcPoint, s: PalcSettin
     for kind in ("period-doubling", "neimark-sacker"):
         if not sign_changed(orbit_test(kind, oa), orbit_test(kind, ob)):
             continue
+        if kind == "neimark-sacker" and area_preserving(oa) and area_preserving(ob):
+            continue  # (a pair's product is 1 all along: the sign is rounding's)
         loc = locate(evaluate, a, b, lambda p, k=kind: orbit_test(k, p.payload), s)  # type: ignore[misc]
         if loc is not None and verified(kind, loc.payload):
             found.append(Located(kind, loc))
+        elif kind == "neimark-sacker" and loc is not None and neutral_saddle(loc.payload):
+            continue  # (two real multipliers mu, 1/mu: none crosses the circle)
         else:
             missed.append(kind)
     found.sort(key=lambda loc: float(np.linalg.norm(loc.point.u - a.u)))

@@ -66,7 +66,7 @@ import numpy as np
 from grazing.core.model import HybridModel
 from grazing.core.options import MAX_PERIOD
 from grazing.errors import ConvergenceError, GrazingError, InvalidParameterError
-from grazing.orbits.bifurcations import Located, between, orbit_test, verified
+from grazing.orbits.bifurcations import Located, between, neimark_sacker_angle, orbit_test, verified
 from grazing.orbits.branch_equations import branch_equations
 from grazing.orbits.contact import GrazingPoint, refine_grazing
 from grazing.orbits.palc import (
@@ -169,6 +169,12 @@ class SpecialPoint:
     def multipliers(self) -> np.ndarray:
         """Floquet multipliers at the point (of the grazing orbit for a grazing)."""
         return self.grazing.multipliers if self.grazing is not None else self.orbit.multipliers
+
+    @property
+    def angle(self) -> float:
+        """For a Neimark-Sacker point: the angle ``theta`` in ``(0, pi)`` of its pair ``exp(+-i theta)`` on
+        the unit circle, in radians (:func:`~grazing.orbits.bifurcations.neimark_sacker_angle`); else nan."""
+        return neimark_sacker_angle(self.multipliers) if self.kind == "neimark-sacker" else math.nan
 
 
 @dataclass

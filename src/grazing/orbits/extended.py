@@ -129,9 +129,22 @@ def _through(mu: np.ndarray, z: float) -> float:
 
 
 def _pair_on_circle(mu: np.ndarray) -> float:
-    """``|mu|^2 - 1`` of the one complex pair among ``mu`` (nan unless there is exactly one)."""
+    """``prod (|mu|^2 - 1) / (1 + |mu|^2)`` over the complex pairs among ``mu`` (nan where there is none).
+
+    Zero where one pair is on the unit circle, whatever the number of pairs (a model of three or more
+    degrees of freedom has several); each factor scaled into ``(-1, 1)``.
+
+    Examples
+    --------
+    >>> two = np.array([1.1 * np.exp(0.4j), 1.1 * np.exp(-0.4j), 0.5 * np.exp(2j), 0.5 * np.exp(-2j)])
+    >>> _pair_on_circle(two) < 0, _pair_on_circle(np.array([0.5, 0.2]))
+    (True, nan)
+    """
     upper = mu[mu.imag > 1e-12]
-    return float(abs(upper[0]) ** 2 - 1.0) if upper.size == 1 else math.nan
+    if not upper.size:
+        return math.nan
+    m2 = np.abs(upper) ** 2
+    return float(np.prod((m2 - 1.0) / (1.0 + m2)))
 
 
 CODIM2_TESTS: dict[str, tuple[str, ...]] = {

@@ -1,0 +1,169 @@
+"""Neimark-Sacker points of models of any dimension, against an exact linear reference.
+
+The test function is the bialternate product's (``det(P_x (.) P_x - I)``, as
+``sign * min |mu_i mu_j - 1| / (1 + |mu_i mu_j|)``), which for two states is
+``det(P_x) - 1`` and for more states is not: on the impact damper (4 states)
+``det(P_x) - 1`` is about -0.9 on both sides of its Neimark-Sacker point
+(issue 42).  The references are built from matrix exponentials
+(:mod:`tests.linear_exact`), not from grazing's engine.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from grazing.cli import main
+from grazing.orbits import continue_orbit, follow_curve
+from grazing.orbits.bifurcations import (
+    neimark_sacker_angle,
+    neimark_sacker_test,
+    neutral_saddle,
+    verified,
+)
+from grazing.orbits.bordered import bialternate
+from tests.linear_exact import (
+    damper,
+    damper_matrices,
+    neimark_sacker_parameter,
+    six_state_matrices,
+    six_state_model,
+)
+
+
+def _only_neimark_sacker(branch):
+    kinds = [sp.kind for sp in branch.special]
+    assert kinds == ["neimark-sacker"], (kinds, [sp.note for sp in branch.special])
+    return branch.special[0]
+
+
+@pytest.mark.parametrize(
+    ("states", "make", "reference", "param"),
+    [
+        (4, lambda: damper(omega=1.2), lambda m: damper_matrices(m.params["omega"]), "omega"),
+        (6, lambda: six_state_model(Om=1.2), six_state_matrices, "Om"),
+    ],
+    ids=["impact-damper", "six-states"],
+)
+def test_the_neimark_sacker_point_is_located_on_models_of_more_than_two_states(states, make, reference, param):
+    model = make()
+    assert model.n_states == states
+    branch = continue_orbit(model, param, 1.2, 1.45)
+    ns = _only_neimark_sacker(branch)  # (no "unlocated stability change": issue 42's report)
+    orbit = ns.orbit
+    # The orbit there is the exact one: the reference's fixed point and monodromy at the same parameter.
+    ref = reference(orbit.model)
+    x, J = ref.periodic_orbit(orbit.state, orbit.t0)
+    np.testing.assert_allclose(orbit.state, x, atol=1e-12)
+    np.testing.assert_allclose(orbit.monodromy, J, atol=1e-11)
+    # det(P_x) - 1, the old test function, is far from zero and does not change sign there.
+    assert abs(np.linalg.det(orbit.monodromy) - 1.0) > 0.5
+    # Located to Newton tolerance: the parameter where the exact map's pair is on the circle.
+    p_ref, mu_ref = neimark_sacker_parameter(
+        lambda p: reference(orbit.model.with_params(**{param: p})), ns.param - 1e-3, ns.param + 1e-3,
+        orbit.state, orbit.t0,
+    )  # fmt: skip
+    assert ns.param == pytest.approx(p_ref, abs=1e-9)
+    assert ns.angle == pytest.approx(abs(np.angle(mu_ref)), abs=1e-9)
+    pair = orbit.multipliers[np.argmin(np.abs(np.abs(orbit.multipliers) - 1.0))]
+    assert abs(abs(pair) - 1.0) < 1e-8
+    # Stable before it, two multipliers outside the circle after it.
+    assert branch.orbits[ns.index].unstable_count == 0 and branch.orbits[-1].unstable_count == 2
+
+
+def test_the_neimark_sacker_curve_of_a_four_state_model_keeps_its_pair_on_the_circle():
+    model = damper(omega=1.2)
+    curve = follow_curve(model, "neimark-sacker", "omega", 1.2, 1.45, "r", (0.7, 0.9))
+    assert len(curve.points) >= 5
+    for point in curve.points:
+        mu = np.asarray(point.multipliers)
+        assert np.min(np.abs(np.abs(mu) - 1.0)) < 1e-8
+    # Each point is a Neimark-Sacker point of the exact map too: the reference's pair on the circle.
+    for point in curve.points[:: max(1, len(curve.points) // 4)]:
+        omega, r = point.values
+        ref = damper_matrices(omega, r=r)
+        _, J = ref.periodic_orbit(np.asarray(point.state), point.section_time)
+        mu = np.linalg.eigvals(J)
+        assert np.min(np.abs(np.abs(mu) - 1.0)) < 1e-8
+
+
+def test_grazing_continue_and_curve_report_the_neimark_sacker_point_with_its_angle(capsys):
+    argv = ["--model", "impact-damper", "--set", "mu=0.3", "--set", "r=0.8", "--param", "omega"]
+    code = main(["continue", *argv, "--start", "1.2", "--stop", "1.45", "--json"])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    special = json.loads(out)["special"]
+    assert [sp["kind"] for sp in special] == ["neimark-sacker"]
+    assert special[0]["value"] == pytest.approx(1.40918347113, abs=1e-9)  # (the exact reference's)
+    assert special[0]["angle"] == pytest.approx(2.7714078182, abs=1e-9)
+    code = main(["continue", *argv, "--start", "1.2", "--stop", "1.45"])
+    out, err = capsys.readouterr()
+    assert code == 0 and "unlocated" not in out and "angle 2.77141 rad" in out, out
+    code = main(
+        ["curve", *argv, "--kind", "neimark-sacker", "--start", "1.2", "--stop", "1.45",
+         "--param2", "r", "--range", "0.75,0.85", "--json"]
+    )  # fmt: skip
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    points = json.loads(out)["points"]
+    assert len(points) >= 3 and {p["r"] for p in points} >= {0.75, 0.85}
+
+
+# ----------------------------------------------------------------------------
+# The test function itself
+
+
+@st.composite
+def spectra(draw):
+    """Real matrices of 2 to 6 states with chosen multipliers: complex pairs and real ones."""
+    n = draw(st.integers(2, 6))
+    blocks, mus = [], []
+    while sum(b.shape[0] for b in blocks) < n:
+        if n - sum(b.shape[0] for b in blocks) >= 2 and draw(st.booleans()):
+            rho, th = draw(st.floats(0.2, 1.8)), draw(st.floats(0.1, 3.0))
+            a, b = rho * math.cos(th), rho * math.sin(th)
+            blocks.append(np.array([[a, -b], [b, a]]))
+            mus += [complex(a, b), complex(a, -b)]
+        else:
+            mu = draw(st.floats(0.1, 2.5)) * draw(st.sampled_from([1.0, -1.0]))
+            blocks.append(np.array([[mu]]))
+            mus.append(complex(mu))
+    D = np.zeros((n, n))
+    k = 0
+    for b in blocks:
+        D[k : k + b.shape[0], k : k + b.shape[0]] = b
+        k += b.shape[0]
+    rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
+    V = rng.normal(size=(n, n)) + 3 * np.eye(n)
+    return V @ D @ np.linalg.inv(V), np.array(mus)
+
+
+@settings(max_examples=200, deadline=None)
+@given(spectra())
+def test_the_test_function_has_the_sign_of_the_bialternate_determinant(case):
+    M, mu = case
+    n = M.shape[0]
+    det = np.linalg.det(bialternate(M, M) - np.eye(n * (n - 1) // 2))
+    prods = [mu[i] * mu[j] for i in range(n) for j in range(i + 1, n)]
+    if min(abs(p - 1.0) for p in prods) < 1e-3:  # (the sign there is rounding's)
+        return
+    value = neimark_sacker_test(np.linalg.eigvals(M))
+    assert np.sign(value) == np.sign(det)
+    assert abs(value) == pytest.approx(min(abs(p - 1.0) / (1 + abs(p)) for p in prods), rel=1e-6)
+
+
+def test_a_neutral_saddle_is_neither_a_neimark_sacker_point_nor_missed():
+    # Two real multipliers mu, 1/mu: the test function vanishes, no multiplier is on the circle.
+    saddle = SimpleNamespace(multipliers=np.array([3.0, 1 / 3.0, 0.2 + 0.1j, 0.2 - 0.1j]))
+    assert abs(neimark_sacker_test(saddle.multipliers)) < 1e-15
+    assert neutral_saddle(saddle) and not verified("neimark-sacker", saddle)
+    assert math.isnan(neimark_sacker_angle(saddle.multipliers))
+    torus = SimpleNamespace(multipliers=np.array([np.exp(0.9j), np.exp(-0.9j), 3.0, 0.2]))
+    assert verified("neimark-sacker", torus) and not neutral_saddle(torus)
+    assert neimark_sacker_angle(torus.multipliers) == pytest.approx(0.9, abs=1e-15)
