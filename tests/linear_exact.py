@@ -69,7 +69,7 @@ class LinearImpactModel:
 
     def first_impact(self, x0: np.ndarray, t0: float, t1: float, skip: int) -> tuple[float, int] | None:
         """The first impact in ``(t0, t1]`` (time, stop), ``skip`` the stop just left (-1: none)."""
-        n = max(4, int(math.ceil((t1 - t0) / self.period * SAMPLES_PER_PERIOD)))
+        n = max(4, math.ceil((t1 - t0) / self.period * SAMPLES_PER_PERIOD))
         ts = np.linspace(t0, t1, n + 1)
         # x(t) on the grid: exp(A k dt) by repeated multiplication
         E = expm(self.A * (ts[1] - ts[0]))
@@ -111,7 +111,9 @@ class LinearImpactModel:
             impacts.append((ti, j))
             x, t, skip = xp, ti, j
 
-    def periodic_orbit(self, x0: np.ndarray, t0: float = 0.0, periods: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    def periodic_orbit(
+        self, x0: np.ndarray, t0: float = 0.0, periods: int = 1
+    ) -> tuple[np.ndarray, np.ndarray]:
         """The fixed point of ``P^n`` near ``x0`` (Newton) and its monodromy."""
         x = np.array(x0, dtype=float)
         for _ in range(30):

@@ -51,7 +51,7 @@ def _only_neimark_sacker(branch):
     ],
     ids=["impact-damper", "six-states"],
 )
-def test_the_neimark_sacker_point_is_located_on_models_of_more_than_two_states(states, make, reference, param):
+def test_the_neimark_sacker_point_is_located_on_models_of_more_states(states, make, reference, param):
     model = make()
     assert model.n_states == states
     branch = continue_orbit(model, param, 1.2, 1.45)

@@ -37,9 +37,10 @@ period-doubling, by none at a branch point where it turns, and by two at a
 Neimark-Sacker point; a multiplier within ``core.options.UNIT_CIRCLE_TOL`` of the
 circle is on it, not outside (an area-preserving map, of a conservative model,
 keeps its complex pairs there, a pair's product is 1 all along, and the
-Neimark-Sacker test function is then no test: :data:`AREA_PRESERVING_TOL`).  A change between two points that the located points do
-not explain, or a test function that changed sign where no point could be
-located, is an *unlocated* stability change, reported as such: never silent.
+Neimark-Sacker test function is then no test: :data:`AREA_PRESERVING_TOL`).
+A change between two points that the located points do not explain, or a test
+function that changed sign where no point could be located, is an *unlocated*
+stability change, reported as such: never silent.
 """
 
 from __future__ import annotations
