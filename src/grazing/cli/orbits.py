@@ -37,6 +37,17 @@ from grazing.errors import GrazingWarning
 from grazing.models.pendulum import max_angle
 
 
+def not_isolated_note(orbit: Any) -> str:
+    """One line on an orbit that is not isolated (``orbit.isolated`` false)."""
+    from grazing.orbits.shooting import kept_directions
+
+    what = "a plane of periodic states" if kept_directions(orbit.monodromy) >= 2 else "a Jordan block"
+    return (
+        f"the orbit is not isolated (its multiplier 1 is double: {what}), so it is neither stable nor "
+        "unstable and no branch can be continued from it"
+    )
+
+
 def _orbit_json(orbit: Any) -> dict[str, Any]:
     out = {
         "period": orbit.period,
@@ -45,6 +56,7 @@ def _orbit_json(orbit: Any) -> dict[str, Any]:
         "multipliers": complex_list(orbit.multipliers),
         "abs_multipliers": np.abs(orbit.multipliers),
         "stable": orbit.stable,
+        "isolated": orbit.isolated,
         "residual": orbit.residual,
         "newton_iterations": len(orbit.residuals) - 1,
         "min_impact_speed": None if math.isnan(orbit.min_impact_speed) else orbit.min_impact_speed,
@@ -103,7 +115,7 @@ def orbit(
     if as_json:
         emit_json(res)
         return
-    kind = "stable" if orb.stable else "unstable"
+    kind = "stable" if orb.stable else ("unstable" if orb.isolated else "not isolated")
     extra = f"; max theta {res['max_theta_deg']:.6f} deg" if "max_theta_deg" in res else ""
     if model.n_stops > 1:
         extra += " (" + ", ".join(f"{k}: {v}" for k, v in res["impacts_per_stop"].items()) + ")"
@@ -112,6 +124,8 @@ def orbit(
     click.echo(f"state at {model.time_label} = 0: {state}")
     for z in orb.multipliers:
         click.echo(f"  multiplier {z.real:+.6f} {z.imag:+.6f}i   |mu| = {abs(z):.6f}")
+    if not orb.isolated:
+        click.echo(f"  note: {not_isolated_note(orb)}")
 
 
 def _grazing_json(g: Any, param: str | None = None) -> dict[str, Any]:

@@ -84,8 +84,9 @@ from grazing.orbits.shooting import (
     SECTION_MARGIN,
     PeriodicOrbit,
     find_orbit,
-    kept_directions,
+    is_isolated,
     move_section,
+    not_isolated_message,
     quiet_section,
 )
 from grazing.orbits.switching import Start, crossing_starts, doubled_start, new_sequence_orbit
@@ -528,12 +529,8 @@ class _Continuation:
             u0 = np.append(orbit.state, orbit.model.params[self.param])
             try:
                 F, DF, orb = evaluate(u0)
-                kept = kept_directions(orb.monodromy)
-                if kept >= 2:
-                    raise ConvergenceError(
-                        f"the period-{n} orbit is not isolated (its monodromy keeps {kept} directions: every "
-                        "state near it is periodic too), so no branch of orbits goes through it"
-                    )
+                if not is_isolated(orb.monodromy):
+                    raise ConvergenceError(not_isolated_message(orb.monodromy, n))
             except GrazingError as exc:
                 if seg == 0 and prev is None:
                     raise ConvergenceError(f"cannot start the continuation: {exc}") from None

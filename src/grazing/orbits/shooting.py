@@ -17,7 +17,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from grazing.core.model import HybridModel
-from grazing.core.options import NEWTON_MAX_ITER, NEWTON_TOL, NOT_ISOLATED_TOL, UNIT_CIRCLE_TOL
+from grazing.core.options import (
+    NEWTON_MAX_ITER,
+    NEWTON_TOL,
+    NON_ISOLATED_TOL,
+    NOT_ISOLATED_TOL,
+    UNIT_CIRCLE_TOL,
+)
 from grazing.core.period import detect_period
 from grazing.core.solution import Solution
 from grazing.engine.simulate import simulate
@@ -61,6 +67,52 @@ def kept_directions(monodromy: np.ndarray) -> int:
     m = np.asarray(monodromy, dtype=float)
     sv = np.linalg.svd(m - np.eye(m.shape[0]), compute_uv=False)
     return int(np.sum(sv <= NOT_ISOLATED_TOL * (1.0 + np.linalg.norm(m, 2))))
+
+
+def multiplier_one_multiplicity(monodromy: np.ndarray) -> int:
+    """The multiplicity of the multiplier 1 of ``M``, up to 2: the singular values of ``(M - I)^2`` below
+    ``core.options.NON_ISOLATED_TOL`` (relative to ``(1 + |M|)^2``).  0: ``M - I`` is regular; 1: one
+    multiplier 1 (a fold, a branch point); 2: a double one (a Jordan block or an eigenspace: the
+    orbit is not isolated, :func:`is_isolated`).
+
+    Examples
+    --------
+    >>> jordan = np.array([[1.0, 5.2], [0.0, 1.0]])  # a free mass at rest over one period T = 5.2
+    >>> [multiplier_one_multiplicity(m) for m in (np.diag([0.3, 0.5]), np.diag([1.0, 0.5]), jordan, np.eye(2))]
+    [0, 1, 2, 2]
+    """
+    m = np.asarray(monodromy, dtype=float)
+    a = m - np.eye(m.shape[0])
+    sv = np.linalg.svd(a @ a, compute_uv=False)
+    scale = (1.0 + np.linalg.norm(m, 2)) ** 2
+    return min(2, int(np.sum(sv <= NON_ISOLATED_TOL * scale)))
+
+
+def is_isolated(monodromy: np.ndarray) -> bool:
+    """Is the periodic orbit of monodromy ``M`` isolated: is its multiplier 1, if any, simple?
+
+    A double multiplier 1 (a Jordan block: ``M = [[1, T], [0, 1]]`` on a free mass at rest; or an
+    eigenspace: ``M = I``) means a family of periodic states through the orbit or a drift away from
+    it: the orbit is neither stable nor unstable, and no branch of orbits can be followed through it.
+    (The stroboscopic map of a forced model has no multiplier 1 of its own, as the autonomous flow's
+    trivial one: every multiplier 1 is the orbit's.)
+
+    Examples
+    --------
+    >>> is_isolated(np.array([[1.0, 5.2], [0.0, 1.0]])), is_isolated(np.diag([1.0, 0.5]))
+    (False, True)
+    """
+    return multiplier_one_multiplicity(monodromy) < 2
+
+
+def not_isolated_message(monodromy: np.ndarray, period: int) -> str:
+    """Why a branch cannot go through an orbit that is not isolated (:func:`is_isolated`), in one line."""
+    kept = kept_directions(monodromy)
+    if kept >= 2:
+        why = f"its monodromy keeps {kept} directions: every state near it is periodic too"
+    else:
+        why = "its multiplier 1 is double, a Jordan block: a neutral direction along which states near it drift"
+    return f"the period-{period} orbit is not isolated ({why}), so no branch of orbits goes through it"
 
 
 @dataclass(frozen=True)
@@ -164,9 +216,16 @@ class PeriodicOrbit:
         return unstable_count(self.multipliers)
 
     @property
+    def isolated(self) -> bool:
+        """No double multiplier 1 (:func:`is_isolated`): ``False`` for an orbit in a family of periodic
+        states or with a drift along one (a Jordan block), which is then neither stable nor unstable."""
+        return is_isolated(self.monodromy)
+
+    @property
     def stable(self) -> bool:
-        """Linearly stable: no multiplier outside the unit circle (one on it, to rounding, is not outside)."""
-        return self.unstable_count == 0
+        """Linearly stable: isolated, no multiplier outside the unit circle (one on it, to rounding, is
+        not outside)."""
+        return self.unstable_count == 0 and self.isolated
 
     @property
     def abs_lambda(self) -> float:

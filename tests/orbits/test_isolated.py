@@ -1,0 +1,93 @@
+"""Orbits that are not isolated: a double multiplier 1, from a Jordan block or an eigenspace.
+
+The impact damper with its particle at rest and clear of the walls has a
+non-impacting orbit whose monodromy holds ``[[1, T], [0, 1]]`` for the particle
+(a free mass: every position is periodic, a small velocity drifts): one kept
+direction, so counting kept directions (the test before issue 42) called it an
+isolated, stable orbit.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+import grazing
+from grazing.cli import main
+from grazing.orbits import continue_orbit, find_orbit
+from grazing.orbits.shooting import is_isolated, kept_directions, multiplier_one_multiplicity
+from tests.linear_exact import six_state_model
+
+EPS = np.finfo(float).eps
+
+
+def _jordan(T: float, others: np.ndarray) -> np.ndarray:
+    n = 2 + others.size
+    M = np.zeros((n, n))
+    M[:2, :2] = [[1.0, T], [0.0, 1.0]]
+    M[2:, 2:] = np.diag(others)
+    V = np.random.default_rng(0).normal(size=(n, n)) + 3 * np.eye(n)
+    return V @ M @ np.linalg.inv(V)
+
+
+@pytest.mark.parametrize("T", [0.5, 5.2, 60.0])
+def test_a_jordan_block_rounded_as_a_monodromy_is_rounded_is_still_double(T):
+    M = _jordan(T, np.array([0.3, -0.5]))
+    rng = np.random.default_rng(1)
+    for _ in range(20):  # (64 eps |M| per entry: the monodromy's accuracy, extended.MONODROMY_ROUNDING)
+        noisy = M + 64 * EPS * np.linalg.norm(M, 2) * rng.uniform(-1, 1, M.shape)
+        assert multiplier_one_multiplicity(noisy) == 2 and not is_isolated(noisy)
+    assert kept_directions(M) == 1  # (what the old test counted: a Jordan block keeps one direction)
+
+
+def test_a_fold_and_two_multipliers_near_one_are_isolated():
+    fold = np.diag([1.0, 0.5, 0.2])
+    assert multiplier_one_multiplicity(fold) == 1 and is_isolated(fold)
+    near = np.diag([1.0 + 1e-4, 1.0 - 1e-4, 0.2])
+    assert multiplier_one_multiplicity(near) == 0 and is_isolated(near)
+    assert not is_isolated(np.diag([1.0, 1.0, 0.2]))  # (an eigenspace)
+
+
+@pytest.mark.parametrize(
+    ("make", "param"),
+    [
+        (lambda: grazing.models.impact_damper(gap=8.0, omega=1.2), "omega"),
+        (lambda: six_state_model(d=20.0, Om=1.2), "Om"),
+    ],
+    ids=["impact-damper", "six-states"],
+)
+def test_the_particle_at_rest_is_a_non_isolated_orbit_never_stable(make, param):
+    model = make()
+    orbit = find_orbit(model)  # (from rest: the particle stays where it is)
+    assert orbit.impacts == 0
+    mu = np.sort_complex(orbit.multipliers)
+    assert np.sum(np.abs(mu - 1.0) < 1e-6) == 2  # the double multiplier 1
+    assert np.all(np.abs(orbit.multipliers[np.abs(orbit.multipliers - 1.0) > 1e-6]) < 1.0)
+    assert orbit.isolated is False and orbit.stable is False
+    with pytest.raises(grazing.ConvergenceError, match="not isolated .*Jordan block"):
+        continue_orbit(model, param, 1.2, 1.3, orbit=orbit)
+
+
+def test_the_cli_names_a_non_isolated_orbit_and_refuses_to_continue_it(capsys):
+    argv = ["--model", "impact-damper", "--set", "gap=8"]
+    assert main(["orbit", *argv, "--set", "omega=1.2", "--json"]) == 0
+    res = json.loads(capsys.readouterr().out)
+    assert res["isolated"] is False and res["stable"] is False
+    assert main(["orbit", *argv, "--set", "omega=1.2"]) == 0
+    out = capsys.readouterr().out
+    assert "not isolated" in out.splitlines()[0]
+    notes = [line for line in out.splitlines() if "note:" in line]
+    assert len(notes) == 1 and "Jordan block" in notes[0]
+    code = main(["continue", *argv, "--param", "omega", "--start", "1.2", "--stop", "1.3"])
+    captured = capsys.readouterr()
+    assert code != 0
+    err = captured.err.strip().splitlines()
+    assert len(err) == 1 and "not isolated" in err[0] and "Jordan block" in err[0], captured.err
+
+
+def test_an_isolated_orbit_stays_isolated_and_stable():
+    orbit = find_orbit(grazing.models.pendulum("B", eta=0.446, theta_hat=math.radians(40)))
+    assert orbit.isolated and orbit.stable
