@@ -67,7 +67,7 @@ def test_the_particle_at_rest_is_a_non_isolated_orbit_never_stable(make, param):
     assert np.sum(np.abs(mu - 1.0) < 1e-6) == 2  # the double multiplier 1
     assert np.all(np.abs(orbit.multipliers[np.abs(orbit.multipliers - 1.0) > 1e-6]) < 1.0)
     assert orbit.isolated is False and orbit.stable is False
-    with pytest.raises(grazing.ConvergenceError, match="not isolated .*Jordan block"):
+    with pytest.raises(grazing.ConvergenceError, match=r"not isolated .*Jordan block"):
         continue_orbit(model, param, 1.2, 1.3, orbit=orbit)
 
 

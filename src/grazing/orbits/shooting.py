@@ -78,7 +78,8 @@ def multiplier_one_multiplicity(monodromy: np.ndarray) -> int:
     Examples
     --------
     >>> jordan = np.array([[1.0, 5.2], [0.0, 1.0]])  # a free mass at rest over one period T = 5.2
-    >>> [multiplier_one_multiplicity(m) for m in (np.diag([0.3, 0.5]), np.diag([1.0, 0.5]), jordan, np.eye(2))]
+    >>> cases = (np.diag([0.3, 0.5]), np.diag([1.0, 0.5]), jordan, np.eye(2))
+    >>> [multiplier_one_multiplicity(m) for m in cases]
     [0, 1, 2, 2]
     """
     m = np.asarray(monodromy, dtype=float)
@@ -111,7 +112,7 @@ def not_isolated_message(monodromy: np.ndarray, period: int) -> str:
     if kept >= 2:
         why = f"its monodromy keeps {kept} directions: every state near it is periodic too"
     else:
-        why = "its multiplier 1 is double, a Jordan block: a neutral direction along which states near it drift"
+        why = "its multiplier 1 is double, a Jordan block: a neutral direction along which nearby states drift"
     return f"the period-{period} orbit is not isolated ({why}), so no branch of orbits goes through it"
 
 
