@@ -112,7 +112,7 @@ def not_isolated_message(monodromy: np.ndarray, period: int) -> str:
     if kept >= 2:
         why = f"its monodromy keeps {kept} directions: every state near it is periodic too"
     else:
-        why = "its multiplier 1 is double, a Jordan block: a neutral direction along which nearby states drift"
+        why = "its multiplier 1 is double, a Jordan block: a neutral direction where nearby states drift"
     return f"the period-{period} orbit is not isolated ({why}), so no branch of orbits goes through it"
 
 
