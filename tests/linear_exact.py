@@ -223,3 +223,68 @@ def six_state_matrices(model: HybridModel) -> LinearImpactModel:
 def damper(**values: float) -> HybridModel:
     """``grazing.models.impact_damper`` at ``values`` (mu = 0.3, r = 0.8 unless given)."""
     return grazing.models.impact_damper(**{"mu": 0.3, "r": 0.8, **values})
+
+
+# ----------------------------------------------------------------------------
+# An inverted pendulum between two walls: a saddle flow between impacts (multipliers ~1e7 near grazing)
+
+
+def inverted_walls(**values: float) -> HybridModel:
+    """``q'' = k q - c q' + a cos(w s)`` between walls at ``q = +-1`` (``q' <- -r q'``), names ``q, v, s``.
+
+    The upright position is a saddle (eigenvalues ``+-sqrt(k)``): over a period the flow between
+    impacts stretches by ``exp(sqrt(k) T)``, and a saltation matrix adds ``1 / v`` as an impact speed
+    ``v`` falls to zero.
+    """
+    q, v, s = sp.symbols("q v s")
+    k, c, a, w, r = sp.symbols("k c a w r")
+    defaults = {"k": 2.0, "c": 0.1, "a": 3.0, "w": 2.0, "r": 0.8}
+    defaults.update(values)
+    reset = [q, -r * v]
+    return HybridModel(
+        "inverted-walls", [q, v], s, [Parameter(name, value) for name, value in defaults.items()],
+        [v, k * q - c * v + a * sp.cos(w * s)], period=2 * sp.pi / w,
+        stops=[Stop("right", 1 - q, reset, [0, 1]), Stop("left", 1 + q, reset, [0, 1])],
+    )  # fmt: skip
+
+
+def inverted_walls_matrices(model: HybridModel) -> LinearImpactModel:
+    """:func:`inverted_walls` as a :class:`LinearImpactModel` at ``model``'s parameter values."""
+    p = model.params
+    A = np.array([[0.0, 1.0], [p["k"], -p["c"]]])
+    R = np.diag([1.0, -p["r"]])
+    stops = [LinearStop(np.array([-1.0, 0.0]), 1.0, R), LinearStop(np.array([1.0, 0.0]), 1.0, R)]
+    return LinearImpactModel(A, np.array([0.0, p["a"]]), p["w"], stops)
+
+
+def grazing_of_impact(build, stops, t0: float, guess: np.ndarray, grazing: int) -> np.ndarray:
+    """The parameter where impact ``grazing`` (an index into ``stops``) of a period-1 orbit has zero speed.
+
+    Unknowns ``z = (s_0, t_1, ..., t_k, p)``; the orbit is flown exactly (matrix exponentials) from
+    ``s_0`` at ``t0`` through impacts on ``stops`` at the times ``t_i`` (each guard zero there), and
+    returns to ``s_0`` at ``t0 + T``; the speed of impact ``grazing`` is zero.  ``build(p)`` gives the
+    :class:`LinearImpactModel`; ``guess`` is a guess of ``z``.  Returns the solved ``z``.
+    """
+    from scipy.optimize import least_squares
+
+    k = len(stops)
+
+    def residual(z: np.ndarray) -> np.ndarray:
+        ref = build(float(z[-1]))
+        x, t = z[:2], t0
+        out = []
+        for i, j in enumerate(stops):
+            ti = float(z[2 + i])
+            y = ref.flow(x, t, ti)
+            st = ref.stops[j]
+            out.append(st.c @ y + st.d)
+            if i == grazing:
+                out.append(st.c @ ref.f(y, ti))  # (the guard's rate: zero speed)
+            x, t = st.R @ y, ti
+        out.extend(ref.flow(x, t, t0 + ref.period) - z[:2])
+        return np.array(out)
+
+    assert len(residual(guess)) == 2 + k + 1
+    sol = least_squares(residual, guess, xtol=1e-15, ftol=1e-15, gtol=1e-15, method="lm")
+    assert np.max(np.abs(residual(sol.x))) < 1e-12, residual(sol.x)
+    return sol.x

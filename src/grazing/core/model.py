@@ -379,6 +379,7 @@ class _Definition:
                 "h_t": lambda: sp.diff(s.guard, s.time),
                 "h_p": lambda: sp.Matrix([s.guard]).jacobian(sp.Matrix(s.params)),
                 "g_t": lambda: sp.diff(sp.Matrix(s.reset), s.time),
+                "g_p": lambda: sp.Matrix(s.reset).jacobian(sp.Matrix(s.params)),
                 "rate": lambda: s.normal_rate,
                 "rate_x": lambda: sp.Matrix([s.normal_rate]).jacobian(x),
                 "rate_t": lambda: sp.diff(s.normal_rate, s.time),

@@ -67,6 +67,14 @@ AREA_PRESERVING_TOL = 2 * UNIT_CIRCLE_TOL
 map preserves area there (a conservative model, or a conservative part of one: ``det(P_x) = 1`` for two
 states) and the Neimark-Sacker test function says nothing (a pair on the unit circle stays on it)."""
 
+UNRESOLVED_NORM = 1.0 / (64 * float(np.finfo(float).eps))
+"""A monodromy of 2-norm beyond this (the orbit within about ``1e-13`` of a grazing, where a saltation
+matrix holds ``1 / v``) resolves no multiplier of order one: its rounding (``64 eps |M|``, as
+``orbits.extended.MONODROMY_ROUNDING``) exceeds 1, and the determinants the test functions take are
+rounding's.  Between two points of which one is such, no test function is evaluated; the stability
+account (the number of multipliers outside the circle) still holds, and a change there that nothing
+explains is reported as unlocated."""
+
 VERIFY_TOL = 1e-5
 """A located point's multiplier must lie this close to its defining value (+1, -1, the unit circle)."""
 
@@ -291,6 +299,8 @@ def between(evaluate: BranchEquations, a: PalcPoint, b: PalcPoint, s: PalcSettin
     oa, ob = a.payload, b.payload
     found: list[Located] = []
     missed: list[str] = []
+    if max(np.linalg.norm(oa.monodromy, 2), np.linalg.norm(ob.monodromy, 2)) > UNRESOLVED_NORM:
+        return Step((), (), (unstable_count(oa), unstable_count(ob)))
     through_one = sign_changed(orbit_test("fold", oa), orbit_test("fold", ob))
     turns = sign_changed(float(a.tangent[index]), float(b.tangent[index]))
     if sign_changed(branch_test(a), branch_test(b)):

@@ -80,6 +80,7 @@ from grazing.orbits.palc import (
     locate,
     sign_changed,
 )
+from grazing.orbits.segments import SegmentLayout, layout_of, segmented_equations
 from grazing.orbits.shooting import (
     SECTION_MARGIN,
     PeriodicOrbit,
@@ -104,6 +105,7 @@ RESECTION_MARGIN = 0.01
 """An impact closer than this fraction of a period to the section moves the section."""
 
 _RESECTION = "an impact approaches the section"
+
 
 ContinuationSettings = PalcSettings
 """Options of :func:`continue_orbit` (see :class:`~grazing.orbits.palc.PalcSettings`)."""
@@ -315,6 +317,12 @@ class Branch:
 # ----------------------------------------------------------------------------
 
 
+def _reduced(u: np.ndarray, nx: int) -> np.ndarray:
+    """``(x, p)`` of a point or tangent ``u`` of either formulation: single shooting's ``(x, p)`` as it is,
+    multiple shooting's ``(s_0, t_1, s_1, ..., p)`` without its impacts' unknowns."""
+    return u if u.size == nx + 1 else np.append(u[:nx], u[-1])
+
+
 def _stop_guard_min(orbit: PeriodicOrbit, stop: int) -> float:
     """The smallest value of stop ``stop``'s guard along a virtual orbit: zero where it grazes that stop.
 
@@ -385,8 +393,8 @@ def grazing_margin(orbit: PeriodicOrbit) -> tuple[float, np.ndarray | None, floa
     if not math.isfinite(least):
         return (math.inf, None, math.nan, "", orbit.stop)
     _, x, t, what, stop = min(
-        (f for f in found if f[0] <= least * (1 + GRAZING_TIE)), key=lambda f: (f[4], f[2])
-    )
+        (f for f in found if f[0] <= least + abs(least) * GRAZING_TIE), key=lambda f: (f[4], f[2])
+    )  # (a margin below zero: the orbit of a multiple-shooting segment passes through the stop)
     return (least, x, t, what, stop)
 
 
@@ -453,6 +461,7 @@ class _Continuation:
         self.detect, self.switch, self.progress = detect, switch, progress
         self.virtual = branch.virtual
         self.switched_smooth = False  # switched at a period-doubling or branch point (done once)
+        self.segmented = False  # the segment in hand is solved by multiple shooting (orbits.segments)
         self.toward = 1.0  # the parameter's direction from the request's start to its stop
 
     # -- acceptance of a step -------------------------------------------------------------
@@ -471,7 +480,23 @@ class _Continuation:
             return STOP, _RESECTION
         if a.unstable_count != b.unstable_count:
             return REFINE, "stability changes"
+        if self.segmented:  # (the segments ignore the stops: past a grazing they pass through one)
+            if b.impact_speeds.size and float(np.min(b.impact_speeds)) <= 0.0:
+                return BOUNDARY, "an impact speed reaches zero (the orbit loses an impact): a grazing"
+            crossed = [name for name in b.crossed_stops if name not in a.crossed_stops]
+            if crossed:
+                return BOUNDARY, (
+                    f"the orbit passes through stop {crossed[0]!r} between its impacts (it gains an impact "
+                    "there): a grazing"
+                )
         return ACCEPT, ""
+
+    def _layout(self, orbit: PeriodicOrbit) -> SegmentLayout | None:
+        """The segments of ``orbit`` for multiple shooting, or None where it does not apply (a virtual
+        branch, an orbit without impacts, a model without a forcing period)."""
+        if self.virtual or not orbit.impacts or not self.model.periodic:
+            return None
+        return layout_of(orbit)
 
     @staticmethod
     def margin(pt: PalcPoint) -> float:
@@ -479,10 +504,13 @@ class _Continuation:
 
     # -- special points between two points --------------------------------------------------
 
-    def _special_between(self, evaluate, prev: PalcPoint, pt: PalcPoint, n: int) -> SpecialPoint | None:
-        """Record the special points between ``prev`` and ``pt``; the first where ``switch`` acts."""
+    def _special_between(
+        self, evaluate, prev: PalcPoint, pt: PalcPoint, n: int, ip: int
+    ) -> SpecialPoint | None:
+        """Record the special points between ``prev`` and ``pt`` (``ip``: the parameter's index in their
+        ``u``); the first where ``switch`` acts."""
         branch, index = self.branch, len(self.branch) - 1
-        step = between(evaluate, prev, pt, self.s, self.nx)
+        step = between(evaluate, prev, pt, self.s, ip)
         first: SpecialPoint | None = None
         for loc in step.located:
             if loc.kind not in self.detect:
@@ -507,12 +535,14 @@ class _Continuation:
                     branch.special.append(dataclasses.replace(found, index=index))
         return first
 
-    @staticmethod
-    def _special(loc: Located, index: int) -> SpecialPoint:
+    def _special(self, loc: Located, index: int) -> SpecialPoint:
+        tangent = loc.point.tangent
+        if tangent is not None and tangent.size != self.nx + 1:
+            tangent = _reduced(tangent, self.nx)
+            tangent = tangent / np.linalg.norm(tangent)
         return SpecialPoint(
-            loc.kind, index, float(loc.point.u[-1]), loc.point.payload, tangent=loc.point.tangent,
-            turns=loc.turns,
-        )  # fmt: skip
+            loc.kind, index, float(loc.point.u[-1]), loc.point.payload, tangent=tangent, turns=loc.turns
+        )
 
     # -- one segment ------------------------------------------------------------------------
 
@@ -523,10 +553,18 @@ class _Continuation:
         branch.segment_origin.append(start.origin)
         orbit, sign, direction = start.orbit, start.sign, start.direction
         prev: PalcPoint | None = None
+        segmented = False  # (multiple shooting, once single shooting has stalled short of a grazing)
         while True:
             n = orbit.period
-            evaluate = branch_equations(self.model, self.param, n, orbit.t0, self.virtual, orbit.stop)
-            u0 = np.append(orbit.state, orbit.model.params[self.param])
+            layout = self._layout(orbit) if segmented else None
+            self.segmented = layout is not None
+            if layout is not None:  # (multiple shooting: a large monodromy, orbits.segments)
+                evaluate = segmented_equations(self.model, self.param, n, orbit.t0, layout, orbit.stop)
+                u0 = layout.pack(orbit, orbit.model.params[self.param])
+            else:
+                evaluate = branch_equations(self.model, self.param, n, orbit.t0, self.virtual, orbit.stop)
+                u0 = np.append(orbit.state, orbit.model.params[self.param])
+            ip = u0.size - 1  # (the parameter's index in u)
             try:
                 F, DF, orb = evaluate(u0)
                 if not is_isolated(orb.monodromy):
@@ -537,9 +575,9 @@ class _Continuation:
                 branch.segment_status.append(f"cannot continue from {self.par.show(u0[-1])}: {exc}")
                 return []
             palc = Palc(
-                evaluate, PalcPoint(u0, F, DF, orb), index=nx, sign=sign, bounds=self.bounds,
+                evaluate, PalcPoint(u0, F, DF, orb), index=ip, sign=sign, bounds={ip: self.bounds[nx]},
                 settings=dataclasses.replace(s, max_points=max(2, s.max_points - len(branch) + 1)),
-                names={nx: self.param}, shows={nx: self.par.show}, check=self.check,
+                names={ip: self.param}, shows={ip: self.par.show}, check=self.check,
                 margin=None if self.virtual else self.margin, direction=direction,
             )  # fmt: skip
             direction = None
@@ -550,8 +588,9 @@ class _Continuation:
                     continue
                 switch_at = None
                 if prev is not None:
-                    switch_at = self._special_between(evaluate, prev, pt, n)
-                    branch.arclength.append(branch.arclength[-1] + float(np.linalg.norm(pt.u - prev.u)))
+                    switch_at = self._special_between(evaluate, prev, pt, n, ip)
+                    step = _reduced(pt.u, nx) - _reduced(prev.u, nx)
+                    branch.arclength.append(branch.arclength[-1] + float(np.linalg.norm(step)))
                 else:
                     branch.arclength.append(branch.arclength[-1] if branch.arclength else 0.0)
                 branch.values.append(float(pt.u[-1]))
@@ -566,7 +605,7 @@ class _Continuation:
                         return starts  # (else the point says why, and the branch goes on)
             status = palc.status
             assert prev is not None and prev.tangent is not None
-            sign = math.copysign(1.0, prev.tangent[nx]) if prev.tangent[nx] != 0 else sign
+            sign = math.copysign(1.0, prev.tangent[ip]) if prev.tangent[ip] != 0 else sign
             last: PeriodicOrbit = prev.payload
             if status == _RESECTION and len(branch) < s.max_points:
                 try:
@@ -579,18 +618,33 @@ class _Continuation:
             if palc.boundary is None:
                 branch.segment_status.append(status)
                 return []
-            return self._grazing_end(palc, prev, sign)
+            point = self._end_grazing(palc, prev)
+            if point is None and not palc.boundary.reached and not self.segmented:
+                if self._layout(last) is not None and len(branch) < s.max_points:
+                    # Single shooting stalled short of the grazing (its residual's rounding, |M| eps |x|,
+                    # above its tolerance where the monodromy is large): multiple shooting from here.
+                    segmented, orbit = True, last
+                    continue
+            return self._grazing_end(palc, prev, sign, point)
 
     # -- how a segment ends -----------------------------------------------------------------
 
-    def _grazing_end(self, palc: Palc, prev: PalcPoint, sign: float) -> list[Start]:
-        """The segment ends at a grazing (bracketed, or ahead of a point beyond which Newton fails)."""
+    def _end_grazing(self, palc: Palc, prev: PalcPoint) -> GrazingPoint | None:
+        """The grazing orbit at the boundary where ``palc`` stopped (None where none is located)."""
+        boundary = palc.boundary
+        assert boundary is not None
+        beyond = boundary.after.payload if boundary.after is not None else None
+        return _locate_grazing(prev.payload, beyond, self.param, self.virtual, boundary.ahead)
+
+    def _grazing_end(
+        self, palc: Palc, prev: PalcPoint, sign: float, point: GrazingPoint | None
+    ) -> list[Start]:
+        """The segment ends at a grazing (bracketed, or ahead of a point beyond which Newton fails), with
+        the grazing orbit ``point`` located there (:meth:`_end_grazing`; None: not located)."""
         branch, par = self.branch, self.par
         boundary = palc.boundary
         assert boundary is not None
         last: PeriodicOrbit = prev.payload
-        beyond = boundary.after.payload if boundary.after is not None else None
-        point = _locate_grazing(last, beyond, self.param, self.virtual, boundary.ahead)
         if point is None and not boundary.reached:
             branch.segment_status.append(palc.status)  # the steps beyond jumped to another orbit
             return []
@@ -652,6 +706,9 @@ class _Continuation:
         else:
             assert at.tangent is not None
             u_star = np.append(at.orbit.state, at.param)
+            if self.segmented:  # (the branches through it are followed by single shooting first)
+                o = at.orbit
+                evaluate = branch_equations(self.model, self.param, o.period, o.t0, self.virtual, o.stop)
             for orbit, direction in crossing_starts(evaluate, u_star, at.tangent, self.s):
                 starts.append(Start(orbit, math.copysign(1.0, direction[-1] or 1.0), direction, i))
             # first the direction of the request (the null vector's sign, and so their order, is arbitrary)

@@ -1,0 +1,312 @@
+"""Periodic orbits as a boundary-value problem with one segment per impact (multiple shooting).
+
+Single shooting solves ``P^n(x) - x = 0`` over the whole period: where the
+monodromy is large (a saddle flow between impacts, a saltation matrix's
+``1 / v`` as an impact speed ``v`` falls to zero: multipliers of ``1e7``) the
+map amplifies rounding by as much, its residual cannot fall below
+``|M| eps |x|`` and Newton's method stalls short of its tolerance.  Here the
+orbit with ``k`` impacts (on stops ``j_1 ... j_k``, in order) is ``k + 1``
+segments of free flight, each its own initial-value problem:
+
+* unknowns: the state ``s_0`` on the section ``t0``; for each impact its time
+  ``t_i`` and the state ``s_i`` just after it; and the parameter ``p``;
+* equations: for each impact, the guard ``h_{j_i}(y_{i-1}, t_i) = 0`` at the
+  segment's end ``y_{i-1} = phi(s_{i-1}, t_{i-1} -> t_i)`` and the reset
+  ``s_i - g_{j_i}(y_{i-1}, t_i) = 0``; and the return ``phi(s_k, t_k -> t0 + n T) - s_0 = 0``.
+
+The residual of each equation is a segment's, rounded as a segment is, so
+Newton's method reaches its tolerance however large the product of the
+segments is; the Jacobian is block-sparse (each segment's ``Phi``, its start
+and end times' ``-Phi f`` and ``f``, the guards' and resets' derivatives) and
+carries no ``1 / v`` (the impact time is an unknown, the guard an equation), so
+the equations stay regular through a grazing, where ``v`` passes through zero.
+This is the formulation of COCO's ``hspo`` toolbox (a segment per mode, event
+times as unknowns, the event and reset as boundary conditions; Dankowicz &
+Schilder, *Recipes for Continuation*, SIAM 2013, ch. 4), with the segments
+between the impacts of one mode.  The segments are integrated with the stops
+ignored: a segment that passes through a stop (it would have hit it) is found
+from its guard minimum, so a branch can tell where its impact sequence ends.
+
+The orbit's monodromy is the product of the segments' ``Phi`` and the saltation
+matrices (its multipliers are the same as single shooting's); the payload of
+each point is a :class:`~grazing.orbits.shooting.PeriodicOrbit`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from grazing.core.model import HybridModel
+from grazing.core.solution import Solution
+from grazing.engine.simulate import simulate
+from grazing.errors import ConvergenceError
+from grazing.orbits.shooting import PeriodicOrbit, sorted_multipliers
+
+MULTIPLE_SHOOTING_NORM = 1e4
+"""Single shooting hands over to multiple shooting where the monodromy's 2-norm exceeds this (its
+residual's rounding, ``|M| eps |x|``, is then within a factor 1e3 of ``core.options.NEWTON_TOL``)."""
+
+
+@dataclass(frozen=True)
+class SegmentFlow:
+    """One segment's free flight from ``(x, ta)`` to ``tb``: the end state and its derivatives.
+
+    Attributes
+    ----------
+    end
+        ``phi(x, ta -> tb)``.
+    jacobian
+        ``d end / d x``.
+    sensitivity
+        ``d end / d p`` with ``ta`` and ``tb`` held fixed (a parameter that sets the forcing period
+        moves neither).
+    solution
+        The run (its guard minima tell whether the segment passes through a stop).
+    """
+
+    end: np.ndarray
+    jacobian: np.ndarray
+    sensitivity: np.ndarray
+    solution: Solution
+
+
+def segment_flow(model: HybridModel, x: np.ndarray, ta: float, tb: float, param: str) -> SegmentFlow:
+    """Free flight (the stops ignored) from state ``x`` at time ``ta`` to time ``tb > ta``.
+
+    The engine samples at a forcing phase: the run's last sample is the phase of
+    ``tb`` after as many periods as it takes to reach it.
+
+    Examples
+    --------
+    >>> import math, grazing
+    >>> m = grazing.models.impact_oscillator()
+    >>> T = m.period
+    >>> a = segment_flow(m, np.array([0.1, 0.2]), 0.3, 0.3 + 1.7 * T, "omega")
+    >>> b = grazing.simulate(m, [0.1, 0.2], t0=0.3, periods=2, phase=2 * math.pi * ((0.3 + 1.7 * T) / T % 1),
+    ...                      events=False).x_final
+    >>> bool(np.allclose(a.end, b, atol=1e-13)), a.jacobian.shape, a.sensitivity.shape
+    (True, (2, 2), (2,))
+    """
+    T = model.period
+    s_phase = tb % T
+    if s_phase >= T * (1.0 - 1e-12):
+        s_phase = 0.0
+    kb = round((tb - s_phase) / T)
+    k0 = math.floor(ta / T)
+    s0 = ta - k0 * T
+    snap = 1e-9 * T  # (engine.timebase.SNAP: where the engine's first sample falls)
+    if s0 >= T - snap:
+        k0, s0 = k0 + 1, s0 - T
+    ks = k0 if s0 < s_phase - snap else k0 + 1
+    periods = kb - ks + 1
+    if periods < 1 or tb - ta < snap:
+        raise ConvergenceError(f"a segment of the orbit has no length (from t = {ta:.12g} to {tb:.12g})")
+    sol = simulate(
+        model, x, t0=ta, periods=periods, phase=2 * math.pi * s_phase / T, jacobian=True,
+        sensitivities=(param,), guard_min=True, events=False, impacts="none",
+    )  # fmt: skip
+    n = model.n_states
+    end = sol.x_final
+    sens = sol.jacobian[:, n]
+    tp = sol.info["period_gradient"][param]
+    if tp:  # (the engine's end (kb + s_phase/T) T(p) moves with T; the segment's end tb does not)
+        sens = sens - model.vector_field(end, sol.t_final) * (sol.t_final / T) * tp
+    return SegmentFlow(end, sol.jacobian[:, :n], sens, sol)
+
+
+@dataclass(frozen=True)
+class SegmentLayout:
+    """Where each unknown lies in ``u = (s_0, t_1, s_1, ..., t_k, s_k, p)``.
+
+    Attributes
+    ----------
+    n_states
+        States of the model (``N``).
+    stops
+        The stop of each impact, in order over one period from the section.
+    """
+
+    n_states: int
+    stops: tuple[int, ...]
+
+    @property
+    def impacts(self) -> int:
+        return len(self.stops)
+
+    @property
+    def size(self) -> int:
+        """Unknowns besides the parameter: ``N + k (N + 1)``."""
+        return self.n_states + self.impacts * (self.n_states + 1)
+
+    def state(self, u: np.ndarray, i: int) -> np.ndarray:
+        """``s_i``: the section state (``i = 0``) or the state just after impact ``i``."""
+        n = self.n_states
+        start = 0 if i == 0 else n + (i - 1) * (n + 1) + 1
+        return u[start : start + n]
+
+    def state_index(self, i: int) -> int:
+        n = self.n_states
+        return 0 if i == 0 else n + (i - 1) * (n + 1) + 1
+
+    def time_index(self, i: int) -> int:
+        """Index of ``t_i`` (``i >= 1``)."""
+        return self.n_states + (i - 1) * (self.n_states + 1)
+
+    def pack(self, orbit: PeriodicOrbit, param_value: float) -> np.ndarray:
+        """``u`` of a periodic orbit found by single shooting (its impacts give the times and states)."""
+        m = orbit.model
+        parts = [orbit.state]
+        assert orbit.impact_states is not None
+        for t, y, j in zip(orbit.impact_times, orbit.impact_states, orbit.impact_stops):
+            parts += [np.array([t]), m.reset(y, t, int(j))]
+        return np.concatenate([*parts, [param_value]])
+
+
+def layout_of(orbit: PeriodicOrbit) -> SegmentLayout:
+    """The segment layout of an orbit's impacts."""
+    return SegmentLayout(orbit.model.n_states, tuple(int(j) for j in orbit.impact_stops))
+
+
+def segmented_equations(
+    model: HybridModel, param: str, period: int, t0: float, layout: SegmentLayout, stop: int = 0
+):
+    """``u -> (F, DF, orbit)`` for the multiple-shooting equations of a period-``period`` orbit.
+
+    ``u`` is laid out by ``layout`` (:class:`SegmentLayout`), the parameter ``param`` last;
+    ``stop`` is the stop whose guard minimum the orbit reports.  ``F`` has as many rows as
+    ``u`` has entries but one (``DF`` one column more), as :func:`branch_equations`'s.
+
+    Examples
+    --------
+    >>> import grazing
+    >>> from grazing.orbits import find_orbit
+    >>> m = grazing.models.impact_oscillator(omega=0.8)
+    >>> o = find_orbit(m)  # (period 1, two impacts: three segments)
+    >>> lay = layout_of(o)
+    >>> F, DF, orbit = segmented_equations(m, "omega", 1, o.t0, lay)(lay.pack(o, 0.8))
+    >>> bool(abs(F).max() < 1e-10), DF.shape, bool(np.allclose(orbit.multipliers, o.multipliers))
+    (True, (8, 9), True)
+    """
+    n, k = layout.n_states, layout.impacts
+    pidx = [p.name for p in model.parameters].index(param)
+    size = layout.size
+
+    def evaluate(u: np.ndarray) -> tuple[np.ndarray, np.ndarray, PeriodicOrbit]:
+        p = float(u[-1])
+        m = model.with_params(**{param: p})
+        T = m.period
+        t_end = t0 + period * T
+        F = np.zeros(size)
+        DF = np.zeros((size, size + 1))
+        M = np.eye(n)
+        times = [t0] + [float(u[layout.time_index(i)]) for i in range(1, k + 1)] + [t_end]
+        if np.any(np.diff(times) <= 0.0):
+            raise ConvergenceError("the impacts of the orbit's segments are no longer in order")
+        runs: list[Solution] = []
+        pre: list[np.ndarray] = []
+        speeds: list[float] = []
+        row = 0
+        for i in range(k + 1):
+            s_i = layout.state(u, i)
+            ta, tb = times[i], times[i + 1]
+            seg = segment_flow(m, s_i, ta, tb, param)
+            runs.append(seg.solution)
+            y = seg.end
+            si, col_t_end = layout.state_index(i), (layout.time_index(i + 1) if i < k else None)
+            # d y = Phi d s_i - Phi f(s_i, ta) d ta + f(y, tb) d tb + S d p
+            f_start = m.vector_field(s_i, ta)
+            f_end = m.vector_field(y, tb)
+            dy = np.zeros((n, size + 1))
+            dy[:, si : si + n] = seg.jacobian
+            if i > 0:
+                dy[:, layout.time_index(i)] = -seg.jacobian @ f_start
+            if col_t_end is not None:
+                dy[:, col_t_end] = f_end
+            tp = seg.solution.info["period_gradient"][param]  # dT/dp: the return time t0 + n T moves
+            dy[:, -1] = seg.sensitivity + (f_end * period * tp if i == k else 0.0)
+            M = seg.jacobian @ M
+            if i == k:  # the return to the section
+                F[row : row + n] = y - layout.state(u, 0)
+                DF[row : row + n] = dy
+                DF[row : row + n, 0:n] -= np.eye(n)
+                row += n
+                continue
+            j = layout.stops[i]
+            cd = m.contact_derivatives(y, tb, j)
+            F[row] = cd["h"]
+            DF[row] = cd["h_x"] @ dy
+            DF[row, col_t_end] += cd["h_t"]
+            DF[row, -1] += cd["h_p"][pidx]
+            row += 1
+            g = m.reset(y, tb, j)
+            _, _, gx = m.jacobians(y, tb, j)
+            gt = np.asarray(m.numeric("g_t", j)(list(y), tb, list(m.param_vector)), dtype=float).reshape(n)
+            gp = np.asarray(m.numeric("g_p", j)(list(y), tb, list(m.param_vector)), dtype=float)
+            gp = gp.reshape(n, -1)[:, pidx]
+            nxt = layout.state_index(i + 1)
+            F[row : row + n] = layout.state(u, i + 1) - g
+            DF[row : row + n] = -(gx @ dy)
+            DF[row : row + n, col_t_end] -= gt
+            DF[row : row + n, -1] -= gp
+            DF[row : row + n, nxt : nxt + n] += np.eye(n)
+            row += n
+            pre.append(y)
+            speeds.append(-cd["rate"])  # (positive: the guard decreases into the stop)
+            M = _saltation(m, y, tb, j, cd, gx, gt) @ M
+        orbit = _segmented_orbit(m, layout, u, t0, period, times, pre, speeds, runs, M, F, stop)
+        return F, DF, orbit
+
+    return evaluate
+
+
+def _saltation(m: HybridModel, y, t, j, cd, gx, gt) -> np.ndarray:
+    """The saltation matrix of an impact at ``y`` (``model.saltation`` with the pieces already at hand)."""
+    fm = m.vector_field(y, t)
+    fp = m.vector_field(m.reset(y, t, j), t)
+    return gx + np.outer(fp - gx @ fm - gt, cd["h_x"]) / (cd["h_x"] @ fm + cd["h_t"])
+
+
+def _least(rows) -> tuple[float, float, np.ndarray] | None:
+    rows = [r for r in rows if r is not None]
+    return min(rows, key=lambda r: r[0]) if rows else None
+
+
+def _segmented_orbit(
+    m: HybridModel, layout: SegmentLayout, u, t0, period, times, pre, speeds, runs, M, F, stop
+) -> PeriodicOrbit:
+    """The payload: the orbit's section state, monodromy, impacts and guard minima over the segments."""
+    n_stops = m.n_stops
+    by_stop = []
+    approach = []
+    for j in range(n_stops):
+        by_stop.append(_least(r.guard_min_by_stop[j] for r in runs if r.guard_min_by_stop))
+        approach.append(_least(r.approach_by_stop[j] for r in runs if r.approach_by_stop))
+    gmin = by_stop[stop]
+    assert gmin is not None
+    v = np.array(speeds)
+    return PeriodicOrbit(
+        model=m,
+        state=np.array(layout.state(u, 0), dtype=float),
+        t0=float(t0),
+        period=period,
+        impacts=layout.impacts,
+        monodromy=M,
+        multipliers=sorted_multipliers(M),
+        guard_min=gmin[0],
+        t_guard_min=gmin[1],
+        min_impact_speed=float(v.min()) if v.size else math.nan,
+        virtual=False,
+        residuals=(float(np.max(np.abs(F))),),
+        x_guard_min=gmin[2],
+        impact_times=np.array(times[1:-1]),
+        impact_speeds=v,
+        impact_states=np.array(pre).reshape(-1, layout.n_states),
+        approach=approach[stop],
+        stop=stop,
+        impact_stops=np.array(layout.stops, dtype=int),
+        guard_min_by_stop=tuple(by_stop),  # type: ignore[arg-type]
+        approach_by_stop=tuple(approach),
+    )

@@ -1,0 +1,113 @@
+"""Multiple shooting: a segment per impact, impact times as unknowns (``grazing.orbits.segments``).
+
+An inverted pendulum between two walls (:func:`tests.linear_exact.inverted_walls`)
+has orbits whose multipliers grow past 1e7 as an impact speed falls to zero (a
+saddle flow between impacts times a saltation matrix's ``1 / v``).  Single
+shooting's residual cannot fall below ``|M| eps |x|`` there, and its branch
+stalled at a = 5.9766 with "Newton's method did not converge"; the segmented
+equations reach the grazing that ends the branch, checked against the exact
+grazing of the linear flow (matrix exponentials).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import grazing
+from grazing.orbits import continue_orbit, find_orbit
+from grazing.orbits.continuation import _Continuation
+from grazing.orbits.segments import layout_of, segmented_equations
+from tests.linear_exact import damper, grazing_of_impact, inverted_walls, inverted_walls_matrices
+
+
+def _central_differences(evaluate, u: np.ndarray) -> np.ndarray:
+    F = evaluate(u)[0]
+    J = np.zeros((F.size, u.size))
+    for i in range(u.size):
+        h = 1e-6 * max(1.0, abs(u[i]))
+        e = np.zeros(u.size)
+        e[i] = h
+        J[:, i] = (evaluate(u + e)[0] - evaluate(u - e)[0]) / (2 * h)
+    return J
+
+
+CASES = [
+    # (model, guess, period, parameters to differentiate by): the period-setting frequency, a guard's and
+    # a reset's parameter, the damping of the flow
+    (lambda: grazing.models.impact_oscillator(omega=0.8), None, 1, ("omega", "sigma", "r", "zeta")),
+    (lambda: damper(omega=1.2), None, 1, ("omega", "mu", "gap", "r")),
+    (lambda: inverted_walls(), [-0.9294, 0.8725], 1, ("w", "a", "r", "k")),
+]
+
+
+@pytest.mark.parametrize(
+    ("make", "guess", "period", "params"), CASES, ids=["oscillator", "damper", "inverted"]
+)
+def test_the_segmented_jacobian_is_the_derivative_of_its_equations(make, guess, period, params):
+    model = make()
+    orbit = find_orbit(model, guess, period=period)
+    assert orbit.impacts >= 1
+    layout = layout_of(orbit)
+    rng = np.random.default_rng(3)
+    for param in params:
+        evaluate = segmented_equations(model, param, period, orbit.t0, layout, 0)
+        u = layout.pack(orbit, model.params[param])
+        u = u + 1e-4 * rng.normal(size=u.size)  # (off the orbit: every term of the Jacobian counts)
+        F, DF, _ = evaluate(u)
+        assert DF.shape == (F.size, u.size) == (layout.size, layout.size + 1)
+        np.testing.assert_allclose(
+            DF, _central_differences(evaluate, u), atol=1e-6 * max(1.0, np.abs(DF).max())
+        )
+
+
+@pytest.mark.parametrize(
+    ("make", "guess", "period", "params"), CASES, ids=["oscillator", "damper", "inverted"]
+)
+def test_the_segmented_orbit_is_the_single_shooting_orbit(make, guess, period, params):
+    model = make()
+    orbit = find_orbit(model, guess, period=period)
+    layout = layout_of(orbit)
+    F, _, same = segmented_equations(model, params[0], period, orbit.t0, layout, 0)(
+        layout.pack(orbit, model.params[params[0]])
+    )
+    assert np.max(np.abs(F)) < 1e-10
+    np.testing.assert_allclose(same.impact_times, orbit.impact_times, atol=1e-12)
+    np.testing.assert_allclose(same.impact_speeds, orbit.impact_speeds, rtol=1e-9)
+    mu, ref = np.sort_complex(same.multipliers), np.sort_complex(orbit.multipliers)
+    np.testing.assert_allclose(mu, ref, rtol=1e-8 * max(1.0, np.abs(ref).max()))
+    assert same.impacts == orbit.impacts and same.signature == orbit.signature
+
+
+@pytest.fixture(scope="module")
+def inverted_branch():
+    model = inverted_walls()
+    orbit = find_orbit(model, [-0.9294, 0.8725], period=1)
+    return model, orbit, continue_orbit(model, "a", 3.0, 9.0, orbit=orbit)
+
+
+def test_a_strongly_unstable_branch_reaches_the_grazing_that_ends_it(inverted_branch):
+    model, _, branch = inverted_branch
+    assert max(o.abs_lambda for o in branch.orbits) > 1e7
+    kinds = [sp.kind for sp in branch.special]
+    assert kinds == ["grazing"], [sp.note for sp in branch.special]  # (no unlocated change on the way)
+    graze = branch.special[0]
+    assert graze.grazing is not None and "loses an impact" in branch.status
+    # The exact grazing: the linear flow's orbit through the same impacts, one of them at zero speed.
+    last = branch.orbits[-1]
+    assert np.min(last.impact_speeds) < 1e-8
+    guess = np.concatenate([last.state, last.impact_times, [graze.param]])
+    exact = grazing_of_impact(
+        lambda a: inverted_walls_matrices(model.with_params(a=a)), list(last.impact_stops), last.t0, guess,
+        int(np.argmin(last.impact_speeds)),
+    )  # fmt: skip
+    assert graze.param == pytest.approx(exact[-1], abs=1e-9)
+
+
+def test_single_shooting_alone_stalls_short_of_it(inverted_branch, monkeypatch):
+    # The same branch without the segments: Newton's method fails where |M| eps |x| exceeds its tolerance.
+    model, orbit, segmented = inverted_branch
+    monkeypatch.setattr(_Continuation, "_layout", lambda self, orbit: None)
+    single = continue_orbit(model, "a", 3.0, 9.0, orbit=orbit)
+    assert "step size fell below" in single.status
+    assert max(single.values) < segmented.special[-1].param - 1e-3
