@@ -93,6 +93,7 @@ def test_a_strongly_unstable_branch_reaches_the_grazing_that_ends_it(inverted_br
     assert kinds == ["grazing"], [sp.note for sp in branch.special]  # (no unlocated change on the way)
     graze = branch.special[0]
     assert graze.grazing is not None and "loses an impact" in branch.status
+    assert "by multiple shooting from a = " in branch.status
     # The exact grazing: the linear flow's orbit through the same impacts, one of them at zero speed.
     last = branch.orbits[-1]
     assert np.min(last.impact_speeds) < 1e-8

@@ -547,7 +547,21 @@ class _Continuation:
     # -- one segment ------------------------------------------------------------------------
 
     def segment(self, start: Start) -> list[Start]:
-        """Follow one segment from ``start``; the starts of the branches it switches to."""
+        """Follow one segment from ``start``; the starts of the branches it switches to.
+
+        Its status says where it went over to multiple shooting, if it did."""
+        self.handover: float | None = None
+        told = len(self.branch.segment_status)
+        starts = self._segment(start)
+        if self.handover is not None and len(self.branch.segment_status) > told:
+            self.branch.segment_status[told] += (
+                f"; by multiple shooting from {self.par.show(self.handover)} on "
+                "(single shooting stalled there)"
+            )
+        return starts
+
+    def _segment(self, start: Start) -> list[Start]:
+        """:meth:`segment` itself."""
         branch, s, nx = self.branch, self.s, self.nx
         seg = len(branch.segment_origin)
         branch.segment_origin.append(start.origin)
@@ -624,6 +638,7 @@ class _Continuation:
                     # Single shooting stalled short of the grazing (its residual's rounding, |M| eps |x|,
                     # above its tolerance where the monodromy is large): multiple shooting from here.
                     segmented, orbit = True, last
+                    self.handover = float(prev.u[-1])
                     continue
             return self._grazing_end(palc, prev, sign, point)
 
