@@ -60,6 +60,7 @@ def test_bouncing_ball_fold_and_period_doubling(n):
     folds = [s for s in down.special if s.kind == "fold"]
     assert folds, down.status
     assert folds[0].param == pytest.approx(a_fold, abs=1e-9)
+    assert abs(folds[0].param - a_fold) <= 2 * folds[0].precision  # (its precision is an honest estimate)
     np.testing.assert_allclose(sorted(folds[0].multipliers.real), [R**2, 1.0], atol=1e-7)
     # Past the fold the branch is the unstable orbit (sin(phi) < 0): it comes back up.
     assert not down.orbits[-1].stable and down.values[-1] > a_fold
@@ -67,6 +68,7 @@ def test_bouncing_ball_fold_and_period_doubling(n):
     pds = [s for s in up.special if s.kind == "period-doubling"]
     assert pds, up.status
     assert pds[0].param == pytest.approx(a_pd, abs=1e-8)
+    assert abs(pds[0].param - a_pd) <= 2 * pds[0].precision
     np.testing.assert_allclose(sorted(pds[0].multipliers.real), [-1.0, -(R**2)], atol=1e-7)
     # One orbit all along: one impact per n periods (the section moves away from the impact
     # near the fold, so the period in which it falls may change).

@@ -103,6 +103,9 @@ def test_a_strongly_unstable_branch_reaches_the_grazing_that_ends_it(inverted_br
         int(np.argmin(last.impact_speeds)),
     )  # fmt: skip
     assert graze.param == pytest.approx(exact[-1], abs=1e-9)
+    lo, hi = graze.interval
+    assert lo <= exact[-1] <= hi and hi - lo < 1e-9
+    assert abs(graze.param - exact[-1]) <= 10 * graze.precision + 1e-13
 
 
 def test_single_shooting_alone_stalls_short_of_it(inverted_branch, monkeypatch):

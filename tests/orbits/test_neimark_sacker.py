@@ -71,6 +71,10 @@ def test_the_neimark_sacker_point_is_located_on_models_of_more_states(states, ma
     )  # fmt: skip
     assert ns.param == pytest.approx(p_ref, abs=1e-9)
     assert ns.angle == pytest.approx(abs(np.angle(mu_ref)), abs=1e-9)
+    # Its precision and interval say how well it is located (as BifurcationKit's special points do).
+    lo, hi = ns.interval
+    assert lo <= p_ref <= hi and lo <= ns.param <= hi
+    assert abs(ns.param - p_ref) <= 2 * ns.precision + 1e-13
     pair = orbit.multipliers[np.argmin(np.abs(np.abs(orbit.multipliers) - 1.0))]
     assert abs(abs(pair) - 1.0) < 1e-8
     # Stable before it, two multipliers outside the circle after it.

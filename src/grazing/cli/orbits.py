@@ -422,6 +422,8 @@ def continue_(
                 **({"between": [back(v) for v in sp_.between]} if sp_.between is not None else {}),
                 **({"note": sp_.note} if sp_.note else {}),
                 **({"angle": sp_.angle} if sp_.kind == "neimark-sacker" else {}),
+                "precision": None if math.isnan(sp_.precision) else back(sp_.precision),  # (a width: linear)
+                "interval": None if sp_.interval is None else sorted(back(v) for v in sp_.interval),
                 "index": sp_.index,
                 "multipliers": complex_list(sp_.multipliers),
                 "state": sp_.orbit.state,

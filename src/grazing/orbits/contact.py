@@ -12,6 +12,8 @@ needs.
 
 from __future__ import annotations
 
+import dataclasses
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -63,6 +65,10 @@ class GrazingPoint:
     approach_by_stop
         ``(h, t, x)`` of every stop's closest approach in free flight (None
         where there is none), as :attr:`PeriodicOrbit.approach_by_stop`.
+    precision
+        For a grazing solved with a free parameter (:func:`refine_grazing`): how far that
+        parameter may be from the grazing's, to first order (the parameter component of the Newton
+        step that would follow the last); nan otherwise.
     """
 
     model: HybridModel
@@ -78,6 +84,7 @@ class GrazingPoint:
     guard_mins: tuple[float, ...] = ()
     other_impacts: Impacts | None = None
     approach_by_stop: tuple[tuple[float, float, np.ndarray] | None, ...] = ()
+    precision: float = math.nan
 
     @property
     def stop_name(self) -> str:
@@ -193,4 +200,9 @@ def refine_grazing(
             "Newton's method for the grazing orbit did not converge near "
             f"{model.parameter(free).show(model.params[free], '.8g')}"
         )
-    return pt.payload
+    try:
+        step = np.linalg.solve(pt.DF, pt.F)  # (the next Newton step: the parameter's remaining error)
+        precision = abs(float(step[-1]))
+    except np.linalg.LinAlgError:
+        precision = math.nan
+    return dataclasses.replace(pt.payload, precision=precision)

@@ -154,6 +154,16 @@ class SpecialPoint:
         fold, always.
     switched
         The continuation switched there onto another branch (``switch``).
+    precision
+        How far :attr:`param` may be from the special point's parameter (as BifurcationKit's
+        ``SpecialPoint.precision``): for a point located between two points of the branch, its test
+        function's value there over the test's slope, at most the final bracket's width; for a grazing,
+        the parameter part of the grazing equations' next Newton step (or the bracket's width where
+        they did not converge); nan for an unlocated change.
+    interval
+        The parameter values between which the special point lies (``(low, high)``, as
+        BifurcationKit's ``interval``): the last bracket of the location (of a grazing: the last point
+        before it and the first beyond, where there is one); None where unknown.
     """
 
     kind: str
@@ -167,6 +177,8 @@ class SpecialPoint:
     tangent: np.ndarray | None = None
     turns: bool = False
     switched: bool = False
+    precision: float = math.nan
+    interval: tuple[float, float] | None = None
 
     @property
     def multipliers(self) -> np.ndarray:
@@ -284,6 +296,11 @@ class Branch:
             ),
             "special_note": ("special", np.array([s.note for s in self.special], dtype=str)),
             "special_switched": ("special", np.array([s.switched for s in self.special], dtype=np.int8)),
+            "special_precision": ("special", np.array([s.precision for s in self.special], dtype=float)),
+            "special_interval": (
+                ("special", "bound"),
+                np.array([s.interval or (np.nan, np.nan) for s in self.special], dtype=float).reshape(-1, 2),
+            ),
         }
         # Where each orbit comes closest to the stop (its largest angle, for the pendulum).
         nan = np.full(len(names), np.nan)
@@ -357,7 +374,14 @@ def _detect_grazing(
     except GrazingError:
         point = None
     value = float(loc.u[-1]) if point is None else point.model.params[param]
-    return SpecialPoint("grazing", -1, value, lo, point, stop)
+    last, bracket = loc.u.size - 1, loc.bracket
+    if point is not None:  # (its own precision; between the two points, which the guard's minimum brackets)
+        precision = point.precision
+        interval = (min(float(a.u[-1]), float(b.u[-1])), max(float(a.u[-1]), float(b.u[-1])))
+    else:
+        precision = bracket.precision(last) if bracket is not None else math.nan
+        interval = bracket.interval(last) if bracket is not None else None
+    return SpecialPoint("grazing", -1, value, lo, point, stop, precision=precision, interval=interval)
 
 
 GRAZING_TIE = 1e-6
@@ -526,8 +550,11 @@ class _Continuation:
                 f"{step.describe()}"
             )
             branch.special.append(
-                SpecialPoint(UNLOCATED, index, 0.5 * (p1 + p2), prev.payload, note=note, between=(p1, p2))
-            )
+                SpecialPoint(
+                    UNLOCATED, index, 0.5 * (p1 + p2), prev.payload, note=note, between=(p1, p2),
+                    interval=(min(p1, p2), max(p1, p2)),
+                )
+            )  # fmt: skip
         if "grazing" in self.detect and self.virtual:  # the grazing of any stop
             for j in range(self.model.n_stops):
                 found = _detect_grazing(evaluate, j, prev, pt, self.param, n, self.s)
@@ -540,9 +567,12 @@ class _Continuation:
         if tangent is not None and tangent.size != self.nx + 1:
             tangent = _reduced(tangent, self.nx)
             tangent = tangent / np.linalg.norm(tangent)
+        bracket, last = loc.point.bracket, loc.point.u.size - 1
         return SpecialPoint(
-            loc.kind, index, float(loc.point.u[-1]), loc.point.payload, tangent=tangent, turns=loc.turns
-        )
+            loc.kind, index, float(loc.point.u[-1]), loc.point.payload, tangent=tangent, turns=loc.turns,
+            precision=bracket.precision(last) if bracket is not None else math.nan,
+            interval=bracket.interval(last) if bracket is not None else None,
+        )  # fmt: skip
 
     # -- one segment ------------------------------------------------------------------------
 
@@ -665,7 +695,14 @@ class _Continuation:
             return []
         value = point.model.params[self.param] if point is not None else float(prev.u[-1])
         where_stop = grazing_margin(last)[4] if point is None else point.stop
-        graze = SpecialPoint("grazing", len(branch) - 1, value, last, point, where_stop)
+        p0 = float(prev.u[-1])
+        p1 = float(boundary.after.u[-1]) if boundary.after is not None else value
+        interval = (min(p0, p1), max(p0, p1)) if p1 != p0 else None
+        precision = point.precision if point is not None else (p1 - p0 if interval else math.nan)
+        graze = SpecialPoint(
+            "grazing", len(branch) - 1, value, last, point, where_stop, precision=abs(precision),
+            interval=interval,
+        )  # fmt: skip
         where = par.show(value)
         if self.model.n_stops > 1:
             where = f"{where} with stop {self.model.stop_names[where_stop]!r}"

@@ -81,15 +81,55 @@ class PalcSettings:
     boundary_tol: float = 1e-10
 
 
+@dataclass(frozen=True)
+class Bracket:
+    """Where the zero of a test function lies, as :func:`locate` leaves it.
+
+    Attributes
+    ----------
+    lo, hi
+        The points ``u`` at the ends of the last bracket along the secant (the test function's
+        signs differ there).
+    step
+        The located point's offset from the zero to first order: the test function's value there
+        over its slope along the secant, times the secant (in ``u``).
+    """
+
+    lo: np.ndarray
+    hi: np.ndarray
+    step: np.ndarray
+
+    def interval(self, i: int) -> tuple[float, float]:
+        """The bracket in component ``i`` of ``u``, as ``(low, high)``."""
+        a, b = float(self.lo[i]), float(self.hi[i])
+        return (min(a, b), max(a, b))
+
+    def precision(self, i: int) -> float:
+        """How far component ``i`` of the located point may be from the zero: the first-order offset,
+        at most the bracket's width, plus the component's own rounding (4 eps of its size).
+
+        Examples
+        --------
+        >>> p = Bracket(np.array([0.0, 1.0]), np.array([0.0, 1.5]), np.array([0.0, 2e-12])).precision(1)
+        >>> bool(2e-12 < p < 2e-12 + 2e-15)
+        True
+        """
+        lo, hi = self.interval(i)
+        rounding = 4 * float(np.finfo(float).eps) * max(abs(lo), abs(hi))
+        return min(abs(float(self.step[i])), hi - lo) + rounding
+
+
 @dataclass
 class PalcPoint:
-    """A point on the curve: ``u``, the residual and Jacobian there, the tangent, a payload."""
+    """A point on the curve: ``u``, the residual and Jacobian there, the tangent, a payload, and for a
+    located zero of a test function its :class:`Bracket`."""
 
     u: np.ndarray
     F: np.ndarray
     DF: np.ndarray
     payload: Any
     tangent: np.ndarray | None = None
+    bracket: Bracket | None = None
 
 
 Evaluate = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, Any]]
@@ -450,6 +490,7 @@ def locate(
     dn = d / np.linalg.norm(d)
     lo, hi = 0.0, 1.0
     flo, fhi = test(a), test(b)
+    true_lo, true_hi = flo, fhi  # (the test's values at the bracket's ends, before Illinois halves them)
     best: PalcPoint | None = None
     side = 0
     for _ in range(60):
@@ -463,16 +504,19 @@ def locate(
             return best
         pt.tangent = tangent(pt.DF, a.tangent)
         f = test(pt)
+        slope = (true_hi - true_lo) / (hi - lo)
+        offset = f / slope if slope != 0 and math.isfinite(f) else math.inf
+        pt.bracket = Bracket(a.u + lo * d, a.u + hi * d, offset * d)
         best = pt
         if (not bisect and abs(f) <= s.locate_tol) or (hi - lo) < 1e-12:
             return pt
         if (f > 0) == (flo > 0):
-            lo, flo = sig, f
+            lo, flo, true_lo = sig, f, f
             if side == -1 and not bisect:
                 fhi *= 0.5
             side = -1
         else:
-            hi, fhi = sig, f
+            hi, fhi, true_hi = sig, f, f
             if side == 1 and not bisect:
                 flo *= 0.5
             side = 1
@@ -537,6 +581,10 @@ def locate_by_interpolation(
             F, DF, payload = evaluate(u)
             if np.all(np.isfinite(F)) and np.max(np.abs(F)) <= s.tol:
                 found = PalcPoint(u, F, DF, payload, tangent(DF, a.tangent))
+                slope = float(np.polyval(np.polyder(np.polyfit(sigmas, values, 3)), root))
+                f = test(found)
+                offset = f / slope if slope != 0 and math.isfinite(f) else math.inf
+                found.bracket = Bracket(a.u.copy(), b.u.copy(), offset * d)
         except (GrazingError, np.linalg.LinAlgError, FloatingPointError):
             pass
         narrow = float(np.linalg.norm(d)) <= INTERPOLATION_WIDTH * max(1.0, float(np.linalg.norm(a.u)))

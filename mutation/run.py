@@ -1,0 +1,132 @@
+"""A random sample of mutants of the structure code, run against the default test suite (cosmic-ray).
+
+``make mutation`` (or ``python mutation/run.py``) draws ``--count`` mutants (default 150, seed
+``--seed``) uniformly from every mutant cosmic-ray makes of ``src/grazing/orbits/``,
+``src/grazing/attractors/`` and ``src/grazing/core/period.py``, runs each against the tests of its
+group (a part of the default suite, ``-m "not slow"``, stopping at the first failure: a mutant killed
+there is killed by the whole suite), and writes ``mutation/report.md`` (the score and every surviving
+mutant, with its diff) and ``mutation/report.json``.  It mutates the files of the tree it runs in: run
+it in a clean checkout (``git worktree add``), not in one you are editing.  Needs the ``mutation``
+extra (``pip install -e ".[test,mutation]"``).  About 15 s a mutant on two cores.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import random
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+COSMIC_RAY = str(Path(sys.executable).with_name("cosmic-ray"))
+PYTEST = f"{sys.executable} -m pytest -q -x -p no:cacheprovider -m 'not slow' -n 2 --dist loadfile"
+
+GROUPS = {
+    "orbits": (
+        sorted(str(p.relative_to(ROOT)) for p in (ROOT / "src/grazing/orbits").glob("*.py")),
+        "tests/orbits tests/cli/test_cli_orbits.py tests/cli/test_cli_curves.py tests/normalform",
+    ),
+    "attractors": (
+        sorted(str(p.relative_to(ROOT)) for p in (ROOT / "src/grazing/attractors").glob("*.py")),
+        "tests/attractors tests/cli/test_cli_attractors.py",
+    ),
+    "period": (["src/grazing/core/period.py"], "tests/core tests/sweeps tests/attractors tests/test_maps.py"),
+}
+"""Each group: the files mutated and the tests run against them."""
+
+TIMEOUT = 600.0
+"""A mutant whose tests run longer than this (seconds) is counted as killed by timeout (cosmic-ray's rule)."""
+
+
+def _config(group: str, folder: Path) -> Path:
+    files, tests = GROUPS[group]
+    cfg = folder / f"{group}.toml"
+    modules = ", ".join(json.dumps(f) for f in files)
+    cfg.write_text(
+        "[cosmic-ray]\n"
+        f"module-path = [{modules}]\n"
+        f"timeout = {TIMEOUT}\n"
+        "excluded-modules = []\n"
+        f'test-command = "{PYTEST} {tests}"\n'
+        "[cosmic-ray.distributor]\n"
+        'name = "local"\n'
+    )
+    return cfg
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--count", type=int, default=150)
+    parser.add_argument("--seed", type=int, default=42)
+    parser.add_argument("--groups", default=",".join(GROUPS))
+    parser.add_argument("--out", default=str(ROOT / "mutation"))
+    args = parser.parse_args(argv)
+    from cosmic_ray.work_db import WorkDB, use_db
+    from cosmic_ray.work_item import WorkerOutcome, WorkResult
+
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    groups = [g for g in args.groups.split(",") if g]
+    sessions = {}
+    population = []
+    for g in groups:
+        cfg = _config(g, out)
+        session = out / f"{g}.sqlite"
+        session.unlink(missing_ok=True)
+        subprocess.run([COSMIC_RAY, "init", str(cfg), str(session)], check=True, cwd=ROOT)
+        sessions[g] = (cfg, session)
+        with use_db(str(session), WorkDB.Mode.open) as db:
+            population += [(g, item.job_id) for item in db.work_items]
+    rng = random.Random(args.seed)
+    chosen = set(rng.sample(population, min(args.count, len(population))))
+    print(f"{len(population)} mutants in {', '.join(groups)}; running {len(chosen)} of them")
+    for g, (cfg, session) in sessions.items():
+        with use_db(str(session), WorkDB.Mode.open) as db:
+            skip = [job for (gg, job) in population if gg == g and (gg, job) not in chosen]
+            db.set_multiple_results(skip, WorkResult(worker_outcome=WorkerOutcome.SKIPPED))
+        start = time.time()
+        subprocess.run([COSMIC_RAY, "exec", str(cfg), str(session)], check=True, cwd=ROOT)
+        print(f"{g}: {time.time() - start:.0f} s")
+    return _report(sessions, out)
+
+
+def _report(sessions: dict, out: Path) -> int:
+    from cosmic_ray.work_db import WorkDB, use_db
+    from cosmic_ray.work_item import TestOutcome, WorkerOutcome
+
+    rows = []
+    for g, (_, session) in sessions.items():
+        with use_db(str(session), WorkDB.Mode.open) as db:
+            for item, result in db.completed_work_items:
+                if result.worker_outcome == WorkerOutcome.SKIPPED:
+                    continue
+                spec = item.mutations[0]
+                rows.append({
+                    "group": g,
+                    "file": str(spec.module_path),
+                    "line": spec.start_pos[0],
+                    "operator": spec.operator_name,
+                    "occurrence": spec.occurrence,
+                    "outcome": str(result.test_outcome),
+                    "worker": str(result.worker_outcome),
+                    "diff": result.diff,
+                })
+    killed = [r for r in rows if r["outcome"] == str(TestOutcome.KILLED)]
+    survived = [r for r in rows if r["outcome"] == str(TestOutcome.SURVIVED)]
+    score = len(killed) / len(rows) if rows else float("nan")
+    stamp = time.strftime("%Y-%m-%d")
+    (out / "report.json").write_text(json.dumps({"date": stamp, "score": score, "mutants": rows}, indent=1))
+    lines = [f"# Mutation sample, {stamp}", "", f"{len(rows)} mutants run, {len(killed)} killed, "
+             f"{len(survived)} survived: score {100 * score:.1f} %", ""]
+    for r in survived:
+        lines += [f"## {r['file']}:{r['line']} ({r['operator']})", "", "```diff", r["diff"].strip(), "```", ""]
+    (out / "report.md").write_text("\n".join(lines))
+    print(lines[2])
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
