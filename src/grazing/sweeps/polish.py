@@ -93,36 +93,48 @@ def contracting_periods(
     out: list[int] = []
     if s.ndim != 2 or not np.all(np.isfinite(s)):
         return out
+    floor = 1e3 * np.finfo(float).eps * (1.0 + float(np.max(np.abs(s))))  # (rounding: a periodic run)
     for p in range(1, min(max_period, s.shape[0] // 3) + 1):
         d = _differences(s, p)
         h = d.size // 2
         first, last = float(np.max(d[:h])), float(np.max(d[-h:]))
-        if last > 0 and last < ratio * first:
+        if first > floor and last < ratio * first:
             out.append(p)
             if len(out) >= most:
                 break
     return out
 
 
-def approaches(samples: np.ndarray, cycle: np.ndarray, ratio: float = POLISH_RATIO) -> bool:
-    """Whether ``samples`` approach the periodic orbit of points ``cycle``: their distance to its
-    nearest point (largest component difference) over their second half is under ``ratio`` of that
-    over their first half, or they are on it to rounding.
+def approaches(
+    samples: np.ndarray, cycle: np.ndarray, largest: float = 1.0, ratio: float = POLISH_RATIO
+) -> bool:
+    """Whether ``samples`` approach the periodic orbit of points ``cycle`` whose largest multiplier has
+    modulus ``largest``, as a run in its basin does.
+
+    Their distance to its nearest point (largest component difference) over their second half must be
+    under ``ratio`` of that over their first half, and no more than the square root of what the
+    multiplier allows over half the samples (``largest ** (h / p)``, ``h`` samples a half, ``p`` the
+    period): a run near an orbit with multipliers of modulus 0.64 is on it to 1e-6 within 32
+    periods; one whose distance shrinks more slowly is passing by (a chaotic run), not converging.
+    Samples on the orbit to rounding approach it.
 
     Examples
     --------
     >>> k = np.arange(40.0)[:, None]
     >>> origin = np.zeros((1, 1))
-    >>> approaches(0.5 * 0.99**k * np.cos(2.7 * k), origin), approaches(np.cos(k), origin)
-    (True, False)
+    >>> spiral = 0.5 * 0.99**k * np.cos(2.7 * k)
+    >>> approaches(spiral, origin, 0.99), approaches(np.cos(k), origin), approaches(spiral, origin, 0.5)
+    (True, False, False)
     """
     s, c = np.asarray(samples, dtype=float), np.asarray(cycle, dtype=float)
     e = np.min(np.max(np.abs(s[:, None, :] - c[None, :, :]), axis=2), axis=1)
     h = e.size // 2
     scale = 1.0 + float(np.max(np.abs(c)))
-    if float(np.max(e[-h:])) <= 1e3 * np.finfo(float).eps * scale:
+    last, first = float(np.max(e[-h:])), float(np.max(e[:h]))
+    if last <= 1e3 * np.finfo(float).eps * scale:
         return True
-    return bool(np.max(e[-h:]) < ratio * np.max(e[:h]))
+    allowed = min(ratio, math.sqrt(min(1.0, float(largest)) ** (h / c.shape[0])))
+    return last < allowed * first
 
 
 def is_neutral(monodromy: np.ndarray, multipliers: np.ndarray | None = None) -> bool:
@@ -200,7 +212,7 @@ def polish(
             cycle = cycle_points(model, orbit.state, float(t0), int(p))
         except (GrazingError, ArithmeticError):
             continue
-        if not approaches(s, cycle):
+        if not approaches(s, cycle, orbit.abs_lambda):
             continue
         lyapunov = math.log(max(orbit.abs_lambda, 1e-300)) / (p * float(model.period))
         return Polished(int(p), cycle, int(orbit.impacts), np.asarray(orbit.multipliers), lyapunov)
