@@ -20,8 +20,8 @@ from grazing.attractors import find_attractors, state_grid
 from grazing.attractors.grid import start_time
 from grazing.core.options import CHAOS_THRESHOLD, SweepSettings
 from grazing.core.period import detect_period
-from grazing.models import impact_damper
 from grazing.maps import flow_map
+from grazing.models import impact_damper
 from grazing.orbits import find_orbit
 from grazing.orbits.shooting import is_isolated
 from grazing.sweeps import run_sweep
