@@ -89,3 +89,35 @@ def test_sweep_both_directions(capsys):
     assert main(argv) == 0
     text = capsys.readouterr().out
     assert "up:" in text and "down:" in text and "up and down differ at" in text
+
+
+DAMPER_CHAOS = (
+    "basins --model impact-damper --set omega=0.825 --states x1,v1 --fixed x2=0.5 "
+    "--x-range -0.1,0.1 --y-range -0.1,0.1 --num 8,8"
+).split()
+
+
+def test_basins_cell_merges_a_chaotic_attractor_larger_than_the_box(capsys):
+    merged = run_json(DAMPER_CHAOS, capsys)
+    assert [a["kind"] for a in merged["attractors"]] == ["chaotic"] and merged["cell"] == 0.05
+    split = run_json([*DAMPER_CHAOS, "--cell", "0"], capsys)  # (cells of the box: it falls apart)
+    assert len(split["attractors"]) > 1 and split["cell"] == 0
+
+
+def test_basins_neutral_and_polished_on_the_command_line(capsys):
+    argv = (
+        "basins --model impact-damper --set mu=0.3 --set r=0.8 --set omega=1.408 --states x1,v1 "
+        "--fixed x2=0.5 --x-range -1,1 --y-range -1,1 --num 5,5 --transient 100 --refine 0"
+    ).split()
+    res = run_json(argv, capsys)
+    assert sorted(a["kind"] for a in res["attractors"]) == ["neutral", "periodic"] and res["polished"] > 0
+    assert main(argv) == 0
+    text = capsys.readouterr().out
+    assert "neutral, period 1, no impacts" in text and "not an isolated attractor" in text
+
+
+def test_bad_cell_is_one_line(capsys):
+    for bad in ("-0.1", "2", "nan", "x"):
+        assert main([*DAMPER_CHAOS, "--cell", bad]) == 2
+        err = capsys.readouterr().err
+        assert len(err.strip().splitlines()) == 1 and "--cell" in err, err

@@ -15,6 +15,7 @@ stop are labelled ``invalid`` and not run.
 from __future__ import annotations
 
 import json
+import math
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
@@ -29,6 +30,7 @@ from grazing.core.model import HybridModel
 from grazing.core.options import (
     BASIN_ADAPTIVE_TOL,
     BASIN_CLOSING_ROUNDS,
+    CELL_FRACTION,
     ESCAPE_FACTOR,
     BasinSettings,
     refuse_unknown,
@@ -60,6 +62,10 @@ class AttractorSet:
         Forcing periods run before sampling, and sampled.
     seconds
         Wall time of the computation.
+    cell_fraction
+        The recurrence cell of an aperiodic attractor, as a fraction of its extent.
+    polished
+        Initial states whose end state was polished by Newton's method onto a stable orbit.
     """
 
     attractors: tuple[Attractor, ...]
@@ -69,6 +75,8 @@ class AttractorSet:
     transient: int
     periods: int
     seconds: float = 0.0
+    cell_fraction: float = CELL_FRACTION
+    polished: int = 0
 
     @property
     def fractions(self) -> dict[int, float]:
@@ -100,6 +108,7 @@ def basin_spec(model: HybridModel, states: np.ndarray, settings: BasinSettings, 
         tol=settings.tol,
         starts=states,
         adaptive_tol=BASIN_ADAPTIVE_TOL,
+        polish=False,  # (the catalogue polishes the end states, a few per attractor)
     )
 
 
@@ -119,6 +128,7 @@ def find_attractors(
     *,
     settings: BasinSettings | None = None,
     cell: Sequence[float] | None = None,
+    cell_fraction: float = CELL_FRACTION,
     escape: float | None = None,
     workers: int | None = None,
     client: Any = None,
@@ -140,7 +150,14 @@ def find_attractors(
         ``chunk_size``); those names are also accepted as keyword arguments.
     cell
         Size of a cell per state component (default: the initial states' box
-        over :data:`~grazing.core.options.CELLS`).
+        over :data:`~grazing.core.options.CELLS`): periodic orbits are one
+        when their points match to :data:`~grazing.core.options.MATCH_TOL`
+        cells, aperiodic end states are recorded on this grid of cells.
+    cell_fraction
+        Aperiodic end states are on one attractor when their samples share a
+        cell, or come within one recurrence cell: this fraction of the extent
+        of the attractor's points per component (at least ``cell``; default
+        :data:`~grazing.core.options.CELL_FRACTION`; 0: shared cells only).
     escape
         Distance from the box (in each component) beyond which a state has
         escaped (default :data:`~grazing.core.options.ESCAPE_FACTOR` times the
@@ -156,7 +173,14 @@ def find_attractors(
 
     The first run of every initial state computes no Lyapunov exponent: the
     aperiodic end states get theirs when they are run on (``refine``), and each
-    orbit from one of its points.
+    orbit from one of its points.  An end state with no period whose samples
+    contract towards a cycle is polished by Newton's method
+    (:mod:`grazing.sweeps.polish`): where that converges to a stable orbit the
+    samples approach, it is on that periodic attractor (an orbit with a
+    multiplier of modulus 0.997 is not "quasiperiodic" for want of a long
+    transient).  A periodic orbit whose multiplier 1 is double (a free mass at
+    rest, never impacting) is ``neutral``: a family of motions, not an
+    isolated attractor (it keeps its share of the initial states that reach it).
 
     Examples
     --------
@@ -178,11 +202,17 @@ def find_attractors(
     cells = default_cell(box) if cell is None else np.broadcast_to(np.asarray(cell, dtype=float), x.shape[1:])
     if not np.all(np.isfinite(cells) & (cells > 0)):
         raise InvalidParameterError(f"cell sizes must be positive numbers, got {cell!r}")
+    try:
+        fraction = float(cell_fraction)
+    except (TypeError, ValueError):
+        fraction = math.nan
+    if not 0.0 <= fraction <= 1.0:
+        raise InvalidParameterError(f"cell_fraction must be in [0, 1], got {cell_fraction!r}")
     side = float(np.ptp(box, axis=0).max())
     reach = ESCAPE_FACTOR * max(side, float(np.abs(box).max()), 1.0) if escape is None else float(escape)
     if not reach > 0:
         raise InvalidParameterError(f"escape must be a positive distance, got {escape!r}")
-    catalogue = Catalogue(model, x.shape[0], cells, box.min(axis=0), reach + side, s.periods, t0)
+    catalogue = Catalogue(model, x.shape[0], cells, box.min(axis=0), reach + side, s.periods, t0, fraction)
     if valid.size:
         run = _Run(workers, client, store, progress)
         spec = basin_spec(model, x[valid], s, s.lyapunov and s.refine == 0)
@@ -190,19 +220,24 @@ def find_attractors(
         deferred = _run(spec, valid, catalogue, looks[0], run, x.shape[0] - valid.size, x.shape[0])
         for look in looks[1:]:
             deferred = _refine(model, catalogue, deferred, s, look, replace(run, store=None, progress=None))
+        exact = catalogue.examine_orbits()
         if s.lyapunov:
-            _orbit_exponents(model, catalogue, s, workers, client)
+            _orbit_exponents(model, catalogue, s, workers, client, exact)
     attractors, labels = catalogue.attractors(int(invalid.sum()))
     seconds = time.perf_counter() - start
-    return AttractorSet(tuple(attractors), labels, np.array(cells), s.phase, s.transient, s.periods, seconds)
+    return AttractorSet(tuple(attractors), labels, np.array(cells), s.phase, s.transient, s.periods, seconds,
+                        fraction, catalogue.polished)  # fmt: skip
 
 
 def _orbit_exponents(model: HybridModel, catalogue: Catalogue, s: BasinSettings, workers: int | None,
-                     client: Any) -> None:  # fmt: skip
-    """Each periodic orbit's largest Lyapunov exponent, from one of its points."""
+                     client: Any, exact: dict[int, float]) -> None:  # fmt: skip
+    """Each periodic orbit's largest Lyapunov exponent: ``exact`` (from its multipliers) where given, else
+    from a run from one of its points."""
     from grazing.sweeps.api import run_sweep
 
-    orbits = catalogue.orbits()
+    for k, value in exact.items():
+        catalogue.entries[k].exponents = [value]
+    orbits = [k for k in catalogue.orbits() if k not in exact]
     if not orbits:
         return
     points = np.array([catalogue.entries[k].points[0] for k in orbits])
@@ -397,7 +432,7 @@ def to_dataset(model: HybridModel, grid: StateGrid, found: AttractorSet) -> Any:
     ds["y"].attrs.update({"long_name": names[j], "symbol": labels[j], "units": units[j] if units else ""})
     ds["label"].attrs["description"] = "the id of the attractor each initial state ends on (0: beyond a stop)"
     ds["kind"].attrs["description"] = (
-        "periodic, sticking, chaotic, quasiperiodic, aperiodic, escaping, failed, invalid"
+        "periodic, sticking, neutral, chaotic, quasiperiodic, aperiodic, escaping, failed, invalid"
     )
     ds["points"].attrs["description"] = "states on the attractor at the sampling phase (NaN-padded)"
     ds.attrs.update(
@@ -410,6 +445,8 @@ def to_dataset(model: HybridModel, grid: StateGrid, found: AttractorSet) -> Any:
             "transient": found.transient,
             "periods": found.periods,
             "cell": json.dumps(found.cell.tolist()),
+            "cell_fraction": found.cell_fraction,
+            "polished": found.polished,
             "state_labels": json.dumps(list(labels)),
             "state_units": json.dumps(list(units)),
             "time_label": model.time_label,

@@ -5,15 +5,23 @@ Each initial state is run for a transient, then sampled at the forcing phase
 
 - **failed** (the run failed: step limit, accumulating impacts) or
   **escaping** (its samples leave a bound around the grid, or it overflowed);
-- **periodic** (its samples repeat with a period ``p <= 64``): on the orbit
-  made of its last ``p`` samples.  Two end states are on one orbit when each
+- **periodic** (its samples repeat with a period ``p <= 64``, or they
+  contract towards a cycle and Newton's method from its last sample
+  converges to a stable orbit they approach: :mod:`grazing.sweeps.polish`):
+  on the orbit made of its last ``p`` samples (or Newton's orbit).  Two end states are on one orbit when each
   point of one is within :data:`~grazing.core.options.MATCH_TOL` cells of a
   point of the other (whatever point of the cycle each ended at: a distance
   between point sets, as Attractors.jl matches attractors).  An orbit whose
   points all lie on a stop, without impacts, is **sticking** (riding on it);
+  one whose multiplier 1 is double (a Jordan block: the impact damper's
+  free particle at rest, periodic only because its velocity is exactly
+  zero) is **neutral**: not an isolated attractor, a family of motions
+  that a slice of state space can hit;
 - aperiodic: its samples are recorded on a grid of cells (the cell grid of
-  Attractors.jl's recurrences); end states whose samples share a cell are
-  on one attractor, which is **chaotic** (the median largest Lyapunov
+  Attractors.jl's recurrences); end states whose samples share a cell, or
+  come within one recurrence cell (:data:`~grazing.core.options.CELL_FRACTION`
+  of the attractor's own extent per component, at least the grid's cell)
+  are on one attractor, which is **chaotic** (the median largest Lyapunov
   exponent of its end states above
   :data:`~grazing.core.options.CHAOS_THRESHOLD`), **quasiperiodic** (within
   it of zero) or **aperiodic** (no exponent: the motion sticks, or it is
@@ -35,13 +43,24 @@ import numpy as np
 
 from grazing.core.cells import group_by_cells
 from grazing.core.model import ON_STOP_TOL, HybridModel
-from grazing.core.options import BASIN_ADAPTIVE_TOL, CHAOS_THRESHOLD, CLOSING_RATIO, MATCH_TOL
+from grazing.core.options import (
+    BASIN_ADAPTIVE_TOL,
+    CELL_FRACTION,
+    CHAOS_THRESHOLD,
+    CLOSING_RATIO,
+    MATCH_TOL,
+    MAX_PERIOD,
+    POLISH_TRIES,
+)
 from grazing.core.period import orbit_impacts
 from grazing.core.solution import Status
+from grazing.errors import GrazingError
+from grazing.sweeps.polish import Polished, contracting_periods, is_neutral, polish
 from grazing.sweeps.spec import ChunkResult
 from grazing.sweeps.status import reason
 
-KINDS = ("periodic", "sticking", "chaotic", "quasiperiodic", "aperiodic", "escaping", "failed", "invalid")
+KINDS = ("periodic", "sticking", "neutral", "chaotic", "quasiperiodic", "aperiodic", "escaping", "failed",
+         "invalid")  # fmt: skip
 """What an initial state can end on (``invalid``: beyond a stop, not run)."""
 
 MAX_POINTS = 2000
@@ -126,6 +145,8 @@ class _Entry:
     count: int = 0
     reason: str = ""
     cells: set[bytes] = field(default_factory=set)
+    failures: int = 0  # (failed Newton polishes of its end states)
+    neutral: bool = False  # (a periodic orbit whose multiplier 1 is double)
 
 
 class Catalogue:
@@ -149,6 +170,16 @@ class Catalogue:
         Sampled periods of each end state (impacts per period from the counts).
     t_sample
         The time of the samples within a forcing period (for the stops' guards).
+    cell_fraction
+        Aperiodic end states whose samples come within one recurrence cell of
+        an attractor's points are on it: the cell is this fraction of the
+        extent of their joint points per component, at least ``cell`` (0:
+        only shared cells of the grid count).
+    polish
+        Polish the aperiodic end states whose samples contract towards a
+        cycle by Newton's method (:func:`grazing.sweeps.polish.polish`), at
+        most :data:`~grazing.core.options.POLISH_TRIES` failed ones per
+        attractor.
     """
 
     def __init__(
@@ -160,6 +191,8 @@ class Catalogue:
         escape: float,
         periods: int,
         t_sample: float,
+        cell_fraction: float = CELL_FRACTION,
+        polish: bool = True,
     ) -> None:
         self.model = model
         self.cell = np.asarray(cell, dtype=float)
@@ -175,6 +208,11 @@ class Catalogue:
         self._by_period: dict[int, list[int]] = {}
         self._outcome: dict[tuple[str, str], int] = {}
         self._owner: dict[bytes, int] = {}
+        self.cell_fraction = float(cell_fraction)
+        self.polish = bool(polish)
+        self.polished = 0  # (end states labelled periodic by a Newton polish)
+        self._trees: dict[int, tuple[int, np.ndarray, Any]] = {}
+        self._aperiodic: list[int] = []
 
     # ------------------------------------------------------------------ entries
 
@@ -199,9 +237,11 @@ class Catalogue:
         e, g = self.entries[keep], self.entries[gone]
         e.count += g.count
         e.exponents = (e.exponents + g.exponents)[:MAX_EXPONENTS]
+        e.failures += g.failures
         if len(e.points) < MAX_POINTS and len(g.points):
             e.points = np.concatenate([e.points, g.points[: MAX_POINTS - len(e.points)]])
         e.cells |= g.cells
+        self._trees.pop(gone, None)
         for key in g.cells:
             self._owner[key] = keep
         g.cells = set()
@@ -289,27 +329,40 @@ class Catalogue:
             for g in range(uniq.shape[0]):
                 members = np.flatnonzero(inverse == g)
                 rep = members[0]
-                k = self._periodic_entry(int(p), cyc[rep], int(index[sel[rep]]), res, int(sel[rep]))
+                row = int(sel[rep])
+                impacts = float(orbit_impacts(np.array([res.impacts[row]]), np.array([p]), self.periods)[0])
+                k = self._periodic_entry(int(p), cyc[rep], int(index[row]), impacts)
                 e = self.entries[k]
                 e.count += members.size
                 exps = np.asarray(res.lyapunov, dtype=float)[sel[members]]
                 e.exponents = e.exponents + [float(v) for v in exps[: MAX_EXPONENTS - len(e.exponents)]]
                 self.labels[index[sel[members]]] = k
 
-    def _periodic_entry(self, p: int, points: np.ndarray, first: int, res: ChunkResult, row: int) -> int:
+    def _add_polished(self, i: int, found: Polished) -> None:
+        """Label initial state ``i`` with the periodic orbit its end state was polished to."""
+        cyc = np.roll(found.cycle, -int(np.argmin(found.cycle[:, 0])), axis=0)
+        k = self._periodic_entry(found.period, cyc, i, float(found.impacts))
+        e = self.entries[k]
+        e.count += 1
+        if len(e.exponents) < MAX_EXPONENTS:
+            e.exponents.append(found.lyapunov)
+        self.labels[i] = k
+        self.polished += 1
+
+    def _periodic_entry(self, p: int, points: np.ndarray, first: int, impacts: float) -> int:
         """The entry of the period-``p`` orbit through ``points`` (a new one if none found so far is it)."""
         for k in self._by_period.get(p, []):
             k = self.root(k)
             if set_distance(self.entries[k].points, points, self.cell) <= MATCH_TOL:
                 return k
-        impacts = float(orbit_impacts(np.array([res.impacts[row]]), np.array([p]), self.periods)[0])
         k = self._new(_Entry("periodic", first, period=p, points=points.copy(), impacts=impacts))
         self._by_period.setdefault(p, []).append(k)
         return k
 
     def _add_aperiodic(self, index: np.ndarray, res: ChunkResult, rows: np.ndarray) -> None:
-        """Aperiodic end states: grouped when their samples share a cell, then merged with the attractors
-        found before that share one."""
+        """Aperiodic end states: those whose samples contract towards a stable orbit polished onto it; the
+        others grouped when their samples share a cell, then merged with the attractors found before
+        that share one or come within a recurrence cell of them."""
         if rows.size == 0:
             return
         samples = np.asarray(res.samples, dtype=float)[rows]  # (states, periods, n)
@@ -320,21 +373,116 @@ class Catalogue:
         impacts = np.asarray(res.impacts, dtype=float)[rows] / self.periods
         for c in np.unique(groups.group):
             members = np.flatnonzero(groups.group == c)
+            fails = 0
+            if self.polish:
+                targets = self._targets(groups.cells_of(owner, members), samples[members].reshape(-1, n))
+                left, fails = self._polish_members(index[rows], samples, members, targets)
+                if left.size == 0:
+                    continue
+                members = left
             cells = groups.cells_of(owner, members)
             first = int(index[rows[members[0]]])
             pts = samples[members].reshape(-1, n)[:MAX_POINTS]
+            owners = self._targets(cells, pts)
             mean_impacts = float(np.mean(impacts[members]))
             k = self._new(_Entry("aperiodic", first, period=0, points=pts.copy(), impacts=mean_impacts))
             e = self.entries[k]
             e.count = members.size
             e.exponents = [float(v) for v in lyap[members][:MAX_EXPONENTS]]
             e.cells = cells
-            owners = {self.root(self._owner[key]) for key in cells if key in self._owner}
+            e.failures = fails
+            self._aperiodic.append(k)
             for key in cells:
                 self._owner[key] = k
             for o in sorted(owners):
                 k = self._union(k, o)
             self.labels[index[rows[members]]] = k
+
+    def _targets(self, cells: set[bytes], points: np.ndarray) -> set[int]:
+        """The aperiodic attractors found so far that end states with samples ``points`` (in ``cells``)
+        are on: sharing a cell, or within a recurrence cell (:meth:`_recurrent`)."""
+        owners = {self.root(self._owner[key]) for key in cells if key in self._owner}
+        return owners | self._recurrent(points)
+
+    def _polish_members(
+        self, index: np.ndarray, samples: np.ndarray, members: np.ndarray, targets: set[int]
+    ) -> tuple[np.ndarray, int]:
+        """Polish the end states ``members`` (rows of ``samples``, initial states ``index``) that contract
+        towards a cycle; label those on a stable orbit.  The others, and the failed attempts (at most
+        :data:`~grazing.core.options.POLISH_TRIES` on the attractors ``targets`` they are on, more as
+        long as attempts succeed), are returned."""
+        budget = POLISH_TRIES - sum(self.entries[self.root(r)].failures for r in targets)
+        left, fails = [], 0
+        for j in members:
+            if budget <= 0:
+                left.append(j)
+                continue
+            candidates = contracting_periods(samples[j], MAX_PERIOD)
+            if not candidates:
+                left.append(j)
+                continue
+            found = polish(self.model, samples[j], self.t_sample, candidates=candidates)
+            if found is None:
+                left.append(j)
+                fails += 1
+                budget -= 1
+                continue
+            budget += 1
+            self._add_polished(int(index[j]), found)
+        return np.asarray(left, dtype=np.int64), fails
+
+    def _recurrent(self, points: np.ndarray) -> set[int]:
+        """The aperiodic attractors found so far within one recurrence cell of ``points``: a point of one
+        within a cell of the other's, the recurrence cell of a point set being ``cell_fraction`` of its
+        extent per component (at least the grid's cell)."""
+        from scipy.spatial import cKDTree
+
+        if self.cell_fraction <= 0 or points.size == 0:
+            return set()
+        roots = sorted({self.root(k) for k in self._aperiodic})
+        roots = [r for r in roots if self.entries[r].family == "aperiodic" and len(self.entries[r].points)]
+        if not roots:
+            return set()
+        pts = points[:MAX_POINTS]
+        mine = self.recurrence_cell(pts)
+        tree = cKDTree(pts / mine)
+        out = set()
+
+        def near(t: Any, q: np.ndarray) -> bool:
+            return bool(np.isfinite(t.query(q, p=np.inf, distance_upper_bound=1.0)[0]).any())
+
+        for r in roots:
+            rtree, rcell = self._tree(r)
+            if near(rtree, pts / rcell) or near(tree, self.entries[r].points / mine):
+                out.add(r)
+        return out
+
+    def _tree(self, r: int) -> tuple[Any, np.ndarray]:
+        """A k-d tree of attractor ``r``'s points in its recurrence cells, and that cell (kept while its
+        points do not change)."""
+        from scipy.spatial import cKDTree
+
+        pts = self.entries[r].points
+        kept = self._trees.get(r)
+        if kept is None or kept[0] != len(pts):
+            cell = self.recurrence_cell(pts)
+            kept = (len(pts), cell, cKDTree(pts / cell))
+            self._trees[r] = kept
+        return kept[2], kept[1]
+
+    def recurrence_cell(self, points: np.ndarray) -> np.ndarray:
+        """The recurrence cell of a point set: ``cell_fraction`` of its extent per component, at least the
+        grid's cell.
+
+        Examples
+        --------
+        >>> import grazing
+        >>> cat = Catalogue(grazing.models.bouncing_ball(), 1, np.full(2, 0.01), np.zeros(2), 1e3, 50, 0.0)
+        >>> cat.recurrence_cell(np.array([[0.0, 0.0], [4.0, 0.1]])).tolist()
+        [0.2, 0.01]
+        """
+        span = np.ptp(np.asarray(points, dtype=float), axis=0)
+        return np.maximum(self.cell, self.cell_fraction * span)
 
     # ------------------------------------------------------------------ the result
 
@@ -402,12 +550,38 @@ class Catalogue:
         if e.family in ("escaping", "failed"):
             return e.family, math.nan
         if e.family == "periodic":
-            return ("sticking" if self._sticks(e) else "periodic"), exponent
+            if self._sticks(e):
+                return "sticking", exponent
+            return ("neutral" if e.neutral else "periodic"), exponent
         if not math.isfinite(exponent):
             return "aperiodic", exponent
         if exponent > CHAOS_THRESHOLD:
             return "chaotic", exponent
         return ("quasiperiodic" if exponent >= -CHAOS_THRESHOLD else "aperiodic"), exponent
+
+    def examine_orbits(self) -> dict[int, float]:
+        """Mark the periodic orbits found that are neutral (:func:`~grazing.sweeps.polish.is_neutral`: a
+        double multiplier 1), from the monodromy at one of their points; return the largest Lyapunov
+        exponent of each orbit whose monodromy was computed, ``ln |mu|_max / (p T)`` (by entry)."""
+        from grazing.maps import flow_map
+
+        out: dict[int, float] = {}
+        for k in self.orbits():
+            e = self.entries[k]
+            if self._sticks(e):
+                continue
+            try:
+                fm = flow_map(self.model, e.points[0], t0=self.t_sample, periods=e.period)
+            except (GrazingError, ArithmeticError):
+                continue
+            if not (fm.solution.jacobian_valid and np.all(np.isfinite(fm.jacobian))):
+                continue
+            mu = np.linalg.eigvals(fm.jacobian)
+            e.neutral = is_neutral(fm.jacobian, mu)
+            largest = float(np.max(np.abs(mu)))
+            if largest > 0:
+                out[k] = math.log(largest) / (e.period * float(self.model.period))
+        return out
 
     def _sticks(self, e: _Entry) -> bool:
         """No impacts, and every point of the orbit on a stop: the motion rides on it."""

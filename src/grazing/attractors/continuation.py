@@ -28,7 +28,7 @@ from grazing.attractors.basins import AttractorSet, find_attractors
 from grazing.attractors.classify import Attractor, set_distance
 from grazing.attractors.grid import state_grid
 from grazing.core.model import HybridModel
-from grazing.core.options import BasinSettings, refuse_unknown, with_shorthands
+from grazing.core.options import CELL_FRACTION, BasinSettings, refuse_unknown, with_shorthands
 from grazing.errors import InvalidParameterError
 
 MATCH_DISTANCE = 8.0
@@ -158,6 +158,7 @@ def continue_attractors(
     settings: BasinSettings | None = None,
     seeds: int = SEEDS,
     threshold: float = MATCH_DISTANCE,
+    cell_fraction: float = CELL_FRACTION,
     workers: int | None = None,
     client: Any = None,
     progress: Callable[[int, int], None] | None = None,
@@ -178,6 +179,9 @@ def continue_attractors(
         Points of each attractor run again as initial states at the next value.
     threshold
         Largest distance (cells) between an attractor at one value and at the next to be followed.
+    cell_fraction
+        The recurrence cell of an aperiodic attractor, a fraction of its extent (as for
+        :func:`~grazing.attractors.basins.find_attractors`).
     workers, client
         Local threads, or a Dask client.
     progress
@@ -217,7 +221,9 @@ def continue_attractors(
         here = model.with_params(**{par.name: float(v)})
         extra, origin = _seeds(previous, seeds)
         states_here = np.concatenate([x, extra]) if extra.size else x
-        found = find_attractors(here, states_here, settings=s, workers=workers, client=client)
+        found = find_attractors(
+            here, states_here, settings=s, cell_fraction=cell_fraction, workers=workers, client=client
+        )
         # (the cell grid of the first value throughout: distances in the same units)
         cell = steps[0].found.cell if steps else found.cell
         seeded = _votes(origin, found.labels[x.shape[0] :])

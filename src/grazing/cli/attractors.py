@@ -29,8 +29,18 @@ from grazing.cli.common import (
     save_dataset,
 )
 from grazing.cli.limits import basin_bytes, check_memory, count_text
-from grazing.cli.validate import FINITE, TOLERANCE, WORKERS, count, path_type, refuse_unused
-from grazing.core.options import BASIN_CHUNK, BASIN_PERIODS, BASIN_REFINE, BASIN_TRANSIENT, SWEEP_TOL
+from grazing.cli.validate import FINITE, TOLERANCE, WORKERS, Number, count, path_type, refuse_unused
+from grazing.core.options import (
+    BASIN_CHUNK,
+    BASIN_PERIODS,
+    BASIN_REFINE,
+    BASIN_TRANSIENT,
+    CELL_FRACTION,
+    SWEEP_TOL,
+)
+
+CELL = Number(0.0, 1.0, low_open=False, high_open=False)
+"""A recurrence cell as a fraction of an attractor's extent (``--cell``)."""
 
 
 def _grid_options(num_name: str) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
@@ -102,6 +112,17 @@ def _grid_options(num_name: str) -> Callable[[Callable[..., Any]], Callable[...,
                 help="Times an aperiodic end state is run on for another transient.",
             ),
             click.option("--no-lyapunov", is_flag=True, help="Skip the Lyapunov exponents."),
+            click.option(
+                "--cell",
+                "cell_fraction",
+                type=CELL,
+                default=CELL_FRACTION,
+                show_default=True,
+                metavar="FRACTION",
+                help="Recurrence cell of a chaotic or quasi-periodic attractor, as a fraction of its own "
+                "extent in each state (0: the grid box over 64): end states whose samples come within "
+                "one cell are on one attractor.",
+            ),
             click.option(
                 "--tol",
                 type=TOLERANCE,
@@ -232,6 +253,8 @@ def _attractor_lines(atts: list[Any], model: grazing.HybridModel) -> list[str]:
             words += f" ({a.reason})"
         if np.isfinite(a.lyapunov):
             words += f", lyapunov {a.lyapunov:+.4g}"
+        if a.kind == "neutral":
+            words += " (a double multiplier 1: a family of motions, not an isolated attractor)"
         if len(a.points) and a.kind not in ("chaotic", "quasiperiodic", "aperiodic"):
             pt = ", ".join(f"{n} = {v:.6g}" for n, v in zip(model.state_names, a.points[0]))
             words += f"; at {pt}"
@@ -271,6 +294,7 @@ def basins_cmd(
     periods: int,
     refine: int,
     no_lyapunov: bool,
+    cell_fraction: float,
     tol: float,
     workers: int | None,
     plot: Path | None,
@@ -326,7 +350,13 @@ def basins_cmd(
                     ),
                 )
         found = find_attractors(
-            model, grid.states_array(), settings=settings, workers=workers, store=store, progress=bar
+            model,
+            grid.states_array(),
+            settings=settings,
+            cell_fraction=cell_fraction,
+            workers=workers,
+            store=store,
+            progress=bar,
         )
     finally:
         bar.close()
@@ -348,6 +378,8 @@ def basins_cmd(
                 "phase": phase,
                 "transient": transient,
                 "periods": periods,
+                "cell": cell_fraction,
+                "polished": found.polished,
                 "x": grid.x,
                 "y": grid.y,
                 "labels": found.labels.reshape(grid.shape),
@@ -408,6 +440,7 @@ def attractors_cmd(
     periods: int,
     refine: int,
     no_lyapunov: bool,
+    cell_fraction: float,
     tol: float,
     workers: int | None,
     plot: Path | None,
@@ -462,6 +495,7 @@ def attractors_cmd(
             fixed=_fixed(fixed),
             settings=settings,
             seeds=seeds,
+            cell_fraction=cell_fraction,
             workers=workers,
             progress=bar,
         )

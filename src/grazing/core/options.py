@@ -150,6 +150,33 @@ multipliers of modulus 0.975, whose samples repeated with period 4 to the detect
 ESCAPE_FACTOR = 1e6
 """A state farther than this many times the grid box's extent from the box has escaped."""
 
+CELL_FRACTION = 0.05
+"""The recurrence cell of an aperiodic attractor (chaotic, quasi-periodic), per state component: this
+fraction of the attractor's own extent (as Attractors.jl sizes its recurrence cells from the
+attractor), never less than the grid's cell.  Two aperiodic end states are one attractor when their
+samples come within one such cell.  Sized from the grid box instead (``box / CELLS``), one chaotic
+attractor of the impact damper larger than a small box was split into 65 "attractors"."""
+
+POLISH_RATIO = 0.99
+"""A run's samples contract towards a period-p cycle where the largest difference ``|x[k + p] - x[k]|``
+over the second half of its samples is under this fraction of that over the first half (an orbit
+with a multiplier of modulus 0.9968 shrinks them by 0.92 over 25 samples)."""
+
+POLISH_CANDIDATES = 2
+"""Periods (the shortest whose differences contract) tried by Newton's method per run."""
+
+POLISH_MAX_ITER = 10
+"""Newton iterations of a run's polish: from a run contracting towards a cycle it converges in a few;
+one that does not is not that cycle's."""
+
+POLISH_TRIES = 3
+"""Failed Newton polishes per aperiodic attractor of a basin computation: past them its other end states
+(on a chaotic set or a torus) are not tried."""
+
+NEUTRAL_TOL = 1e-6
+"""A periodic orbit is neutral when two of its multipliers are within this of 1 (a Jordan block found
+to rounding) or its multiplier 1 is double (:data:`NON_ISOLATED_TOL`)."""
+
 IMPACTS = ("none", "sampled", "all")
 """What :class:`SaveAt` can record of the impacts."""
 

@@ -54,11 +54,13 @@ def describe(kind: str, period: int, impacts: float) -> str:
     --------
     >>> describe("periodic", 5, 1.0), describe("periodic", 1, 0.0), describe("chaotic", 0, 0.8)
     ('period 5, 1 impact', 'period 1, no impacts', 'chaotic')
+    >>> describe("neutral", 1, 0.0)
+    'neutral, period 1, no impacts'
     """
-    if kind == "periodic":
+    if kind in ("periodic", "neutral"):
         n = round(float(impacts)) if np.isfinite(impacts) else -1
         imp = "no impacts" if n == 0 else ("1 impact" if n == 1 else f"{n} impacts" if n > 0 else "")
-        return f"period {period}" + (f", {imp}" if imp else "")
+        return ("neutral, " if kind == "neutral" else "") + f"period {period}" + (f", {imp}" if imp else "")
     return kind
 
 

@@ -63,7 +63,7 @@ from typing import Any
 import numpy as np
 
 from grazing.core.cells import one_attractor
-from grazing.core.options import CHAIN_CELLS, CHAIN_SHIFTS, CHAIN_TOL
+from grazing.core.options import CHAIN_CELLS, CHAIN_SHIFTS, CHAIN_TOL, PERIOD_TOL
 from grazing.core.solution import Status
 from grazing.sweeps.spec import ChunkResult, SweepSpec
 
@@ -121,18 +121,34 @@ def same_outcome(a: ChunkResult, i: int, b: ChunkResult, j: int, tol: float = CH
     Both failed for the same reason; or both on one periodic orbit at one point of it: the same
     period, samples and final state equal to ``tol``; or both aperiodic on one attractor: their
     samples share a cell of the grid of :data:`~grazing.core.options.CHAIN_CELLS` cells along their
-    joint box (:func:`~grazing.core.cells.one_attractor`, the basins' rule).
+    joint box (:func:`~grazing.core.cells.one_attractor`, the basins' rule).  Two points given one
+    period by a Newton polish (:mod:`grazing.sweeps.polish`: their samples approach the orbit, they
+    do not repeat) are as aperiodic ones: on one attractor by that rule.
     """
     sa, sb = int(a.status[i]), int(b.status[j])
     if sa != Status.OK or sb != Status.OK:
         return sa == sb
     p = int(a.period[i])
-    if p <= 0 and int(b.period[j]) <= 0:
+    if p == int(b.period[j]) and not repeats(a.samples[i], p) and not repeats(b.samples[j], p):
         return one_attractor(a.samples[i], b.samples[j], CHAIN_CELLS)
     if p <= 0 or p != int(b.period[j]):
         return False
     close = np.max(np.abs(a.samples[i] - b.samples[j])) <= tol
     return bool(close and np.max(np.abs(a.x_final[i] - b.x_final[j])) <= tol)
+
+
+def repeats(samples: np.ndarray, p: int) -> bool:
+    """Whether ``samples`` repeat with period ``p > 0`` to :data:`~grazing.core.options.PERIOD_TOL` (a
+    point whose period a Newton polish gave does not: its samples still approach the orbit).
+
+    Examples
+    --------
+    >>> k = np.arange(20.0)[:, None]
+    >>> repeats(np.cos(np.pi * k), 2), repeats(0.9**k * np.cos(np.pi * k), 2), repeats(np.ones((4, 1)), 0)
+    (True, False, False)
+    """
+    s = np.asarray(samples, dtype=float)
+    return p > 0 and bool(np.max(np.abs(s[p:] - s[:-p])) <= PERIOD_TOL)
 
 
 _UNSET = object()
@@ -220,7 +236,7 @@ def orbit_period(spec: SweepSpec, res: ChunkResult | None) -> int:
     if res is None or not spec.model.periodic or int(res.status[0]) != Status.OK:
         return 0
     p = int(res.period[0])
-    return p if 2 <= p <= CHAIN_SHIFTS else 0
+    return p if 2 <= p <= CHAIN_SHIFTS and repeats(res.samples[0], p) else 0
 
 
 def orbit_advance(guess: ChunkResult, res: ChunkResult, p: int) -> int | None:
@@ -258,7 +274,9 @@ def shifted_start(spec: SweepSpec, index: int, res: ChunkResult, advance: int) -
 def in_phase_through(spec: SweepSpec, res: ChunkResult, p: int) -> bool:
     """Whether every point of ``res`` ends on a period-``p`` orbit: a chunk's shift is then as far ahead at
     its end as at its first point (the chunk after it starts that far along its orbit)."""
-    return bool(spec.model.periodic and np.all(res.status == Status.OK) and np.all(res.period == p))
+    if not (spec.model.periodic and np.all(res.status == Status.OK) and np.all(res.period == p)):
+        return False
+    return all(repeats(s, p) for s in res.samples)
 
 
 @dataclass

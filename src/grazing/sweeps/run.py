@@ -47,6 +47,7 @@ from grazing.engine.codegen import taylor_order
 from grazing.engine.native import load_sweep_lanes
 from grazing.engine.records import LaneJobs, LanePoints, LaneResults, LaneSettings
 from grazing.engine.runner import step_safety
+from grazing.sweeps.polish import polish
 from grazing.sweeps.spec import ChunkResult, SweepSpec
 from grazing.sweeps.status import NOT_COMPUTED, STATUS_DTYPE
 
@@ -215,9 +216,25 @@ class LaneBatch:
         out, at = [], 0
         for k in ks:
             a, b = self._bounds[k]
+            self._polish(k, periods[at : at + b - a])
             out.append(self._result(k, periods[at : at + b - a]))
             at += b - a
         return out
+
+    def _polish(self, k: int, period: np.ndarray) -> None:
+        """Give the points of chunk ``parts[k]`` with no period whose samples contract towards a stable
+        orbit that orbit's period (:func:`grazing.sweeps.polish.polish`), in place."""
+        spec, i = self.parts[k]
+        if not spec.polish or spec.zdm is not None or not spec.model.periodic:
+            return
+        a, b = self._bounds[k]
+        first = spec.chunk(i).start
+        for j in np.flatnonzero((period == 0) & (self.status[a:b] == Status.OK)):
+            model = spec.model_at(spec.points[first + j])
+            t0 = float(self.sphase[a + j])
+            found = polish(model, self.samples[a + j], t0, max_period=DEFAULT_MAX_PERIOD)
+            if found is not None:
+                period[j] = found.period
 
     def _result(self, k: int, period: np.ndarray) -> ChunkResult:
         """The result of chunk ``parts[k]`` (once finished), its points' periods given."""

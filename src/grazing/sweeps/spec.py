@@ -85,6 +85,11 @@ class SweepSpec:
         Chattering shorter than this fraction of the forcing period is summed
         to its accumulation point and continued as sticking (as
         :class:`~grazing.core.options.Solver`'s).
+    polish
+        A point with no period whose samples contract towards a cycle is
+        polished by Newton's method (:mod:`grazing.sweeps.polish`): where it
+        converges to a stable orbit the samples approach, the point has that
+        orbit's period.  (The basins polish their end states themselves.)
     """
 
     model: HybridModel
@@ -106,6 +111,7 @@ class SweepSpec:
     adaptive_tol: float = ADAPTIVE_TOL
     resume: tuple[float, tuple[float, ...]] | None = None
     chatter_tol: float = CHATTER_TOL
+    polish: bool = True
 
     def __post_init__(self) -> None:
         if not self.points:
@@ -214,6 +220,8 @@ class SweepSpec:
             d["adaptive_tol"] = self.adaptive_tol
         if self.chatter_tol != CHATTER_TOL:
             d["chatter_tol"] = self.chatter_tol
+        if not self.polish:
+            d["polish"] = False
         return d
 
     def fingerprint(self) -> str:

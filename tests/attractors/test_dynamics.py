@@ -1,0 +1,150 @@
+"""Attractors classified from the dynamics, not the window (issue 42, part 5).
+
+On the impact damper (states x1, v1, x2, v2): a stable orbit slow to attract is periodic (Newton's
+method from the last samples), not quasiperiodic; one chaotic attractor larger than a small grid box
+is one attractor (recurrence cells sized from the attractor); the free particle at rest is neutral;
+the torus past the Neimark-Sacker point (omega = 1.40918 at mu = 0.3, r = 0.8) is quasiperiodic.
+Every expected value is a property (multipliers, find_orbit's period), none a number of our output.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+import grazing
+from grazing.attractors import find_attractors, state_grid
+from grazing.attractors.grid import start_time
+from grazing.core.options import CHAOS_THRESHOLD, SweepSettings
+from grazing.core.period import detect_period
+from grazing.maps import flow_map
+from grazing.models import impact_damper
+from grazing.orbits import find_orbit
+from grazing.orbits.shooting import is_isolated
+from grazing.sweeps import run_sweep
+from grazing.sweeps.polish import approaches, contracting_periods, polish
+from grazing.sweeps.spec import sweep_spec
+
+SLOW = impact_damper(mu=0.3, r=0.8, omega=1.408)  # the period-1 two-impact orbit, just before its NS point
+TORUS = impact_damper(mu=0.3, r=0.8, omega=1.412)  # just past it
+CHAOS = impact_damper(omega=0.825)  # the default damper is chaotic there
+
+
+def grid(model, num=(5, 5), **fixed):
+    return state_grid(model, (-1.0, 1.0), (-1.0, 1.0), num, states=("x1", "v1"), fixed=fixed)
+
+
+def orbit_through(model, attractor, found):
+    """find_orbit from the attractor's first point, at the samples' time, with its period."""
+    t0 = start_time(model, found.phase)
+    return find_orbit(model, attractor.points[0], period=int(attractor.period), t0=t0)
+
+
+def test_a_slowly_contracting_orbit_is_periodic_not_quasiperiodic():
+    x = grid(SLOW, v2=0.3).states_array()
+    found = find_attractors(SLOW, x, workers=2, transient=100, refine=0)  # (a short transient)
+    (a,) = found.attractors
+    assert (a.kind, a.count) == ("periodic", x.shape[0])
+    orbit = orbit_through(SLOW, a, found)
+    mu = float(np.abs(orbit.multipliers).max())
+    assert orbit.stable and orbit.isolated and 0.98 < mu < 1.0  # (slow: what the issue is about)
+    assert orbit.period == a.period and orbit.impacts == a.impacts_per_period
+    assert math.isclose(a.lyapunov, math.log(mu) / (a.period * SLOW.period), rel_tol=1e-6)
+    assert abs(a.lyapunov) < CHAOS_THRESHOLD  # (its exponent alone would say quasiperiodic)
+    # the window alone shows no period: Newton's method decided it
+    run = grazing.simulate(SLOW, x[0], transient=100, periods=found.periods, tol=1e-10)
+    assert detect_period(run.samples) == 0 and found.polished > 0
+    assert contracting_periods(run.samples)[0] == orbit.period
+
+
+def test_the_sweep_gives_a_slow_orbit_its_period():
+    settings = SweepSettings(transient=100, periods=50, fresh=True)
+    spec = sweep_spec(SLOW, "omega", [1.404, 1.408], x0=(0.0, 0.0, 0.5, 0.0), settings=settings)
+    ds = run_sweep(spec, workers=1)
+    raw = run_sweep(replace(spec, polish=False), workers=1)
+    assert raw.period.values.tolist() == [0, 0]  # (the samples do not repeat to 1e-6 yet)
+    for omega, p, samples in zip(ds.value.values, ds.period.values, ds.samples.values):
+        orbit = find_orbit(SLOW.with_params(omega=float(omega)), samples[-1], period=1)
+        assert orbit.stable and np.abs(orbit.multipliers).max() > 0.98
+        assert p == orbit.period
+
+
+def test_the_particle_at_rest_is_neutral_not_an_attractor():
+    x = grid(SLOW, x2=0.5).states_array()  # (v2 = 0: the particle starts at rest)
+    found = find_attractors(SLOW, x, workers=2, transient=100, refine=0)
+    kinds = {a.kind: a for a in found.attractors}
+    assert set(kinds) == {"periodic", "neutral"}
+    rest = kinds["neutral"]
+    assert rest.impacts_per_period == 0 and rest.points[0][3] == 0.0  # (never impacts, at rest)
+    fm = flow_map(SLOW, rest.points[0], t0=start_time(SLOW, found.phase), periods=rest.period)
+    assert np.abs(fm.image - rest.points[0]).max() < 1e-9 and fm.impacts == 0  # (a periodic motion)
+    assert not is_isolated(fm.jacobian)  # (a double multiplier 1: a Jordan block)
+    assert np.sum(np.abs(np.linalg.eigvals(fm.jacobian) - 1) < 1e-6) >= 2
+    moving = kinds["periodic"]
+    assert orbit_through(SLOW, moving, found).stable and moving.impacts_per_period > 0
+    assert math.isclose(sum(found.fractions.values()), 1.0)  # (it keeps the states that reach it)
+
+
+def test_one_chaotic_attractor_larger_than_the_box_is_one_attractor():
+    g = state_grid(CHAOS, (-0.1, 0.1), (-0.1, 0.1), (10, 10), states=("x1", "v1"), fixed={"x2": 0.5})
+    found = find_attractors(CHAOS, g.states_array(), workers=2)
+    (a,) = found.attractors
+    assert a.kind == "chaotic" and a.lyapunov > CHAOS_THRESHOLD and a.count == g.size
+    extent = np.ptp(a.points, axis=0)
+    box = np.ptp(g.states_array(), axis=0)
+    assert (extent[:2] > box[:2]).all()  # (the attractor is larger than the grid's box)
+    # with cells of the box (1/64 of it), its end states' samples rarely share one: it falls apart
+    split = find_attractors(CHAOS, g.states_array(), workers=2, cell_fraction=0.0)
+    assert len(split.attractors) > 1 and {b.kind for b in split.attractors} == {"chaotic"}
+
+
+def test_the_torus_past_neimark_sacker_is_quasiperiodic():
+    x = grid(TORUS, (4, 4), v2=0.3).states_array()
+    found = find_attractors(TORUS, x, workers=2)
+    (a,) = found.attractors
+    assert (a.kind, a.period, a.count) == ("quasiperiodic", 0, x.shape[0])
+    assert abs(a.lyapunov) <= CHAOS_THRESHOLD
+    # inside it, the period-1 orbit lost its stability to a complex pair
+    orbit = find_orbit(TORUS, a.points.mean(axis=0), period=1, t0=start_time(TORUS, found.phase))
+    mu = orbit.multipliers[0]
+    assert abs(mu) > 1 and abs(mu.imag) > 0 and orbit.unstable_count == 2
+    # the samples fill a closed curve around it: every angle, never near it
+    d = (a.points - orbit.state)[:, :2] / np.ptp(a.points[:, :2], axis=0)
+    angle, radius = np.arctan2(d[:, 1], d[:, 0]), np.hypot(d[:, 0], d[:, 1])
+    assert np.unique(np.floor((angle + np.pi) / (np.pi / 8))).size == 16
+    assert radius.min() > 0.2 * radius.max()
+    # and no Newton polish made it an orbit: from its samples, it is none
+    assert polish(TORUS, a.points[:50], start_time(TORUS, found.phase)) is None
+
+
+def test_a_failed_polish_leaves_the_label_and_is_bounded(monkeypatch):
+    """Newton failing everywhere (raising inside find_orbit) changes no label and costs at most a few
+    attempts per attractor."""
+    import grazing.orbits.shooting as shooting
+
+    calls = []
+
+    def failing(*args, **kwargs):
+        calls.append(1)
+        raise grazing.ConvergenceError("no")
+
+    monkeypatch.setattr(shooting, "find_orbit", failing)
+    x = grid(SLOW, v2=0.3).states_array()
+    found = find_attractors(SLOW, x, workers=2, transient=100, refine=0)
+    assert [a.kind for a in found.attractors] in (["quasiperiodic"], ["aperiodic"])  # (what the samples say)
+    assert 0 < len(calls) <= 2 * 3  # (POLISH_TRIES failures, each at most POLISH_CANDIDATES periods)
+
+
+@pytest.mark.parametrize("bad", [-0.1, 1.5, math.nan, "x"])
+def test_bad_cell_fractions_are_refused(bad):
+    with pytest.raises(grazing.InvalidParameterError, match="cell_fraction"):
+        find_attractors(SLOW, [[0.0, 0.0, 0.5, 0.3]], cell_fraction=bad)
+
+
+def test_approaches_needs_the_contraction_the_multipliers_allow():
+    k = np.arange(50.0)[:, None]
+    fast = 0.3 * np.cos(1.7 * k) * (1.0 - 0.002 * k)  # (shrinking, but far slower than 0.5 a period)
+    assert approaches(fast, np.zeros((1, 1)), 0.999) and not approaches(fast, np.zeros((1, 1)), 0.5)
