@@ -165,7 +165,7 @@ with a multiplier of modulus 0.9968 shrinks them by 0.92 over 25 samples)."""
 POLISH_CANDIDATES = 2
 """Periods (the shortest whose differences contract) tried by Newton's method per run."""
 
-POLISH_MAX_ITER = 10
+POLISH_MAX_ITER = 6
 """Newton iterations of a run's polish: from a run contracting towards a cycle it converges in a few;
 one that does not is not that cycle's."""
 

@@ -429,6 +429,7 @@ def find_orbit(
     max_iter: int = NEWTON_MAX_ITER,
     transient: int = 500,
     stop_name: int | str | None = None,
+    through_stops: bool = True,
 ) -> PeriodicOrbit:
     """Find a periodic orbit by Newton's method on the stroboscopic map.
 
@@ -463,6 +464,10 @@ def find_orbit(
     stop_name
         The stop (name or index; the first by default) whose closest approach
         the orbit reports (``guard_min``, ``approach``), for grazing analysis.
+    through_stops
+        Where Newton's method on the physical map fails, try it on the flow
+        through the stops too (see ``virtual``); False: do not (a caller that
+        only wants the orbit a run approaches, at the cost of one try).
 
     Raises
     ------
@@ -486,7 +491,7 @@ def find_orbit(
     if t0 is None:
         orbit = find_orbit(
             model, x0, period=period, t0=0.0, virtual=virtual, tol=tol, max_iter=max_iter,
-            transient=transient, stop_name=stop_name,
+            transient=transient, stop_name=stop_name, through_stops=through_stops,
         )  # fmt: skip
         if orbit.section_clearance() >= SECTION_MARGIN:
             return orbit
@@ -516,7 +521,7 @@ def find_orbit(
     try:
         return newton.solve(x, virtual, advice, guess, note)
     except ConvergenceError:
-        inside = None if virtual else newton.nonimpacting(x)
+        inside = None if virtual or not through_stops else newton.nonimpacting(x)
         if inside is None:
             raise
         return inside

@@ -79,6 +79,8 @@ def contracting_periods(
     the second half of the samples is under ``ratio`` of the largest over the first half, and not
     zero (the samples of a run that has settled repeat: it is periodic, not contracting).  Only
     periods up to a third of the samples are tried (each half then holds several differences).
+    (Chaotic runs pass this too, about one candidate for every two of the pendulum's chaotic sweep
+    points, measured; Newton's method then fails on them, which is what tells them apart.)
 
     Examples
     --------
@@ -203,7 +205,9 @@ def polish(
     tries = contracting_periods(s, max_period) if candidates is None else list(candidates)
     for p in tries:
         try:
-            orbit = find_orbit(model, s[-1], period=int(p), t0=float(t0), max_iter=max_iter)
+            orbit = find_orbit(
+                model, s[-1], period=int(p), t0=float(t0), max_iter=max_iter, through_stops=False
+            )
         except (GrazingError, ArithmeticError, np.linalg.LinAlgError):
             continue
         if not orbit.stable or is_neutral(orbit.monodromy, orbit.multipliers):
