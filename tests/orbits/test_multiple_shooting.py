@@ -115,3 +115,27 @@ def test_single_shooting_alone_stalls_short_of_it(inverted_branch, monkeypatch):
     single = continue_orbit(model, "a", 3.0, 9.0, orbit=orbit)
     assert "step size fell below" in single.status
     assert max(single.values) < segmented.special[-1].param - 1e-3
+
+
+def test_find_orbit_from_a_guess_solves_the_segments_where_the_monodromy_is_large(
+    inverted_branch, monkeypatch
+):
+    # From within 1e-10 of a strongly unstable orbit (|M| from 1e6 to 1e8), single shooting's first step
+    # (|M| times the guess's error) lands on another orbit; the segments of the guess's run do not.
+    from grazing.orbits.shooting import _Newton
+
+    model, _, branch = inverted_branch
+    picked = [o for o in branch.orbits if 1e6 < o.abs_lambda < 1e8][::8]
+    assert len(picked) >= 4
+
+    def found(orbit):
+        m = model.with_params(a=orbit.model.params["a"])
+        return find_orbit(m, orbit.state * (1 + 1e-10), period=1, t0=orbit.t0)
+
+    for orbit in picked:
+        again = found(orbit)
+        np.testing.assert_allclose(again.state, orbit.state, atol=1e-10)
+        assert again.abs_lambda == pytest.approx(orbit.abs_lambda, rel=1e-6)
+    monkeypatch.setattr(_Newton, "segments_from_guess", lambda self, fm, virtual: False)
+    elsewhere = [np.max(np.abs(found(orbit).state - orbit.state)) for orbit in picked]
+    assert max(elsewhere) > 1e-4  # (single shooting alone: another orbit, for some of them)

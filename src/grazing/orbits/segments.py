@@ -34,6 +34,7 @@ each point is a :class:`~grazing.orbits.shooting.PeriodicOrbit`.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -73,7 +74,7 @@ class SegmentFlow:
     solution: Solution
 
 
-def segment_flow(model: HybridModel, x: np.ndarray, ta: float, tb: float, param: str) -> SegmentFlow:
+def segment_flow(model: HybridModel, x: np.ndarray, ta: float, tb: float, param: str | None) -> SegmentFlow:
     """Free flight (the stops ignored) from state ``x`` at time ``ta`` to time ``tb > ta``.
 
     The engine samples at a forcing phase: the run's last sample is the phase of
@@ -106,10 +107,12 @@ def segment_flow(model: HybridModel, x: np.ndarray, ta: float, tb: float, param:
         raise ConvergenceError(f"a segment of the orbit has no length (from t = {ta:.12g} to {tb:.12g})")
     sol = simulate(
         model, x, t0=ta, periods=periods, phase=2 * math.pi * s_phase / T, jacobian=True,
-        sensitivities=(param,), guard_min=True, events=False, impacts="none",
+        sensitivities=() if param is None else (param,), guard_min=True, events=False, impacts="none",
     )  # fmt: skip
     n = model.n_states
     end = sol.x_final
+    if param is None:
+        return SegmentFlow(end, sol.jacobian[:, :n], np.zeros(n), sol)
     sens = sol.jacobian[:, n]
     tp = sol.info["period_gradient"][param]
     if tp:  # (the engine's end (kb + s_phase/T) T(p) moves with T; the segment's end tb does not)
@@ -177,7 +180,9 @@ def segmented_equations(
 
     ``u`` is laid out by ``layout`` (:class:`SegmentLayout`), the parameter ``param`` last;
     ``stop`` is the stop whose guard minimum the orbit reports.  ``F`` has as many rows as
-    ``u`` has entries but one (``DF`` one column more), as :func:`branch_equations`'s.
+    ``u`` has entries but one (``DF`` one column more), as :func:`branch_equations`'s.  With
+    ``param`` None the parameters are fixed: the last entry of ``u`` is ignored and the last
+    column of ``DF`` is zero (:func:`segmented_newton`).
 
     Examples
     --------
@@ -191,12 +196,11 @@ def segmented_equations(
     (True, (8, 9), True)
     """
     n, k = layout.n_states, layout.impacts
-    pidx = [p.name for p in model.parameters].index(param)
+    pidx = [p.name for p in model.parameters].index(param) if param is not None else -1
     size = layout.size
 
     def evaluate(u: np.ndarray) -> tuple[np.ndarray, np.ndarray, PeriodicOrbit]:
-        p = float(u[-1])
-        m = model.with_params(**{param: p})
+        m = model.with_params(**{param: float(u[-1])}) if param is not None else model
         T = m.period
         t_end = t0 + period * T
         F = np.zeros(size)
@@ -225,8 +229,9 @@ def segmented_equations(
                 dy[:, layout.time_index(i)] = -seg.jacobian @ f_start
             if col_t_end is not None:
                 dy[:, col_t_end] = f_end
-            tp = seg.solution.info["period_gradient"][param]  # dT/dp: the return time t0 + n T moves
-            dy[:, -1] = seg.sensitivity + (f_end * period * tp if i == k else 0.0)
+            if param is not None:
+                tp = seg.solution.info["period_gradient"][param]  # dT/dp: the return time t0 + n T moves
+                dy[:, -1] = seg.sensitivity + (f_end * period * tp if i == k else 0.0)
             M = seg.jacobian @ M
             if i == k:  # the return to the section
                 F[row : row + n] = y - layout.state(u, 0)
@@ -239,18 +244,19 @@ def segmented_equations(
             F[row] = cd["h"]
             DF[row] = cd["h_x"] @ dy
             DF[row, col_t_end] += cd["h_t"]
-            DF[row, -1] += cd["h_p"][pidx]
+            if param is not None:
+                DF[row, -1] += cd["h_p"][pidx]
             row += 1
             g = m.reset(y, tb, j)
             _, _, gx = m.jacobians(y, tb, j)
             gt = np.asarray(m.numeric("g_t", j)(list(y), tb, list(m.param_vector)), dtype=float).reshape(n)
-            gp = np.asarray(m.numeric("g_p", j)(list(y), tb, list(m.param_vector)), dtype=float)
-            gp = gp.reshape(n, -1)[:, pidx]
             nxt = layout.state_index(i + 1)
             F[row : row + n] = layout.state(u, i + 1) - g
             DF[row : row + n] = -(gx @ dy)
             DF[row : row + n, col_t_end] -= gt
-            DF[row : row + n, -1] -= gp
+            if param is not None:
+                gp = np.asarray(m.numeric("g_p", j)(list(y), tb, list(m.param_vector)), dtype=float)
+                DF[row : row + n, -1] -= gp.reshape(n, -1)[:, pidx]
             DF[row : row + n, nxt : nxt + n] += np.eye(n)
             row += n
             pre.append(y)
@@ -309,4 +315,64 @@ def _segmented_orbit(
         impact_stops=np.array(layout.stops, dtype=int),
         guard_min_by_stop=tuple(by_stop),  # type: ignore[arg-type]
         approach_by_stop=tuple(approach),
+    )
+
+
+def run_layout(model: HybridModel, x: np.ndarray, t0: float, period: int, stop: int = 0):
+    """The segments of the run of ``period`` forcing periods from ``x`` at ``t0`` (its impacts) and its ``u``.
+
+    Returns ``(layout, u)`` (``u`` with a trailing 0 for the parameter), or None where the run has no
+    impact or sticks.
+    """
+    sol = simulate(
+        model, x, t0=t0, periods=period, phase=2 * math.pi * (t0 / model.period % 1.0), impacts="all",
+        stop_name=stop,
+    )  # fmt: skip
+    imp = sol.impacts
+    if not len(imp) or len(sol.sticking):
+        return None
+    layout = SegmentLayout(model.n_states, tuple(int(j) for j in imp.stop))
+    parts = [np.asarray(x, dtype=float)]
+    for t, y, j in zip(imp.t, imp.state, imp.stop):
+        parts += [np.array([t]), model.reset(y, t, int(j))]
+    return layout, np.concatenate([*parts, [0.0]])
+
+
+def segmented_newton(
+    model: HybridModel, x: np.ndarray, t0: float, period: int, *, tol: float, max_iter: int, stop: int = 0
+) -> PeriodicOrbit:
+    """The period-``period`` orbit near the run from ``x`` at ``t0``, by Newton's method on the segmented
+    equations (the run's impacts give the segments).
+
+    Raises
+    ------
+    ConvergenceError
+        Where the run has no impact, Newton's method does not reach ``tol``, or the orbit it finds is
+        not a motion of the system (an impact speed not positive, a segment through a stop).
+    """
+    start = run_layout(model, x, t0, period, stop)
+    if start is None:
+        raise ConvergenceError("the run from the guess has no impact to make segments of")
+    layout, u = start
+    evaluate = segmented_equations(model, None, period, t0, layout, stop)
+    residuals: list[float] = []
+    for _ in range(max_iter + 1):
+        F, DF, orbit = evaluate(u)
+        residuals.append(float(np.max(np.abs(F))))
+        if not np.isfinite(residuals[-1]):
+            break
+        if residuals[-1] <= tol:
+            if orbit.crossed_stops or float(np.min(orbit.impact_speeds)) <= 0.0:
+                raise ConvergenceError(
+                    "the segmented orbit is not a motion of the system (it passes through a stop, or an "
+                    "impact has no speed)"
+                )
+            return dataclasses.replace(orbit, residuals=tuple(residuals))
+        try:
+            u[:-1] = u[:-1] - np.linalg.solve(DF[:, :-1], F)
+        except np.linalg.LinAlgError:
+            break
+    raise ConvergenceError(
+        f"Newton's method on the segmented equations did not converge: residual {residuals[-1]:.3g} after "
+        f"{len(residuals) - 1} iterations"
     )

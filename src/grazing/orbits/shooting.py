@@ -567,6 +567,15 @@ class _Newton:
             residuals.append(res)
             if not np.isfinite(res):
                 break
+            if it == 0 and self.segments_from_guess(fm, virtual):
+                # A large monodromy: single shooting's residual cannot fall below |M| eps |x|, and its
+                # steps may land on another orbit; the segments of the guess's own run are solved.
+                from grazing.orbits.segments import segmented_newton
+
+                try:
+                    return segmented_newton(model, x, t0, n, tol=tol, max_iter=self.max_iter, stop=stop)
+                except (GrazingError, np.linalg.LinAlgError):
+                    pass  # (then single shooting, as for any other guess)
             if res <= tol:
                 return _orbit_from(model, x, t0, n, fm, virtual, residuals, stop)
             if it == self.max_iter:
@@ -589,6 +598,16 @@ class _Newton:
             f"Newton did not converge to a period-{n} orbit: residual {residuals[-1]:.3g} after "
             f"{len(residuals) - 1} iterations{why}; {advice}"
         )
+
+    def segments_from_guess(self, fm: FlowMap, virtual: bool) -> bool:
+        """Is the guess's run to be solved by multiple shooting (:mod:`grazing.orbits.segments`): a
+        physical run with impacts of a periodic model whose monodromy exceeds
+        :data:`~grazing.orbits.segments.MULTIPLE_SHOOTING_NORM`?"""
+        from grazing.orbits.segments import MULTIPLE_SHOOTING_NORM
+
+        if virtual or not fm.impacts or not self.model.periodic or not fm.solution.jacobian_valid:
+            return False
+        return float(np.linalg.norm(fm.jacobian, 2)) > MULTIPLE_SHOOTING_NORM
 
     def nonimpacting(self, x: np.ndarray) -> PeriodicOrbit | None:
         """A physical orbit that touches no stop, found from ``x`` on the flow through the stops, or None.
