@@ -104,25 +104,32 @@ def _report(sessions: dict, out: Path) -> int:
                 if result.worker_outcome == WorkerOutcome.SKIPPED:
                     continue
                 spec = item.mutations[0]
-                rows.append({
-                    "group": g,
-                    "file": str(spec.module_path),
-                    "line": spec.start_pos[0],
-                    "operator": spec.operator_name,
-                    "occurrence": spec.occurrence,
-                    "outcome": str(result.test_outcome),
-                    "worker": str(result.worker_outcome),
-                    "diff": result.diff,
-                })
+                rows.append(
+                    {
+                        "group": g,
+                        "file": str(spec.module_path),
+                        "line": spec.start_pos[0],
+                        "operator": spec.operator_name,
+                        "occurrence": spec.occurrence,
+                        "outcome": str(result.test_outcome),
+                        "worker": str(result.worker_outcome),
+                        "diff": result.diff,
+                    }
+                )
     killed = [r for r in rows if r["outcome"] == str(TestOutcome.KILLED)]
     survived = [r for r in rows if r["outcome"] == str(TestOutcome.SURVIVED)]
     score = len(killed) / len(rows) if rows else float("nan")
     stamp = time.strftime("%Y-%m-%d")
     (out / "report.json").write_text(json.dumps({"date": stamp, "score": score, "mutants": rows}, indent=1))
-    lines = [f"# Mutation sample, {stamp}", "", f"{len(rows)} mutants run, {len(killed)} killed, "
-             f"{len(survived)} survived: score {100 * score:.1f} %", ""]
+    lines = [
+        f"# Mutation sample, {stamp}",
+        "",
+        f"{len(rows)} mutants run, {len(killed)} killed, {len(survived)} survived: score {100 * score:.1f} %",
+        "",
+    ]
     for r in survived:
-        lines += [f"## {r['file']}:{r['line']} ({r['operator']})", "", "```diff", r["diff"].strip(), "```", ""]
+        head = f"## {r['file']}:{r['line']} ({r['operator']})"
+        lines += [head, "", "```diff", r["diff"].strip(), "```", ""]
     (out / "report.md").write_text("\n".join(lines))
     print(lines[2])
     return 0
