@@ -386,3 +386,42 @@ def test_a_conservative_branch_has_no_spurious_stability_change(eta, to, virtual
     if virtual:  # (an elliptic orbit: on the circle, neither stable nor unstable by chance)
         pairs = [o.multipliers for o in br.orbits]
         assert all(np.all(np.abs(np.abs(mu) - 1) < 1e-12) and o.stable for mu, o in zip(pairs, br.orbits))
+
+
+# --------------------------------------------------------------------------
+# a test function that jumps is not a bifurcation: the located point fails its condition
+
+
+def _jumping_system(before: complex, after: complex, at: float = 0.5):
+    """A one-state 'branch' ``x = 0`` whose multiplier jumps from ``before`` to ``after`` at ``p = at``."""
+    from types import SimpleNamespace
+
+    from grazing.orbits.shooting import unstable_count as count
+
+    def orbit(p: float):
+        mu = np.array([before if p < at else after], dtype=complex)
+        return SimpleNamespace(monodromy=np.diag(mu.real), multipliers=mu, unstable_count=count(mu))
+
+    def evaluate(u):
+        return np.array([u[0]]), np.array([[1.0, 0.0]]), orbit(float(u[1]))
+
+    return evaluate
+
+
+@pytest.mark.parametrize(
+    ("kind", "before", "after"),
+    [("period-doubling", -0.97, -1.03), ("period-doubling", -0.995, -1.005), ("fold", 0.98, 1.02)],
+)
+def test_a_multiplier_that_jumps_across_the_circle_is_unlocated_not_a_bifurcation(kind, before, after):
+    # The test function changes sign, and regula falsi closes in on the jump; the point there has a
+    # multiplier 0.005 to 0.03 from -1 (or +1), which no tolerance of located points may accept.
+    from grazing.orbits.bifurcations import between
+    from grazing.orbits.palc import PalcPoint, PalcSettings
+
+    evaluate = _jumping_system(before, after)
+    tangent = np.array([0.0, 1.0])
+    a, b = (PalcPoint(np.array([0.0, p]), *evaluate(np.array([0.0, p])), tangent=tangent) for p in (0.3, 0.7))
+    step = between(evaluate, a, b, PalcSettings(), 1)
+    assert step.located == () and not step.explained, step
+    assert step.unstable == (0, 1)
+    assert any(kind in m for m in step.missed), step.missed
