@@ -288,3 +288,70 @@ def grazing_of_impact(build, stops, t0: float, guess: np.ndarray, grazing: int) 
     sol = least_squares(residual, guess, xtol=1e-15, ftol=1e-15, gtol=1e-15, method="lm")
     assert np.max(np.abs(residual(sol.x))) < 1e-12, residual(sol.x)
     return sol.x
+
+
+# ----------------------------------------------------------------------------
+# Random two- and three-body models: a primary mass, a rattling mass between two walls, an absorber
+
+
+def chain_model(bodies: int) -> HybridModel:
+    """A forced primary mass ``P`` (spring ``kP``, damping ``cP``, forcing ``F0 cos(wf s)``), a mass ``Q``
+    rattling in a cavity of half-width ``gap`` (tied to ``P`` by a spring ``kQ`` and dashpot ``cQ``;
+    stops ``upper`` and ``lower``, momentum-conserving resets with mass ratio ``m`` and restitution
+    ``e``), and with ``bodies = 3`` an absorber ``A`` on ``P`` (spring ``kA``, damping ``cA``).
+
+    States ``P, dP, Q, dQ[, A, dA]``; time ``s``; the period ``2 pi / wf`` is set by ``wf``.  Every
+    parameter's default is 1 (they are drawn by the tests).
+    """
+    P, dP, Q, dQ, A, dA, s = sp.symbols("P dP Q dQ A dA s")
+    kP, cP, F0, wf, kQ, cQ, gap, m, e, kA, cA = sp.symbols("kP cP F0 wf kQ cQ gap m e kA cA")
+    coupling = kQ * (Q - P) + cQ * (dQ - dP)
+    field = [dP, -kP * P - cP * dP + F0 * sp.cos(wf * s) + m * coupling, dQ, -coupling]
+    states = [P, dP, Q, dQ]
+    names = ["kP", "cP", "F0", "wf", "kQ", "cQ", "gap", "m", "e"]
+    if bodies == 3:
+        field[1] += kA * (A - P) + cA * (dA - dP)
+        field += [dA, -kA * (A - P) - cA * (dA - dP)]
+        states += [A, dA]
+        names += ["kA", "cA"]
+    dv = dQ - dP
+    reset = [P, dP + m * (1 + e) / (1 + m) * dv, Q, dQ - (1 + e) / (1 + m) * dv, *states[4:]]
+    direction = [0, m, 0, -1] + [0] * (len(states) - 4)
+    params = [Parameter(name, 1.0) for name in names]
+    return HybridModel(
+        f"chain-{bodies}", states, s, params, field, period=2 * sp.pi / wf,
+        stops=[
+            Stop("upper", gap - (Q - P), reset, direction), Stop("lower", gap + (Q - P), reset, direction),
+        ],
+    )  # fmt: skip
+
+
+def chain_matrices(model: HybridModel) -> LinearImpactModel:
+    """:func:`chain_model` as a :class:`LinearImpactModel` at ``model``'s parameter values."""
+    p = model.params
+    n = model.n_states
+    A = np.zeros((n, n))
+    A[0, 1] = A[2, 3] = 1.0
+    A[1, 0], A[1, 1] = -p["kP"], -p["cP"]
+    # the coupling kQ (Q - P) + cQ (dQ - dP): + m on P's acceleration, - on Q's
+    for row, sign in ((1, p["m"]), (3, -1.0)):
+        A[row, 2] += sign * p["kQ"]
+        A[row, 0] -= sign * p["kQ"]
+        A[row, 3] += sign * p["cQ"]
+        A[row, 1] -= sign * p["cQ"]
+    if n == 6:
+        A[4, 5] = 1.0
+        for row, sign in ((1, 1.0), (5, -1.0)):
+            A[row, 4] += sign * p["kA"]
+            A[row, 0] -= sign * p["kA"]
+            A[row, 5] += sign * p["cA"]
+            A[row, 1] -= sign * p["cA"]
+    b = np.zeros(n)
+    b[1] = p["F0"]
+    R = np.eye(n)
+    a1, a2 = p["m"] * (1 + p["e"]) / (1 + p["m"]), (1 + p["e"]) / (1 + p["m"])
+    R[1, 1], R[1, 3] = 1 - a1, a1
+    R[3, 1], R[3, 3] = a2, 1 - a2
+    c = np.zeros(n)
+    c[0], c[2] = 1.0, -1.0  # upper: gap - (Q - P)
+    return LinearImpactModel(A, b, p["wf"], [LinearStop(c, p["gap"], R), LinearStop(-c, p["gap"], R)])
