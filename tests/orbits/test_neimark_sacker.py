@@ -32,6 +32,7 @@ from tests.linear_exact import (
     damper,
     damper_matrices,
     neimark_sacker_parameter,
+    pair_closest_to_circle,
     six_state_matrices,
     six_state_model,
 )
@@ -95,6 +96,19 @@ def test_the_neimark_sacker_curve_of_a_four_state_model_keeps_its_pair_on_the_ci
         _, J = ref.periodic_orbit(np.asarray(point.state), point.section_time)
         mu = np.linalg.eigvals(J)
         assert np.min(np.abs(np.abs(mu) - 1.0)) < 1e-8
+
+
+def test_the_neimark_sacker_curve_of_a_six_state_model_is_the_exact_maps():
+    model = six_state_model(Om=1.2)
+    curve = follow_curve(model, "neimark-sacker", "Om", 1.2, 1.45, "rr", (0.75, 0.85))
+    assert len(curve.points) >= 3
+    for point in curve.points[:: max(1, len(curve.points) // 3)]:
+        om, rr = point.values
+        ref = six_state_matrices(model.with_params(Om=om, rr=rr))
+        _, J = ref.periodic_orbit(np.asarray(point.state), point.section_time)
+        pair = pair_closest_to_circle(J)
+        assert abs(abs(pair) - 1.0) < 1e-8
+        assert np.min(np.abs(np.abs(np.asarray(point.multipliers)) - 1.0)) < 1e-8
 
 
 def test_grazing_continue_and_curve_report_the_neimark_sacker_point_with_its_angle(capsys):
