@@ -425,3 +425,29 @@ def test_a_multiplier_that_jumps_across_the_circle_is_unlocated_not_a_bifurcatio
     assert step.located == () and not step.explained, step
     assert step.unstable == (0, 1)
     assert any(kind in m for m in step.missed), step.missed
+
+
+def test_an_unexplained_step_with_located_points_names_them():
+    step = Step((Located("fold", None, turns=True),), ("period-doubling",), (0, 2))
+    assert not step.explained
+    text = step.describe()
+    assert text.startswith("stable -> 2 multipliers outside the unit circle")
+    assert "located: fold" in text and "a multiplier passes through -1" in text
+
+
+def test_a_candidate_short_of_the_extrapolated_boundary_is_a_jump():
+    # The margin (an impact speed squared) falls 4 -> 1 from p = 0 to 1: it vanishes between p = 4/3
+    # (linearly) and 2 (quadratically); a candidate beyond the boundary at p = 1.1 is less than half-way
+    # to the nearer zero from the last point (p = 1): the corrector jumped to another curve.
+    from grazing.orbits.palc import Palc, PalcPoint
+
+    palc = object.__new__(Palc)
+    palc.index = 0
+    margins = [(0.0, 4.0), (1.0, 1.0)]
+
+    def at(p):
+        return PalcPoint(np.array([p]), np.zeros(1), np.zeros((1, 1)), None)
+
+    assert palc._jumped(margins, at(1.1))
+    assert not palc._jumped(margins, at(1.3))
+    assert palc._jumped([(0.0, 1.0), (1.0, 2.0)], at(1.5))  # (moving away from the boundary)

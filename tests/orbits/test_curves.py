@@ -840,3 +840,18 @@ def test_grazing_curve_meets_a_fold_and_ends_at_a_double_grazing():
     h_right = last.approach_by_stop[0][0]  # the right stop's closest approach in free flight
     assert 0 <= h_right < DOUBLE_GRAZING_MARGIN and last.impacts == 1 and last.stop_name == "left"
     _condition_holds(curve, "grazing")
+
+
+def test_the_gradient_is_one_sided_where_a_step_leaves_the_domain():
+    from grazing.errors import GrazingError
+    from grazing.orbits.crossings import _gradient
+
+    for side in (1.0, -1.0):  # (the domain ends at u0 = 1 above, then below)
+
+        def f(u, side=side):
+            if side * (u[0] - 1.0) > 0:  # (beyond the stop)
+                raise GrazingError("beyond the stop")
+            return float(u[0] ** 2 + 3 * u[1])
+
+        u = np.array([1.0, 2.0])
+        np.testing.assert_allclose(_gradient(f, u, f(u)), [2.0, 3.0], rtol=1e-5)

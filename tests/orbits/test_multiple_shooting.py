@@ -77,6 +77,12 @@ def test_the_segmented_orbit_is_the_single_shooting_orbit(make, guess, period, p
     mu, ref = np.sort_complex(same.multipliers), np.sort_complex(orbit.multipliers)
     np.testing.assert_allclose(mu, ref, rtol=1e-8 * max(1.0, np.abs(ref).max()))
     assert same.impacts == orbit.impacts and same.signature == orbit.signature
+    # Its guard minima: zero at the impacts, the free flight's closest approaches where there are any.
+    assert same.guard_min == pytest.approx(orbit.guard_min, abs=1e-9)
+    for ours, theirs in zip(same.approach_by_stop, orbit.approach_by_stop):
+        assert (ours is None) == (theirs is None)
+        if ours is not None:
+            assert ours[0] == pytest.approx(theirs[0], abs=1e-9)
 
 
 @pytest.fixture(scope="module")

@@ -287,9 +287,15 @@ def _segmented_orbit(
     n_stops = m.n_stops
     by_stop = []
     approach = []
+    edge = 1e-9 * m.period  # (a segment's ends are the impacts, not closest approaches in free flight)
     for j in range(n_stops):
         by_stop.append(_least(r.guard_min_by_stop[j] for r in runs if r.guard_min_by_stop))
-        approach.append(_least(r.approach_by_stop[j] for r in runs if r.approach_by_stop))
+        inner = []
+        for i, r in enumerate(runs):
+            a = r.approach_by_stop[j] if r.approach_by_stop else None
+            if a is not None and times[i] + edge < a[1] < times[i + 1] - edge:
+                inner.append(a)
+        approach.append(_least(inner))
     gmin = by_stop[stop]
     assert gmin is not None
     v = np.array(speeds)
