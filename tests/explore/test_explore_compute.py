@@ -183,3 +183,19 @@ def test_a_model_file_with_two_walls_counts_the_impacts_on_each(tmp_path):
     # mirror symmetry: the orbit's state half a period later is minus itself
     half = grazing.simulate(rep.model, rep.orbit.state, t0=0.0, periods=1, phase=math.pi).samples[0]
     assert half == pytest.approx(-rep.orbit.state, abs=1e-8)
+
+
+def test_a_click_on_a_map_that_is_not_square_starts_from_the_cell_clicked():
+    # A map's arrays are (n2, n1): the nearest cell's index is (i2, i1), for a map of 3 x 5 cells too
+    # (on a square map the transposed index is a cell as well, only the wrong one).
+    from grazing.core.solution import Status
+    from grazing.explore.diagram import Diagram
+
+    p1, p2 = np.linspace(0.0, 1.0, 3), np.linspace(10.0, 14.0, 5)
+    i2, i1 = np.meshgrid(np.arange(5), np.arange(3), indexing="ij")
+    x_final = np.stack([i1, i2], axis=-1).astype(float)  # (5, 3, 2): each cell's own (i1, i2)
+    ok = np.full((5, 3), int(Status.OK))
+    diagram = Diagram(None, (p1, p2), np.ones((5, 3)), np.ones((5, 3)), ok, x_final, None, 0.0)  # type: ignore[arg-type]
+    for v1, v2, cell in [(0.5, 13.0, (1, 3)), (1.0, 10.2, (2, 0)), (0.1, 14.0, (0, 4))]:
+        assert diagram.nearest((v1, v2)) == (cell[1], cell[0])
+        assert tuple(diagram.start_state((v1, v2))) == cell
