@@ -240,7 +240,7 @@ class Diagram:
     def nearest(self, values: Sequence[float]) -> tuple[int, ...]:
         """The index of the computed point nearest to ``values`` (in each parameter)."""
         index = tuple(int(np.argmin(np.abs(vals - v))) for vals, v in zip(self.values, values))
-XX
+        return index if len(index) == 1 else index[::-1]  # (a map's arrays are (n2, n1))
 
     def start_state(self, values: Sequence[float]) -> np.ndarray:
         """Where a simulation at ``values`` starts: the final state of the nearest point that did not fail.
