@@ -855,3 +855,19 @@ def test_the_gradient_is_one_sided_where_a_step_leaves_the_domain():
 
         u = np.array([1.0, 2.0])
         np.testing.assert_allclose(_gradient(f, u, f(u)), [2.0, 3.0], rtol=1e-5)
+
+
+def test_a_branch_point_curve_ends_at_once_where_the_second_parameter_breaks_the_symmetry():
+    # The two-sided oscillator is symmetric only with equal gaps: in (omega, gap_right) its branch point
+    # does not persist, and the regularising shift grows like the asymmetry (7.6e-3 where gap_right is
+    # 0.004 from the other gap) — far above SHIFT_TOL, far below anything the curve could go on with.
+    from grazing.orbits.curves import SHIFT_TOL
+
+    m = two_sided_oscillator(amp=2.0, omega=1.0, zeta=0.05, r=0.8)
+    curve = follow_curve(m, "branch-point", "omega", 1.0, 1.2, "gap_right", (0.95, 1.05), period=1)
+    assert len(curve.points) == 1 and curve.points[0].values[1] == 1.0
+    first, last = curve.status.split("; at the last point: ")
+    for end in (first, last):
+        assert "does not persist in two parameters" in end
+        shift = float(end.split("shift = ")[1].split(" ")[0])
+        assert SHIFT_TOL < abs(shift) < 0.1
