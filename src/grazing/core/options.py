@@ -51,14 +51,14 @@ UNIT_CIRCLE_TOL = 1e-9
 multipliers of an area-preserving map (a conservative model: no damping, elastic impacts) lie on the
 circle up to rounding (measured: 2e-16), which would make such an orbit stable or unstable by chance."""
 
-NON_ISOLATED_TOL = 1e-11
-"""A periodic orbit is not isolated where its multiplier 1 is double (or more): ``(M - I)^2`` has two
-singular values below this (relative to ``(1 + |M|)^2``).  That is a Jordan block (``M = [[1, T], [0, 1]]``
-on a free mass at rest: a line of periodic states, and states off it drift) or an eigenspace (``M = I``).
-The monodromy is accurate to about ``64 eps |M|`` (``orbits.extended.MONODROMY_ROUNDING``), which moves
-the singular values of a Jordan block's ``(M - I)^2`` by about ``|M|`` times that: this is a thousand
-times it.  Two distinct multipliers both within about ``3e-6 (1 + |M|)`` of 1 look the same (a Jordan
-block perturbed by ``delta`` splits its multipliers by ``sqrt(delta)``)."""
+NON_ISOLATED_TOL = 1e-6
+"""A periodic orbit is not isolated where its multiplier 1 is double (or more): two multipliers within
+this of 1, or two kept directions (:data:`NOT_ISOLATED_TOL`).  That is a Jordan block
+(``M = [[1, T], [0, 1]]`` on a free mass at rest: a line of periodic states, and states off it drift),
+computed to a split of about ``sqrt(eps T)`` (3e-8 for T = 5), or an eigenspace (``M = I``).  An
+absolute tolerance: near a grazing, where the monodromy is far from normal (``|M| = 4e5``), any
+tolerance that grows with ``|M|`` (as the singular values of ``(M - I)^2`` do, ``1e-3`` there with no
+multiplier within 0.1 of 1) calls folds there not isolated."""
 
 NOT_ISOLATED_TOL = 1e-8
 """A periodic orbit is not isolated where its monodromy matrix ``M`` keeps two or more directions:

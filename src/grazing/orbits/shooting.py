@@ -70,10 +70,11 @@ def kept_directions(monodromy: np.ndarray) -> int:
 
 
 def multiplier_one_multiplicity(monodromy: np.ndarray) -> int:
-    """The multiplicity of the multiplier 1 of ``M``, up to 2: the singular values of ``(M - I)^2`` below
-    ``core.options.NON_ISOLATED_TOL`` (relative to ``(1 + |M|)^2``).  0: ``M - I`` is regular; 1: one
-    multiplier 1 (a fold, a branch point); 2: a double one (a Jordan block or an eigenspace: the
-    orbit is not isolated, :func:`is_isolated`).
+    """The multiplicity of the multiplier 1 of ``M``, up to 2: the multipliers within
+    ``core.options.NON_ISOLATED_TOL`` of 1, or the directions ``M`` keeps (:func:`kept_directions`) if
+    more.  0: ``M - I`` is regular; 1: one multiplier 1 (a fold, a branch
+    point); 2: a double one (a Jordan block or an eigenspace: the orbit is not isolated,
+    :func:`is_isolated`).
 
     Examples
     --------
@@ -83,10 +84,9 @@ def multiplier_one_multiplicity(monodromy: np.ndarray) -> int:
     [0, 1, 2, 2]
     """
     m = np.asarray(monodromy, dtype=float)
-    a = m - np.eye(m.shape[0])
-    sv = np.linalg.svd(a @ a, compute_uv=False)
-    scale = (1.0 + np.linalg.norm(m, 2)) ** 2
-    return min(2, int(np.sum(sv <= NON_ISOLATED_TOL * scale)))
+    mu = np.linalg.eigvals(m)
+    near = int(np.sum(np.abs(mu - 1.0) <= NON_ISOLATED_TOL))
+    return min(2, max(near, kept_directions(m)))
 
 
 def is_isolated(monodromy: np.ndarray) -> bool:
