@@ -13,6 +13,8 @@ extra (``pip install -e ".[test,mutation]"``).  About 15 s a mutant on two cores
 from __future__ import annotations
 
 import argparse
+import ast
+import functools
 import json
 import random
 import subprocess
@@ -63,7 +65,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seed", type=int, default=42)
     parser.add_argument("--groups", default=",".join(GROUPS))
     parser.add_argument("--out", default=str(ROOT / "mutation"))
+    parser.add_argument(
+        "--report-only", action="store_true", help="summarise the sessions already in --out (run or not)"
+    )
     args = parser.parse_args(argv)
+    if args.report_only:
+        found = {g: (None, Path(args.out) / f"{g}.sqlite") for g in args.groups.split(",")}
+        return _report({g: v for g, v in found.items() if v[1].exists()}, Path(args.out))
     from cosmic_ray.work_db import WorkDB, use_db
     from cosmic_ray.work_item import WorkerOutcome, WorkResult
 
@@ -93,6 +101,31 @@ def main(argv: list[str] | None = None) -> int:
     return _report(sessions, out)
 
 
+@functools.cache
+def _annotation_spans(path: str) -> tuple[tuple[int, int, int, int], ...]:
+    """The source spans of every annotation in a module (under ``from __future__ import annotations``,
+    as every module of grazing's, they are never evaluated)."""
+    tree = ast.parse((ROOT / path).read_text())
+    spans = []
+    for node in ast.walk(tree):
+        notes = []
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            notes.append(node.returns)
+            a = node.args
+            notes += [x.annotation for x in (*a.posonlyargs, *a.args, *a.kwonlyargs, a.vararg, a.kwarg) if x]
+        elif isinstance(node, ast.AnnAssign):
+            notes.append(node.annotation)
+        for n in notes:
+            if n is not None:
+                spans.append((n.lineno, n.col_offset, n.end_lineno or n.lineno, n.end_col_offset or 0))
+    return tuple(spans)
+
+
+def in_annotation(path: str, line: int, col: int) -> bool:
+    """Is position ``(line, col)`` of module ``path`` inside an annotation (an equivalent mutant there)?"""
+    return any((l0, c0) <= (line, col) < (l1, c1) for l0, c0, l1, c1 in _annotation_spans(path))
+
+
 def _report(sessions: dict, out: Path) -> int:
     from cosmic_ray.work_db import WorkDB, use_db
     from cosmic_ray.work_item import TestOutcome, WorkerOutcome
@@ -111,6 +144,7 @@ def _report(sessions: dict, out: Path) -> int:
                         "line": spec.start_pos[0],
                         "operator": spec.operator_name,
                         "occurrence": spec.occurrence,
+                        "annotation": in_annotation(str(spec.module_path), *spec.start_pos),
                         "outcome": str(result.test_outcome),
                         "worker": str(result.worker_outcome),
                         "diff": result.diff,
@@ -118,16 +152,21 @@ def _report(sessions: dict, out: Path) -> int:
                 )
     killed = [r for r in rows if r["outcome"] == str(TestOutcome.KILLED)]
     survived = [r for r in rows if r["outcome"] == str(TestOutcome.SURVIVED)]
+    equivalent = [r for r in survived if r["annotation"]]
     score = len(killed) / len(rows) if rows else float("nan")
+    effective = len(killed) / max(1, len(rows) - len(equivalent))
     stamp = time.strftime("%Y-%m-%d")
-    (out / "report.json").write_text(json.dumps({"date": stamp, "score": score, "mutants": rows}, indent=1))
+    summary = {"date": stamp, "score": score, "score_not_equivalent": effective, "mutants": rows}
+    (out / "report.json").write_text(json.dumps(summary, indent=1))
     lines = [
         f"# Mutation sample, {stamp}",
         "",
-        f"{len(rows)} mutants run, {len(killed)} killed, {len(survived)} survived: score {100 * score:.1f} %",
+        f"{len(rows)} mutants run, {len(killed)} killed, {len(survived)} survived, {len(equivalent)} of them "
+        f"in annotations (never evaluated: equivalent): score {100 * score:.1f} %, "
+        f"{100 * effective:.1f} % of the mutants that are not equivalent",
         "",
     ]
-    for r in survived:
+    for r in [r for r in survived if not r["annotation"]]:
         head = f"## {r['file']}:{r['line']} ({r['operator']})"
         lines += [head, "", "```diff", r["diff"].strip(), "```", ""]
     (out / "report.md").write_text("\n".join(lines))

@@ -944,3 +944,21 @@ def test_a_branch_point_curve_ends_at_once_where_the_second_parameter_breaks_the
         assert "does not persist in two parameters" in end
         shift = float(end.split("shift = ")[1].split(" ")[0])
         assert SHIFT_TOL < abs(shift) < 0.1
+
+
+def test_the_margin_to_another_contact_leaves_out_the_grazing_contact_itself():
+    # A grazing orbit's own contact is a closest approach at h = 0 on the stop it grazes: not another
+    # contact. The margin is the other stop's approach (0.3), not zero.
+    from types import SimpleNamespace
+
+    from grazing.orbits.curves import _other_contact_margin
+
+    model = grazing.models.two_sided_oscillator()
+    for stop in (0, 1):
+        point = SimpleNamespace(
+            model=model, other_impacts=None, stop=stop, t_graze=1.0, period=1,
+            approach_by_stop=tuple(
+                (0.0, 1.0, np.zeros(2)) if j == stop else (0.3, 2.0, np.zeros(2)) for j in range(2)
+            ),
+        )  # fmt: skip
+        assert _other_contact_margin(point) == pytest.approx(0.3)

@@ -477,14 +477,12 @@ def locate(
     b: PalcPoint,
     test: Callable[[PalcPoint], float],
     s: PalcSettings,
-    *,
-    bisect: bool = False,
 ) -> PalcPoint | None:
     """Zero of ``test`` between consecutive points ``a`` and ``b`` (signs differ).
 
     Corrected points along the secant ``a + sigma (b - a)`` are found by Newton
     with the constraint orthogonal to the secant; ``sigma`` is updated by the
-    Illinois variant of regula falsi (or by bisection for a discrete test).
+    Illinois variant of regula falsi.
     """
     d = b.u - a.u
     dn = d / np.linalg.norm(d)
@@ -494,11 +492,8 @@ def locate(
     best: PalcPoint | None = None
     side = 0
     for _ in range(60):
-        if bisect or fhi == flo:
-            sig = 0.5 * (lo + hi)
-        else:
-            sig = (lo * fhi - hi * flo) / (fhi - flo)
-            sig = min(max(sig, lo + 1e-3 * (hi - lo)), hi - 1e-3 * (hi - lo))
+        sig = (lo * fhi - hi * flo) / (fhi - flo)  # (fhi and flo differ in sign: never equal)
+        sig = min(max(sig, lo + 1e-3 * (hi - lo)), hi - 1e-3 * (hi - lo))
         pt = correct(evaluate, a.u + sig * d, dn, s)
         if pt is None:
             return best
@@ -508,16 +503,16 @@ def locate(
         offset = f / slope if slope != 0 and math.isfinite(f) else math.inf
         pt.bracket = Bracket(a.u + lo * d, a.u + hi * d, offset * d)
         best = pt
-        if (not bisect and abs(f) <= s.locate_tol) or (hi - lo) < 1e-12:
+        if abs(f) <= s.locate_tol or (hi - lo) < 1e-12:
             return pt
         if (f > 0) == (flo > 0):
             lo, flo, true_lo = sig, f, f
-            if side == -1 and not bisect:
+            if side == -1:
                 fhi *= 0.5
             side = -1
         else:
             hi, fhi, true_hi = sig, f, f
-            if side == 1 and not bisect:
+            if side == 1:
                 flo *= 0.5
             side = 1
     return best
