@@ -148,3 +148,32 @@ def test_approaches_needs_the_contraction_the_multipliers_allow():
     k = np.arange(50.0)[:, None]
     fast = 0.3 * np.cos(1.7 * k) * (1.0 - 0.002 * k)  # (shrinking, but far slower than 0.5 a period)
     assert approaches(fast, np.zeros((1, 1)), 0.999) and not approaches(fast, np.zeros((1, 1)), 0.5)
+
+
+def test_a_large_chaotic_set_takes_in_a_small_one_within_its_own_recurrence_cell():
+    # Recurrence works both ways: a new set whose points are far from a small attractor in that
+    # attractor's cells (1e-3 here) but within one of its own (0.1: 5 % of its extent of 2) is the same
+    # attractor.
+    from grazing.attractors.classify import Catalogue, _Entry
+
+    cat = Catalogue(grazing.models.bouncing_ball(), 1, np.full(2, 1e-3), np.zeros(2), 1e3, 50, 0.0)
+    small = cat._new(_Entry("aperiodic", 0, points=np.array([[0.0, 0.0], [0.01, 0.01]])))
+    cat._aperiodic.append(small)
+    large = np.array([[0.05, 0.0], [2.0, 2.0], [1.0, 0.5]])
+    assert cat._recurrent(large) == {small}
+    assert cat._recurrent(large + 1.0) == set()  # (0.95 from it: 9.5 of its own cells)
+
+
+def test_failed_polishes_stop_at_their_budget_per_attractor(monkeypatch):
+    # On a chaotic attractor every run may look like it contracts; Newton's method is tried on at most
+    # POLISH_TRIES of them that fail (then the attractor's other end states are not tried).
+    import grazing.attractors.classify as classify
+    from grazing.core.options import POLISH_TRIES
+
+    calls = []
+    monkeypatch.setattr(classify, "contracting_periods", lambda samples, most: [1])
+    monkeypatch.setattr(classify, "polish", lambda *a, **k: calls.append(1))
+    g = state_grid(CHAOS, (-0.1, 0.1), (-0.1, 0.1), (4, 4), states=("x1", "v1"), fixed={"x2": 0.5})
+    found = find_attractors(CHAOS, g.states_array(), workers=1, chunk_size=4)
+    assert [a.kind for a in found.attractors] == ["chaotic"]
+    assert 1 <= len(calls) <= POLISH_TRIES
