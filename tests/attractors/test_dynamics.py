@@ -177,3 +177,20 @@ def test_failed_polishes_stop_at_their_budget_per_attractor(monkeypatch):
     found = find_attractors(CHAOS, g.states_array(), workers=1, chunk_size=4)
     assert [a.kind for a in found.attractors] == ["chaotic"]
     assert 1 <= len(calls) <= POLISH_TRIES
+
+
+def test_progress_counts_every_initial_state_once_invalid_ones_first():
+    # A grid half beyond the stop: the invalid states count at once, then each run as it is labelled.
+    m = grazing.models.pendulum("B", eta=0.40, theta_hat=math.radians(40))
+    x = np.column_stack([np.linspace(0.3, 1.0, 8), np.zeros(8)])  # (theta beyond 40 deg: invalid)
+    valid = int(np.sum(x[:, 0] < math.radians(40)))
+    assert 0 < valid < 8
+    seen = []
+    found = find_attractors(
+        m, x, transient=50, periods=16, chunk_size=2, progress=lambda d, t: seen.append((d, t))
+    )
+    kinds = {a.id: a.kind for a in found.attractors}
+    assert sum(1 for label in found.labels if kinds[int(label)] == "invalid") == 8 - valid
+    done = [d for d, _ in seen]
+    assert {t for _, t in seen} == {8} and done == sorted(done)
+    assert done[0] >= 8 - valid and done[-1] == 8
