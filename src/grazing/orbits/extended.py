@@ -307,7 +307,6 @@ class OrbitSystem:
         self.model, self.kind, self.params = model, kind, params
         self.period, self.t0, self.virtual, self.stop = period, t0, virtual, stop
         self.n = model.n_states
-        self.size = self.n + (3 if kind == "branch-point" else 2)
         self.borders = Borders.of(defining_matrix(kind, monodromy))
 
     def start(self, orbit: PeriodicOrbit) -> np.ndarray:
@@ -423,7 +422,6 @@ class GrazingSystem:
 
     def __init__(self, model: HybridModel, params: tuple[str, str], period: int, events: bool, stop: int):
         self.params, self.n = params, model.n_states
-        self.size = self.n + 3
         self._evaluate = contact_system(model, params, period, events=events, stop=stop)
 
     def start(self, point: GrazingPoint) -> np.ndarray:
