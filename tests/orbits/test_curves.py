@@ -955,10 +955,11 @@ def test_the_margin_to_another_contact_leaves_out_the_grazing_contact_itself():
 
     model = grazing.models.two_sided_oscillator()
     for stop in (0, 1):
-        point = SimpleNamespace(
-            model=model, other_impacts=None, stop=stop, t_graze=1.0, period=1,
-            approach_by_stop=tuple(
-                (0.0, 1.0, np.zeros(2)) if j == stop else (0.3, 2.0, np.zeros(2)) for j in range(2)
-            ),
-        )  # fmt: skip
-        assert _other_contact_margin(point) == pytest.approx(0.3)
+        for lag in (0.0, 1e-9, -1e-9):  # (the contact's own approach, found to rounding of its time)
+            point = SimpleNamespace(
+                model=model, other_impacts=None, stop=stop, t_graze=1.0, period=1,
+                approach_by_stop=tuple(
+                    (0.0, 1.0 + lag, np.zeros(2)) if j == stop else (0.3, 2.0, np.zeros(2)) for j in range(2)
+                ),
+            )  # fmt: skip
+            assert _other_contact_margin(point) == pytest.approx(0.3)

@@ -21,6 +21,20 @@ from grazing.orbits.segments import layout_of, segmented_equations
 from tests.linear_exact import damper, grazing_of_impact, inverted_walls, inverted_walls_matrices
 
 
+def _ball_period_two():
+    """The ball on its period-2 orbit with one impact (a flight of two forcing periods), and the orbit."""
+    from tests.orbits.test_closed_forms import ball_orbit, ball_period_doubling
+
+    return ball_orbit(2, 0.95 * ball_period_doubling(2))
+
+
+def _start(make, guess, period):
+    made = make()
+    if guess == "ball":  # (the closed form's orbit)
+        return made.model, made
+    return made, find_orbit(made, guess, period=period)
+
+
 def _central_differences(evaluate, u: np.ndarray) -> np.ndarray:
     F = evaluate(u)[0]
     J = np.zeros((F.size, u.size))
@@ -34,19 +48,19 @@ def _central_differences(evaluate, u: np.ndarray) -> np.ndarray:
 
 CASES = [
     # (model, guess, period, parameters to differentiate by): the period-setting frequency, a guard's and
-    # a reset's parameter, the damping of the flow
+    # a reset's parameter, the damping of the flow; a flight longer than a forcing period (the ball)
     (lambda: grazing.models.impact_oscillator(omega=0.8), None, 1, ("omega", "sigma", "r", "zeta")),
+    (lambda: _ball_period_two(), "ball", 2, ("amplitude", "r")),
     (lambda: damper(omega=1.2), None, 1, ("omega", "mu", "gap", "r")),
     (lambda: inverted_walls(), [-0.9294, 0.8725], 1, ("w", "a", "r", "k")),
 ]
 
 
 @pytest.mark.parametrize(
-    ("make", "guess", "period", "params"), CASES, ids=["oscillator", "damper", "inverted"]
+    ("make", "guess", "period", "params"), CASES, ids=["oscillator", "ball", "damper", "inverted"]
 )
 def test_the_segmented_jacobian_is_the_derivative_of_its_equations(make, guess, period, params):
-    model = make()
-    orbit = find_orbit(model, guess, period=period)
+    model, orbit = _start(make, guess, period)
     assert orbit.impacts >= 1
     layout = layout_of(orbit)
     rng = np.random.default_rng(3)
@@ -62,11 +76,10 @@ def test_the_segmented_jacobian_is_the_derivative_of_its_equations(make, guess, 
 
 
 @pytest.mark.parametrize(
-    ("make", "guess", "period", "params"), CASES, ids=["oscillator", "damper", "inverted"]
+    ("make", "guess", "period", "params"), CASES, ids=["oscillator", "ball", "damper", "inverted"]
 )
 def test_the_segmented_orbit_is_the_single_shooting_orbit(make, guess, period, params):
-    model = make()
-    orbit = find_orbit(model, guess, period=period)
+    model, orbit = _start(make, guess, period)
     layout = layout_of(orbit)
     F, _, same = segmented_equations(model, params[0], period, orbit.t0, layout, 0)(
         layout.pack(orbit, model.params[params[0]])

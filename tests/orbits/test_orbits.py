@@ -182,6 +182,11 @@ def test_grazing_curve_fold_and_agreement_with_response_curve():
     assert thetas[0] == pytest.approx(5 * DEG)
     fold = curve.fold.model.params["theta_hat"]
     assert thetas.max() <= fold + 1e-12 and fold - thetas.max() < 1e-3  # the fold is the true top
+    # fold_index is the point just before the fold: the fold's eta lies between it and the next
+    i, etas = curve.fold_index, curve.values("eta")
+    eta_fold = curve.fold.model.params["eta"]
+    assert 0 <= i < len(curve.points) - 1
+    assert min(etas[i], etas[i + 1]) <= eta_fold <= max(etas[i], etas[i + 1])
 
 
 def test_flow_map_on_a_section_at_any_phase(pendulum_b):
