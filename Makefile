@@ -69,8 +69,8 @@ bench-all: $(STAMP)
 
 # A random sample of 150 mutants of orbits/, attractors/ and core/period.py run against the default suite's
 # tests of each (cosmic-ray, the `mutation` extra; not in CI): the score and the surviving mutants in
-# mutation/results/report.md.  It mutates a temporary checkout of HEAD, not this tree.  About 15 s a
-# mutant on two cores: under an hour.
+# mutation/results/report.md.  It mutates a temporary checkout of HEAD, not this tree.  30 to 60 s a
+# mutant on two cores: one to two hours (docs/contributing.md has the last sample's score).
 mutation: $(STAMP)
 	$(BIN)/python -m pip install --quiet -e ".[test,mutation]"
 	rm -rf .mutation-tree && git worktree prune && git worktree add --detach .mutation-tree HEAD
