@@ -71,10 +71,12 @@ bench-all: $(STAMP)
 # tests of each (cosmic-ray, the `mutation` extra; not in CI): the score and the surviving mutants in
 # mutation/results/report.md.  It mutates a temporary checkout of HEAD, not this tree.  30 to 60 s a
 # mutant on two cores: one to two hours (docs/contributing.md has the last sample's score).
+MUTANTS ?= 150
+
 mutation: $(STAMP)
 	$(BIN)/python -m pip install --quiet -e ".[test,mutation]"
 	rm -rf .mutation-tree && git worktree prune && git worktree add --detach .mutation-tree HEAD
-	cd .mutation-tree && PYTHONPATH=$$PWD/src:$$PWD $(abspath $(BIN))/python mutation/run.py --out $(CURDIR)/mutation/results
+	cd .mutation-tree && PYTHONPATH=$$PWD/src:$$PWD $(abspath $(BIN))/python mutation/run.py --count $(MUTANTS) --out $(CURDIR)/mutation/results
 	git worktree remove --force .mutation-tree
 
 lint: $(STAMP)
