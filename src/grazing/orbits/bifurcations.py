@@ -114,7 +114,7 @@ def neimark_sacker_test(multipliers: np.ndarray) -> float:
     >>> outside = np.array([1.1 * np.exp(0.5j), 1.1 * np.exp(-0.5j), 0.3, -0.2])
     >>> neimark_sacker_test(inside) * neimark_sacker_test(outside) < 0
     True
-    >>> round(neimark_sacker_test(np.array([np.exp(1j), np.exp(-1j), 0.5, 0.4]) * (1 + 1e-6)), 9)
+    >>> round(abs(neimark_sacker_test(np.array([np.exp(1j), np.exp(-1j), 0.5, 0.4]) * (1 + 1e-6))), 9)
     1e-06
     """
     prods, _ = pair_products(multipliers)

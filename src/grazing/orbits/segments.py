@@ -44,7 +44,13 @@ from grazing.core.model import HybridModel
 from grazing.core.solution import Solution
 from grazing.engine.simulate import simulate
 from grazing.errors import ConvergenceError
-from grazing.orbits.shooting import PeriodicOrbit, sorted_multipliers
+from grazing.orbits.periodic import PeriodicOrbit, sorted_multipliers
+
+GRAZING_SPEED_RATIO = 1e-3
+"""``find_orbit`` does not solve the segments of a guess's run one of whose impacts is slower than this
+fraction of its fastest: that impact is at a grazing (the run from a guess taken just past it touches
+the stop at 7e-5 where the orbit's other impact has 1.5), and the segments would keep it as an impact
+of zero speed where single shooting finds the orbit without it."""
 
 MULTIPLE_SHOOTING_NORM = 1e4
 """Single shooting hands over to multiple shooting where the monodromy's 2-norm exceeds this (its
