@@ -500,10 +500,6 @@ class _Continuation:
                 f"the orbit {what} an impact (impacts per forcing period {list(a.signature)} -> "
                 f"{list(b.signature)}): a grazing"
             )
-        if not self.virtual and b.section_clearance() < RESECTION_MARGIN:
-            return STOP, _RESECTION
-        if a.unstable_count != b.unstable_count:
-            return REFINE, "stability changes"
         if self.segmented:  # (the segments ignore the stops: past a grazing they pass through one)
             if b.impact_speeds.size and float(np.min(b.impact_speeds)) <= 0.0:
                 return BOUNDARY, "an impact speed reaches zero (the orbit loses an impact): a grazing"
@@ -513,6 +509,10 @@ class _Continuation:
                     f"the orbit passes through stop {crossed[0]!r} between its impacts (it gains an impact "
                     "there): a grazing"
                 )
+        if not self.virtual and b.section_clearance() < RESECTION_MARGIN:
+            return STOP, _RESECTION
+        if a.unstable_count != b.unstable_count:
+            return REFINE, "stability changes"
         return ACCEPT, ""
 
     def _layout(self, orbit: PeriodicOrbit) -> SegmentLayout | None:
