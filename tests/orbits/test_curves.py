@@ -963,3 +963,20 @@ def test_the_margin_to_another_contact_leaves_out_the_grazing_contact_itself():
                 ),
             )  # fmt: skip
             assert _other_contact_margin(point) == pytest.approx(0.3)
+
+
+def test_a_difference_step_that_changes_the_impact_count_is_refused_either_way():
+    # The monodromy's derivatives are differences of the map's Jacobian: a step across a grazing (an impact
+    # more or fewer than the point's) is no derivative, and is refused.
+    from grazing.errors import ConvergenceError
+    from grazing.models import impact_oscillator
+    from grazing.orbits.extended import OrbitSystem
+
+    m = impact_oscillator(omega=0.8)
+    orbit = find_orbit(m)
+    system = OrbitSystem(m, "fold", ("omega", "r"), 1, orbit.t0, False, 0, orbit.monodromy)
+    p = np.array([0.8, m.params["r"]])
+    assert system.jacobian(orbit.state, p, orbit.impacts).shape == (2, 4)
+    for other in (orbit.impacts - 1, orbit.impacts + 1):
+        with pytest.raises(ConvergenceError, match="crosses a grazing"):
+            system.jacobian(orbit.state, p, other)
