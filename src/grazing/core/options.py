@@ -173,10 +173,6 @@ POLISH_TRIES = 3
 """Failed Newton polishes per aperiodic attractor of a basin computation: past them its other end states
 (on a chaotic set or a torus) are not tried."""
 
-NEUTRAL_TOL = 1e-6
-"""A periodic orbit is neutral when two of its multipliers are within this of 1 (a Jordan block found
-to rounding) or its multiplier 1 is double (:data:`NON_ISOLATED_TOL`)."""
-
 IMPACTS = ("none", "sampled", "all")
 """What :class:`SaveAt` can record of the impacts."""
 

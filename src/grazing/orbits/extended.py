@@ -47,6 +47,7 @@ import numpy as np
 from grazing.core.model import HybridModel
 from grazing.errors import ConvergenceError, GrazingError
 from grazing.maps import FlowMap, flow_map
+from grazing.orbits.bifurcations import critical_pair
 from grazing.orbits.bordered import Bordered, Borders, bialternate, bordered
 from grazing.orbits.contact import GrazingPoint, contact_system
 from grazing.orbits.shooting import PeriodicOrbit, _orbit_from
@@ -156,8 +157,7 @@ def _critical(kind: str, mu: np.ndarray) -> list[int]:
     if kind == "period-doubling":
         return [int(np.argmin(np.abs(mu + 1.0)))]
     if kind == "neimark-sacker":
-        pairs = [(i, j) for i in range(len(mu)) for j in range(i + 1, len(mu))]
-        return list(min(pairs, key=lambda ij: abs(mu[ij[0]] * mu[ij[1]] - 1.0)))
+        return list(critical_pair(mu))
     return []
 
 

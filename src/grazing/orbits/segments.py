@@ -43,6 +43,7 @@ import numpy as np
 from grazing.core.model import HybridModel
 from grazing.core.solution import Solution
 from grazing.engine.simulate import simulate
+from grazing.engine.timebase import SNAP, start_times
 from grazing.errors import ConvergenceError
 from grazing.orbits.periodic import PeriodicOrbit, sorted_multipliers
 
@@ -102,14 +103,9 @@ def segment_flow(model: HybridModel, x: np.ndarray, ta: float, tb: float, param:
     if s_phase >= T * (1.0 - 1e-12):
         s_phase = 0.0
     kb = round((tb - s_phase) / T)
-    k0 = math.floor(ta / T)
-    s0 = ta - k0 * T
-    snap = 1e-9 * T  # (engine.timebase.SNAP: where the engine's first sample falls)
-    if s0 >= T - snap:
-        k0, s0 = k0 + 1, s0 - T
-    ks = k0 if s0 < s_phase - snap else k0 + 1
+    _, _, ks, _ = start_times(ta, T, s_phase, True)  # (the engine's first sample, as it finds it)
     periods = kb - ks + 1
-    if periods < 1 or tb - ta < snap:
+    if periods < 1 or tb - ta < SNAP * T:
         raise ConvergenceError(f"a segment of the orbit has no length (from t = {ta:.12g} to {tb:.12g})")
     sol = simulate(
         model, x, t0=ta, periods=periods, phase=2 * math.pi * s_phase / T, jacobian=True,
@@ -267,18 +263,11 @@ def segmented_equations(
             row += n
             pre.append(y)
             speeds.append(-cd["rate"])  # (positive: the guard decreases into the stop)
-            M = _saltation(m, y, tb, j, cd, gx, gt) @ M
+            M = m.saltation(y, tb, j) @ M
         orbit = _segmented_orbit(m, layout, u, t0, period, times, pre, speeds, runs, M, F, stop)
         return F, DF, orbit
 
     return evaluate
-
-
-def _saltation(m: HybridModel, y, t, j, cd, gx, gt) -> np.ndarray:
-    """The saltation matrix of an impact at ``y`` (``model.saltation`` with the pieces already at hand)."""
-    fm = m.vector_field(y, t)
-    fp = m.vector_field(m.reset(y, t, j), t)
-    return gx + np.outer(fp - gx @ fm - gt, cd["h_x"]) / (cd["h_x"] @ fm + cd["h_t"])
 
 
 def _least(rows) -> tuple[float, float, np.ndarray] | None:

@@ -29,7 +29,6 @@ import numpy as np
 from grazing.core.model import HybridModel
 from grazing.core.options import (
     MAX_PERIOD,
-    NEUTRAL_TOL,
     POLISH_CANDIDATES,
     POLISH_MAX_ITER,
     POLISH_RATIO,
@@ -143,9 +142,9 @@ def approaches(
 
 
 def is_neutral(monodromy: np.ndarray, multipliers: np.ndarray | None = None) -> bool:
-    """Whether a periodic orbit of monodromy ``M`` is neutral: its multiplier 1 is double (a Jordan block,
-    :func:`grazing.orbits.shooting.is_isolated`, or an eigenspace), or two multipliers lie within
-    :data:`~grazing.core.options.NEUTRAL_TOL` of 1.
+    """Whether a periodic orbit of monodromy ``M`` is neutral: it is not isolated, its multiplier 1 double
+    (a Jordan block or an eigenspace: :func:`grazing.orbits.periodic.is_isolated`).  ``multipliers`` is
+    not needed (kept for callers that pass it).
 
     The impact damper's free particle at rest in its cavity, never reaching a wall, is periodic
     only because its velocity is exactly zero: its monodromy has the block ``[[1, T], [0, 1]]``.
@@ -156,11 +155,9 @@ def is_neutral(monodromy: np.ndarray, multipliers: np.ndarray | None = None) -> 
     >>> is_neutral(particle), is_neutral(np.diag([0.5, 1.0]))
     (True, False)
     """
-    from grazing.orbits.shooting import is_isolated
+    from grazing.orbits.periodic import is_isolated
 
-    m = np.asarray(monodromy, dtype=float)
-    mu = np.linalg.eigvals(m) if multipliers is None else np.asarray(multipliers)
-    return (not is_isolated(m)) or int(np.sum(np.abs(mu - 1.0) < NEUTRAL_TOL)) >= 2
+    return not is_isolated(np.asarray(monodromy, dtype=float))
 
 
 def cycle_points(model: HybridModel, state: np.ndarray, t0: float, period: int) -> np.ndarray:
