@@ -13,6 +13,7 @@ import grazing
 from grazing import InvalidParameterError, InvalidStateError, SimulationError
 from grazing.engine import simulate as simulate_module
 from grazing.models import bouncing_ball, impact_oscillator, pendulum, two_sided_oscillator
+from tests.far_stop import far_stop_swing, orbit_state
 
 # --------------------------------------------------------------------------
 # Closed forms: a ball on a fixed floor, released from rest at height 1.
@@ -364,3 +365,13 @@ def test_a_dense_trajectory_of_other_models_has_every_row(make, x0):
     assert len(t) == pytest.approx(periods * per_period + 1 + 2 * sol.impacts.t.size, abs=2)
     assert np.max(np.diff(t)) <= T / per_period * (1 + 1e-9)
     np.testing.assert_allclose(sol.trajectory[-1], sol.samples[-1], atol=1e-12)  # (the span ends at a sample)
+
+
+@pytest.mark.parametrize("distance", [10.0, 1e6, 1e12])
+def test_a_stop_far_away_leaves_the_orbit_as_accurate(distance):
+    # The closed-form orbit of a damped linear oscillator to rounding, wherever its (unreached) stop is: the
+    # guard's value, offset by the stop's distance, once set the step's scale (1e12: samples off by 1e-4).
+    m = far_stop_swing(force=1.0, distance=distance)
+    for x0 in ([0.3, 0.0], [-0.2, 0.1]):  # (the sweeps' lanes: tests/attractors/test_dynamics.py)
+        run = grazing.simulate(m, x0, transient=400, periods=8)
+        np.testing.assert_allclose(run.samples, np.tile(orbit_state(1.0), (8, 1)), rtol=0, atol=1e-12)

@@ -33,6 +33,12 @@ _LN2_LO = 1.90821492927058770002e-10
 _LOG2E = 1.4426950408889634
 _SQRT2 = 1.4142135623730951
 _RATIO_MIN, _RATIO_MAX = 1e-300, 1e300
+
+GUARD_SCALE = 16.0
+"""In free flight a guard's value counts in the step's scale (:func:`step_size`) up to this many times
+the state's, ``max(1, |x|)``: it is offset by its stop's distance, which says nothing about the scale
+of the solution (a stop at 1e12, counted in full, made the steps of an orbit of size 1 a thousand
+times too long).  Every guard of the built-in models stays within it: their results are unchanged."""
 """The ratios whose logarithms :func:`step_from_norms` takes are clamped to this range (``fast_log``'s)."""
 
 
@@ -102,7 +108,7 @@ def step_factor(safety, order):
 
 
 @njit(cache=True, inline="always")
-def step_size(X, n, O, nout, orow, order, max_step, factor):
+def step_size(X, n, O, nout, orow, cap, order, max_step, factor):
     """Jorba-Zou step size from the last two Taylor coefficients.
 
     ``h = rho * factor`` where ``rho`` estimates the radius of convergence and
@@ -114,11 +120,13 @@ def step_size(X, n, O, nout, orow, order, max_step, factor):
     Jacobian are as accurate as the state even where the state itself is
     constant (sticking, an equilibrium).  The scale of the values counts the
     state and one event row, ``orow`` (the first stop's guard in free flight,
-    the contact force while sticking): another stop's guard is offset by its
-    distance, which says nothing about the scale of the solution.  Inlined
-    into the driver (no reference counting of its arrays on the hot path).
+    the contact force while sticking), that row up to ``cap`` times the
+    state's scale ``max(1, |x|)`` (:data:`GUARD_SCALE` for a guard, ``inf``
+    for the contact force): a guard is offset by its stop's distance, which
+    says nothing about the scale of the solution.  Inlined into the driver
+    (no reference counting of its arrays on the hot path).
     """
-    nx = abs(O[orow, 0])
+    nx = 0.0
     n1 = 0.0
     n2 = 0.0
     for r in range(nout):
@@ -128,6 +136,7 @@ def step_size(X, n, O, nout, orow, order, max_step, factor):
         nx = max(nx, abs(X[i, 0]))
         n1 = max(n1, abs(X[i, order - 1]))
         n2 = max(n2, abs(X[i, order]))
+    nx = max(nx, min(abs(O[orow, 0]), cap * max(1.0, nx)))
     return step_from_norms(nx, n1, n2, order, max_step, factor)
 
 

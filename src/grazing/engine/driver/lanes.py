@@ -44,7 +44,7 @@ from grazing.engine.driver.step import STEP_LAST, accept_step, end_plain_step, e
 from grazing.engine.lanevec import LANE_WIDTH, advance_rows, certify_stop
 from grazing.engine.polyroots import quadratic_bound, work_shape
 from grazing.engine.records import Kernels, LaneJobs, LanePoints, LaneResults, LaneSettings
-from grazing.engine.stepping import new_table, step_factor, step_size, steps_from_norms
+from grazing.engine.stepping import GUARD_SCALE, new_table, step_factor, step_size, steps_from_norms
 
 LANE_ROOT_ROWS, LANE_ROOT_MIN_COLS = work_shape(0)
 ADAPTIVE_BLOCK = 32  # (grazing.sweeps.run.ADAPTIVE_BLOCK)
@@ -377,7 +377,7 @@ def _lane_norms(m, ls, XT, OT, kinds, nvar, factor, norms, nl):
     nstops = m.nstops
     ntot = n + n * n
     for lane in range(nl):
-        norms[lane] = abs(OT[0, 0, lane])
+        norms[lane] = 0.0
         norms[nl + lane] = 0.0
         norms[2 * nl + lane] = 0.0
     for r in range(nstops):
@@ -390,7 +390,8 @@ def _lane_norms(m, ls, XT, OT, kinds, nvar, factor, norms, nl):
                 norms[lane] = max(norms[lane], abs(XT[i, 0, lane]))
                 norms[nl + lane] = max(norms[nl + lane], abs(XT[i, order - 1, lane]))
                 norms[2 * nl + lane] = max(norms[2 * nl + lane], abs(XT[i, order, lane]))
-    for lane in range(nl):
+    for lane in range(nl):  # (the first guard, up to GUARD_SCALE times the state's scale: step_size)
+        norms[lane] = max(norms[lane], min(abs(OT[0, 0, lane]), GUARD_SCALE * max(1.0, norms[lane])))
         norms[4 * nl + lane] = ls[lane].T
     steps_from_norms(norms[:nl], norms[nl : 2 * nl], norms[2 * nl : 3 * nl], order, norms[4 * nl :],
                      factor, norms[3 * nl : 4 * nl])  # fmt: skip
@@ -522,7 +523,7 @@ def plan_steps(m, cfg, la, zdms, norms, coeffs, factor, plan):
                 xl[i] = XS[i, lane]
             tc_stick(m, xl, s, pl[lane], Xs, Os, stuck)
             to_lane(Xs, Os, n, nstops, K, XT, OT, lane)
-            h = step_size(Xs, n, Os, nstops, stuck, order, T, factor)
+            h = step_size(Xs, n, Os, nstops, stuck, math.inf, order, T, factor)
         else:
             h = hfree[lane]
         h, ends = step_end(ls[lane], h, cfg.zdm, zdms[p])

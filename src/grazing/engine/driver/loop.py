@@ -55,6 +55,7 @@ from grazing.engine.driver.step import STEP_LAST, accept_step, end_plain_step, e
 from grazing.engine.polyroots import work_shape
 from grazing.engine.records import Config, Kernels, RunOutput, Start
 from grazing.engine.stepping import (
+    GUARD_SCALE,
     append_pair,
     append_row,
     copy_rows,
@@ -165,10 +166,10 @@ def integrate(start, pv, cfg, m, out):
                 tc_var(m, x, r.s, pv, X, O)
             else:
                 tc_free(m, x, r.s, pv, X, O)
-            h = step_size(X, ntot, O, nstops, 0, order, max_step, factor)
+            h = step_size(X, ntot, O, nstops, 0, GUARD_SCALE, order, max_step, factor)
         else:
             tc_stick(m, x, r.s, pv, X, O, r.stuck)  # the first n rows only
-            h = step_size(X, n, O, nstops, r.stuck, order, max_step, factor)
+            h = step_size(X, n, O, nstops, r.stuck, math.inf, order, max_step, factor)
         h, ends = step_end(r, h, zdm_on, sz)  # (at the last sample, at the map's phase)
         is_last = (ends & STEP_LAST) != 0
 
