@@ -18,7 +18,7 @@ import pytest
 import grazing
 from grazing.attractors import find_attractors, state_grid
 from grazing.attractors.grid import start_time
-from grazing.core.options import CHAOS_THRESHOLD, SweepSettings
+from grazing.core.options import CHAOS_THRESHOLD, ESCAPE_FACTOR, MATCH_TOL, SweepSettings
 from grazing.core.period import detect_period
 from grazing.maps import flow_map
 from grazing.models import impact_damper
@@ -27,6 +27,7 @@ from grazing.orbits.shooting import is_isolated
 from grazing.sweeps import run_sweep
 from grazing.sweeps.polish import approaches, contracting_periods, polish
 from grazing.sweeps.spec import sweep_spec
+from tests.far_stop import RESPONSE, far_stop_swing
 
 SLOW = impact_damper(mu=0.3, r=0.8, omega=1.408)  # the period-1 two-impact orbit, just before its NS point
 TORUS = impact_damper(mu=0.3, r=0.8, omega=1.412)  # just past it
@@ -194,3 +195,54 @@ def test_progress_counts_every_initial_state_once_invalid_ones_first():
     done = [d for d, _ in seen]
     assert {t for _, t in seen} == {8} and done == sorted(done)
     assert done[0] >= 8 - valid and done[-1] == 8
+
+
+def test_resuming_a_finished_store_reports_every_state_done_at_once(tmp_path):
+    # The second run reads every chunk from the store: its first report counts them all.
+    m = grazing.models.pendulum("B", eta=0.40, theta_hat=math.radians(40))
+    x = np.column_stack([np.linspace(0.0, 0.5, 6), np.zeros(6)])
+    store = tmp_path / "runs.zarr"
+    first = find_attractors(m, x, transient=50, periods=16, chunk_size=2, store=store)
+    seen = []
+    again = find_attractors(
+        m, x, transient=50, periods=16, chunk_size=2, store=store, progress=lambda d, t: seen.append((d, t))
+    )
+    assert seen[0] == (6, 6)
+    assert again.labels.tolist() == first.labels.tolist()
+
+
+def test_an_attractor_far_larger_than_a_box_wider_than_one_is_not_escaping():
+    # The escape distance is ESCAPE_FACTOR times the box's size, or 1 if less (here 2000, and 1): a periodic
+    # orbit of amplitude 6.5e3 reached from it is an attractor.
+    m = far_stop_swing(5e3, distance=1e7)
+    amplitude = 5e3 * abs(RESPONSE)
+    for half in (0.5, 1000.0):
+        x = state_grid(m, (-half, half), (-half, half), (2, 2)).states_array()
+        found = find_attractors(m, x, transient=200, periods=8, workers=1)
+        (a,) = found.attractors
+        assert (a.kind, a.period, a.count) == ("periodic", 1, 4)
+        assert float(np.max(np.abs(a.points[:, 0]))) < amplitude < ESCAPE_FACTOR * max(2 * half, 1.0)
+
+
+@pytest.mark.parametrize(("amplitude", "period"), [(1e-6, 1), (0.2, 2)])
+def test_a_run_closing_in_on_a_shorter_period_has_it_only_within_a_match(amplitude, period):
+    # Samples repeating with period 2 whose two points close in on one (x = 0.5 + a (-0.8)^k): on the last
+    # look they are period 1 where their last difference is within a match (MATCH_TOL cells: 1e-5 here),
+    # and keep period 2 where it is not (5e-4 for a = 0.2).
+    from grazing.attractors.classify import Catalogue, closing_period
+    from grazing.sweeps.spec import ChunkResult
+
+    k = np.arange(32.0)
+    x = 0.5 + amplitude * (-0.8) ** k
+    samples = np.stack([x, np.full_like(x, 0.1)], axis=1)[None]
+    cell = np.full(2, 0.01)
+    d, off = closing_period(samples[0], 2)
+    assert d == 1 and (off <= MATCH_TOL * cell[0]) == (period == 1)
+    cat = Catalogue(grazing.models.bouncing_ball(), 1, cell, np.zeros(2), 1e3, 32, 0.0, polish=False)
+    one = np.ones(1)
+    res = ChunkResult(
+        0, samples, np.array([2]), 2 * one, -one, 100 * one, samples[:, -1], np.zeros(1, dtype=int)
+    )
+    cat.add(0, res)
+    (a,), labels = cat.attractors()
+    assert (a.kind, a.period, labels.tolist()) == ("periodic", period, [1])

@@ -107,3 +107,45 @@ class ClosedForm:
         return math.sqrt(1.0 - 2.0 * self.zeta**2), 1.0 / (
             2.0 * abs(self.zeta) * math.sqrt(1.0 - self.zeta**2)
         )
+
+
+BYSTANDER_DAMPING, BYSTANDER_STIFFNESS = 0.5, 3.0
+
+
+def negative_damping_with_bystander(**values: float) -> HybridModel:
+    """The same oscillator beside a second one that never meets a stop and does not act on it (4 states).
+
+    States in the order ``(b, q, b_t, qdot)``: the bystander ``b'' + 0.5 b' + 3 b = 0.4 sin(w s)`` comes
+    first, so that an index into the states, the tangent or the contact that is right only for two
+    states (or only where the contact coordinate is the first one) shows.  Its periodic response is
+    stable; the impacting oscillator's orbit, multipliers, grazings and grazing curve are those of
+    :class:`ClosedForm`, and the bystander adds the multipliers ``exp(T (-0.25 +- i sqrt(2.9375)))``.
+    """
+    b, q, b_t, qdot, s = sp.symbols("b q b_t qdot s")
+    zeta, w, upper, lower, e = sp.symbols("zeta w upper lower e")
+    base = negative_damping()
+    model = HybridModel(
+        "negative-damping-with-bystander",
+        states=[b, q, b_t, qdot],
+        time=s,
+        parameters=list(base.parameters),
+        vector_field=[
+            b_t,
+            qdot,
+            -BYSTANDER_DAMPING * b_t - BYSTANDER_STIFFNESS * b + sp.Rational(2, 5) * sp.sin(w * s),
+            -2 * zeta * qdot - q + sp.cos(w * s),
+        ],
+        period=2 * sp.pi / w,
+        stops=[
+            Stop("ceiling", upper - q, [b, q, b_t, -e * qdot], contact_direction=[0, 0, 0, 1]),
+            Stop("floor", q + lower, [b, q, b_t, -e * qdot], contact_direction=[0, 0, 0, 1]),
+        ],
+    )
+    return model.with_params(**values) if values else model
+
+
+def bystander_multipliers(w: float) -> np.ndarray:
+    """The bystander's two Floquet multipliers over one forcing period ``2 pi / w``."""
+    c = BYSTANDER_DAMPING / 2.0
+    z = np.exp((2.0 * math.pi / w) * complex(-c, math.sqrt(BYSTANDER_STIFFNESS - c * c)))
+    return np.array([z, z.conjugate()])

@@ -17,6 +17,7 @@ import pytest
 
 import grazing
 from grazing.cli import main
+from grazing.core.options import NOT_ISOLATED_TOL
 from grazing.orbits import continue_orbit, find_orbit
 from grazing.orbits.shooting import is_isolated, kept_directions, multiplier_one_multiplicity
 from tests.linear_exact import six_state_model
@@ -103,3 +104,19 @@ def test_the_cli_names_a_non_isolated_orbit_and_refuses_to_continue_it(capsys):
 def test_an_isolated_orbit_stays_isolated_and_stable():
     orbit = find_orbit(grazing.models.pendulum("B", eta=0.446, theta_hat=math.radians(40)))
     assert orbit.isolated and orbit.stable
+
+
+@pytest.mark.parametrize("largest", [0.5, 100.0])
+def test_kept_directions_are_counted_relative_to_one_plus_the_norm(largest):
+    """Two directions kept within ``NOT_ISOLATED_TOL (1 + |M|)`` of the identity, and not beyond it,
+    whatever the size of the rest of ``M`` (a norm of 1, or 100)."""
+    scale = NOT_ISOLATED_TOL * (1.0 + max(largest, 1.0))
+
+    def matrix(offset: float) -> np.ndarray:
+        m = np.diag([1.0 + offset, 1.0 + offset, largest])
+        # (an orthogonal change of basis: the same singular values)
+        basis = np.linalg.qr(np.random.default_rng(3).normal(size=(3, 3)))[0]
+        return basis @ m @ basis.T
+
+    assert kept_directions(matrix(0.9 * scale)) == 2
+    assert kept_directions(matrix(1.1 * scale)) == 0

@@ -15,8 +15,9 @@ import numpy as np
 import pytest
 
 import grazing
-from grazing.orbits import continue_orbit, find_orbit
+from grazing.orbits import continue_orbit, find_orbit, follow_curve
 from grazing.orbits.continuation import _Continuation
+from grazing.orbits.palc import PalcSettings
 from grazing.orbits.segments import layout_of, segmented_equations
 from tests.linear_exact import damper, grazing_of_impact, inverted_walls, inverted_walls_matrices
 
@@ -158,3 +159,31 @@ def test_find_orbit_from_a_guess_solves_the_segments_where_the_monodromy_is_larg
     monkeypatch.setattr(_Newton, "segments_from_guess", lambda self, fm, virtual: False)
     elsewhere = [np.max(np.abs(found(orbit).state - orbit.state)) for orbit in picked]
     assert max(elsewhere) > 1e-4  # (single shooting alone: another orbit, for some of them)
+
+
+def test_the_grazing_equations_and_curve_need_no_segments(inverted_branch):
+    # On the section through the contact the vanishing impact is not applied: its saltation matrix's 1 / v
+    # never enters the grazing equations, whose monodromy is of moderate size (|M| ~ 1e2 where the
+    # branch's reached 1e24).  The grazing's curve in (a, c) is followed by single shooting, and each of
+    # its points is the exact linear flow's grazing at that damping to 1e-9.
+    model, _, branch = inverted_branch
+    graze = branch.special[0]
+    assert graze.grazing.abs_lambda < 1e3 < 1e7 < max(o.abs_lambda for o in branch.orbits)
+    near = min(branch.orbits, key=lambda o: abs(o.model.params["a"] - (graze.param - 0.1)))
+    a0 = near.model.params["a"]
+    curve = follow_curve(model.with_params(a=a0), "grazing", "a", a0, 9.0, "c", (0.05, 0.2), orbit=near,
+                         settings=PalcSettings(ds=0.01, ds_max=0.02))  # fmt: skip
+    cs, avals = curve.values("c"), curve.values("a")
+    assert len(cs) >= 8 and cs.min() < 0.09 and cs.max() > 0.11
+    last = branch.orbits[-1]
+    stops, vanishing = list(last.impact_stops), int(np.argmin(last.impact_speeds))
+    start = np.concatenate([last.state, last.impact_times, [graze.param]])
+    for c, a in sorted(zip(cs, avals), key=lambda ca: abs(ca[0] - 0.1)):  # (from c = 0.1 out)
+        z = grazing_of_impact(
+            lambda v, c=c: inverted_walls_matrices(model.with_params(a=v, c=c)),
+            stops,
+            last.t0,
+            start,
+            vanishing,
+        )
+        assert a == pytest.approx(z[-1], abs=1e-9)

@@ -13,17 +13,28 @@ from __future__ import annotations
 import math
 import re
 import warnings
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
 import grazing
+from grazing.core.options import NEWTON_TOL
 from grazing.errors import GrazingWarning
 from grazing.models import bouncing_ball, impact_oscillator, pendulum, two_sided_oscillator
 from grazing.models.pendulum import max_angle
 from grazing.normalform import find_grazing_point, normal_form_at
-from grazing.orbits import continue_orbit, find_grazings, find_orbit, grazing_curve
-from tests.orbits.negative_damping import LOWER, UPPER, ZETA, ClosedForm, negative_damping
+from grazing.orbits import continue_orbit, find_grazings, find_orbit, grazing_curve, shooting
+from grazing.orbits.shooting import move_section
+from tests.orbits.negative_damping import (
+    LOWER,
+    UPPER,
+    ZETA,
+    ClosedForm,
+    bystander_multipliers,
+    negative_damping,
+    negative_damping_with_bystander,
+)
 
 CF = ClosedForm()
 GUESS = r"give an initial guess x0 \(--initial\)"
@@ -211,3 +222,56 @@ def test_switch_follows_a_nonimpacting_orbit_physically_to_its_grazing(model, pa
     end = next(s for s in physical.special if s.kind == "grazing")
     assert end.param == pytest.approx(first.param, abs=1e-9)
     assert "switch" in physical.status and "followed with switch (--switch)" not in physical.status
+
+
+def test_moving_the_section_starts_newton_on_the_orbit():
+    """move_section follows the orbit to the new section: Newton's method starts there on the orbit
+    (its first residual is the integration's), at the closed form's state."""
+    orbit = find_orbit(negative_damping(w=0.7), [0.0, 0.0], period=1)
+    T = orbit.model.period
+    for t_new in (0.3 * T, 0.77 * T):
+        moved = move_section(orbit, t_new)
+        assert moved.t0 == t_new and moved.residuals[0] < 1e-9
+        np.testing.assert_allclose(moved.state, CF.state(0.7, t_new), rtol=0, atol=1e-11)
+        np.testing.assert_allclose(sorted_mu(moved.multipliers), sorted_mu(orbit.multipliers), rtol=1e-9)
+
+
+def test_an_orbit_clear_of_the_stops_whose_physical_map_does_not_close_is_refused(monkeypatch):
+    """The orbit found on the flow through the stops is a physical orbit only if the physical map
+    closes on it to the tolerance: one whose physical image is off by 1e-6 is not returned."""
+    model = negative_damping(w=0.7)
+    orbit = find_orbit(model, [0.0, 0.0], period=1)  # (the check passes on the true map)
+    assert not orbit.virtual and orbit.residual <= NEWTON_TOL
+    true_map = shooting.flow_map
+
+    def off(*args, **kwargs):  # (the physical map only: the flow through the stops stays true)
+        fm = true_map(*args, **kwargs)
+        return fm if kwargs.get("virtual") else replace(fm, image=fm.image + 1e-6)
+
+    monkeypatch.setattr(shooting, "flow_map", off)
+    newton = shooting._Newton(model, 0.0, 1, 0, NEWTON_TOL, 20)
+    assert newton.nonimpacting(np.array([0.0, 0.0])) is None
+
+
+def test_a_grazing_curve_with_two_more_states_first_is_the_resonance_curve():
+    """The same grazing curve and fold with a 4-state model whose impacting coordinate is the second state
+    (a bystander oscillator first): every index into the states and the tangent must be the model's."""
+    model = negative_damping_with_bystander()
+    orbit = find_orbit(model.with_params(w=0.7), np.zeros(4), period=1)
+    np.testing.assert_allclose(orbit.state[[1, 3]], CF.state(0.7), rtol=0, atol=1e-11)
+    expected = np.concatenate([CF.multipliers(0.7), bystander_multipliers(0.7)])
+    np.testing.assert_allclose(sorted_mu(orbit.multipliers), sorted_mu(expected), rtol=1e-9)
+    fold_w, fold_a = CF.fold()
+    # From the grazing below the resonance (w grows along the curve) and from the one above it (w falls)
+    for search, direction in (((0.5, 1.0), 1.0), ((0.9, 1.5), -1.0)):  # (search: also the bounds on w)
+        curve = grazing_curve(model, ("w", "upper"), UPPER, search=search, x0=np.zeros(4))
+        assert len(curve.points) > 20
+        w, upper = curve.values("w"), curve.values("upper")
+        assert np.sign(w[1] - w[0]) == direction
+        np.testing.assert_allclose(upper, [CF.amplitude(v) for v in w], rtol=1e-11)
+        assert curve.fold is not None
+        assert curve.fold.model.params["w"] == pytest.approx(fold_w, rel=1e-8)
+        assert curve.fold.model.params["upper"] == pytest.approx(fold_a, rel=1e-12)
+        # (the fold lies between the point before it and the next, in the order the curve was followed)
+        i = curve.fold_index
+        assert min(upper[i], upper[i + 1]) <= fold_a and max(w[i], w[i + 1]) >= fold_w >= min(w[i], w[i + 1])

@@ -141,7 +141,7 @@ class _Entry:
     period: int = -1
     points: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
     impacts: float = math.nan
-    exponents: list[float] = field(default_factory=list)
+    exponents: list[float] = field(default_factory=list)  # (an orbit's: set by basins._orbit_exponents)
     count: int = 0
     reason: str = ""
     cells: set[bytes] = field(default_factory=set)
@@ -334,18 +334,13 @@ class Catalogue:
                 k = self._periodic_entry(int(p), cyc[rep], int(index[row]), impacts)
                 e = self.entries[k]
                 e.count += members.size
-                exps = np.asarray(res.lyapunov, dtype=float)[sel[members]]
-                e.exponents = e.exponents + [float(v) for v in exps[: MAX_EXPONENTS - len(e.exponents)]]
                 self.labels[index[sel[members]]] = k
 
     def _add_polished(self, i: int, found: Polished) -> None:
         """Label initial state ``i`` with the periodic orbit its end state was polished to."""
         cyc = np.roll(found.cycle, -int(np.argmin(found.cycle[:, 0])), axis=0)
         k = self._periodic_entry(found.period, cyc, i, float(found.impacts))
-        e = self.entries[k]
-        e.count += 1
-        if len(e.exponents) < MAX_EXPONENTS:
-            e.exponents.append(found.lyapunov)
+        self.entries[k].count += 1
         self.labels[i] = k
         self.polished += 1
 
