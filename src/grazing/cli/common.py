@@ -84,9 +84,10 @@ def run_user_code(failed: str, call: Callable[[], Any]) -> Any:
     """``call()``, the user's code (a model file, its model function), as one line if it fails.
 
     What it prints to stdout goes to stderr (stdout stays clean for ``--json``);
-    any exception it raises, or a ``sys.exit``, becomes an :class:`InputError`
+    any exception it raises (any :class:`BaseException`: a ``GeneratorExit`` raised
+    at the top of a file too), or a ``sys.exit``, becomes an :class:`InputError`
     starting with ``failed`` (``"--model: m.py failed to load"``) that shows the
-    start of what it printed.  ``KeyboardInterrupt`` passes (Ctrl-C).
+    start of what it printed.  ``KeyboardInterrupt`` passes (Ctrl-C, SIGTERM).
     """
     import contextlib
     import io
@@ -97,10 +98,12 @@ def run_user_code(failed: str, call: Callable[[], Any]) -> Any:
             result = call()
     except SystemExit as exc:
         reason = "it called sys.exit()" if exc.code is None else f"it called sys.exit({exc.code!r})"
+    except KeyboardInterrupt:
+        raise
     except grazing.GrazingError as exc:
         reason = str(exc)
-    except Exception as exc:  # the user's code: any error is theirs, reported in one line
-        reason = f"{type(exc).__name__}: {exc}"
+    except BaseException as exc:  # the user's code: anything it raises is theirs, reported in one line
+        reason = f"{type(exc).__name__}: {exc}".rstrip(": ")
     else:
         if printed.getvalue():
             click.echo(printed.getvalue(), err=True, nl=False)
@@ -385,6 +388,26 @@ def parse_pair(
     if not (math.isfinite(a) and math.isfinite(b)):
         raise InputError(f"{option} must be finite numbers, got {text!r}")
     return a, b
+
+
+def spaced_values(start: float, stop: float, num: int, options: str) -> np.ndarray:
+    """``num`` values evenly spaced from ``start`` to ``stop`` (``np.linspace``); one line where the span
+    between them overflows (``--start -1e308 --stop 1e308``), which numpy would warn about.
+
+    Examples
+    --------
+    >>> spaced_values(0.0, 1.0, 3, "--start/--stop").tolist()
+    [0.0, 0.5, 1.0]
+    """
+    check_span(start, stop, options)
+    return np.linspace(start, stop, num)
+
+
+def check_span(lo: float, hi: float, options: str) -> None:
+    """One line if the distance from ``lo`` to ``hi`` is no finite float (a range or grid of them would
+    overflow)."""
+    if not math.isfinite(hi - lo):
+        raise InputError(f"{options}: the range from {lo:g} to {hi:g} is wider than floats can hold")
 
 
 class Progress:
