@@ -11,6 +11,7 @@ import tracemalloc
 
 import pytest
 
+from grazing.cli import main
 from grazing.cli.limits import MEMORY_ENV
 from grazing.experiment.synthetic import synthetic_sweep
 from tests.cli.test_cli_robustness import CURVE, MODEL_FILE, _one_line_error
@@ -126,3 +127,37 @@ def test_a_missing_nested_grazing_cache_dir_is_refused_and_not_made(tmp_path, ca
         "unset it\n"
     )
     assert list(tmp_path.iterdir()) == []
+
+
+SWEEP = "sweep --param eta --start 0.44 --stop 0.45 --num 2 --periods 3 --transient 3 --out out.nc".split()
+
+
+def _add_attribute(path):
+    import h5py
+
+    with h5py.File(path, "r+") as f:
+        f.attrs["checked"] = "by me"
+
+
+def _append_byte(path):
+    with open(path, "ab") as fh:
+        fh.write(b"\n")
+
+
+@pytest.mark.parametrize("edit", [_add_attribute, _append_byte])
+def test_a_netcdf_file_edited_after_grazing_wrote_it_is_not_replaced(edit, capsys, tmp_path, monkeypatch):
+    """However it was edited, data untouched: refused without --overwrite, replaced with it."""
+    monkeypatch.chdir(tmp_path)
+    assert main(SWEEP) == 0
+    assert main(SWEEP) == 0  # (grazing's own file: replaced)
+    edit(tmp_path / "out.nc")
+    before = (tmp_path / "out.nc").read_bytes()
+    capsys.readouterr()
+    assert main(SWEEP) == 1
+    assert capsys.readouterr().err == (
+        "grazing: error: out.nc exists and was not written by grazing (or was changed since); it was left "
+        "untouched: use another name, or --overwrite to replace it\n"
+    )
+    assert (tmp_path / "out.nc").read_bytes() == before
+    assert main([*SWEEP, "--overwrite"]) == 0
+    assert (tmp_path / "out.nc").read_bytes() != before
