@@ -19,8 +19,10 @@ from grazing.cli.common import (
     EXIT_FAILURE,
     EXIT_INTERRUPTED,
     EXIT_USAGE,
+    buffered_stdout,
     discard_output,
     error_line,
+    flush_or_discard_output,
     output_closed,
 )
 from grazing.cli.limits import MEMORY_ENV
@@ -106,6 +108,7 @@ def main(argv: list[str] | None = None) -> int:
     import sys
 
     args = list(sys.argv[1:] if argv is None else argv) or ["--help"]
+    buffered_stdout()
     try:
         # (not cli.main: on Ctrl-C it writes an empty line to stderr, whatever stderr is)
         with cli.make_context("grazing", args) as ctx:
@@ -126,6 +129,7 @@ def main(argv: list[str] | None = None) -> int:
             discard_output()
             return EXIT_CLOSED_PIPE
         error_line(f"{exc.strerror or exc}: {exc.filename or ''}".rstrip(": "))
+        flush_or_discard_output()  # (the standard output on a full disk: said once)
         return EXIT_FAILURE
     except MemoryError:
         error_line(f"out of memory (the estimate before the run was too low; {MEMORY_ENV} lowers the bound)")

@@ -669,6 +669,39 @@ def output_closed(fd: int = 1) -> bool:
     return any(event & (select.POLLERR | select.POLLHUP | select.POLLNVAL) for _, event in poller.poll(0))
 
 
+def buffered_stdout() -> None:
+    """Give the standard output back a buffer where ``PYTHONUNBUFFERED`` (``python -u``) took it away.
+
+    Unbuffered, Python writes the standard output straight to its file
+    descriptor, and a ``write`` that the system takes only a part of (a pipe
+    whose reader has left after a few bytes, a disk that filled up) loses the
+    rest without an error: ``grazing simulate --json | head -c 100`` ended
+    with status 0, ``> full-disk/out.json`` left a truncated file and status
+    0.  A buffered writer writes everything or raises the error.  It is
+    flushed at every line (and by every command after what it prints), so the
+    output comes as promptly as unbuffered.  Nothing is changed where the
+    standard output has a buffer already, or is no file (a test's capture).
+    """
+    import io
+
+    stream = sys.stdout
+    raw = getattr(stream, "buffer", None)
+    if not isinstance(raw, io.RawIOBase):
+        return
+    stream.flush()
+    writer = io.BufferedWriter(io.FileIO(raw.fileno(), "w", closefd=False))
+    sys.stdout = io.TextIOWrapper(writer, encoding=stream.encoding, errors=stream.errors, line_buffering=True)
+
+
+def flush_or_discard_output() -> None:
+    """Flush the standard output; where it cannot take what is left (a full disk), drop that instead (the
+    error has been said: the flush at the process's end must not report it again, in several lines)."""
+    try:
+        sys.stdout.flush()
+    except (OSError, ValueError):
+        discard_output()
+
+
 def discard_output() -> None:
     """Send what is left of the standard output to ``/dev/null``: its reader has gone, and the flush at the
     process's end must not fail again (Python would print an "Exception ignored" message)."""
