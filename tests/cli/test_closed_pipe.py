@@ -73,7 +73,7 @@ def test_output_closed_is_false_for_a_file(tmp_path):
 UNBUFFERED = {**os.environ, "PYTHONUNBUFFERED": "1"}
 LARGE = {
     "simulate": ["simulate", "--periods", "20000", "--transient", "10", "--json"],
-    "sweep": "sweep --param eta --start 0.44 --stop 0.45 --num 2000 --periods 10 --transient 10 --json".split(),
+    "sweep": "sweep --param eta --start .44 --stop .45 --num 2000 --periods 10 --transient 1 --json".split(),
 }  # (over a megabyte and 500 kB of JSON: more than a pipe holds)
 
 
