@@ -18,6 +18,7 @@ from grazing.cli.common import (
     EXIT_CLOSED_PIPE,
     EXIT_FAILURE,
     EXIT_INTERRUPTED,
+    EXIT_TERMINATED,
     EXIT_USAGE,
     buffered_stdout,
     discard_output,
@@ -26,6 +27,7 @@ from grazing.cli.common import (
     output_closed,
 )
 from grazing.cli.limits import MEMORY_ENV
+from grazing.engine.interrupts import Terminated, terminating_as_interrupted
 from grazing.errors import GrazingError
 
 __all__ = ["COMMANDS", "cli", "main"]
@@ -96,12 +98,20 @@ def interrupted_line() -> None:
     click.echo(("\n" if sys.stderr.isatty() else "") + "grazing: interrupted", err=True)
 
 
+def terminated_line() -> None:
+    """Say on stderr that the command was ended by SIGTERM, in one line."""
+    click.echo("grazing: terminated", err=True)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI; every error becomes one line on stderr and an exit status.
 
     Output to a pipe whose reader has gone (``grazing sweep --json | head``)
     ends the command without a message, with status 141
     (:data:`~grazing.cli.common.EXIT_CLOSED_PIPE`), as a Unix tool ends.
+    SIGTERM ends it as Ctrl-C does (its temporaries removed, its workers
+    stopped), with one line and status 143
+    (:data:`~grazing.cli.common.EXIT_TERMINATED`).
 
     Without arguments it prints the help, as ``grazing --help`` does.
     """
@@ -111,10 +121,13 @@ def main(argv: list[str] | None = None) -> int:
     buffered_stdout()
     try:
         # (not cli.main: on Ctrl-C it writes an empty line to stderr, whatever stderr is)
-        with cli.make_context("grazing", args) as ctx:
+        with terminating_as_interrupted(), cli.make_context("grazing", args) as ctx:
             cli.invoke(ctx)
     except click.exceptions.Exit as exc:
         return int(exc.exit_code)
+    except Terminated:
+        terminated_line()
+        return EXIT_TERMINATED
     except (click.exceptions.Abort, KeyboardInterrupt, EOFError):
         interrupted_line()
         return EXIT_INTERRUPTED

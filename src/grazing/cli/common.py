@@ -45,6 +45,8 @@ PENDULUM_UNFOLDING = ("eta", "theta_hat")
 EXIT_USAGE = 2
 EXIT_FAILURE = 1
 EXIT_INTERRUPTED = 130
+EXIT_TERMINATED = 143
+"""A command ended by SIGTERM (128 + 15), after the same clean-up as on Ctrl-C."""
 EXIT_CLOSED_PIPE = 141
 """A command whose output's reader went away (``grazing sweep --json | head``): 128 + SIGPIPE, the status
 of a Unix tool ended by that signal, and no message (nothing failed that the user asked for)."""
