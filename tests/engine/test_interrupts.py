@@ -63,7 +63,15 @@ def test_ctrl_c_stops_a_long_run_inside_the_driver(name, make, x0, default_sigin
     np.testing.assert_array_equal(again.samples, fresh.samples)
 
 
-def test_sigterm_stops_a_long_run_inside_the_driver_as_terminated(default_sigint):
+@pytest.fixture
+def default_sigterm():
+    """SIGTERM's default action, as in a new interpreter (a test runner's worker may have a handler)."""
+    previous = signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    yield
+    signal.signal(signal.SIGTERM, previous)
+
+
+def test_sigterm_stops_a_long_run_inside_the_driver_as_terminated(default_sigint, default_sigterm):
     """issue 43: under the command line's SIGTERM handler the driver counts SIGTERM too, and the caller
     raises Terminated (a KeyboardInterrupt: the same clean-up), not a plain KeyboardInterrupt."""
     model = grazing.models.pendulum("B", eta=0.446, theta_hat=math.radians(40))

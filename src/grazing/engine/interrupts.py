@@ -74,6 +74,7 @@ def terminating_as_interrupted() -> Iterator[None]:
 
     Examples
     --------
+    >>> previous = signal.signal(signal.SIGTERM, signal.SIG_DFL)  # as in a new Python
     >>> with terminating_as_interrupted():
     ...     try:
     ...         signal.raise_signal(signal.SIGTERM)
@@ -82,6 +83,7 @@ def terminating_as_interrupted() -> Iterator[None]:
     ended as on Ctrl-C
     >>> signal.getsignal(signal.SIGTERM) == signal.SIG_DFL
     True
+    >>> _ = signal.signal(signal.SIGTERM, previous)
     """
     if threading.current_thread() is not threading.main_thread():
         yield
