@@ -22,11 +22,34 @@ threads of its own, and the BLAS library's threads, started when numpy is import
 command does is large linear algebra."""
 
 
+EXIT_TERMINATED = 143  # grazing.cli.common.EXIT_TERMINATED
+
+
+class _Terminated(KeyboardInterrupt):
+    """SIGTERM while importing (grazing.engine.interrupts.Terminated is not imported yet)."""
+
+
+def _raise_terminated(_signum: int, _frame: object) -> None:
+    raise _Terminated
+
+
 def main() -> int:
-    """Import the command line and run it; a Ctrl-C while importing is one line."""
+    """Import the command line and run it; a Ctrl-C or a SIGTERM while importing is one line."""
+    import signal
+
     os.environ.setdefault("OPENBLAS_NUM_THREADS", BLAS_THREADS)  # (before numpy is imported)
+    default_term = signal.getsignal(signal.SIGTERM) == signal.SIG_DFL
     try:
-        from grazing.cli import main as run
+        if default_term:
+            signal.signal(signal.SIGTERM, _raise_terminated)
+        try:
+            from grazing.cli import main as run
+        finally:
+            if default_term:  # (grazing.cli.main installs its own)
+                signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    except _Terminated:
+        print("grazing: terminated", file=sys.stderr)  # (cli.terminated_line)
+        return EXIT_TERMINATED
     except KeyboardInterrupt:
         print(
             ("\n" if sys.stderr.isatty() else "") + "grazing: interrupted", file=sys.stderr

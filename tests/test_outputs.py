@@ -3,9 +3,11 @@ it is never replaced (unless asked), symbolic links are followed, and a full dis
 
 from __future__ import annotations
 
+import hashlib
 import io
 import json
 import os
+import re
 import struct
 import zlib
 
@@ -145,6 +147,33 @@ def _edit_netcdf_in_place(path):
         f["period"][0] = 99
 
 
+def _add_attribute_with_h5py(path):
+    """The data untouched: a note added (issue 43: the mark covered the data only)."""
+    import h5py
+
+    with h5py.File(path, "r+") as f:
+        f.attrs["note"] = "checked by hand"
+
+
+def _change_a_variable_attribute(path):
+    import h5py
+
+    with h5py.File(path, "r+") as f:
+        f["period"].attrs["long_name"] = "my own name"
+
+
+def _add_a_group(path):
+    import h5py
+
+    with h5py.File(path, "r+") as f:
+        f.create_group("mine").attrs["x"] = 1
+
+
+def _append_a_byte(path):
+    with open(path, "ab") as fh:
+        fh.write(b"\0")
+
+
 CHANGES = [
     ("csv", _edit_csv),
     ("csv", _append_csv),
@@ -152,6 +181,11 @@ CHANGES = [
     ("png", _repaint_png),
     ("nc", _subset_netcdf),
     ("nc", _edit_netcdf_in_place),
+    ("nc", _add_attribute_with_h5py),
+    ("nc", _change_a_variable_attribute),
+    ("nc", _add_a_group),
+    ("nc", _append_a_byte),
+    ("nc groups", _append_a_byte),
 ]
 
 
@@ -211,6 +245,11 @@ def test_a_netcdf_file_reads_back_with_its_data_and_the_mark(tmp_path):
         xr.testing.assert_identical(back.drop_attrs(), ds.drop_attrs())
         assert back.attrs["written_by"].startswith("grazing ") and back.attrs["params"] == "eta"
     assert "written_by" not in ds.attrs  # the caller's dataset is not changed
+    # the mark's digest is of the whole file, with its own 64 digits as zeros (an independent hash here)
+    data = path.read_bytes()
+    digest = re.fullmatch(r"grazing \S+ \(sha256 of the file: ([0-9a-f]{64})\)", back.attrs["written_by"])[1]
+    assert data.count(digest.encode()) == 1
+    assert hashlib.sha256(data.replace(digest.encode(), b"0" * 64)).hexdigest() == digest
 
 
 # --------------------------------------------------------------------------

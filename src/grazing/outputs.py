@@ -4,7 +4,7 @@ Every file grazing writes says so, together with a SHA-256 digest of what it hol
 
 ==========  ===========================================================================
 CSV         a last line ``# written by grazing X.Y.Z (sha256 of the lines above: …)``
-NetCDF      the global attribute ``written_by``: ``grazing X.Y.Z (sha256 of the data: …)``
+NetCDF      the global attribute ``written_by``: ``grazing X.Y.Z (sha256 of the file: …)``
 PNG         the text chunk ``Software``: ``grazing X.Y.Z (sha256 of the image: …)``
 JSON        the key ``written_by``: ``grazing X.Y.Z (sha256 of the other keys: …)``
 ==========  ===========================================================================
@@ -12,7 +12,11 @@ JSON        the key ``written_by``: ``grazing X.Y.Z (sha256 of the other keys: �
 A file is grazing's (:func:`written_by_grazing`) when its mark is there and its
 digest matches what the file holds: a file changed after grazing wrote it
 (edited by hand, appended to, re-saved by a program that kept the attribute) is
-no longer grazing's.
+no longer grazing's.  A NetCDF file's digest is of every byte of the file (its
+own 64 digits read as zeros), so any change to it counts, however it was made:
+an attribute or a group added with h5py, a byte appended.  (A NetCDF file of an
+earlier grazing, whose mark covered its data only, is no longer taken for
+grazing's: it is refused unless ``overwrite`` is given.)
 
 Before a file is written, :func:`check_replaceable` refuses to replace a file
 that is not grazing's, with a one-line :class:`~grazing.errors.ForeignFileError`,
@@ -62,7 +66,7 @@ from pathlib import Path
 from typing import Any
 
 from grazing.atomic import resolved, write_bytes_atomic, write_text_atomic
-from grazing.errors import ForeignFileError
+from grazing.errors import ForeignFileError, WriteError
 
 MARK_KEY = "written_by"
 """The NetCDF global attribute and the JSON key that hold the mark."""
@@ -409,34 +413,33 @@ def write_png_bytes(
 # NetCDF
 
 
-def _hdf5_digest(h5: Any) -> str:
-    """SHA-256 of every dataset of an open HDF5 file: its name, type, shape and values."""
-    import h5py
-    import numpy as np
+FILE_DIGEST_WHAT = "the file"
+"""What a NetCDF file's mark says its digest is of: the whole file, the digest's own 64 digits as zeros."""
 
-    names: list[str] = []
-    h5.visititems(lambda name, obj: names.append(name) if isinstance(obj, h5py.Dataset) else None)
+_PLACEHOLDER = b"0" * 64
+_FILE_MARK = re.compile(rb"grazing \S+ \(sha256 of the file: ([0-9a-f]{64})\)")
+
+
+def _file_digest(data: Any, at: int) -> str:
+    """SHA-256 of the bytes ``data`` with the 64 bytes from ``at`` (the digest's place) read as zeros."""
     sha = hashlib.sha256()
-    for name in sorted(names):
-        d = h5[name]
-        sha.update(f"{name}\0{d.dtype.str}\0{d.shape}\0".encode())
-        values = d[()]
-        if isinstance(values, h5py.Empty):
-            continue
-        values = np.asarray(values)
-        if values.dtype.kind == "O":
-            sha.update(b"\0".join(v if isinstance(v, bytes) else str(v).encode() for v in values.ravel()))
-        else:
-            sha.update(np.ascontiguousarray(values).tobytes())
+    with memoryview(data) as view:
+        sha.update(view[:at])
+        sha.update(_PLACEHOLDER)
+        sha.update(view[at + len(_PLACEHOLDER) :])
     return sha.hexdigest()
 
 
 def _netcdf_is_ours(fh: Any) -> bool:
-    import h5py
+    """Whether an HDF5 file's bytes hold exactly one mark whose digest is that of the whole file."""
+    import mmap
 
-    with h5py.File(fh, "r") as h5:  # (a file object: no HDF5 file locking, which some mounts lack)
-        digest = _digest_of_mark(h5.attrs.get(MARK_KEY, ""))
-        return digest is not None and _hdf5_digest(h5) == digest
+    with mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as data:
+        marks = _FILE_MARK.finditer(data)
+        first = next(marks, None)
+        if first is None or next(marks, None) is not None:  # (two marks: which one would be the file's?)
+            return False
+        return _file_digest(data, first.start(1)) == first.group(1).decode()
 
 
 def netcdf_bytes(data: Any, *, compress: bool = False) -> memoryview:
@@ -458,9 +461,15 @@ def netcdf_bytes(data: Any, *, compress: bool = False) -> memoryview:
             ds = ds.copy(deep=False)
             del ds.attrs[MARK_KEY]
         ds.to_netcdf(buf, mode="w" if i == 0 else "a", group=group, engine="h5netcdf", encoding=enc)
-    with h5py.File(buf, "r+") as h5:
-        h5.attrs[MARK_KEY] = mark_text("the data", _hdf5_digest(h5))
-    return buf.getbuffer()
+    with h5py.File(buf, "r+") as h5:  # (a variable-length string: its bytes lie as they are in the file)
+        h5.attrs[MARK_KEY] = mark_text(FILE_DIGEST_WHAT, _PLACEHOLDER.decode())
+    data = buf.getbuffer()
+    places = [m.start(1) for m in _FILE_MARK.finditer(data)]
+    if len(places) != 1:  # pragma: no cover - a dataset whose own text holds a mark of grazing's
+        raise WriteError("the dataset's text holds grazing's mark already; it was not written")
+    at = places[0]
+    data[at : at + len(_PLACEHOLDER)] = _file_digest(data, at).encode()
+    return data
 
 
 def write_netcdf(

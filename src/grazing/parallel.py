@@ -15,7 +15,9 @@ worker runs :func:`init_worker`, and then
   within :data:`WATCH_INTERVAL` seconds of the parent's death;
 - ignores SIGINT (where the parent stops its workers itself on Ctrl-C): Ctrl-C in
   a terminal reaches the whole process group, and the parent, not each worker,
-  decides what to cancel.
+  decides what to cancel;
+- takes SIGTERM's default action back (the command's handler, which ends it as
+  Ctrl-C does, is the parent's).
 """
 
 from __future__ import annotations
@@ -86,6 +88,8 @@ def init_worker(parent_pid: int, ignore_sigint: bool = True) -> None:
     """
     if ignore_sigint:
         signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if signal.getsignal(signal.SIGTERM) != signal.SIG_DFL:  # (the command's own, forked: a pool's end
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)  # of its workers by SIGTERM ends them)
     set_parent_death_signal()
     if os.getppid() != parent_pid:  # the parent died before the request took effect
         os._exit(1)

@@ -116,3 +116,107 @@ def test_the_command_runs_one_blas_thread_unless_told_otherwise():
     env["OPENBLAS_NUM_THREADS"] = "2"  # (a user's setting stays)
     out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env, check=True)
     assert out.stdout.splitlines()[-1] == "2 True"
+
+
+# --------------------------------------------------------------------------
+# issue 43: SIGTERM is handled as Ctrl-C is; a compile does not hold up Ctrl-C; what a killed or failed
+# run made is not left behind
+
+TERMINATED = {
+    "simulate": LONG_RUNNING["simulate"],  # (in the compiled driver: its signal counter)
+    "sweep": LONG_RUNNING["sweep"],  # (threads)
+    "map": LONG_RUNNING["map"],  # (a NetCDF file at the end)
+    "synthesize into a folder": ["synthesize", "--eta", "0.446", "--eta", "0.45", "--transient", "10000000",
+                                 "--periods", "8", "--out", "recs"],  # (a hidden folder beside it)
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("name", list(TERMINATED))
+def test_sigterm_ends_the_command_as_ctrl_c_does_with_143(name, warm, tmp_path):
+    # (``kill PID``: to the process only, not its group)
+    proc = subprocess.Popen([*ENTRY, *TERMINATED[name]], cwd=tmp_path, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)  # fmt: skip
+    try:
+        time.sleep(2.0)
+        assert proc.poll() is None, proc.communicate()
+        proc.terminate()
+        out, err = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert (proc.returncode, err, out) == (143, "grazing: terminated\n", "")
+    assert list(tmp_path.iterdir()) == []  # its temporaries removed
+
+
+def test_sigterm_while_the_command_line_is_imported():
+    """The console script's own handler until grazing.cli's: one line and 143 at any moment."""
+    script = (
+        "import signal, sys, _grazing_entry\n"
+        "sys.modules.pop('grazing.cli', None)\n"
+        "class Finder:\n"
+        "    def find_spec(self, name, *args):\n"
+        "        if name == 'grazing.cli':\n"
+        "            signal.raise_signal(signal.SIGTERM)\n"
+        "sys.meta_path.insert(0, Finder())\n"
+        "sys.exit(_grazing_entry.main())\n"
+    )
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=False)
+    assert (done.returncode, done.stderr) == (143, "grazing: terminated\n")
+
+
+def test_a_folder_left_by_a_killed_synthesize_is_removed_by_the_next_run(warm, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    dead = tmp_path / ".recs.partial-999999999-abc123"  # (a PID above any system's pid_max: gone)
+    dead.mkdir()
+    (dead / "p40_eta0.44600.csv").write_text("time,angle\n")
+    (dead / ".p40_eta0.44600.csv.x1y2.tmp").write_text("")
+    alive = tmp_path / f".recs.partial-{os.getpid()}-def456"  # (a running process's: left alone)
+    alive.mkdir()
+    argv = ["synthesize", "--eta", "0.446", "--eta", "0.45", "--periods", "8", "--transient", "2", "--out",
+            "recs"]  # fmt: skip
+    assert main(argv) == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == [alive.name, "recs"]
+
+
+def test_a_report_whose_folder_cannot_be_marked_leaves_no_folder(tmp_path):
+    """A full disk: "nothing was written", and the new folder it made is gone too."""
+    from tests.processes import limit_file_size
+
+    done = subprocess.run(
+        [*ENTRY, "report", "--only", "eq", "--out", "rep"], cwd=tmp_path, capture_output=True, text=True,
+        timeout=300, check=False, preexec_fn=lambda: limit_file_size(0),
+    )  # fmt: skip
+    assert (done.returncode, done.stderr) == (
+        1, "grazing: error: cannot write rep/.grazing-report: File too large; nothing was written\n"
+    )  # fmt: skip
+    assert list(tmp_path.iterdir()) == []
+
+
+CONSOLE = [sys.executable, "-c", "from _grazing_entry import console; console()"]
+"""The ``grazing`` console script, as installed (it ends by ``quick_exit``)."""
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("after", [3.0, 8.0])
+def test_ctrl_c_during_the_first_compile_ends_the_command_within_a_second(after, tmp_path):
+    """The sweep's driver compiles (about 40 s) in a thread of its own; Ctrl-C ended the command only when
+    the compile had: 35-40 s late."""
+    env = {**os.environ, "GRAZING_CACHE_DIR": str(tmp_path / "cache")}
+    argv = ["sweep", "--param", "eta", "--start", "0.44", "--stop", "0.45", "--num", "3", "--periods", "5",
+            "--json"]  # fmt: skip
+    proc = subprocess.Popen(
+        [*CONSOLE, *argv], cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
+        start_new_session=True, preexec_fn=_default_sigint,
+    )  # fmt: skip
+    try:
+        time.sleep(after)
+        assert proc.poll() is None, proc.communicate()
+        os.killpg(proc.pid, signal.SIGINT)
+        sent = time.monotonic()
+        out, err = proc.communicate(timeout=120)
+        took = time.monotonic() - sent
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert (proc.returncode, err, out) == (130, "grazing: interrupted\n", "")
+    assert took < 1.0, took

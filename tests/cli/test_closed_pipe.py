@@ -65,3 +65,39 @@ def test_a_broken_pipe_that_is_not_the_output_is_an_error_line(monkeypatch, caps
 def test_output_closed_is_false_for_a_file(tmp_path):
     with open(tmp_path / "out.txt", "w") as fh:
         assert not output_closed(fh.fileno())
+
+
+# issue 43: with PYTHONUNBUFFERED=1 (which users set), Python's standard output has no buffer, and a write
+# that the system takes only a part of lost the rest without an error: status 0 after ``| head -c 100``,
+# and a truncated file with status 0 on a full disk.
+UNBUFFERED = {**os.environ, "PYTHONUNBUFFERED": "1"}
+LARGE = {
+    "simulate": ["simulate", "--periods", "20000", "--transient", "10", "--json"],
+    "sweep": "sweep --param eta --start .44 --stop .45 --num 2000 --periods 10 --transient 1 --json".split(),
+}  # (over a megabyte and 500 kB of JSON: more than a pipe holds)
+
+
+@pytest.mark.parametrize("name", list(LARGE))
+def test_a_reader_that_leaves_after_a_few_bytes_ends_the_command_with_141(name):
+    proc = subprocess.Popen([*CONSOLE, *LARGE[name]], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            env=UNBUFFERED)  # fmt: skip
+    try:
+        assert len(proc.stdout.read(100)) == 100  # (as head -c 100)
+        proc.stdout.close()
+        err = proc.stderr.read().decode()
+        proc.wait(timeout=300)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert (proc.returncode, err) == (EXIT_CLOSED_PIPE, "")
+
+
+def test_a_full_disk_under_the_standard_output_is_one_line_and_status_1(tmp_path):
+    from tests.processes import limit_file_size
+
+    with open(tmp_path / "out.json", "wb") as out:
+        done = subprocess.run(
+            [*CONSOLE, *LARGE["simulate"]], stdout=out, stderr=subprocess.PIPE, timeout=300, env=UNBUFFERED,
+            preexec_fn=lambda: limit_file_size(100_000), check=False,
+        )  # fmt: skip
+    assert (done.returncode, done.stderr.decode()) == (1, "grazing: error: File too large\n")

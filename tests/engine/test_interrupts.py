@@ -63,6 +63,37 @@ def test_ctrl_c_stops_a_long_run_inside_the_driver(name, make, x0, default_sigin
     np.testing.assert_array_equal(again.samples, fresh.samples)
 
 
+@pytest.fixture
+def default_sigterm():
+    """SIGTERM's default action, as in a new interpreter (a test runner's worker may have a handler)."""
+    previous = signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    yield
+    signal.signal(signal.SIGTERM, previous)
+
+
+def test_sigterm_stops_a_long_run_inside_the_driver_as_terminated(default_sigint, default_sigterm):
+    """issue 43: under the command line's SIGTERM handler the driver counts SIGTERM too, and the caller
+    raises Terminated (a KeyboardInterrupt: the same clean-up), not a plain KeyboardInterrupt."""
+    model = grazing.models.pendulum("B", eta=0.446, theta_hat=math.radians(40))
+    runner = Runner(model, np.zeros(2))
+    with interrupts.terminating_as_interrupted():
+        timer = threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGTERM))
+        timer.start()
+        start = time.monotonic()
+        try:
+            with pytest.raises(interrupts.Terminated):
+                runner.advance(LONG, 1)
+        finally:
+            timer.cancel()
+        assert time.monotonic() - start < 60.0
+        assert signal.getsignal(signal.SIGTERM) is interrupts.raise_terminated  # (back after the call)
+        with pytest.raises(KeyboardInterrupt) as caught:  # (a SIGINT after it is a Ctrl-C again)
+            timer = _sigint_after(0.5)
+            runner.advance(LONG, 1)
+        assert type(caught.value) is KeyboardInterrupt
+    assert signal.getsignal(signal.SIGTERM) == signal.SIG_DFL
+
+
 def test_a_handler_of_the_program_is_kept_and_runs_after_the_call(default_sigint):
     # A program with a SIGINT handler of its own: the run is not cut short, the handler runs once.
     model = grazing.models.pendulum("B", eta=0.446, theta_hat=math.radians(40))

@@ -78,8 +78,12 @@ def test_an_unusable_grazing_cache_dir_is_refused_in_one_line(tmp_path, monkeypa
         monkeypatch.setenv("GRAZING_CACHE_DIR", str(value))
         with pytest.raises(WriteError, match=f"GRAZING_CACHE_DIR={value} cannot hold the compiled kernels"):
             codegen._cached_file("x.bin", lambda: b"x")
+    # issue 43: a missing nested path is a typo more often than a wish: its parents are not made
+    monkeypatch.setenv("GRAZING_CACHE_DIR", str(tmp_path / "new" / "cache"))
+    with pytest.raises(WriteError, match=f"its folder '{tmp_path / 'new'}' does not exist"):
+        codegen._cached_file("x.bin", lambda: b"x")
     assert blocker.read_text() == "mine" and sorted(p.name for p in tmp_path.iterdir()) == ["a-file"]
-    monkeypatch.setenv("GRAZING_CACHE_DIR", str(tmp_path / "new" / "cache"))  # missing: made
+    monkeypatch.setenv("GRAZING_CACHE_DIR", str(tmp_path / "cache"))  # missing, in a folder that is: made
     assert codegen._cached_file("x.bin", lambda: b"x").read_bytes() == b"x"
 
 

@@ -75,6 +75,35 @@ def test_a_batch_that_cannot_be_built_stops_the_threads():
     assert alive == []
 
 
+def test_a_stopped_stream_does_not_wait_for_a_batch_being_built():
+    """issue 43: a batch being built when the consumer stops (Ctrl-C during the driver's first compile,
+    which nothing interrupts: half a minute) is not waited for; its daemon thread finishes it alone."""
+    import time
+
+    spec = sweep_spec(pendulum("B"), "eta", np.linspace(0.44, 0.49, 4), settings=SweepSettings(
+        fresh=True, chunk_size=2, transient=20, periods=6))  # fmt: skip
+    building, release = threading.Event(), threading.Event()
+
+    def long_compile() -> LaneBatch:
+        building.set()
+        release.wait(60)
+        return LaneBatch([(spec, 1)])
+
+    stream = stream_batches([functools.partial(LaneBatch, [(spec, 0)]), long_compile], 2)
+    try:
+        assert next(stream)[:2] == (0, 0)
+        assert building.wait(30)
+        start = time.monotonic()
+        stream.close()  # (as a KeyboardInterrupt in the consumer's loop)
+        assert time.monotonic() - start < 1.0
+        alive = [t for t in threading.enumerate() if t.name.startswith(("grazing-sweep", "grazing-batch"))]
+        assert [(t.name, t.daemon) for t in alive] == [("grazing-batch", True)]  # (the one building)
+    finally:
+        release.set()
+    for t in alive:
+        t.join(60)
+
+
 @pytest.mark.parametrize("fresh", [True, False])
 def test_the_dataset_is_prepared_while_the_cores_compute(fresh, monkeypatch):
     """issue 29: what a sweep's dataset needs besides its results (xarray, the dask it asks about, the

@@ -18,12 +18,16 @@ from grazing.cli.common import (
     EXIT_CLOSED_PIPE,
     EXIT_FAILURE,
     EXIT_INTERRUPTED,
+    EXIT_TERMINATED,
     EXIT_USAGE,
+    buffered_stdout,
     discard_output,
     error_line,
+    flush_or_discard_output,
     output_closed,
 )
 from grazing.cli.limits import MEMORY_ENV
+from grazing.engine.interrupts import Terminated, terminating_as_interrupted
 from grazing.errors import GrazingError
 
 __all__ = ["COMMANDS", "cli", "main"]
@@ -94,24 +98,36 @@ def interrupted_line() -> None:
     click.echo(("\n" if sys.stderr.isatty() else "") + "grazing: interrupted", err=True)
 
 
+def terminated_line() -> None:
+    """Say on stderr that the command was ended by SIGTERM, in one line."""
+    click.echo("grazing: terminated", err=True)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI; every error becomes one line on stderr and an exit status.
 
     Output to a pipe whose reader has gone (``grazing sweep --json | head``)
     ends the command without a message, with status 141
     (:data:`~grazing.cli.common.EXIT_CLOSED_PIPE`), as a Unix tool ends.
+    SIGTERM ends it as Ctrl-C does (its temporaries removed, its workers
+    stopped), with one line and status 143
+    (:data:`~grazing.cli.common.EXIT_TERMINATED`).
 
     Without arguments it prints the help, as ``grazing --help`` does.
     """
     import sys
 
     args = list(sys.argv[1:] if argv is None else argv) or ["--help"]
+    buffered_stdout()
     try:
         # (not cli.main: on Ctrl-C it writes an empty line to stderr, whatever stderr is)
-        with cli.make_context("grazing", args) as ctx:
+        with terminating_as_interrupted(), cli.make_context("grazing", args) as ctx:
             cli.invoke(ctx)
     except click.exceptions.Exit as exc:
         return int(exc.exit_code)
+    except Terminated:
+        terminated_line()
+        return EXIT_TERMINATED
     except (click.exceptions.Abort, KeyboardInterrupt, EOFError):
         interrupted_line()
         return EXIT_INTERRUPTED
@@ -126,6 +142,7 @@ def main(argv: list[str] | None = None) -> int:
             discard_output()
             return EXIT_CLOSED_PIPE
         error_line(f"{exc.strerror or exc}: {exc.filename or ''}".rstrip(": "))
+        flush_or_discard_output()  # (the standard output on a full disk: said once)
         return EXIT_FAILURE
     except MemoryError:
         error_line(f"out of memory (the estimate before the run was too low; {MEMORY_ENV} lowers the bound)")

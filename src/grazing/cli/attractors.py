@@ -18,6 +18,7 @@ from grazing.cli.common import (
     Progress,
     check_folder,
     check_out,
+    check_span,
     emit_json,
     json_option,
     model_options,
@@ -27,6 +28,7 @@ from grazing.cli.common import (
     parse_pair,
     refuse_varied,
     save_dataset,
+    spaced_values,
 )
 from grazing.cli.limits import basin_bytes, check_memory, count_text
 from grazing.cli.validate import FINITE, TOLERANCE, WORKERS, Number, count, path_type, refuse_unused
@@ -191,6 +193,8 @@ def _grid(
 
     xr_ = parse_pair(x_range, "--x-range", "LO,HI")
     yr_ = parse_pair(y_range, "--y-range", "LO,HI")
+    check_span(*xr_, "--x-range")
+    check_span(*yr_, "--y-range")
     n = _counts(num, num_option)
     names = [s.strip() for s in states.split(",")]
     if len(names) != 2 or not all(names):
@@ -459,10 +463,8 @@ def attractors_cmd(
         num == 1 and stop != start,
         f"with --num 1 (its one value is --start {start:g}: give the same value to both, or --num 2 or more)",
     )
-    shown = np.linspace(start, stop, num)
-    values = np.array([par.from_display(v) for v in shown])
-    for v in (values[0], values[-1]):
-        model.with_params(**{par.name: float(v)})
+    for v in (start, stop):  # (the ends' values, before the --num values are made: after the check below)
+        model.with_params(**{par.name: par.from_display(v)})
     grid = _grid(model, x_range, y_range, num_grid, "--num-grid", states, fixed, phase)
     _check_outputs(out, plot, overwrite, False, zarr_ok=False)
     need = basin_bytes(
@@ -476,9 +478,11 @@ def attractors_cmd(
     )
     check_memory(
         need,
-        f"{num} basins of {count_text(grid.size)} initial states",
+        f"{count_text(num)} basins of {count_text(grid.size)} initial states",
         "use a coarser grid (--num-grid) or fewer values",
     )
+    shown = spaced_values(start, stop, num, "--start/--stop")
+    values = np.array([par.from_display(v) for v in shown])
     settings = _settings(transient, periods, phase, refine, no_lyapunov, tol, BASIN_CHUNK)
     bar = Progress("attractors", enabled=not as_json, unit="values")
     t0 = time.perf_counter()

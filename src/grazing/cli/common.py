@@ -45,6 +45,8 @@ PENDULUM_UNFOLDING = ("eta", "theta_hat")
 EXIT_USAGE = 2
 EXIT_FAILURE = 1
 EXIT_INTERRUPTED = 130
+EXIT_TERMINATED = 143
+"""A command ended by SIGTERM (128 + 15), after the same clean-up as on Ctrl-C."""
 EXIT_CLOSED_PIPE = 141
 """A command whose output's reader went away (``grazing sweep --json | head``): 128 + SIGPIPE, the status
 of a Unix tool ended by that signal, and no message (nothing failed that the user asked for)."""
@@ -84,9 +86,10 @@ def run_user_code(failed: str, call: Callable[[], Any]) -> Any:
     """``call()``, the user's code (a model file, its model function), as one line if it fails.
 
     What it prints to stdout goes to stderr (stdout stays clean for ``--json``);
-    any exception it raises, or a ``sys.exit``, becomes an :class:`InputError`
+    any exception it raises (any :class:`BaseException`: a ``GeneratorExit`` raised
+    at the top of a file too), or a ``sys.exit``, becomes an :class:`InputError`
     starting with ``failed`` (``"--model: m.py failed to load"``) that shows the
-    start of what it printed.  ``KeyboardInterrupt`` passes (Ctrl-C).
+    start of what it printed.  ``KeyboardInterrupt`` passes (Ctrl-C, SIGTERM).
     """
     import contextlib
     import io
@@ -97,10 +100,12 @@ def run_user_code(failed: str, call: Callable[[], Any]) -> Any:
             result = call()
     except SystemExit as exc:
         reason = "it called sys.exit()" if exc.code is None else f"it called sys.exit({exc.code!r})"
+    except KeyboardInterrupt:
+        raise
     except grazing.GrazingError as exc:
         reason = str(exc)
-    except Exception as exc:  # the user's code: any error is theirs, reported in one line
-        reason = f"{type(exc).__name__}: {exc}"
+    except BaseException as exc:  # the user's code: anything it raises is theirs, reported in one line
+        reason = f"{type(exc).__name__}: {exc}".rstrip(": ")
     else:
         if printed.getvalue():
             click.echo(printed.getvalue(), err=True, nl=False)
@@ -387,6 +392,26 @@ def parse_pair(
     return a, b
 
 
+def spaced_values(start: float, stop: float, num: int, options: str) -> np.ndarray:
+    """``num`` values evenly spaced from ``start`` to ``stop`` (``np.linspace``); one line where the span
+    between them overflows (``--start -1e308 --stop 1e308``), which numpy would warn about.
+
+    Examples
+    --------
+    >>> spaced_values(0.0, 1.0, 3, "--start/--stop").tolist()
+    [0.0, 0.5, 1.0]
+    """
+    check_span(start, stop, options)
+    return np.linspace(start, stop, num)
+
+
+def check_span(lo: float, hi: float, options: str) -> None:
+    """One line if the distance from ``lo`` to ``hi`` is no finite float (a range or grid of them would
+    overflow)."""
+    if not math.isfinite(hi - lo):
+        raise InputError(f"{options}: the range from {lo:g} to {hi:g} is wider than floats can hold")
+
+
 class Progress:
     """A progress bar on stderr that appears only if the work lasts over a second."""
 
@@ -644,6 +669,39 @@ def output_closed(fd: int = 1) -> bool:
     poller = select.poll()
     poller.register(fd, 0)  # (no events asked: errors and hang-ups are reported anyway)
     return any(event & (select.POLLERR | select.POLLHUP | select.POLLNVAL) for _, event in poller.poll(0))
+
+
+def buffered_stdout() -> None:
+    """Give the standard output back a buffer where ``PYTHONUNBUFFERED`` (``python -u``) took it away.
+
+    Unbuffered, Python writes the standard output straight to its file
+    descriptor, and a ``write`` that the system takes only a part of (a pipe
+    whose reader has left after a few bytes, a disk that filled up) loses the
+    rest without an error: ``grazing simulate --json | head -c 100`` ended
+    with status 0, ``> full-disk/out.json`` left a truncated file and status
+    0.  A buffered writer writes everything or raises the error.  It is
+    flushed at every line (and by every command after what it prints), so the
+    output comes as promptly as unbuffered.  Nothing is changed where the
+    standard output has a buffer already, or is no file (a test's capture).
+    """
+    import io
+
+    stream = sys.stdout
+    raw = getattr(stream, "buffer", None)
+    if not isinstance(raw, io.RawIOBase):
+        return
+    stream.flush()
+    writer = io.BufferedWriter(io.FileIO(raw.fileno(), "w", closefd=False))
+    sys.stdout = io.TextIOWrapper(writer, encoding=stream.encoding, errors=stream.errors, line_buffering=True)
+
+
+def flush_or_discard_output() -> None:
+    """Flush the standard output; where it cannot take what is left (a full disk), drop that instead (the
+    error has been said: the flush at the process's end must not report it again, in several lines)."""
+    try:
+        sys.stdout.flush()
+    except (OSError, ValueError):
+        discard_output()
 
 
 def discard_output() -> None:

@@ -123,7 +123,7 @@ def curve(
         model.with_params(**{p1.name: v})
     lo, hi = _range(prange, p2, model)
     check_out(out, ".nc", overwrite=overwrite)
-    x0 = parse_state(initial, model.with_params(**{p1.name: a})) if initial else None
+    x0 = parse_state(initial, model.with_params(**{p1.name: a})) if initial is not None else None
     bars = {"branch": Progress("continuing", enabled=not as_json),
             "curve": Progress("following the curve", enabled=not as_json)}  # fmt: skip
     seen = [model.params[p2.name]] * 2

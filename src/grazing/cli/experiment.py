@@ -629,17 +629,22 @@ def _synthesize_folder(out: Path, theta_hat: float, etas: tuple[float, ...], **k
     ``out`` (or the hidden folder renamed to ``out`` if it did not exist), so a
     failure part-way leaves nothing behind.  The files they replace in ``out``
     were checked before (grazing's, or ``--overwrite``); a symbolic link there
-    is followed.
+    is followed.  The hidden folder is named with the process's PID: one left
+    by a process killed outright (SIGKILL) is removed by the next run.
     """
     import shutil
     import tempfile
 
-    from grazing.atomic import rename_noreplace, resolved, write_bytes_atomic
+    from grazing.atomic import remove_dead_folders, rename_noreplace, resolved, write_bytes_atomic
     from grazing.errors import WriteError
     from grazing.experiment.synthetic import synthetic_sweep
 
     parent = out.parent if str(out.parent) else Path(".")
-    tmp = Path(tempfile.mkdtemp(dir=parent, prefix=f".{out.name}.partial-"))
+    prefix = f".{out.name}.partial-"
+    remove_dead_folders(
+        parent, prefix, lambda f: all(p.is_file() and not p.is_symlink() for p in f.iterdir())
+    )
+    tmp = Path(tempfile.mkdtemp(dir=parent, prefix=f"{prefix}{os.getpid()}-"))
     try:
         written = synthetic_sweep(tmp, theta_hat, etas, **kwargs)
         if out.is_dir():

@@ -206,10 +206,13 @@ def basin_bytes(
     """Memory of ``basins`` and ``attractors``: per initial state (state, labels), and the chunks in flight.
 
     The end states are classified chunk by chunk, so only the chunks in flight hold samples; the
-    labels of every parameter value (``values``) are kept.
+    labels of every parameter value (``values``) are kept, and each value's own row
+    (:data:`POINT_OVERHEAD`: the value, its attractors' rows, its JSON).
     """
     per_point = BASIN_POINT + 3 * n_states * VALUE + (BASIN_JSON if as_json else 0)
     flight = float(chunk_points) * (2 * workers + 2) * periods * n_states * VALUE * 2
-    return float(n_points) * (per_point + 4 * (values - 1)) + min(
-        flight, float(n_points) * periods * n_states * 16
+    return (
+        float(n_points) * (per_point + 4 * (values - 1))
+        + min(flight, float(n_points) * periods * n_states * 16)
+        + (float(values) * POINT_OVERHEAD if values > 1 else 0.0)
     )

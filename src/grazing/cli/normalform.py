@@ -10,6 +10,7 @@ import numpy as np
 import grazing
 from grazing.cli.common import (
     PENDULUM_UNFOLDING,
+    InputError,
     complex_list,
     emit_json,
     json_option,
@@ -58,8 +59,11 @@ def normal_form_cmd(
     """Grazing normal form at a grazing of the period-1 orbit: multipliers, the
     discontinuity map's coefficients and the predicted scenario past grazing."""
     from grazing.normalform import find_grazing_point, normal_form_at, observe, predict
+    from grazing.normalform.discontinuity import no_contact_direction
 
     stop = stop_option_index(model, stop_name)
+    if model.symbolic.stops[stop].contact_direction is None:  # (before the search, not after it)
+        raise InputError(f"--model: {no_contact_direction(model, stop)}")
     par, lo, hi, pendulum = search_range(model, "normal-form", gparam, prange, eta_min, eta_max)
     x0 = range_start_state(initial, model, {par.name: lo})
     point = find_grazing_point(model, par.name, lo, hi, which, stop_name=stop, x0=x0)

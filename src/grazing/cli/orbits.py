@@ -384,7 +384,11 @@ def continue_(
             if not ANGLE_DEG.accepts(v):
                 raise InputError(f"{opt} for theta-hat must be {ANGLE_DEG.describe()}, got {v:g}")
     check_out(out, ".nc", overwrite=overwrite)
-    x0 = parse_state(initial, model.with_params(**{name: par.from_display(start)})) if initial else None
+    x0 = (
+        parse_state(initial, model.with_params(**{name: par.from_display(start)}))
+        if initial is not None
+        else None
+    )
     a, b = par.from_display(start), par.from_display(stop)
     for v in (a, b):  # both ends within the parameter's bounds, before any work ("r = 2 is outside [0, 1]")
         model.with_params(**{name: v})

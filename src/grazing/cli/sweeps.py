@@ -30,6 +30,7 @@ from grazing.cli.common import (
     parse_state,
     refuse_varied,
     save_dataset,
+    spaced_values,
 )
 from grazing.cli.limits import POINT_OVERHEAD, check_memory, count_text, sweep_bytes
 from grazing.cli.validate import FINITE, POSITIVE, TOLERANCE, WORKERS, count, path_type, refuse_unused
@@ -315,7 +316,7 @@ def sweep_cmd(
     _check_sweep_options(
         out, scheduler, chunk_size, runs * num, periods, n_states, workers, as_json, "a sweep", overwrite
     )
-    shown = np.linspace(start, stop, num)
+    shown = spaced_values(start, stop, num, "--start/--stop")
     vals = np.array([par.from_display(v) for v in shown])
     order = np.sort(vals) if direction != "down" else np.sort(vals)[::-1]
     x0 = parse_state(initial, model)
@@ -462,7 +463,8 @@ def map_cmd(
     chunk_size = num1 if chunk_size is None else chunk_size
     _check_sweep_options(out, scheduler, chunk_size, num1 * num2, periods, model.n_states, workers, as_json,
                          "a map", overwrite)  # fmt: skip
-    s1, s2 = np.linspace(start1, stop1, num1), np.linspace(start2, stop2, num2)
+    s1 = spaced_values(start1, stop1, num1, "--start1/--stop1")
+    s2 = spaced_values(start2, stop2, num2, "--start2/--stop2")
     v1 = np.array([par1.from_display(v) for v in s1])
     v2 = np.array([par2.from_display(v) for v in s2])
     v1, v2 = np.sort(v1), np.sort(v2)

@@ -13,9 +13,10 @@ once per machine and it calls the model's functions through their addresses
 (:mod:`grazing.engine.abi`).
 
 The cache directory is ``$GRAZING_CACHE_DIR`` if set, else
-``$XDG_CACHE_HOME/grazing`` (``~/.cache/grazing``); it is made if missing.  A
-``GRAZING_CACHE_DIR`` that cannot be used (not a folder, not writable) is an
-error of one line: you chose it.  Where the default folder cannot be used (a
+``$XDG_CACHE_HOME/grazing`` (``~/.cache/grazing``); it is made if missing
+(``GRAZING_CACHE_DIR``'s folder must exist: only the last level is made).  A
+``GRAZING_CACHE_DIR`` that cannot be used (not a folder, not writable, in a
+missing folder) is an error of one line: you chose it.  Where the default folder cannot be used (a
 read-only home), the kernels are cached in a private folder of the system's
 temporary folder instead, and one line on stderr says so.  Cache files are
 written all at once, after the compilation succeeded: a failed compilation or
@@ -297,10 +298,12 @@ def cache_dir() -> Path:
     return Path(base) / "grazing"
 
 
-def _unusable(folder: Path, private: bool = False) -> str | None:
-    """Why ``folder`` cannot hold the cache (made if missing), or None."""
+def _unusable(folder: Path, private: bool = False, parents: bool = True) -> str | None:
+    """Why ``folder`` cannot hold the cache (made if missing, with its parents if ``parents``), or None."""
+    if not parents and not os.path.lexists(folder) and not folder.parent.is_dir():
+        return f"its folder {str(folder.parent)!r} does not exist"
     try:
-        folder.mkdir(mode=0o700 if private else 0o777, parents=True, exist_ok=True)
+        folder.mkdir(mode=0o700 if private else 0o777, parents=parents, exist_ok=True)
     except OSError as exc:
         return exc.strerror or str(exc)
     if not folder.is_dir():
@@ -326,10 +329,11 @@ def usable_cache_dir() -> Path:
         default folder nor the private fallback in the temporary folder can.
     """
     folder = cache_dir()
-    problem = _unusable(folder)
+    chosen = bool(os.environ.get(CACHE_ENV))  # (a folder the user named is made, not its parents: a typo)
+    problem = _unusable(folder, parents=not chosen)
     if problem is None:
         return folder
-    if os.environ.get(CACHE_ENV):
+    if chosen:
         raise WriteError(
             f"{CACHE_ENV}={os.environ[CACHE_ENV]} cannot hold the compiled kernels ({problem}): set it to a "
             "writable folder, or unset it"

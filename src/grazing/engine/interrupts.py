@@ -16,6 +16,15 @@ The handler is installed only where Python's default handler is in place
 the main thread, on POSIX systems: a program with a SIGINT handler of its
 own keeps it, and its handler runs when the driver call returns, as before.
 
+SIGTERM (``kill``, a scheduler ending a job) ends a command as Ctrl-C does
+where :func:`terminating_as_interrupted` is in force (the command line):
+:func:`raise_terminated` raises :class:`Terminated`, a ``KeyboardInterrupt``,
+so that the same clean-up runs (temporaries removed, workers stopped) and the
+command ends with status 143 instead of 130.  Around a driver call it is
+counted by the same machine-code handler, which also keeps the number of the
+last signal (:data:`LAST_SIGNAL`): :func:`raise_if_interrupted` then raises
+:class:`Terminated`.
+
 Examples
 --------
 >>> import signal
@@ -43,7 +52,52 @@ from typing import Any
 import numpy as np
 
 SIGINTS = np.zeros(1, dtype=np.int64)
-"""How many SIGINTs the machine-code handler has seen in this process (only ever increased)."""
+"""How many SIGINTs (and SIGTERMs) the machine-code handler has seen in this process (only ever increased)."""
+
+LAST_SIGNAL = np.zeros(1, dtype=np.int64)
+"""The number of the last signal the machine-code handler counted (SIGINT or SIGTERM)."""
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM: the command ends as on Ctrl-C (the same clean-up), with its own status (143)."""
+
+
+def raise_terminated(_signum: int, _frame: object) -> None:
+    """The SIGTERM handler of :func:`terminating_as_interrupted`: raise :class:`Terminated`."""
+    raise Terminated
+
+
+@contextmanager
+def terminating_as_interrupted() -> Iterator[None]:
+    """Within the block, SIGTERM raises :class:`Terminated` (in the main thread, where SIGTERM's default
+    action is in place: a program with a handler of its own keeps it); the default is restored after.
+
+    Examples
+    --------
+    >>> previous = signal.signal(signal.SIGTERM, signal.SIG_DFL)  # as in a new Python
+    >>> with terminating_as_interrupted():
+    ...     try:
+    ...         signal.raise_signal(signal.SIGTERM)
+    ...     except Terminated:
+    ...         print("ended as on Ctrl-C")
+    ended as on Ctrl-C
+    >>> signal.getsignal(signal.SIGTERM) == signal.SIG_DFL
+    True
+    >>> _ = signal.signal(signal.SIGTERM, previous)
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.getsignal(signal.SIGTERM)
+    if previous != signal.SIG_DFL:
+        yield
+        return
+    signal.signal(signal.SIGTERM, raise_terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
 
 _SIGACTION_BYTES = 512
 """Room for a ``struct sigaction`` on every POSIX system (152 bytes on Linux x86-64)."""
@@ -63,6 +117,8 @@ def _handler_address() -> int:
         i64 = ir.IntType(64)
         fn = ir.Function(module, ir.FunctionType(ir.VoidType(), [ir.IntType(32)]), "grazing_count_sigint")
         builder = ir.IRBuilder(fn.append_basic_block())
+        last = builder.inttoptr(ir.Constant(i64, LAST_SIGNAL.ctypes.data), i64.as_pointer())
+        builder.store_atomic(builder.sext(fn.args[0], i64), last, "seq_cst", 8)  # (before the count moves)
         counter = builder.inttoptr(ir.Constant(i64, SIGINTS.ctypes.data), i64.as_pointer())
         builder.atomic_rmw("add", counter, ir.Constant(i64, 1), "seq_cst")
         builder.ret_void()
@@ -90,18 +146,21 @@ def _sigaction() -> Any:
     return _state["sigaction"]
 
 
-def _counting_applies() -> bool:
-    return (
-        threading.current_thread() is threading.main_thread()
-        # (signal.getsignal's value, without its 2 us of trying the handler as an enum member)
-        and _signal.getsignal(signal.SIGINT) is signal.default_int_handler
-        and _sigaction() is not None
-    )
+_COUNTED = {signal.SIGINT: signal.default_int_handler, signal.SIGTERM: raise_terminated}
+"""The signals the machine-code handler counts, each where this Python handler of it is in place."""
+
+
+def _counted_signals() -> list[int]:
+    if threading.current_thread() is not threading.main_thread() or _sigaction() is None:
+        return []
+    # (signal.getsignal's value, without its 2 us of trying the handler as an enum member)
+    return [sig for sig, handler in _COUNTED.items() if _signal.getsignal(sig) is handler]
 
 
 @contextmanager
 def counting_sigint() -> Iterator[int]:
-    """Within the block, SIGINT adds one to :data:`SIGINTS` instead of running Python's handler.
+    """Within the block, SIGINT (and SIGTERM, see the module) adds one to :data:`SIGINTS` instead of running
+    Python's handler.
 
     Yields the count at the start (what the driver compares with).  Where the
     counting handler does not apply (another thread, a handler of the
@@ -109,24 +168,26 @@ def counting_sigint() -> Iterator[int]:
     moves and a SIGINT is handled by Python when the block ends.
     """
     seen = int(SIGINTS[0])
-    if not _counting_applies():
-        yield seen
-        return
+    signals = _counted_signals()
     sigaction = _sigaction()
-    old = ctypes.create_string_buffer(_SIGACTION_BYTES)
-    if sigaction(signal.SIGINT, None, old) != 0:  # pragma: no cover - cannot fail for SIGINT
-        yield seen
-        return
-    new = ctypes.create_string_buffer(old.raw, _SIGACTION_BYTES)  # same mask and flags
-    ctypes.c_void_p.from_buffer(new).value = _handler_address()  # the handler is the first member
-    sigaction(signal.SIGINT, new, None)
+    restore = []
     try:
+        for sig in signals:
+            old = ctypes.create_string_buffer(_SIGACTION_BYTES)
+            if sigaction(sig, None, old) != 0:  # pragma: no cover - cannot fail for SIGINT or SIGTERM
+                continue
+            new = ctypes.create_string_buffer(old.raw, _SIGACTION_BYTES)  # same mask and flags
+            ctypes.c_void_p.from_buffer(new).value = _handler_address()  # the handler is the first member
+            sigaction(sig, new, None)
+            restore.append((sig, old))
         yield seen
     finally:
-        sigaction(signal.SIGINT, old, None)
+        for sig, old in reversed(restore):
+            sigaction(sig, old, None)
 
 
 def raise_if_interrupted(seen: int) -> None:
-    """Raise :class:`KeyboardInterrupt` if a SIGINT was counted since the count was ``seen``."""
+    """Raise :class:`KeyboardInterrupt` (:class:`Terminated` for a SIGTERM) if a signal was counted since
+    the count was ``seen``."""
     if int(SIGINTS[0]) != seen:
-        raise KeyboardInterrupt
+        raise Terminated if int(LAST_SIGNAL[0]) == signal.SIGTERM else KeyboardInterrupt

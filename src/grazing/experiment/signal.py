@@ -92,7 +92,12 @@ def lowpass(x: np.ndarray, fs: float, cutoff_hz: float, *, order: int = FILTER_O
     x = np.asarray(x, dtype=float)
     sos = _sos(int(order), float(cutoff_hz) / (0.5 * fs))
     padlen = min(x.size - 1, 3 * (2 * len(sos) + 1) * 10)
-    return sosfiltfilt(sos, x, padlen=padlen)
+    try:
+        return sosfiltfilt(sos, x, padlen=padlen)
+    except np.linalg.LinAlgError:  # (a cutoff so far below the sampling rate that the filter is singular)
+        raise InvalidParameterError(
+            f"the cutoff {cutoff_hz:g} Hz is too low for a filter at {fs:g} samples per second"
+        ) from None
 
 
 @lru_cache(maxsize=32)
@@ -366,6 +371,16 @@ def analyze_recording(
             raise InvalidParameterError(f"cutoff multiple must be positive, got {cutoff_multiple:g}")
         cutoff_hz = min(cutoff_multiple * clock.forcing_hz, 0.4 * fs)
     _check_cutoff(fs, cutoff_hz)
+    T = clock.period
+    margin = 1.0 / cutoff_hz  # (the filter's settling time, left out at both ends)
+    ts = clock.sample_times(phase)
+    ts = ts[(ts >= rec.time[0] + margin) & (ts + T / 4 <= rec.time[-1] - margin)]
+    if ts.size == 0:  # (before the filter: a cutoff of 1e-300 Hz is no filter numpy can build)
+        raise InvalidParameterError(
+            f"no sampling time at phase {phase:g} rad lies in the recording ({rec.time[0]:g} s to "
+            f"{rec.time[-1]:g} s) less the filter's settling time of 1/cutoff = {margin:.3g} s at both "
+            "ends: give a phase within a few forcing periods, or a higher cutoff"
+        )
     x = rec.filled_angle()
     xf = lowpass(x, fs, cutoff_hz)
     sigma = estimate_noise(x, fs) if noise is None else float(noise)
@@ -374,10 +389,6 @@ def analyze_recording(
     # floor: a noise-free record still carries interpolation and filtering errors of ~1e-6 of its range
     floor = SAMPLE_NOISE_FLOOR * max(float(np.ptp(xf)), 1e-3)
     s_noise = max(sigma * noise_gain(float(fs), float(cutoff_hz)), floor)
-    T = clock.period
-    margin = 1.0 / cutoff_hz
-    ts = clock.sample_times(phase)
-    ts = ts[(ts >= rec.time[0] + margin) & (ts + T / 4 <= rec.time[-1] - margin)]
     samples = stroboscopic(rec.time, xf, ts)
     quarter = stroboscopic(rec.time, xf, ts + T / 4)
     if rec.gaps:

@@ -66,9 +66,15 @@ def _measure(
             raise InvalidParameterError(f"{name} must be a non-negative number, got {val!r}")
     rng = np.random.default_rng(seed)
     u = t / max(duration, 1e-300)
-    y = angle + noise * rng.standard_normal(angle.size) + drift * (0.7 * u + 0.3 * np.sin(math.pi * u))
-    if quantum > 0:
-        y = np.round(y / quantum) * quantum
+    with np.errstate(over="ignore", invalid="ignore"):  # (checked below, in one line)
+        y = angle + noise * rng.standard_normal(angle.size) + drift * (0.7 * u + 0.3 * np.sin(math.pi * u))
+        if quantum > 0:
+            y = np.round(y / quantum) * quantum
+    if not np.all(np.isfinite(y)):
+        raise InvalidParameterError(
+            f"the measured angle overflows with noise {noise:g} rad and drift {drift:g} rad: give a noise "
+            "level of the order of the angle's"
+        )
     return y
 
 

@@ -8,6 +8,7 @@ left behind).  The diagram of each page opened is computed for that page.
 from __future__ import annotations
 
 import errno
+import logging
 import signal
 import socket
 from collections.abc import Callable
@@ -26,6 +27,48 @@ DEFAULT_ADDRESS = "127.0.0.1"
 
 class PortInUseError(GrazingError):
     """The port asked for is taken."""
+
+
+REFUSED_SHOWN = 160
+"""Characters of a refused message's error that its log line shows."""
+
+WEBSOCKET_LOGGERS = ("bokeh.server.views.ws", "bokeh.server.protocol_handler")
+"""Bokeh's loggers that report a websocket message the server could not read or apply."""
+
+
+class OneLineRefusals(logging.Filter):
+    """Bokeh's report of a bad websocket message as one line: no traceback, no echo of the message.
+
+    A frame that is not JSON, a message of an unknown type, a patch naming a
+    model the page does not have: Bokeh logs each with its traceback (and
+    the message itself, however long), then that it closes the connection.
+    This filter makes that one line, ``grazing explore: refused a websocket
+    message (ERROR)``; the server goes on serving the other pages.
+
+    Examples
+    --------
+    >>> import sys
+    >>> try:
+    ...     raise KeyError("NOPE")
+    ... except KeyError:
+    ...     record = logging.LogRecord("bokeh.server.views.ws", logging.ERROR, "ws.py", 1,
+    ...                                "Unhandled exception receiving a message: %r: %r", (0, "{}"),
+    ...                                sys.exc_info())
+    >>> OneLineRefusals().filter(record), record.getMessage(), record.exc_info
+    (True, "grazing explore: refused a websocket message (KeyError: 'NOPE')", None)
+    """
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        if record.getMessage().startswith("Bokeh Server internal error: server failed to"):
+            return False  # (the closing of the connection, after the line below)
+        if record.exc_info and record.exc_info[1] is not None:
+            exc = record.exc_info[1]
+            text = " ".join(f"{type(exc).__name__}: {exc}".split())
+            if len(text) > REFUSED_SHOWN:
+                text = text[: REFUSED_SHOWN - 3] + "..."
+            record.msg, record.args = "grazing explore: refused a websocket message (%s)", (text,)
+            record.exc_info, record.exc_text = None, None
+        return True
 
 
 def check_port(address: str, port: int) -> int:
@@ -87,6 +130,9 @@ def serve(
         loop.add_callback_from_signal(loop.stop)
 
     previous = signal.signal(signal.SIGINT, on_sigint)  # (Panel's own handler would stop it silently)
+    refusals = OneLineRefusals()
+    for name in WEBSOCKET_LOGGERS:
+        logging.getLogger(name).addFilter(refusals)
     try:
         server.start()
         url = f"http://{address}:{server.port}/"
@@ -98,6 +144,8 @@ def serve(
             webbrowser.open(url)
         loop.start()
     finally:
+        for name in WEBSOCKET_LOGGERS:
+            logging.getLogger(name).removeFilter(refusals)
         signal.signal(signal.SIGINT, previous)
         for explorer in pages:
             explorer.jobs.close(timeout=0)

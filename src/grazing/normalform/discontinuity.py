@@ -42,8 +42,17 @@ import numpy as np
 
 from grazing.core.model import HybridModel
 from grazing.engine.runner import DiscontinuityMap
+from grazing.errors import InvalidParameterError
 from grazing.maps import flow_map
 from grazing.orbits.contact import GrazingPoint
+
+
+def no_contact_direction(model: HybridModel, stop: int = 0) -> str:
+    """The message for a stop without a contact direction, which the discontinuity map needs."""
+    return (
+        f"model {model.name!r} defines no contact direction for stop {model.stop_names[stop]!r}; the "
+        "grazing normal form needs one (HybridModel(..., contact_direction=[...]))"
+    )
 
 
 def zdm_direction(model: HybridModel, x: np.ndarray, t: float, stop: int = 0) -> np.ndarray:
@@ -52,7 +61,7 @@ def zdm_direction(model: HybridModel, x: np.ndarray, t: float, stop: int = 0) ->
     c = np.zeros(model.n_states)
     model.kernels().contact_dir(np.asarray(x, dtype=float), float(t), model.param_vector, c, stop)
     if not np.any(c):
-        raise ValueError(f"model {model.name!r} defines no contact direction; the ZDM needs one")
+        raise InvalidParameterError(no_contact_direction(model, stop))
     grad_rate = model.contact_derivatives(x, t, stop)["rate_x"]
     return (gx - np.eye(model.n_states)) @ c / float(grad_rate @ c)
 

@@ -25,6 +25,7 @@ grazing.errors.ForeignFileError: ... exists and is not a report folder of grazin
 
 from __future__ import annotations
 
+import contextlib
 import os
 from pathlib import Path
 
@@ -65,8 +66,19 @@ def check_report_folder(path: str | Path, *, overwrite: bool = False, hint: str 
 
 
 def claim_report_folder(path: str | Path) -> None:
-    """Make the folder ``path`` if missing and mark it as grazing's (after :func:`check_report_folder`)."""
+    """Make the folder ``path`` if missing and mark it as grazing's (after :func:`check_report_folder`).
+
+    Where the mark cannot be written (a full disk), the folders this call made are removed again: the
+    error says that nothing was written.
+    """
     target = resolved(path)
+    made = [p for p in (target, *target.parents) if not os.path.lexists(p)]
     target.mkdir(parents=True, exist_ok=True)
     if not (target / MARKER).is_file():
-        write_json(target / MARKER, {"grazing_report": 1}, overwrite=True)
+        try:
+            write_json(target / MARKER, {"grazing_report": 1}, overwrite=True)
+        except BaseException:
+            for folder in made:  # (innermost first; each empty: the failed write left nothing)
+                with contextlib.suppress(OSError):
+                    folder.rmdir()
+            raise

@@ -332,11 +332,14 @@ def stream_batches(
     a batch goes on to the next one at once, so that no thread waits for the
     others' last points at a batch's end.  When the consumer stops early
     (Ctrl-C, an error, ``close()``) the threads are told to stop and have
-    returned, at their next step, before this returns.
+    returned, at their next step, before this returns.  A batch being built
+    then is not waited for: its builder thread (:class:`BatchBuilder`) goes on
+    in the background, a daemon, and the first compile of the driver (half a
+    minute) no longer holds up a Ctrl-C.
     """
     if not batches:
         return
-    from concurrent.futures import Future, ThreadPoolExecutor
+    from concurrent.futures import Future
 
     errors: list[BaseException] = []
     finished = threading.Semaphore(0)
@@ -344,7 +347,7 @@ def stream_batches(
     lock = threading.Lock()
     built: dict[int, Future[LaneBatch]] = {}  # (batches built or being built, not yet all reported)
     reported: set[int] = set()  # (batches all reported: let go)
-    builder = ThreadPoolExecutor(1, thread_name_prefix="grazing-batch")
+    builder = BatchBuilder()
 
     def build(k: int) -> LaneBatch:
         batch = batches[k]()
@@ -368,8 +371,8 @@ def stream_batches(
                     batch_at(k + 1)  # (built while this one runs)
                 if future is None:  # (the other threads ran it)
                     continue
-                batch = future.result()
-                if stopping.is_set():
+                batch = _when_built(future, stopping)
+                if batch is None or stopping.is_set():
                     break
                 batch.run()
         except BaseException as exc:  # (reported by the consumer's thread)
@@ -420,10 +423,84 @@ def stream_batches(
         yield from report()
     finally:
         stop()
-        builder.shutdown(wait=False, cancel_futures=True)  # (a thread waiting for a batch not begun returns)
+        builder.shutdown()  # (a batch not begun is cancelled; one being built is left to its daemon thread)
         for w in workers:
             w.join()
-        builder.shutdown(wait=True)
+
+
+def _when_built(future: Any, stopping: threading.Event) -> LaneBatch | None:
+    """The batch of ``future`` once built, or None as soon as ``stopping`` is set (or it was cancelled)."""
+    from concurrent.futures import CancelledError
+
+    while True:
+        try:
+            return future.result(timeout=POLL_INTERVAL)  # type: ignore[no-any-return]
+        except TimeoutError:
+            if stopping.is_set():
+                return None
+        except CancelledError:
+            return None
+
+
+class BatchBuilder:
+    """Builds batches one after the other in a thread of its own, a daemon.
+
+    As a one-thread :class:`~concurrent.futures.ThreadPoolExecutor`, but the
+    process's end does not wait for its thread: a batch being built when the
+    sweep is stopped may be the first compile of the driver, which cannot be
+    interrupted and takes half a minute (issue 43: Ctrl-C ended such a sweep
+    35-40 s late).  What it builds then is thrown away.
+    """
+
+    def __init__(self) -> None:
+        import queue
+
+        self._jobs: Any = queue.SimpleQueue()
+        self._thread: threading.Thread | None = None
+        self._busy = threading.Event()  # (set while a batch is being built)
+
+    def submit(self, fn: Callable[..., Any], *args: Any) -> Any:
+        """Build ``fn(*args)`` after the batches submitted before; a future of it."""
+        from concurrent.futures import Future
+
+        future: Future[Any] = Future()
+        self._jobs.put((future, fn, args))
+        if self._thread is None:
+            self._thread = threading.Thread(target=self._work, name="grazing-batch", daemon=True)
+            self._thread.start()
+        return future
+
+    def _work(self) -> None:
+        while True:
+            job = self._jobs.get()
+            if job is None:
+                return
+            future, fn, args = job
+            if not future.set_running_or_notify_cancel():
+                continue
+            self._busy.set()
+            try:
+                future.set_result(fn(*args))
+            except BaseException as exc:  # (the consumer's thread reports it)
+                future.set_exception(exc)
+            finally:
+                self._busy.clear()
+
+    def shutdown(self) -> None:
+        """Cancel the batches not begun; the thread ends now if idle, else after the batch it builds (not
+        waited for)."""
+        import queue
+
+        while True:
+            try:
+                job = self._jobs.get_nowait()
+            except queue.Empty:
+                break
+            if job is not None:
+                job[0].cancel()
+        self._jobs.put(None)
+        if self._thread is not None and not self._busy.is_set():
+            self._thread.join(timeout=1.0)  # (idle: it ends at once)
 
 
 def run_chunk(spec: SweepSpec, index: int) -> ChunkResult:
