@@ -20,6 +20,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from grazing.cli import main
+from grazing.models import impact_damper
 from grazing.orbits import continue_orbit, follow_curve
 from grazing.orbits.bifurcations import (
     neimark_sacker_angle,
@@ -28,6 +29,7 @@ from grazing.orbits.bifurcations import (
     verified,
 )
 from grazing.orbits.bordered import bialternate
+from grazing.orbits.crossings import limit_condition, reduced_limit
 from tests.linear_exact import (
     damper,
     damper_matrices,
@@ -185,3 +187,31 @@ def test_a_neutral_saddle_is_neither_a_neimark_sacker_point_nor_missed():
     torus = SimpleNamespace(multipliers=np.array([np.exp(0.9j), np.exp(-0.9j), 3.0, 0.2]))
     assert verified("neimark-sacker", torus) and not neutral_saddle(torus)
     assert neimark_sacker_angle(torus.multipliers) == pytest.approx(0.9, abs=1e-15)
+
+
+@pytest.fixture(scope="module")
+def damper_grazing():
+    """The grazing that ends the damper's branch below omega = 1.2 (mu = 0.3, r = 0.8): 4 states."""
+    branch = continue_orbit(impact_damper(mu=0.3, r=0.8), "omega", 1.2, 0.6)
+    (graze,) = [s for s in branch.special if s.kind == "grazing"]
+    return graze.grazing
+
+
+def test_the_neimark_sacker_limit_at_a_lost_impact_is_that_of_the_bounded_multipliers(damper_grazing):
+    # With an impact of speed nu at the contact the monodromy is g_x J + N (h_x J) / nu: one multiplier grows
+    # as 1 / nu, the other three tend to those of the reduced matrix, whose pairs' products minus one are the
+    # limit condition of a Neimark-Sacker curve of 4 states (nan before).
+    point = damper_grazing
+    m, y, t, j = point.model, point.contact, point.t_graze, point.stop
+    _, h_x, g_x = m.jacobians(y, t, j)
+    g_t = np.asarray(m._call("g_t", y, t, j), dtype=float).reshape(-1)
+    N = m.vector_field(m.reset(y, t, j), t) - g_x @ m.vector_field(y, t) - g_t
+    M0, c = g_x @ point.monodromy, h_x @ point.monodromy
+    nu = 1e-7
+    mu = np.linalg.eigvals(M0 + np.outer(N, c) / nu)
+    mu = mu[np.argsort(np.abs(mu))][:-1]  # (the three bounded ones)
+    assert np.allclose(np.sort_complex(mu), np.sort_complex(np.linalg.eigvals(reduced_limit(M0, N, c))),
+                       rtol=0, atol=1e-5)  # fmt: skip
+    pairs = np.prod([mu[a] * mu[b] - 1 for a in range(3) for b in range(a + 1, 3)])
+    value = limit_condition("neimark-sacker", point, loses=True)
+    assert math.isfinite(value) and value == pytest.approx(pairs.real, rel=1e-4)

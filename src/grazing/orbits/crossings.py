@@ -22,7 +22,13 @@ found in two steps, from the last point of the curve before it:
    grazing only where ``d1 = 0``.  There the curve meets the grazing curve
    tangentially (the multipliers vary as the square root of the distance to
    it), which is why step 1 alone locates it only to about the square root of
-   the last point's distance.
+   the last point's distance.  A Neimark-Sacker curve of more than two states
+   (its bialternate product is quadratic in ``S J``: not a rank-one change):
+   as ``nu -> 0`` one multiplier grows as ``c N / nu`` (``c = h_x J``) and the
+   others tend to those of ``P g_x J`` on the hyperplane ``c x = 0``, ``P``
+   the projection onto it along ``N``; the condition is that two of those
+   have the product 1, ``det A(Q^T P g_x J Q) = 0`` (``Q`` an orthonormal
+   basis of the hyperplane; the same whatever the basis).
 """
 
 from __future__ import annotations
@@ -91,21 +97,21 @@ def limit_condition(kind: str, point: GrazingPoint, loses: bool) -> float:
     """The defining condition of a curve of ``kind`` in its limit at a grazing (see the module docstring).
 
     ``loses``: the curve's orbit has an impact at the contact (its speed tending to zero);
-    else it only touches the stop there.  NaN where the limit is not a single coefficient
-    (a Neimark-Sacker point of more than two states losing an impact).
+    else it only touches the stop there.  NaN where the limit has no multiplier growing as
+    ``1 / nu`` (``c N = 0``).
     """
     det_kind = "fold" if kind == "branch-point" else kind
     J = point.monodromy
     if not loses:
         return float(np.linalg.det(defining_matrix(det_kind, J)))
     n = J.shape[0]
-    if kind == "neimark-sacker" and n > 2:
-        return math.nan
     m, y, t, j = point.model, point.contact, point.t_graze, point.stop
     _, h_x, g_x = m.jacobians(y, t, j)
     g_t = np.asarray(m._call("g_t", y, t, j), dtype=float).reshape(-1)
     N = m.vector_field(m.reset(y, t, j), t) - g_x @ m.vector_field(y, t) - g_t
     M0 = g_x @ J
+    if kind == "neimark-sacker" and n > 2:
+        return float(np.linalg.det(defining_matrix(det_kind, reduced_limit(M0, N, h_x @ J))))
     R = np.outer(N, h_x @ J)
     size = float(np.linalg.norm(R))
     if size == 0:
@@ -114,6 +120,26 @@ def limit_condition(kind: str, point: GrazingPoint, loses: bool) -> float:
     return float(
         np.linalg.det(defining_matrix(det_kind, M0 + R)) - np.linalg.det(defining_matrix(det_kind, M0))
     )
+
+
+def reduced_limit(M0: np.ndarray, N: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """The matrix whose eigenvalues are the limits of the bounded eigenvalues of ``M0 + N c^T / nu`` as
+    ``nu -> 0`` (one grows as ``c N / nu``): ``P M0`` on the hyperplane ``c x = 0``, in an orthonormal
+    basis ``Q`` of it, ``P = I - N c^T / (c N)`` the projection onto it along ``N``.  NaN where ``c N = 0``.
+
+    Examples
+    --------
+    >>> M0, N, c = np.diag([0.5, 0.8, 2.0]), np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, 1.0])
+    >>> np.sort(np.linalg.eigvals(reduced_limit(M0, N, c))).tolist()
+    [0.5, 0.8]
+    """
+    n = M0.shape[0]
+    cN = float(c @ N)
+    if not (math.isfinite(cN) and abs(cN) > 0.0):
+        return np.full((n - 1, n - 1), math.nan)
+    P = np.eye(n) - np.outer(N, c) / cN
+    Q = np.linalg.svd(c[None, :])[2][1:].T  # (n, n - 1): orthonormal, orthogonal to c
+    return Q.T @ P @ M0 @ Q
 
 
 def _gradient(f, u: np.ndarray, fu: float) -> np.ndarray:
