@@ -187,3 +187,17 @@ def test_the_grazing_equations_and_curve_need_no_segments(inverted_branch):
             vanishing,
         )
         assert a == pytest.approx(z[-1], abs=1e-9)
+
+
+def test_a_multiplier_below_the_monodromys_rounding_makes_no_neimark_sacker_sign_change():
+    # At w = 1.294 the branch in a ends at a grazing with |M| = 1e9 a few points before it: the small
+    # multiplier (det M / |M| = 2e-10) came out as 1e-7, its product with the large one went from 0.25 to
+    # 175, and the Neimark-Sacker test's sign change was reported as an unlocated stability change (the
+    # count of unstable multipliers stays 1 all along).
+    model = inverted_walls(w=1.2940109689978085)
+    orbit = find_orbit(model, [-0.98392617, 0.30520675], period=1)  # (a point of it)
+    assert orbit.impacts == 2
+    branch = continue_orbit(model, "a", 3.0, 9.0, orbit=orbit)
+    assert [s.kind for s in branch.special] == ["grazing"], [s.note for s in branch.special]
+    assert max(o.abs_lambda for o in branch.orbits) > 1e9
+    assert {o.unstable_count for o in branch.orbits} == {1}

@@ -26,6 +26,7 @@ from grazing.orbits.bifurcations import (
     neimark_sacker_angle,
     neimark_sacker_test,
     neutral_saddle,
+    orbit_test,
     verified,
 )
 from grazing.orbits.bordered import bialternate
@@ -215,3 +216,20 @@ def test_the_neimark_sacker_limit_at_a_lost_impact_is_that_of_the_bounded_multip
     pairs = np.prod([mu[a] * mu[b] - 1 for a in range(3) for b in range(a + 1, 3)])
     value = limit_condition("neimark-sacker", point, loses=True)
     assert math.isfinite(value) and value == pytest.approx(pairs.real, rel=1e-4)
+
+
+def test_a_multiplier_within_the_monodromys_rounding_changes_no_sign_of_the_test():
+    # An orbit near a grazing with a saddle flow: multipliers mu and det / mu, det = 0.25 (their product,
+    # below 1 all along), |mu| from 1e6 to 1e10, the monodromy rounded as one is (eps |M| per entry).  The
+    # small multiplier then comes out as rounding's (1e-7 for 2e-10): its product with the large one, which
+    # the Neimark-Sacker test takes, was 175 at some of them, a sign change where nothing happens.
+    rng = np.random.default_rng(7)
+    eps = np.finfo(float).eps
+    signs = set()
+    for large in np.geomspace(1e6, 1e10, 40):
+        V = np.array([[1.0, 0.3], [-0.2, 1.0]]) + 0.1 * rng.normal(size=(2, 2))
+        M = V @ np.diag([large, 0.25 / large]) @ np.linalg.inv(V)
+        M = M + eps * np.linalg.norm(M, 2) * rng.uniform(-1, 1, M.shape)
+        orbit = SimpleNamespace(monodromy=M, multipliers=np.linalg.eigvals(M))
+        signs.add(math.copysign(1.0, orbit_test("neimark-sacker", orbit)))
+    assert signs == {-1.0}

@@ -30,6 +30,7 @@ from grazing.cli.common import (
     stop_option_index,
 )
 from grazing.cli.validate import ANGLE_DEG, FINITE, ORBIT_PERIOD, POSITIVE
+from grazing.core.options import MAX_STEP
 from grazing.errors import NotFoundError
 from grazing.orbits.curves import CURVE_KINDS
 
@@ -79,7 +80,13 @@ def _parameters(curve: Any) -> tuple[grazing.Parameter, grazing.Parameter]:
 @click.option("--period", type=ORBIT_PERIOD, help="Period of the orbit (default: detected).")
 @click.option("--initial", metavar="X1,X2,...", help="Initial guess at time 0, one number per state.")
 @stop_name_option
-@click.option("--max-step", type=POSITIVE, default=0.04, show_default=True, help="Largest continuation step.")
+@click.option(
+    "--max-step",
+    type=POSITIVE,
+    default=MAX_STEP,
+    show_default=True,
+    help="Largest continuation step.",
+)
 @netcdf_out_option
 @json_option
 def curve(

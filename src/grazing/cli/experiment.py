@@ -48,6 +48,7 @@ from grazing.cli.validate import (
     path_type,
     refuse_unused,
 )
+from grazing.core.options import DEFAULT_TRANSIENT
 from grazing.models.pendulum import CASES, DEFAULT_CASE, case_values
 
 _RELATIONS = ["model", "paper", "protocol"]
@@ -559,7 +560,7 @@ def _analyze_folder(
 @_case_option
 @click.option("--periods", type=count(8), default=100, show_default=True,
               help="Forcing periods recorded.")  # fmt: skip
-@click.option("--transient", type=count(0), default=500, show_default=True,
+@click.option("--transient", type=count(0), default=DEFAULT_TRANSIENT, show_default=True,
               help="Forcing periods simulated before recording.")  # fmt: skip
 @click.option("--sample-rate", type=SAMPLE_RATE, default=1000.0, show_default=True,
               help="Samples per second, at most 1e6 (times are written to the microsecond).")  # fmt: skip

@@ -33,6 +33,7 @@ from grazing.cli.common import (
     stop_option_index,
 )
 from grazing.cli.validate import ANGLE_DEG, FINITE, ORBIT_PERIOD, POSITIVE, count, refuse_unused
+from grazing.core.options import DEFAULT_TRANSIENT, MAX_STEP
 from grazing.errors import GrazingWarning
 from grazing.models.pendulum import max_angle
 
@@ -94,7 +95,7 @@ def range_start_state(
     help="Initial guess at time 0, one per state (default: simulated from rest; give one where that "
     "motion sticks, diverges or settles on another orbit).",
 )
-@click.option("--transient", type=count(0), default=500, show_default=True,
+@click.option("--transient", type=count(0), default=DEFAULT_TRANSIENT, show_default=True,
               help="Forcing periods simulated for the initial guess (without --initial).")  # fmt: skip
 @json_option
 def orbit(
@@ -337,7 +338,13 @@ def graze_curve(
 @click.option("--virtual/--physical", default=None,
               help="Ignore the stops (default: for a nonimpacting starting orbit, without "
               "--switch).")  # fmt: skip
-@click.option("--max-step", type=POSITIVE, default=0.04, show_default=True, help="Largest continuation step.")
+@click.option(
+    "--max-step",
+    type=POSITIVE,
+    default=MAX_STEP,
+    show_default=True,
+    help="Largest continuation step.",
+)
 @click.option("--switch", is_flag=True,
               help="Switch branches, each switch starting a new branch segment: at the first "
               "period-doubling or branch point met, onto the period-2n orbit born there or the other "

@@ -25,13 +25,14 @@ from grazing.cli.common import (
 )
 from grazing.cli.limits import check_memory, count_text, simulate_bytes
 from grazing.cli.validate import FINITE, count, path_type, refuse_unused
+from grazing.core.options import DEFAULT_TRANSIENT
 
 
 @click.command()
 @model_options(any_model=True)
 @click.option("--initial", default=None, metavar="X1,X2,...",
               help="Initial state at time 0, one per state (default: zero; pendulum: rad).")  # fmt: skip
-@click.option("--transient", type=count(0), default=500, show_default=True,
+@click.option("--transient", type=count(0), default=DEFAULT_TRANSIENT, show_default=True,
               help="Forcing periods run and discarded first.")  # fmt: skip
 @click.option("--periods", type=count(1), default=100, show_default=True,
               help="Forcing periods sampled.")  # fmt: skip

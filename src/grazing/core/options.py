@@ -46,6 +46,18 @@ STEPS_EXTRA = 100_000
 NEWTON_TOL = 1e-11
 """Periodic orbits: Newton's method stops when ``max |P^n(x) - x|`` is below this."""
 
+CORRECTOR_TOL = 1e-10
+"""Continuation (branches and curves): the corrector accepts a point when the largest of its
+equations' residuals is below this (:class:`~grazing.orbits.palc.PalcSettings` ``tol``)."""
+
+MAX_STEP = 0.04
+"""Continuation's largest step (:class:`~grazing.orbits.palc.PalcSettings` ``ds_max``; ``--max-step``)."""
+
+DEFAULT_TRANSIENT = 500
+"""Forcing periods run before sampling where none is given: a periodic orbit's guess simulated from rest
+(:func:`~grazing.orbits.find_orbit`), and the ``--transient`` of ``simulate``, ``orbit`` and
+``synthesize``."""
+
 UNIT_CIRCLE_TOL = 1e-9
 """A Floquet multiplier within this of the unit circle is on it (neither stable nor unstable): the
 multipliers of an area-preserving map (a conservative model: no damping, elastic impacts) lie on the
@@ -83,7 +95,18 @@ CHUNK_SIZE = 50
 """Points per chunk of a one-parameter sweep: the unit of parallel work and of saving."""
 
 ADAPTIVE_TOL = 1e-9
-"""A sweep's adaptive transient ends once the samples repeat to this (with a period of at most 16)."""
+"""A sweep's adaptive transient ends once the samples repeat to this (with a period of at most
+:data:`ADAPTIVE_MAX_PERIOD`)."""
+
+ADAPTIVE_BLOCK = 32
+"""An adaptive transient is run in blocks of this many forcing periods, checked after each."""
+
+ADAPTIVE_MAX_PERIOD = 16
+"""The longest period with which an adaptive transient's samples may repeat to end it."""
+
+LYAPUNOV_ALIGN = 16
+"""With Lyapunov exponents, the last forcing periods of the transient (at most this many) align the
+tangent vectors before the exponent is taken over the sampled periods."""
 
 BASIN_ADAPTIVE_TOL = 1e-7
 """The same for the initial states of a basin: their orbits are told apart to 1e-3 cells, and recognised

@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from grazing.atomic import atomic_path
+from grazing.core.options import DEFAULT_TRANSIENT
 from grazing.errors import InvalidParameterError
 from grazing.experiment.apparatus import PAPER_RIG, Apparatus
 from grazing.experiment.recording import Recording, from_arrays
@@ -84,7 +85,7 @@ def synthetic_recording(
     *,
     case: str | None = "B",
     periods: int = 100,
-    transient: int = 500,
+    transient: int = DEFAULT_TRANSIENT,
     x0: Sequence[float] = (0.0, 0.0),
     sample_rate: float = SAMPLE_RATE,
     noise: float = NOISE,

@@ -179,8 +179,30 @@ def orbit_test(kind: str, orbit: PeriodicOrbit) -> float:
     if kind == "period-doubling":
         return float(np.linalg.det(J + eye))
     if kind == "neimark-sacker":
-        return neimark_sacker_test(orbit.multipliers)
+        return neimark_sacker_test(resolved_multipliers(orbit))
     raise ValueError(f"unknown special point kind {kind!r}")
+
+
+def resolved_multipliers(orbit: PeriodicOrbit) -> np.ndarray:
+    """The multipliers, those within the monodromy's rounding of zero (``64 eps |M|``) set to zero.
+
+    A multiplier that small is rounding's (the eigenvalues of ``M`` are known to ``eps |M|``): beside
+    one of ``1e9`` a multiplier of ``2e-10`` came out as ``1e-7``, and its product with the large one,
+    which the Neimark-Sacker test takes, went from ``0.25`` (``det M``) to ``175``: a sign change of the
+    test where nothing happened.  Such a multiplier is in no complex pair on the unit circle (its
+    conjugate would be as small), so zero loses no Neimark-Sacker point.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace
+    >>> near_grazing = SimpleNamespace(monodromy=np.diag([1.5e9, 1e-7]), multipliers=np.array([1.5e9, 1e-7]))
+    >>> resolved_multipliers(near_grazing).real.tolist()
+    [1500000000.0, 0.0]
+    """
+    floor = 64 * float(np.finfo(float).eps) * float(np.linalg.norm(orbit.monodromy, 2))
+    mu = np.array(orbit.multipliers, dtype=complex)
+    mu[np.abs(mu) <= floor] = 0.0
+    return mu
 
 
 def branch_test(pt: PalcPoint) -> float:

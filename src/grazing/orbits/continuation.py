@@ -66,7 +66,7 @@ import numpy as np
 from grazing.core.model import HybridModel
 from grazing.core.options import MAX_PERIOD
 from grazing.errors import ConvergenceError, GrazingError, InvalidParameterError
-from grazing.orbits.bifurcations import Located, between, neimark_sacker_angle, orbit_test, verified
+from grazing.orbits.bifurcations import Located, between, neimark_sacker_angle
 from grazing.orbits.branch_equations import branch_equations
 from grazing.orbits.contact import GrazingPoint, refine_grazing
 from grazing.orbits.palc import (
@@ -109,11 +109,6 @@ _RESECTION = "an impact approaches the section"
 
 ContinuationSettings = PalcSettings
 """Options of :func:`continue_orbit` (see :class:`~grazing.orbits.palc.PalcSettings`)."""
-
-_evaluator = branch_equations  # (the former private name)
-_test_function = orbit_test
-_verified = verified
-_switch_orbit = new_sequence_orbit
 
 
 @dataclass(frozen=True)
@@ -346,14 +341,6 @@ def _stop_guard_min(orbit: PeriodicOrbit, stop: int) -> float:
     (A physical branch ends at its grazings instead: nan.)
     """
     return orbit.guard_min_by_stop[stop][0] if orbit.virtual else math.nan
-
-
-def _detect(evaluate, kind: str, a: PalcPoint, b: PalcPoint, s: PalcSettings) -> PalcPoint | None:
-    """The point of ``kind`` (an orbit-based test function) between ``a`` and ``b``, located and verified."""
-    if not sign_changed(orbit_test(kind, a.payload), orbit_test(kind, b.payload)):
-        return None
-    loc = locate(evaluate, a, b, lambda p: orbit_test(kind, p.payload), s)
-    return loc if loc is not None and verified(kind, loc.payload) else None
 
 
 def _detect_grazing(

@@ -55,8 +55,6 @@ from grazing.orbits.shooting import PeriodicOrbit, _orbit_from
 DIFFERENCE_STEP = 1e-6
 """Step of the central differences of the map's Jacobian, relative to ``max(1, |x|, |p|)``."""
 
-ORBIT_KINDS = ("fold", "period-doubling", "neimark-sacker", "branch-point")
-"""Curves whose points are periodic orbits with a degenerate multiplier."""
 
 MONODROMY_ROUNDING = 64.0
 """The computed monodromy ``M`` is taken to be accurate to this many ``eps |M|`` (``eps`` the

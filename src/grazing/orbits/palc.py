@@ -30,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from grazing.core.options import CORRECTOR_TOL, MAX_STEP
 from grazing.errors import GrazingError
 
 ACCEPT = "accept"
@@ -70,9 +71,9 @@ class PalcSettings:
 
     ds: float = 0.01
     ds_min: float = 1e-6
-    ds_max: float = 0.04
+    ds_max: float = MAX_STEP
     max_points: int = 2000
-    tol: float = 1e-10
+    tol: float = CORRECTOR_TOL
     max_newton: int = 8
     locate_tol: float = 1e-9
     min_cos: float = 0.9

@@ -18,6 +18,7 @@ import numpy as np
 
 from grazing.core.model import HybridModel
 from grazing.core.options import (
+    DEFAULT_TRANSIENT,
     NEWTON_MAX_ITER,
     NEWTON_TOL,
 )
@@ -152,7 +153,12 @@ def sticking_phrase(sol: Solution, periods: int) -> str:
 
 
 def initial_guess(
-    model: HybridModel, *, t0: float = 0.0, transient: int = 500, samples: int = 128, virtual: bool = False
+    model: HybridModel,
+    *,
+    t0: float = 0.0,
+    transient: int = DEFAULT_TRANSIENT,
+    samples: int = 128,
+    virtual: bool = False,
 ) -> InitialGuess:
     """A point near an attractor and its period, from simulation starting at rest.
 
@@ -197,7 +203,7 @@ def find_orbit(
     virtual: bool = False,
     tol: float = NEWTON_TOL,
     max_iter: int = NEWTON_MAX_ITER,
-    transient: int = 500,
+    transient: int = DEFAULT_TRANSIENT,
     stop_name: int | str | None = None,
     through_stops: bool = True,
 ) -> PeriodicOrbit:

@@ -229,11 +229,6 @@ class Runs:
         return self.main + self.zoom + self.overview
 
 
-def zoom_of(run: PanelRun, zoomed: Sequence[PanelRun]) -> PanelRun | None:
-    """The magnified sweep of ``run``'s panel among ``zoomed`` (None if that panel has none)."""
-    return next((z for z in zoomed if z.panel == run.panel), None)
-
-
 _GRAZING_POINTS: dict[tuple[str, float, float | None], list[Any]] = {}
 """The grazings of each panel's model found in this process (all views and figs 7 and 10 share them)."""
 
@@ -761,13 +756,6 @@ def is_reverse_adding(periods: Sequence[int], min_windows: int = 3) -> bool:
 def sequence(windows: Sequence[Window]) -> list[int]:
     """The periods of the windows in order (impacting period 1 included)."""
     return [w.period for w in windows]
-
-
-def grazing_text(run: PanelRun) -> str:
-    """``"η_g = 0.4451 (|λ| = 0.508), 0.5473 (|λ| = 0.576)"``."""
-    if not run.grazings:
-        return "no grazing for η in [0.2, 1]"
-    return ", ".join(f"{g.eta:.4f} (|λ| = {g.abs_lambda:.3f})" for g in run.grazings)
 
 
 @dataclass(frozen=True)

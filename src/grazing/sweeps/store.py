@@ -525,19 +525,6 @@ def _short(exc: BaseException) -> str:
     return text if len(text) <= 160 else text[:157] + "..."
 
 
-def build_dataset_flat(spec: SweepSpec, arrays: dict[str, np.ndarray], attrs: dict[str, Any]) -> Any:
-    """The flat (``point``-indexed) raw arrays as stored on disk, with the spec attributes.
-
-    No string coordinates are stored (component names come from the spec on
-    loading), so the store uses only Zarr v3's numeric types.
-    """
-    ds = _flat(arrays)
-    summary = spec_summary(spec)
-    ds.attrs.update({"spec": json.dumps(summary, sort_keys=True), "fingerprint": summary["fingerprint"]})
-    ds.attrs.update(attrs)
-    return ds
-
-
 def open_store(
     path: str | Path, spec: SweepSpec, attrs: dict[str, Any] | None = None, *, wait: bool = False
 ) -> ZarrStore:

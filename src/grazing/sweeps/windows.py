@@ -135,26 +135,6 @@ class WindowComparison:
         return float("nan") if self.other is None else self.other.stop - self.reference.stop
 
 
-def compare_windows(reference: Any, other: Any, origin: float, min_points: int = 2) -> list[WindowComparison]:
-    """Pair each impacting periodic window of ``reference`` with ``other``'s window of that period.
-
-    Both are datasets of :func:`grazing.sweeps.sweep` over the same values.
-    Windows are listed by their distance from ``origin`` (the grazing value);
-    when a period has several windows in ``other``, the nearest is paired.
-    """
-
-    def periodic(ds: Any) -> list[Window]:
-        return [w for w in find_windows(ds) if w.period > 0 and w.impacting and w.points >= min_points]
-
-    oth = periodic(other)
-    rows = []
-    for w in sorted(periodic(reference), key=lambda w: abs(w.start - origin)):
-        same = [o for o in oth if o.period == w.period]
-        best = min(same, key=lambda o: abs(o.start - w.start) + abs(o.stop - w.stop)) if same else None
-        rows.append(WindowComparison(w.period, w, best, abs(w.start - origin)))
-    return rows
-
-
 @dataclass(frozen=True)
 class Hysteresis:
     """A run of consecutive values where a sweep up and a sweep down end on different attractors.

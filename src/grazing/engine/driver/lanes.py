@@ -12,10 +12,11 @@ function; a lane whose point is finished takes the next one, so a lane that
 impacts or sticks holds up no other.  Every lane's arithmetic is the scalar
 path's: the results are the same numbers, bit for bit.
 
-A point is the protocol of :func:`grazing.sweeps.run.run_point`: the
-transient in blocks of ``ADAPTIVE_BLOCK`` periods (stopped early, at the
-point of the cycle where it would have ended, once the samples repeat to
-``adaptive_tol`` with a period of at most ``ADAPTIVE_MAX_PERIOD``, when ``adaptive``), then either
+A point is run as :mod:`grazing.sweeps.run` describes: the transient in
+blocks of :data:`~grazing.core.options.ADAPTIVE_BLOCK` periods (stopped
+early, at the point of the cycle where it would have ended, once the samples
+repeat to ``adaptive_tol`` with a period of at most
+:data:`~grazing.core.options.ADAPTIVE_MAX_PERIOD`, when ``adaptive``), then either
 ``periods`` sampled periods, or (``lyapunov``) ``align + periods`` with the
 variational equations from the identity, the Lyapunov sums taken over the
 last ``periods``.  ``jobs`` are runs of consecutive points; within a job each
@@ -32,7 +33,13 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from grazing.core.options import STEPS_EXTRA, STEPS_PER_PERIOD
+from grazing.core.options import (
+    ADAPTIVE_BLOCK,
+    ADAPTIVE_MAX_PERIOD,
+    LYAPUNOV_ALIGN,
+    STEPS_EXTRA,
+    STEPS_PER_PERIOD,
+)
 from grazing.engine import timebase
 from grazing.engine.abi import TC_FREE_LANES, TC_VAR_LANES, call_model
 from grazing.engine.driver.atomics import fetch_add, load_acquire, store_release
@@ -45,11 +52,9 @@ from grazing.engine.lanevec import LANE_WIDTH, advance_rows, certify_stop
 from grazing.engine.polyroots import quadratic_bound, work_shape
 from grazing.engine.records import Kernels, LaneJobs, LanePoints, LaneResults, LaneSettings
 from grazing.engine.stepping import GUARD_SCALE, new_table, step_factor, step_size, steps_from_norms
+from grazing.engine.timebase import SNAP
 
 LANE_ROOT_ROWS, LANE_ROOT_MIN_COLS = work_shape(0)
-ADAPTIVE_BLOCK = 32  # (grazing.sweeps.run.ADAPTIVE_BLOCK)
-ADAPTIVE_MAX_PERIOD = 16
-LYAPUNOV_ALIGN = 16
 VECTOR_MIN_LANES = 3
 """Fewest lanes of a kind for which the lane function is called (else the scalar one, lane by lane)."""
 
@@ -124,7 +129,7 @@ def begin_request(st, periods, keep, use_var, T, zdm_s):
     k = st.k
     s = st.s
     st.lyap_t0 = k * T + s
-    st.kz = k if s < zdm_s - 1e-9 * T else k + 1
+    st.kz = k if s < zdm_s - SNAP * T else k + 1
 
 
 @njit(cache=False, nogil=True)  # (compiled once per machine into its own object file, grazing.engine.native)
@@ -702,7 +707,7 @@ def finish_point(m, cfg, out, la, lane, align):
 def final_request(st, XS, n, lane, align, cfg, s_phase, zdm_s):
     """The recorded stage of a point: with the variational equations (from the identity) for Lyapunov."""
     T = st.T
-    if cfg.lyapunov:  # a new Runner at the current time (as run_point's ``var``)
+    if cfg.lyapunov:  # a new Runner at the current time, with the variational equations
         t0 = st.k * T + st.s
         k0, s0, ks0, ss0 = start_times(t0, T, s_phase, cfg.periodic)
         st.k = k0

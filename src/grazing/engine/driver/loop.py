@@ -65,6 +65,7 @@ from grazing.engine.stepping import (
     step_size,
     unpack_var,
 )
+from grazing.engine.timebase import SNAP
 
 ROOT_WORK_ROWS, ROOT_WORK_MIN_COLS = work_shape(0)
 
@@ -281,7 +282,7 @@ def start_run(m, r, start, cfg, x, tables):
     r.n_traj = 0
     r.kt = r.k
     r.st = r.s
-    r.kz = r.k if r.s < cfg.zdm_s - 1e-9 * T else r.k + 1
+    r.kz = r.k if r.s < cfg.zdm_s - SNAP * T else r.k + 1
     r.status = STATUS_OK
     r.steps = 0
     r.zero_events = 0

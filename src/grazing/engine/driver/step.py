@@ -12,8 +12,6 @@ from grazing.engine.driver.impacts import at_event, enter_contact
 from grazing.engine.driver.state import STATUS_ZENO
 from grazing.engine.driver.tangent import discontinuity_map, lyapunov_step, shift_period
 
-STEP_EVENT = 1
-"""The step ends at an event."""
 STEP_LAST = 2
 """The step ends at the run's last sample."""
 STEP_MAP = 4
