@@ -59,10 +59,13 @@ _POINT = """(() => {
 class ExplorerPage:
     """``grazing explore ARGS --no-browser --port 0`` and its page in headless Chromium (context manager)."""
 
-    def __init__(self, args: list[str], cwd: Path, width: int = 1400, height: int = 1000) -> None:
+    def __init__(
+        self, args: list[str], cwd: Path, width: int = 1400, height: int = 1000, *, mobile: bool = False
+    ) -> None:
         self.args = args
         self.cwd = cwd
         self.width, self.height = width, height
+        self.mobile = mobile  # (a phone: the page is laid out as its viewport tag says, 980 px without one)
         self.server: subprocess.Popen[str] | None = None
         self.url = ""
         self.exit_code: int | None = None
@@ -94,7 +97,7 @@ class ExplorerPage:
         self.dt.send("Runtime.enable", session=self.session)
         self.dt.send(
             "Emulation.setDeviceMetricsOverride",
-            {"width": self.width, "height": self.height, "deviceScaleFactor": 1, "mobile": False},
+            {"width": self.width, "height": self.height, "deviceScaleFactor": 1, "mobile": self.mobile},
             session=self.session,
         )
         self.dt.send("Page.navigate", {"url": self.url}, session=self.session)
