@@ -196,8 +196,9 @@ def _read_line(proc: subprocess.Popen[str], limit: float) -> str:
 
 
 def docs_screenshot(path: Path) -> None:
-    """The screenshot of docs/explore.md: the default view, η = 0.446 clicked, its orbit continued, the
-    grazings found (``python -m tests.explore.page docs/img/explore.png``)."""
+    """The screenshot of docs/explore.md: the default view, η = 0.446 clicked, its orbit continued (the
+    diagram framed to its narrow branch and computed again there), the grazings found
+    (``python -m tests.explore.page docs/img/explore.png``)."""
     from grazing.outputs import write_png_bytes
 
     with ExplorerPage([], Path(tempfile.gettempdir()), width=1400, height=1000) as page:
@@ -211,13 +212,6 @@ def docs_screenshot(path: Path) -> None:
         ):
             page.evaluate(_CLICK_BUTTON % label)
             page.wait_for(done, 120)
-        for _ in range(3):  # zoomed in on the period-adding cascade: the diagram is refined there
-            page.dt.send(
-                "Input.dispatchMouseEvent",
-                {"type": "mouseWheel", "x": where["x"], "y": where["y"], "deltaX": 0, "deltaY": -300},
-                session=page.session,
-            )
-            time.sleep(0.3)
         page.wait_for(r"refined: 200 points", 120)
         page.dt.send("Input.dispatchMouseEvent", {"type": "mouseMoved", "x": 5, "y": 5}, session=page.session)
         time.sleep(1.0)  # (the plots redraw)
