@@ -103,24 +103,22 @@ def test_the_explorer_fits_the_screen_with_a_legend_degrees_and_no_tooltip_over_
             page.wait_for(r"the diagram is framed to the branch")
         page.evaluate(_CLICK_BUTTON % "Copy as code")
         page.wait_for(r"Python Command line")
-        point = None
-        for _ in range(50):  # (drawn: the branch, on the diagram framed to it)
-            point = page.evaluate(_POINT_OF % ("stable" if phone else "code", 0.446, 0.446))
-            if point:
+        point: dict = {}
+        for k in range(150):  # (drawn: the branch, on the diagram framed to it; the code box; the point read)
+            if k % 10 == 0:  # the mouse over the point (again: on a loaded machine the frame may still move)
+                found = page.evaluate(_POINT_OF % ("stable" if phone else "code", 0.446, 0.446))
+                point = json.loads(found) if found else {}
+                if point:
+                    page.dt.send(
+                        "Input.dispatchMouseEvent",
+                        {"type": "mouseMoved", "x": point["x"], "y": point["y"]},
+                        session=page.session,
+                    )
+            shown = json.loads(page.evaluate(_LAYOUT))
+            if point and shown["codeFont"] is not None and point["text"] in shown["readout"]:
                 break
             time.sleep(0.1)
         assert point, "nothing drawn to hover over"
-        point = json.loads(point)
-        page.dt.send(  # the mouse over the point: read under the diagram
-            "Input.dispatchMouseEvent",
-            {"type": "mouseMoved", "x": point["x"], "y": point["y"]},
-            session=page.session,
-        )
-        for _ in range(100):  # (the code box shown, the point read)
-            shown = json.loads(page.evaluate(_LAYOUT))
-            if shown["codeFont"] is not None and point["text"] in shown["readout"]:
-                break
-            time.sleep(0.1)
         page.screenshot(tmp_path / f"explore-{width}.png")
         assert shown["codeFont"] is not None, "no code shown"
     # the page at the screen's width (no viewport tag: a phone lays it out at 980 px), nothing past it
