@@ -115,6 +115,8 @@ def test_the_page_answers_a_click_continues_and_copies(page):
     assert page.refined.view.axes[0].lo == pytest.approx(start)
     page.show_code()
     assert page.code_python.visible and "continue_orbit(point, 'eta', 0.446" in page.code_python.value
+    # the diagram the click started from, not the one computed again over the frame since
+    assert "np.linspace(0.44, 0.49, 21)" in page.code_python.value
     assert page.code_cli.value.startswith("grazing sweep --model pendulum")
 
 

@@ -105,6 +105,7 @@ class Explorer:
         self.diagram: Diagram | None = None
         self.refined: Diagram | None = None
         self.point: PointReport | None = None
+        self.point_diagram: Diagram | None = None  # (the diagram the clicked point started from)
         self.continued: Continued | None = None
         self.basins: BasinView | None = None  # (found at the clicked point, for copy as code)
         self.grazings: Grazings | None = None  # (sought over the range, for copy as code)
@@ -334,7 +335,11 @@ class Explorer:
         def work(cancelled: Callable[[], bool]) -> PointReport:
             return inspect_click(diagram, values, cancelled=cancelled)
 
-        self.jobs.submit("point", work, self._point_done, self._point_failed)
+        def done(rep: PointReport) -> None:
+            self.point_diagram = diagram  # (the one its simulation started from: copy as code sweeps it)
+            self._point_done(rep)
+
+        self.jobs.submit("point", work, done, self._point_failed)
 
     def _diagram_for(self, values: list[float]) -> Diagram:
         """The finest computed diagram containing the point (the refined one when zoomed)."""
@@ -467,7 +472,7 @@ class Explorer:
 
     def show_code(self) -> None:
         """Show the Python and the command lines that reproduce the view."""
-        view = self.view if self.point is None else self._diagram_for(list(self.point.values.values())).view
+        view = self.view if self.point is None or self.point_diagram is None else self.point_diagram.view
         code = view_code(
             view,
             self.point,
