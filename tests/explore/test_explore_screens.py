@@ -88,39 +88,50 @@ _POINT_OF = """(() => {
 """The page pixel of the point nearest to ``x`` of the first renderer with a column: ``% (column, x, x)``."""
 
 
+def _look(page: ExplorerPage, phone: bool) -> tuple[dict, dict]:
+    """Click eta = 0.446 (on the phone, continue its orbit too), copy as code, hover over the point:
+    what the page then shows (:data:`_LAYOUT`), and the point hovered over."""
+    page.wait_for(r"diagram: 100 points in [0-9.]+ s; failed: 0")
+    where = page.diagram_pixel(0.446)
+    page.click(where["x"], where["y"])
+    page.wait_for(r"Floquet multipliers")
+    if phone:
+        page.evaluate(_CLICK_BUTTON % "Continue this orbit")
+        page.wait_for(r"the diagram is framed to the branch")
+    page.evaluate(_CLICK_BUTTON % "Copy as code")
+    page.wait_for(r"Python Command line")
+    point: dict = {}
+    for k in range(150):  # (drawn: the branch, on the diagram framed to it; the code box; the point read)
+        if k % 10 == 0:  # the mouse over the point (again: on a loaded machine the frame may still move)
+            found = page.evaluate(_POINT_OF % ("stable" if phone else "code", 0.446, 0.446))
+            point = json.loads(found) if found else {}
+            if point:
+                page.dt.send(
+                    "Input.dispatchMouseEvent",
+                    {"type": "mouseMoved", "x": point["x"], "y": point["y"]},
+                    session=page.session,
+                )
+        shown = json.loads(page.evaluate(_LAYOUT))
+        if point and shown["codeFont"] is not None and point["text"] in shown["readout"]:
+            break
+        time.sleep(0.1)
+    assert point, "nothing drawn to hover over"
+    assert shown["codeFont"] is not None, "no code shown"
+    return shown, point
+
+
 @pytest.mark.parametrize("width", [400, 1300])
 def test_the_explorer_fits_the_screen_with_a_legend_degrees_and_no_tooltip_over_the_plot(tmp_path, width):
     """On the phone the clicked orbit is continued too (its branch framed and hovered over); on the
     desktop a point of the diagram is hovered over."""
     phone = width < 500
-    with ExplorerPage([*ARGS, "--num", "100"], tmp_path, width=width, height=900, mobile=phone) as page:
-        page.wait_for(r"diagram: 100 points in [0-9.]+ s; failed: 0")
-        where = page.diagram_pixel(0.446)
-        page.click(where["x"], where["y"])
-        page.wait_for(r"Floquet multipliers")
-        if phone:
-            page.evaluate(_CLICK_BUTTON % "Continue this orbit")
-            page.wait_for(r"the diagram is framed to the branch")
-        page.evaluate(_CLICK_BUTTON % "Copy as code")
-        page.wait_for(r"Python Command line")
-        point: dict = {}
-        for k in range(150):  # (drawn: the branch, on the diagram framed to it; the code box; the point read)
-            if k % 10 == 0:  # the mouse over the point (again: on a loaded machine the frame may still move)
-                found = page.evaluate(_POINT_OF % ("stable" if phone else "code", 0.446, 0.446))
-                point = json.loads(found) if found else {}
-                if point:
-                    page.dt.send(
-                        "Input.dispatchMouseEvent",
-                        {"type": "mouseMoved", "x": point["x"], "y": point["y"]},
-                        session=page.session,
-                    )
-            shown = json.loads(page.evaluate(_LAYOUT))
-            if point and shown["codeFont"] is not None and point["text"] in shown["readout"]:
-                break
-            time.sleep(0.1)
-        assert point, "nothing drawn to hover over"
-        page.screenshot(tmp_path / f"explore-{width}.png")
-        assert shown["codeFont"] is not None, "no code shown"
+    page = ExplorerPage([*ARGS, "--num", "100"], tmp_path, width=width, height=900, mobile=phone)
+    try:
+        with page:
+            shown, point = _look(page, phone)
+            page.screenshot(tmp_path / f"explore-{width}.png")
+    except AssertionError as exc:  # (with what the server said: a failure on a loaded machine is read)
+        raise AssertionError(f"{exc}\nthe server's stderr: {page.stderr[-3000:]}") from None
     # the page at the screen's width (no viewport tag: a phone lays it out at 980 px), nothing past it
     assert shown["innerWidth"] == width
     assert shown["scrollWidth"] <= width, shown["scrollWidth"]
