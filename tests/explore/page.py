@@ -59,10 +59,13 @@ _POINT = """(() => {
 class ExplorerPage:
     """``grazing explore ARGS --no-browser --port 0`` and its page in headless Chromium (context manager)."""
 
-    def __init__(self, args: list[str], cwd: Path, width: int = 1400, height: int = 1000) -> None:
+    def __init__(
+        self, args: list[str], cwd: Path, width: int = 1400, height: int = 1000, *, mobile: bool = False
+    ) -> None:
         self.args = args
         self.cwd = cwd
         self.width, self.height = width, height
+        self.mobile = mobile  # (a phone: the page is laid out as its viewport tag says, 980 px without one)
         self.server: subprocess.Popen[str] | None = None
         self.url = ""
         self.exit_code: int | None = None
@@ -94,7 +97,7 @@ class ExplorerPage:
         self.dt.send("Runtime.enable", session=self.session)
         self.dt.send(
             "Emulation.setDeviceMetricsOverride",
-            {"width": self.width, "height": self.height, "deviceScaleFactor": 1, "mobile": False},
+            {"width": self.width, "height": self.height, "deviceScaleFactor": 1, "mobile": self.mobile},
             session=self.session,
         )
         self.dt.send("Page.navigate", {"url": self.url}, session=self.session)
@@ -193,8 +196,9 @@ def _read_line(proc: subprocess.Popen[str], limit: float) -> str:
 
 
 def docs_screenshot(path: Path) -> None:
-    """The screenshot of docs/explore.md: the default view, η = 0.446 clicked, its orbit continued, the
-    grazings found (``python -m tests.explore.page docs/img/explore.png``)."""
+    """The screenshot of docs/explore.md: the default view, η = 0.446 clicked, its orbit continued (the
+    diagram framed to its narrow branch and computed again there), the grazings found
+    (``python -m tests.explore.page docs/img/explore.png``)."""
     from grazing.outputs import write_png_bytes
 
     with ExplorerPage([], Path(tempfile.gettempdir()), width=1400, height=1000) as page:
@@ -208,13 +212,6 @@ def docs_screenshot(path: Path) -> None:
         ):
             page.evaluate(_CLICK_BUTTON % label)
             page.wait_for(done, 120)
-        for _ in range(3):  # zoomed in on the period-adding cascade: the diagram is refined there
-            page.dt.send(
-                "Input.dispatchMouseEvent",
-                {"type": "mouseWheel", "x": where["x"], "y": where["y"], "deltaX": 0, "deltaY": -300},
-                session=page.session,
-            )
-            time.sleep(0.3)
         page.wait_for(r"refined: 200 points", 120)
         page.dt.send("Input.dispatchMouseEvent", {"type": "mouseMoved", "x": 5, "y": 5}, session=page.session)
         time.sleep(1.0)  # (the plots redraw)

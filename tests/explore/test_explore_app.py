@@ -103,8 +103,20 @@ def test_the_page_answers_a_click_continues_and_copies(page):
     wait_until(lambda: page.continued is not None)
     assert "grazing at eta = 0.44512118" in page.actions_text.object
     assert len(page.figures.marks.data["x"]) == 5 * len(page.continued.marks)
+    # the period-5 window is ~0.001 wide of the 0.05 computed: the diagram is framed to its branch,
+    # the branch (grazing to grazing) in the middle third, and computed again there
+    start, end = page.figures.diagram.x_range.start, page.figures.diagram.x_range.end
+    graze = sorted(m.value for m in page.continued.marks if m.kind == "grazing")
+    assert start < graze[0] < graze[1] < end and end - start == pytest.approx(
+        3 * (graze[1] - graze[0]), rel=0.05
+    )
+    assert "the diagram is framed to the branch: eta in [0.44389" in page.actions_text.object
+    wait_until(lambda: page.refined is not None)
+    assert page.refined.view.axes[0].lo == pytest.approx(start)
     page.show_code()
     assert page.code_python.visible and "continue_orbit(point, 'eta', 0.446" in page.code_python.value
+    # the diagram the click started from, not the one computed again over the frame since
+    assert "np.linspace(0.44, 0.49, 21)" in page.code_python.value
     assert page.code_cli.value.startswith("grazing sweep --model pendulum")
 
 
@@ -176,8 +188,9 @@ class _Zoom:
 
 
 def test_zoomed_in_the_diagram_is_computed_again_there_and_clicks_use_it(page):
+    before = page.refined  # (a continued orbit's narrow branch may have framed and refined it already)
     page._on_ranges(_Zoom(0.4480, 0.4460))  # (either order)
-    wait_until(lambda: page.refined is not None)
+    wait_until(lambda: page.refined is not None and page.refined is not before)
     axis = page.refined.view.axes[0]
     assert (axis.lo, axis.hi, axis.num) == (pytest.approx(0.446), pytest.approx(0.448), 21)
     assert page.status.object.startswith("refined: 21 points over eta in [0.446, 0.448]")
@@ -266,7 +279,7 @@ def test_the_basins_at_the_clicked_point_hold_its_attractor(page):
     assert label.shape == (40, 40) and set(np.unique(label)) <= {0.0, 1.0, 2.0, 3.0, 4.0, 5.0}
     # the attractor's points drawn are those of the clicked orbit (the same 5 points at phase 0)
     pts = np.column_stack([page.figures.basin_points.data["x"], page.figures.basin_points.data["y"]])
-    orbit = page.point.samples[-5:]
+    orbit = np.degrees(page.point.samples[-5:])  # (drawn in degrees, as the page's header gives angles)
     assert all(np.min(np.abs(pts - p).sum(axis=1)) < 1e-5 for p in orbit)
     # copy as code gives the basins shown (tests/explore/test_explore_code.py runs such code)
     wait_until(lambda: page.basins is not None)

@@ -120,9 +120,14 @@ def test_the_branch_through_the_clicked_orbit_ends_at_the_grazings_of_the_window
     # the window's ends as the README's sweep sees them: [0.445455, 0.446306] lies between the grazings
     graze = sorted(m.value for m in c.marks if m.kind == "grazing")
     assert graze[0] < 0.445455 and 0.446306 < graze[1] < 0.4468
-    # every branch point drawn has its period-5 orbit's 5 points at phase 0, stable or not
+    # every branch point drawn has its period-5 orbit's 5 points at phase 0, stable or not; the clicked
+    # orbit, where both directions start, once (a hover over it lists it once)
     cols = branch_columns(pendulum_diagram.view, c, 0)
-    assert len(cols["x"]) == 5 * sum(len(p.values) for p in c.pieces)
+    assert [p.values[0] for p in c.pieces] == [0.446, 0.446]
+    assert len(cols["x"]) == 5 * (sum(len(p.values) for p in c.pieces) - 1)
+    assert len(set(zip(cols["x"], cols["y"]))) == len(cols["x"])
+    # in degrees, as the page's header gives angles: theta at phase 0 of the clicked orbit
+    assert sorted(cols["y"][:5]) == pytest.approx(sorted(np.degrees(rep.samples[-5:, 0])), abs=1e-5)
     assert set(cols["stable"]) == {"stable", "unstable"}  # (unstable past the period-doubling)
     assert len(mark_columns(pendulum_diagram.view, c.marks, 0)["x"]) == 5 * len(c.marks)
 

@@ -33,12 +33,44 @@ from grazing.explore.figures import Figures
 from grazing.explore.jobs import Jobs
 from grazing.explore.point import PointReport, inspect_click
 
-__all__ = ["REFINE_BELOW", "Explorer", "explorer"]
+__all__ = ["NARROW", "PAGE_TEMPLATE", "REFINE_BELOW", "Explorer", "explorer"]
 
 REFINE_BELOW = 0.5
 """Zoomed in to less than this fraction of the computed range, the diagram is computed again there."""
 
 CLICK_HINT = "Click a point of the diagram (or type a value below) to see its orbit."
+
+NARROW = 560
+"""The least width (CSS pixels) of the diagram's column and the orbit's beside it: on a narrower screen
+(a phone) the page's columns stack, one above the other."""
+
+PAGE_TEMPLATE = (
+    '{% block postamble %}<meta name="viewport" content="width=device-width, initial-scale=1">{% endblock %}'
+)
+"""The served page's template (Panel's own, extended): a phone lays it out at its own width."""
+
+MONOSPACE = (
+    ":host textarea { font-family: ui-monospace, SFMono-Regular, Menlo, Consolas, 'DejaVu Sans Mono', "
+    "'Liberation Mono', monospace; font-size: 13px; white-space: pre; overflow-x: auto; }"
+)
+"""The code boxes' style: code in a monospace font, its lines not wrapped (scrolled)."""
+
+
+def flex(*children: Any, basis: int = NARROW) -> Any:
+    """A row whose ``children`` share the width, each at least ``basis`` pixels wide, or wrap one under
+    the other (the page's stacked layout on a narrow screen)."""
+    import panel as pn
+
+    for child in children:
+        child.styles = {**child.styles, "flex": f"1 1 {basis}px", "min-width": "0"}
+    return pn.FlexBox(*children, flex_wrap="wrap", sizing_mode="stretch_width")
+
+
+def wrap(*children: Any) -> Any:
+    """Widgets side by side, wrapping onto the next line where the screen is too narrow."""
+    import panel as pn
+
+    return pn.FlexBox(*children, flex_wrap="wrap", sizing_mode="stretch_width")
 
 
 def message_of(exc: BaseException) -> str:
@@ -73,6 +105,7 @@ class Explorer:
         self.diagram: Diagram | None = None
         self.refined: Diagram | None = None
         self.point: PointReport | None = None
+        self.point_diagram: Diagram | None = None  # (the diagram the clicked point started from)
         self.continued: Continued | None = None
         self.basins: BasinView | None = None  # (found at the clicked point, for copy as code)
         self.grazings: Grazings | None = None  # (sought over the range, for copy as code)
@@ -115,10 +148,14 @@ class Explorer:
         )
         self.curves_text = pn.pane.Markdown("", sizing_mode="stretch_width", css_classes=["grazing-curves"])
         self.code_python = pn.widgets.TextAreaInput(
-            label="Python", height=260, sizing_mode="stretch_width", visible=False
+            label="Python", height=260, sizing_mode="stretch_width", visible=False, stylesheets=[MONOSPACE]
         )
         self.code_cli = pn.widgets.TextAreaInput(
-            label="Command line", height=160, sizing_mode="stretch_width", visible=False
+            label="Command line",
+            height=160,
+            sizing_mode="stretch_width",
+            visible=False,
+            stylesheets=[MONOSPACE],
         )
         self.show_button.on_click(lambda _e: self.click_values([w.value for w in self.inputs]))
         self.continue_button.on_click(lambda _e: self.continue_orbit())
@@ -133,30 +170,30 @@ class Explorer:
         self.figures.diagram.on_event(RangesUpdate, self._on_ranges)
         self.panel = pn.Column(
             self.header,
-            pn.Row(self.progress, self.status, sizing_mode="stretch_width"),
-            pn.Row(
+            wrap(self.progress, self.status),
+            flex(
                 pn.Column(
                     pn.pane.Bokeh(self.figures.diagram, sizing_mode="stretch_width"),
-                    pn.Row(*self.inputs, self.show_button),
+                    pn.pane.Bokeh(self.figures.readout, sizing_mode="stretch_width"),
+                    pn.pane.Bokeh(self.figures.legend, sizing_mode="stretch_width"),
+                    wrap(*self.inputs, self.show_button),
                     sizing_mode="stretch_width",
                 ),
                 pn.Column(
                     pn.pane.Markdown("#### Orbit"),
                     self.orbit,
-                    pn.Row(self.continue_button, self.grazings_button, self.code_button),
-                    pn.Row(self.curves_button, self.basins_button),
+                    wrap(self.continue_button, self.grazings_button, self.code_button),
+                    wrap(self.curves_button, self.basins_button),
                     self.actions_text,
                     self.grazings_text,
                     self.curves_text,
                     self.basins_text,
                     sizing_mode="stretch_width",
                 ),
-                sizing_mode="stretch_width",
             ),
-            pn.Row(
+            flex(
                 pn.pane.Bokeh(self.figures.series, sizing_mode="stretch_width"),
                 pn.pane.Bokeh(self.figures.phase, sizing_mode="stretch_width"),
-                sizing_mode="stretch_width",
             ),
             pn.pane.Bokeh(self.figures.basins, sizing_mode="stretch_width"),
             self.code_python,
@@ -232,11 +269,16 @@ class Explorer:
     def _on_ranges(self, event: Any) -> None:
         """Zoomed in far enough: compute the diagram (or map) again over the visible range (as many
         points or cells).  On a map, far enough in either parameter."""
+        self.refine(event.x0, event.x1, getattr(event, "y0", None), getattr(event, "y1", None))
+
+    def refine(self, x0: float, x1: float, y0: float | None = None, y1: float | None = None) -> None:
+        """The diagram shown over ``[x0, x1]`` (and a map's ``[y0, y1]``; display units): computed again
+        there when that is far enough inside the computed range (:data:`REFINE_BELOW`)."""
         if self.diagram is None:
             return
-        ranges = [self._visible(0, event.x0, event.x1)]
+        ranges = [self._visible(0, x0, x1)]
         if len(self.view.axes) == 2:
-            ranges.append(self._visible(1, getattr(event, "y0", None), getattr(event, "y1", None)))
+            ranges.append(self._visible(1, y0, y1))
         if any(r is None for r in ranges):
             return
         full = [a.hi - a.lo for a in self.view.axes]
@@ -293,7 +335,11 @@ class Explorer:
         def work(cancelled: Callable[[], bool]) -> PointReport:
             return inspect_click(diagram, values, cancelled=cancelled)
 
-        self.jobs.submit("point", work, self._point_done, self._point_failed)
+        def done(rep: PointReport) -> None:
+            self.point_diagram = diagram  # (the one its simulation started from: copy as code sweeps it)
+            self._point_done(rep)
+
+        self.jobs.submit("point", work, done, self._point_failed)
 
     def _diagram_for(self, values: list[float]) -> Diagram:
         """The finest computed diagram containing the point (the refined one when zoomed)."""
@@ -334,8 +380,16 @@ class Explorer:
         def done(c: Continued) -> None:
             if self.point is not point:
                 return  # another point was clicked meanwhile
-            self.figures.show_branch(c, self._row(point))
-            self.actions_text.object = "\n\n".join(c.lines)
+            frame = self.figures.show_branch(c, self._row(point))
+            lines = list(c.lines)
+            if frame is not None:
+                par = self.view.parameter(0)
+                shown = par.show_range(par.from_display(frame[0]), par.from_display(frame[1]), ".6g")
+                lines.append(
+                    f"the diagram is framed to the branch: {shown} (the toolbar's reset shows it all)"
+                )
+                self.refine(*frame)  # (computed again there, as a zoom there would)
+            self.actions_text.object = "\n\n".join(lines)
             self.curves_button.disabled = False
             self.continued, self.curves = c, None
             if self.code_python.visible:
@@ -418,7 +472,7 @@ class Explorer:
 
     def show_code(self) -> None:
         """Show the Python and the command lines that reproduce the view."""
-        view = self.view if self.point is None else self._diagram_for(list(self.point.values.values())).view
+        view = self.view if self.point is None or self.point_diagram is None else self.point_diagram.view
         code = view_code(
             view,
             self.point,

@@ -101,7 +101,7 @@ def serve(
     """
     import panel as pn
 
-    from grazing.explore.app import Explorer
+    from grazing.explore.app import PAGE_TEMPLATE, Explorer
 
     port = check_port(address, port)
     pages: list[Explorer] = []
@@ -109,6 +109,7 @@ def serve(
     def page() -> object:
         explorer = Explorer(view)
         pages.append(explorer)
+        pn.state.curdoc.template = PAGE_TEMPLATE  # (a viewport: a phone lays the page out at its width)
         pn.state.on_session_destroyed(lambda _ctx: explorer.close())
         return explorer.panel
 

@@ -8,6 +8,8 @@ grazing`` never loads it and never selects a backend); the helpers draw on an
 :func:`mark_grazings`, :func:`period_classes`, :func:`plot_period_map`.
 :mod:`~grazing.plotting.attractors`: :func:`plot_basins`, :func:`plot_fractions`.
 :mod:`~grazing.plotting.labels`: axis labels from parameter and state metadata.
+:mod:`~grazing.plotting.palette`: the colours of detected periods, shared by the report, the docs
+and ``grazing explore``.
 The array helpers :func:`~grazing.experiment.signal.uniform_resample` and
 :func:`~grazing.experiment.signal.delay_coordinates` live with the signal
 processing.

@@ -27,6 +27,7 @@ from grazing.plotting.labels import (
     swept_parameter,
     with_unit,
 )
+from grazing.plotting.palette import class_colours, class_labels, period_codes
 from grazing.sweeps.windows import Window, find_windows
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -346,7 +347,8 @@ DIRECTION_COLORS = {"up": "tab:blue", "down": "tab:orange"}
 def period_classes(
     period: np.ndarray, impacts_per_period: np.ndarray, max_period: int = 8
 ) -> tuple[np.ndarray, list[str], list[str]]:
-    """Map detected periods to the colour classes of :func:`plot_period_map`.
+    """Map detected periods to the colour classes of :func:`plot_period_map` (the shared palette of
+    :mod:`grazing.plotting.palette`).
 
     Classes, in order: failed (period -1), aperiodic (0), period 1 without
     impacts, period 1 with impacts, periods 2 ... ``max_period``, and longer
@@ -364,18 +366,8 @@ def period_classes(
     >>> codes.tolist(), [labels[c] for c in codes]
     ([2, 3, 1, 5, 7], ['1, no impacts', '1, impacting', 'aperiodic', '3', '> 4'])
     """
-    period = np.asarray(period, dtype=int)
-    imp = np.asarray(impacts_per_period, dtype=float) > 0
-    codes = np.where(period == 0, 1, 0)  # failed points (period -1) stay 0
-    codes = np.where(period == 1, np.where(imp, 3, 2), codes)
-    codes = np.where((period >= 2) & (period <= max_period), period + 2, codes)
-    codes = np.where(period > max_period, max_period + 3, codes)
-    labels = ["failed", "aperiodic", "1, no impacts", "1, impacting"]
-    labels += [str(p) for p in range(2, max_period + 1)] + [f"> {max_period}"]
-    palette = ["#d62728", "#1f77b4", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2",
-               "#17becf", "#bcbd22", "#7f7f7f", "#aec7e8", "#ffbb78", "#98df8a"]  # fmt: skip
-    colors = ["#ffffff", "#000000", "#e4e4e4", "#9ecae1"]
-    colors += [palette[(p - 2) % len(palette)] for p in range(2, max_period + 1)] + ["#f7b6d2"]
+    codes = period_codes(period, impacts_per_period, max_period)
+    labels, colors = class_labels(max_period), class_colours(max_period)
     return codes, labels, colors
 
 
@@ -390,7 +382,7 @@ def plot_period_map(
     """Colour a two-parameter map by the detected period.
 
     Aperiodic points (no period up to the detection limit) are black,
-    nonimpacting period 1 light grey, impacting period 1 light blue, periods
+    nonimpacting period 1 grey, impacting period 1 light blue, periods
     2 ... ``max_period`` distinct colours (:func:`period_classes`).  Only the
     classes present get a colour-bar entry; the mesh's values index them.
 
