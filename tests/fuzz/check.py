@@ -50,7 +50,9 @@ def check_case(case: Case, template: Template, tmp: Path) -> Outcome:
         outcome = run_process(case, work, scratch) if case.process else run_in_process(case, work)
         after = snapshot(work)
         problems = status_violations(case, outcome)
-        problems += file_violations(case, outcome.returncode, work, template.entries, after, template.grazings)
+        problems += file_violations(
+            case, outcome.returncode, work, template.entries, after, template.grazings
+        )
         assert not problems, describe(case, outcome, problems)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)

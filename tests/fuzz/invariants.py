@@ -57,8 +57,10 @@ def allowed_codes(case: Case, sent: int | None = None) -> set[int]:
 
 
 def status_violations(case: Case, outcome: Outcome, sent: int | None = None) -> list[str]:
-    """What is wrong with the exit status, stderr and stdout of ``outcome``."""
+    """What is wrong with the exit status, stderr and stdout of ``outcome`` (``sent``: a signal the test
+    sent it, if not the case's own Ctrl-C)."""
     bad: list[str] = []
+    sent = sent or outcome.sent
     err = outcome.stderr
     if outcome.hung:
         return [f"hung: still running after {case.timeout:g} s"]
@@ -68,10 +70,18 @@ def status_violations(case: Case, outcome: Outcome, sent: int | None = None) -> 
         bad.append("a traceback on stderr")
     code = outcome.returncode
     if code < 0:
+        if sent == signal.SIGKILL and code == -signal.SIGKILL:
+            return bad
         return [*bad, f"killed by signal {-code} ({signal.Signals(-code).name})"]
     if code not in allowed_codes(case, sent):
         bad.append(f"exit status {code}")
     lines = _stderr_lines(case, err)
+    if case.command == "report":  # (it says on stderr what it builds: the error, if any, is the last line)
+        if any(ERROR_WORDS.search(line) for line in lines[:-1]):
+            bad.append("an error or warning among the report's progress lines")
+        lines = lines[-1:]
+    if case.family == "huge" and "out of memory" in err:
+        bad.append("out of memory: the memory the size needs was not checked before the work")
     if code == 0:
         if case.invalid:
             bad.append("exit 0 for an input that is certainly wrong")
@@ -125,9 +135,11 @@ def file_violations(
     before: dict[str, Entry],
     after: dict[str, Entry],
     grazings: set[str],
+    interrupted: bool = False,
 ) -> list[str]:
     """What ``case``'s run changed in ``root`` that it must not have (``grazings``: the files of ``before``
-    that grazing wrote)."""
+    that grazing wrote; ``interrupted``: by a signal, which may leave its outputs unmade or part made, a
+    store to resume)."""
     bad: list[str] = []
     outputs = {o for o in case.outputs() if o}
     if case.command == "synthesize":  # (a recording's sidecar: the same name, .json)
@@ -137,6 +149,9 @@ def file_violations(
     def under_output(rel: str) -> bool:
         return any(rel == n or rel.startswith(n + os.sep) for n in named)
 
+    if interrupted:
+        code = 0
+
     def may_change(rel: str) -> bool:
         if not under_output(rel) or code != 0:
             return False
@@ -144,7 +159,9 @@ def file_violations(
         was = before.get(top)
         if was is None:  # made by this run
             return True
-        if was.kind == "dir":  # a folder it writes into: a store of grazing's, a report's, a folder of recordings
+        if (
+            was.kind == "dir"
+        ):  # a folder it writes into: a store of grazing's, a report's, a folder of recordings
             return top in GRAZINGS_FOLDERS or case.command in ("report", "synthesize")
         return rel in grazings or case.overwrite
 
@@ -160,7 +177,7 @@ def file_violations(
         if under_output(rel) and code == 0:
             continue
         bad.append(f"{rel}: left behind" if code != 0 or _is_scratch(rel) else f"{rel}: made (not an output)")
-    if code == 0:
+    if code == 0 and not interrupted:
         bad += _outputs_whole(case, root, named, after)
     return bad
 
@@ -178,6 +195,10 @@ def _outputs_whole(case: Case, root: Path, named: set[str], after: dict[str, Ent
         entry = after.get(rel)
         if entry is None:
             bad.append(f"{rel}: the output of a success is missing")
-        elif entry.kind == "file" and rel.endswith((".csv", ".nc", ".png")) and not written_by_grazing(root / rel):
+        elif (
+            entry.kind == "file"
+            and rel.endswith((".csv", ".nc", ".png"))
+            and not written_by_grazing(root / rel)
+        ):
             bad.append(f"{rel}: the output of a success is not whole (no valid mark of grazing's)")
     return bad

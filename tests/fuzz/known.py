@@ -29,25 +29,31 @@ HUGE_RANGE_VALUES = {"1e308", "-1e308", "-1e308,1e308"}
 """Values whose differences overflow (numpy's RuntimeWarning printed before the error line)."""
 
 KNOWN: dict[str, Callable[[Case], bool]] = {
-    "analyze --cutoff-hz tiny: a traceback": lambda c: c.command == "analyze"
-    and _value(c, "--cutoff-hz") in ("1e-320", "1e-300"),
-    "analyze --phase 1e308: a traceback": lambda c: c.command == "analyze"
-    and _value(c, "--phase") in ("1e308", "-1e308", "99999999999999999999"),
-    "normal-form on a model without contact_direction: a traceback": lambda c: c.command == "normal-form"
-    and "nocd.py:nocd" in c.argv,
+    "analyze --cutoff-hz tiny: a traceback": lambda c: (
+        c.command == "analyze" and _value(c, "--cutoff-hz") in ("1e-320", "1e-300")
+    ),
+    "analyze --phase 1e308: a traceback": lambda c: (
+        c.command == "analyze" and _value(c, "--phase") in ("1e308", "-1e308", "99999999999999999999")
+    ),
+    "normal-form on a model without contact_direction: a traceback": lambda c: (
+        c.command == "normal-form" and "nocd.py:nocd" in c.argv
+    ),
     "a model file raising BaseException: a traceback": lambda c: any(
         f"{f}.py:model" in c.argv for f in ("base", "basecall", "genexit")
     ),
-    "attractors --num 1000000000: memory grows, no refusal": lambda c: c.command == "attractors"
-    and _value(c, "--num") == HUGE_INT,
+    "attractors --num 1000000000: memory grows, no refusal": lambda c: (
+        c.command == "attractors" and _value(c, "--num") == HUGE_INT
+    ),
     "an edited NetCDF file replaced without --overwrite": lambda c: "edited.nc" in c.argv and not c.overwrite,
-    "stdout on a full disk without PYTHONUNBUFFERED: exit 120 and Python's own lines": lambda c: c.stdout == "full"
-    and _env(c, "PYTHONUNBUFFERED") is None,
+    "stdout on a full disk without PYTHONUNBUFFERED: exit 120 and Python's own lines": lambda c: (
+        c.stdout == "full" and _env(c, "PYTHONUNBUFFERED") is None
+    ),
     "numpy's RuntimeWarning before the error line for huge ranges": lambda c: any(
         v in HUGE_RANGE_VALUES for v in c.argv
     ),
-    "--initial '' ignored by continue and curve": lambda c: c.command in ("continue", "curve")
-    and _value(c, "--initial") == "",
+    "--initial '' ignored by continue and curve": lambda c: (
+        c.command in ("continue", "curve") and _value(c, "--initial") == ""
+    ),
 }
 """Each known bug of issue 43 -> whether a case shows it."""
 

@@ -23,7 +23,7 @@ CONSOLE = [sys.executable, "-c", "from _grazing_entry import console; console()"
 
 MODULE = [sys.executable, "-m", "grazing"]
 
-MEMORY_LIMIT = 8 * 2**30
+MEMORY_LIMIT = 4 * 2**30
 """Address space of a case's process (a command that would allocate without bound fails instead of
 taking the machine's memory)."""
 
@@ -41,6 +41,8 @@ class Outcome:
     stderr: str
     escaped: str | None = None
     hung: bool = False
+    sent: int | None = None
+    """The signal the test sent the process (a case's ``interrupt_after``), if it did."""
     stdout_read: bool = True
     """Whether ``stdout`` holds all the command wrote (not for a closed pipe, /dev/full, ...)."""
     seconds: float = 0.0
@@ -50,7 +52,7 @@ class CaseTimeout(BaseException):
     """The case ran past its time (raised in this process by a timer)."""
 
 
-class Served(Exception):
+class ServedError(Exception):
     """``explore`` passed every check and would serve its page now (in this process: not served)."""
 
 
@@ -82,12 +84,12 @@ def _time_limit(seconds: float) -> Iterator[None]:
         signal.signal(signal.SIGALRM, old)
 
 
-def _show_on_stderr(message, category, filename, lineno, file=None, line=None) -> None:  # noqa: ANN001
+def _show_on_stderr(message, category, filename, lineno, file=None, line=None) -> None:
     sys.stderr.write(warnings.formatwarning(message, category, filename, lineno, line))
 
 
 def _serve_stub(*_args: object, **_kwargs: object) -> None:
-    raise Served
+    raise ServedError
 
 
 def run_in_process(case: Case, cwd: Path) -> Outcome:
@@ -108,7 +110,7 @@ def run_in_process(case: Case, cwd: Path) -> Outcome:
                 warnings.simplefilter("always")  # (on stderr, as a process shows them; not pytest's record)
                 warnings.showwarning = _show_on_stderr
                 code = main(list(case.argv))
-    except Served:
+    except ServedError:
         code = 0
     except CaseTimeout:
         hung = True
@@ -119,7 +121,9 @@ def run_in_process(case: Case, cwd: Path) -> Outcome:
     finally:
         os.chdir(here)
         server.serve = real_serve
-    return Outcome(code, out.getvalue(), err.getvalue(), escaped, hung, True, time.perf_counter() - start)
+    return Outcome(
+        code, out.getvalue(), err.getvalue(), escaped, hung, None, True, time.perf_counter() - start
+    )
 
 
 def _preexec(fsize: int | None) -> Callable[[], None]:
@@ -148,8 +152,16 @@ def process_env(case: Case) -> dict[str, str]:
 def start(case: Case, cwd: Path, stdout: int | None) -> subprocess.Popen:
     """Start ``case`` as a process in ``cwd``, in a session of its own, its output to ``stdout``."""
     argv = [*(CONSOLE if case.entry == "console" else MODULE), *case.argv]
-    return subprocess.Popen(argv, cwd=cwd, env=process_env(case), stdin=subprocess.DEVNULL, stdout=stdout,
-                            stderr=subprocess.PIPE, start_new_session=True, preexec_fn=_preexec(case.fsize))  # fmt: skip
+    return subprocess.Popen(
+        argv,
+        cwd=cwd,
+        env=process_env(case),
+        stdin=subprocess.DEVNULL,
+        stdout=stdout,
+        stderr=subprocess.PIPE,
+        start_new_session=True,
+        preexec_fn=_preexec(case.fsize),
+    )
 
 
 def stop_group(proc: subprocess.Popen) -> None:
@@ -206,6 +218,13 @@ def run_process(case: Case, cwd: Path, scratch: Path) -> Outcome:
         if reader is not None:  # read 100 bytes (or to the end, if there are fewer), then close
             out = _head(reader, time.monotonic() + case.timeout)
             reader = None
+        sent = None
+        if case.interrupt_after is not None:
+            try:
+                proc.wait(timeout=case.interrupt_after)
+            except subprocess.TimeoutExpired:
+                sent = signal.SIGINT
+                os.killpg(proc.pid, signal.SIGINT)
         got_out, got_err = proc.communicate(timeout=case.timeout)
     except subprocess.TimeoutExpired:
         hung = True
@@ -218,5 +237,13 @@ def run_process(case: Case, cwd: Path, scratch: Path) -> Outcome:
         out = got_out or b""
     elif case.stdout == "file":
         out = (scratch / "stdout.txt").read_bytes()
-    return Outcome(proc.returncode if not hung else -9, out.decode(errors="replace"), got_err.decode(errors="replace"),
-                   None, hung, read_all, time.perf_counter() - t0)  # fmt: skip
+    return Outcome(
+        proc.returncode if not hung else -9,
+        out.decode(errors="replace"),
+        got_err.decode(errors="replace"),
+        None,
+        hung,
+        sent,
+        read_all,
+        time.perf_counter() - t0,
+    )

@@ -103,13 +103,47 @@ def _grazings_files(root: Path) -> None:
     from grazing.cli import main
 
     runs = [
-        ["sweep", "--param", "eta", "--start", "0.44", "--stop", "0.45", "--num", "2", "--periods", "3",
-         "--transient", "3", "--workers", "1", "--out", "ours.nc"],
-        ["sweep", "--param", "eta", "--start", "0.44", "--stop", "0.45", "--num", "2", "--periods", "3",
-         "--transient", "3", "--workers", "1", "--out", "ours.zarr"],
+        [
+            "sweep",
+            "--param",
+            "eta",
+            "--start",
+            "0.44",
+            "--stop",
+            "0.45",
+            "--num",
+            "2",
+            "--periods",
+            "3",
+            "--transient",
+            "3",
+            "--workers",
+            "1",
+            "--out",
+            "ours.nc",
+        ],
+        [
+            "sweep",
+            "--param",
+            "eta",
+            "--start",
+            "0.44",
+            "--stop",
+            "0.45",
+            "--num",
+            "2",
+            "--periods",
+            "3",
+            "--transient",
+            "3",
+            "--workers",
+            "1",
+            "--out",
+            "ours.zarr",
+        ],
         ["simulate", "--transient", "3", "--periods", "3", "--trajectory", "ours.csv"],
         ["analyze", "rec.csv", "--plot", "ours.png"],
-    ]  # fmt: skip
+    ]
     here = os.getcwd()
     os.chdir(root)
     try:
@@ -169,7 +203,9 @@ def snapshot(root: Path) -> dict[str, Entry]:
             elif stat.S_ISDIR(st.st_mode):
                 out[rel] = Entry("dir", "", stat.S_IMODE(st.st_mode))
             elif stat.S_ISREG(st.st_mode):
-                out[rel] = Entry("file", hashlib.sha256(path.read_bytes()).hexdigest(), stat.S_IMODE(st.st_mode))
+                out[rel] = Entry(
+                    "file", hashlib.sha256(path.read_bytes()).hexdigest(), stat.S_IMODE(st.st_mode)
+                )
             else:
                 out[rel] = Entry("other")
     return out
