@@ -637,6 +637,7 @@ def targets(suffix: str) -> list[tuple[str, str, bool]]:
         ("user", user, None),  # refused without --overwrite, replaced with it
         ("grazings", f"ours{suffix}", False),
         ("edited", f"edited{suffix}", None),
+        *([("edited-attrs", "edited-attrs.nc", None)] if suffix == ".nc" else []),
         ("readonly", f"readonly{suffix}", None),
         ("folder", f"adir{suffix}", True),
         ("link", f"link{suffix}", None),

@@ -159,6 +159,11 @@ def _grazings_files(root: Path) -> None:
     first = next(iter(edited.data_vars))
     edited[first] = edited[first] * 0 + 1
     edited.to_netcdf(root / "edited.nc")
+    shutil.copy(root / "ours.nc", root / "edited-attrs.nc")  # (only an attribute: a note of the user's)
+    import h5py
+
+    with h5py.File(root / "edited-attrs.nc", "r+") as h5:
+        h5.attrs["note"] = "my note"
     (root / "edited.csv").write_bytes((root / "ours.csv").read_bytes() + b"1,2\n")
     (root / "edited.png").write_bytes((root / "ours.png").read_bytes() + b"\0")
 
