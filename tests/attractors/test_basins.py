@@ -277,3 +277,11 @@ def test_an_orbit_slow_to_settle_is_not_split_into_spurious_periods():
     detector's 1e-6 with periods 2, 7 and 9, each reported as an attractor of its own (the same
     Lyapunov exponent to 1e-11). Such end states are run on before they are classified."""
     only_period_one(1, 800, damping=0.03125, stiffness=1.0, omega=2.0, restitution=0.75)
+
+
+def test_refine_may_be_huge_the_looks_are_made_as_they_are_used():
+    """``--refine 1000000000`` (issue 43's fuzz): a list of its looks took 8 GB before the first run."""
+    from grazing.attractors.basins import _Look, _looks
+
+    looks = _looks(10**12)
+    assert [next(looks) for _ in range(3)] == [_Look(defer=True)] * 3

@@ -14,10 +14,11 @@ stop are labelled ``invalid`` and not run.
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -217,8 +218,10 @@ def find_attractors(
         run = _Run(workers, client, store, progress)
         spec = basin_spec(model, x[valid], s, s.lyapunov and s.refine == 0)
         looks = _looks(s.refine)
-        deferred = _run(spec, valid, catalogue, looks[0], run, x.shape[0] - valid.size, x.shape[0])
-        for look in looks[1:]:
+        deferred = _run(spec, valid, catalogue, next(looks), run, x.shape[0] - valid.size, x.shape[0])
+        for look in looks:
+            if deferred.index.size == 0:  # (nothing left to run on: --refine 10**9 ends here too)
+                break
             deferred = _refine(model, catalogue, deferred, s, look, replace(run, store=None, progress=None))
         exact = catalogue.examine_orbits()
         if s.lyapunov:
@@ -257,20 +260,21 @@ class _Look:
     hold: bool = False
 
 
-def _looks(refine: int) -> list[_Look]:
+def _looks(refine: int) -> Iterator[_Look]:
     """The runs of an initial state, at most: the first, ``refine`` runs on, then up to
     :data:`~grazing.core.options.BASIN_CLOSING_ROUNDS` for the end states closing in on a shorter
-    period (none without ``refine``: a run on was not asked for).
+    period (none without ``refine``: a run on was not asked for).  An iterator: ``refine`` may be
+    huge (a list of 10**9 looks took 8 GB before the first run).
 
     Examples
     --------
-    >>> [(look.defer, look.hold) for look in _looks(1)][:3], len(_looks(1)), _looks(0)
+    >>> [(look.defer, look.hold) for look in _looks(1)][:3], len(list(_looks(1))), list(_looks(0))
     ([(True, False), (False, True), (False, True)], 6, [_Look(defer=False, hold=False)])
     """
     if refine == 0:
-        return [_Look(defer=False)]
+        return iter([_Look(defer=False)])
     held = [_Look(defer=False, hold=True)] * BASIN_CLOSING_ROUNDS  # (the last run on, then all but one)
-    return [*([_Look(defer=True)] * refine), *held, _Look(defer=False)]
+    return itertools.chain(itertools.repeat(_Look(defer=True), refine), held, [_Look(defer=False)])
 
 
 @dataclass
