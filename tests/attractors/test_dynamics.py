@@ -246,3 +246,16 @@ def test_a_run_closing_in_on_a_shorter_period_has_it_only_within_a_match(amplitu
     cat.add(0, res)
     (a,), labels = cat.attractors()
     assert (a.kind, a.period, labels.tolist()) == ("periodic", period, [1])
+
+
+def test_a_box_too_narrow_for_its_cells_is_refused():
+    # A box 1e-320 wide: its cells (1.6e-322) times the match tolerance underflow to zero (numpy's
+    # warnings, then every orbit in one cell); cells given smaller than that are refused the same way.
+    ball = grazing.models.bouncing_ball()
+    x = np.array([[0.0, -1.0], [1e-320, 1.0]])
+    with pytest.raises(grazing.InvalidParameterError, match="too narrow to tell attractors apart"):
+        find_attractors(ball, x, workers=1)
+    with pytest.raises(
+        grazing.InvalidParameterError, match="cell sizes must be positive numbers of at least"
+    ):
+        find_attractors(ball, np.array([[0.0, -1.0], [1.0, 1.0]]), cell=[1e-310, 0.1], workers=1)

@@ -21,7 +21,6 @@ import pytest
 from tests.fuzz.cases import COMMANDS, LONG_COMMANDS, Case
 from tests.fuzz.check import Template, describe
 from tests.fuzz.invariants import file_violations, status_violations
-from tests.fuzz.known import REASON
 from tests.fuzz.runner import Outcome, run_process, start, stop_group
 from tests.fuzz.workspace import fresh_copy, snapshot
 from tests.processes import all_gone, descendants
@@ -30,8 +29,6 @@ pytestmark = [pytest.mark.slow, pytest.mark.skipif(os.name != "posix", reason="s
 
 MOMENTS = (0.3, 2.0, 5.0)
 """When a signal is sent, in seconds after the start: while Python imports, at work, later at work."""
-
-SIGTERM_XFAIL = pytest.mark.xfail(strict=False, reason=f"{REASON}: SIGTERM should end with 143 and one line")
 
 
 def _signalled(
@@ -91,7 +88,6 @@ def test_ctrl_c_ends_with_130_and_one_line(name, moment, template, tmp_path):
     assert not problems, describe(case, outcome, problems)
 
 
-@SIGTERM_XFAIL
 @pytest.mark.parametrize("moment", MOMENTS)
 @pytest.mark.parametrize("name", LONG_COMMANDS)
 def test_sigterm_ends_with_143_and_one_line(name, moment, template, tmp_path):
@@ -284,7 +280,6 @@ def test_killed_then_run_again_succeeds_and_resumes(name, moment, template, tmp_
 # The first compile, the cache folder
 
 
-@pytest.mark.xfail(strict=False, reason=f"{REASON}: Ctrl-C during the first compile")
 def test_ctrl_c_during_the_first_compile(template, tmp_path):
     cache = tmp_path / "cache"
     cache.mkdir()
@@ -301,7 +296,6 @@ def test_ctrl_c_during_the_first_compile(template, tmp_path):
     assert not [p for p in cache.rglob("*") if p.name.startswith(".") or p.suffix == ".tmp"]
 
 
-@pytest.mark.xfail(strict=False, reason=f"{REASON}: GRAZING_CACHE_DIR's missing parents are made")
 def test_a_cache_folder_whose_parents_are_missing(template, tmp_path):
     """``GRAZING_CACHE_DIR`` in a folder that does not exist: not a tree of folders made silently."""
     work = fresh_copy(template.root, tmp_path / "w")
@@ -374,7 +368,6 @@ def _bad_frames(port: int) -> None:
                 s.recv(4096)
 
 
-@pytest.mark.xfail(strict=False, reason=f"{REASON}: the explorer's websocket given bad frames")
 def test_explorer_given_bad_frames_stays_quiet_and_ends_on_ctrl_c(template, tmp_path):
     pytest.importorskip("panel")
     work = fresh_copy(template.root, tmp_path / "w")

@@ -32,7 +32,9 @@ from grazing.core.options import (
     BASIN_ADAPTIVE_TOL,
     BASIN_CLOSING_ROUNDS,
     CELL_FRACTION,
+    CELLS,
     ESCAPE_FACTOR,
+    MATCH_TOL,
     BasinSettings,
     refuse_unknown,
     with_shorthands,
@@ -42,6 +44,9 @@ from grazing.sweeps.spec import ChunkResult, SweepSpec
 
 Progress = Callable[[int, int], None]
 """Called as ``progress(initial_states_done, initial_states_total)``."""
+
+SMALLEST_CELL = float(np.finfo(float).tiny) / MATCH_TOL
+"""The smallest cell size: periodic orbits are matched to ``MATCH_TOL`` cells, a positive normal number."""
 
 
 @dataclass(frozen=True)
@@ -201,8 +206,17 @@ def find_attractors(
     valid = np.flatnonzero(~invalid)
     box = x[valid] if valid.size else x
     cells = default_cell(box) if cell is None else np.broadcast_to(np.asarray(cell, dtype=float), x.shape[1:])
-    if not np.all(np.isfinite(cells) & (cells > 0)):
-        raise InvalidParameterError(f"cell sizes must be positive numbers, got {cell!r}")
+    smallest = SMALLEST_CELL
+    if cell is not None and not np.all(np.isfinite(cells) & (cells >= smallest)):
+        raise InvalidParameterError(
+            f"cell sizes must be positive numbers of at least {smallest:.3g}, got {cell!r}"
+        )
+    if cell is None and not np.all(cells >= smallest):
+        raise InvalidParameterError(
+            "the initial states' box is too narrow to tell attractors apart (cells of "
+            f"{float(cells.min()):.3g}, its extent over {CELLS}): widen the box (or give cells of at "
+            f"least {smallest:.3g})"
+        )
     try:
         fraction = float(cell_fraction)
     except (TypeError, ValueError):
