@@ -196,14 +196,22 @@ CONSOLE = [sys.executable, "-c", "from _grazing_entry import console; console()"
 """The ``grazing`` console script, as installed (it ends by ``quick_exit``)."""
 
 
+COMPILING = {
+    "sweep": ["sweep", "--param", "eta", "--start", "0.44", "--stop", "0.45", "--num", "3", "--periods", "5",
+              "--json"],
+    "simulate": ["simulate", "--transient", "3", "--periods", "3"],
+}  # fmt: skip
+"""A command of each driver (the sweeps' lanes, the scalar integrator) that compiles it the first time."""
+
+
 @pytest.mark.slow
+@pytest.mark.parametrize("command", sorted(COMPILING))
 @pytest.mark.parametrize("after", [3.0, 8.0])
-def test_ctrl_c_during_the_first_compile_ends_the_command_within_a_second(after, tmp_path):
-    """The sweep's driver compiles (about 40 s) in a thread of its own; Ctrl-C ended the command only when
-    the compile had: 35-40 s late."""
+def test_ctrl_c_during_the_first_compile_ends_the_command_within_a_second(command, after, tmp_path):
+    """A driver compiles (about 40 s) in a thread of its own; Ctrl-C ended the command only when the compile
+    had: 35-40 s late (the sweep), or was lost in one of llvmlite's callbacks, exit 0 (simulate)."""
     env = {**os.environ, "GRAZING_CACHE_DIR": str(tmp_path / "cache")}
-    argv = ["sweep", "--param", "eta", "--start", "0.44", "--stop", "0.45", "--num", "3", "--periods", "5",
-            "--json"]  # fmt: skip
+    argv = COMPILING[command]
     proc = subprocess.Popen(
         [*CONSOLE, *argv], cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
         start_new_session=True, preexec_fn=_default_sigint,
@@ -220,3 +228,28 @@ def test_ctrl_c_during_the_first_compile_ends_the_command_within_a_second(after,
             proc.kill()
     assert (proc.returncode, err, out) == (130, "grazing: interrupted\n", "")
     assert took < 1.0, took
+
+
+ZARR_BUSY = """
+import asyncio, sys, time
+import zarr.core.sync as sync
+loop = sync._get_loop()
+loop.call_soon_threadsafe(time.sleep, 30)  # (zarr's thread held, as by a write in flight at a Ctrl-C)
+time.sleep(0.2)
+if sys.argv[1] == "interrupted":
+    from grazing.cli import quiet_store_exit
+    quiet_store_exit()
+"""
+
+
+@pytest.mark.parametrize("how", ["interrupted", "as zarr ends"])
+def test_an_interrupt_during_a_store_write_ends_without_zarrs_traceback(how, tmp_path):
+    # A Ctrl-C while zarr's thread was writing: zarr's exit hook logged a line and raised closing the running
+    # loop (a traceback after "grazing: interrupted", seen by the fuzz's signal suite under load).
+    script = tmp_path / "busy.py"
+    script.write_text(ZARR_BUSY)
+    done = subprocess.run([sys.executable, str(script), how], capture_output=True, text=True, timeout=60)
+    if how == "interrupted":
+        assert (done.returncode, done.stderr) == (0, "")
+    elif "Cannot close a running event loop" not in done.stderr:  # (without it: the case is real)
+        pytest.skip("this zarr's exit hook ends a busy thread quietly: nothing to silence")

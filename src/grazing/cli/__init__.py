@@ -103,6 +103,34 @@ def terminated_line() -> None:
     click.echo("grazing: terminated", err=True)
 
 
+def quiet_store_exit() -> None:
+    """After an interrupt, end zarr's input-output thread quietly at exit.
+
+    A Ctrl-C or SIGTERM during a store's write leaves zarr's event loop running a task; zarr's own exit
+    hook then waits 0.2 s, logs "Thread did not finish cleanly" and raises closing the running loop (a
+    traceback after the one line).  The process is ending: its hook runs with its log silenced and its
+    error dropped.
+    """
+    import atexit
+    import logging
+    import sys
+
+    sync = sys.modules.get("zarr.core.sync")
+    cleanup = getattr(sync, "cleanup_resources", None)
+    if cleanup is None:
+        return
+
+    def quietly() -> None:
+        logging.getLogger(sync.__name__).disabled = True
+        try:
+            cleanup()
+        except RuntimeError:  # ("Cannot close a running event loop")
+            pass
+
+    atexit.unregister(cleanup)
+    atexit.register(quietly)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI; every error becomes one line on stderr and an exit status.
 
@@ -126,9 +154,11 @@ def main(argv: list[str] | None = None) -> int:
     except click.exceptions.Exit as exc:
         return int(exc.exit_code)
     except Terminated:
+        quiet_store_exit()
         terminated_line()
         return EXIT_TERMINATED
     except (click.exceptions.Abort, KeyboardInterrupt, EOFError):
+        quiet_store_exit()
         interrupted_line()
         return EXIT_INTERRUPTED
     except click.ClickException as exc:

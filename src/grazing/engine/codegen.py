@@ -48,6 +48,7 @@ from grazing.core.options import MACHINE_EPSILON
 from grazing.core.symbolic import SymbolicSystem
 from grazing.engine import driver, outputs
 from grazing.engine.abi import LANE_SLOTS, SLOTS
+from grazing.engine.interrupts import interruptibly
 from grazing.errors import WriteError
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -461,7 +462,7 @@ def _cached_file(name: str, make: Callable[[], bytes]) -> Path:
     """
     path = usable_cache_dir() / name
     if not path.exists():
-        data = make()
+        data = interruptibly(make)  # (a Ctrl-C ends a compile at once)
         write_bytes_atomic(path, data)
     return path
 

@@ -45,11 +45,13 @@ import ctypes
 import os
 import signal
 import threading
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
+
+T = TypeVar("T")
 
 SIGINTS = np.zeros(1, dtype=np.int64)
 """How many SIGINTs (and SIGTERMs) the machine-code handler has seen in this process (only ever increased)."""
@@ -60,6 +62,39 @@ LAST_SIGNAL = np.zeros(1, dtype=np.int64)
 
 class Terminated(KeyboardInterrupt):
     """SIGTERM: the command ends as on Ctrl-C (the same clean-up), with its own status (143)."""
+
+
+def interruptibly(make: Callable[[], T]) -> T:
+    """``make()`` (a compile: half a minute the first time), run so that a Ctrl-C ends it at once.
+
+    In the main thread it runs in a daemon thread of its own, waited for in slices of 50 ms: the
+    ``KeyboardInterrupt`` (or :class:`Terminated`) is raised here at once, and the compile, left to its
+    thread, ends with the process.  Run there, a Ctrl-C that fell inside one of llvmlite's ctypes
+    callbacks was "ignored" (a traceback on stderr) and the command went on to the end, exit 0.
+    Elsewhere ``make()`` is called directly.
+
+    Examples
+    --------
+    >>> interruptibly(lambda: 6 * 7)
+    42
+    """
+    if threading.current_thread() is not threading.main_thread():
+        return make()
+    done: dict[str, Any] = {}
+
+    def work() -> None:
+        try:
+            done["value"] = make()
+        except BaseException as exc:  # (re-raised in the caller's thread)
+            done["error"] = exc
+
+    worker = threading.Thread(target=work, name="grazing-compile", daemon=True)
+    worker.start()
+    while worker.is_alive():
+        worker.join(0.05)
+    if "error" in done:
+        raise done["error"]
+    return done["value"]
 
 
 def raise_terminated(_signum: int, _frame: object) -> None:

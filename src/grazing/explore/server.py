@@ -32,8 +32,9 @@ class PortInUseError(GrazingError):
 REFUSED_SHOWN = 160
 """Characters of a refused message's error that its log line shows."""
 
-WEBSOCKET_LOGGERS = ("bokeh.server.views.ws", "bokeh.server.protocol_handler")
-"""Bokeh's loggers that report a websocket message the server could not read or apply."""
+WEBSOCKET_LOGGERS = ("bokeh.server.views.ws", "bokeh.server.protocol_handler", "tornado.application")
+"""Bokeh's loggers that report a websocket message the server could not read or apply, and Tornado's,
+that reports a request its handler failed on (a websocket opened with a token that is not one)."""
 
 
 class OneLineRefusals(logging.Filter):
@@ -66,7 +67,8 @@ class OneLineRefusals(logging.Filter):
             text = " ".join(f"{type(exc).__name__}: {exc}".split())
             if len(text) > REFUSED_SHOWN:
                 text = text[: REFUSED_SHOWN - 3] + "..."
-            record.msg, record.args = "grazing explore: refused a websocket message (%s)", (text,)
+            what = "request" if record.name.startswith("tornado") else "websocket message"
+            record.msg, record.args = f"grazing explore: refused a {what} (%s)", (text,)
             record.exc_info, record.exc_text = None, None
         return True
 
