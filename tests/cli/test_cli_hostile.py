@@ -64,6 +64,10 @@ ONE_LINE = [
         "--initial must be THETA,THETADOT in radians, got ''",
     ),
     ([*CURVE, "--kind", "fold", "--initial", ""], "--initial must be THETA,THETADOT in radians, got ''"),
+    (  # (a store is never replaced: sweep and map refuse it so; found by the fuzz)
+        [*BASINS, "--x-range", "0,1", "--periods", "3", "--out", "b.zarr", "--overwrite"],
+        "--overwrite is not used with a Zarr store and no --plot (a store is never replaced)",
+    ),
     # multi-line errors (numpy's warnings before the line: see also the test in a process below)
     ([*BASINS, "--x-range", "-1e308,1e308"], "--x-range: the range from -1e+308 to 1e+308 is wider than"),
     (
