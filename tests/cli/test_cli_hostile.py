@@ -57,6 +57,8 @@ ONE_LINE = [
         "generatorexit.py failed to load: GeneratorExit: closed",
     ),
     (["simulate", "--model", "baseexception.py:model"], "baseexception.py failed to load: Halt: stopped"),
+    # a value just outside its interval, said with the digits that put it outside (found by the fuzz)
+    (["orbit", "--r", "1.0000001"], "r = 1.0000001 is outside [0, 1] (coefficient of restitution)"),
     # options ignored
     (["analyze", "rec.csv", "--phase", "1e308"], f"no sampling time at phase 1e+308 {NO_SAMPLE}"),
     (
