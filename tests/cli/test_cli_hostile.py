@@ -57,6 +57,8 @@ ONE_LINE = [
         "generatorexit.py failed to load: GeneratorExit: closed",
     ),
     (["simulate", "--model", "baseexception.py:model"], "baseexception.py failed to load: Halt: stopped"),
+    # a value just outside its interval, said with the digits that put it outside (found by the fuzz)
+    (["orbit", "--r", "1.0000001"], "r = 1.0000001 is outside [0, 1] (coefficient of restitution)"),
     # options ignored
     (["analyze", "rec.csv", "--phase", "1e308"], f"no sampling time at phase 1e+308 {NO_SAMPLE}"),
     (
@@ -64,6 +66,10 @@ ONE_LINE = [
         "--initial must be THETA,THETADOT in radians, got ''",
     ),
     ([*CURVE, "--kind", "fold", "--initial", ""], "--initial must be THETA,THETADOT in radians, got ''"),
+    (  # (a store is never replaced: sweep and map refuse it so; found by the fuzz)
+        [*BASINS, "--x-range", "0,1", "--periods", "3", "--out", "b.zarr", "--overwrite"],
+        "--overwrite is not used with a Zarr store and no --plot (a store is never replaced)",
+    ),
     # multi-line errors (numpy's warnings before the line: see also the test in a process below)
     ([*BASINS, "--x-range", "-1e308,1e308"], "--x-range: the range from -1e+308 to 1e+308 is wider than"),
     (

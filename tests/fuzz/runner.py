@@ -190,6 +190,33 @@ def _head(fd: int, deadline: float) -> bytes:
     return out
 
 
+SERVING = b"http://127.0.0.1:"
+"""What ``explore`` prints on its standard output once it serves its page (then it serves until Ctrl-C)."""
+
+
+def serves(case: Case) -> bool:
+    """Whether ``case``, run as a process, may start a server that runs until Ctrl-C (``explore``: in this
+    process, its server is stubbed instead; as a process, a valid call serves, by design, and gets a
+    Ctrl-C once it says so: it must then end as after any Ctrl-C, 130 and one line)."""
+    return case.command == "explore" and case.stdout == "pipe"
+
+
+def _until_served(fd: int, deadline: float) -> tuple[bytes, bool]:
+    """What ``fd`` gives until the serving line (or its end, or ``deadline``); whether it came."""
+    import select
+
+    out = b""
+    while SERVING not in out and time.monotonic() < deadline:
+        ready, _, _ = select.select([fd], [], [], max(0.0, deadline - time.monotonic()))
+        if not ready:
+            break
+        chunk = os.read(fd, 4096)
+        if not chunk:
+            break
+        out += chunk
+    return out, SERVING in out
+
+
 def run_process(case: Case, cwd: Path, scratch: Path) -> Outcome:
     """Run ``case`` as a process in ``cwd``; ``scratch`` (outside ``cwd``) holds its output file."""
     t0 = time.perf_counter()
@@ -219,7 +246,13 @@ def run_process(case: Case, cwd: Path, scratch: Path) -> Outcome:
             out = _head(reader, time.monotonic() + case.timeout)
             reader = None
         sent = None
-        if case.interrupt_after is not None:
+        if serves(case) and proc.stdout is not None:
+            wait = case.interrupt_after if case.interrupt_after is not None else case.timeout
+            out, served = _until_served(proc.stdout.fileno(), time.monotonic() + wait)
+            if served and proc.poll() is None:
+                sent = signal.SIGINT
+                os.killpg(proc.pid, signal.SIGINT)
+        if case.interrupt_after is not None and sent is None:
             try:
                 proc.wait(timeout=case.interrupt_after)
             except subprocess.TimeoutExpired:
@@ -234,7 +267,7 @@ def run_process(case: Case, cwd: Path, scratch: Path) -> Outcome:
         if reader is not None:
             os.close(reader)
     if case.stdout == "pipe":
-        out = got_out or b""
+        out += got_out or b""
     elif case.stdout == "file":
         out = (scratch / "stdout.txt").read_bytes()
     return Outcome(

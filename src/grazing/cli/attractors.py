@@ -227,6 +227,8 @@ def _check_outputs(out: Path | None, plot: Path | None, overwrite: bool, wait: b
     if plot is not None:
         check_out(plot, ".png", "--plot", overwrite)
     refuse_unused(["overwrite"], out is None and plot is None, "without --out or --plot")
+    no_file = "with a Zarr store and no --plot (a store is never replaced)"
+    refuse_unused(["overwrite"], zarr_out and plot is None, no_file)
     refuse_unused(["wait"], not zarr_out, "without a Zarr store (--out FILE.zarr)")
     return zarr_out
 

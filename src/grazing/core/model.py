@@ -170,7 +170,7 @@ class Parameter:
         above = v > self.upper or (self.upper_open and v == self.upper)
         if below or above:
             what = f" ({self.description})" if self.description else ""
-            raise InvalidParameterError(f"{self.name} = {v:g} is outside {self.interval()}{what}")
+            raise InvalidParameterError(f"{self.name} = {_value_text(v)} is outside {self.interval()}{what}")
         return v
 
     def admits(self, values: np.ndarray) -> np.ndarray:
@@ -185,6 +185,17 @@ class Parameter:
         below = (values < self.lower) | (self.lower_open & (values == self.lower))
         above = (values > self.upper) | (self.upper_open & (values == self.upper))
         return np.isfinite(values) & ~below & ~above
+
+
+def _value_text(v: float) -> str:
+    """``v`` as ``:g`` prints it, or all its digits where ``:g`` would round it (``r = 1.0000001`` outside
+    ``[0, 1]``, not ``r = 1``).
+
+    >>> _value_text(2.0), _value_text(1.0000001), _value_text(-1e-9)
+    ('2', '1.0000001', '-1e-09')
+    """
+    short = f"{v:g}"
+    return short if float(short) == v else repr(v)
 
 
 class _Definition:
