@@ -11,6 +11,7 @@ import errno
 import logging
 import signal
 import socket
+import sys
 from collections.abc import Callable
 
 from grazing.errors import GrazingError
@@ -44,7 +45,8 @@ class OneLineRefusals(logging.Filter):
     model the page does not have: Bokeh logs each with its traceback (and
     the message itself, however long), then that it closes the connection.
     This filter makes that one line, ``grazing explore: refused a websocket
-    message (ERROR)``; the server goes on serving the other pages.
+    message (ERROR)``, written by ``say`` (to stderr, without the logging
+    prefix of Bokeh's handler); the server goes on serving the other pages.
 
     Examples
     --------
@@ -55,9 +57,14 @@ class OneLineRefusals(logging.Filter):
     ...     record = logging.LogRecord("bokeh.server.views.ws", logging.ERROR, "ws.py", 1,
     ...                                "Unhandled exception receiving a message: %r: %r", (0, "{}"),
     ...                                sys.exc_info())
-    >>> OneLineRefusals().filter(record), record.getMessage(), record.exc_info
-    (True, "grazing explore: refused a websocket message (KeyError: 'NOPE')", None)
+    >>> said = []
+    >>> OneLineRefusals(said.append).filter(record), said
+    (False, ["grazing explore: refused a websocket message (KeyError: 'NOPE')"])
     """
+
+    def __init__(self, say: Callable[[str], object] | None = None) -> None:
+        super().__init__()
+        self.say = say if say is not None else (lambda line: print(line, file=sys.stderr, flush=True))
 
     def filter(self, record: logging.LogRecord) -> bool:
         if record.getMessage().startswith("Bokeh Server internal error: server failed to"):
@@ -68,8 +75,8 @@ class OneLineRefusals(logging.Filter):
             if len(text) > REFUSED_SHOWN:
                 text = text[: REFUSED_SHOWN - 3] + "..."
             what = "request" if record.name.startswith("tornado") else "websocket message"
-            record.msg, record.args = f"grazing explore: refused a {what} (%s)", (text,)
-            record.exc_info, record.exc_text = None, None
+            self.say(f"grazing explore: refused a {what} ({text})")
+            return False
         return True
 
 
