@@ -15,6 +15,8 @@ import stat
 from dataclasses import dataclass
 from pathlib import Path
 
+from tests.fuzz.cases import SWEEP
+
 MODEL_BODY = """
 import sympy as sp
 import grazing
@@ -103,44 +105,8 @@ def _grazings_files(root: Path) -> None:
     from grazing.cli import main
 
     runs = [
-        [
-            "sweep",
-            "--param",
-            "eta",
-            "--start",
-            "0.44",
-            "--stop",
-            "0.45",
-            "--num",
-            "2",
-            "--periods",
-            "3",
-            "--transient",
-            "3",
-            "--workers",
-            "1",
-            "--out",
-            "ours.nc",
-        ],
-        [
-            "sweep",
-            "--param",
-            "eta",
-            "--start",
-            "0.44",
-            "--stop",
-            "0.45",
-            "--num",
-            "2",
-            "--periods",
-            "3",
-            "--transient",
-            "3",
-            "--workers",
-            "1",
-            "--out",
-            "ours.zarr",
-        ],
+        [*SWEEP, "--out", "ours.nc"],
+        [*SWEEP, "--out", "ours.zarr"],
         ["simulate", "--transient", "3", "--periods", "3", "--trajectory", "ours.csv"],
         ["analyze", "rec.csv", "--plot", "ours.png"],
     ]

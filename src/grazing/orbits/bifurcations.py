@@ -199,10 +199,15 @@ def resolved_multipliers(orbit: PeriodicOrbit) -> np.ndarray:
     >>> resolved_multipliers(near_grazing).real.tolist()
     [1500000000.0, 0.0]
     """
-    floor = 64 * float(np.finfo(float).eps) * float(np.linalg.norm(orbit.monodromy, 2))
     mu = np.array(orbit.multipliers, dtype=complex)
-    mu[np.abs(mu) <= floor] = 0.0
+    mu[np.abs(mu) <= multiplier_floor(orbit.monodromy)] = 0.0
     return mu
+
+
+def multiplier_floor(monodromy: np.ndarray) -> float:
+    """The monodromy's rounding, ``64 eps |M|`` (``|M| / UNRESOLVED_NORM``): a multiplier below it is
+    rounding's."""
+    return float(np.linalg.norm(monodromy, 2)) / UNRESOLVED_NORM
 
 
 def branch_test(pt: PalcPoint) -> float:
@@ -239,7 +244,7 @@ def resolved_unstable_count(orbit: PeriodicOrbit) -> int:
     >>> resolved_unstable_count(at_grazing)
     1
     """
-    floor = float(np.linalg.norm(orbit.monodromy, 2)) / UNRESOLVED_NORM
+    floor = multiplier_floor(orbit.monodromy)
     mu = np.abs(orbit.multipliers)
     return int(np.sum((mu > 1.0 + UNIT_CIRCLE_TOL) & (mu > floor)))
 
