@@ -61,6 +61,26 @@ def project_on_contact(model: HybridModel, y: np.ndarray, t: float, stop: int) -
     return y - np.linalg.lstsq(rows, np.array([cd["h"], cd["rate"]]), rcond=None)[0]
 
 
+def contact_guess(
+    model: HybridModel, params: tuple[str, str], period: int, events: bool, stop: int, y: np.ndarray,
+    t: float, p: np.ndarray,
+) -> GrazingPoint | None:  # fmt: skip
+    """The grazing orbit's guess itself: the contact equations evaluated at ``(y, t)`` moved onto the
+    contact (:func:`project_on_contact`) and the parameters ``p``, not solved (None where the evaluation
+    fails).
+
+    Where a fold curve meets a grazing curve, the grazing curve turns back in the parameters (the
+    orbits' surface folds there): no grazing orbit is "nearest" along a line through ``p``
+    (:func:`nearest_grazing`), and :func:`meeting_point` starts from this guess instead.
+    """
+    m = model.with_params(**{q: float(v) for q, v in zip(params, p)})
+    contact = contact_system(model, params, period, events=events, stop=stop)
+    try:
+        return contact(np.concatenate([project_on_contact(m, y, t, stop), [t], p]))[2]
+    except FAILURES:
+        return None
+
+
 def nearest_grazing(
     model: HybridModel, params: tuple[str, str], period: int, events: bool, stop: int, y: np.ndarray,
     t: float, p: np.ndarray,

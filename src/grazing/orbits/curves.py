@@ -16,6 +16,10 @@ branch (bisection with a secant on the grazing margin), the point is solved
 from the grazing equations (the contact equations in both parameters with the
 point on the curve's secant) and the curve ends.  A curve of an orbit computed
 with the stops ignored (a nonimpacting orbit) reports its grazings and goes on.
+Where the orbit's monodromy is large (at the start, or where single shooting
+stalls along the curve) the fold, period-doubling, Neimark-Sacker and
+branch-point curves are followed on the segmented equations instead
+(:mod:`grazing.orbits.segmented_curves`: multiple shooting, one segment per impact).
 The other codimension-two points are zeros of test functions
 (:data:`~grazing.orbits.extended.CODIM2_TESTS`), located by regula falsi
 along the curve; the 1:1 and 1:2 resonances end a Neimark-Sacker curve.
@@ -40,7 +44,7 @@ from grazing.orbits.continuation import (
     continue_orbit,
     grazing_margin,
 )
-from grazing.orbits.crossings import meeting_point, nearest_grazing
+from grazing.orbits.crossings import contact_guess, meeting_point, nearest_grazing
 from grazing.orbits.curve_data import BifurcationCurve, CurvePoint, CurveSpecial
 from grazing.orbits.extended import CODIM2_TESTS, ENDING, Evaluation, GrazingSystem, OrbitSystem
 from grazing.orbits.palc import (
@@ -55,6 +59,8 @@ from grazing.orbits.palc import (
     sign_changed,
     tangent,
 )
+from grazing.orbits.segmented_curves import SegmentedOrbitSystem
+from grazing.orbits.segments import MULTIPLE_SHOOTING_NORM
 from grazing.orbits.shooting import CROSSING_TOL, PeriodicOrbit, move_section, quiet_section
 
 CURVE_KINDS = ("fold", "period-doubling", "neimark-sacker", "branch-point", "grazing")
@@ -168,6 +174,8 @@ class _Direction:
         self.pal: list[PalcPoint] = []
         self.special: list[tuple[int, CurveSpecial]] = []  # (index of the point on the start's side, special)
         self.status = ""
+        self.handover: tuple[float, float] | None = None  # where it went over to multiple shooting
+        self.segmented_start: float | None = None  # the monodromy's norm where it started on the segments
 
 
 class _Follower:
@@ -187,17 +195,37 @@ class _Follower:
         self.bounds1 = (lo1, hi1)
         self.bounds2 = (max(range2[0], lo2), min(range2[1], hi2))
         self.count = 0
+        self.segmented = False  # the system in hand is on the segmented equations (orbits.segmented_curves)
+        self._offset = self.n + 1 if kind == "grazing" else self.n
 
     # -- the systems --------------------------------------------------------
     def offset(self) -> int:
-        """Index of ``p1`` in the unknowns (``p2`` follows it)."""
-        return self.n + 1 if self.kind == "grazing" else self.n
+        """Index of ``p1`` in the unknowns of the system in hand (``p2`` follows it)."""
+        return self._offset
 
-    def system(self, start: PeriodicOrbit | GrazingPoint) -> OrbitSystem | GrazingSystem:
+    def can_segment(self, orbit: PeriodicOrbit) -> bool:
+        """Can the curve through ``orbit`` be followed on the segmented equations (it has impacts, it is
+        not virtual, the model has a forcing period)?"""
+        return self.kind != "grazing" and not self.virtual and orbit.impacts > 0 and self.model.periodic
+
+    def system(
+        self, start: PeriodicOrbit | GrazingPoint, segmented: bool = False
+    ) -> OrbitSystem | GrazingSystem | SegmentedOrbitSystem:
+        """The extended system through ``start``: on the segmented equations where asked (``segmented``)
+        or where the monodromy exceeds :data:`~grazing.orbits.segments.MULTIPLE_SHOOTING_NORM`."""
         if self.kind == "grazing":
             assert isinstance(start, GrazingPoint)
             return GrazingSystem(self.model, self.params, self.period, _with_events(start), start.stop)
         assert isinstance(start, PeriodicOrbit)
+        large = float(np.linalg.norm(start.monodromy, 2)) > MULTIPLE_SHOOTING_NORM
+        self.segmented = self.can_segment(start) and (segmented or large)
+        if self.segmented:
+            system = SegmentedOrbitSystem(
+                self.model, self.kind, self.params, self.period, start.t0, self.stop, start
+            )
+            self._offset = system.offset
+            return system
+        self._offset = self.n
         return OrbitSystem(
             self.model,
             self.kind,
@@ -243,6 +271,17 @@ class _Follower:
                 f"the orbit {what} an impact (impacts per forcing period {list(oa.signature)} -> "
                 f"{list(ob.signature)}): the curve meets a grazing"
             )
+        if self.segmented:  # (the segments ignore the stops: past a grazing they pass through one)
+            if ob.impact_speeds.size and float(np.min(ob.impact_speeds)) <= 0.0:
+                return BOUNDARY, (
+                    "an impact speed reaches zero (the orbit loses an impact): the curve meets a grazing"
+                )
+            crossed = [name for name in ob.crossed_stops if name not in oa.crossed_stops]
+            if crossed:
+                return BOUNDARY, (
+                    f"the orbit passes through stop {crossed[0]!r} between its impacts (it gains an impact "
+                    "there): the curve meets a grazing"
+                )
         if ob.section_clearance() < RESECTION_MARGIN:
             return STOP, _RESECTION
         return ACCEPT, ""
@@ -265,16 +304,33 @@ class _Follower:
             )
         return pt
 
-    def run(self, start: PeriodicOrbit | GrazingPoint, sign: float, index: int) -> _Direction:
-        """Follow the curve from ``start`` with component ``index`` moving in direction ``sign``."""
+    def run(self, start: PeriodicOrbit | GrazingPoint, sign: float, which: int) -> _Direction:
+        """Follow the curve from ``start`` with parameter ``which`` (0: ``p1``, 1: ``p2``) moving in
+        direction ``sign``.  Where single shooting stalls on an orbit with impacts, the curve goes on on
+        the segmented equations from its last point."""
         d = _Direction()
-        i1 = self.offset()
-        bounds = {i1: self.bounds1, i1 + 1: self.bounds2}
-        names = {i1: self.params[0], i1 + 1: self.params[1]}
-        shows = {i1: self.pars[0].show, i1 + 1: self.pars[1].show}
+        d.status = self._run(d, start, sign, which)
+        if d.handover is not None:
+            where = self.show(d.handover)
+            d.status += f"; by multiple shooting from {where} on (single shooting stalled there)"
+        elif d.segmented_start is not None:
+            norm = f"{d.segmented_start:.1e}"
+            d.status += f"; by multiple shooting (the monodromy's norm is {norm} at the start)"
+        return d
+
+    def _run(self, d: _Direction, start: PeriodicOrbit | GrazingPoint, sign: float, which: int) -> str:
+        """:meth:`run` itself: fills ``d``, returns its status."""
         current = start
+        segmented = False
         while True:
-            system = self.system(current)
+            system = self.system(current, segmented)
+            if self.segmented and not segmented and not d.pal:
+                d.segmented_start = float(np.linalg.norm(current.monodromy, 2))  # type: ignore[union-attr]
+            i1 = self.offset()
+            index = i1 + which
+            bounds = {i1: self.bounds1, i1 + 1: self.bounds2}
+            names = {i1: self.params[0], i1 + 1: self.params[1]}
+            shows = {i1: self.pars[0].show, i1 + 1: self.pars[1].show}
             u0 = system.start(current)
             first = self.first(system, u0, i1 + 1 if not d.pal else index)
             palc = Palc(
@@ -290,19 +346,18 @@ class _Follower:
                     system.accept(pt.payload)
                     continue
                 if abs(pt.payload.shift) > SHIFT_TOL:
-                    d.status = (
+                    return (
                         f"shift = {pt.payload.shift:.3g} at {self.show(self.curve_point(pt).values)}: the "
                         "branch point does not persist in two parameters (the model lacks the symmetry that "
                         "keeps it)"
                     )
-                    return d
                 if d.pal and self.detect(system, d, d.pal[-1], pt):
                     ended = True
                     break
                 self.append(d, pt)
                 system.accept(pt.payload)
             if ended:
-                return d
+                return d.status
             d.status = palc.status
             last = d.pal[-1]
             assert last.tangent is not None
@@ -311,12 +366,23 @@ class _Follower:
                 try:
                     current = move_section(last.payload.orbit, quiet_section(last.payload.orbit))
                 except GrazingError as exc:
-                    d.status = f"{_RESECTION} and the orbit could not be found on another section ({exc})"
-                    return d
+                    return f"{_RESECTION} and the orbit could not be found on another section ({exc})"
                 continue
-            if palc.boundary is not None:
-                self.end_at_grazing(d, palc)
-            return d
+            if palc.boundary is None:
+                return d.status
+            if self.end_at_grazing(d, palc):
+                return d.status
+            orbit = last.payload.orbit
+            if (
+                not palc.boundary.reached and not self.segmented and self.can_segment(orbit)
+                and len(d.points) < self.s.max_points
+            ):  # fmt: skip
+                # Single shooting stalled (its residual's rounding, |M| eps |x|, above its tolerance where
+                # the monodromy is large) with no grazing just ahead: the segmented equations from here.
+                segmented, current = True, orbit
+                d.handover = self.curve_point(last).values
+                continue
+            return d.status
 
     def append(self, d: _Direction, pt: PalcPoint) -> None:
         d.pal.append(pt)
@@ -423,6 +489,12 @@ class _Follower:
         first = not self.virtual and others > 0
         for events in (first,) if self.virtual else (first, not first):
             near = nearest_grazing(self.model, self.params, self.period, events, stop, y, t, pb)
+            if near is None and self.kind == "fold":  # (the grazing curve turns back where it meets a fold)
+                guess = contact_guess(self.model, self.params, self.period, events, stop, y, t, pb)
+                near = None if guess is None else meeting_point(self.kind, self.params, events, guess, loses)
+                if near is not None and near.impacts == others and not (not events and _crossing(near)):
+                    return near, True
+                continue
             if near is None or near.impacts != others or (not events and _crossing(near)):
                 continue
             pn = np.array([near.model.params[q] for q in self.params])
@@ -432,8 +504,11 @@ class _Follower:
             return (near, False) if exact is None else (exact, True)
         return None, False
 
-    def end_at_grazing(self, d: _Direction, palc: Palc) -> None:
-        """The curve ends at a boundary: the orbit gains or loses an impact (a codimension-two grazing)."""
+    def end_at_grazing(self, d: _Direction, palc: Palc) -> bool:
+        """The curve ends at a boundary: the orbit gains or loses an impact (a codimension-two grazing).
+
+        False where the boundary is not confirmed and no grazing is just ahead (Newton's method fails
+        beyond the last point): then nothing is recorded."""
         boundary = palc.boundary
         assert boundary is not None
         before = d.pal[-1]
@@ -453,7 +528,8 @@ class _Follower:
                         "this side)"
                     )
                 d.status = f"ended at a double grazing at {self.show(cp.values)}: {reason}"
-            return
+                return True
+            return False
         orbit = before.payload.orbit
         _, y, t, what, stop = grazing_margin(orbit)
         loses = what == "loses an impact"
@@ -463,7 +539,7 @@ class _Follower:
                 y, t, stop, before, boundary.after, orbit.impacts - loses, loses
             )
         if point is None and not boundary.reached:
-            return  # stuck (Newton's method fails beyond the last point), no grazing just ahead: as palc says
+            return False  # stuck (Newton's method fails beyond the last point), no grazing just ahead
         special = self.grazing_special(index, before, point, exact)
         d.special.append((index, special))
         where = self.show(special.values)
@@ -479,6 +555,7 @@ class _Follower:
         elif not exact:
             where += " (the grazing nearest the curve's last point: the meeting point did not converge)"
         d.status = f"ended at a grazing at {where}: {reason}"
+        return True
 
 
 def follow_curve(
@@ -613,9 +690,9 @@ def _follow_from(
     i1 = f.offset()
     u0 = system.start(first)
     t = tangent(f.first(system, u0, i1 + 1).DF)
-    index = i1 if abs(t[i1]) >= abs(t[i1 + 1]) else i1 + 1  # the parameter that moves most
-    back = f.run(first, -1.0, index)
-    ahead = f.run(first, 1.0, index)
+    which = 0 if abs(t[i1]) >= abs(t[i1 + 1]) else 1  # the parameter that moves most
+    back = f.run(first, -1.0, which)
+    ahead = f.run(first, 1.0, which)
     curve = BifurcationCurve(
         model=f.model,
         kind=f.kind,

@@ -47,7 +47,7 @@ import numpy as np
 from grazing.core.model import HybridModel
 from grazing.errors import ConvergenceError, GrazingError
 from grazing.maps import FlowMap, flow_map
-from grazing.orbits.bifurcations import critical_pair
+from grazing.orbits.bifurcations import critical_pair, resolved_multipliers
 from grazing.orbits.bordered import Bordered, Borders, bialternate, bordered
 from grazing.orbits.contact import GrazingPoint, contact_system
 from grazing.orbits.shooting import PeriodicOrbit, _orbit_from
@@ -380,7 +380,7 @@ class OrbitSystem:
                 return self._branch_point(u, orbit, fm, sol, T)
         F = np.append(F0, sol.g)
         DF = np.vstack([np.hstack([M - np.eye(n), S]), grad])
-        tests = codim2_tests(kind, orbit.multipliers, cusp)
+        tests = codim2_tests(kind, resolved_multipliers(orbit), cusp)
         accuracy = multiplier_accuracy(kind, M, sol, grad, u)
         return F, DF, Evaluation(orbit, None, sol.g, tests, 0.0, sol, accuracy)
 
@@ -406,7 +406,7 @@ class OrbitSystem:
         DF[:n, n + 2] = psi
         DF[n, : n + 2] = grad_g
         DF[n + 1, : n + 2] = grad_g2
-        tests = codim2_tests("branch-point", orbit.multipliers)
+        tests = codim2_tests("branch-point", resolved_multipliers(orbit))
         accuracy = multiplier_accuracy("branch-point", M, sol, grad_g, u)
         return F, DF, Evaluation(orbit, None, sol.g, tests, shift, sol, accuracy)
 

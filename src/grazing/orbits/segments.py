@@ -70,7 +70,7 @@ class SegmentFlow:
         ``d end / d x``.
     sensitivity
         ``d end / d p`` with ``ta`` and ``tb`` held fixed (a parameter that sets the forcing period
-        moves neither).
+        moves neither): a vector for one parameter, a matrix with a column per parameter for several.
     solution
         The run (its guard minima tell whether the segment passes through a stop).
     """
@@ -81,9 +81,12 @@ class SegmentFlow:
     solution: Solution
 
 
-def segment_flow(model: HybridModel, x: np.ndarray, ta: float, tb: float, param: str | None) -> SegmentFlow:
+def segment_flow(
+    model: HybridModel, x: np.ndarray, ta: float, tb: float, param: str | tuple[str, ...] | None
+) -> SegmentFlow:
     """Free flight (the stops ignored) from state ``x`` at time ``ta`` to time ``tb > ta``.
 
+    ``param``: the parameter (or a tuple of them) whose sensitivities are computed (None: none).
     The engine samples at a forcing phase: the run's last sample is the phase of
     ``tb`` after as many periods as it takes to reach it.
 
@@ -107,19 +110,24 @@ def segment_flow(model: HybridModel, x: np.ndarray, ta: float, tb: float, param:
     periods = kb - ks + 1
     if periods < 1 or tb - ta < SNAP * T:
         raise ConvergenceError(f"a segment of the orbit has no length (from t = {ta:.12g} to {tb:.12g})")
+    names = () if param is None else (param,) if isinstance(param, str) else tuple(param)
     sol = simulate(
         model, x, t0=ta, periods=periods, phase=2 * math.pi * s_phase / T, jacobian=True,
-        sensitivities=() if param is None else (param,), guard_min=True, events=False, impacts="none",
+        sensitivities=names, guard_min=True, events=False, impacts="none",
     )  # fmt: skip
     n = model.n_states
     end = sol.x_final
-    if param is None:
+    if not names:
         return SegmentFlow(end, sol.jacobian[:, :n], np.zeros(n), sol)
-    sens = sol.jacobian[:, n]
-    tp = sol.info["period_gradient"][param]
-    if tp:  # (the engine's end (kb + s_phase/T) T(p) moves with T; the segment's end tb does not)
-        sens = sens - model.vector_field(end, sol.t_final) * (sol.t_final / T) * tp
-    return SegmentFlow(end, sol.jacobian[:, :n], sens, sol)
+    columns = []
+    for i, name in enumerate(names):
+        sens = sol.jacobian[:, n + i]
+        tp = sol.info["period_gradient"][name]
+        if tp:  # (the engine's end (kb + s_phase/T) T(p) moves with T; the segment's end tb does not)
+            sens = sens - model.vector_field(end, sol.t_final) * (sol.t_final / T) * tp
+        columns.append(sens)
+    sensitivity = columns[0] if isinstance(param, str) else np.stack(columns, axis=1)
+    return SegmentFlow(end, sol.jacobian[:, :n], sensitivity, sol)
 
 
 @dataclass(frozen=True)
@@ -176,15 +184,18 @@ def layout_of(orbit: PeriodicOrbit) -> SegmentLayout:
 
 
 def segmented_equations(
-    model: HybridModel, param: str, period: int, t0: float, layout: SegmentLayout, stop: int = 0
-):
+    model: HybridModel, param: str | tuple[str, ...] | None, period: int, t0: float, layout: SegmentLayout,
+    stop: int = 0,
+):  # fmt: skip
     """``u -> (F, DF, orbit)`` for the multiple-shooting equations of a period-``period`` orbit.
 
     ``u`` is laid out by ``layout`` (:class:`SegmentLayout`), the parameter ``param`` last;
     ``stop`` is the stop whose guard minimum the orbit reports.  ``F`` has as many rows as
     ``u`` has entries but one (``DF`` one column more), as :func:`branch_equations`'s.  With
     ``param`` None the parameters are fixed: the last entry of ``u`` is ignored and the last
-    column of ``DF`` is zero (:func:`segmented_newton`).
+    column of ``DF`` is zero (:func:`segmented_newton`).  With a tuple of parameters (a curve
+    in two parameters, :mod:`grazing.orbits.segmented_curves`) they are the last entries of
+    ``u``, in order, and ``DF`` has a column for each.
 
     Examples
     --------
@@ -198,15 +209,19 @@ def segmented_equations(
     (True, (8, 9), True)
     """
     n, k = layout.n_states, layout.impacts
-    pidx = [p.name for p in model.parameters].index(param) if param is not None else -1
-    size = layout.size
+    names = () if param is None else (param,) if isinstance(param, str) else tuple(param)
+    order = [p.name for p in model.parameters]
+    pidx = [order.index(name) for name in names]
+    size, extra = layout.size, max(1, len(names))
+    pcols = slice(size, size + len(names))
 
     def evaluate(u: np.ndarray) -> tuple[np.ndarray, np.ndarray, PeriodicOrbit]:
-        m = model.with_params(**{param: float(u[-1])}) if param is not None else model
+        values = u[size : size + len(names)]
+        m = model.with_params(**{q: float(v) for q, v in zip(names, values)}) if names else model
         T = m.period
         t_end = t0 + period * T
         F = np.zeros(size)
-        DF = np.zeros((size, size + 1))
+        DF = np.zeros((size, size + extra))
         M = np.eye(n)
         times = [t0] + [float(u[layout.time_index(i)]) for i in range(1, k + 1)] + [t_end]
         if np.any(np.diff(times) <= 0.0):
@@ -218,22 +233,22 @@ def segmented_equations(
         for i in range(k + 1):
             s_i = layout.state(u, i)
             ta, tb = times[i], times[i + 1]
-            seg = segment_flow(m, s_i, ta, tb, param)
+            seg = segment_flow(m, s_i, ta, tb, names)
             runs.append(seg.solution)
             y = seg.end
             si, col_t_end = layout.state_index(i), (layout.time_index(i + 1) if i < k else None)
             # d y = Phi d s_i - Phi f(s_i, ta) d ta + f(y, tb) d tb + S d p
             f_start = m.vector_field(s_i, ta)
             f_end = m.vector_field(y, tb)
-            dy = np.zeros((n, size + 1))
+            dy = np.zeros((n, size + extra))
             dy[:, si : si + n] = seg.jacobian
             if i > 0:
                 dy[:, layout.time_index(i)] = -seg.jacobian @ f_start
             if col_t_end is not None:
                 dy[:, col_t_end] = f_end
-            if param is not None:
-                tp = seg.solution.info["period_gradient"][param]  # dT/dp: the return time t0 + n T moves
-                dy[:, -1] = seg.sensitivity + (f_end * period * tp if i == k else 0.0)
+            for c, name in enumerate(names):
+                tp = seg.solution.info["period_gradient"][name]  # dT/dp: the return time t0 + n T moves
+                dy[:, size + c] = seg.sensitivity[:, c] + (f_end * period * tp if i == k else 0.0)
             M = seg.jacobian @ M
             if i == k:  # the return to the section
                 F[row : row + n] = y - layout.state(u, 0)
@@ -246,8 +261,8 @@ def segmented_equations(
             F[row] = cd["h"]
             DF[row] = cd["h_x"] @ dy
             DF[row, col_t_end] += cd["h_t"]
-            if param is not None:
-                DF[row, -1] += cd["h_p"][pidx]
+            if names:
+                DF[row, pcols] += np.asarray(cd["h_p"])[pidx]
             row += 1
             g = m.reset(y, tb, j)
             _, _, gx = m.jacobians(y, tb, j)
@@ -256,9 +271,9 @@ def segmented_equations(
             F[row : row + n] = layout.state(u, i + 1) - g
             DF[row : row + n] = -(gx @ dy)
             DF[row : row + n, col_t_end] -= gt
-            if param is not None:
+            if names:
                 gp = np.asarray(m.numeric("g_p", j)(list(y), tb, list(m.param_vector)), dtype=float)
-                DF[row : row + n, -1] -= gp.reshape(n, -1)[:, pidx]
+                DF[row : row + n, pcols] -= gp.reshape(n, -1)[:, pidx]
             DF[row : row + n, nxt : nxt + n] += np.eye(n)
             row += n
             pre.append(y)
