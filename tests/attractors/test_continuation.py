@@ -46,10 +46,23 @@ def test_the_ball_along_its_amplitude_follows_the_closed_forms():
 
 
 def test_matching_prefers_the_seeds_then_the_nearest():
-    a = Attractor(1, "periodic", 1, 1.0, -0.1, np.array([[0.0, 0.0]]))
-    b = Attractor(2, "periodic", 1, 1.0, -0.1, np.array([[5.0, 5.0]]))
-    far = Attractor(1, "periodic", 1, 1.0, -0.1, np.array([[50.0, 50.0]]))
-    near = Attractor(2, "periodic", 1, 1.0, -0.1, np.array([[0.5, 0.0]]))
+    a = Attractor(
+        id=1, kind="periodic", period=1, impacts_per_period=1.0, lyapunov=-0.1, points=np.array([[0.0, 0.0]])
+    )
+    b = Attractor(
+        id=2, kind="periodic", period=1, impacts_per_period=1.0, lyapunov=-0.1, points=np.array([[5.0, 5.0]])
+    )
+    far = Attractor(
+        id=1,
+        kind="periodic",
+        period=1,
+        impacts_per_period=1.0,
+        lyapunov=-0.1,
+        points=np.array([[50.0, 50.0]]),
+    )
+    near = Attractor(
+        id=2, kind="periodic", period=1, impacts_per_period=1.0, lyapunov=-0.1, points=np.array([[0.5, 0.0]])
+    )
     # by distance, a continues as the near one and b is too far from the far one (a new attractor)
     assert match([a, b], [far, near], np.ones(2), threshold=8.0) == {2: 1}
     # b's seeds all ended on the far one: that is b, however far it moved

@@ -25,7 +25,7 @@ import grazing
 from grazing.maps import flow_map
 from grazing.models import two_sided_oscillator
 from grazing.orbits import PalcSettings, continue_orbit, find_orbit
-from grazing.orbits.bifurcations import CROSSINGS, Located, Step
+from grazing.orbits.bifurcations import CROSSINGS, Located, StepAccount
 from grazing.orbits.continuation import _locate_grazing
 from grazing.orbits.shooting import move_section
 from tests.orbits.any_damping import any_damping
@@ -300,7 +300,7 @@ def test_the_account_of_a_step(kinds, before, change, missed):
         for k in kinds  # type: ignore[arg-type]
     )
     after = max(0, before + change)
-    step = Step(located, ("fold",) if missed else (), (before, after))
+    step = StepAccount(located, ("fold",) if missed else (), (before, after))
     crossings = [0 if k == "branch point (turns)" else CROSSINGS[k] for k in kinds]
     reachable = {
         sum(sign * c for sign, c in zip(signs, crossings)) for signs in product((-1, 1), repeat=len(kinds))
@@ -428,7 +428,7 @@ def test_a_multiplier_that_jumps_across_the_circle_is_unlocated_not_a_bifurcatio
 
 
 def test_an_unexplained_step_with_located_points_names_them():
-    step = Step((Located("fold", None, turns=True),), ("period-doubling",), (0, 2))
+    step = StepAccount((Located("fold", None, turns=True),), ("period-doubling",), (0, 2))
     assert not step.explained
     text = step.describe()
     assert text.startswith("stable -> 2 multipliers outside the unit circle")

@@ -42,7 +42,7 @@ from grazing.core.options import (
 from grazing.errors import InvalidParameterError
 from grazing.sweeps.spec import ChunkResult, SweepSpec
 
-Progress = Callable[[int, int], None]
+BasinsProgress = Callable[[int, int], None]
 """Called as ``progress(initial_states_done, initial_states_total)``."""
 
 SMALLEST_CELL = float(np.finfo(float).tiny) / MATCH_TOL
@@ -125,7 +125,7 @@ class _Run:
     workers: int | None
     client: Any
     store: Any
-    progress: Progress | None
+    progress: BasinsProgress | None
 
 
 def find_attractors(
@@ -139,7 +139,7 @@ def find_attractors(
     workers: int | None = None,
     client: Any = None,
     store: Any = None,
-    progress: Progress | None = None,
+    progress: BasinsProgress | None = None,
     **shorthands: Any,
 ) -> AttractorSet:
     """The attractors reached from the initial states ``states`` (rows), and which one each reaches.

@@ -73,7 +73,7 @@ INVALID = 0
 """The label of an initial state beyond a stop (not run); attractors are numbered from 1."""
 
 
-@dataclass
+@dataclass(kw_only=True)
 class Attractor:
     """An attractor (or an outcome: escaping, failed, invalid) and the initial states that end on it.
 
@@ -497,16 +497,16 @@ class Catalogue:
             n = self.model.n_states
             out.append(
                 Attractor(
-                    INVALID,
-                    "invalid",
-                    -1,
-                    math.nan,
-                    math.nan,
-                    np.zeros((0, n)),
-                    "beyond a stop",
-                    invalid,
-                    invalid / total,
-                    -1,
+                    id=INVALID,
+                    kind="invalid",
+                    period=-1,
+                    impacts_per_period=math.nan,
+                    lyapunov=math.nan,
+                    points=np.zeros((0, n)),
+                    reason="beyond a stop",
+                    count=invalid,
+                    fraction=invalid / total,
+                    first=-1,
                 )
             )
         for k in roots:
@@ -515,16 +515,16 @@ class Catalogue:
             pts = e.points if e.points.size else np.zeros((0, self.model.n_states))
             out.append(
                 Attractor(
-                    ids[k],
-                    kind,
-                    e.period,
-                    e.impacts,
-                    exponent,
-                    pts,
-                    e.reason,
-                    e.count,
-                    e.count / total,
-                    e.first,
+                    id=ids[k],
+                    kind=kind,
+                    period=e.period,
+                    impacts_per_period=e.impacts,
+                    lyapunov=exponent,
+                    points=pts,
+                    reason=e.reason,
+                    count=e.count,
+                    fraction=e.count / total,
+                    first=e.first,
                 )
             )
         table = np.array(

@@ -45,8 +45,8 @@ OUTCOMES = ("escaping", "failed", "invalid")
 """Kinds that are outcomes, not attractors: matched by kind and reason."""
 
 
-@dataclass(frozen=True)
-class Step:
+@dataclass(frozen=True, kw_only=True)
+class ContinuationStep:
     """One parameter value of a continuation: what was found there, and the followed id of each attractor."""
 
     value: float
@@ -81,10 +81,11 @@ def match(
 
     Examples
     --------
-    >>> a = Attractor(1, "periodic", 1, 1.0, -0.1, np.array([[0.0, 0.0]]))
-    >>> b = Attractor(2, "periodic", 1, 1.0, -0.1, np.array([[5.0, 5.0]]))
-    >>> moved = [Attractor(1, "periodic", 1, 1.0, -0.1, np.array([[5.5, 5.0]])),
-    ...          Attractor(2, "periodic", 1, 1.0, -0.1, np.array([[0.5, 0.0]]))]
+    >>> def periodic(i, x, y):
+    ...     return Attractor(id=i, kind="periodic", period=1, impacts_per_period=1.0, lyapunov=-0.1,
+    ...                      points=np.array([[x, y]]))
+    >>> a, b = periodic(1, 0.0, 0.0), periodic(2, 5.0, 5.0)
+    >>> moved = [periodic(1, 5.5, 5.0), periodic(2, 0.5, 0.0)]
     >>> match([a, b], moved, np.ones(2))
     {1: 2, 2: 1}
     """
@@ -214,7 +215,7 @@ def continue_attractors(
         model.with_params(**{par.name: float(v)})
     grid = state_grid(model, x_range, y_range, num, states=states, fixed=fixed, phase=s.phase)
     x = grid.states_array()
-    steps: list[Step] = []
+    steps: list[ContinuationStep] = []
     next_id = 1
     previous: list[Attractor] = []
     for k, v in enumerate(vals):
@@ -238,14 +239,16 @@ def continue_attractors(
             else:
                 ids[a.id] = next_id
                 next_id += 1
-        steps.append(Step(float(v), found, x.shape[0], ids))
+        steps.append(ContinuationStep(value=float(v), found=found, grid_size=x.shape[0], ids=ids))
         previous = list(found.attractors)
         if progress is not None:
             progress(k + 1, vals.size)
     return to_dataset(model, par.name, grid, steps, time.perf_counter() - start)
 
 
-def to_dataset(model: HybridModel, param: str, grid: Any, steps: Sequence[Step], seconds: float) -> Any:
+def to_dataset(
+    model: HybridModel, param: str, grid: Any, steps: Sequence[ContinuationStep], seconds: float
+) -> Any:
     """The dataset of :func:`continue_attractors`."""
     import xarray as xr
 

@@ -3,6 +3,7 @@ parameters."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Any
 
@@ -54,6 +55,19 @@ def _values(curve: Any, values: tuple[float, float]) -> dict[str, float]:
     return {p.name: p.to_display(v) for p, v in zip(_parameters(curve), values)}
 
 
+def _widths(curve: Any, widths: tuple[float, float]) -> dict[str, float | None]:
+    """A special point's precision in each parameter, in its display unit (a width: the unit's scale
+    alone); None where unknown."""
+    return {p.name: None if math.isnan(w) else p.to_display(w) for p, w in zip(_parameters(curve), widths)}
+
+
+def _intervals(curve: Any, interval: Any) -> dict[str, list[float]] | None:
+    """A special point's bracket in each parameter, ``[low, high]`` in its display unit (None: none)."""
+    if interval is None:
+        return None
+    return {p.name: sorted(p.to_display(v) for v in iv) for p, iv in zip(_parameters(curve), interval)}
+
+
 def _parameters(curve: Any) -> tuple[grazing.Parameter, grazing.Parameter]:
     return curve.model.parameter(curve.params[0]), curve.model.parameter(curve.params[1])
 
@@ -62,7 +76,7 @@ def _parameters(curve: Any) -> tuple[grazing.Parameter, grazing.Parameter]:
 @model_options(any_model=True)
 @click.option(
     "--kind",
-    type=click.Choice(CURVE_KINDS),
+    type=click.Choice([str(k) for k in CURVE_KINDS]),  # (the words: click takes an enum by its names)
     required=True,
     help="The bifurcation to follow: the first one of this kind met from --start towards --stop.",
 )
@@ -167,7 +181,8 @@ def curve(
         ],
         "special": [
             {"kind": sp_.kind, **_values(result, sp_.values), "located": sp_.located,
-             "multipliers": complex_list(sp_.multipliers), "index": sp_.index}
+             "multipliers": complex_list(sp_.multipliers), "index": sp_.index,
+             "precision": _widths(result, sp_.precision), "interval": _intervals(result, sp_.interval)}
             for sp_ in result.special
         ],
         "status": result.status,

@@ -24,6 +24,7 @@ from grazing.explore.diagram import IsCancelled, SupersededError, View, checkpoi
 from grazing.explore.point import PointReport
 from grazing.orbits.continuation import Branch, continue_orbit
 from grazing.orbits.grazing import find_grazings
+from grazing.orbits.kinds import SpecialKind
 from grazing.orbits.shooting import PeriodicOrbit
 
 __all__ = [
@@ -184,7 +185,7 @@ def grazings_in_view(
         )
     marks, lines = [], []
     for sp in branch.special:
-        if sp.kind != "grazing" or sp.grazing is None:
+        if sp.kind != SpecialKind.GRAZING or sp.grazing is None:
             continue
         checkpoint(cancelled)
         g = sp.grazing
@@ -202,16 +203,6 @@ def grazings_in_view(
     if not marks:
         lines.append(f"no grazing of the nonimpacting period-{period} orbit in the range ({branch.status})")
     return Grazings(axis.name, tuple(marks), tuple(lines), (axis.lo, axis.hi), dict(fixed or {}))
-
-
-CURVE_OF = {
-    "fold": "fold",
-    "period-doubling": "period-doubling",
-    "neimark-sacker": "neimark-sacker",
-    "branch point": "branch-point",
-    "grazing": "grazing",
-}
-"""The curve (:data:`grazing.orbits.curves.CURVE_KINDS`) that follows each kind of special point."""
 
 
 @dataclass(frozen=True)
@@ -261,7 +252,7 @@ def follow_click_curves(
     for piece in continued.pieces:
         done = set()
         for sp in piece.branch.special:
-            kind = CURVE_OF.get(sp.kind)
+            kind = SpecialKind(sp.kind).curve  # (the curve that follows it; None: an unlocated change)
             if kind is None or kind in done:
                 continue
             done.add(kind)

@@ -297,7 +297,7 @@ def _curves_code(
     view = found.view or view  # (the map they were followed over, not a zoomed part of it)
     a, b = view.axes
     start, period = point.values[a.name], point.orbit.period
-    asked = [(c.kind, c.stop) for c in found.curves]
+    asked = [(str(c.kind), c.stop) for c in found.curves]
     py += [
         "",
         f"# the bifurcation curves through the branch's special points, in ({a.name}, {b.name})",

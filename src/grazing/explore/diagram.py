@@ -46,7 +46,8 @@ class SupersededError(GrazingError):
     """A computation stopped because a newer request of the page replaced it."""
 
 
-Progress = Callable[[int, int], None]
+DiagramProgress = Callable[[int, int], None]
+"""Called as ``progress(points_done, points_total)``."""
 IsCancelled = Callable[[], bool]
 
 
@@ -263,7 +264,7 @@ class Diagram:
 def compute_diagram(
     view: View,
     *,
-    progress: Progress | None = None,
+    progress: DiagramProgress | None = None,
     cancelled: IsCancelled | None = None,
     workers: int | None = None,
 ) -> Diagram:

@@ -52,13 +52,21 @@ import numpy as np
 
 from grazing.core.options import UNIT_CIRCLE_TOL
 from grazing.orbits.branch_equations import BranchEquations
+from grazing.orbits.kinds import SpecialKind
 from grazing.orbits.palc import PalcPoint, PalcSettings, locate, locate_by_interpolation, sign_changed
 from grazing.orbits.shooting import PeriodicOrbit
 
-SMOOTH_KINDS = ("fold", "branch point", "period-doubling", "neimark-sacker")
+SMOOTH_KINDS = (
+    SpecialKind.FOLD, SpecialKind.BRANCH_POINT, SpecialKind.PERIOD_DOUBLING, SpecialKind.NEIMARK_SACKER
+)  # fmt: skip
 """The special points located between two points of a branch of one impact signature."""
 
-CROSSINGS = {"fold": 1, "branch point": 1, "period-doubling": 1, "neimark-sacker": 2}
+CROSSINGS = {
+    SpecialKind.FOLD: 1,
+    SpecialKind.BRANCH_POINT: 1,
+    SpecialKind.PERIOD_DOUBLING: 1,
+    SpecialKind.NEIMARK_SACKER: 2,
+}
 """How many multipliers cross the unit circle at each kind (a branch point where the parameter
 turns: none)."""
 
@@ -170,15 +178,15 @@ def neutral_saddle(orbit: PeriodicOrbit) -> bool:
     return not _conjugate_pair(mu[i], mu[j]) and abs(mu[i] * mu[j] - 1.0) < VERIFY_TOL
 
 
-def orbit_test(kind: str, orbit: PeriodicOrbit) -> float:
+def orbit_test(kind: SpecialKind, orbit: PeriodicOrbit) -> float:
     """Test function of a special point (smooth along a branch of one impact signature)."""
     J = orbit.monodromy
     eye = np.eye(J.shape[0])
-    if kind == "fold":
+    if kind == SpecialKind.FOLD:
         return float(np.linalg.det(J - eye))
-    if kind == "period-doubling":
+    if kind == SpecialKind.PERIOD_DOUBLING:
         return float(np.linalg.det(J + eye))
-    if kind == "neimark-sacker":
+    if kind == SpecialKind.NEIMARK_SACKER:
         return neimark_sacker_test(resolved_multipliers(orbit))
     raise ValueError(f"unknown special point kind {kind!r}")
 
@@ -216,14 +224,14 @@ def branch_test(pt: PalcPoint) -> float:
     return float(np.linalg.det(np.vstack([pt.DF, pt.tangent])))
 
 
-def verified(kind: str, orbit: PeriodicOrbit) -> bool:
+def verified(kind: SpecialKind, orbit: PeriodicOrbit) -> bool:
     """Does a located point satisfy the defining condition of its kind?"""
     mu = orbit.multipliers
-    if kind in ("fold", "branch point"):
+    if kind in (SpecialKind.FOLD, SpecialKind.BRANCH_POINT):
         return bool(np.min(np.abs(mu - 1.0)) < VERIFY_TOL)
-    if kind == "period-doubling":
+    if kind == SpecialKind.PERIOD_DOUBLING:
         return bool(np.min(np.abs(mu + 1.0)) < VERIFY_TOL)
-    if kind == "neimark-sacker":
+    if kind == SpecialKind.NEIMARK_SACKER:
         if mu.size < 2:
             return False
         i, j = critical_pair(mu)
@@ -268,18 +276,18 @@ class Located:
         The parameter turns there (a fold; a branch point on the curved branch of a pitchfork).
     """
 
-    kind: str
+    kind: SpecialKind
     point: PalcPoint
     turns: bool = False
 
     @property
     def crossings(self) -> int:
         """How many multipliers cross the unit circle there."""
-        return 0 if self.kind == "branch point" and self.turns else CROSSINGS[self.kind]
+        return 0 if self.kind == SpecialKind.BRANCH_POINT and self.turns else CROSSINGS[self.kind]
 
 
 @dataclass(frozen=True)
-class Step:
+class StepAccount:
     """What lies between two consecutive points ``a`` and ``b`` of a branch.
 
     Attributes
@@ -325,16 +333,18 @@ def _outside(n: int) -> str:
 
 
 _MISSED = {
-    "fold": "the parameter turns (a fold)",
-    "branch point": "the pseudo-arclength determinant changes sign (a branch point)",
+    SpecialKind.FOLD: "the parameter turns (a fold)",
+    SpecialKind.BRANCH_POINT: "the pseudo-arclength determinant changes sign (a branch point)",
     "fold or branch point": "a multiplier passes through +1 (det(P_x - I) changes sign) where the parameter "
     "does not turn and no branch point is detected",
-    "period-doubling": "a multiplier passes through -1 (det(P_x + I) changes sign)",
-    "neimark-sacker": "a complex pair crosses the unit circle (det(P_x (.) P_x - I) changes sign)",
+    SpecialKind.PERIOD_DOUBLING: "a multiplier passes through -1 (det(P_x + I) changes sign)",
+    SpecialKind.NEIMARK_SACKER: "a complex pair crosses the unit circle (det(P_x (.) P_x - I) changes sign)",
 }
 
 
-def between(evaluate: BranchEquations, a: PalcPoint, b: PalcPoint, s: PalcSettings, index: int) -> Step:
+def between(
+    evaluate: BranchEquations, a: PalcPoint, b: PalcPoint, s: PalcSettings, index: int
+) -> StepAccount:
     """Locate the smooth special points between consecutive points ``a`` and ``b`` of a branch.
 
     ``index`` is the parameter's component in ``u``.  Both points carry their orbit
@@ -345,41 +355,41 @@ def between(evaluate: BranchEquations, a: PalcPoint, b: PalcPoint, s: PalcSettin
     found: list[Located] = []
     missed: list[str] = []
     if max(np.linalg.norm(oa.monodromy, 2), np.linalg.norm(ob.monodromy, 2)) > UNRESOLVED_NORM:
-        return Step((), (), (resolved_unstable_count(oa), resolved_unstable_count(ob)))
-    through_one = sign_changed(orbit_test("fold", oa), orbit_test("fold", ob))
+        return StepAccount((), (), (resolved_unstable_count(oa), resolved_unstable_count(ob)))
+    through_one = sign_changed(orbit_test(SpecialKind.FOLD, oa), orbit_test(SpecialKind.FOLD, ob))
     turns = sign_changed(float(a.tangent[index]), float(b.tangent[index]))
     if sign_changed(branch_test(a), branch_test(b)):
         loc = locate_by_interpolation(evaluate, a, b, branch_test, s)
-        if loc is not None and verified("branch point", loc.payload):
+        if loc is not None and verified(SpecialKind.BRANCH_POINT, loc.payload):
             # The null space is two-dimensional there: the branch's tangent is the one on both sides.
             along = a.tangent + b.tangent
             loc.tangent = along / np.linalg.norm(along)
-            found.append(Located("branch point", loc, turns))
+            found.append(Located(SpecialKind.BRANCH_POINT, loc, turns))
         else:
-            missed.append("branch point")
+            missed.append(SpecialKind.BRANCH_POINT)
     elif turns:
         # (located by det(P_x - I) where it changes sign: the point where the multiplier is 1)
         if through_one:
-            loc = locate(evaluate, a, b, lambda p: orbit_test("fold", p.payload), s)
+            loc = locate(evaluate, a, b, lambda p: orbit_test(SpecialKind.FOLD, p.payload), s)
         else:
             loc = locate(evaluate, a, b, lambda p: float(p.tangent[index]), s)  # type: ignore[index]
-        if loc is not None and verified("fold", loc.payload):
-            found.append(Located("fold", loc, True))
+        if loc is not None and verified(SpecialKind.FOLD, loc.payload):
+            found.append(Located(SpecialKind.FOLD, loc, True))
         else:
-            missed.append("fold")
+            missed.append(SpecialKind.FOLD)
     elif through_one:
         missed.append("fold or branch point")
-    for kind in ("period-doubling", "neimark-sacker"):
+    for kind in (SpecialKind.PERIOD_DOUBLING, SpecialKind.NEIMARK_SACKER):
         if not sign_changed(orbit_test(kind, oa), orbit_test(kind, ob)):
             continue
-        if kind == "neimark-sacker" and area_preserving(oa) and area_preserving(ob):
+        if kind == SpecialKind.NEIMARK_SACKER and area_preserving(oa) and area_preserving(ob):
             continue  # (a pair's product is 1 all along: the sign is rounding's)
         loc = locate(evaluate, a, b, lambda p, k=kind: orbit_test(k, p.payload), s)  # type: ignore[misc]
         if loc is not None and verified(kind, loc.payload):
             found.append(Located(kind, loc))
-        elif kind == "neimark-sacker" and loc is not None and neutral_saddle(loc.payload):
+        elif kind == SpecialKind.NEIMARK_SACKER and loc is not None and neutral_saddle(loc.payload):
             continue  # (two real multipliers mu, 1/mu: none crosses the circle)
         else:
             missed.append(kind)
     found.sort(key=lambda loc: float(np.linalg.norm(loc.point.u - a.u)))
-    return Step(tuple(found), tuple(missed), (unstable_count(oa), unstable_count(ob)))
+    return StepAccount(tuple(found), tuple(missed), (unstable_count(oa), unstable_count(ob)))

@@ -68,7 +68,9 @@ class GrazingPoint:
     precision
         For a grazing solved with a free parameter (:func:`refine_grazing`): how far that
         parameter may be from the grazing's, to first order (the parameter component of the Newton
-        step that would follow the last); nan otherwise.
+        step that would follow the last); for a codimension-two meeting point
+        (:func:`~grazing.orbits.crossings.meeting_point`), the larger parameter component of its last
+        Newton step; nan otherwise.
     """
 
     model: HybridModel

@@ -55,6 +55,7 @@ point records its section time.
 from __future__ import annotations
 
 import dataclasses
+import enum
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -69,12 +70,14 @@ from grazing.errors import ConvergenceError, GrazingError, InvalidParameterError
 from grazing.orbits.bifurcations import Located, between, neimark_sacker_angle
 from grazing.orbits.branch_equations import branch_equations
 from grazing.orbits.contact import GrazingPoint, refine_grazing
+from grazing.orbits.kinds import SpecialKind, TextEnum
 from grazing.orbits.palc import (
     ACCEPT,
     BOUNDARY,
     REFINE,
     STOP,
     Palc,
+    PalcEnd,
     PalcPoint,
     PalcSettings,
     locate,
@@ -90,35 +93,73 @@ from grazing.orbits.shooting import (
     not_isolated_message,
     quiet_section,
 )
-from grazing.orbits.switching import Start, crossing_starts, doubled_start, new_sequence_orbit
+from grazing.orbits.switching import SegmentStart, crossing_starts, doubled_start, new_sequence_orbit
 
-SPECIAL_KINDS = ("fold", "branch point", "period-doubling", "neimark-sacker", "grazing")
+SPECIAL_KINDS = tuple(k for k in SpecialKind if k is not SpecialKind.UNLOCATED)
 """The special points that :func:`continue_orbit` detects and locates (its ``detect``)."""
 
-UNLOCATED = "unlocated"
+UNLOCATED = SpecialKind.UNLOCATED
 """The kind of a special point that stands for a stability change no located point explains."""
 
-SWITCH_KINDS = ("period-doubling", "branch point", "grazing")
+SWITCH_KINDS = (SpecialKind.PERIOD_DOUBLING, SpecialKind.BRANCH_POINT, SpecialKind.GRAZING)
 """The special points where another branch starts: ``switch`` continues onto it."""
 
 RESECTION_MARGIN = 0.01
 """An impact closer than this fraction of a period to the section moves the section."""
 
-_RESECTION = "an impact approaches the section"
+RESECTION = "an impact approaches the section"
+"""Why a branch or a curve stops to move its section (:data:`RESECTION_MARGIN`): the ``STOP`` reason of
+their checks, and the start of their status where the orbit is not found on another section."""
+
+
+class BranchEnd(enum.Enum):
+    """Why a segment of a branch ended (:attr:`Branch.outcome`, :attr:`Branch.segment_outcome`): its
+    :attr:`message` in a few words; the branch's :attr:`Branch.status` says it in full, with the values.
+
+    Examples
+    --------
+    >>> BranchEnd.GRAZING.message
+    'ended at a grazing'
+    """
+
+    BOUND = "reached the end of the range"
+    MAX_POINTS = "maximum number of points reached"
+    STUCK = "Newton's method failed beyond the last point"
+    RESECTION = RESECTION
+    """The section had to move, with no points left to go on."""
+    NO_SECTION = "the orbit could not be found on another section"
+    CANNOT_CONTINUE = "the orbit could not be computed where the segment starts"
+    GRAZING = "ended at a grazing"
+    SWITCHED = "switched to another branch"
+
+    @property
+    def message(self) -> str:
+        """The outcome in a few words."""
+        return str(self.value)
+
+    @classmethod
+    def of(cls, end: PalcEnd | None) -> BranchEnd:
+        """The outcome of a segment whose continuation ended with ``end`` (not at a grazing)."""
+        return {
+            PalcEnd.BOUND: cls.BOUND,
+            PalcEnd.STOPPED: cls.RESECTION,
+            PalcEnd.MAX_POINTS: cls.MAX_POINTS,
+        }.get(end, cls.STUCK)  # type: ignore[arg-type]
 
 
 ContinuationSettings = PalcSettings
 """Options of :func:`continue_orbit` (see :class:`~grazing.orbits.palc.PalcSettings`)."""
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class SpecialPoint:
     """A located special point on a branch (between points ``index`` and ``index + 1``).
 
     Attributes
     ----------
     kind
-        One of :data:`SPECIAL_KINDS`, or :data:`UNLOCATED`.
+        One of :data:`SPECIAL_KINDS`, or :data:`UNLOCATED` (a :class:`~grazing.orbits.kinds.SpecialKind`: a
+        string equal to the ``kind`` that ``--json`` and the branch's dataset write).
     index
         The branch point just before it.
     param
@@ -157,11 +198,14 @@ class SpecialPoint:
         they did not converge); nan for an unlocated change.
     interval
         The parameter values between which the special point lies (``(low, high)``, as
-        BifurcationKit's ``interval``): the last bracket of the location (of a grazing: the last point
-        before it and the first beyond, where there is one); None where unknown.
+        BifurcationKit's ``interval``): the parameter at the two points of the branch that end the last
+        bracket of the location, widened to hold ``param +- precision`` (where the branch bends between
+        them, as it does at a fold, both ends may lie on one side of the point:
+        :meth:`~grazing.orbits.palc.Bracket.interval`); of a grazing: the last point before it and the
+        first beyond, where there is one; of an unlocated change: its two points; None where unknown.
     """
 
-    kind: str
+    kind: SpecialKind
     index: int
     param: float
     orbit: PeriodicOrbit
@@ -184,7 +228,7 @@ class SpecialPoint:
     def angle(self) -> float:
         """For a Neimark-Sacker point: the angle ``theta`` in ``(0, pi)`` of its pair ``exp(+-i theta)`` on
         the unit circle, in radians (:func:`~grazing.orbits.bifurcations.neimark_sacker_angle`); else nan."""
-        return neimark_sacker_angle(self.multipliers) if self.kind == "neimark-sacker" else math.nan
+        return neimark_sacker_angle(self.multipliers) if self.kind == SpecialKind.NEIMARK_SACKER else math.nan
 
 
 @dataclass
@@ -208,10 +252,14 @@ class Branch:
     special
         Located special points, in order along the branch (segment after segment).
     status
-        Why the continuation stopped (its last segment; :attr:`segment_status` has each
-        segment's).
+        Why the continuation stopped, in words (its last segment; :attr:`segment_status` has each
+        segment's); :attr:`outcome` the same as a :class:`BranchEnd`.
     segment_status
         Why each segment ended.
+    outcome
+        Why the continuation stopped (its last segment's :attr:`segment_outcome`).
+    segment_outcome
+        Why each segment ended, as a :class:`BranchEnd` (beside :attr:`segment_status`).
     segment_origin
         For each segment, the index in :attr:`special` of the point it was switched to from
         (-1 for the first).
@@ -229,6 +277,13 @@ class Branch:
     status: str = ""
     segment_status: list[str] = field(default_factory=list)
     segment_origin: list[int] = field(default_factory=list)
+    outcome: BranchEnd | None = None
+    segment_outcome: list[BranchEnd] = field(default_factory=list)
+
+    def end_segment(self, outcome: BranchEnd, status: str) -> None:
+        """Record why a segment ended: its outcome and the sentence that says it."""
+        self.segment_outcome.append(outcome)
+        self.segment_status.append(status)
 
     def __len__(self) -> int:
         return len(self.values)
@@ -335,6 +390,12 @@ def _reduced(u: np.ndarray, nx: int) -> np.ndarray:
     return u if u.size == nx + 1 else np.append(u[:nx], u[-1])
 
 
+def _sign_of(direction: np.ndarray) -> float:
+    """The direction in which the parameter (the last component of ``direction``) moves first (+1 where
+    it does not move)."""
+    return math.copysign(1.0, direction[-1] or 1.0)
+
+
 def _stop_guard_min(orbit: PeriodicOrbit, stop: int) -> float:
     """The smallest value of stop ``stop``'s guard along a virtual orbit: zero where it grazes that stop.
 
@@ -368,7 +429,10 @@ def _detect_grazing(
     else:
         precision = bracket.precision(last) if bracket is not None else math.nan
         interval = bracket.interval(last) if bracket is not None else None
-    return SpecialPoint("grazing", -1, value, lo, point, stop, precision=precision, interval=interval)
+    return SpecialPoint(
+        kind=SpecialKind.GRAZING, index=-1, param=value, orbit=lo, grazing=point, stop=stop,
+        precision=precision, interval=interval,
+    )  # fmt: skip
 
 
 GRAZING_TIE = 1e-6
@@ -377,8 +441,44 @@ grazing (a symmetric orbit touching both walls at once): the stop with the lower
 whichever rounding makes the smaller."""
 
 
-def grazing_margin(orbit: PeriodicOrbit) -> tuple[float, np.ndarray | None, float, str, int]:
-    """How far ``orbit`` is from grazing, and where: ``(delta, contact guess, time, what, stop)``.
+class ImpactChange(TextEnum):
+    """What a grazing does to an orbit's impacts (:attr:`GrazingMargin.change`), in the words of the
+    branch's status."""
+
+    GAINS = "gains an impact"
+    """A closest approach to the stop between the impacts reaches it."""
+    LOSES = "loses an impact"
+    """An impact's speed reaches zero."""
+
+
+@dataclass(frozen=True, kw_only=True)
+class GrazingMargin:
+    """How far an orbit is from grazing, and where (:func:`grazing_margin`).
+
+    Attributes
+    ----------
+    delta
+        The margin: zero at the grazing (``inf`` for an orbit that neither impacts nor approaches a stop).
+    contact
+        A guess of the contact state (the closest approach, or the weakest impact); None with ``delta``
+        infinite.
+    time
+        The time of that contact (nan without one).
+    change
+        Whether the orbit gains an impact or loses one there (None without a contact).
+    stop
+        The index of the stop concerned.
+    """
+
+    delta: float
+    contact: np.ndarray | None
+    time: float
+    change: ImpactChange | None
+    stop: int
+
+
+def grazing_margin(orbit: PeriodicOrbit) -> GrazingMargin:
+    """How far ``orbit`` is from grazing, and where (:class:`GrazingMargin`).
 
     ``delta`` is the smaller of the closest approach to the stop away from the
     impacts (``h`` at a local minimum of the guard) and, over the impacts,
@@ -390,23 +490,23 @@ def grazing_margin(orbit: PeriodicOrbit) -> tuple[float, np.ndarray | None, floa
     impacts on every stop are considered; of stops whose margins are equal to
     :data:`GRAZING_TIE`, the first, then the earliest contact).
     """
-    found: list[tuple[float, np.ndarray | None, float, str, int]] = []
+    found: list[tuple[float, np.ndarray | None, float, ImpactChange, int]] = []
     for j, ap in enumerate(orbit.approach_by_stop):  # a new impact on any stop
         if ap is not None:
-            found.append((ap[0], ap[2], ap[1], "gains an impact", j))
+            found.append((ap[0], ap[2], ap[1], ImpactChange.GAINS, j))
     if orbit.impact_states is not None:
         stops = orbit.impact_stops if orbit.impact_stops.size == orbit.impact_times.size else None
         for i, (t, v, x) in enumerate(zip(orbit.impact_times, orbit.impact_speeds, orbit.impact_states)):
             j = int(stops[i]) if stops is not None else 0
             a = abs(orbit.model.normal_accel(x, t, j))
-            found.append((v * v / (2 * a) if a > 0 else math.inf, x, float(t), "loses an impact", j))
+            found.append((v * v / (2 * a) if a > 0 else math.inf, x, float(t), ImpactChange.LOSES, j))
     least = min((f[0] for f in found), default=math.inf)
     if not math.isfinite(least):
-        return (math.inf, None, math.nan, "", orbit.stop)
-    _, x, t, what, stop = min(
+        return GrazingMargin(delta=math.inf, contact=None, time=math.nan, change=None, stop=orbit.stop)
+    _, x, t, change, stop = min(
         (f for f in found if f[0] <= least + abs(least) * GRAZING_TIE), key=lambda f: (f[4], f[2])
     )  # (a margin below zero: the orbit of a multiple-shooting segment passes through the stop)
-    return (least, x, t, what, stop)
+    return GrazingMargin(delta=least, contact=x, time=t, change=change, stop=stop)
 
 
 AHEAD_FACTOR = 2.0
@@ -433,12 +533,13 @@ def _locate_grazing(
     :data:`AHEAD_FACTOR` times that distance, with its contact next to the vanishing impact
     (:data:`NEAR_CONTACT`): the same orbit's grazing.
     """
-    _, y, tg, _, stop = grazing_margin(last)
+    margin = grazing_margin(last)
+    y, tg = margin.contact, margin.time
     if y is None:
         return None
     try:
         point = refine_grazing(
-            last.model, y, tg, param, period=last.period, events=not virtual, stop_name=stop
+            last.model, y, tg, param, period=last.period, events=not virtual, stop_name=margin.stop
         )
     except GrazingError:
         return None
@@ -463,7 +564,7 @@ class _Continuation:
     """One run of :func:`continue_orbit`: its settings, the branch it fills, one segment at a time."""
 
     def __init__(self, model: HybridModel, param: str, branch: Branch, s: PalcSettings,
-                 bounds: tuple[float, float], detect: tuple[str, ...], switch: bool,
+                 bounds: tuple[float, float], detect: tuple[SpecialKind, ...], switch: bool,
                  progress: Callable[[int, float], None] | None):  # fmt: skip
         self.model, self.param, self.branch, self.s = model, param, branch, s
         self.par = model.parameter(param)
@@ -497,7 +598,7 @@ class _Continuation:
                     "there): a grazing"
                 )
         if not self.virtual and b.section_clearance() < RESECTION_MARGIN:
-            return STOP, _RESECTION
+            return STOP, RESECTION
         if a.unstable_count != b.unstable_count:
             return REFINE, "stability changes"
         return ACCEPT, ""
@@ -511,7 +612,7 @@ class _Continuation:
 
     @staticmethod
     def margin(pt: PalcPoint) -> float:
-        return grazing_margin(pt.payload)[0]
+        return grazing_margin(pt.payload).delta
 
     # -- special points between two points --------------------------------------------------
 
@@ -538,11 +639,11 @@ class _Continuation:
             )
             branch.special.append(
                 SpecialPoint(
-                    UNLOCATED, index, 0.5 * (p1 + p2), prev.payload, note=note, between=(p1, p2),
-                    interval=(min(p1, p2), max(p1, p2)),
+                    kind=UNLOCATED, index=index, param=0.5 * (p1 + p2), orbit=prev.payload, note=note,
+                    between=(p1, p2), interval=(min(p1, p2), max(p1, p2)),
                 )
             )  # fmt: skip
-        if "grazing" in self.detect and self.virtual:  # the grazing of any stop
+        if SpecialKind.GRAZING in self.detect and self.virtual:  # the grazing of any stop
             for j in range(self.model.n_stops):
                 found = _detect_grazing(evaluate, j, prev, pt, self.param, n, self.s)
                 if found is not None:
@@ -556,14 +657,15 @@ class _Continuation:
             tangent = tangent / np.linalg.norm(tangent)
         bracket, last = loc.point.bracket, loc.point.u.size - 1
         return SpecialPoint(
-            loc.kind, index, float(loc.point.u[-1]), loc.point.payload, tangent=tangent, turns=loc.turns,
+            kind=loc.kind, index=index, param=float(loc.point.u[-1]), orbit=loc.point.payload,
+            tangent=tangent, turns=loc.turns,
             precision=bracket.precision(last) if bracket is not None else math.nan,
             interval=bracket.interval(last) if bracket is not None else None,
         )  # fmt: skip
 
     # -- one segment ------------------------------------------------------------------------
 
-    def segment(self, start: Start) -> list[Start]:
+    def segment(self, start: SegmentStart) -> list[SegmentStart]:
         """Follow one segment from ``start``; the starts of the branches it switches to.
 
         Its status says where it went over to multiple shooting, if it did."""
@@ -577,7 +679,7 @@ class _Continuation:
             )
         return starts
 
-    def _segment(self, start: Start) -> list[Start]:
+    def _segment(self, start: SegmentStart) -> list[SegmentStart]:
         """:meth:`segment` itself."""
         branch, s, nx = self.branch, self.s, self.nx
         seg = len(branch.segment_origin)
@@ -603,7 +705,9 @@ class _Continuation:
             except GrazingError as exc:
                 if seg == 0 and prev is None:
                     raise ConvergenceError(f"cannot start the continuation: {exc}") from None
-                branch.segment_status.append(f"cannot continue from {self.par.show(u0[-1])}: {exc}")
+                branch.end_segment(
+                    BranchEnd.CANNOT_CONTINUE, f"cannot continue from {self.par.show(u0[-1])}: {exc}"
+                )
                 return []
             palc = Palc(
                 evaluate, PalcPoint(u0, F, DF, orb), index=ip, sign=sign, bounds={ip: self.bounds[nx]},
@@ -638,16 +742,16 @@ class _Continuation:
             assert prev is not None and prev.tangent is not None
             sign = math.copysign(1.0, prev.tangent[ip]) if prev.tangent[ip] != 0 else sign
             last: PeriodicOrbit = prev.payload
-            if status == _RESECTION and len(branch) < s.max_points:
+            if palc.end is PalcEnd.STOPPED and len(branch) < s.max_points:  # (check's STOP: RESECTION)
                 try:
                     orbit = move_section(last, quiet_section(last))
                 except GrazingError as exc:
-                    status = f"{_RESECTION} and the orbit could not be found on another section ({exc})"
-                    branch.segment_status.append(status)
+                    status = f"{RESECTION} and the orbit could not be found on another section ({exc})"
+                    branch.end_segment(BranchEnd.NO_SECTION, status)
                     return []
                 continue
             if palc.boundary is None:
-                branch.segment_status.append(status)
+                branch.end_segment(BranchEnd.of(palc.end), status)
                 return []
             point = self._end_grazing(palc, prev)
             if point is None and not palc.boundary.reached and not self.segmented:
@@ -670,7 +774,7 @@ class _Continuation:
 
     def _grazing_end(
         self, palc: Palc, prev: PalcPoint, sign: float, point: GrazingPoint | None
-    ) -> list[Start]:
+    ) -> list[SegmentStart]:
         """The segment ends at a grazing (bracketed, or ahead of a point beyond which Newton fails), with
         the grazing orbit ``point`` located there (:meth:`_end_grazing`; None: not located)."""
         branch, par = self.branch, self.par
@@ -678,17 +782,19 @@ class _Continuation:
         assert boundary is not None
         last: PeriodicOrbit = prev.payload
         if point is None and not boundary.reached:
-            branch.segment_status.append(palc.status)  # the steps beyond jumped to another orbit
+            branch.end_segment(
+                BranchEnd.of(palc.end), palc.status
+            )  # the steps beyond jumped to another orbit
             return []
         value = point.model.params[self.param] if point is not None else float(prev.u[-1])
-        where_stop = grazing_margin(last)[4] if point is None else point.stop
+        where_stop = grazing_margin(last).stop if point is None else point.stop
         p0 = float(prev.u[-1])
         p1 = float(boundary.after.u[-1]) if boundary.after is not None else value
         interval = (min(p0, p1), max(p0, p1)) if p1 != p0 else None
         precision = point.precision if point is not None else (p1 - p0 if interval else math.nan)
         graze = SpecialPoint(
-            "grazing", len(branch) - 1, value, last, point, where_stop, precision=abs(precision),
-            interval=interval,
+            kind=SpecialKind.GRAZING, index=len(branch) - 1, param=value, orbit=last, grazing=point,
+            stop=where_stop, precision=abs(precision), interval=interval,
         )  # fmt: skip
         where = par.show(value)
         if self.model.n_stops > 1:
@@ -700,45 +806,49 @@ class _Continuation:
             )
         reason = boundary.reason
         if not boundary.reached:
-            what = grazing_margin(last)[3]
+            what = grazing_margin(last).change or ""
             reason = f"an impact speed reaches zero: the orbit {what}"
-            if what == "gains an impact":
+            if what is ImpactChange.GAINS:
                 reason = f"the orbit touches the stop between its impacts: it {what}"
             reason += " (located from this side: the branch does not continue beyond it)"
         status = f"ended at a grazing at {where}: {reason}"
         if not self.switch:
             branch.special.append(graze)
-            branch.segment_status.append(
-                status + "; the orbit with the new impact sequence can be followed with switch (--switch)"
+            branch.end_segment(
+                BranchEnd.GRAZING,
+                status + "; the orbit with the new impact sequence can be followed with switch (--switch)",
             )
             return []
         new = new_sequence_orbit(last, self.param, value, sign, self.virtual)
         if new is None:
             branch.special.append(graze)
-            branch.segment_status.append(
-                status + "; no orbit with another impact sequence was found just past it to switch to"
+            branch.end_segment(
+                BranchEnd.GRAZING,
+                status + "; no orbit with another impact sequence was found just past it to switch to",
             )
             return []
         branch.special.append(dataclasses.replace(graze, switched=True))
-        branch.segment_status.append(status + "; switched to the orbit with the new impact sequence")
+        branch.end_segment(
+            BranchEnd.SWITCHED, status + "; switched to the orbit with the new impact sequence"
+        )
         if new.section_clearance() < SECTION_MARGIN:
             new = move_section(new, quiet_section(new))
         sign = math.copysign(1.0, new.model.params[self.param] - value)
-        return [Start(new, sign, None, len(branch.special) - 1)]
+        return [SegmentStart(orbit=new, sign=sign, origin=len(branch.special) - 1)]
 
-    def _switch_smooth(self, at: SpecialPoint, evaluate) -> list[Start]:
+    def _switch_smooth(self, at: SpecialPoint, evaluate) -> list[SegmentStart]:
         """The starts of the branches born at a period-doubling or branch point just passed; none (the
         point's note says why) if there is none to follow.  Only the first such point is tried."""
         branch, par = self.branch, self.par
         self.switched_smooth = True
         i = next(j for j in range(len(branch.special) - 1, -1, -1) if branch.special[j] is at)
-        starts: list[Start] = []
-        if at.kind == "period-doubling":
+        starts: list[SegmentStart] = []
+        if at.kind == SpecialKind.PERIOD_DOUBLING:
             n2 = 2 * at.orbit.period
             found = doubled_start(at.orbit, self.param, self.s) if n2 <= MAX_PERIOD else None
             if found is not None:
                 orbit, direction = found
-                starts = [Start(orbit, math.copysign(1.0, direction[-1] or 1.0), direction, i)]
+                starts = [SegmentStart(orbit=orbit, sign=_sign_of(direction), direction=direction, origin=i)]
             why = f"periods above {MAX_PERIOD} are not switched to" if n2 > MAX_PERIOD else "none was found"
             missing = f"not switched to the period-{n2} orbit born here: {why}"
             what = f"the period-{n2} orbit born there"
@@ -749,7 +859,9 @@ class _Continuation:
                 o = at.orbit
                 evaluate = branch_equations(self.model, self.param, o.period, o.t0, self.virtual, o.stop)
             for orbit, direction in crossing_starts(evaluate, u_star, at.tangent, self.s):
-                starts.append(Start(orbit, math.copysign(1.0, direction[-1] or 1.0), direction, i))
+                starts.append(
+                    SegmentStart(orbit=orbit, sign=_sign_of(direction), direction=direction, origin=i)
+                )
             # first the direction of the request (the null vector's sign, and so their order, is arbitrary)
             starts.sort(key=lambda st: st.sign != self.toward)
             missing = "not switched: no other branch was found through it"
@@ -758,7 +870,7 @@ class _Continuation:
             branch.special[i] = dataclasses.replace(at, note=missing)
             return []
         branch.special[i] = dataclasses.replace(at, switched=True)
-        branch.segment_status.append(f"switched at the {at.kind} at {par.show(at.param)} to {what}")
+        branch.end_segment(BranchEnd.SWITCHED, f"switched at the {at.kind} at {par.show(at.param)} to {what}")
         return starts
 
 
@@ -774,7 +886,7 @@ def continue_orbit(
     t0: float | None = None,
     virtual: bool | None = None,
     settings: PalcSettings | None = None,
-    detect: tuple[str, ...] = SPECIAL_KINDS,
+    detect: tuple[SpecialKind | str, ...] = SPECIAL_KINDS,
     switch: bool = False,
     progress: Callable[[int, float], None] | None = None,
     stop_name: int | str | None = None,
@@ -885,10 +997,17 @@ def continue_orbit(
         virtual = orbit.virtual
     branch = Branch(model=model, param=param, period=orbit.period, virtual=bool(virtual))
     run = _Continuation(
-        model, param, branch, s, (min(start, stop), max(start, stop)), tuple(detect), switch, progress
+        model,
+        param,
+        branch,
+        s,
+        (min(start, stop), max(start, stop)),
+        tuple(SpecialKind(k) for k in detect),
+        switch,
+        progress,
     )
     run.toward = math.copysign(1.0, stop - start)
-    pending = [Start(orbit, run.toward)]  # (a stack: each chain to its end first)
+    pending = [SegmentStart(orbit=orbit, sign=run.toward)]  # (a stack: each chain to its end first)
     while pending:
         if len(branch) >= s.max_points:
             left = len(pending)
@@ -899,4 +1018,5 @@ def continue_orbit(
             break
         pending.extend(reversed(run.segment(pending.pop())))
     branch.status = branch.segment_status[-1]
+    branch.outcome = branch.segment_outcome[-1]
     return branch

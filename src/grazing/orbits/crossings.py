@@ -33,6 +33,7 @@ found in two steps, from the last point of the curve before it:
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -41,6 +42,7 @@ from grazing.core.model import HybridModel
 from grazing.errors import GrazingError
 from grazing.orbits.contact import GrazingPoint, contact_system
 from grazing.orbits.extended import defining_matrix
+from grazing.orbits.kinds import CurveKind
 from grazing.orbits.palc import PalcSettings, newton
 
 FAILURES = (GrazingError, np.linalg.LinAlgError, FloatingPointError)
@@ -120,7 +122,7 @@ def limit_condition(kind: str, point: GrazingPoint, loses: bool) -> float:
     else it only touches the stop there.  NaN where the limit has no multiplier growing as
     ``1 / nu`` (``c N = 0``).
     """
-    det_kind = "fold" if kind == "branch-point" else kind
+    det_kind = CurveKind.FOLD if kind == CurveKind.BRANCH_POINT else kind
     J = point.monodromy
     if not loses:
         return float(np.linalg.det(defining_matrix(det_kind, J)))
@@ -130,7 +132,7 @@ def limit_condition(kind: str, point: GrazingPoint, loses: bool) -> float:
     g_t = np.asarray(m._call("g_t", y, t, j), dtype=float).reshape(-1)
     N = m.vector_field(m.reset(y, t, j), t) - g_x @ m.vector_field(y, t) - g_t
     M0 = g_x @ J
-    if kind == "neimark-sacker" and n > 2:
+    if kind == CurveKind.NEIMARK_SACKER and n > 2:
         return float(np.linalg.det(defining_matrix(det_kind, reduced_limit(M0, N, h_x @ J))))
     R = np.outer(N, h_x @ J)
     size = float(np.linalg.norm(R))
@@ -192,7 +194,9 @@ def meeting_point(
     """The codimension-two point where the curve of ``kind`` meets the grazing curve, from a grazing
     orbit ``near`` it: Newton's method on the contact equations and :func:`limit_condition` (its
     gradient by central differences).  None if it does not converge, or converges far from ``near``
-    (more than 1e-3 relative in the parameters)."""
+    (more than 1e-3 relative in the parameters).  Its ``precision`` is the larger parameter component of
+    the last Newton step (the error before that step: a bound on the error after it, once the iteration
+    converges)."""
     model, period, stop = near.model, near.period, near.stop
     n = model.n_states
     contact = contact_system(model, params, period, events=events, stop=stop)
@@ -227,4 +231,6 @@ def meeting_point(
     except FAILURES:
         return None
     far = np.max(np.abs(u[n + 1 :] - p0)) > 1e-3 * max(1.0, float(np.max(np.abs(p0))))
-    return None if far or not np.max(np.abs(F)) <= 1e-10 else point
+    if far or not np.max(np.abs(F)) <= 1e-10:
+        return None
+    return dataclasses.replace(point, precision=float(np.max(np.abs(du[n + 1 :]))))

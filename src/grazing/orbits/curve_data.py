@@ -15,6 +15,7 @@ import numpy as np
 from grazing.core.model import HybridModel
 from grazing.orbits.contact import GrazingPoint
 from grazing.orbits.continuation import Branch, SpecialPoint
+from grazing.orbits.kinds import CurveKind
 from grazing.orbits.shooting import PeriodicOrbit, unstable_count
 
 ACCURACY_NOTE = 1e-6
@@ -99,6 +100,19 @@ class CurveSpecial:
         those of the last point before it).
     grazing
         For a grazing: the grazing orbit, solved from the grazing equations.
+    precision
+        How far each parameter's value may be from the point's (as
+        :attr:`~grazing.orbits.continuation.SpecialPoint.precision`, one per parameter): for a zero of a
+        test function located along the curve, its value over its slope on the last bracket, at most the
+        bracket's width; for a grazing solved as the meeting point of the two curves, the parameter part
+        of the last Newton step; for a point only bracketed (not :attr:`located`, or a grazing whose
+        meeting point did not converge: the grazing orbit nearest the curve's last point), the width of
+        the bracket in each parameter; nan where there is no bracket (a curve stopped by Newton's method
+        short of its grazing).
+    interval
+        The bracket in which the point lies, ``((low1, high1), (low2, high2))`` in the two parameters: the
+        last bracket of the location along the curve, or the last point before the point and the first
+        beyond; None where there is none.
     """
 
     kind: str
@@ -108,6 +122,26 @@ class CurveSpecial:
     state: np.ndarray
     located: bool = True
     grazing: GrazingPoint | None = None
+    precision: tuple[float, float] = (math.nan, math.nan)
+    interval: tuple[tuple[float, float], tuple[float, float]] | None = None
+
+
+def bracket_between(
+    a: np.ndarray, b: np.ndarray | None
+) -> tuple[tuple[float, float], tuple[tuple[float, float], tuple[float, float]] | None]:
+    """``(precision, interval)`` of a point known only to lie between two points of a curve whose two
+    parameters are ``a`` and ``b`` (``b`` None: no point beyond, nan and None).
+
+    Examples
+    --------
+    >>> bracket_between(np.array([0.5, 2.0]), np.array([0.25, 2.5]))
+    ((0.25, 0.5), ((0.25, 0.5), (2.0, 2.5)))
+    """
+    if b is None:
+        return (math.nan, math.nan), None
+    lo, hi = np.minimum(a, b), np.maximum(a, b)
+    interval = ((float(lo[0]), float(hi[0])), (float(lo[1]), float(hi[1])))
+    return (interval[0][1] - interval[0][0], interval[1][1] - interval[1][0]), interval
 
 
 @dataclass
@@ -141,7 +175,7 @@ class BifurcationCurve:
     """
 
     model: HybridModel
-    kind: str
+    kind: CurveKind
     params: tuple[str, str]
     period: int
     virtual: bool
@@ -202,6 +236,16 @@ class BifurcationCurve:
             "special_param1": ("special", np.array([s.values[0] for s in self.special], dtype=float)),
             "special_param2": ("special", np.array([s.values[1] for s in self.special], dtype=float)),
             "special_located": ("special", np.array([s.located for s in self.special], dtype=np.int8)),
+            "special_precision": (
+                ("special", "param"),
+                np.array([s.precision for s in self.special], dtype=float).reshape(-1, 2),
+            ),
+            "special_interval": (
+                ("special", "param", "bound"),
+                np.array(
+                    [s.interval or ((np.nan, np.nan), (np.nan, np.nan)) for s in self.special], dtype=float
+                ).reshape(-1, 2, 2),
+            ),
             "special_state": (("special", "component"), sp_state),
             "special_multiplier_re": (("special", "multiplier"), sp_mu.real),
             "special_multiplier_im": (("special", "multiplier"), sp_mu.imag),
@@ -213,7 +257,7 @@ class BifurcationCurve:
         ds.section_time.attrs["long_name"] = "contact phase" if self.kind == "grazing" else "section time"
         attrs: dict[str, Any] = {
             "model": self.model.name,
-            "kind": self.kind,
+            "kind": str(self.kind),
             "params": ",".join(self.params),
             "period": self.period,
             "virtual": int(self.virtual),

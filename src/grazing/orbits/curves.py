@@ -38,20 +38,24 @@ from grazing.core.model import HybridModel, Parameter
 from grazing.errors import ConvergenceError, GrazingError, InvalidParameterError, NotFoundError
 from grazing.orbits.contact import GrazingPoint
 from grazing.orbits.continuation import (
+    RESECTION,
     RESECTION_MARGIN,
     Branch,
+    ImpactChange,
     SpecialPoint,
     continue_orbit,
     grazing_margin,
 )
 from grazing.orbits.crossings import contact_guess, meeting_point, nearest_grazing
-from grazing.orbits.curve_data import BifurcationCurve, CurvePoint, CurveSpecial
+from grazing.orbits.curve_data import BifurcationCurve, CurvePoint, CurveSpecial, bracket_between
 from grazing.orbits.extended import CODIM2_TESTS, ENDING, Evaluation, GrazingSystem, OrbitSystem
+from grazing.orbits.kinds import CurveKind
 from grazing.orbits.palc import (
     ACCEPT,
     BOUNDARY,
     STOP,
     Palc,
+    PalcEnd,
     PalcPoint,
     PalcSettings,
     correct,
@@ -63,18 +67,9 @@ from grazing.orbits.segmented_curves import SegmentedOrbitSystem
 from grazing.orbits.segments import MULTIPLE_SHOOTING_NORM
 from grazing.orbits.shooting import CROSSING_TOL, PeriodicOrbit, move_section, quiet_section
 
-CURVE_KINDS = ("fold", "period-doubling", "neimark-sacker", "branch-point", "grazing")
-"""The kinds of curves :func:`follow_curve` follows."""
-
-START_KINDS = {
-    "fold": "fold",
-    "period-doubling": "period-doubling",
-    "neimark-sacker": "neimark-sacker",
-    "branch-point": "branch point",
-    "grazing": "grazing",
-}
-"""The kind of the one-parameter special point (:class:`~grazing.orbits.continuation.SpecialPoint`) each
-curve starts from."""
+CURVE_KINDS = tuple(CurveKind)
+"""The kinds of curves :func:`follow_curve` follows (each starts from the special point
+:attr:`~grazing.orbits.kinds.CurveKind.start`)."""
 
 SHIFT_TOL = 1e-7
 """Largest ``|shift|`` on a branch-point curve: beyond it the branch point does not persist in two
@@ -84,10 +79,8 @@ DOUBLE_GRAZING_MARGIN = 1e-6
 """Where a grazing curve gets stuck with its orbit this close to another contact with a stop
 (:func:`_other_contact_margin`), it ends at a double grazing."""
 
-_RESECTION = "an impact approaches the section"
 
-
-Progress = Callable[[str, int, float, float], None]
+CurveProgress = Callable[[str, int, float, float], None]
 """``progress(stage, points, value1, value2)``: stage ``"branch"`` (the one-parameter continuation
 to the start) or ``"curve"``."""
 
@@ -148,15 +141,15 @@ def _crossing(point: GrazingPoint) -> bool:
     return bool(point.guard_mins) and min(point.guard_mins) < -CROSSING_TOL
 
 
-def _start_point(branch: Branch, kind: str, stop: int | None) -> SpecialPoint:
+def _start_point(branch: Branch, kind: CurveKind, stop: int | None) -> SpecialPoint:
     """The first special point of ``kind`` on ``branch``, or :class:`NotFoundError` naming what was met."""
-    wanted = START_KINDS[kind]
+    wanted = kind.start
     for sp_ in branch.special:
-        if sp_.kind == wanted and (kind != "grazing" or stop is None or sp_.stop == stop):
+        if sp_.kind == wanted and (kind != CurveKind.GRAZING or stop is None or sp_.stop == stop):
             return sp_
     par = branch.model.parameter(branch.param)
     lo, hi = branch.values[0], branch.values[-1]
-    what = f"no {wanted}" + (f" with stop {branch.model.stop_names[stop]!r}" if kind == "grazing" and
+    what = f"no {wanted}" + (f" with stop {branch.model.stop_names[stop]!r}" if kind == CurveKind.GRAZING and
                              stop is not None else "")  # fmt: skip
     met = ", ".join(f"{s.kind} at {par.show(s.param, '.8g')}" for s in branch.special)
     raise NotFoundError(
@@ -283,13 +276,13 @@ class _Follower:
                     "there): the curve meets a grazing"
                 )
         if ob.section_clearance() < RESECTION_MARGIN:
-            return STOP, _RESECTION
+            return STOP, RESECTION
         return ACCEPT, ""
 
     def margin(self, pt: PalcPoint) -> float:
         if self.kind == "grazing":
             return _other_contact_margin(pt.payload.grazing)
-        return grazing_margin(pt.payload.orbit)[0]
+        return grazing_margin(pt.payload.orbit).delta
 
     # -- following ------------------------------------------------------------
     def first(self, system: OrbitSystem | GrazingSystem, u0: np.ndarray, index: int) -> PalcPoint:
@@ -362,11 +355,11 @@ class _Follower:
             last = d.pal[-1]
             assert last.tangent is not None
             sign = math.copysign(1.0, last.tangent[index]) if last.tangent[index] != 0 else sign
-            if d.status == _RESECTION and len(d.points) < self.s.max_points:
+            if palc.end is PalcEnd.STOPPED and len(d.points) < self.s.max_points:  # (check's STOP: RESECTION)
                 try:
                     current = move_section(last.payload.orbit, quiet_section(last.payload.orbit))
                 except GrazingError as exc:
-                    return f"{_RESECTION} and the orbit could not be found on another section ({exc})"
+                    return f"{RESECTION} and the orbit could not be found on another section ({exc})"
                 continue
             if palc.boundary is None:
                 return d.status
@@ -407,7 +400,8 @@ class _Follower:
             if abs(value) > ends:
                 continue  # a pole, not a zero (the cusp coefficient at a 1:1 resonance, say)
             if loc is None or not abs(value) <= max(self.s.locate_tol, 1e-6 * ends):
-                found.append((0.0, self.special_at(name, len(d.points) - 1, a, located=False), None))
+                special = self.special_at(name, len(d.points) - 1, a, located=False, beyond=b)
+                found.append((0.0, special, None))
                 continue  # bracketed only: said so (its values are those of the point before it)
             where = float(np.dot(loc.u - a.u, b.u - a.u) / np.dot(b.u - a.u, b.u - a.u))
             found.append((where, self.special_at(name, len(d.points) - 1, loc), loc))
@@ -433,9 +427,26 @@ class _Follower:
             d.special.append((special.index, special))
         return False
 
-    def special_at(self, kind: str, index: int, pt: PalcPoint, located: bool = True) -> CurveSpecial:
+    def special_at(
+        self, kind: str, index: int, pt: PalcPoint, located: bool = True, beyond: PalcPoint | None = None
+    ) -> CurveSpecial:
+        """The codimension-two point at ``pt`` (located: its bracket; else between ``pt`` and ``beyond``)."""
         cp = self.curve_point(pt)
-        return CurveSpecial(kind, index, cp.values, cp.multipliers, cp.state, located)
+        precision, interval = self.bracket(pt, beyond)
+        return CurveSpecial(
+            kind=kind, index=index, values=cp.values, multipliers=cp.multipliers, state=cp.state,
+            located=located, precision=precision, interval=interval,
+        )  # fmt: skip
+
+    def bracket(self, pt: PalcPoint, beyond: PalcPoint | None = None) -> tuple[Any, Any]:
+        """``(precision, interval)`` in the two parameters of a point located at ``pt`` (its bracket), or
+        only bracketed between ``pt`` and ``beyond`` (:func:`~grazing.orbits.curve_data.bracket_between`)."""
+        i = self.offset()
+        if pt.bracket is not None and beyond is None:
+            return (pt.bracket.precision(i), pt.bracket.precision(i + 1)), (
+                pt.bracket.interval(i), pt.bracket.interval(i + 1)
+            )  # fmt: skip
+        return bracket_between(pt.u[i : i + 2], None if beyond is None else beyond.u[i : i + 2])
 
     def show(self, values: tuple[float, float]) -> str:
         return f"{self.pars[0].show(values[0])}, {self.pars[1].show(values[1])}"
@@ -457,16 +468,29 @@ class _Follower:
         _, t, x = loc.payload.orbit.guard_min_by_stop[j]
         point, exact = self.solve_grazing(x, t, j, loc, None, 0, False)
         where = float(np.dot(loc.u - a.u, b.u - a.u) / np.dot(b.u - a.u, b.u - a.u))
-        return where, self.grazing_special(index, loc, point, exact), None
+        return where, self.grazing_special(index, loc, point, exact, self.bracket(loc)), None
 
     def grazing_special(
-        self, index: int, before: PalcPoint, point: GrazingPoint | None, exact: bool
+        self, index: int, before: PalcPoint, point: GrazingPoint | None, exact: bool, bracket: tuple[Any, Any]
     ) -> CurveSpecial:
+        """The grazing where the curve meets the grazing curve: ``point`` (the meeting point if ``exact``),
+        else only bracketed after ``before``; ``bracket``: ``(precision, interval)`` of that bracket."""
+        precision, interval = bracket
         if point is None:
             cp = self.curve_point(before)
-            return CurveSpecial("grazing", index, cp.values, cp.multipliers, cp.state, located=False)
+            return CurveSpecial(
+                kind="grazing", index=index, values=cp.values, multipliers=cp.multipliers, state=cp.state,
+                located=False, precision=precision, interval=interval,
+            )  # fmt: skip
         values = (point.model.params[self.params[0]], point.model.params[self.params[1]])
-        return CurveSpecial("grazing", index, values, point.multipliers, point.contact.copy(), exact, point)
+        if interval is None:  # (found ahead of the last point, none beyond it: between the two)
+            interval = bracket_between(before.u[self.offset() : self.offset() + 2], np.array(values))[1]
+        if exact:
+            precision = (point.precision, point.precision)
+        return CurveSpecial(
+            kind="grazing", index=index, values=values, multipliers=point.multipliers,
+            state=point.contact.copy(), located=exact, grazing=point, precision=precision, interval=interval,
+        )  # fmt: skip
 
     def solve_grazing(
         self, y: np.ndarray, t: float, stop: int, before: PalcPoint, after: PalcPoint | None, others: int,
@@ -517,9 +541,12 @@ class _Follower:
             cp = self.curve_point(before)
             near = _other_contact_margin(before.payload.grazing)
             if boundary.reached or near <= DOUBLE_GRAZING_MARGIN:
-                d.special.append(
-                    (index, CurveSpecial("double grazing", index, cp.values, cp.multipliers, cp.state, False))
-                )
+                precision, interval = self.bracket(before, boundary.after)
+                double = CurveSpecial(
+                    kind="double grazing", index=index, values=cp.values, multipliers=cp.multipliers,
+                    state=cp.state, located=False, precision=precision, interval=interval,
+                )  # fmt: skip
+                d.special.append((index, double))
                 reason = boundary.reason
                 if not boundary.reached:
                     reason = (
@@ -531,8 +558,9 @@ class _Follower:
                 return True
             return False
         orbit = before.payload.orbit
-        _, y, t, what, stop = grazing_margin(orbit)
-        loses = what == "loses an impact"
+        margin = grazing_margin(orbit)
+        y, t, what, stop = margin.contact, margin.time, margin.change or "", margin.stop
+        loses = what is ImpactChange.LOSES
         point, exact = (None, False)
         if y is not None:
             point, exact = self.solve_grazing(
@@ -540,7 +568,7 @@ class _Follower:
             )
         if point is None and not boundary.reached:
             return False  # stuck (Newton's method fails beyond the last point), no grazing just ahead
-        special = self.grazing_special(index, before, point, exact)
+        special = self.grazing_special(index, before, point, exact, self.bracket(before, boundary.after))
         d.special.append((index, special))
         where = self.show(special.values)
         if self.model.n_stops > 1:
@@ -548,7 +576,7 @@ class _Follower:
         reason = boundary.reason
         if not boundary.reached:
             reason = f"an impact speed reaches zero: the orbit {what}"
-            if what == "gains an impact":
+            if what is ImpactChange.GAINS:
                 reason = f"the orbit touches the stop between its impacts: it {what}"
         if point is None:
             where += " (bracketed only: the grazing equations did not converge)"
@@ -572,7 +600,7 @@ def follow_curve(
     period: int | None = None,
     stop_name: int | str | None = None,
     settings: PalcSettings | None = None,
-    progress: Progress | None = None,
+    progress: CurveProgress | None = None,
 ) -> BifurcationCurve:
     """Follow a bifurcation of a periodic orbit in two parameters.
 
@@ -637,6 +665,7 @@ def follow_curve(
     """
     if kind not in CURVE_KINDS:
         raise InvalidParameterError(f"unknown curve kind {kind!r} (known: {', '.join(CURVE_KINDS)})")
+    kind = CurveKind(kind)
     for name in (param, param2):
         model.parameter(name)  # unknown names: one line naming the known ones
     if param2 == param:

@@ -30,6 +30,7 @@ from grazing.core.model import HybridModel, Parameter
 from grazing.errors import ConvergenceError, GrazingWarning, InvalidParameterError
 from grazing.orbits.contact import GrazingPoint, contact_system
 from grazing.orbits.continuation import Branch, continue_orbit
+from grazing.orbits.kinds import SpecialKind
 from grazing.orbits.palc import Palc, PalcPoint, PalcSettings, locate, sign_changed
 
 
@@ -81,7 +82,7 @@ def find_grazings(
         period=period,
         virtual=True,
         settings=settings,
-        detect=("fold", "grazing"),
+        detect=(SpecialKind.FOLD, SpecialKind.GRAZING),
         progress=progress,
         stop_name=stop_name,
     )
@@ -89,7 +90,7 @@ def find_grazings(
     par = model.parameter(param)
     points = []
     for sp_ in branch.special:
-        if sp_.kind != "grazing":
+        if sp_.kind != SpecialKind.GRAZING:
             continue
         if sp_.stop != watch:
             continue

@@ -23,6 +23,7 @@ Step control does not jump over what it should see:
 
 from __future__ import annotations
 
+import enum
 import math
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
@@ -39,6 +40,16 @@ BOUNDARY = "boundary"
 STOP = "stop"
 """Verdicts of a :data:`Check`: accept the candidate; halve the step; the candidate is
 beyond a boundary; accept the candidate and end the iteration."""
+
+
+class PalcEnd(enum.Enum):
+    """Why a :class:`Palc` iteration ended (:attr:`Palc.end`; :attr:`Palc.status` says it in words)."""
+
+    MAX_POINTS = "maximum number of points reached"
+    BOUND = "reached a bound"
+    STUCK = "the step size fell below its minimum"
+    BOUNDARY = "reached a boundary of the curve's domain"
+    STOPPED = "the caller's check stopped it"
 
 
 @dataclass(frozen=True)
@@ -89,25 +100,45 @@ class Bracket:
     Attributes
     ----------
     lo, hi
-        The points ``u`` at the ends of the last bracket along the secant (the test function's
+        The points ``u`` of the curve (corrected) at the ends of the last bracket (the test function's
         signs differ there).
     step
         The located point's offset from the zero to first order: the test function's value there
         over its slope along the secant, times the secant (in ``u``).
+    at
+        The located point's ``u`` (None: only the ends are known).
     """
 
     lo: np.ndarray
     hi: np.ndarray
     step: np.ndarray
+    at: np.ndarray | None = None
 
     def interval(self, i: int) -> tuple[float, float]:
-        """The bracket in component ``i`` of ``u``, as ``(low, high)``."""
+        """Where component ``i`` of the zero lies, as ``(low, high)``: between its values at the bracket's
+        ends, and within :meth:`precision` of the located point's.
+
+        The located point's own value may lie outside the ends' (at a fold, where the parameter turns
+        between them: both ends lie on the same side of the fold's value).
+
+        Examples
+        --------
+        >>> ends, at = (np.array([0.0, 0.9]), np.array([1.0, 0.9])), np.array([0.5, 1.0])
+        >>> fold = Bracket(*ends, np.array([0.0, 1e-9]), at)
+        >>> fold.interval(1)[0] == 0.9 and 1.0 < fold.interval(1)[1] < 1.0 + 2e-9
+        True
+        """
         a, b = float(self.lo[i]), float(self.hi[i])
-        return (min(a, b), max(a, b))
+        lo, hi = min(a, b), max(a, b)
+        if self.at is None:
+            return (lo, hi)
+        p, width = float(self.at[i]), self.precision(i)
+        return (min(lo, p - width), max(hi, p + width))
 
     def precision(self, i: int) -> float:
         """How far component ``i`` of the located point may be from the zero: the first-order offset,
-        at most the bracket's width, plus the component's own rounding (4 eps of its size).
+        at most the width of the bracket (its ends and the located point), plus the component's own
+        rounding (4 eps of its size).
 
         Examples
         --------
@@ -115,7 +146,8 @@ class Bracket:
         >>> bool(2e-12 < p < 2e-12 + 2e-15)
         True
         """
-        lo, hi = self.interval(i)
+        values = [float(self.lo[i]), float(self.hi[i])] + ([] if self.at is None else [float(self.at[i])])
+        lo, hi = min(values), max(values)
         rounding = 4 * float(np.finfo(float).eps) * max(abs(lo), abs(hi))
         return min(abs(float(self.step[i])), hi - lo) + rounding
 
@@ -274,6 +306,7 @@ class Palc:
             t = -t
         first.tangent = t
         self.status = ""
+        self.end: PalcEnd | None = None
         self.boundary: Boundary | None = None
         self._margins: list[tuple[float, float]] = []  # (u[index], margin) of the last accepted points
 
@@ -308,6 +341,7 @@ class Palc:
             zeros = margin_zeros(self._margins)
             self.boundary = Boundary(cur, None, why, reached=False, ahead=None if zeros is None else zeros[1])
         self.status = f"step size fell below {self.s.ds_min:g} at {self._where(cur)}: {why}"
+        self.end = PalcEnd.STUCK
 
     def _jumped(self, margins: list[tuple[float, float]], cand: PalcPoint) -> bool:
         """Is ``cand`` (beyond a boundary by the caller's check) short of where the margin predicts it?
@@ -443,6 +477,7 @@ class Palc:
                 if found.reached:
                     self.boundary = found
                     self.status = f"{reason} at {self._where(found.before)}"
+                    self.end = PalcEnd.BOUNDARY
                     return
                 # The corrector jumped to another curve: go on along this one with shorter steps.
                 if found.before is not cur and self.margin is not None:
@@ -464,12 +499,15 @@ class Palc:
                 del margins[:-2]
             if out is not None:
                 self.status = f"reached the bound {self._show(out[0], out[1])}"
+                self.end = PalcEnd.BOUND
                 return
             if verdict == STOP:
                 self.status = reason
+                self.end = PalcEnd.STOPPED
                 return
             ds = min(ds * 1.3, s.ds_max)
-        self.status = "maximum number of points reached"
+        self.status = PalcEnd.MAX_POINTS.value
+        self.end = PalcEnd.MAX_POINTS
 
 
 def locate(
@@ -490,6 +528,7 @@ def locate(
     lo, hi = 0.0, 1.0
     flo, fhi = test(a), test(b)
     true_lo, true_hi = flo, fhi  # (the test's values at the bracket's ends, before Illinois halves them)
+    u_lo, u_hi = a.u, b.u  # (the corrected points at the bracket's ends)
     best: PalcPoint | None = None
     side = 0
     for _ in range(60):
@@ -502,17 +541,17 @@ def locate(
         f = test(pt)
         slope = (true_hi - true_lo) / (hi - lo)
         offset = f / slope if slope != 0 and math.isfinite(f) else math.inf
-        pt.bracket = Bracket(a.u + lo * d, a.u + hi * d, offset * d)
+        pt.bracket = Bracket(u_lo, u_hi, offset * d, pt.u)
         best = pt
         if abs(f) <= s.locate_tol or (hi - lo) < 1e-12:
             return pt
         if (f > 0) == (flo > 0):
-            lo, flo, true_lo = sig, f, f
+            lo, flo, true_lo, u_lo = sig, f, f, pt.u
             if side == -1:
                 fhi *= 0.5
             side = -1
         else:
-            hi, fhi, true_hi = sig, f, f
+            hi, fhi, true_hi, u_hi = sig, f, f, pt.u
             if side == 1:
                 flo *= 0.5
             side = 1
@@ -580,7 +619,7 @@ def locate_by_interpolation(
                 slope = float(np.polyval(np.polyder(np.polyfit(sigmas, values, 3)), root))
                 f = test(found)
                 offset = f / slope if slope != 0 and math.isfinite(f) else math.inf
-                found.bracket = Bracket(a.u.copy(), b.u.copy(), offset * d)
+                found.bracket = Bracket(a.u.copy(), b.u.copy(), offset * d, u)
         except (GrazingError, np.linalg.LinAlgError, FloatingPointError):
             pass
         narrow = float(np.linalg.norm(d)) <= INTERPOLATION_WIDTH * max(1.0, float(np.linalg.norm(a.u)))

@@ -38,8 +38,8 @@ CROSSING_SLOPE = 10.0
 direction ``w`` (orthogonal to the branch followed) is at most this (about 6 degrees from it or more)."""
 
 
-@dataclass(frozen=True)
-class Start:
+@dataclass(frozen=True, kw_only=True)
+class SegmentStart:
     """Where a segment of a branch starts.
 
     Attributes

@@ -52,7 +52,7 @@ from grazing.report import (
     figstops,
     paper,
 )
-from grazing.report.base import Comparison, DataFile, Dynamics, FigureResult, Image, Progress
+from grazing.report.base import Comparison, DataFile, Dynamics, FigureResult, Image, Say
 from grazing.report.folder import check_report_folder, claim_report_folder
 from grazing.report.html import RULES_TEXT, ReportMeta, render, scoreboard
 from grazing.report.provenance import collect, source_root
@@ -164,7 +164,7 @@ def comparisons_json(results: Sequence[FigureResult], meta: ReportMeta) -> dict[
 
 def build_report(
     out_dir: Path | str,
-    progress: Progress | None = None,
+    progress: Say | None = None,
     only: Sequence[str] | None = None,
     overwrite: bool = False,
 ) -> Path:

@@ -23,8 +23,8 @@ from grazing.core.options import CHAOS_THRESHOLD as LYAPUNOV_CHAOS
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
 
-Progress = Callable[[str], None]
-"""A callback that receives one-line progress messages."""
+Say = Callable[[str], None]
+"""A callback that receives one-line progress messages (a figure saying how far it has got)."""
 
 DPI = 150
 """Resolution of every PNG in the report."""

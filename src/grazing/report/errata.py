@@ -23,7 +23,7 @@ import numpy as np
 import grazing
 from grazing.experiment.apparatus import STANDARD_GRAVITY
 from grazing.report import paper
-from grazing.report.base import Comparison, FigureResult, Progress
+from grazing.report.base import Comparison, FigureResult, Say
 from grazing.report.rules import criterion_row, numeric_row
 
 FIGURE_ID = "eq"
@@ -140,7 +140,7 @@ def eq19_rows() -> list[Comparison]:
     ]
 
 
-def build(out_dir: Path, progress: Progress | None = None) -> FigureResult:
+def build(out_dir: Path, progress: Say | None = None) -> FigureResult:
     """Compute the rows (no image)."""
     say = progress or (lambda _msg: None)
     start = time.perf_counter()

@@ -32,7 +32,7 @@ from grazing.report.base import (
     DataFile,
     FigureResult,
     Image,
-    Progress,
+    Say,
     finish_figure,
 )
 
@@ -339,7 +339,7 @@ def series_datasets(result: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
-def build(out_dir: Path, progress: Progress | None = None) -> FigureResult:
+def build(out_dir: Path, progress: Say | None = None) -> FigureResult:
     """Write the synthetic fig 2- and fig 3-style figures and data into ``out_dir`` and describe them."""
     say = progress or (lambda _msg: None)
     start = time.perf_counter()

@@ -37,7 +37,7 @@ from grazing.report.base import (
     DataFile,
     FigureResult,
     Image,
-    Progress,
+    Say,
     finish_figure,
     new_figure,
 )
@@ -221,7 +221,7 @@ def figure_4b(
 # Fig 2 style: bifurcation diagrams from synthetic recordings
 
 
-def build(out_dir: Path, progress: Progress | None = None) -> FigureResult:
+def build(out_dir: Path, progress: Say | None = None) -> FigureResult:
     """Compute fig 4 (a, b), write the PNGs and data into ``out_dir`` and describe them."""
     say = progress or (lambda _msg: None)
     start = time.perf_counter()

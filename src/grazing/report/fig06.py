@@ -27,7 +27,7 @@ import grazing
 from grazing.models.pendulum import max_angle
 from grazing.orbits import continue_orbit, find_grazings, find_orbit, grazing_curve
 from grazing.report import paper
-from grazing.report.base import Comparison, DataFile, FigureResult, Image, Progress, save_png
+from grazing.report.base import Comparison, DataFile, FigureResult, Image, Say, save_png
 from grazing.report.data import write_dataset, write_groups
 from grazing.report.rules import complex_row, complex_text, criterion_row, numeric_row
 
@@ -323,7 +323,7 @@ def draw(data: Fig6, path: Path) -> None:
     save_png(fig, path)
 
 
-def build(out_dir: Path, progress: Progress | None = None) -> FigureResult:
+def build(out_dir: Path, progress: Say | None = None) -> FigureResult:
     """Compute fig 6, write its PNG into ``out_dir`` and describe it."""
     say = progress or (lambda _msg: None)
     start = time.perf_counter()

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from grazing.report import diagrams, paper
-from grazing.report.base import Comparison, DataFile, FigureResult, Image, Progress
+from grazing.report.base import Comparison, DataFile, FigureResult, Image, Say
 from grazing.report.diagrams import Panel, PanelRun, Runs, Settings
 from grazing.report.rules import criterion_row, numeric_row
 
@@ -103,7 +103,7 @@ def headlines(runs: Runs) -> dict[str, str]:
     }
 
 
-def build(out_dir: Path, progress: Progress | None = None, settings: Settings | None = None) -> FigureResult:
+def build(out_dir: Path, progress: Say | None = None, settings: Settings | None = None) -> FigureResult:
     """Compute fig 7, write its PNGs and data into ``out_dir`` and describe them."""
     say = progress or (lambda _msg: None)
     start = time.perf_counter()

@@ -24,7 +24,7 @@ from grazing.models.pendulum import max_angle
 from grazing.orbits import find_orbit
 from grazing.plotting import mark_grazings, plot_bifurcation
 from grazing.report import diagrams, paper
-from grazing.report.base import Comparison, DataFile, FigureResult, Image, Progress, save_png
+from grazing.report.base import Comparison, DataFile, FigureResult, Image, Say, save_png
 from grazing.report.data import slim_sweep, write_csv, write_groups
 from grazing.report.rules import criterion_row, numeric_row
 from grazing.sweeps import sweep
@@ -145,7 +145,7 @@ def draw(runs: list[PanelRun], path: Path) -> None:
     save_png(fig, path)
 
 
-def build(out_dir: Path, progress: Progress | None = None, settings: Settings | None = None) -> FigureResult:
+def build(out_dir: Path, progress: Say | None = None, settings: Settings | None = None) -> FigureResult:
     """Compute fig 8, write its PNG into ``out_dir`` and describe it."""
     say = progress or (lambda _msg: None)
     start = time.perf_counter()

@@ -33,7 +33,7 @@ from grazing.report.base import (
     Dynamics,
     FigureResult,
     Image,
-    Progress,
+    Say,
     save_png,
     signed,
 )
@@ -355,7 +355,7 @@ def _draw_delay(runs: list[CaseRun], path: Path) -> None:
     save_png(fig, path)
 
 
-def build(out_dir: Path, progress: Progress | None = None) -> FigureResult:
+def build(out_dir: Path, progress: Say | None = None) -> FigureResult:
     """Compute fig 9 and the delay plots, write the PNGs into ``out_dir`` and describe them."""
     say = progress or (lambda _msg: None)
     start = time.perf_counter()

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from grazing.report import diagrams, fig07, paper
-from grazing.report.base import Comparison, DataFile, FigureResult, Image, Progress
+from grazing.report.base import Comparison, DataFile, FigureResult, Image, Say
 from grazing.report.data import write_csv
 from grazing.report.diagrams import Panel, PanelRun, Runs, Settings, Window
 from grazing.report.rules import WindowMatch, criterion_row, majority, match_windows, minus
@@ -139,7 +139,7 @@ def _cascade_end(run: PanelRun) -> float:
     return twos[-1].stop if twos else math.nan
 
 
-def build(out_dir: Path, progress: Progress | None = None, settings: Settings | None = None) -> FigureResult:
+def build(out_dir: Path, progress: Say | None = None, settings: Settings | None = None) -> FigureResult:
     """Compute fig 10, write its PNGs and data into ``out_dir`` and describe them."""
     say = progress or (lambda _msg: None)
     start = time.perf_counter()

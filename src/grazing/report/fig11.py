@@ -24,7 +24,7 @@ import grazing
 from grazing.models import pendulum
 from grazing.normalform import find_grazing_point, normal_form_at
 from grazing.report import paper
-from grazing.report.base import CHAOS_THRESHOLD, DataFile, FigureResult, Image, Progress, save_png, signed
+from grazing.report.base import CHAOS_THRESHOLD, DataFile, FigureResult, Image, Say, save_png, signed
 from grazing.report.data import write_dataset
 from grazing.report.rules import criterion_row
 
@@ -53,7 +53,7 @@ def _histogram_distance(a: np.ndarray, b: np.ndarray, bins: int = 60) -> float:
     return 0.5 * float(np.abs(ha / ha.sum() - hb / hb.sum()).sum())
 
 
-def build(out_dir: Path, progress: Progress | None = None) -> FigureResult:
+def build(out_dir: Path, progress: Say | None = None) -> FigureResult:
     """Compute fig 11, write its PNG into ``out_dir`` and describe it."""
     import matplotlib.pyplot as plt
 

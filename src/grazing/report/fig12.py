@@ -13,7 +13,7 @@ import time
 from pathlib import Path
 
 from grazing.report import diagrams, fig07, paper
-from grazing.report.base import Comparison, DataFile, FigureResult, Image, Progress
+from grazing.report.base import Comparison, DataFile, FigureResult, Image, Say
 from grazing.report.diagrams import Panel, PanelRun, Runs, Settings, Window
 from grazing.report.rules import criterion_row, fmt_delta, numeric_row, overlap_length, span
 
@@ -40,7 +40,7 @@ HEAD_WINDOW = (
 )
 
 
-def build(out_dir: Path, progress: Progress | None = None, settings: Settings | None = None) -> FigureResult:
+def build(out_dir: Path, progress: Say | None = None, settings: Settings | None = None) -> FigureResult:
     """Compute fig 12, write its PNGs and data into ``out_dir`` and describe them."""
     say = progress or (lambda _msg: None)
     start = time.perf_counter()

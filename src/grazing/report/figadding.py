@@ -38,7 +38,7 @@ from grazing.orbits import BifurcationCurve, find_orbit, follow_curve
 from grazing.plotting import plot_period_map
 from grazing.plotting.diagrams import period_classes
 from grazing.report import figmap
-from grazing.report.base import Comparison, DataFile, FigureResult, Image, Progress, save_png
+from grazing.report.base import Comparison, DataFile, FigureResult, Image, Say, save_png
 from grazing.report.data import write_dataset, write_groups
 from grazing.report.rules import CurveOnMap, criterion_row, curve_on_map
 
@@ -231,7 +231,7 @@ def follow_from_map(
     return None, failures
 
 
-def compute(s: Settings, progress: Progress | None = None) -> AddingRun:
+def compute(s: Settings, progress: Say | None = None) -> AddingRun:
     say = progress or (lambda _msg: None)
     ds, seconds, cpu = figmap.period_map(
         figmap.Settings(eta=s.eta, theta_hat_deg=s.theta_hat_deg, transient=s.transient, periods=s.periods,
@@ -346,7 +346,7 @@ def draw(run: AddingRun, path: Path) -> None:
     save_png(fig, path)
 
 
-def build(out_dir: Path, progress: Progress | None = None, settings: Settings | None = None) -> FigureResult:
+def build(out_dir: Path, progress: Say | None = None, settings: Settings | None = None) -> FigureResult:
     """Compute the map and the curves, write the PNG and the data into ``out_dir`` and describe them."""
     say = progress or (lambda _msg: None)
     start = time.perf_counter()

@@ -29,7 +29,7 @@ from grazing.core.period import detect_period
 from grazing.orbits import find_grazings
 from grazing.plotting import mark_grazings, plot_basins, plot_bifurcation
 from grazing.report import paper
-from grazing.report.base import Comparison, DataFile, FigureResult, Image, Progress, new_figure, save_png
+from grazing.report.base import Comparison, DataFile, FigureResult, Image, Say, new_figure, save_png
 from grazing.report.data import write_dataset
 from grazing.report.rules import criterion_row, numeric_row
 from grazing.sweeps import sweep
@@ -76,7 +76,7 @@ class Run:
     seconds: float
 
 
-def compute(s: Settings, progress: Progress | None = None) -> Run:
+def compute(s: Settings, progress: Say | None = None) -> Run:
     say = progress or (lambda _msg: None)
     start = time.perf_counter()
     model = grazing.models.pendulum("B", theta_hat=math.radians(THETA_HAT_DEG))
@@ -338,7 +338,7 @@ def write_data(run: Run, out_dir: Path) -> DataFile:
     return DataFile(path.name, "the sweeps' periods and impacts (up, down, from rest) and the basins, NetCDF")
 
 
-def build(out_dir: Path, progress: Progress | None = None, settings: Settings | None = None) -> FigureResult:
+def build(out_dir: Path, progress: Say | None = None, settings: Settings | None = None) -> FigureResult:
     """Compute the section, write its PNG and data into ``out_dir`` and describe it."""
     say = progress or (lambda _msg: None)
     start = time.perf_counter()

@@ -23,7 +23,7 @@ from grazing.models.pendulum import max_angle
 from grazing.orbits import find_orbit, grazing_curve
 from grazing.plotting import plot_period_map
 from grazing.report import diagrams
-from grazing.report.base import Comparison, DataFile, FigureResult, Image, Progress, save_png
+from grazing.report.base import Comparison, DataFile, FigureResult, Image, Say, save_png
 from grazing.report.data import write_dataset
 from grazing.report.rules import criterion_row
 from grazing.sweeps import parameter_map
@@ -74,7 +74,7 @@ def max_angles(etas: np.ndarray) -> np.ndarray:
     return out
 
 
-def period_map(s: Settings, say: Progress, label: str = "map") -> tuple[Any, float, float]:
+def period_map(s: Settings, say: Say, label: str = "map") -> tuple[Any, float, float]:
     """Case B's period map at the resolution of ``s``: the dataset, its wall and CPU seconds.
 
     The CPU seconds include the worker processes'.  ``label`` starts the progress messages.
@@ -105,7 +105,7 @@ def period_map(s: Settings, say: Progress, label: str = "map") -> tuple[Any, flo
     return ds, time.perf_counter() - start, cpu_seconds() - cpu
 
 
-def compute(s: Settings, progress: Progress | None = None) -> MapRun:
+def compute(s: Settings, progress: Say | None = None) -> MapRun:
     say = progress or (lambda _msg: None)
     start, cpu = time.perf_counter(), cpu_seconds()
     ds, _, _ = period_map(s, say)
@@ -177,7 +177,7 @@ def draw(run: MapRun, path: Path) -> None:
     save_png(fig, path)
 
 
-def build(out_dir: Path, progress: Progress | None = None, settings: Settings | None = None) -> FigureResult:
+def build(out_dir: Path, progress: Say | None = None, settings: Settings | None = None) -> FigureResult:
     """Compute the map, write its PNG into ``out_dir`` and describe it."""
     say = progress or (lambda _msg: None)
     start = time.perf_counter()

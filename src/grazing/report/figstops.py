@@ -25,7 +25,7 @@ from grazing.errors import GrazingWarning
 from grazing.models import two_sided_oscillator
 from grazing.orbits import find_grazings, find_orbit
 from grazing.plotting import plot_bifurcation
-from grazing.report.base import Comparison, DataFile, FigureResult, Image, Progress, new_figure, save_png
+from grazing.report.base import Comparison, DataFile, FigureResult, Image, Say, new_figure, save_png
 from grazing.report.data import write_dataset
 from grazing.report.rules import criterion_row, numeric_row
 from grazing.sweeps import sweep
@@ -80,7 +80,7 @@ class Run:
     seconds: float
 
 
-def compute(s: Settings, progress: Progress | None = None) -> Run:
+def compute(s: Settings, progress: Say | None = None) -> Run:
     say = progress or (lambda _msg: None)
     start = time.perf_counter()
     model = two_sided_oscillator(**dict(s.params))
@@ -240,7 +240,7 @@ def write_data(run: Run, out_dir: Path) -> DataFile:
     return DataFile(path.name, "the sweep's detected period and impacts per period on each stop, NetCDF")
 
 
-def build(out_dir: Path, progress: Progress | None = None, settings: Settings | None = None) -> FigureResult:
+def build(out_dir: Path, progress: Say | None = None, settings: Settings | None = None) -> FigureResult:
     """Compute the section, write its PNG and data into ``out_dir`` and describe it."""
     say = progress or (lambda _msg: None)
     start = time.perf_counter()

@@ -36,7 +36,7 @@ from typing import Any
 import grazing
 from grazing.atomic import write_text_atomic
 from grazing.core.options import SWEEP_TOL
-from grazing.report.base import FigureResult, Progress, number_rows
+from grazing.report.base import FigureResult, Say, number_rows
 
 RESULTS = "results"
 """The folder of ``out`` holding each built figure's :class:`FigureResult` as ``<id>.json``."""
@@ -77,7 +77,7 @@ def groups(modules: Sequence[ModuleType]) -> list[list[ModuleType]]:
     return jobs
 
 
-def build_one(module: ModuleType, out: Path, say: Progress, commit: str) -> FigureResult:
+def build_one(module: ModuleType, out: Path, say: Say, commit: str) -> FigureResult:
     """Build one figure into ``out`` and keep its result as ``results/<id>.json`` (written at once)."""
     res = module.build(out, say)
     res = replace(
@@ -148,7 +148,7 @@ def _relay(queue: Any, say: Callable[[str], None], stop: threading.Event) -> Non
 
 
 def build_figures(
-    modules: Sequence[ModuleType], out: Path, say: Progress, commit: str, workers: int | None = None
+    modules: Sequence[ModuleType], out: Path, say: Say, commit: str, workers: int | None = None
 ) -> float:
     """Compile the :data:`KERNELS`, then build ``modules`` into ``out``, on up to ``workers`` processes.
 
