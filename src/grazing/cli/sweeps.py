@@ -32,6 +32,7 @@ from grazing.cli.common import (
     save_dataset,
     spaced_values,
 )
+from grazing.cli.hints import flag_hints
 from grazing.cli.limits import POINT_OVERHEAD, check_memory, count_text, sweep_bytes
 from grazing.cli.validate import FINITE, POSITIVE, TOLERANCE, WORKERS, count, path_type, refuse_unused
 from grazing.core.options import CHUNK_SIZE, SweepSettings
@@ -181,7 +182,8 @@ def _run_sweep_spec(
             store = MemoryStore(spec)
         ds = run_sweep(
             spec, store=store, workers=workers, client=client, progress=bar, timeout=timeout,
-            notice=lambda msg: click.echo(f"grazing: {msg}", err=True), load=not (streamed or memory),
+            notice=lambda msg: click.echo(f"grazing: {flag_hints(msg)}", err=True),
+            load=not (streamed or memory),
         )  # fmt: skip
         flat = {name: store.read(name) for name in ("period", "status", "impacts")} if streamed else None
     finally:

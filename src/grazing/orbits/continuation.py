@@ -709,7 +709,7 @@ class _Continuation:
         if not self.switch:
             branch.special.append(graze)
             branch.segment_status.append(
-                status + "; the orbit with the new impact sequence can be followed with switch (--switch)"
+                status + "; the orbit with the new impact sequence can be followed with switch (switch=True)"
             )
             return []
         new = new_sequence_orbit(last, self.param, value, sign, self.virtual)
