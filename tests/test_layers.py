@@ -9,6 +9,7 @@ count too.  The one exception is reading the package version
 from __future__ import annotations
 
 import ast
+import re
 import subprocess
 import sys
 from concurrent.futures import ThreadPoolExecutor
@@ -259,3 +260,55 @@ def test_architecture_doc_lists_the_same_layers() -> None:
         for name in re.findall(r"`([a-z_]+)(?:/|\.py)`", packages):
             documented[f"grazing.{name}"] = int(layer)
     assert documented == LAYERS
+
+
+LIBRARY = [name for name in LAYERS if name != "grazing.cli"]
+"""The parts of the package a Python user calls: all but the command line (the explorer too, which a
+notebook shows)."""
+
+PRINTS_COMMAND_LINES = {
+    "grazing.explore.code": "copy as code: the command lines that reproduce the view",
+    "grazing.explore.source": "the --model/--set options of those command lines",
+    "grazing.report.html": "the page's reproduction commands",
+    "grazing.report.browser": "its own command line, and Chromium's",
+    "grazing.report.provenance": "the git command it runs",
+}
+"""The modules that print command lines by design, and what they print."""
+
+FLAG = re.compile(r"(?<![\w-])--[a-z][a-z0-9-]*")
+"""A command-line option (``--initial``)."""
+
+
+def _strings_in_code(path: Path) -> list[tuple[int, str]]:
+    """String constants of a file with their lines, docstrings left out (f-strings' pieces included)."""
+    tree = ast.parse(path.read_text())
+    docstrings = {id(n.value) for n in ast.walk(tree) if isinstance(n, ast.Expr)}
+    return [
+        (node.lineno, node.value)
+        for node in ast.walk(tree)
+        if isinstance(node, ast.Constant) and isinstance(node.value, str) and id(node) not in docstrings
+    ]
+
+
+def test_no_library_message_names_a_command_line_option():
+    """A Python user reads about arguments (``x0=``), never about options they do not have (``--initial``):
+    the command line turns the one into the other (``grazing.cli.hints``)."""
+    problems = []
+    for module, path in modules().items():
+        if part(module) in LIBRARY and module not in PRINTS_COMMAND_LINES:
+            for line, text in _strings_in_code(path):
+                if FLAG.search(text):
+                    problems.append(f"{path.relative_to(SRC)}:{line}: {FLAG.findall(text)} in {text!r}")
+    assert not problems, "\n".join(problems)
+
+
+def test_no_library_module_imports_the_command_line():
+    """The explorer included: it is a library beside the command line, not a part of it."""
+    problems = [
+        f"{path.relative_to(SRC)}:{line} imports {target}"
+        for module, path in modules().items()
+        if part(module) in LIBRARY
+        for target, line in imports(path, module)
+        if part(target) == "grazing.cli"
+    ]
+    assert not problems, "\n".join(problems)

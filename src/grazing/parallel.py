@@ -189,7 +189,7 @@ def map_unordered(
         if isinstance(exc, BrokenProcessPool):
             raise SimulationError(
                 "a worker process died (killed by the system: out of memory?); the finished chunks "
-                "are kept in a --out store: run the same command again to resume"
+                "are kept in a result store (store=): run it again to resume"
             ) from None
         raise
     ex.shutdown(wait=True)

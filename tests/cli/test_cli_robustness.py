@@ -539,9 +539,9 @@ NEG = f"{Path(__file__).resolve().parents[1] / 'orbits' / 'negative_damping.py'}
 DIVERGED = (
     r"cannot guess the orbit by simulating from rest with the stops ignored: the state became non-finite"
 )
-GUESS = r"give an initial guess x0 \(--initial\) near the orbit, from which Newton's method finds it"
+GUESS = r"give an initial guess \(--initial\) near the orbit, from which Newton's method finds it"
 STICKS = r"the default initial guess sticks: simulated from rest for 500 forcing periods, the motion "
-NOT_STICKING = r"give an initial guess x0 \(--initial\) near an orbit that does not stick"
+NOT_STICKING = r"give an initial guess \(--initial\) near an orbit that does not stick"
 ORBIT_MESSAGES = [
     (["orbit", "--model", "bouncing-ball"], f"{STICKS}ends riding on the stop, .*{NOT_STICKING}"),
     (

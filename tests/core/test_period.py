@@ -7,6 +7,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from grazing import detect_period
+from grazing.core.period import detect_periods, repeats_with_period
 
 
 @given(p=st.integers(1, 64), reps=st.integers(2, 4), seed=st.integers(0, 2**31))
@@ -29,3 +30,26 @@ def test_tolerance_and_noise():
 def test_too_few_samples_for_the_period():
     assert detect_period(np.array([0.0, 1.0, 2.0])) == 0
     assert detect_period(np.array([[0.0, 1.0]])) == 0
+
+
+@given(
+    p=st.integers(1, 8),
+    n=st.integers(6, 40),
+    cut=st.integers(0, 40),
+    tol=st.sampled_from([0.0, 1e-9, 1e-3]),
+    spoil=st.lists(st.tuples(st.integers(0, 39), st.integers(0, 1), st.sampled_from(
+        [np.nan, np.inf, -np.inf, 1e-9, -1e-9, 2e-3, -0.0])), max_size=3),
+    seed=st.integers(0, 2**31),
+)  # fmt: skip
+def test_the_lanes_loop_is_detect_periods_one_run_at_a_time(p, n, cut, tol, spoil, seed):
+    """The compiled lanes' test of a repeating transient and the sweeps' give the same period (NaN, inf,
+    a difference exactly at the tolerance, too few samples)."""
+    rng = np.random.default_rng(seed)
+    s = np.tile(rng.uniform(-1, 1, size=(p, 2)), (n // p + 1, 1))[:n]
+    for i, c, v in spoil:
+        if i < n:
+            s[i, c] = v if not np.isfinite(v) or v == 0.0 else s[i, c] + v
+    count = min(cut, n)
+    for max_period in (3, 64):
+        expected = int(detect_periods(s[None, :count], tol, max_period)[0])
+        assert repeats_with_period(s, count, tol, max_period) == expected

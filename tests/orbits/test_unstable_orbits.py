@@ -37,7 +37,7 @@ from tests.orbits.negative_damping import (
 )
 
 CF = ClosedForm()
-GUESS = r"give an initial guess x0 \(--initial\)"
+GUESS = r"give an initial guess \(x0=\)"
 DIVERGES = (
     r"cannot guess the orbit by simulating from rest with the stops ignored: the state became non-finite"
 )
@@ -221,7 +221,7 @@ def test_switch_follows_a_nonimpacting_orbit_physically_to_its_grazing(model, pa
     first = next(s for s in ignored.special if s.kind == "grazing")
     end = next(s for s in physical.special if s.kind == "grazing")
     assert end.param == pytest.approx(first.param, abs=1e-9)
-    assert "switch" in physical.status and "followed with switch (--switch)" not in physical.status
+    assert "switch" in physical.status and "followed with switch (switch=True)" not in physical.status
 
 
 def test_moving_the_section_starts_newton_on_the_orbit():

@@ -312,7 +312,7 @@ def test_wait_waits_for_the_other_run_and_without_it_the_pid_is_named(tmp_path, 
         assert busy.returncode == 1 and busy.stdout == ""
         assert busy.stderr == (
             f"grazing: error: {out} is being written by another grazing run (PID {holder.pid}); "
-            "wait for it to finish (--wait) or use another --out\n"
+            "wait for it to finish (--wait) or use another store (--out)\n"
         )
         waiter = subprocess.Popen(
             _cli(*argv, "--wait"), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
@@ -451,7 +451,7 @@ def test_a_cluster_without_workers_says_so_and_times_out(tmp_path, monkeypatch, 
     assert lines == [
         f"grazing: no Dask worker is connected to {addr}: waiting for one (giving up after 1 s)",
         f"grazing: error: no Dask worker connected to {addr} within 1 s; start workers (dask worker ADDRESS) "
-        "or run without --scheduler",
+        "or run without a scheduler (--scheduler)",
     ]
     assert list(tmp_path.iterdir()) == []
 

@@ -69,6 +69,11 @@ MAX_POINTS = 2000
 MAX_EXPONENTS = 4096
 """Most Lyapunov exponents of an aperiodic attractor's end states kept for its median."""
 
+RIDING_TOL = 1e3 * ON_STOP_TOL
+"""A motion without impacts rides on a stop when each of its sampled points is on one to this (relative
+to ``max(1, |x|)``): a thousand times the rounding of a state put on the stop (``ON_STOP_TOL``), for a
+sample taken while sticking is on the stop to the integrator's accuracy, not to rounding alone."""
+
 INVALID = 0
 """The label of an initial state beyond a stop (not run); attractors are numbered from 1."""
 
@@ -583,7 +588,7 @@ class Catalogue:
         if not e.impacts == 0 or not self.model.has_sticking:
             return False
         for x in e.points:
-            tol = 1e3 * ON_STOP_TOL * max(1.0, float(np.max(np.abs(x))))
+            tol = RIDING_TOL * max(1.0, float(np.max(np.abs(x))))
             if not any(abs(self.model.guard(x, self.t_sample, j)) <= tol for j in range(self.model.n_stops)):
                 return False
         return True

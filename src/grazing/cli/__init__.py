@@ -26,6 +26,7 @@ from grazing.cli.common import (
     flush_or_discard_output,
     output_closed,
 )
+from grazing.cli.hints import flag_hints
 from grazing.cli.limits import MEMORY_ENV
 from grazing.engine.interrupts import Terminated, terminating_as_interrupted
 from grazing.errors import GrazingError
@@ -165,7 +166,7 @@ def main(argv: list[str] | None = None) -> int:
         error_line(exc.format_message())
         return EXIT_USAGE
     except GrazingError as exc:
-        error_line(str(exc))
+        error_line(flag_hints(str(exc)))
         return EXIT_FAILURE
     except OSError as exc:
         if isinstance(exc, BrokenPipeError) and output_closed():  # (``sweep --json | head``: read enough)

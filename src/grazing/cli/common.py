@@ -30,6 +30,7 @@ import orjson
 
 import grazing
 from grazing.atomic import resolved
+from grazing.cli.hints import flag_hints
 from grazing.cli.validate import (
     ANGLE_DEG,
     InputError,
@@ -103,7 +104,7 @@ def run_user_code(failed: str, call: Callable[[], Any]) -> Any:
     except KeyboardInterrupt:
         raise
     except grazing.GrazingError as exc:
-        reason = str(exc)
+        reason = flag_hints(str(exc))
     except BaseException as exc:  # the user's code: anything it raises is theirs, reported in one line
         reason = f"{type(exc).__name__}: {exc}".rstrip(": ")
     else:
@@ -589,32 +590,6 @@ def check_eta_range(eta_min: float, eta_max: float) -> None:
 
 def complex_list(mu: np.ndarray) -> list[list[float]]:
     return [[float(z.real), float(z.imag)] for z in np.asarray(mu, dtype=complex)]
-
-
-def multipliers_text(pairs: Any, digits: int = 4) -> str:
-    """Multipliers (complex numbers or ``[re, im]`` pairs) as ``+a+bi, ...`` to ``digits`` decimals.
-
-    A part that rounds to zero is printed ``+0.0000``, whatever its sign: the sign of a
-    rounding-level imaginary part (a double real multiplier) depends on the processor's linear
-    algebra.
-
-    Examples
-    --------
-    >>> multipliers_text([complex(-0.03214, 1e-17), complex(-0.03214, -1e-17)])
-    '-0.0321+0.0000i, -0.0321+0.0000i'
-    >>> multipliers_text([[0.5, 0.25]], digits=2)
-    '+0.50+0.25i'
-    """
-
-    def part(v: float) -> str:
-        r = round(float(v), digits)
-        return f"{(r if r != 0.0 else 0.0):+.{digits}f}"
-
-    out = []
-    for z in pairs:
-        re_, im = (z.real, z.imag) if isinstance(z, complex | np.complexfloating) else z
-        out.append(f"{part(re_)}{part(im)}i")
-    return ", ".join(out)
 
 
 def check_out(out: Path | None, suffix: str, option: str = "--out", overwrite: bool = False) -> None:

@@ -21,7 +21,6 @@ from grazing.cli.common import (
     model_options,
     model_parameter,
     model_params_json,
-    multipliers_text,
     netcdf_out_option,
     parse_pair,
     parse_state,
@@ -34,6 +33,7 @@ from grazing.cli.validate import ANGLE_DEG, FINITE, ORBIT_PERIOD, POSITIVE
 from grazing.core.options import MAX_STEP
 from grazing.errors import NotFoundError
 from grazing.orbits.curves import CURVE_KINDS
+from grazing.orbits.periodic import multipliers_text
 
 
 def _range(text: str, par: grazing.Parameter, model: grazing.HybridModel) -> tuple[float, float]:

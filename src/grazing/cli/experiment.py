@@ -48,7 +48,8 @@ from grazing.cli.validate import (
     path_type,
     refuse_unused,
 )
-from grazing.core.options import DEFAULT_TRANSIENT
+from grazing.core.options import DEFAULT_TRANSIENT, MAX_PERIOD
+from grazing.experiment.signal import DEFAULT_CUTOFF_MULTIPLE, DEFAULT_MAX_PERIOD
 from grazing.models.pendulum import CASES, DEFAULT_CASE, case_values
 
 _RELATIONS = ["model", "paper", "protocol"]
@@ -410,9 +411,10 @@ def _plot_recording(a: Any, path: Path, overwrite: bool) -> None:
 @click.option("--degrees", is_flag=True, help="The angle column is in degrees.")
 @click.option("--cutoff-hz", type=POSITIVE,
               help="Low-pass cutoff in Hz (default: a multiple of the forcing).")  # fmt: skip
-@click.option("--cutoff-multiple", type=POSITIVE, default=20.0, show_default=True,
+@click.option("--cutoff-multiple", type=POSITIVE, default=DEFAULT_CUTOFF_MULTIPLE, show_default=True,
               help="Default cutoff in multiples of the forcing frequency.")  # fmt: skip
-@click.option("--max-period", type=click.IntRange(min=1, max=64), default=32, show_default=True,
+@click.option("--max-period", type=click.IntRange(min=1, max=MAX_PERIOD), default=DEFAULT_MAX_PERIOD,
+              show_default=True,
               help="Largest period tested.")  # fmt: skip
 @click.option("--noise", type=POSITIVE, help="Noise level of the angle in rad (default: estimated).")
 @click.option("--theta-hat", "theta_hat", type=ANGLE_DEG, metavar="DEG",

@@ -16,13 +16,13 @@ from grazing.cli.common import (
     json_option,
     model_options,
     model_params_json,
-    multipliers_text,
     search_range,
     stop_name_option,
     stop_option_index,
 )
 from grazing.cli.orbits import initial_option, range_start_state
 from grazing.cli.validate import POSITIVE
+from grazing.orbits.periodic import multipliers_text
 
 
 @click.command("normal-form")

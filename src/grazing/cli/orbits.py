@@ -22,7 +22,6 @@ from grazing.cli.common import (
     model_options,
     model_parameter,
     model_params_json,
-    multipliers_text,
     netcdf_out_option,
     parse_pair,
     parse_state,
@@ -32,10 +31,12 @@ from grazing.cli.common import (
     stop_name_option,
     stop_option_index,
 )
+from grazing.cli.hints import flag_hints
 from grazing.cli.validate import ANGLE_DEG, FINITE, ORBIT_PERIOD, POSITIVE, count, refuse_unused
 from grazing.core.options import DEFAULT_TRANSIENT, MAX_STEP
 from grazing.errors import GrazingWarning
 from grazing.models.pendulum import max_angle
+from grazing.orbits.periodic import multipliers_text
 
 
 def not_isolated_note(orbit: Any) -> str:
@@ -442,8 +443,8 @@ def continue_(
             }
             for sp_ in branch.special
         ],
-        "segment_status": branch.segment_status,
-        "status": branch.status,
+        "segment_status": [flag_hints(s) for s in branch.segment_status],
+        "status": flag_hints(branch.status),
         "out": str(out) if out else None,
     }
     if model.name == "pendulum":
@@ -459,7 +460,7 @@ def continue_(
         periods = sorted(set(branch.periods.tolist()))
         listed = f"period{'s' * (len(periods) > 1)} {', '.join(map(str, periods))}"
         more = f" in {segs} segments (switched at: {', '.join(kinds)}; {listed})"
-    click.echo(f"{len(branch)} points of the period-{branch.period} orbit{more}, {kind}; {branch.status}")
+    click.echo(f"{len(branch)} points of the period-{branch.period} orbit{more}, {kind}; {res['status']}")
     for point, sp_ in zip(branch.special, res["special"]):
         if point.between is not None:  # an unlocated stability change: what was seen, in words
             click.echo(f"  {sp_['kind']:16s} {point.note}")
@@ -472,7 +473,7 @@ def continue_(
             f"  {sp_['kind']:16s} {par.show(point.param, '.8g')}   multipliers {mu}{angle}{on}{switched}"
         )
     if segs > 1:
-        for i, (origin, status) in enumerate(zip(branch.segment_origin, branch.segment_status)):
+        for i, (origin, status) in enumerate(zip(branch.segment_origin, res["segment_status"])):
             at = branch.special[origin] if origin >= 0 else None
             start = f" (from the {at.kind} at {par.show(at.param, '.8g')})" if at is not None else ""
             period = branch.periods[branch.segments.index(i)] if i in branch.segments else branch.period

@@ -32,6 +32,7 @@ from grazing.cli.common import (
     save_dataset,
     spaced_values,
 )
+from grazing.cli.hints import flag_hints
 from grazing.cli.limits import POINT_OVERHEAD, check_memory, count_text, sweep_bytes
 from grazing.cli.validate import FINITE, POSITIVE, TOLERANCE, WORKERS, count, path_type, refuse_unused
 from grazing.core.options import CHUNK_SIZE, SweepSettings
@@ -40,13 +41,16 @@ from grazing.core.solution import Status
 ONE_VALUE = "with {num} 1 (its one value is {start}: give the same value to both, or {num} 2 or more)"
 """Why the last value is refused with one value: ``--stop is not used with --num 1 (...)``."""
 
+SWEEP_DEFAULTS = SweepSettings()
+"""The defaults of ``sweep`` and ``map``'s options: those of :class:`~grazing.core.options.SweepSettings`."""
+
 
 def _sweep_options(func: Callable[..., Any]) -> Callable[..., Any]:
     options = [
-        click.option("--transient", type=count(0), default=500, show_default=True,
+        click.option("--transient", type=count(0), default=SWEEP_DEFAULTS.transient, show_default=True,
                      help="Forcing periods discarded at each point.")
         ,
-        click.option("--periods", type=count(1), default=100, show_default=True,
+        click.option("--periods", type=count(1), default=SWEEP_DEFAULTS.periods, show_default=True,
                      help="Forcing periods sampled at each point."),
         click.option("--initial", default=None, metavar="X1,X2,...",
                      help="Initial state (of every chunk; of every point with --fresh), one number per "
@@ -61,7 +65,7 @@ def _sweep_options(func: Callable[..., Any]) -> Callable[..., Any]:
                           "(default: wait; a message after 5 s)."),
         click.option("--no-lyapunov", is_flag=True, help="Skip the Lyapunov exponents."),
         click.option("--no-adaptive", is_flag=True, help="Always run the full transient."),
-        click.option("--tol", type=TOLERANCE, default=1e-10, show_default=True,
+        click.option("--tol", type=TOLERANCE, default=SWEEP_DEFAULTS.tol, show_default=True,
                      help="Integrator tolerance, in (0, 0.01)."),
         click.option("--out", type=path_type(), metavar="FILE.zarr|FILE.nc",
                      help="Zarr store (resumable; one run at a time) or NetCDF file."),
@@ -181,7 +185,8 @@ def _run_sweep_spec(
             store = MemoryStore(spec)
         ds = run_sweep(
             spec, store=store, workers=workers, client=client, progress=bar, timeout=timeout,
-            notice=lambda msg: click.echo(f"grazing: {msg}", err=True), load=not (streamed or memory),
+            notice=lambda msg: click.echo(f"grazing: {flag_hints(msg)}", err=True),
+            load=not (streamed or memory),
         )  # fmt: skip
         flat = {name: store.read(name) for name in ("period", "status", "impacts")} if streamed else None
     finally:

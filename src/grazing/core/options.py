@@ -50,13 +50,24 @@ CORRECTOR_TOL = 1e-10
 """Continuation (branches and curves): the corrector accepts a point when the largest of its
 equations' residuals is below this (:class:`~grazing.orbits.palc.PalcSettings` ``tol``)."""
 
+LOCATE_TOL = 1e-9
+"""Continuation: a special point is located where its test function is below this (absolute;
+:class:`~grazing.orbits.palc.PalcSettings` ``locate_tol``).  The test functions come from corrected
+points, known to about :data:`CORRECTOR_TOL`: ten times that is as close to zero as their sign is sure."""
+
+BOUNDARY_TOL = 1e-10
+"""Continuation: a boundary of a branch (a grazing, an orbit sticking) is bracketed until the followed
+component (the continued parameter) differs by at most this across it (relative to ``max(1, |value|)``;
+:class:`~grazing.orbits.palc.PalcSettings` ``boundary_tol``): the corrector's :data:`CORRECTOR_TOL`,
+below which the two corrected points are not told apart."""
+
 MAX_STEP = 0.04
 """Continuation's largest step (:class:`~grazing.orbits.palc.PalcSettings` ``ds_max``; ``--max-step``)."""
 
 DEFAULT_TRANSIENT = 500
 """Forcing periods run before sampling where none is given: a periodic orbit's guess simulated from rest
-(:func:`~grazing.orbits.find_orbit`), and the ``--transient`` of ``simulate``, ``orbit`` and
-``synthesize``."""
+(:func:`~grazing.orbits.find_orbit`), a sweep's points (:class:`SweepSettings`), and the ``--transient``
+of ``simulate``, ``orbit``, ``synthesize``, ``sweep`` and ``map``."""
 
 UNIT_CIRCLE_TOL = 1e-9
 """A Floquet multiplier within this of the unit circle is on it (neither stable nor unstable): the
@@ -370,7 +381,7 @@ class SweepSettings:
         Local error tolerance of the integrator.
     """
 
-    transient: int = 500
+    transient: int = DEFAULT_TRANSIENT
     periods: int = 100
     phase: float = 0.0
     fresh: bool = False

@@ -66,6 +66,35 @@ def detect_periods(
     return found
 
 
+def repeats_with_period(samples: np.ndarray, count: int, tol: float, max_period: int) -> int:
+    """:func:`detect_period` of ``samples[:count]`` (rows of a 2-d array), written as loops that make no
+    array: the test the sweeps' compiled lanes inline to end a transient once it repeats
+    (:mod:`grazing.engine.driver.lanes`).
+
+    The same test as :func:`detect_periods`, one run at a time: a period ``p`` fits when every
+    ``|s_{i+p} - s_i| <= tol`` (a NaN fails it, as it makes the other's maximum NaN), periods up to
+    ``count // 2`` (``tests/core/test_period.py`` checks that the two agree).
+
+    Examples
+    --------
+    >>> repeats_with_period(np.array([[1.0], [2.0], [1.0], [2.0], [9.0]]), 4, 1e-9, 64)
+    2
+    """
+    n = samples.shape[1]
+    for p in range(1, min(max_period, count // 2) + 1):
+        ok = True
+        for i in range(count - p):
+            for c in range(n):
+                if not abs(samples[i + p, c] - samples[i, c]) <= tol:  # (NaN: not periodic)
+                    ok = False
+                    break
+            if not ok:
+                break
+        if ok:
+            return p
+    return 0
+
+
 def orbit_impacts(count: np.ndarray, period: np.ndarray, periods: int) -> np.ndarray:
     """Impacts per period of a periodic orbit (per forcing period where ``period`` is 0 or less) from
     ``count``, the impacts in a window of ``periods`` forcing periods (negative: a failed point, nan).

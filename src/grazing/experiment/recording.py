@@ -468,7 +468,7 @@ def forcing_clock(
         clock = ForcingClock(hz, np.asarray(refs, dtype=float), True)
     else:
         if forcing_hz is None:
-            raise RecordingError(f"{src}: no trigger column; give the forcing frequency (--forcing-hz)")
+            raise RecordingError(f"{src}: no trigger column; give the forcing frequency (forcing_hz=)")
         T = 1.0 / forcing_hz
         k0 = math.ceil(rec.time[0] / T - 1e-9)
         k1 = math.floor(rec.time[-1] / T + 1e-9)

@@ -17,7 +17,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from grazing.cli.common import multipliers_text
 from grazing.engine.simulate import simulate
 from grazing.errors import GrazingError, GrazingWarning, InvalidParameterError
 from grazing.explore.diagram import IsCancelled, SupersededError, View, checkpoint
@@ -25,6 +24,7 @@ from grazing.explore.point import PointReport
 from grazing.orbits.continuation import Branch, continue_orbit
 from grazing.orbits.grazing import find_grazings
 from grazing.orbits.kinds import SpecialKind
+from grazing.orbits.periodic import multipliers_text
 from grazing.orbits.shooting import PeriodicOrbit
 
 __all__ = [
@@ -241,7 +241,7 @@ def follow_click_curves(
 
     if len(view.axes) != 2:
         raise InvalidParameterError(
-            "a bifurcation curve needs two parameters: explore a period map (--params)"
+            "a bifurcation curve needs two parameters: explore a period map (two parameters)"
         )
     if point.orbit is None:
         raise InvalidParameterError(f"no orbit to follow: {point.message}")

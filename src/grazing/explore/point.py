@@ -17,12 +17,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from grazing.cli.common import multipliers_text
 from grazing.core.model import HybridModel
 from grazing.core.options import MAX_PERIOD
 from grazing.engine.simulate import simulate
 from grazing.errors import GrazingError
 from grazing.explore.diagram import Diagram, IsCancelled, View, checkpoint
+from grazing.orbits.periodic import multipliers_text
 from grazing.orbits.shooting import PeriodicOrbit, find_orbit
 
 __all__ = ["INSPECT_SETTINGS", "InspectSettings", "PointReport", "inspect_click", "inspect_point"]

@@ -89,7 +89,7 @@ def check_port(address: str, port: int) -> int:
         except OSError as exc:
             if exc.errno == errno.EADDRINUSE:
                 raise PortInUseError(
-                    f"port {port} is in use: give another with --port (0: any free port)"
+                    f"port {port} is in use: give another with port= (0: any free port)"
                 ) from None
             raise GrazingError(f"cannot listen on {address}:{port}: {exc.strerror or exc}") from None
 

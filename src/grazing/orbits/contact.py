@@ -25,6 +25,15 @@ from grazing.maps import flow_map
 from grazing.orbits.palc import PalcSettings, newton
 from grazing.orbits.shooting import CROSSING_TOL, sorted_multipliers
 
+CONTACT_TOL = 1e-12
+"""Newton's method on the contact (grazing) equations stops when their largest residual is below this:
+a grazing orbit is an end result (its parameter is reported, a normal form is built on it), and its
+equations, as many as unknowns, are solved to near rounding."""
+
+CONTACT_MAX_NEWTON = 12
+"""Newton's iterations on the contact equations: from a closest approach or a weak impact they converge
+quadratically in a few; no convergence in this many is no grazing there."""
+
 
 @dataclass(frozen=True)
 class GrazingPoint:
@@ -182,7 +191,7 @@ def refine_grazing(
     free: str,
     *,
     period: int = 1,
-    tol: float = 1e-12,
+    tol: float = CONTACT_TOL,
     events: bool = False,
     stop_name: int | str | None = None,
 ) -> GrazingPoint:
@@ -196,7 +205,7 @@ def refine_grazing(
     """
     evaluate = contact_system(model, (free,), period, events=events, stop=model.stop_index(stop_name))
     u0 = np.concatenate([contact, [t_graze, model.params[free]]])
-    pt = newton(evaluate, u0, PalcSettings(tol=tol, max_newton=12))  # n + 2 equations, n + 2 unknowns
+    pt = newton(evaluate, u0, PalcSettings(tol=tol, max_newton=CONTACT_MAX_NEWTON))  # (n + 2 by n + 2)
     if pt is None:
         raise ConvergenceError(
             "Newton's method for the grazing orbit did not converge near "

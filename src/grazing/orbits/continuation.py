@@ -517,6 +517,16 @@ NEAR_CONTACT = 0.05
 """A grazing located that way must touch the stop within this fraction of a forcing period of the
 vanishing impact (or closest approach), and within this fraction of ``max(1, |x|)`` of its state."""
 
+BETWEEN_SLACK = 1e-8
+"""A grazing located between the last orbit of a branch and the first beyond it may lie outside their
+values by this (relative to ``max(1, |value|)``): a hundred times the width to which the boundary is
+bracketed (:data:`~grazing.core.options.BOUNDARY_TOL`), for the grazing equations' own error."""
+
+NEAR_LAST = 1e-4
+"""A grazing located from a branch's last orbit alone (its Newton steps failed beyond) within this of
+its value (relative to ``max(1, |value|)``) is that orbit's, with no other check: far below the steps
+near a boundary (halved down to ``ds_max / 16``), so no other grazing is that close."""
+
 
 def _locate_grazing(
     last: PeriodicOrbit,
@@ -528,7 +538,7 @@ def _locate_grazing(
     """The grazing orbit at the end of a branch, from its last orbit (Newton on the contact equations).
 
     With ``beyond`` (the first orbit past the boundary) the grazing must lie between the two.
-    Without it, within ``1e-4 max(1, |p|)`` of the last value ``p``, or, given ``ahead`` (where
+    Without it, within :data:`NEAR_LAST` ``max(1, |p|)`` of the last value ``p``, or, given ``ahead`` (where
     the margin extrapolates to zero), ahead of ``p`` in the direction of travel up to
     :data:`AHEAD_FACTOR` times that distance, with its contact next to the vanishing impact
     (:data:`NEAR_CONTACT`): the same orbit's grazing.
@@ -548,8 +558,8 @@ def _locate_grazing(
     scale = max(1.0, abs(p))
     if beyond is not None:
         q = beyond.model.params[param]
-        return point if min(p, q) - 1e-8 * scale <= pg <= max(p, q) + 1e-8 * scale else None
-    if abs(pg - p) <= 1e-4 * scale:
+        return point if min(p, q) - BETWEEN_SLACK * scale <= pg <= max(p, q) + BETWEEN_SLACK * scale else None
+    if abs(pg - p) <= NEAR_LAST * scale:
         return point
     if ahead is None or not (pg - p) * (ahead - p) > 0 or abs(pg - p) > AHEAD_FACTOR * abs(ahead - p):
         return None
@@ -816,7 +826,7 @@ class _Continuation:
             branch.special.append(graze)
             branch.end_segment(
                 BranchEnd.GRAZING,
-                status + "; the orbit with the new impact sequence can be followed with switch (--switch)",
+                status + "; the orbit with the new impact sequence can be followed with switch (switch=True)",
             )
             return []
         new = new_sequence_orbit(last, self.param, value, sign, self.virtual)

@@ -39,8 +39,9 @@ import math
 import numpy as np
 
 from grazing.core.model import HybridModel
+from grazing.core.options import CORRECTOR_TOL
 from grazing.errors import GrazingError
-from grazing.orbits.contact import GrazingPoint, contact_system
+from grazing.orbits.contact import CONTACT_MAX_NEWTON, CONTACT_TOL, GrazingPoint, contact_system
 from grazing.orbits.extended import defining_matrix
 from grazing.orbits.kinds import CurveKind
 from grazing.orbits.palc import PalcSettings, newton
@@ -48,8 +49,26 @@ from grazing.orbits.palc import PalcSettings, newton
 FAILURES = (GrazingError, np.linalg.LinAlgError, FloatingPointError)
 """Errors of an evaluation that mean: no solution here."""
 
-NEWTON = PalcSettings(tol=1e-12, max_newton=12)
+NEWTON = PalcSettings(tol=CONTACT_TOL, max_newton=CONTACT_MAX_NEWTON)
 """Newton's method on the contact equations (as :func:`~grazing.orbits.contact.refine_grazing`)."""
+
+DIFFERENCE_STEP = 1e-7
+"""The step of :func:`_gradient`'s central differences (relative to ``max(1, |u|)``): near the square
+root of the machine epsilon, the usual step for a function computed to rounding (truncation error about
+1e-14, rounding about 1e-9 relative).  The gradient only steers Newton's method, whose end is decided on
+its step (:data:`MEETING_STEP`) and on the residual (:data:`MEETING_RESIDUAL`)."""
+
+MEETING_STEP = 1e-12
+"""Newton's method for a codimension-two point stops once its step is below this (relative to
+``max(1, |u|)``), as the contact equations' own (:data:`~grazing.orbits.contact.CONTACT_TOL`)."""
+
+MEETING_REACH = 1e-3
+"""A codimension-two point farther than this (relative) in the parameters from the grazing orbit it was
+sought from is another one (Newton wandered), and not taken."""
+
+MEETING_RESIDUAL = CORRECTOR_TOL
+"""A codimension-two point is taken when the contact equations hold there to this: the tolerance of the
+curves it lies on (:data:`~grazing.core.options.CORRECTOR_TOL`)."""
 
 
 def project_on_contact(model: HybridModel, y: np.ndarray, t: float, stop: int) -> np.ndarray:
@@ -169,7 +188,7 @@ def _gradient(f, u: np.ndarray, fu: float) -> np.ndarray:
     (a contact state moved beyond its stop)."""
     grad = np.empty(u.size)
     for k in range(u.size):
-        h = 1e-7 * max(1.0, abs(u[k]))
+        h = DIFFERENCE_STEP * max(1.0, abs(u[k]))
         e = np.zeros(u.size)
         e[k] = h
         values = []
@@ -194,9 +213,9 @@ def meeting_point(
     """The codimension-two point where the curve of ``kind`` meets the grazing curve, from a grazing
     orbit ``near`` it: Newton's method on the contact equations and :func:`limit_condition` (its
     gradient by central differences).  None if it does not converge, or converges far from ``near``
-    (more than 1e-3 relative in the parameters).  Its ``precision`` is the larger parameter component of
-    the last Newton step (the error before that step: a bound on the error after it, once the iteration
-    converges)."""
+    (more than :data:`MEETING_REACH` relative in the parameters).  Its ``precision`` is the larger
+    parameter component of the last Newton step (the error before that step: a bound on the error after
+    it, once the iteration converges)."""
     model, period, stop = near.model, near.period, near.stop
     n = model.n_states
     contact = contact_system(model, params, period, events=events, stop=stop)
@@ -222,7 +241,7 @@ def meeting_point(
         except FAILURES:  # a failed evaluation or a singular system: not found
             return None
         u = u + du
-        if np.max(np.abs(du)) <= 1e-12 * scale:
+        if np.max(np.abs(du)) <= MEETING_STEP * scale:
             break
     else:
         return None
@@ -230,7 +249,7 @@ def meeting_point(
         F, _, point = system(u)
     except FAILURES:
         return None
-    far = np.max(np.abs(u[n + 1 :] - p0)) > 1e-3 * max(1.0, float(np.max(np.abs(p0))))
-    if far or not np.max(np.abs(F)) <= 1e-10:
+    far = np.max(np.abs(u[n + 1 :] - p0)) > MEETING_REACH * max(1.0, float(np.max(np.abs(p0))))
+    if far or not np.max(np.abs(F)) <= MEETING_RESIDUAL:
         return None
     return dataclasses.replace(point, precision=float(np.max(np.abs(du[n + 1 :]))))

@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from grazing.core.options import CORRECTOR_TOL, MAX_STEP
+from grazing.core.options import BOUNDARY_TOL, CORRECTOR_TOL, LOCATE_TOL, MAX_STEP
 from grazing.errors import GrazingError
 
 ACCEPT = "accept"
@@ -40,6 +40,38 @@ BOUNDARY = "boundary"
 STOP = "stop"
 """Verdicts of a :data:`Check`: accept the candidate; halve the step; the candidate is
 beyond a boundary; accept the candidate and end the iteration."""
+
+ARCLENGTH_FLOOR = 1e-15
+"""A boundary's bracket in the arclength is not narrowed below this (relative to ``max(1, its far
+end)``): about five units in the last place (:data:`~grazing.core.options.MACHINE_EPSILON`), where its
+midpoint is no longer a new step."""
+
+INSIDE_BRACKET = 1e-3
+"""A secant's or regula falsi's trial is kept at least this fraction of its bracket's width inside it
+(:func:`locate`, a boundary's bracketing): a trial at an end would only compute that end again, and a
+side where the secant stagnates still moves."""
+
+MARGIN_REACHED = 1e-3
+"""A boundary with a margin (a grazing: the distance to the stop) is reached continuously when the
+margin at the last point before it has fallen to this fraction of its value where the bracketing began:
+it tends to zero linearly at the boundary, where ten halvings of the bracket take it (2**-10); a margin
+that stays larger means the corrector jumped across."""
+
+JUMP_GAP = 1e-4
+"""A boundary without a margin is reached continuously when the last points on either side of it are
+within this of each other (relative to ``max(1, |u|)``): the points beyond tend to the last one before
+it, and this is a million times the width to which the followed component is bracketed
+(:data:`~grazing.core.options.BOUNDARY_TOL`); a larger gap is a jump of the corrector."""
+
+LOCATE_WIDTH = 1e-12
+""":func:`locate` ends when its bracket on the secant is narrower than this (in the secant's parameter,
+0 to 1): with a secant at most ``ds_max`` long, the point is then within about 4e-14 of the zero, the
+rounding of the corrected points, whatever the test function's value."""
+
+REAL_ROOT_TOL = 1e-12
+"""A root of :func:`locate_by_interpolation`'s cubic (in the secant's parameter, 0 to 1) is real when
+its imaginary part is below this: a real root comes out of ``np.roots`` with an imaginary part of
+rounding (zero or about 1e-16)."""
 
 
 class PalcEnd(enum.Enum):
@@ -76,8 +108,8 @@ class PalcSettings:
         Steps on which the caller's check asks for refinement are halved down to
         this length (default ``ds_max / 16``).
     boundary_tol
-        A boundary is bracketed until the bounded component differs by at most
-        this (relative to ``max(1, |value|)``) across it.
+        A boundary is bracketed until the followed component (:class:`Palc`'s ``index``) differs by
+        at most this (relative to ``max(1, |value|)``) across it.
     """
 
     ds: float = 0.01
@@ -86,11 +118,11 @@ class PalcSettings:
     max_points: int = 2000
     tol: float = CORRECTOR_TOL
     max_newton: int = 8
-    locate_tol: float = 1e-9
+    locate_tol: float = LOCATE_TOL
     min_cos: float = 0.9
     max_correction: float = 0.5
     ds_refine: float | None = None
-    boundary_tol: float = 1e-10
+    boundary_tol: float = BOUNDARY_TOL
 
 
 @dataclass(frozen=True)
@@ -389,7 +421,7 @@ class Palc:
             scale = max(1.0, abs(best.u[i]))
             if after is not None and abs(after.u[i] - best.u[i]) <= self.s.boundary_tol * scale:
                 break
-            if hi - lo <= 1e-15 * max(1.0, hi):
+            if hi - lo <= ARCLENGTH_FLOOR * max(1.0, hi):
                 break
             sig = 0.5 * (lo + hi)
             if len(history) >= 2:
@@ -398,7 +430,7 @@ class Palc:
                     guess = sb + mb * (sb - sa) / (ma - mb)
                     width = hi - lo
                     if lo < guess < hi:  # else bisect
-                        sig = min(max(guess, lo + 1e-3 * width), hi - 1e-3 * width)
+                        sig = min(max(guess, lo + INSIDE_BRACKET * width), hi - INSIDE_BRACKET * width)
             pt = self._step(cur, sig)
             verdict = BOUNDARY if pt is None or self.check is None else self.check(cur, pt)[0]
             if pt is not None and verdict != BOUNDARY:
@@ -410,10 +442,10 @@ class Palc:
         # A boundary of the curve is reached continuously: the margin tends to zero, the
         # points beyond tend to the last point before it.  Otherwise the corrector jumped.
         if history and history[0][1] > 0:
-            reached = history[-1][1] <= 1e-3 * history[0][1]
+            reached = history[-1][1] <= MARGIN_REACHED * history[0][1]
         else:
             gap = math.inf if after is None else float(np.linalg.norm(after.u - best.u))
-            reached = gap <= 1e-4 * max(1.0, float(np.linalg.norm(best.u)))
+            reached = gap <= JUMP_GAP * max(1.0, float(np.linalg.norm(best.u)))
         return Boundary(best, after, reason, reached)
 
     def __iter__(self) -> Iterator[PalcPoint]:
@@ -533,7 +565,7 @@ def locate(
     side = 0
     for _ in range(60):
         sig = (lo * fhi - hi * flo) / (fhi - flo)  # (fhi and flo differ in sign: never equal)
-        sig = min(max(sig, lo + 1e-3 * (hi - lo)), hi - 1e-3 * (hi - lo))
+        sig = min(max(sig, lo + INSIDE_BRACKET * (hi - lo)), hi - INSIDE_BRACKET * (hi - lo))
         pt = correct(evaluate, a.u + sig * d, dn, s)
         if pt is None:
             return best
@@ -543,7 +575,7 @@ def locate(
         offset = f / slope if slope != 0 and math.isfinite(f) else math.inf
         pt.bracket = Bracket(u_lo, u_hi, offset * d, pt.u)
         best = pt
-        if abs(f) <= s.locate_tol or (hi - lo) < 1e-12:
+        if abs(f) <= s.locate_tol or (hi - lo) < LOCATE_WIDTH:
             return pt
         if (f > 0) == (flo > 0):
             lo, flo, true_lo, u_lo = sig, f, f, pt.u
@@ -605,7 +637,7 @@ def locate_by_interpolation(
         if not np.all(np.isfinite(values)):
             return None
         roots = np.roots(np.polyfit(sigmas, values, 3))
-        real = roots[(np.abs(roots.imag) < 1e-12) & (roots.real >= 0.0) & (roots.real <= 1.0)].real
+        real = roots[(np.abs(roots.imag) < REAL_ROOT_TOL) & (roots.real >= 0.0) & (roots.real <= 1.0)].real
         if not real.size:
             return None
         root = float(real[np.argmin(np.abs(real - guess))])

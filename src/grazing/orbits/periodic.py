@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -31,6 +32,32 @@ def unstable_count(multipliers: np.ndarray) -> int:
     (1, 0)
     """
     return int(np.sum(np.abs(multipliers) > 1.0 + UNIT_CIRCLE_TOL))
+
+
+def multipliers_text(pairs: Any, digits: int = 4) -> str:
+    """Multipliers (complex numbers or ``[re, im]`` pairs) as ``+a+bi, ...`` to ``digits`` decimals.
+
+    A part that rounds to zero is printed ``+0.0000``, whatever its sign: the sign of a
+    rounding-level imaginary part (a double real multiplier) depends on the processor's linear
+    algebra.
+
+    Examples
+    --------
+    >>> multipliers_text([complex(-0.03214, 1e-17), complex(-0.03214, -1e-17)])
+    '-0.0321+0.0000i, -0.0321+0.0000i'
+    >>> multipliers_text([[0.5, 0.25]], digits=2)
+    '+0.50+0.25i'
+    """
+
+    def part(v: float) -> str:
+        r = round(float(v), digits)
+        return f"{(r if r != 0.0 else 0.0):+.{digits}f}"
+
+    out = []
+    for z in pairs:
+        re_, im = (z.real, z.imag) if isinstance(z, complex | np.complexfloating) else z
+        out.append(f"{part(re_)}{part(im)}i")
+    return ", ".join(out)
 
 
 def kept_directions(monodromy: np.ndarray) -> int:

@@ -83,7 +83,7 @@ def move_section(orbit: PeriodicOrbit, t_new: float, *, tol: float = NEWTON_TOL)
     )
 
 
-GUESS = "an initial guess x0 (--initial)"
+GUESS = "an initial guess (x0=)"
 """What to give when the default guess, simulated from rest, cannot start Newton's method."""
 
 
@@ -276,7 +276,7 @@ def find_orbit(
     guess: InitialGuess | None = None
     note = ""  # why the default guess's period was not used, if it was not
     if x0 is None:
-        advice = "try another period (--period), an initial guess x0 (--initial) or a longer transient"
+        advice = "try another period (period=), an initial guess (x0=) or a longer transient"
         guess = initial_guess(model, t0=t0, transient=transient, virtual=virtual)
         x, detected = guess.state, guess.period
         n = int(period or detected or 1)
@@ -286,8 +286,8 @@ def find_orbit(
                 "transient not yet settled), so a period-1 orbit was tried"
             )
             advice = (
-                f"{note}; give the period (--period) or an initial guess x0 (--initial), or a longer "
-                "transient (--transient)"
+                f"{note}; give the period (period=) or an initial guess (x0=), or a longer transient "
+                "(transient=)"
             )
     else:
         advice = "try another initial guess or another period"

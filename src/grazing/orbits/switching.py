@@ -32,6 +32,17 @@ SWITCH_STEPS = (1e-3, 1e-2, 1e-4)
 """Distances from a period-doubling or branch point (relative to ``max(1, |u|)``) at which the new
 branch's first point is sought, in this order."""
 
+IN_NULL_SPACE = 1e-3
+"""At a branch point the tangent of the branch followed lies in the two-dimensional null space of the
+equations' Jacobian: its component there is at least this fraction of it, or the point is not a branch
+point (the null space computed is of a nearly singular Jacobian elsewhere)."""
+
+PAST_GRAZING = (1e-7, 1e-6, 1e-5, 1e-4)
+"""Distances past a grazing (relative to ``max(1, |value|)``) at which an orbit with the new impact
+sequence is sought, nearest first: beyond the grazing's own error (the boundary is bracketed to
+:data:`~grazing.core.options.BOUNDARY_TOL`), and close enough that the orbit past it is the grazing
+orbit's continuation."""
+
 
 CROSSING_SLOPE = 10.0
 """A branch crossing at a branch point is followed if it leaves it at an angle whose cotangent to the
@@ -114,7 +125,7 @@ def crossing_starts(
     _, _, vt = np.linalg.svd(DF)
     null = vt[-2:]  # the two right singular vectors of the smallest singular values (one is zero)
     c = null @ along
-    if float(np.linalg.norm(c)) < 1e-3 * float(np.linalg.norm(along)):
+    if float(np.linalg.norm(c)) < IN_NULL_SPACE * float(np.linalg.norm(along)):
         return []  # the branch followed does not lie in the null space: not a branch point
     w = null.T @ np.array([-c[1], c[0]])
     w /= np.linalg.norm(w)
@@ -140,7 +151,7 @@ def new_sequence_orbit(
     p = last.model.params[param]
     par = next(q for q in last.model.parameters if q.name == param)
     for sign in (direction, -direction):
-        for eps in (1e-7, 1e-6, 1e-5, 1e-4):
+        for eps in PAST_GRAZING:
             trial = value + sign * eps * max(1.0, abs(value))
             try:
                 par.check(trial)

@@ -269,12 +269,12 @@ def dask_parts(
             idle_since = idle_since if idle_since is not None else now
             if not noticed and notice is not None and now - idle_since >= DASK_NOTICE_AFTER:
                 noticed = True
-                give_up = f"giving up after {timeout:g} s" if timeout is not None else "--timeout to give up"
+                give_up = f"giving up after {timeout:g} s" if timeout is not None else "timeout= to give up"
                 notice(f"no Dask worker is connected to {address}: waiting for one ({give_up})")
             if timeout is not None and now - idle_since >= timeout:
                 raise SweepTimeoutError(
                     f"no Dask worker connected to {address} within {timeout:g} s; start workers "
-                    "(dask worker ADDRESS) or run without --scheduler"
+                    "(dask worker ADDRESS) or run without a scheduler (client=)"
                 )
     except BaseException:
         if pending:

@@ -95,7 +95,7 @@ class StoreLock:
                     who = f"PID {holder}" if holder is not None else "a process"
                     raise StoreBusyError(
                         f"{self.name} is being written by another grazing run ({who}); wait for it to "
-                        "finish (--wait) or use another --out"
+                        "finish (wait=True) or use another store (store=)"
                     )
                 if on_wait is not None:
                     on_wait(holder)

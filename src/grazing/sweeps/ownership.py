@@ -61,7 +61,7 @@ def check_is_store(path: str | Path) -> None:
     """Raise :class:`ForeignStoreError` unless ``path`` is a grazing sweep store (read only)."""
     path = Path(path)
     if not path.is_dir():
-        raise ForeignStoreError(f"{path} exists and is not a grazing sweep store; use another --out")
+        raise ForeignStoreError(f"{path} exists and is not a grazing sweep store; use another store (store=)")
     meta = marker_path(path)
     if not meta.is_file():
         raise ForeignStoreError(_foreign_message(path))
@@ -86,7 +86,7 @@ def _foreign_message(path: Path) -> str:
         pass
     return (
         f"{path} exists and is not a grazing sweep store{legacy}; it was left untouched: "
-        "use another --out, or delete it yourself"
+        "use another store (store=), or delete it yourself"
     )
 
 

@@ -8,17 +8,17 @@ sweeps (unless ``fresh``), at the sampling phase of its own forcing period;
 every chunk starts from ``x0``.
 
 Adaptive transients: the transient is run in blocks of
-:data:`~grazing.core.options.ADAPTIVE_BLOCK` (32) periods and stopped as soon
+:data:`~grazing.core.options.ADAPTIVE_BLOCK` periods and stopped as soon
 as the samples repeat with a period p <=
-:data:`~grazing.core.options.ADAPTIVE_MAX_PERIOD` (16) to
-:data:`~grazing.core.options.ADAPTIVE_TOL` (1e-9), at the point of
+:data:`~grazing.core.options.ADAPTIVE_MAX_PERIOD` to
+:data:`~grazing.core.options.ADAPTIVE_TOL`, at the point of
 the cycle where the full transient would have ended (the periods run are
 congruent to the full transient modulo p).  The samples, and in a continuation
 sweep the next point's starting state, are then those of the full transient to
-about 1e-9.  (In a continuation sweep through chaos with coexisting attractors,
-such a 1e-9 difference can, like any rounding difference, lead the next points
+about that tolerance.  (In a continuation sweep through chaos with coexisting
+attractors, such a difference can, like any rounding difference, lead the next points
 to another attractor; fresh sweeps are unaffected.)  With Lyapunov exponents,
-the last :data:`~grazing.core.options.LYAPUNOV_ALIGN` (16) periods of the
+the last :data:`~grazing.core.options.LYAPUNOV_ALIGN` periods of the
 transient align the tangent vectors, and the exponent is taken over the
 sampled periods.
 

@@ -423,7 +423,7 @@ class ZarrStore:
             f"{self.path} holds a different sweep; differs in "
             + ", ".join(diffs[:4])
             + ("" if len(diffs) <= 4 else f" and {len(diffs) - 4} more")
-            + "; use another --out or delete it"
+            + "; use another store (store=) or delete it"
         )
 
     def _build(self, folder: Path) -> None:

@@ -33,13 +33,9 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from grazing.core.options import (
-    ADAPTIVE_BLOCK,
-    ADAPTIVE_MAX_PERIOD,
-    LYAPUNOV_ALIGN,
-    STEPS_EXTRA,
-    STEPS_PER_PERIOD,
-)
+from grazing.core import options as core_options
+from grazing.core import period as core_period
+from grazing.core.options import ADAPTIVE_BLOCK, ADAPTIVE_MAX_PERIOD, LYAPUNOV_ALIGN
 from grazing.engine import timebase
 from grazing.engine.abi import TC_FREE_LANES, TC_VAR_LANES, call_model
 from grazing.engine.driver.atomics import fetch_add, load_acquire, store_release
@@ -77,22 +73,11 @@ FAILED = 8
 """A lane's step flag: its point failed."""
 
 
-@njit(cache=True)
-def repeats_with_period(samples, count, n, tol, max_period):
-    """Smallest ``p <= max_period`` with ``samples[:count]`` p-periodic to ``tol`` (as ``detect_period``)."""
-    for p in range(1, min(max_period, count // 2) + 1):
-        ok = True
-        for i in range(count - p):
-            for c in range(n):
-                if not abs(samples[i + p, c] - samples[i, c]) <= tol:  # (NaN: not periodic)
-                    ok = False
-                    break
-            if not ok:
-                break
-        if ok:
-            return p
-    return 0
+repeats_with_period = njit(inline="always")(core_period.repeats_with_period)
+"""Smallest ``p <= max_period`` with ``samples[:count]`` p-periodic to ``tol`` (``core.period``'s test)."""
 
+step_limit = njit(inline="always")(core_options.step_limit)
+"""The step limit of a run over ``periods`` forcing periods (``core.options``', as the scalar runner's)."""
 
 start_times = njit(inline="always")(timebase.start_times)
 """``(k, s, ks, ss)`` of a run starting at ``t0`` sampled at local time ``s_phase`` (as ``Runner``'s)."""
@@ -119,7 +104,7 @@ def begin_request(st, periods, keep, use_var, T, zdm_s):
     st.lyap_started = st.recording
     st.span_dt = math.nan
     st.steps = 0
-    st.max_steps = STEPS_PER_PERIOD * periods + STEPS_EXTRA  # (core.options.step_limit)
+    st.max_steps = step_limit(periods)
     st.zero_events = 0
     st.jac_valid = True
     st.use_var = use_var
@@ -632,7 +617,7 @@ def end_request(m, cfg, points, out, la, lane, budget, align):
         used = ls[lane].used
         nxt = -1
         if cfg.adaptive and blk == ADAPTIVE_BLOCK:
-            per = repeats_with_period(buf[lane], blk, n, cfg.adaptive_tol, ADAPTIVE_MAX_PERIOD)
+            per = repeats_with_period(buf[lane], blk, cfg.adaptive_tol, ADAPTIVE_MAX_PERIOD)
             if per > 0:
                 extra = (budget - used) % per
                 if extra:
