@@ -60,7 +60,8 @@ def detect_periods(
             break
         part = s[todo]
         # (a NaN anywhere makes the maximum NaN, which is not <= tol: not periodic)
-        periodic = np.max(np.abs(part[:, p:] - part[:, :-p]), axis=(1, 2)) <= tol
+        with np.errstate(invalid="ignore"):  # (inf - inf: NaN, not periodic)
+            periodic = np.max(np.abs(part[:, p:] - part[:, :-p]), axis=(1, 2)) <= tol
         found[todo[periodic]] = p
         todo = todo[~periodic]
     return found

@@ -14,7 +14,7 @@ Continuation*, SIAM 2013):
 
 * unknowns ``u = (z, p1, p2)`` (``z`` the segment unknowns
   ``(s_0, t_1, s_1, ..., t_k, s_k)``), and for a Neimark-Sacker curve the
-  angle ``theta`` of the critical pair, for a branch-point curve the
+  angle of the critical pair (``angle``), for a branch-point curve the
   regularising ``shift`` (as in :mod:`grazing.orbits.extended`), last;
 * equations: the segmented equations ``F(z; p) = 0`` and the defining
   condition.
@@ -29,8 +29,8 @@ multiplier:
 
 * fold and branch point: ``A(1) = J`` singular;
 * period-doubling: ``A(-1)`` singular;
-* Neimark-Sacker: ``A(exp(i theta))`` singular, a complex condition (two real
-  equations) with ``theta`` an unknown: the critical pair ``exp(+-i theta)``.
+* Neimark-Sacker: ``A(exp(i angle))`` singular, a complex condition (two real
+  equations) with ``angle`` an unknown: the critical pair ``exp(+-i angle)``.
 
 The defining condition is the ``g`` of the bordered system of ``A``
 (:mod:`grazing.orbits.bordered`), its gradient ``-w^T dA v`` with the
@@ -66,7 +66,7 @@ from grazing.orbits.segments import SegmentLayout, layout_of, segmented_equation
 
 CRITICAL_MULTIPLIER = {"fold": 1.0, "branch-point": 1.0, "period-doubling": -1.0}
 """The multiplier ``mu`` at which ``A(mu)`` is singular on a curve of each real kind (the
-Neimark-Sacker curve's is ``exp(i theta)``, ``theta`` an unknown)."""
+Neimark-Sacker curve's is ``exp(i angle)``, ``angle`` an unknown)."""
 
 
 @dataclass(frozen=True)
@@ -152,7 +152,7 @@ class SegmentedOrbitSystem:
     """The extended system of a fold, period-doubling, Neimark-Sacker or branch-point curve on the
     segmented equations (see the module docstring).
 
-    Unknowns ``u = (z, p1, p2)``, then ``theta`` (Neimark-Sacker) or ``shift``
+    Unknowns ``u = (z, p1, p2)``, then ``angle`` (Neimark-Sacker) or ``shift``
     (branch point); ``evaluate(u) -> (F, DF, Evaluation)``.  The bordering vectors
     are those of the last accepted point (:meth:`accept`).  :attr:`offset` is the
     index of ``p1`` in ``u``.
@@ -171,7 +171,7 @@ class SegmentedOrbitSystem:
 
     # -- the unknowns ---------------------------------------------------------------------
     def start(self, orbit: PeriodicOrbit) -> np.ndarray:
-        """The unknowns at an orbit of this impact sequence (``theta``: its critical pair's angle)."""
+        """The unknowns at an orbit of this impact sequence (``angle``: its critical pair's angle)."""
         values = [orbit.model.params[q] for q in self.params]
         u = self.layout.pack(orbit, values[0])
         u = np.append(u, values[1])
@@ -253,19 +253,19 @@ class SegmentedOrbitSystem:
         return F, DF, Evaluation(orbit, None, g, tests, 0.0, null, accuracy)  # type: ignore[arg-type]
 
     def _neimark_sacker(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray, Evaluation]:
-        """``(F, Re g, Im g)`` in ``(z, p1, p2, theta)``: ``A(exp(i theta))`` singular."""
+        """``(F, Re g, Im g)`` in ``(z, p1, p2, angle)``: ``A(exp(i angle))`` singular."""
         m, n = self.offset + 2, self.n
-        z, theta = u[:m], float(u[m])
+        z, angle = u[:m], float(u[m])
         F0, DF0, orbit = self._equations(z)
         J = DF0[:, : self.offset]
-        mu = complex(np.exp(1j * theta))
+        mu = complex(np.exp(1j * angle))
         null = self._null(self.defining(J, mu))
         pad = np.zeros(2)
         Dr = self.along(z, np.concatenate([null.v.real, pad]))
         Di = self.along(z, np.concatenate([null.v.imag, pad]))
         dg = -(null.w @ Dr + 1j * (null.w @ Di))  # d g / d (z, p1, p2)
-        dg_theta = 1j * mu * multiplier_slope(null, n)  # dg/dmu dmu/dtheta
-        grad = np.append(dg, dg_theta)
+        dg_angle = 1j * mu * multiplier_slope(null, n)  # dg/dmu dmu/dangle
+        grad = np.append(dg, dg_angle)
         F = np.concatenate([F0, [null.g.real, null.g.imag]])
         DF = np.zeros((F.size, u.size))
         DF[: F0.size, :m] = DF0
