@@ -50,9 +50,10 @@ from grazing.core.options import (
     CLOSING_RATIO,
     MATCH_TOL,
     MAX_PERIOD,
+    PERIOD_TOL,
     POLISH_TRIES,
 )
-from grazing.core.period import orbit_impacts
+from grazing.core.period import orbit_impacts, sample_scale
 from grazing.core.solution import Status
 from grazing.errors import GrazingError
 from grazing.sweeps.polish import Polished, contracting_periods, is_neutral, polish
@@ -353,7 +354,9 @@ class Catalogue:
         """The entry of the period-``p`` orbit through ``points`` (a new one if none found so far is it)."""
         for k in self._by_period.get(p, []):
             k = self.root(k)
-            if set_distance(self.entries[k].points, points, self.cell) <= MATCH_TOL:
+            if set_distance(self.entries[k].points, points, self.cell) <= MATCH_TOL or same_points(
+                self.entries[k].points, points
+            ):
                 return k
         k = self._new(_Entry("periodic", first, period=p, points=points.copy(), impacts=impacts))
         self._by_period.setdefault(p, []).append(k)
@@ -596,7 +599,8 @@ class Catalogue:
 
 def unsettled(samples: np.ndarray, period: np.ndarray, tol: float = BASIN_ADAPTIVE_TOL) -> np.ndarray:
     """Which periodic end states have not settled: their samples repeat with their period only to more
-    than ``tol`` (an orbit on its attractor repeats to rounding; the period detector accepts 1e-6), or
+    than ``tol`` of their scale (:func:`~grazing.core.period.sample_scale`; an orbit on its attractor
+    repeats to rounding; the period detector accepts 1e-6), or
     they are closing in on a shorter period (a divisor's differences shrink over the samples).
 
     The second: an orbit slow to settle on a period-1 orbit with a multiplier near -1 (-0.94) repeats
@@ -616,7 +620,7 @@ def unsettled(samples: np.ndarray, period: np.ndarray, tol: float = BASIN_ADAPTI
     for i in np.flatnonzero(period > 0):
         p = int(period[i])
         repeats = np.max(np.abs(samples[i, p:] - samples[i, :-p]))
-        out[i] = bool(repeats > tol) or closing_period(samples[i], p)[0] != p
+        out[i] = bool(repeats > tol * sample_scale(samples[i])) or closing_period(samples[i], p)[0] != p
     return out
 
 
@@ -640,6 +644,25 @@ def closing_period(samples: np.ndarray, p: int) -> tuple[int, float]:
         if diff.size >= 2 * p and np.max(diff[-p:]) < CLOSING_RATIO * np.max(diff[:p]):
             return d, float(np.max(diff[-p:]))
     return p, 0.0
+
+
+def same_points(a: np.ndarray, b: np.ndarray) -> bool:
+    """Are two periodic orbits' points the same to the period detector's tolerance (within
+    :data:`~grazing.core.options.PERIOD_TOL` of their scale, :func:`~grazing.core.period.sample_scale`)?
+
+    Two runs whose samples each repeat to that tolerance and whose points are that close are one orbit
+    to the detector, whatever the cell: in small units (an orbit of size 1e-5, its cells 1e-8) the
+    engine's error, ``tol`` times ``max(1, |x|)``, set two runs' points 5e-10 apart, more than a match's
+    1e-3 cells, and one attractor was counted once per initial state.
+
+    Examples
+    --------
+    >>> a = np.array([[1.3e-5, 8.7e-7]])
+    >>> same_points(a, a + 5e-10), same_points(a, a + 1e-5), same_points(1e5 * a, 1e5 * a + 1e-4)
+    (True, False, True)
+    """
+    scale = max(sample_scale(a), sample_scale(b))
+    return set_distance(a, b, np.ones(np.shape(a)[-1])) <= PERIOD_TOL * scale
 
 
 def set_distance(a: np.ndarray, b: np.ndarray, cell: np.ndarray) -> float:

@@ -93,7 +93,11 @@ NEWTON_MAX_ITER = 30
 """Periodic orbits: the largest number of Newton iterations."""
 
 PERIOD_TOL = 1e-6
-"""Stroboscopic samples are p-periodic when they repeat to this (absolute) tolerance."""
+"""Stroboscopic samples are p-periodic when they repeat to this tolerance, relative to their scale
+``max(1, max |s|)`` (:func:`grazing.core.period.sample_scale`): the engine's error is relative to that
+scale (its steps are sized by it), so a model in other units has the same periods.  An orbit of
+amplitude 1.3e5 repeated only to 5e-6 (the error of the adaptive steps, 1e-10 of its size, changes
+from one forcing period to the next) and was called aperiodic against an absolute 1e-6."""
 
 MAX_PERIOD = 64
 """The largest period detected on computed samples."""

@@ -2,12 +2,28 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from grazing.core.options import MAX_PERIOD, PERIOD_TOL
 
 DEFAULT_PERIOD_TOL = PERIOD_TOL
 DEFAULT_MAX_PERIOD = MAX_PERIOD
+
+
+def sample_scale(samples: np.ndarray) -> float:
+    """``max(1, max |s|)`` over the finite entries of ``samples``: the scale that the period tolerances
+    are relative to (:data:`~grazing.core.options.PERIOD_TOL`).
+
+    Examples
+    --------
+    >>> sample_scale(np.array([[0.5, -2.0], [np.inf, np.nan]])), sample_scale(np.array([1e-5]))
+    (2.0, 1.0)
+    """
+    s = np.abs(np.asarray(samples, dtype=float))
+    finite = s[np.isfinite(s)]
+    return float(max(1.0, finite.max())) if finite.size else 1.0
 
 
 def detect_period(
@@ -18,7 +34,9 @@ def detect_period(
     """Smallest ``p <= max_period`` such that the samples are p-periodic to ``tol``.
 
     The sequence ``s_0, s_1, ...`` (rows of ``samples``) is p-periodic when
-    ``max |s_{i+p} - s_i| <= tol`` over all components and all ``i``.  Only
+    ``max |s_{i+p} - s_i| <= tol * scale`` over all components and all ``i``, with ``scale`` the
+    samples' :func:`sample_scale` (``max(1, max |s|)``: ``tol`` is absolute for samples of size up to
+    1, relative beyond).  Only
     periods up to half the number of samples are tested, so that every point
     of a cycle is seen at least twice.  Returns 0 when no period fits
     (chaos, quasi-periodicity, or a transient that has not died out).
@@ -29,6 +47,8 @@ def detect_period(
     2
     >>> detect_period(np.array([0.1, 0.5, 0.3, 0.9]))
     0
+    >>> detect_period(1e5 * np.array([1.0, 2.0, 1.0, 2.0]) + [0.0, 0.0, 1e-2, 0.0])  # (in other units)
+    2
     """
     s = np.asarray(samples, dtype=float)
     if s.ndim == 1:
@@ -55,13 +75,17 @@ def detect_periods(
     found = np.zeros(s.shape[0], dtype=np.int64)
     todo = np.arange(s.shape[0])
     m = s.shape[1]
+    if m == 0:
+        return found
+    magnitude = np.where(np.isfinite(s), np.abs(s), 0.0)
+    scaled = tol * np.maximum(1.0, magnitude.max(axis=(1, 2)))  # (sample_scale of each run)
     for p in range(1, min(max_period, m // 2) + 1):
         if todo.size == 0:
             break
         part = s[todo]
         # (a NaN anywhere makes the maximum NaN, which is not <= tol: not periodic)
         with np.errstate(invalid="ignore"):  # (inf - inf: NaN, not periodic)
-            periodic = np.max(np.abs(part[:, p:] - part[:, :-p]), axis=(1, 2)) <= tol
+            periodic = np.max(np.abs(part[:, p:] - part[:, :-p]), axis=(1, 2)) <= scaled[todo]
         found[todo[periodic]] = p
         todo = todo[~periodic]
     return found
@@ -73,8 +97,9 @@ def repeats_with_period(samples: np.ndarray, count: int, tol: float, max_period:
     (:mod:`grazing.engine.driver.lanes`).
 
     The same test as :func:`detect_periods`, one run at a time: a period ``p`` fits when every
-    ``|s_{i+p} - s_i| <= tol`` (a NaN fails it, as it makes the other's maximum NaN), periods up to
-    ``count // 2`` (``tests/core/test_period.py`` checks that the two agree).
+    ``|s_{i+p} - s_i| <= tol * scale`` (``scale`` the :func:`sample_scale` of ``samples[:count]``; a
+    NaN fails it, as it makes the other's maximum NaN), periods up to ``count // 2``
+    (``tests/core/test_period.py`` checks that the two agree).
 
     Examples
     --------
@@ -82,6 +107,13 @@ def repeats_with_period(samples: np.ndarray, count: int, tol: float, max_period:
     2
     """
     n = samples.shape[1]
+    scale = 1.0
+    for i in range(count):
+        for c in range(n):
+            size = abs(samples[i, c])
+            if size > scale and size < math.inf:  # (NaN and inf do not count)
+                scale = size
+    tol = tol * scale
     for p in range(1, min(max_period, count // 2) + 1):
         ok = True
         for i in range(count - p):

@@ -64,6 +64,7 @@ import numpy as np
 
 from grazing.core.cells import one_attractor
 from grazing.core.options import CHAIN_CELLS, CHAIN_SHIFTS, CHAIN_TOL, PERIOD_TOL
+from grazing.core.period import sample_scale
 from grazing.core.solution import Status
 from grazing.sweeps.spec import ChunkResult, SweepSpec
 
@@ -138,8 +139,9 @@ def same_outcome(a: ChunkResult, i: int, b: ChunkResult, j: int, tol: float = CH
 
 
 def repeats(samples: np.ndarray, p: int) -> bool:
-    """Whether ``samples`` repeat with period ``p > 0`` to :data:`~grazing.core.options.PERIOD_TOL` (a
-    point whose period a Newton polish gave does not: its samples still approach the orbit).
+    """Whether ``samples`` repeat with period ``p > 0`` to :data:`~grazing.core.options.PERIOD_TOL` of
+    their scale (:func:`~grazing.core.period.sample_scale`; a point whose period a Newton polish gave
+    does not: its samples still approach the orbit).
 
     Examples
     --------
@@ -148,7 +150,7 @@ def repeats(samples: np.ndarray, p: int) -> bool:
     (True, False, False)
     """
     s = np.asarray(samples, dtype=float)
-    return p > 0 and bool(np.max(np.abs(s[p:] - s[:-p])) <= PERIOD_TOL)
+    return p > 0 and bool(np.max(np.abs(s[p:] - s[:-p])) <= PERIOD_TOL * sample_scale(s))
 
 
 _UNSET = object()
