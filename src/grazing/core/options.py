@@ -436,8 +436,9 @@ class SweepSettings:
     The defaults, and a short sweep across the paper's first grazing at
     θ̂ = 40°: period 1 free of the stop, then period 4 and chaos past it:
 
-    >>> SweepSettings()
-    SweepSettings(transient=500, periods=100, phase=0.0, fresh=False, chunk_size=50, adaptive=True, lyapunov=True, tol=1e-10)
+    >>> SweepSettings()  # doctest: +NORMALIZE_WHITESPACE
+    SweepSettings(transient=500, periods=100, phase=0.0, fresh=False, chunk_size=50,
+                  adaptive=True, lyapunov=True, tol=1e-10)
     >>> import math, numpy as np, grazing
     >>> from grazing.sweeps import sweep
     >>> model = grazing.models.pendulum("B", theta_hat=math.radians(40))
