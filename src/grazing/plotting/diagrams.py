@@ -61,6 +61,11 @@ def visible_windows(
     impacting_one
         Also keep impacting period-1 windows.
 
+    Returns
+    -------
+    list of Window
+        The windows kept, in the order given.
+
     Examples
     --------
     >>> ws = [Window(4, True, 0, 9, 0.0, 0.9, 0.0, 0.95), Window(5, True, 10, 10, 1.0, 1.0, 0.95, 1.05)]
@@ -141,6 +146,24 @@ def label_windows(
     -------
     list of Window
         The windows labelled, in the order given.
+
+    Examples
+    --------
+    Two windows far apart share the first row; one too close to the first
+    goes to the next row:
+
+    >>> from matplotlib.figure import Figure
+    >>> from grazing.sweeps.windows import Window
+    >>> ax = Figure().add_subplot()
+    >>> _ = ax.set_xlim(0.0, 1.0)
+    >>> ws = [Window(3, True, 0, 5, 0.10, 0.15, 0.10, 0.15),
+    ...       Window(5, True, 6, 7, 0.135, 0.145, 0.135, 0.145),
+    ...       Window(2, True, 8, 20, 0.5, 0.8, 0.5, 0.8)]
+    >>> [w.period for w in label_windows(ax, ws)], [t.get_text() for t in ax.texts]
+    ([3, 5, 2], ['3', '5', '2'])
+    >>> ys = [t.get_position()[1] for t in ax.texts]
+    >>> bool(ys[0] == ys[2] != ys[1])
+    True
     """
     x0, x1 = ax.get_xlim()
     trans = ax.get_xaxis_transform()  # x in data, y in axes fraction
@@ -202,6 +225,15 @@ def mark_grazings(
         One text per line (default: the value, e.g. ``"0.4451"``).
     color, fontsize
         Style of the lines and labels.
+
+    Examples
+    --------
+    >>> from matplotlib.figure import Figure
+    >>> ax = Figure().add_subplot()
+    >>> _ = ax.set_xlim(0.40, 0.60)
+    >>> mark_grazings(ax, [0.44512, 0.54729])
+    >>> [line.get_xdata()[0] for line in ax.lines], [t.get_text() for t in ax.texts]
+    ([0.44512, 0.54729], [' 0.4451', ' 0.5473'])
     """
     trans = ax.get_xaxis_transform()
     for k, v in enumerate(values):
@@ -393,6 +425,15 @@ def period_classes(
     Classes, in order: failed (period -1), aperiodic (0), period 1 without
     impacts, period 1 with impacts, periods 2 ... ``max_period``, and longer
     periods.
+
+    Parameters
+    ----------
+    period
+        The detected period of each point (-1 failed, 0 aperiodic).
+    impacts_per_period
+        The impacts per period of each point (same shape).
+    max_period
+        The longest period with a class of its own.
 
     Returns
     -------
