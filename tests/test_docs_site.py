@@ -229,6 +229,8 @@ def test_the_site_builds_with_warnings_as_errors(tmp_path: Path) -> None:
     pytest.importorskip("myst_nb")
     docs = tmp_path / "docs"
     shutil.copytree(DOCS, docs, ignore=shutil.ignore_patterns("_build", "api"))
+    for name in ("CHANGELOG.md", "CITATION.cff"):  # (the changelog and citation pages are made from them)
+        shutil.copyfile(ROOT / name, tmp_path / name)
     html = docs / "_build" / "html"
     out = subprocess.run(
         [
@@ -250,5 +252,8 @@ def test_the_site_builds_with_warnings_as_errors(tmp_path: Path) -> None:
     walk = (html / "tutorials" / "paper-walkthrough.html").read_text()
     assert walk.count("<img") >= 5
     assert (html / "api" / "generated" / "grazing.simulate.html").is_file()
+    assert "piiroinen2004" in (html / "citation.html").read_text()  # the BibTeX from CITATION.cff
+    assert "_static/mathjax/tex-chtml.js" in (html / "equations.html").read_text()  # served from the site
+    assert (html / "_static" / "mathjax" / "tex-chtml.js").is_file()
     if find_chromium() is not None:
         assert main([str(html)]) == 0
