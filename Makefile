@@ -26,7 +26,8 @@ check-report: $(STAMP)
 	$(BIN)/python -m grazing.report.browser report/index.html
 
 # The documentation site, into docs/_build/html: warnings are errors; the tutorials are executed,
-# their outputs cached in docs/_build/.jupyter_cache (a rebuild re-runs only the changed ones).
+# their outputs cached in docs/_build/.jupyter_cache (a rebuild re-runs only the changed ones);
+# MathJax is served from the site (no network to read it).
 # The `docs` extra is installed here, once per change of pyproject.toml, not by `make install`.
 DOCS_STAMP := $(VENV)/.docs-$(shell cat pyproject.toml | cksum | cut -d' ' -f1)
 
@@ -35,7 +36,10 @@ $(DOCS_STAMP): $(STAMP)
 	rm -f $(VENV)/.docs-*
 	touch $(DOCS_STAMP)
 
+# First docs/check_reference.py: every public function and class of the reference documents its
+# parameters and returns and shows an example (the examples run with the tests' doctests).
 docs: $(DOCS_STAMP)
+	$(BIN)/python docs/check_reference.py
 	$(BIN)/python -m sphinx -b html -W --keep-going -q docs docs/_build/html
 
 # Every page of the built site in headless Chromium: no broken link, image or blank figure.

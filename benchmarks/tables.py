@@ -1,12 +1,14 @@
 """The benchmark tables of README.md and benchmarks/README.md, rewritten from the saved run.
 
-Every number the two READMEs quote about speed stands between a pair of markers::
+Every number the two READMEs (and docs/installation.md) quote about speed stands between a pair of
+markers::
 
     <!-- bench:NAME -->
     ...generated text...
     <!-- /bench:NAME -->
 
-and is generated here from ``benchmarks/results/latest.json`` (written by ``run_all.py``).
+and is generated here from ``benchmarks/results/latest.json`` (written by ``run_all.py``), the
+first compile and the whole report from ``benchmarks/results/first_run.json`` (``bench_first_run.py``).
 ``python benchmarks/tables.py`` rewrites the blocks; ``--check`` only says whether they
 agree with the saved run (``tests/test_benchmark_tables.py`` does the same without running
 anything).  Text outside the markers is left alone.
@@ -25,8 +27,11 @@ from typing import Any
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 SAVED_RUN = HERE / "results" / "latest.json"
+FIRST_RUN = HERE / "results" / "first_run.json"
+"""The saved run of ``bench_first_run.py`` (the first compile, the whole report): a run of its own."""
 README = ROOT / "README.md"
 BENCH_README = HERE / "README.md"
+INSTALLATION = ROOT / "docs" / "installation.md"
 LARGE = 100_000  # bench_simulate.py's long run
 
 MARKER = re.compile(r"(<!-- bench:(?P<name>[a-z-]+) -->\n)(?P<body>.*?)(<!-- /bench:(?P=name) -->)", re.S)
@@ -248,6 +253,34 @@ def readme_curve(record: dict[str, Any]) -> str:
     )
 
 
+def readme_first_run(_record: dict[str, Any]) -> str:
+    """The first compile and the whole report, from :data:`FIRST_RUN` (``bench_first_run.py``)."""
+    run = json.loads(FIRST_RUN.read_text())
+    st, m = run["steps"], run["machine"]
+    text = (
+        f"On a fresh machine the first command compiles the integration driver (numba, once per machine) "
+        f"and the model's kernels: {st['first_compile']['wall_s']:.0f} s for the first `grazing simulate` "
+        f"of the pendulum, {st['cached']['wall_s']:.1f} s for the same command once they are cached, and "
+        f"{st['new_model']['wall_s']:.1f} s for a first run of another model (its kernels compiled, the "
+        "driver cached)."
+    )
+    if "report" in st:
+        rep = st["report"]
+        text += (
+            f" The whole report (`grazing report` after those steps, compiling the kernels it needs beyond "
+            f"theirs) took {rep['wall_s']:.0f} s of wall time and {rep['cpu_s']:.0f} CPU-seconds over all "
+            "its processes."
+        )
+    text += (
+        f" Saved run of {run['date']} (`benchmarks/results/first_run.json`, `{run['command']}`): {m['cpu']}, "
+        f"{m['cores']} cores, {m['vector_isa']}; load average {m['loadavg_start']} at the start, "
+        f"{m['loadavg_end']} at the end."
+    )
+    if float(m["loadavg_start"].split()[0]) > 0.5 * m["cores"]:
+        text += " Other programs kept the cores busy during the run: on a quiet machine expect less."
+    return text
+
+
 # ----------------------------------------------------------------------------- benchmarks/README.md
 
 
@@ -305,6 +338,7 @@ BLOCKS: dict[Path, dict[str, Callable[[dict[str, Any]], str]]] = {
         "sweep": readme_sweep,
         "equal-work": readme_equal_work,
         "grazing-curve": readme_curve,
+        "first-run": readme_first_run,
     },
     BENCH_README: {
         "run": bench_run,
@@ -315,6 +349,7 @@ BLOCKS: dict[Path, dict[str, Callable[[dict[str, Any]], str]]] = {
         "curves-full": stored_markdown("curves"),
         "scaling-full": stored_markdown("scaling"),
     },
+    INSTALLATION: {"first-run": readme_first_run},
 }
 
 

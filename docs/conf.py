@@ -2,7 +2,10 @@
 
 The site is Sphinx with myst-nb (Markdown pages; tutorials are MyST notebooks executed at
 build time, their outputs cached by jupyter-cache in ``docs/_build/.jupyter_cache``), numpydoc
-(the docstrings are numpydoc) and the pydata theme.  The API reference is written from each
+(the docstrings are numpydoc; the types of the parameters and returns come from the annotations),
+MathJax served from the site itself (``sphinx-mathjax-offline``: no network when a page is read)
+and the pydata theme.  The changelog and citation pages are made from ``CHANGELOG.md`` and
+``CITATION.cff`` at the root of the repository.  The API reference is written from each
 public module's ``__all__`` when the build starts (:func:`write_api_pages`), so a public name
 added to a module appears in the reference without editing any page.  See contributing.md.
 """
@@ -28,6 +31,10 @@ extensions = [
     "numpydoc",
     "sphinx.ext.autodoc",
     "sphinx.ext.autosummary",
+    "sphinx.ext.mathjax",
+    "annotated_types",  # docs/_ext: the annotations as the parameters' types
+    "changelog_citation",  # docs/_ext: changelog.md and citation.md from CHANGELOG.md, CITATION.cff
+    "mathjax_offline",  # docs/_ext: MathJax from the sphinx-mathjax-offline package, into _static
 ]
 
 exclude_patterns = ["_build", "_ext", "**/.ipynb_checkpoints"]
@@ -35,9 +42,8 @@ source_suffix = {".rst": "restructuredtext", ".md": "myst-nb"}
 root_doc = "index"
 
 # Markdown: ::: fences, anchors for every heading down to level 3 (the pages link to their own
-# sections, e.g. user-models.md#supported-functions).  No TeX maths: MathJax would come from a
-# CDN, which a reader offline (and CI) does not reach; the equations are written in Unicode.
-myst_enable_extensions = ["colon_fence", "deflist"]
+# sections, e.g. user-models.md#supported-functions), TeX maths in $...$, $$...$$ and {math}.
+myst_enable_extensions = ["colon_fence", "deflist", "dollarmath", "amsmath"]
 myst_heading_anchors = 3
 
 # Notebooks: executed at build time, each cell's outputs cached (jupyter-cache) so that a rebuild
@@ -65,6 +71,9 @@ os.environ["PYTHONPATH"] = os.pathsep.join([_SRC, *filter(None, [os.environ.get(
 # API reference: numpydoc renders the docstrings; autosummary writes one page per object.
 autosummary_generate = True
 autosummary_imported_members = True
+# The types shown are the annotations', written into numpydoc's Parameters and Attributes entries
+# (docs/_ext/annotated_types.py: autodoc's "description" mode writes :param: fields, which numpydoc
+# does not use); the signatures stay short.
 autodoc_typehints = "none"
 autodoc_default_options = {"member-order": "bysource"}
 numpydoc_show_class_members = True
@@ -74,15 +83,18 @@ numpydoc_xref_param_type = False
 
 html_theme = "pydata_sphinx_theme"
 html_title = f"grazing {release}"
-html_static_path: list[str] = []
+html_static_path = ["_static"]
+html_css_files = ["grazing.css"]
 html_theme_options = {
     "navigation_with_keys": False,
+    # every page of the top bar shown at 1300 px, the API reference among them (not under "More")
+    "header_links_before_dropdown": 5,
     "show_toc_level": 2,
     "secondary_sidebar_items": ["page-toc"],
     "footer_start": ["copyright"],
     "footer_end": ["sphinx-version"],
 }
-html_sidebars = {"index": [], "installation": [], "platforms": []}
+html_sidebars = {"index": [], "installation": [], "platforms": [], "changelog": [], "citation": []}
 html_copy_source = False
 html_show_sourcelink = False
 

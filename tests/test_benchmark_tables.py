@@ -74,3 +74,19 @@ def test_text_outside_the_markers_is_kept(tables, record):
     assert new == "before\n<!-- bench:simulate -->\nnew\n<!-- /bench:simulate -->\nafter <!-- bench:x -->\n"
     with pytest.raises(ValueError, match="no markers for block"):
         tables.rewrite("no blocks here", {"simulate": "new\n"})
+
+
+def test_the_first_run_names_its_date_and_machine_and_is_quoted_where_its_block_is(tables):
+    """The first compile and the report's time (README.md, docs/installation.md) come from
+    benchmarks/results/first_run.json, a run of benchmarks/bench_first_run.py."""
+    import json
+
+    run = json.loads(tables.FIRST_RUN.read_text())
+    assert re.fullmatch(r"\d{4}-\d{2}-\d{2} \d{2}:\d{2} UTC", run["date"])
+    assert run["machine"]["cpu"] and run["machine"]["cores"] >= 1 and run["machine"]["loadavg_end"]
+    assert {"first_compile", "cached", "new_model"} <= set(run["steps"])
+    assert run["steps"]["cached"]["wall_s"] < run["steps"]["first_compile"]["wall_s"]
+    text = tables.readme_first_run({})
+    assert f"{run['steps']['first_compile']['wall_s']:.0f} s" in text and run["machine"]["cpu"] in text
+    for path in (tables.README, tables.INSTALLATION):
+        assert tables.blocks(path.read_text())["first-run"] == text + "\n"

@@ -8,6 +8,8 @@ executed by the build itself (``make docs``, which CI runs, or the slow test bel
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 import importlib
 import inspect
 import pkgutil
@@ -25,9 +27,14 @@ from grazing.report.browser import check_site, find_chromium, is_blank, main
 ROOT = Path(__file__).resolve().parents[1]
 DOCS = ROOT / "docs"
 sys.path.insert(0, str(DOCS / "_ext"))
+import annotated_types  # noqa: E402
 import api_pages  # noqa: E402
 
 sys.path.remove(str(DOCS / "_ext"))
+sys.path.insert(0, str(DOCS))
+import check_reference  # noqa: E402
+
+sys.path.remove(str(DOCS))
 
 chromium = pytest.mark.skipif(find_chromium() is None, reason="no Chromium installed")
 
@@ -75,6 +82,91 @@ def test_the_pages_are_written_from_all(tmp_path: Path) -> None:
     assert "``grazing.sweeps.detect_period``: :obj:`grazing.detect_period`" in sweeps
     index = (tmp_path / "index.rst").read_text()
     assert all(f"   {m}\n" in index for m, _ in api_pages.API_MODULES)
+
+
+def test_every_public_function_and_class_documents_its_parameters_and_shows_an_example() -> None:
+    """``make docs`` runs docs/check_reference.py first; CI runs this."""
+    assert check_reference.check() == []
+
+
+def _without_section(doc: str, section: str) -> str:
+    """``doc`` with one numpydoc section (its heading, underline and body) taken out."""
+    lines = doc.splitlines()
+    start = next(i for i, line in enumerate(lines) if line.strip() == section)
+    end = next(
+        (i for i in range(start + 2, len(lines)) if set(lines[i].strip()) == {"-"} and i > start + 2),
+        len(lines) + 1,
+    )
+    return "\n".join(lines[:start] + lines[end - 1 :])
+
+
+@pytest.mark.parametrize("section", ["Parameters", "Returns", "Examples"])
+def test_the_reference_check_finds_a_section_taken_out_of_a_real_docstring(section: str) -> None:
+    from grazing.sweeps import parameter_map
+
+    assert check_reference.problems("grazing.sweeps.parameter_map", parameter_map) == []
+
+    @functools.wraps(parameter_map)
+    def changed(*args, **kwargs):  # the same signature (functools.wraps), the docstring less a section
+        return parameter_map(*args, **kwargs)
+
+    changed.__doc__ = _without_section(inspect.getdoc(parameter_map), section)
+    assert section not in changed.__doc__ and "Two-parameter" in changed.__doc__
+    (found,) = check_reference.problems("grazing.sweeps.parameter_map", changed)
+    assert found.startswith(f"grazing.sweeps.parameter_map: no {section} section")
+
+
+def test_the_reference_check_names_an_undocumented_parameter_and_a_class_without_example() -> None:
+    def f(a: int, b: float) -> int:
+        """F.
+
+        Parameters
+        ----------
+        a
+            A.
+
+        Returns
+        -------
+        int
+
+        Examples
+        --------
+        >>> f(1, 2.0)
+        1
+        """
+        return a
+
+    @dataclasses.dataclass
+    class Record:
+        """A record.
+
+        Attributes
+        ----------
+        x
+            The x.
+        """
+
+        x: float
+
+    assert check_reference.problems("f", f) == ["f: parameters not documented: b"]
+    assert check_reference.problems("Record", Record) == ["Record: no Examples section (with a >>> example)"]
+
+
+def test_the_types_shown_are_the_annotations() -> None:
+    def f(x: float, ys: list[int] | None = None) -> None:
+        """F.
+
+        Parameters
+        ----------
+        x
+            A number.
+        ys : list of int, optional
+            Kept as written.
+        """
+
+    lines = inspect.getdoc(f).splitlines()
+    annotated_types.add_types(None, "function", "f", f, None, lines)
+    assert lines[4:7] == ["x : float", "    A number.", "ys : list of int, optional"]
 
 
 def _png(path: Path, painted: bool) -> None:
@@ -137,6 +229,8 @@ def test_the_site_builds_with_warnings_as_errors(tmp_path: Path) -> None:
     pytest.importorskip("myst_nb")
     docs = tmp_path / "docs"
     shutil.copytree(DOCS, docs, ignore=shutil.ignore_patterns("_build", "api"))
+    for name in ("CHANGELOG.md", "CITATION.cff"):  # (the changelog and citation pages are made from them)
+        shutil.copyfile(ROOT / name, tmp_path / name)
     html = docs / "_build" / "html"
     out = subprocess.run(
         [
@@ -158,5 +252,8 @@ def test_the_site_builds_with_warnings_as_errors(tmp_path: Path) -> None:
     walk = (html / "tutorials" / "paper-walkthrough.html").read_text()
     assert walk.count("<img") >= 5
     assert (html / "api" / "generated" / "grazing.simulate.html").is_file()
+    assert "piiroinen2004" in (html / "citation.html").read_text()  # the BibTeX from CITATION.cff
+    assert "_static/mathjax/tex-chtml.js" in (html / "equations.html").read_text()  # served from the site
+    assert (html / "_static" / "mathjax" / "tex-chtml.js").is_file()
     if find_chromium() is not None:
         assert main([str(html)]) == 0

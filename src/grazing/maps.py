@@ -34,7 +34,28 @@ from grazing.errors import InvalidParameterError
 
 @dataclass(frozen=True)
 class FlowMap:
-    """``P^n`` at a point: the image, its Jacobians and what happened on the way."""
+    """``P^n`` at a point: the image, its Jacobians and what happened on the way (:func:`flow_map`).
+
+    Parameters
+    ----------
+    image
+        ``P^n(x)``: the state ``n`` forcing periods later.
+    jacobian
+        ``d P^n / d x``, with the saltation matrices of the impacts on the way.
+    sensitivity
+        ``d P^n / d p``, one column per parameter asked for.
+    solution
+        The simulation that computed them (its impacts, guard minimum ...).
+
+    Examples
+    --------
+    >>> import math, grazing
+    >>> from grazing.maps import flow_map
+    >>> m = grazing.models.pendulum("B", eta=0.446, theta_hat=math.radians(40))
+    >>> fm = flow_map(m, [0.0, 0.0], sensitivities=("eta",))
+    >>> fm.image.shape, fm.jacobian.shape, fm.sensitivity.shape, fm.impacts
+    ((2,), (2, 2), (2, 1), 0)
+    """
 
     image: np.ndarray
     jacobian: np.ndarray  # d P^n / d x
@@ -67,6 +88,52 @@ def flow_map(
     stop (``x`` on the stop with zero normal velocity), which is not an impact.
     ``stop_name`` names the stop that the contact and the solution's ``guard_min``
     refer to (the first by default).
+
+    Parameters
+    ----------
+    model
+        The model with its parameter values.
+    x
+        The state at ``t0``.
+    t0
+        Time of the section.
+    periods
+        ``n``: forcing periods the map spans.
+    sensitivities
+        Parameter names whose derivatives are wanted (:attr:`FlowMap.sensitivity`).
+    virtual
+        Ignore the stop (the flow passes through it).
+    touching
+        ``x`` is a grazing contact with the stop, not an impact.
+    stop_name
+        The stop the contact and the guard minimum refer to (name or index).
+
+    Returns
+    -------
+    FlowMap
+        The image, its Jacobians and the simulation.
+
+    Examples
+    --------
+    On the period-5 orbit at θ̂ = 40°, η = 0.446 the map of five periods
+    fixes the point, and its Jacobian's eigenvalues are the orbit's Floquet
+    multipliers (both inside the unit circle: a stable orbit):
+
+    >>> import math, numpy as np, grazing
+    >>> from grazing.maps import StroboscopicMap
+    >>> m = grazing.models.pendulum("B", eta=0.446, theta_hat=math.radians(40))
+    >>> x = StroboscopicMap(m, periods=5).iterate([0.0, 0.0], 120)[-1]
+    >>> fm = flow_map(m, x, periods=5)
+    >>> bool(np.abs(fm.image - x).max() < 1e-9), fm.impacts
+    (True, 1)
+    >>> np.sort(np.abs(np.linalg.eigvals(fm.jacobian))).round(4).tolist()
+    [0.002, 0.3464]
+
+    With the stop ignored, the same orbit would pass it (a negative guard minimum):
+
+    >>> fm = flow_map(m, x, periods=5, virtual=True)
+    >>> fm.impacts, bool(fm.solution.guard_min[0] < 0)
+    (0, True)
     """
     sol = simulate(
         model,
@@ -106,6 +173,21 @@ class StroboscopicMap:
         ``n``: forcing periods per application.
     virtual
         Ignore the stop (the flow passes through it).
+
+    Examples
+    --------
+    The map is a discrete system: call it, iterate it, linearise it.
+
+    >>> import math, numpy as np, grazing
+    >>> m = grazing.models.pendulum("B", eta=0.446, theta_hat=math.radians(40))
+    >>> P = StroboscopicMap(m)
+    >>> xs = P.iterate([0.0, 0.0], 400)
+    >>> xs.shape, grazing.detect_period(xs[-50:])
+    ((400, 2), 5)
+    >>> bool(np.allclose(P(xs[-2]), xs[-1], atol=1e-9))  # one more application: the next iterate
+    True
+    >>> P.linearize(xs[-1]).jacobian.shape
+    (2, 2)
     """
 
     model: HybridModel
@@ -148,6 +230,19 @@ class ImpactMap:
         The model with its parameter values.
     max_periods
         Give up looking for the next impacts after this many forcing periods.
+
+    Examples
+    --------
+    The period-5 orbit at θ̂ = 40°, η = 0.446 hits the stop once every five
+    forcing periods (5 × 2π apart), always at the same speed:
+
+    >>> import math, numpy as np, grazing
+    >>> from grazing.maps import StroboscopicMap
+    >>> m = grazing.models.pendulum("B", eta=0.446, theta_hat=math.radians(40))
+    >>> x = StroboscopicMap(m, periods=5).iterate([0.0, 0.0], 120)[-1]
+    >>> imp = ImpactMap(m).iterate(x, 0.0, 4)
+    >>> np.diff(imp.t).round(6).tolist() == [round(10 * math.pi, 6)] * 3, imp.speed.round(5).tolist()
+    (True, [0.08977, 0.08977, 0.08977, 0.08977])
     """
 
     model: HybridModel

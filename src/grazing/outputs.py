@@ -99,7 +99,26 @@ def _version() -> str:
 
 
 def mark_text(what: str, digest: str) -> str:
-    """The mark: ``grazing VERSION (sha256 of WHAT: DIGEST)``."""
+    """The mark: ``grazing VERSION (sha256 of WHAT: DIGEST)``.
+
+    Parameters
+    ----------
+    what
+        What the digest is of (``"the lines above"``, ``"the image"`` ...).
+    digest
+        The SHA-256 digest, 64 hexadecimal digits.
+
+    Returns
+    -------
+    str
+        The mark, with this grazing's version.
+
+    Examples
+    --------
+    >>> import grazing
+    >>> mark_text("the image", "0" * 64) == f"grazing {grazing.__version__} (sha256 of the image: {'0' * 64})"
+    True
+    """
     return f"grazing {_version()} (sha256 of {what}: {digest})"
 
 
@@ -123,6 +142,29 @@ def owned_folder(root: str | Path) -> Iterator[None]:
     """Within the block, any file under ``root`` may be replaced: ``root`` is grazing's as a whole.
 
     The caller has checked it (a report's folder).  Workers forked inside the block inherit it.
+
+    Parameters
+    ----------
+    root
+        The folder.
+
+    Yields
+    ------
+    None
+        Inside the ``with`` block, files under ``root`` are replaceable.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> root = Path(tempfile.mkdtemp())
+    >>> _ = (root / "old.csv").write_text("a user's file")
+    >>> with owned_folder(root):
+    ...     check_replaceable(root / "old.csv")  # no error: the folder is grazing's
+    >>> check_replaceable(root / "old.csv")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    grazing.errors.ForeignFileError: .../old.csv exists and was not written by grazing ...
     """
     key = Path(root).resolve()
     _OWNED.append(key)
@@ -143,6 +185,25 @@ def written_by_grazing(path: str | Path) -> bool:
     """Whether the file at ``path`` carries grazing's mark and is unchanged since grazing wrote it.
 
     Anything that cannot be read or parsed, or is no regular file, is not grazing's.
+
+    Parameters
+    ----------
+    path
+        The file (CSV, JSON, PNG or NetCDF, told by its first bytes).
+
+    Returns
+    -------
+    bool
+        True when the mark is there and its digest matches the file.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> path = Path(tempfile.mkdtemp()) / "result.json"
+    >>> write_json(path, {"period": 5})
+    >>> written_by_grazing(path), written_by_grazing(path.parent), written_by_grazing(path.parent / "none")
+    (True, False, False)
     """
     try:
         target = resolved(path)
@@ -178,6 +239,17 @@ def check_replaceable(path: str | Path, *, overwrite: bool = False, hint: str = 
         Replace a regular file that grazing did not write.
     hint
         How the message ends (what the caller can do instead).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> folder = Path(tempfile.mkdtemp())
+    >>> check_replaceable(folder / "new.csv")  # nothing there: fine
+    >>> check_replaceable(folder)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    grazing.errors.ForeignFileError: ... is a folder; it was left untouched: name a file
     """
     shown = Path(path)
     target = resolved(shown)
@@ -225,13 +297,51 @@ def write_csv(
     """Write a text table through ``write(file_handle)``, all at once, with grazing's mark as its last line.
 
     ``path`` is checked first (:func:`check_replaceable`).
+
+    Parameters
+    ----------
+    path
+        Where the file goes.
+    write
+        Called with the open text file; writes the table (``numpy.savetxt``,
+        ``csv.writer``, ``fh.write`` ...).
+    overwrite
+        Replace a regular file that grazing did not write.
+    hint
+        How a refusal's message ends (what the caller can do instead; the CLI
+        names ``--overwrite``).
+
+    Examples
+    --------
+    >>> import tempfile, numpy as np
+    >>> from pathlib import Path
+    >>> path = Path(tempfile.mkdtemp()) / "table.csv"
+    >>> write_csv(path, lambda fh: np.savetxt(fh, [[0.5, 0.01]], delimiter=",", header="r,beta"))
+    >>> np.loadtxt(path, delimiter=",").tolist()  # the mark is a comment line
+    [0.5, 0.01]
     """
     check_replaceable(path, overwrite=overwrite, hint=hint)
     write_text_atomic(path, lambda fh: write_marked_csv(fh, write))
 
 
 def write_marked_csv(fh: Any, write: Callable[[Any], Any]) -> None:
-    """Write a text table into the open file ``fh`` through ``write(file_handle)``, then grazing's mark."""
+    """Write a text table into the open file ``fh`` through ``write(file_handle)``, then grazing's mark.
+
+    Parameters
+    ----------
+    fh
+        An open text file (a temporary file that is then moved into place).
+    write
+        Called with a handle that writes to ``fh`` and hashes what it writes.
+
+    Examples
+    --------
+    >>> import io
+    >>> fh = io.StringIO()
+    >>> write_marked_csv(fh, lambda out: out.write("a,b\\n1,2"))
+    >>> fh.getvalue().splitlines()[1], fh.getvalue().splitlines()[2].startswith("# written by grazing")
+    ('1,2', True)
+    """
     out = _HashingWriter(fh)
     write(out)
     if out.last != "\n":
@@ -276,14 +386,54 @@ def _canonical_json(obj: Any) -> bytes:
 def write_json(
     path: str | Path, obj: Mapping[str, Any], *, overwrite: bool = False, hint: str = PYTHON_HINT
 ) -> None:
-    """Write a JSON object (indented), all at once, with grazing's mark as its last key."""
+    """Write a JSON object (indented), all at once, with grazing's mark as its last key.
+
+    Parameters
+    ----------
+    path
+        Where the file goes (checked first: :func:`check_replaceable`).
+    obj
+        The object: JSON's types only.
+    overwrite
+        Replace a regular file that grazing did not write.
+    hint
+        How a refusal's message ends (what the caller can do instead; the CLI
+        names ``--overwrite``).
+
+    Examples
+    --------
+    >>> import json, tempfile
+    >>> from pathlib import Path
+    >>> path = Path(tempfile.mkdtemp()) / "orbit.json"
+    >>> write_json(path, {"period": 5, "impacts": 1})
+    >>> sorted(json.loads(path.read_text()))
+    ['impacts', 'period', 'written_by']
+    >>> write_json(path, {"period": 4})  # grazing's own file: replaced
+    """
     check_replaceable(path, overwrite=overwrite, hint=hint)
     text = marked_json(obj)
     write_text_atomic(path, lambda fh: fh.write(text))
 
 
 def marked_json(obj: Mapping[str, Any]) -> str:
-    """The text of a JSON object (indented) with grazing's mark as its last key (an earlier mark dropped)."""
+    """The text of a JSON object (indented) with grazing's mark as its last key (an earlier mark dropped).
+
+    Parameters
+    ----------
+    obj
+        The object: JSON's types only.
+
+    Returns
+    -------
+    str
+        The indented JSON text, ending in a newline.
+
+    Examples
+    --------
+    >>> import json
+    >>> list(json.loads(marked_json({"period": 5})))
+    ['period', 'written_by']
+    """
     body = {k: v for k, v in obj.items() if k != MARK_KEY}
     digest = hashlib.sha256(_canonical_json(body)).hexdigest()
     return json.dumps({**body, MARK_KEY: mark_text("the other keys", digest)}, indent=1) + "\n"
@@ -351,7 +501,26 @@ def _with_text(chunks: list[tuple[bytes, bytes]], key: str, text: str) -> bytes:
 
 
 def mark_png(data: bytes) -> bytes:
-    """A PNG file's bytes with grazing's mark (a ``Software`` text chunk right after the header)."""
+    """A PNG file's bytes with grazing's mark (a ``Software`` text chunk right after the header).
+
+    Parameters
+    ----------
+    data
+        The bytes of a PNG file (an earlier mark in it is dropped).
+
+    Returns
+    -------
+    bytes
+        The same image, marked.
+
+    Examples
+    --------
+    >>> import io
+    >>> from PIL import Image
+    >>> buf = io.BytesIO(); Image.new("RGB", (2, 2)).save(buf, format="png")
+    >>> png_text(mark_png(buf.getvalue()), "Software").startswith("grazing ")
+    True
+    """
     chunks = [c for c in _png_chunks(data) if not _is_png_mark(*c)]
     return _with_text(chunks, PNG_MARK_KEY, mark_text("the image", _png_digest(chunks)))
 
@@ -365,7 +534,40 @@ def _png_is_ours(data: bytes) -> bool:
 def save_png(
     fig: Any, path: str | Path, *, dpi: float, overwrite: bool = False, hint: str = PYTHON_HINT
 ) -> Path:
-    """Save a matplotlib figure as a PNG with grazing's mark, all at once; return the path."""
+    """Save a matplotlib figure as a PNG with grazing's mark, all at once; return the path.
+
+    The image also records its plot areas (:mod:`grazing.plot_areas`), which
+    ``make check-report`` reads.
+
+    Parameters
+    ----------
+    fig
+        The figure.
+    path
+        Where the file goes (checked first: :func:`check_replaceable`).
+    dpi
+        Resolution, dots per inch.
+    overwrite
+        Replace a regular file that grazing did not write.
+    hint
+        How a refusal's message ends (what the caller can do instead; the CLI
+        names ``--overwrite``).
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from matplotlib.figure import Figure
+    >>> fig = Figure(figsize=(2, 1)); _ = fig.add_subplot().plot([0, 1], [1, 0])
+    >>> path = save_png(fig, Path(tempfile.mkdtemp()) / "line.png", dpi=50)
+    >>> path.name, written_by_grazing(path)
+    ('line.png', True)
+    """
     from grazing.plot_areas import LAYOUT_KEY, axes_layout, layout_text
 
     check_replaceable(path, overwrite=overwrite, hint=hint)
@@ -378,6 +580,20 @@ def save_png(
 
 def add_png_text(data: bytes, key: str, text: str) -> bytes:
     """A PNG file's bytes with a text chunk ``key`` (replacing one of that key) right after the header.
+
+    Parameters
+    ----------
+    data
+        The bytes of a PNG file.
+    key
+        The chunk's keyword (Latin-1).
+    text
+        Its text (Latin-1).
+
+    Returns
+    -------
+    bytes
+        The same image with the text chunk.
 
     Examples
     --------
@@ -393,7 +609,32 @@ def add_png_text(data: bytes, key: str, text: str) -> bytes:
 
 
 def png_text(data: bytes, key: str) -> str | None:
-    """The text of a PNG file's ``tEXt`` chunk ``key``, or None (ValueError if ``data`` is not a PNG file)."""
+    """The text of a PNG file's ``tEXt`` chunk ``key``, or None (ValueError if ``data`` is not a PNG file).
+
+    Parameters
+    ----------
+    data
+        The bytes of a PNG file.
+    key
+        The chunk's keyword.
+
+    Returns
+    -------
+    str or None
+        The chunk's text; None when the file has no such chunk.
+
+    Examples
+    --------
+    >>> import io
+    >>> from PIL import Image
+    >>> buf = io.BytesIO(); Image.new("RGB", (2, 2)).save(buf, format="png")
+    >>> png_text(buf.getvalue(), "Software") is None
+    True
+    >>> png_text(b"not a png", "Software")
+    Traceback (most recent call last):
+    ...
+    ValueError: not a PNG file
+    """
     for kind, payload in _png_chunks(data):
         name, sep, text = payload.partition(b"\0")
         if kind == b"tEXt" and sep and name == key.encode("latin-1"):
@@ -404,7 +645,31 @@ def png_text(data: bytes, key: str) -> str | None:
 def write_png_bytes(
     path: str | Path, data: bytes, *, overwrite: bool = False, hint: str = PYTHON_HINT
 ) -> None:
-    """Write a PNG image given as bytes (a screenshot...) with grazing's mark, all at once."""
+    """Write a PNG image given as bytes (a screenshot...) with grazing's mark, all at once.
+
+    Parameters
+    ----------
+    path
+        Where the file goes (checked first: :func:`check_replaceable`).
+    data
+        The bytes of a PNG file.
+    overwrite
+        Replace a regular file that grazing did not write.
+    hint
+        How a refusal's message ends (what the caller can do instead; the CLI
+        names ``--overwrite``).
+
+    Examples
+    --------
+    >>> import io, tempfile
+    >>> from pathlib import Path
+    >>> from PIL import Image
+    >>> buf = io.BytesIO(); Image.new("RGB", (2, 2)).save(buf, format="png")
+    >>> path = Path(tempfile.mkdtemp()) / "shot.png"
+    >>> write_png_bytes(path, buf.getvalue())
+    >>> written_by_grazing(path), Image.open(path).size
+    (True, (2, 2))
+    """
     check_replaceable(path, overwrite=overwrite, hint=hint)
     write_bytes_atomic(path, mark_png(data))
 
@@ -448,6 +713,25 @@ def netcdf_bytes(data: Any, *, compress: bool = False) -> memoryview:
     The file is built in memory (h5netcdf on a :class:`io.BytesIO`): libhdf5
     writes nothing to disk.  With ``compress`` every float variable of one or
     more dimensions is compressed (:data:`COMPRESSION`).
+
+    Parameters
+    ----------
+    data
+        An :class:`xarray.Dataset`, or a mapping of group names to datasets.
+    compress
+        Compress the float variables.
+
+    Returns
+    -------
+    memoryview
+        The file's bytes.
+
+    Examples
+    --------
+    >>> import io, xarray as xr
+    >>> raw = netcdf_bytes(xr.Dataset({"period": ("point", [1, 5])}))
+    >>> bytes(raw[:4]), xr.open_dataset(io.BytesIO(raw), engine="h5netcdf").period.values.tolist()
+    (b'\\x89HDF', [1, 5])
     """
     import h5py
 
@@ -480,6 +764,34 @@ def write_netcdf(
     ``path`` is checked first (:func:`check_replaceable`); the file is built in
     memory (:func:`netcdf_bytes`) and written with plain file I/O, so a full
     disk is a :class:`~grazing.errors.WriteError` and leaves nothing.
+
+    Parameters
+    ----------
+    path
+        Where the file goes.
+    data
+        An :class:`xarray.Dataset`, or a mapping of group names to datasets.
+    compress
+        Compress the float variables (:data:`COMPRESSION`).
+    overwrite
+        Replace a regular file that grazing did not write.
+    hint
+        How a refusal's message ends (what the caller can do instead; the CLI
+        names ``--overwrite``).
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+
+    Examples
+    --------
+    >>> import tempfile, xarray as xr
+    >>> from pathlib import Path
+    >>> ds = xr.Dataset({"period": ("point", [1, 5])})
+    >>> path = write_netcdf(Path(tempfile.mkdtemp()) / "sweep.nc", {"up": ds, "down": ds})
+    >>> written_by_grazing(path), xr.open_dataset(path, group="down").period.values.tolist()
+    (True, [1, 5])
     """
     check_replaceable(path, overwrite=overwrite, hint=hint)
     write_bytes_atomic(path, netcdf_bytes(data, compress=compress))

@@ -166,3 +166,27 @@ def test_drop_doublings_and_describe() -> None:
     assert [w.period for w in drop_doublings(ws, gap=20)] == [2, 3]
     assert describe_windows([]) == "none"
     assert describe_windows(ws[:1], digits=2) == "2 (η 0–0.9)"
+
+
+def test_a_sweep_up_and_down_is_drawn_in_markers_of_real_size_and_shaded_as_each_sweep_says() -> None:
+    """The hysteresis diagram: both sweeps seen (rings and dots, not 1-px points); the nonimpacting
+    shade where both sweeps are free of the stop, and a hatch in the down sweep's colour where only it is."""
+    up = synthetic_sweep()
+    down = up.copy(deep=True)
+    down["impacts_per_period"].values[10:15] = 0.0  # swept down, free of the stop 5 points further
+    down["period"].values[10:15] = 1
+    ds = xr.concat([up, down], dim="direction").assign_coords(direction=["up", "down"])
+    ax = Figure().add_subplot()
+    plot_bifurcation(ax, ds, windows=False)
+    lines = {line.get_label(): line for line in ax.lines}
+    assert set(lines) == {"swept up", "swept down"}
+    assert lines["swept up"].get_markersize() >= 3 and lines["swept up"].get_markerfacecolor() == "none"
+    assert lines["swept down"].get_markersize() >= 1.5
+    assert lines["swept down"].get_markersize() < lines["swept up"].get_markersize()  # a dot inside a ring
+    value = up["value"].values
+    spans = [(p.get_x(), p.get_x() + p.get_width(), p.get_hatch()) for p in ax.patches]
+    shaded = [(a, b) for a, b, h in spans if not h]
+    hatched = [(a, b) for a, b, h in spans if h]
+    assert len(shaded) == 1 and np.isclose(shaded[0][1], (value[9] + value[10]) / 2)  # both free
+    assert len(hatched) == 1 and np.isclose(hatched[0][0], shaded[0][1])  # the down sweep alone
+    assert np.isclose(hatched[0][1], (value[14] + value[15]) / 2)

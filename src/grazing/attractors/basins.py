@@ -72,6 +72,19 @@ class AttractorSet:
         The recurrence cell of an aperiodic attractor, as a fraction of its extent.
     polished
         Initial states whose end state was polished by Newton's method onto a stable orbit.
+
+    Examples
+    --------
+    What :func:`find_attractors` returns:
+
+    >>> import grazing
+    >>> from grazing.attractors import find_attractors
+    >>> ball = grazing.models.bouncing_ball(amplitude=0.8, r=0.8)
+    >>> found = find_attractors(ball, [[0.0, 0.8], [3.6, -2.0], [-1.0, 0.0]], workers=1)
+    >>> found.labels.tolist(), [round(f, 3) for f in found.fractions.values()]
+    ([1, 2, 0], [0.333, 0.333, 0.333])
+    >>> found.transient, found.periods  # the defaults of BasinSettings
+    (300, 50)
     """
 
     attractors: tuple[Attractor, ...]
@@ -176,6 +189,16 @@ def find_attractors(
         run: interrupted and run again, it computes only the chunks missing.
     progress
         Called as ``progress(done, total)``.
+    **shorthands
+        Any field of :class:`~grazing.core.options.BasinSettings` by name
+        (``transient=200``, ``lyapunov=False`` ...), replacing that field of
+        ``settings``.
+
+    Returns
+    -------
+    AttractorSet
+        The attractors (and outcomes) with their basin fractions, and the
+        attractor of each initial state.
 
     The first run of every initial state computes no Lyapunov exponent: the
     aperiodic end states get theirs when they are run on (``refine``), and each
@@ -395,11 +418,32 @@ def basins(
     values (default 0), at forcing phase ``phase``; ``options`` are those of
     :func:`find_attractors`.
 
-    Returns a dataset with ``label`` (``y``, ``x``: the attractor id of each
-    initial state; 0 beyond a stop), and along ``attractor`` (the ids):
-    ``kind``, ``period``, ``impacts_per_period``, ``lyapunov``, ``fraction``,
-    ``count``, ``reason``, ``points`` (``attractor``, ``point``,
-    ``component``; NaN-padded) and ``n_points``.
+    Parameters
+    ----------
+    model
+        The model with its parameter values.
+    x_range, y_range
+        ``(lo, hi)`` of the two state components varied.
+    num
+        Initial states along each.
+    states
+        The two state components varied (indices or names).
+    fixed
+        Values of the other state components (default 0).
+    phase
+        Forcing phase of the initial states and of the samples (radians).
+    **options
+        Those of :func:`find_attractors` (``settings``, ``workers``,
+        ``store``, the :class:`~grazing.core.options.BasinSettings` fields ...).
+
+    Returns
+    -------
+    xarray.Dataset
+        ``label`` (``y``, ``x``: the attractor id of each initial state; 0
+        beyond a stop), and along ``attractor`` (the ids): ``kind``,
+        ``period``, ``impacts_per_period``, ``lyapunov``, ``fraction``,
+        ``count``, ``reason``, ``points`` (``attractor``, ``point``,
+        ``component``; NaN-padded) and ``n_points``.
 
     Examples
     --------
@@ -415,7 +459,32 @@ def basins(
 
 
 def to_dataset(model: HybridModel, grid: StateGrid, found: AttractorSet) -> Any:
-    """The dataset of :func:`basins` from the grid and what :func:`find_attractors` found on it."""
+    """The dataset of :func:`basins` from the grid and what :func:`find_attractors` found on it.
+
+    Parameters
+    ----------
+    model
+        The model.
+    grid
+        The grid of initial states (:func:`~grazing.attractors.state_grid`).
+    found
+        What :func:`find_attractors` found from the grid's states.
+
+    Returns
+    -------
+    xarray.Dataset
+        As :func:`basins` returns.
+
+    Examples
+    --------
+    >>> import grazing
+    >>> from grazing.attractors import state_grid
+    >>> ball = grazing.models.bouncing_ball(amplitude=0.8, r=0.8)
+    >>> grid = state_grid(ball, (-1.0, 6.0), (-4.0, 4.0), (3, 2))
+    >>> ds = to_dataset(ball, grid, find_attractors(ball, grid.states_array(), workers=1))
+    >>> ds.label.values.tolist(), ds.kind.values.tolist()
+    ([[0, 1, 2], [0, 2, 1]], ['invalid', 'sticking', 'periodic'])
+    """
     import xarray as xr
 
     i, j = grid.states

@@ -106,6 +106,22 @@ class Attractor:
         ``count`` over all initial states.
     first
         The index of its first initial state.
+
+    Examples
+    --------
+    The ball on a vibrating table: from three initial states, one beyond the
+    table (``invalid``, id 0), one that comes to rest on it (``sticking``) and
+    one on the period-1 orbit with one impact a period:
+
+    >>> import grazing
+    >>> from grazing.attractors import find_attractors
+    >>> ball = grazing.models.bouncing_ball(amplitude=0.8, r=0.8)
+    >>> found = find_attractors(ball, [[0.0, 0.8], [3.6, -2.0], [-1.0, 0.0]], workers=1)
+    >>> [(a.id, a.kind, a.period, a.count, a.reason) for a in found.attractors]
+    [(0, 'invalid', -1, 1, 'beyond a stop'), (1, 'sticking', 1, 1, ''), (2, 'periodic', 1, 1, '')]
+    >>> a = found.attractor(2)
+    >>> a.impacts_per_period, a.points.shape, a.first
+    (1.0, (1, 2), 1)
     """
 
     id: int

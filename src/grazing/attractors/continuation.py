@@ -187,13 +187,18 @@ def continue_attractors(
         Local threads, or a Dask client.
     progress
         Called as ``progress(values_done, values_total)``.
+    **shorthands
+        Any field of :class:`~grazing.core.options.BasinSettings` by name.
 
-    Returns a dataset along ``value`` and ``attractor`` (the followed ids, 1,
-    2, ... in order of appearance; 0 is ``invalid``): ``fraction`` (0 where the
-    attractor is not found; an attractor found only from the seeds has 0),
-    ``present``, ``kind``, ``period``, ``impacts_per_period``, ``lyapunov``,
-    ``points`` (NaN-padded), and ``label`` (``value``, ``y``, ``x``: the
-    followed id of each initial state).
+    Returns
+    -------
+    xarray.Dataset
+        Along ``value`` and ``attractor`` (the followed ids, 1, 2, ... in
+        order of appearance; 0 is ``invalid``): ``fraction`` (0 where the
+        attractor is not found; an attractor found only from the seeds has 0),
+        ``present``, ``kind``, ``period``, ``impacts_per_period``,
+        ``lyapunov``, ``points`` (NaN-padded), and ``label`` (``value``, ``y``,
+        ``x``: the followed id of each initial state).
 
     Examples
     --------

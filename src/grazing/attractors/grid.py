@@ -125,11 +125,26 @@ def state_grid(
     phase
         Forcing phase of the initial states (radians).
 
+    Returns
+    -------
+    StateGrid
+        The grid: its values along each state varied, and every initial
+        state (:meth:`StateGrid.states_array`, row by row, ``x`` fastest).
+
     Raises
     ------
     InvalidParameterError
         An empty grid, a state index out of range or unknown, a fixed value of
         a varied or unknown state, a range that is not finite or is reversed.
+
+    Examples
+    --------
+    >>> import grazing
+    >>> grid = state_grid(grazing.models.bouncing_ball(), (-1.0, 6.0), (-4.0, 4.0), (3, 2))
+    >>> grid.x.tolist(), grid.y.tolist()
+    ([-1.0, 2.5, 6.0], [-4.0, 4.0])
+    >>> grid.states_array().tolist()
+    [[-1.0, -4.0], [2.5, -4.0], [6.0, -4.0], [-1.0, 4.0], [2.5, 4.0], [6.0, 4.0]]
     """
     if model.n_states < 2:
         raise InvalidParameterError(f"model {model.name!r} has one state: a grid needs two")

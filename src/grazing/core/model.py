@@ -529,6 +529,10 @@ class HybridModel:
     state_units
         Units of the states, for labels (``"rad"`` marks an angle, shown in
         degrees when a plot asks for degrees); empty by default.
+    description
+        One line saying what the model is (shown by ``grazing models``).
+    reference
+        Where the model comes from (a paper, a book), for the reader.
     values
         Parameter values (defaults from ``parameters``).
 

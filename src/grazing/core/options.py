@@ -267,6 +267,27 @@ class SaveAt:
     guard_min
         Track the smallest guard value over the sampled span and the closest
         approach to the stop away from contacts.
+
+    Examples
+    --------
+    Ten stroboscopic samples after 400 periods, and the dense trajectory over
+    them at 50 points per period (505 rows: both states at each impact added):
+
+    >>> import math, grazing
+    >>> model = grazing.models.pendulum("B", eta=0.446, theta_hat=math.radians(40))
+    >>> save = SaveAt(periods=10, transient=400, trajectory=50)
+    >>> sol = grazing.simulate(model, [0.0, 0.0], save=save)
+    >>> sol.samples.shape, sol.trajectory.shape, sol.period()
+    ((10, 2), (505, 2), 5)
+
+    The same fields are keywords of :func:`grazing.simulate`
+    (``simulate(model, x0, periods=10, transient=400)``); a bad value is
+    refused when the object is made:
+
+    >>> SaveAt(periods=0)
+    Traceback (most recent call last):
+    ...
+    grazing.errors.InvalidParameterError: periods must be >= 1, got 0
     """
 
     periods: int = 100
@@ -300,6 +321,28 @@ class Tangent:
     lyapunov
         The Lyapunov exponents over the sampled span (cannot be combined with
         the Jacobian in one run).
+
+    Examples
+    --------
+    The Jacobian of the final state with respect to the initial one, with a
+    column for the derivative with respect to ``eta`` appended:
+
+    >>> import math, grazing
+    >>> model = grazing.models.pendulum("B", eta=0.446, theta_hat=math.radians(40))
+    >>> sol = grazing.simulate(model, [0.0, 0.0], transient=400, periods=10,
+    ...                        tangent=Tangent(sensitivities=("eta",)))
+    >>> sol.jacobian.shape, sol.jacobian_valid
+    ((2, 3), True)
+
+    On the stable period-5 orbit both Lyapunov exponents are negative:
+
+    >>> sol = grazing.simulate(model, [0.0, 0.0], transient=400, periods=50, tangent=Tangent(lyapunov=True))
+    >>> bool((sol.lyapunov < 0).all())
+    True
+    >>> Tangent(jacobian=True, lyapunov=True)
+    Traceback (most recent call last):
+    ...
+    grazing.errors.InvalidParameterError: lyapunov and jacobian/sensitivities cannot be combined in one run
     """
 
     jacobian: bool = False
@@ -346,6 +389,25 @@ class Solver:
         A chattering sequence whose remaining duration is below this fraction
         of the period is summed to its accumulation point and continued as
         sticking.
+
+    Examples
+    --------
+    A looser tolerance takes a lower Taylor order (:attr:`Solution.info`
+    says which); the samples agree to about that tolerance:
+
+    >>> import math, numpy as np, grazing
+    >>> model = grazing.models.pendulum("B", eta=0.446, theta_hat=math.radians(40))
+    >>> exact = grazing.simulate(model, [0.0, 0.0], transient=400, periods=10)
+    >>> loose = grazing.simulate(model, [0.0, 0.0], transient=400, periods=10, solver=Solver(tol=1e-12))
+    >>> exact.info["order"], loose.info["order"], bool(np.abs(loose.samples - exact.samples).max() < 1e-9)
+    (20, 15, True)
+
+    A run that needs more steps than ``max_steps`` stops with one line:
+
+    >>> grazing.simulate(model, [0.0, 0.0], periods=10, solver=Solver(max_steps=100))
+    Traceback (most recent call last):
+    ...
+    grazing.errors.SimulationError: step limit of 100 steps reached at t = 46.1425
     """
 
     tol: float = MACHINE_EPSILON
@@ -383,6 +445,22 @@ class SweepSettings:
         Compute the largest Lyapunov exponent (per unit time).
     tol
         Local error tolerance of the integrator.
+
+    Examples
+    --------
+    The defaults, and a short sweep across the paper's first grazing at
+    θ̂ = 40°: period 1 free of the stop, then period 4 and chaos past it:
+
+    >>> SweepSettings()  # doctest: +NORMALIZE_WHITESPACE
+    SweepSettings(transient=500, periods=100, phase=0.0, fresh=False, chunk_size=50,
+                  adaptive=True, lyapunov=True, tol=1e-10)
+    >>> import math, numpy as np, grazing
+    >>> from grazing.sweeps import sweep
+    >>> model = grazing.models.pendulum("B", theta_hat=math.radians(40))
+    >>> settings = SweepSettings(transient=300, periods=40, lyapunov=False)
+    >>> ds = sweep(model, "eta", np.linspace(0.44, 0.45, 5), settings=settings, workers=1)
+    >>> ds.period.values.tolist(), ds.impacts_per_period.values[:3].tolist()
+    ([1, 1, 1, 4, 0], [0.0, 0.0, 0.0])
     """
 
     transient: int = DEFAULT_TRANSIENT

@@ -41,6 +41,21 @@ def detect_period(
     of a cycle is seen at least twice.  Returns 0 when no period fits
     (chaos, quasi-periodicity, or a transient that has not died out).
 
+    Parameters
+    ----------
+    samples
+        The samples, one per row (shape ``(n,)`` or ``(n, components)``), in
+        order; a NaN anywhere makes them aperiodic.
+    tol
+        Absolute tolerance to which the samples must repeat.
+    max_period
+        Longest period tried (and at most half the number of samples).
+
+    Returns
+    -------
+    int
+        The smallest period, or 0 when none fits.
+
     Examples
     --------
     >>> detect_period(np.array([1.0, 2.0, 1.0, 2.0, 1.0, 2.0]))
@@ -49,6 +64,15 @@ def detect_period(
     0
     >>> detect_period(1e5 * np.array([1.0, 2.0, 1.0, 2.0]) + [0.0, 0.0, 1e-2, 0.0])  # (in other units)
     2
+    >>> detect_period(np.array([1.0, 2.0, 1.0, 2.0 + 1e-4]), tol=1e-3)
+    2
+
+    The samples of a simulation (:meth:`grazing.Solution.period` calls it):
+
+    >>> import math, grazing
+    >>> m = grazing.models.pendulum("B", eta=0.446, theta_hat=math.radians(40))
+    >>> detect_period(grazing.simulate(m, [0.0, 0.0], transient=400, periods=20).samples)
+    5
     """
     s = np.asarray(samples, dtype=float)
     if s.ndim == 1:

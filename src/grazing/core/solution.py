@@ -236,6 +236,29 @@ class Solution:
         None when stop ``j`` has no closest approach in free flight).
     n_steps
         Number of Taylor steps taken.
+    info
+        How the run was made: ``"order"`` (the Taylor order the tolerance
+        chose), ``"tol"`` (the local error tolerance), ``"transient"`` (forcing
+        periods run before the samples), ``"phase"`` (the stroboscopic phase
+        of the samples, radians) and ``"period_gradient"`` (for each parameter
+        of ``Tangent.sensitivities``, the derivative of the forcing period with
+        respect to it: 0 for a parameter that does not set the period).
+
+    Examples
+    --------
+    The paper's period-5 orbit at θ̂ = 40°, η = 0.446 (its fig. 7): ten
+    samples after a transient of 400 periods, two impacts among them (none on
+    the back face of the stop):
+
+    >>> import math, grazing
+    >>> model = grazing.models.pendulum("B", eta=0.446, theta_hat=math.radians(40))
+    >>> sol = grazing.simulate(model, [0.0, 0.0], transient=400, periods=10)
+    >>> sol.samples.shape, sol.period(), len(sol.impacts), sol.impacts.per_stop()
+    ((10, 2), 5, 2, {'stop': 2, 'back': 0})
+    >>> sorted(sol.info), sol.info["order"], sol.info["transient"]
+    (['order', 'period_gradient', 'phase', 'tol', 'transient'], 20, 400)
+    >>> bool(abs(sol.t[1] - sol.t[0] - model.period) < 1e-12), sol.x_final.shape  # one sample a period
+    (True, (2,))
     """
 
     model: HybridModel

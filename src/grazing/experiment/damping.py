@@ -100,6 +100,15 @@ class FreeDecay:
         ``A_0``).
     r, beta
         The model's restitution and damping.
+
+    Examples
+    --------
+    The paper's point B (r = 0.7675, beta = 0.048) released 0.5 rad from the
+    stop: one impact a cycle of about ``2 pi``, the swing never past the stop:
+
+    >>> dec = free_decay(0.7675, 0.048, peaks=3)
+    >>> dec.amplitudes.round(4).tolist(), dec.peak_t.round(2).tolist(), bool(dec.angle.max() <= 1e-12)
+    ([0.5, 0.281, 0.1588, 0.09], [0.0, 6.38, 12.72, 19.03], True)
     """
 
     t: np.ndarray
@@ -139,6 +148,11 @@ def free_decay(
         Resolution of the dense trajectory (per ``2 pi`` of ``omega_0 t``).
     eta
         Time scale of the simulation (no effect on the amplitudes).
+
+    Returns
+    -------
+    FreeDecay
+        The trajectory, its peaks and their amplitudes.
 
     Examples
     --------
@@ -246,6 +260,16 @@ class DampingEstimate:
         ``"eq6"`` or ``"eq1"``.
     amplitudes
         The peak amplitudes the estimate used.
+
+    Examples
+    --------
+    Amplitudes falling by ``exp(-2 pi 0.07)`` a peak: ``D = 0.07`` from every
+    pair, at spacings 1 and 2 (five pairs and four):
+
+    >>> import math
+    >>> est = log_decrement([math.exp(-2 * math.pi * 0.07 * k) for k in range(6)], k_hat=(1, 2))
+    >>> round(est.damping, 12), est.values.size, round(est.spread, 12), est.k_hat, est.normalisation
+    (0.07, 9, 0.0, (1, 2), 'eq6')
     """
 
     damping: float
@@ -278,6 +302,11 @@ def log_decrement(
         A peak spacing, or several (the estimate averages over all of them).
     normalisation
         ``"eq6"`` (default) or ``"eq1"``.
+
+    Returns
+    -------
+    DampingEstimate
+        ``D``, its spread over the ratios, and the ratios used.
 
     Examples
     --------
@@ -326,6 +355,24 @@ def model_damping(
     Simulates :func:`free_decay` and applies :func:`log_decrement` to the
     release and the ``peaks`` peaks after it.
 
+    Parameters
+    ----------
+    r
+        Restitution, in (0, 1].
+    beta
+        Linear damping.
+    amplitude
+        Release angle below the stop, in radians.
+    peaks
+        Peaks after the release used.
+    k_hat, normalisation
+        As in :func:`log_decrement`.
+
+    Returns
+    -------
+    DampingEstimate
+        What eq. 1's procedure measures.
+
     Examples
     --------
     >>> round(model_damping(1.0, 0.048).damping, 4)  # eq. 6: D = beta (r = 1)
@@ -345,6 +392,20 @@ def linear_damping(r: float, beta: float, *, normalisation: Normalisation = "eq6
     ``(2 pi beta / sqrt(1 - 4 beta^2) - ln r) / c`` with ``c = 2 pi`` (eq6)
     or ``4 pi`` (eq1): half a damped natural cycle and one impact per peak.
 
+    Parameters
+    ----------
+    r
+        Restitution, in (0, 1].
+    beta
+        Linear damping.
+    normalisation
+        ``"eq6"`` (default: ``D = beta`` at ``r = 1``) or ``"eq1"`` (the formula as printed).
+
+    Returns
+    -------
+    float
+        The damping ``D`` of small swings.
+
     Examples
     --------
     >>> round(linear_damping(1.0, 0.068), 4), round(linear_damping(0.7675, 0.048), 4)
@@ -357,6 +418,18 @@ def linear_damping(r: float, beta: float, *, normalisation: Normalisation = "eq6
 
 def paper_relation(r: float, beta: float) -> float:
     """``D = beta - ln(r) / (4 pi)``: the relation the paper's fig 4(b) points satisfy.
+
+    Parameters
+    ----------
+    r
+        Restitution, in (0, 1].
+    beta
+        Linear damping.
+
+    Returns
+    -------
+    float
+        The damping ``D``.
 
     Examples
     --------
@@ -422,6 +495,23 @@ def beta_for_damping(r: float, damping: float, *, relation: Relation = "model", 
     Raises :class:`~grazing.errors.InvalidParameterError` when even
     ``beta = 0`` gives more damping than ``D`` (impacts alone lose too much).
 
+    Parameters
+    ----------
+    r
+        Restitution, in (0, 1].
+    damping
+        The damping ``D`` wanted.
+    relation
+        ``"model"`` (eq. 1's procedure on the simulated free decay),
+        ``"paper"`` (:func:`paper_relation`) or ``"protocol"`` (see :class:`IsoDampingCurve`).
+    **protocol
+        ``amplitude``, ``peaks``, ``k_hat``, ``normalisation`` for :func:`model_damping`.
+
+    Returns
+    -------
+    float
+        The linear damping ``beta``.
+
     Examples
     --------
     >>> b = beta_for_damping(0.7675, 0.0905)
@@ -460,6 +550,22 @@ def r_for_damping(beta: float, damping: float, *, relation: Relation = "model", 
 
     Raises :class:`~grazing.errors.InvalidParameterError` when ``beta`` alone
     gives more damping than ``D`` (that would need ``r > 1``).
+
+    Parameters
+    ----------
+    beta
+        Linear damping.
+    damping
+        The damping ``D`` wanted.
+    relation
+        ``"model"``, ``"paper"`` or ``"protocol"`` (as :func:`beta_for_damping`).
+    **protocol
+        ``amplitude``, ``peaks``, ``k_hat``, ``normalisation`` for :func:`model_damping`.
+
+    Returns
+    -------
+    float
+        The restitution ``r``.
 
     Examples
     --------
@@ -505,6 +611,16 @@ class IsoDampingCurve:
         ``"model"`` (root-finding on the model's measured ``D``),
         ``"paper"`` (``D = beta - ln(r) / (4 pi)``) or ``"protocol"``
         (root-finding on :func:`paper_protocol_damping`).
+
+    Examples
+    --------
+    The paper's relation: at ``beta = 0`` the impacts alone give ``D``, so
+    ``r_min = exp(-4 pi D)``; at ``r = 1``, ``beta = D``:
+
+    >>> import math
+    >>> c = iso_damping(0.07, relation="paper", num=3)
+    >>> c.r.round(4).tolist(), c.beta.round(4).tolist(), round(math.exp(-4 * math.pi * 0.07), 4)
+    ([0.4149, 0.7075, 1.0], [0.0, 0.0425, 0.07], 0.4149)
     """
 
     damping: float
@@ -540,6 +656,11 @@ def iso_damping(
     **protocol
         ``amplitude``, ``peaks``, ``k_hat``, ``normalisation`` for
         :func:`model_damping`.
+
+    Returns
+    -------
+    IsoDampingCurve
+        The curve's ``r`` and ``beta``.
 
     Examples
     --------
@@ -645,6 +766,12 @@ def recorded_damping(
         Smallest amplitude used, in radians.
     cutoff_hz
         Low-pass cutoff in Hz.
+
+    Returns
+    -------
+    RecordedDecay
+        The estimate (``estimate``: a :class:`DampingEstimate`) with the
+        peaks and the rest angle it was measured from.
 
     Examples
     --------

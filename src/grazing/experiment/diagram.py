@@ -41,6 +41,21 @@ class ExperimentDiagram:
         The recordings' file names.
     synthetic
         True when every sidecar says the recording is synthetic.
+
+    Examples
+    --------
+    Two synthetic recordings at θ̂ = 40° analysed as the rig's would be
+    (:func:`load_diagram`): period 1 before the grazing, period 5 after, each file
+    named by its forcing frequency in Hz on the paper's rig:
+
+    >>> import tempfile
+    >>> from grazing.experiment import load_diagram
+    >>> from grazing.experiment.synthetic import synthetic_sweep
+    >>> folder = tempfile.mkdtemp()
+    >>> _ = synthetic_sweep(folder, 40.0, [0.43, 0.446], periods=30, sample_rate=250.0)
+    >>> d = load_diagram(folder)
+    >>> d.synthetic, len(d.analyses), d.files
+    (True, 2, ('theta40_0.442759Hz.csv', 'theta40_0.459234Hz.csv'))
     """
 
     theta_hat_deg: float | None
@@ -124,6 +139,11 @@ def load_diagram(
     progress
         Called as ``progress(done, total)``.
 
+    Returns
+    -------
+    ExperimentDiagram
+        One analysis per recording, in increasing forcing frequency.
+
     Examples
     --------
     >>> import tempfile
@@ -184,6 +204,28 @@ def model_sweep(
 
     A thin wrapper of :func:`grazing.sweeps.sweep` (increasing ``eta``,
     continuation from point to point, as the rig is swept).
+
+    Parameters
+    ----------
+    theta_hat_deg
+        Stop angle in degrees.
+    etas
+        The forcing frequencies.
+    case
+        The pendulum's parameter case (``None``: the model's defaults).
+    periods, transient
+        Forcing periods sampled, and run before, at each ``eta``.
+    workers
+        Local threads (default: all cores).
+    progress
+        Called as ``progress(done, total)``.
+    **params
+        Other parameter values of the pendulum (``alpha``, ``beta``, ``r``).
+
+    Returns
+    -------
+    xarray.Dataset
+        As :func:`grazing.sweeps.sweep` returns.
 
     Examples
     --------

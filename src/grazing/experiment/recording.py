@@ -61,7 +61,16 @@ _HZ_IN_NAME = re.compile(r"(\d+(?:[.p]\d+)?)\s*hz", re.IGNORECASE)
 
 
 class RecordingError(GrazingError, ValueError):
-    """A recording cannot be used as it is (a one-line message names the file and the problem)."""
+    """A recording cannot be used as it is (a one-line message names the file and the problem).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from_arrays(np.array([0.0, 1.0, 0.5]), np.zeros(3))
+    Traceback (most recent call last):
+    ...
+    grazing.experiment.recording.RecordingError: <memory>: only 3 samples; a recording needs at least 16
+    """
 
 
 @dataclass(frozen=True)
@@ -86,6 +95,15 @@ class Recording:
         ``(t_start, t_end)`` of every run of missing samples.
     metadata
         The sidecar JSON (empty if none).
+
+    Examples
+    --------
+    >>> from grazing.experiment.synthetic import synthetic_recording
+    >>> rec = synthetic_recording(0.446, 40.0, periods=40, sample_rate=250.0, seed=2)
+    >>> round(rec.sample_rate, 6), rec.time.size, rec.trigger_times is not None, rec.resampled, rec.gaps
+    (250.0, 21776, True, False, ())
+    >>> rec.metadata["synthetic"], rec.metadata["eta"]
+    (True, 0.446)
     """
 
     time: np.ndarray
@@ -141,6 +159,11 @@ def from_arrays(
         Optional 0/1 trigger column, one value per sample.
     source, metadata
         Name used in messages, and extra information to keep.
+
+    Returns
+    -------
+    Recording
+        The record, uniform in time.
 
     Examples
     --------
@@ -270,6 +293,11 @@ def load_recording(path: str | Path, *, degrees: bool = False) -> Recording:
     degrees
         The angle column is in degrees (converted to radians).
 
+    Returns
+    -------
+    Recording
+        The record, with its sidecar's metadata.
+
     Raises
     ------
     RecordingError
@@ -395,6 +423,16 @@ class ForcingClock:
         Times (s) of the reference phase within the record.
     from_trigger
         True when measured from the trigger column.
+
+    Examples
+    --------
+    A synthetic recording of the rig at η = 0.446 (0.4592 Hz), with its trigger column:
+
+    >>> from grazing.experiment.synthetic import synthetic_recording
+    >>> rec = synthetic_recording(0.446, 40.0, periods=40, sample_rate=250.0, seed=2)
+    >>> clock = forcing_clock(rec)
+    >>> round(clock.forcing_hz, 4), clock.from_trigger, clock.reference_times[:2].round(4).tolist()
+    (0.4592, True, [0.0, 2.1776])
     """
 
     forcing_hz: float
@@ -430,6 +468,11 @@ def forcing_clock(
         trigger column, it must agree with the pulses to 2 %.
     min_periods
         The record must span at least this many forcing periods.
+
+    Returns
+    -------
+    ForcingClock
+        The forcing frequency and the times of its reference phase.
 
     Examples
     --------

@@ -205,6 +205,35 @@ def synthetic_free_decay(
 ) -> Recording:
     """A synthetic recording of the rig's damping test: free decay against the stop at equilibrium.
 
+    Parameters
+    ----------
+    r
+        Restitution, in (0, 1].
+    beta
+        Linear damping.
+    amplitude
+        Release angle below the stop, in radians.
+    duration
+        Length of the record in seconds.
+    sample_rate
+        Samples per second.
+    noise
+        Standard deviation of the white measurement noise, in radians.
+    quantum
+        The quantisation step of the angle (a 12-bit converter over one turn by default), in radians
+        (0: none).
+    drift
+        A slow drift of the angle's zero over the record, in radians.
+    seed
+        Seed of the noise.
+    apparatus
+        The rig (converts the model's time to seconds).
+
+    Returns
+    -------
+    Recording
+        The record (no trigger column), marked synthetic in its metadata.
+
     Examples
     --------
     >>> rec = synthetic_free_decay(0.7148, 0.0426, duration=5.0)
@@ -251,6 +280,26 @@ def write_recording(
     (:class:`~grazing.errors.ForeignFileError`) unless ``overwrite``.  Both are
     written through temporaries and renamed together at the end, so a failure
     leaves nothing half-written.
+
+    Parameters
+    ----------
+    rec
+        The recording.
+    path
+        Where the CSV file goes (the sidecar beside it, ``.json``).
+    trigger
+        Write the trigger column (from :attr:`Recording.trigger_times`).
+    sidecar
+        Write the metadata's sidecar.
+    overwrite
+        Replace files that grazing did not write.
+    hint
+        How a refusal's message ends.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
 
     Examples
     --------
@@ -335,6 +384,11 @@ def synthetic_sweep(
         for every file before any work; see :func:`write_recording`).
     **kwargs
         Further :func:`synthetic_recording` arguments.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The recordings written (with their sidecars), in the order of ``etas``.
 
     Examples
     --------

@@ -52,7 +52,40 @@ __all__ = [
 
 
 def explorer(model: Any, ranges: dict[str, tuple[float, float]] | None = None, **kwargs: Any) -> Any:
-    """The explorer of ``model`` as a Panel component (display it in Jupyter; see :func:`.app.explorer`)."""
+    """The explorer of ``model`` as a Panel component (display it in Jupyter; see :func:`.app.explorer`).
+
+    Parameters
+    ----------
+    model
+        A :class:`~grazing.HybridModel`, its other parameters set.
+    ranges
+        ``{name: (lo, hi)}`` in display units (degrees for angles): one parameter
+        (a bifurcation diagram) or two (a period map); default for the pendulum
+        ``{"eta": (0.44, 0.49)}``.
+    **kwargs
+        ``num`` (points per parameter), ``component`` (the state on the
+        vertical axis) and ``source`` (the model as ``--model`` takes it).
+
+    Returns
+    -------
+    panel.layout.Column
+        The page, computing its diagram in the background (needs the
+        ``explore`` extra: Panel and Bokeh).
+
+    Examples
+    --------
+    In a notebook, ``pn.extension()`` first, then the component as a cell's value:
+
+    >>> import math, grazing
+    >>> model = grazing.models.pendulum("B", theta_hat=math.radians(40))
+    >>> page = explorer(model, {"eta": (0.44, 0.46)}, num=5)
+    >>> type(page).__name__
+    'Column'
+    >>> explorer(grazing.models.bouncing_ball())
+    Traceback (most recent call last):
+    ...
+    grazing.errors.GrazingError: give the ranges explored: {name: (lo, hi)}
+    """
     from grazing.explore.app import explorer as make
 
     return make(model, ranges, **kwargs)

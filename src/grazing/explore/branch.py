@@ -81,7 +81,33 @@ class BranchPiece:
 
 @dataclass(frozen=True)
 class Continued:
-    """The clicked orbit continued both ways: pieces (one per direction), special points, summary."""
+    """The clicked orbit continued both ways: pieces (one per direction), special points, summary.
+
+    Parameters
+    ----------
+    param
+        The parameter continued (the view's first).
+    pieces
+        The branch towards each end of the range.
+    marks
+        The special points met, for the diagram.
+    lines
+        The summary, one line per direction and per special point.
+
+    Examples
+    --------
+    The paper's period-5 orbit at θ̂ = 40°, η = 0.446, continued over the
+    view's range (:func:`continue_click`):
+
+    >>> import math, grazing
+    >>> from grazing.explore import View, compute_diagram, inspect_click
+    >>> m = grazing.models.pendulum("B", theta_hat=math.radians(40))
+    >>> view = View.of(m, {"eta": (0.44, 0.46)}, num=5)
+    >>> point = inspect_click(compute_diagram(view, workers=1), [0.446])
+    >>> c = continue_click(view, point)
+    >>> c.param, len(c.pieces), [mark.kind for mark in c.marks]
+    ('eta', 2, ['period-doubling', 'grazing', 'grazing'])
+    """
 
     param: str
     pieces: tuple[BranchPiece, ...]
@@ -101,10 +127,35 @@ def _special_text(view: View, kind: str, value: float, mu: np.ndarray, note: str
 def continue_click(view: View, point: PointReport, *, cancelled: IsCancelled | None = None) -> Continued:
     """Continue the orbit of ``point`` in the view's first parameter, both ways to the ends of its range.
 
+    Parameters
+    ----------
+    view
+        The view (its first parameter and range).
+    point
+        The clicked point (:func:`~grazing.explore.inspect_click`), with its orbit.
+    cancelled
+        Looked at between the steps: when it returns True, :class:`SupersededError` is raised.
+
+    Returns
+    -------
+    Continued
+        The branch both ways, its special points and a summary.
+
     Raises
     ------
     InvalidParameterError
         The point has no orbit (:attr:`PointReport.message` says why).
+
+    Examples
+    --------
+    >>> import math, grazing
+    >>> from grazing.explore import View, compute_diagram, inspect_click
+    >>> m = grazing.models.pendulum("B", theta_hat=math.radians(40))
+    >>> view = View.of(m, {"eta": (0.44, 0.46)}, num=5)
+    >>> point = inspect_click(compute_diagram(view, workers=1), [0.446])
+    >>> c = continue_click(view, point)
+    >>> [round(mark.value, 6) for mark in c.marks]  # period-doubling, and a grazing each way
+    [0.445393, 0.445121, 0.44635]
     """
     if point.orbit is None:
         raise InvalidParameterError(f"no orbit to continue: {point.message}")
@@ -151,7 +202,30 @@ def continue_click(view: View, point: PointReport, *, cancelled: IsCancelled | N
 @dataclass(frozen=True)
 class Grazings:
     """The grazings of the nonimpacting orbit in the view's range: marks and one line each; where they
-    were sought (the parameter, its range, the other explored parameter's value held: ``fixed``)."""
+    were sought (the parameter, its range, the other explored parameter's value held: ``fixed``).
+
+    Parameters
+    ----------
+    param
+        The parameter of the range.
+    marks
+        The grazings, for the diagram.
+    lines
+        One line per grazing.
+    range
+        Where they were sought.
+    fixed
+        The other explored parameter's value held (a period map), else empty.
+
+    Examples
+    --------
+    >>> import math, grazing
+    >>> from grazing.explore import View, grazings_in_view
+    >>> view = View.of(grazing.models.pendulum("B", theta_hat=math.radians(40)), {"eta": (0.44, 0.46)})
+    >>> g = grazings_in_view(view)
+    >>> g.param, g.range, [round(mark.value, 6) for mark in g.marks]
+    ('eta', (0.44, 0.46), [0.445121])
+    """
 
     param: str
     marks: tuple[Mark, ...]
@@ -175,6 +249,32 @@ def grazings_in_view(
     ``fixed``: the other explored parameter's value (a period map: the clicked row).
     The orbit is followed with the stops ignored from the range's start (its guess:
     a simulation from rest with the stops ignored), through folds.
+
+    Parameters
+    ----------
+    view
+        The view (its first parameter and range).
+    fixed
+        The other explored parameter's value, by name (a period map).
+    period
+        Period of the nonimpacting orbit, in forcing periods.
+    cancelled
+        Looked at between the steps: when it returns True, :class:`SupersededError` is raised.
+
+    Returns
+    -------
+    Grazings
+        Every stop's grazings in the range, with one line each.
+
+    Examples
+    --------
+    The paper's first grazing at θ̂ = 40° is the only one in η in [0.44, 0.46]:
+
+    >>> import math, grazing
+    >>> from grazing.explore import View
+    >>> view = View.of(grazing.models.pendulum("B", theta_hat=math.radians(40)), {"eta": (0.44, 0.46)})
+    >>> print(grazings_in_view(view).summary())
+    grazing at eta = 0.44512118, multipliers +0.4612+0.2127i, +0.4612-0.2127i (stop stop)
     """
     axis = view.axes[0]
     model = view.model.with_params(**(fixed or {}))
@@ -219,7 +319,31 @@ class CurveView:
 
 @dataclass(frozen=True)
 class Curves:
-    """The bifurcation curves through the special points of a continued orbit, and one line each."""
+    """The bifurcation curves through the special points of a continued orbit, and one line each.
+
+    Parameters
+    ----------
+    curves
+        The curves followed (their kind, both parameters' values, the stop of a grazing curve).
+    lines
+        One line per curve.
+    view
+        The map they were followed over (for "copy as code").
+
+    Examples
+    --------
+    On a period map, the curves through the special points of the period-5
+    orbit's branch (:func:`follow_click_curves`):
+
+    >>> import math, grazing
+    >>> from grazing.explore import View, compute_diagram, continue_click, inspect_click
+    >>> m = grazing.models.pendulum("B", theta_hat=math.radians(40))
+    >>> view = View.of(m, {"eta": (0.44, 0.46), "theta_hat": (38, 42)}, num=3)
+    >>> point = inspect_click(compute_diagram(view, workers=1), [0.446, math.radians(40)])
+    >>> curves = follow_click_curves(view, point, continue_click(view, point))
+    >>> [c.kind for c in curves.curves]
+    ['period-doubling', 'grazing', 'grazing']
+    """
 
     curves: tuple[CurveView, ...]
     lines: tuple[str, ...]
@@ -232,10 +356,38 @@ def follow_click_curves(
     """Follow each special point of the clicked orbit's branch (the first of each kind, each way) in
     the map's two parameters over the map's range (:func:`grazing.orbits.follow_curve`).
 
+    Parameters
+    ----------
+    view
+        A period map (two parameters).
+    point
+        The clicked point, with its orbit.
+    continued
+        Its branch (:func:`continue_click`).
+    cancelled
+        Looked at between the curves: when it returns True, :class:`SupersededError` is raised.
+
+    Returns
+    -------
+    Curves
+        The curves followed and one line each.
+
     Raises
     ------
     InvalidParameterError
         A view with one parameter (a curve needs two), or a point without an orbit.
+
+    Examples
+    --------
+    >>> import math, grazing
+    >>> from grazing.explore import View, compute_diagram, continue_click, inspect_click
+    >>> m = grazing.models.pendulum("B", theta_hat=math.radians(40))
+    >>> view = View.of(m, {"eta": (0.44, 0.46), "theta_hat": (38, 42)}, num=3)
+    >>> point = inspect_click(compute_diagram(view, workers=1), [0.446, math.radians(40)])
+    >>> curves = follow_click_curves(view, point, continue_click(view, point))
+    >>> print(curves.lines[0])  # doctest: +NORMALIZE_WHITESPACE
+    period-doubling curve from eta = 0.44539259: 10 points; at the first point: reached the bound
+    theta_hat = 38 deg; at the last point: reached the bound theta_hat = 42 deg
     """
     from grazing.orbits.curves import follow_curve
 

@@ -29,7 +29,28 @@ __all__ = ["Code", "view_code"]
 
 @dataclass(frozen=True)
 class Code:
-    """The view as Python (one script that prints what the page shows) and as command lines."""
+    """The view as Python (one script that prints what the page shows) and as command lines.
+
+    Parameters
+    ----------
+    python
+        The Python script.
+    cli
+        The command lines, one per line.
+
+    Examples
+    --------
+    What :func:`view_code` writes:
+
+    >>> import math, grazing
+    >>> from grazing.explore import View, compute_diagram, inspect_click
+    >>> m = grazing.models.pendulum("B", theta_hat=math.radians(40))
+    >>> view = View.of(m, {"eta": (0.44, 0.46)}, num=5)
+    >>> point = inspect_click(compute_diagram(view, workers=1), [0.446])
+    >>> code = view_code(view, point)
+    >>> code.cli.splitlines()[0].split(" --set")[0], "find_orbit(point" in code.python
+    ('grazing sweep --model pendulum', True)
+    """
 
     python: str
     cli: str
@@ -68,6 +89,43 @@ def view_code(
     grazings, ``grazings [VALUE, ...]``; for each curve, ``curve KIND POINTS STATUS``.
     Command lines need a model given by ``--model`` (a built-in name or a file): for a
     model object given in Python, :attr:`Code.cli` says so instead.
+
+    Parameters
+    ----------
+    view
+        The diagram or map.
+    point
+        The clicked point, if any.
+    continued
+        Add the continuation of its orbit.
+    basins
+        The basins found at the point, if any.
+    grazings
+        The grazings sought over the range, if any.
+    curves
+        The bifurcation curves followed from the point, if any.
+
+    Returns
+    -------
+    Code
+        The Python script and the command lines.
+
+    Examples
+    --------
+    The script runs as it is, and prints what the page shows:
+
+    >>> import math, grazing
+    >>> from grazing.explore import View, compute_diagram, inspect_click
+    >>> m = grazing.models.pendulum("B", theta_hat=math.radians(40))
+    >>> view = View.of(m, {"eta": (0.44, 0.46)}, num=5)
+    >>> point = inspect_click(compute_diagram(view, workers=1), [0.446])
+    >>> code = view_code(view, point)
+    >>> import contextlib, io
+    >>> out = io.StringIO()
+    >>> with contextlib.redirect_stdout(out):
+    ...     exec(code.python, {})
+    >>> out.getvalue().splitlines()[0]
+    'period 5 impacts 1.0'
     """
     orbits = ["continue_orbit", "find_orbit"] if point is not None else []
     orbits += ["find_grazings"] if grazings is not None else []

@@ -43,7 +43,19 @@ periods, one carried chain), without the Lyapunov exponents (not shown), in chun
 
 
 class SupersededError(GrazingError):
-    """A computation stopped because a newer request of the page replaced it."""
+    """A computation stopped because a newer request of the page replaced it.
+
+    Examples
+    --------
+    A computation whose ``cancelled()`` says so stops at its next checkpoint:
+
+    >>> import math, grazing
+    >>> view = View.of(grazing.models.pendulum("B"), {"eta": (0.44, 0.46)}, num=5)
+    >>> compute_diagram(view, workers=1, cancelled=lambda: True)
+    Traceback (most recent call last):
+    ...
+    grazing.explore.diagram.SupersededError: replaced by a newer request
+    """
 
 
 DiagramProgress = Callable[[int, int], None]
@@ -84,6 +96,15 @@ def check_display(par: Parameter, value: float) -> None:
 @dataclass(frozen=True)
 class Axis:
     """One explored parameter and the range of its diagram, in the model's units.
+
+    Parameters
+    ----------
+    name
+        The parameter's name.
+    lo, hi
+        Its range, in the model's units (radians for angles).
+    num
+        Values computed over the range.
 
     Examples
     --------
@@ -128,6 +149,19 @@ class View:
     InvalidParameterError
         An unknown or repeated parameter, an empty range, a range end outside the
         parameter's interval, fewer than 2 points.
+
+    Examples
+    --------
+    :meth:`View.of` takes the ranges in display units (degrees for angles):
+
+    >>> import math, grazing
+    >>> view = View.of(grazing.models.pendulum("B"), {"eta": (0.44, 0.46), "theta_hat": (38, 42)}, num=3)
+    >>> view.names, [round(math.degrees(v), 6) for v in view.axes[1].values()]
+    (('eta', 'theta_hat'), [38.0, 40.0, 42.0])
+    >>> View.of(grazing.models.pendulum("B"), {"eta": (0.46, 0.44)})  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    grazing.errors.InvalidParameterError: the range of eta must be finite and increasing, got ...
     """
 
     model: HybridModel
@@ -217,6 +251,16 @@ class Diagram:
         One parameter: the stroboscopic samples, ``(n, periods, n_states)``; else None.
     elapsed
         Seconds it took.
+
+    Examples
+    --------
+    >>> import math, grazing
+    >>> m = grazing.models.pendulum("B", theta_hat=math.radians(40))
+    >>> d = compute_diagram(View.of(m, {"eta": (0.44, 0.45)}, num=5), workers=1)
+    >>> d.values[0].tolist(), d.period.tolist(), d.samples.shape
+    ([0.44, 0.4425, 0.445, 0.4475, 0.45], [1, 1, 1, 4, 0], (5, 100, 2))
+    >>> d.nearest([0.4474])
+    (3,)
     """
 
     view: View
@@ -281,6 +325,11 @@ def compute_diagram(
         :class:`SupersededError` is raised.
     workers
         Local threads (default: all cores).
+
+    Returns
+    -------
+    Diagram
+        Each point's period, impacts per period, status and final state.
 
     Examples
     --------

@@ -43,6 +43,15 @@ class InspectSettings:
         Points per forcing period of the dense trajectory shown.
     shown_periods
         Forcing periods shown of a motion without a period.
+
+    Examples
+    --------
+    >>> InspectSettings()
+    InspectSettings(transient=200, periods=128, points_per_period=200, shown_periods=20)
+    >>> import math, grazing
+    >>> m = grazing.models.pendulum("B", theta_hat=math.radians(40))
+    >>> inspect_point(m, {"eta": 0.446}, [0.0, 0.0], settings=InspectSettings(transient=500)).period
+    5
     """
 
     transient: int = 200
@@ -85,6 +94,25 @@ class PointReport:
         the forcing period), or None.
     message
         Why there is no orbit (no period, Newton's method failed), else "".
+    impacts_by_stop
+        Impacts per period on each stop, by name.
+    shown_periods
+        Forcing periods of the trajectory shown (the period, or
+        :attr:`InspectSettings.shown_periods` without one).
+    settings
+        How the point was simulated.
+
+    Examples
+    --------
+    >>> import math, grazing
+    >>> from grazing.explore import View, compute_diagram, inspect_click
+    >>> m = grazing.models.pendulum("B", theta_hat=math.radians(40))
+    >>> view = View.of(m, {"eta": (0.44, 0.46)}, num=5)
+    >>> point = inspect_click(compute_diagram(view, workers=1), [0.446])
+    >>> point.period, point.impacts_per_period, point.impacts_by_stop, point.shown_periods
+    (5, 1.0, {'stop': 1.0, 'back': 0.0}, 5)
+    >>> point.orbit.period, point.message, point.trajectory.shape[1]
+    (5, '', 2)
     """
 
     values: dict[str, float]
@@ -151,6 +179,24 @@ def inspect_point(
     cancelled: IsCancelled | None = None,
 ) -> PointReport:
     """Simulate ``model`` at the parameters ``values`` from ``x0``; its period, impacts and orbit.
+
+    Parameters
+    ----------
+    model
+        The model.
+    values
+        The explored parameters' values at the point (model units), by name.
+    x0
+        The state the simulation starts from, at time 0.
+    settings
+        How the point is simulated.
+    cancelled
+        Looked at between the steps.
+
+    Returns
+    -------
+    PointReport
+        The point's period, impacts, trajectory and periodic orbit.
 
     Raises
     ------
@@ -221,10 +267,39 @@ def inspect_click(
     The simulation starts from the state the diagram reached at the nearest
     point, so it shows the attractor the diagram shows there.
 
+    Parameters
+    ----------
+    diagram
+        The computed diagram (:func:`~grazing.explore.compute_diagram`).
+    values
+        The point clicked, one value per explored parameter (model units).
+    settings
+        How the point is simulated.
+    cancelled
+        Looked at between the steps.
+
+    Returns
+    -------
+    PointReport
+        As :func:`inspect_point`.
+
     Raises
     ------
     InvalidParameterError
         A point outside the computed range, or a value outside a parameter's interval.
+
+    Examples
+    --------
+    >>> import math, grazing
+    >>> from grazing.explore import View, compute_diagram
+    >>> m = grazing.models.pendulum("B", theta_hat=math.radians(40))
+    >>> d = compute_diagram(View.of(m, {"eta": (0.44, 0.46)}, num=5), workers=1)
+    >>> inspect_click(d, [0.446]).period
+    5
+    >>> inspect_click(d, [0.47])  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    grazing.errors.InvalidParameterError: eta = 0.47 is outside the computed range ...
     """
     view: View = diagram.view
     if len(values) != len(view.axes):

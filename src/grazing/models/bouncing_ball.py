@@ -64,6 +64,19 @@ def _base() -> HybridModel:
 def bouncing_ball(**values: float) -> HybridModel:
     """The bouncing ball with parameter overrides.
 
+    Parameters
+    ----------
+    **values
+        Parameter values by name, each replacing its default: ``amplitude`` (table amplitude,
+        default 0.1), ``omega`` (table frequency, default 1), ``gravity`` (gravitational
+        acceleration, default 1), ``r`` (coefficient of restitution, default 0.5).
+
+    Returns
+    -------
+    HybridModel
+        The model with those values (its kernels are compiled once and
+        cached, whatever the values).
+
     Examples
     --------
     >>> bouncing_ball(amplitude=0.0).params["amplitude"]

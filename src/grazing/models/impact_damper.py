@@ -79,6 +79,22 @@ def _base() -> HybridModel:
 def impact_damper(**values: float) -> HybridModel:
     """The impact damper with parameter overrides.
 
+    Parameters
+    ----------
+    **values
+        Parameter values by name, each replacing its default: ``zeta`` (damping ratio of the
+        primary mass, default 0.05), ``amp`` (forcing amplitude, default 1), ``omega`` (forcing
+        frequency, default 1.2), ``mu`` (mass ratio m2/m1, default 0.1), ``gap`` (half-width of
+        the cavity, default 2), ``r`` (coefficient of restitution, default 0.6), ``omega2``
+        (natural frequency of the secondary mass, default 0), ``zeta2`` (damping ratio of the
+        secondary mass, default 0.05).
+
+    Returns
+    -------
+    HybridModel
+        The model with those values (its kernels are compiled once and
+        cached, whatever the values).
+
     Examples
     --------
     >>> m = impact_damper(mu=0.2)

@@ -56,6 +56,19 @@ def _base() -> HybridModel:
 def impact_oscillator(**values: float) -> HybridModel:
     """The linear impact oscillator with parameter overrides.
 
+    Parameters
+    ----------
+    **values
+        Parameter values by name, each replacing its default: ``zeta`` (damping ratio, default
+        0.05), ``omega`` (forcing frequency, default 2.8), ``sigma`` (stop position, default
+        0.1), ``r`` (coefficient of restitution, default 0.8).
+
+    Returns
+    -------
+    HybridModel
+        The model with those values (its kernels are compiled once and
+        cached, whatever the values).
+
     Examples
     --------
     >>> impact_oscillator(sigma=0.0).params["sigma"]

@@ -64,6 +64,17 @@ DEFAULT_CASE = "B"
 def case_values(name: str) -> dict[str, float]:
     """Parameter values ``{r, beta, alpha}`` of a named case (case-insensitive).
 
+    Parameters
+    ----------
+    name
+        One of the paper's cases: ``A``, ``B``, ``C``, ``D``, ``A-reduced``
+        (:data:`CASES`).
+
+    Returns
+    -------
+    dict of str to float
+        The case's restitution ``r``, damping ``beta`` and forcing amplitude ``alpha``.
+
     Examples
     --------
     >>> case_values("b")
@@ -142,7 +153,14 @@ def pendulum(case: str | None = DEFAULT_CASE, **values: float) -> HybridModel:
         One of ``A``, ``B`` (default), ``C``, ``D``, ``A-reduced`` (sets r,
         beta, alpha), or ``None`` for the defaults.
     **values
-        Any of ``alpha``, ``beta``, ``eta``, ``r``, ``theta_hat`` (radians).
+        Any of ``alpha``, ``beta``, ``eta``, ``r``, ``theta_hat`` (radians),
+        replacing the case's value.
+
+    Returns
+    -------
+    HybridModel
+        The pendulum of the paper's eqs. 4-5, with its stop at ``theta_hat``
+        and the stop's back face at ``theta_hat - 2 pi``.
 
     Examples
     --------
@@ -150,6 +168,12 @@ def pendulum(case: str | None = DEFAULT_CASE, **values: float) -> HybridModel:
     >>> m = pendulum("B", eta=0.446, theta_hat=math.radians(40))
     >>> round(m.params["r"], 4), m.period == 2 * math.pi
     (0.7675, True)
+    >>> m.stop_names
+    ('stop', 'back')
+    >>> pendulum("B", r=2.0)
+    Traceback (most recent call last):
+    ...
+    grazing.errors.InvalidParameterError: r = 2 is outside [0, 1] (coefficient of restitution)
     """
     vals = case_values(case) if case is not None else {}
     vals.update(values)

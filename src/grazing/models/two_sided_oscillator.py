@@ -66,6 +66,20 @@ def _base() -> HybridModel:
 def two_sided_oscillator(**values: float) -> HybridModel:
     """The two-sided impact oscillator with parameter overrides.
 
+    Parameters
+    ----------
+    **values
+        Parameter values by name, each replacing its default: ``zeta`` (damping ratio, default
+        0.05), ``amp`` (forcing amplitude, default 1), ``omega`` (forcing frequency, default
+        0.8), ``gap_left`` (distance to the left stop, default 1), ``gap_right`` (distance to
+        the right stop, default 1), ``r`` (coefficient of restitution, default 0.8).
+
+    Returns
+    -------
+    HybridModel
+        The model with those values (its kernels are compiled once and
+        cached, whatever the values).
+
     Examples
     --------
     >>> m = two_sided_oscillator(omega=0.5)

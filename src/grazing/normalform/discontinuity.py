@@ -56,7 +56,33 @@ def no_contact_direction(model: HybridModel, stop: int = 0) -> str:
 
 
 def zdm_direction(model: HybridModel, x: np.ndarray, t: float, stop: int = 0) -> np.ndarray:
-    """``stop``'s reset jump per unit approach speed at ``x``: ``e = (g_x - I) c / (grad(L_f h) @ c)``."""
+    """``stop``'s reset jump per unit approach speed at ``x``: ``e = (g_x - I) c / (grad(L_f h) @ c)``.
+
+    Parameters
+    ----------
+    model
+        The model (its stop needs a contact direction).
+    x
+        The state (a grazing contact).
+    t
+        The time.
+    stop
+        Index of the stop.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``e``, one entry per state component.
+
+    Examples
+    --------
+    For the pendulum, whose reset is ``theta' <- -r theta'``, ``e = (0, 1 + r)``:
+
+    >>> import math, grazing
+    >>> m = grazing.models.pendulum("B", theta_hat=math.radians(40))
+    >>> zdm_direction(m, [math.radians(40), 0.0], 0.0).tolist() == [0.0, 1 + m.params["r"]]
+    True
+    """
     _, _, gx = model.jacobians(x, t, stop)
     c = np.zeros(model.n_states)
     model.kernels().contact_dir(np.asarray(x, dtype=float), float(t), model.param_vector, c, stop)
@@ -89,6 +115,24 @@ class GrazingNormalForm:
         For each parameter name: ``(b, h_p, rate_p)``: the unfolding vector
         ``dP/dp`` at the contact and the explicit parameter derivatives of ``h``
         and ``L_f h``.
+
+    Examples
+    --------
+    At the paper's first grazing at θ̂ = 40° (:func:`normal_form_at` builds it):
+
+    >>> import math, numpy as np, grazing
+    >>> from grazing.normalform import find_grazing_point, normal_form_at
+    >>> g = find_grazing_point(grazing.models.pendulum("B", theta_hat=math.radians(40)), "eta", 0.40, 0.47)
+    >>> nf = normal_form_at(g, ("eta",))
+    >>> round(nf.accel, 4), round(nf.kappa, 3), bool(nf.kappa > 0)
+    (0.6892, 0.28, True)
+
+    On the stop, the zero-time discontinuity map is the restitution law (a
+    state reaching the stop at speed 0.01 leaves at ``-r`` times it):
+
+    >>> x = nf.contact + np.array([0.0, 0.01])
+    >>> bool(np.allclose(nf.zdm(x), [nf.contact[0], -nf.model.params["r"] * 0.01]))
+    True
     """
 
     point: GrazingPoint
@@ -163,6 +207,18 @@ class GrazingNormalForm:
 def normal_form_at(point: GrazingPoint, params: tuple[str, ...]) -> GrazingNormalForm:
     """Build the normal form of a grazing point, with unfolding vectors for the parameters ``params``.
 
+    Parameters
+    ----------
+    point
+        The grazing orbit (:func:`find_grazing_point`, :func:`~grazing.orbits.find_grazings`).
+    params
+        The unfolding parameters (the derivatives of the map with respect to them are computed).
+
+    Returns
+    -------
+    GrazingNormalForm
+        The map's ingredients at the point.
+
     Examples
     --------
     >>> import math, grazing
@@ -212,6 +268,36 @@ def find_grazing_point(
     :func:`~grazing.orbits.grazing.find_grazings`).
 
     Raises :class:`~grazing.errors.ConvergenceError` (one clear line) if there is none.
+
+    Parameters
+    ----------
+    model
+        The model, with the values of the other parameters.
+    param
+        The parameter searched.
+    lo, hi
+        Its interval.
+    which
+        ``"first"`` or ``"second"`` grazing in increasing ``param``.
+    stop_name
+        The stop grazed (name or index; the first by default).
+    x0
+        A guess of the nonimpacting orbit (see above).
+
+    Returns
+    -------
+    GrazingPoint
+        The grazing orbit.
+
+    Examples
+    --------
+    The paper's two grazings at θ̂ = 40° (case B):
+
+    >>> import math, grazing
+    >>> m = grazing.models.pendulum("B", theta_hat=math.radians(40))
+    >>> [round(find_grazing_point(m, "eta", 0.40, 0.60, which).model.params["eta"], 4)
+    ...  for which in ("first", "second")]
+    [0.4451, 0.5473]
     """
     from grazing.errors import ConvergenceError, InvalidParameterError
     from grazing.orbits.grazing import find_grazings

@@ -75,6 +75,22 @@ class Prediction:
         the orbit impact.
     windows
         From the 2-D iteration: ``(mu, period)`` pairs (period 0: aperiodic).
+
+    Examples
+    --------
+    At the paper's first grazing at θ̂ = 40°: complex multipliers of modulus
+    0.508, so no one-line rule; the 2-D normal form iterated past the grazing
+    shows windows of period 7, 6, 5 ... separated by chaos (the paper's fig. 10):
+
+    >>> import math, numpy as np, grazing
+    >>> from grazing.normalform import find_grazing_point, normal_form_at
+    >>> g = find_grazing_point(grazing.models.pendulum("B", theta_hat=math.radians(40)), "eta", 0.40, 0.47)
+    >>> nf = normal_form_at(g, ("eta",))
+    >>> p = predict(nf)
+    >>> p.scenario, p.rule, round(p.abs_lambda, 4), p.side
+    ('period-adding cascade with chaotic bands', '2-D normal form iteration', 0.5079, 1.0)
+    >>> p.windows[0]  # (distance past the grazing, period)
+    (1e-06, 7)
     """
 
     scenario: str
@@ -196,6 +212,23 @@ def predict(nf: GrazingNormalForm, param: str | None = None, mu_range: tuple[flo
 
     ``param`` is one of the normal form's unfolding parameters (default: the first).
 
+    Parameters
+    ----------
+    nf
+        The normal form at the grazing point (:func:`~grazing.normalform.normal_form_at`).
+    param
+        The unfolding parameter varied.
+    mu_range
+        Distances past the grazing (in ``param``) at which the 2-D normal form
+        is iterated, where no one-line rule decides.
+    points
+        Number of distances, spaced logarithmically.
+
+    Returns
+    -------
+    Prediction
+        The scenario, the rule that decided it and the numbers it used.
+
     Examples
     --------
     >>> import math, grazing
@@ -255,10 +288,27 @@ def predicted_windows(lam: float, n_max: int = 12) -> list[tuple[int, float, flo
     and neighbours overlap iff ``lambda < 1/4``; a few low-period windows
     survive above 2/3.
 
+    Parameters
+    ----------
+    lam
+        The multiplier ``lambda`` of the 1-D map, in (0, 1).
+    n_max
+        The longest period considered.
+
+    Returns
+    -------
+    list of (int, float, float)
+        ``(n, lower, upper)``: each period-n window's interval of ``mu_hat``.
+
     Examples
     --------
     >>> [n for n, lo, hi in predicted_windows(0.5, 6)]
     [2, 3, 4, 5, 6]
+
+    Above 2/3 only a few low-period windows are left (robust chaos between them):
+
+    >>> [n for n, lo, hi in predicted_windows(0.8, 12)]
+    [2, 3, 4]
     """
     out = []
     for n in range(2, n_max + 1):
@@ -271,7 +321,36 @@ def predicted_windows(lam: float, n_max: int = 12) -> list[tuple[int, float, flo
 
 @dataclass(frozen=True)
 class Observation:
-    """What direct simulation of the impacting system shows just past a grazing point."""
+    """What direct simulation of the impacting system shows just past a grazing point (:func:`observe`).
+
+    Parameters
+    ----------
+    scenario
+        The scenario named from the runs (as :class:`Prediction`'s).
+    offsets
+        The distances ``mu`` past the grazing that were simulated.
+    periods
+        The period of each run's attractor (0: aperiodic).
+    sizes
+        Each attractor's largest distance from the grazing orbit.
+    impacting
+        Whether each attractor impacts.
+
+    Examples
+    --------
+    Simulated past the paper's first grazing at θ̂ = 40°: the period-adding
+    cascade of fig. 10, periods 7, 6, 5, 4 with chaos between:
+
+    >>> import math, numpy as np, grazing
+    >>> from grazing.normalform import find_grazing_point, normal_form_at
+    >>> g = find_grazing_point(grazing.models.pendulum("B", theta_hat=math.radians(40)), "eta", 0.40, 0.47)
+    >>> nf = normal_form_at(g, ("eta",))
+    >>> obs = observe(nf)
+    >>> obs.scenario, obs.periods[::3]
+    ('period-adding cascade with chaotic bands', [7, 7, 7, 7, 6, 6, 5, 0])
+    >>> all(obs.impacting), len(obs.offsets)
+    (True, 24)
+    """
 
     scenario: str
     offsets: list[float]
@@ -289,6 +368,35 @@ def observe(nf: GrazingNormalForm, param: str | None = None, mu_range: tuple[flo
     Every run starts from the grazing orbit (on the section through the
     contact), so that the attractor reached is the one born at grazing; the
     attractor's size is its largest distance from the grazing orbit.
+
+    Parameters
+    ----------
+    nf
+        The normal form at the grazing point.
+    param
+        The unfolding parameter varied.
+    mu_range
+        Distances past the grazing (in ``param``) simulated.
+    points
+        Number of distances, spaced logarithmically.
+    transient, periods
+        Forcing periods run before sampling, and sampled, at each distance.
+
+    Returns
+    -------
+    Observation
+        The scenario and each run's period, size and impacts.
+
+    Examples
+    --------
+    Fewer, shorter runs than the default, past the paper's first grazing at
+    θ̂ = 40°: the windows' periods fall as the distance grows:
+
+    >>> import math, grazing
+    >>> from grazing.normalform import find_grazing_point, normal_form_at
+    >>> g = find_grazing_point(grazing.models.pendulum("B", theta_hat=math.radians(40)), "eta", 0.40, 0.47)
+    >>> observe(normal_form_at(g, ("eta",)), points=6, transient=500, periods=100).periods
+    [7, 7, 7, 6, 5, 4]
     """
     from grazing.engine.simulate import simulate
 

@@ -80,6 +80,20 @@ class GrazingPoint:
         step that would follow the last); for a codimension-two meeting point
         (:func:`~grazing.orbits.crossings.meeting_point`), the larger parameter component of its last
         Newton step; nan otherwise.
+
+    Examples
+    --------
+    The paper's first grazing at θ̂ = 40° (case B): the nonimpacting period-1
+    orbit touches the stop at η = 0.4451 with multipliers of modulus 0.508
+    (its §6.1; the paper prints 0.5114, an erratum):
+
+    >>> import math, numpy as np, grazing
+    >>> from grazing.orbits import find_grazings
+    >>> (g,), _ = find_grazings(grazing.models.pendulum("B", theta_hat=math.radians(40)), "eta", 0.40, 0.50)
+    >>> round(g.model.params["eta"], 4), g.period, g.impacts, bool(g.accel > 0)
+    (0.4451, 1, 0, True)
+    >>> np.abs(g.multipliers).round(4).tolist(), g.contact.round(6).tolist()
+    ([0.5079, 0.5079], [0.698132, 0.0])
     """
 
     model: HybridModel
@@ -202,6 +216,51 @@ def refine_grazing(
     weakest impact of an impacting one).  With ``events`` the orbit's other
     impacts are applied (see :func:`contact_system`).  ``stop_name``: the stop
     touched (name or index; the first by default).
+
+    Parameters
+    ----------
+    model
+        The model, with the initial guess of ``free``'s value.
+    contact
+        A guess of the state at the contact.
+    t_graze
+        A guess of the time of the contact.
+    free
+        The parameter solved for.
+    period
+        Period of the orbit in forcing periods.
+    tol
+        Newton's tolerance on the equations' residual.
+    events
+        Apply the orbit's other impacts (an impacting orbit that grazes).
+    stop_name
+        The stop touched (name or index; the first by default).
+
+    Returns
+    -------
+    GrazingPoint
+        The grazing orbit, with the model at ``free``'s grazing value and the
+        ``precision`` of that value.
+
+    Raises
+    ------
+    ConvergenceError
+        Newton's method did not converge from the guess.
+
+    Examples
+    --------
+    From the closest approach of the nonimpacting orbit at η = 0.445, just
+    before the paper's first grazing at θ̂ = 40°:
+
+    >>> import math, grazing
+    >>> from grazing.orbits import find_orbit
+    >>> m = grazing.models.pendulum("B", theta_hat=math.radians(40), eta=0.445)
+    >>> h, t, x = find_orbit(m, virtual=True).approach
+    >>> round(h, 4)  # the orbit misses the stop by 0.0015 rad
+    0.0015
+    >>> g = refine_grazing(m, x, t, "eta")
+    >>> round(g.model.params["eta"], 6), bool(g.precision < 1e-10)
+    (0.445121, True)
     """
     evaluate = contact_system(model, (free,), period, events=events, stop=model.stop_index(stop_name))
     u0 = np.concatenate([contact, [t_graze, model.params[free]]])

@@ -203,6 +203,19 @@ class SpecialPoint:
         them, as it does at a fold, both ends may lie on one side of the point:
         :meth:`~grazing.orbits.palc.Bracket.interval`); of a grazing: the last point before it and the
         first beyond, where there is one; of an unlocated change: its two points; None where unknown.
+
+    Examples
+    --------
+    The first grazing of the period-1 orbit at θ̂ = 40° (case B), met by
+    :func:`continue_orbit`: where, how precisely, and its multipliers:
+
+    >>> import math, numpy as np, grazing
+    >>> m = grazing.models.pendulum("B", theta_hat=math.radians(40))
+    >>> sp = continue_orbit(m, "eta", 0.40, 0.47).special[0]
+    >>> round(sp.param, 6), bool(sp.precision < 1e-10), sp.interval[0] < sp.param < sp.interval[1]
+    (0.445121, True, True)
+    >>> np.abs(sp.multipliers).round(4).tolist(), sp.orbit.impacts
+    ([0.5079, 0.5079], 0)
     """
 
     kind: SpecialKind
@@ -263,6 +276,27 @@ class Branch:
     segment_origin
         For each segment, the index in :attr:`special` of the point it was switched to from
         (-1 for the first).
+    model
+        The model (with the values of the other parameters).
+    virtual
+        The orbits are computed with the stops ignored (a nonimpacting orbit
+        followed past its grazing).
+    arclength
+        The pseudo-arclength of each point from the first.
+
+    Examples
+    --------
+    The nonimpacting period-1 orbit of the pendulum at θ̂ = 40° (case B),
+    from η = 0.40 up to its grazing:
+
+    >>> import math, grazing
+    >>> m = grazing.models.pendulum("B", theta_hat=math.radians(40))
+    >>> br = continue_orbit(m, "eta", 0.40, 0.47)
+    >>> br.period, br.virtual, br.values[0], br.status
+    (1, True, 0.4, 'reached the bound eta = 0.47')
+    >>> ds = br.to_dataset()
+    >>> ds.param.size == len(br), bool((ds.arclength.diff("point") > 0).all())
+    (True, True)
     """
 
     model: HybridModel

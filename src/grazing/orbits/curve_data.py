@@ -58,6 +58,22 @@ class CurvePoint:
         (docs/bifurcation-curves.md): ``1e-14`` to ``1e-10`` where the monodromy is close to
         normal, far worse within ``1e-5`` of a grazing (where it grows like ``1 / v^2``, ``v`` the
         impact speed).  nan on a grazing curve.
+
+    Examples
+    --------
+    The first point of the fold curve of the impacting period-1 orbit of the
+    pendulum (case B; the fold at θ̂ = 40° is near η = 0.654), at θ̂ = 30°:
+    one multiplier is 1, to the point's accuracy:
+
+    >>> import math, numpy as np, grazing
+    >>> from grazing.orbits import follow_curve
+    >>> m = grazing.models.pendulum("B", theta_hat=math.radians(40))
+    >>> curve = follow_curve(m, "fold", "eta", 0.55, 0.70, "theta_hat", (math.radians(30), math.radians(50)))
+    >>> p = curve.points[0]
+    >>> round(math.degrees(p.values[1]), 6), p.period, p.impacts, p.stable
+    (30.0, 1, 1, True)
+    >>> bool(abs(p.multipliers[0] - 1) < 1e-9), bool(p.accuracy < 1e-9)
+    (True, True)
     """
 
     values: tuple[float, float]
@@ -113,6 +129,20 @@ class CurveSpecial:
         The bracket in which the point lies, ``((low1, high1), (low2, high2))`` in the two parameters: the
         last bracket of the location along the curve, or the last point before the point and the first
         beyond; None where there is none.
+
+    Examples
+    --------
+    The period-doubling curve of the period-5 orbit at θ̂ = 40° (case B) ends
+    where the orbit loses its impact, at θ̂ = 35.9°:
+
+    >>> import math, grazing
+    >>> from grazing.orbits import follow_curve
+    >>> m = grazing.models.pendulum("B", theta_hat=math.radians(40))
+    >>> curve = follow_curve(m, "period-doubling", "eta", 0.446, 0.44, "theta_hat",
+    ...                      (math.radians(30), math.radians(41)))
+    >>> (s,) = curve.special
+    >>> s.kind, s.located, round(s.values[0], 6), round(math.degrees(s.values[1]), 4)
+    ('grazing', True, 0.43866, 35.9051)
     """
 
     kind: str
@@ -172,6 +202,22 @@ class BifurcationCurve:
         Its index among :attr:`points`.
     branch
         The one-parameter branch on which the start was found.
+
+    Examples
+    --------
+    The fold of the impacting period-1 orbit of the pendulum (case B) in
+    (η, θ̂), from the fold near η = 0.654 at θ̂ = 40° to both ends of
+    θ̂'s range:
+
+    >>> import math, grazing
+    >>> from grazing.orbits import follow_curve
+    >>> m = grazing.models.pendulum("B", theta_hat=math.radians(40))
+    >>> curve = follow_curve(m, "fold", "eta", 0.55, 0.70, "theta_hat", (math.radians(30), math.radians(50)))
+    >>> curve.kind, curve.params, curve.period, round(curve.start.param, 4)
+    ('fold', ('eta', 'theta_hat'), 1, 0.6543)
+    >>> theta = curve.values("theta_hat")
+    >>> round(math.degrees(theta.min()), 6), round(math.degrees(theta.max()), 6), curve.special
+    (30.0, 50.0, [])
     """
 
     model: HybridModel

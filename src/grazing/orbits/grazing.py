@@ -60,6 +60,25 @@ def find_grazings(
     (:attr:`GrazingPoint.crossed`) is not a motion of the system: it is
     returned, with a :class:`~grazing.errors.GrazingWarning`.
 
+    Parameters
+    ----------
+    model
+        The model, with the values of the other parameters.
+    param
+        The parameter followed.
+    start, stop
+        The interval of ``param`` searched, from ``start``.
+    x0
+        A guess of the orbit's state at time 0 with ``param = start``.
+    period
+        Period of the nonimpacting orbit, in forcing periods.
+    settings
+        The continuation's settings (:class:`~grazing.orbits.PalcSettings`).
+    progress
+        Called as ``progress(step, value)`` after each continuation step.
+    stop_name
+        The stop whose grazings are sought (name or index; the first by default).
+
     Returns
     -------
     grazings, branch
@@ -125,8 +144,27 @@ class GrazingCurve:
     fold
         The turning point in the second parameter (its largest value on the
         curve, beyond which no grazing occurs), if the curve has one.
+    fold_index
+        The fold lies between ``points[fold_index]`` and the point after it
+        (-1 without a fold).
     status
         Why the continuation stopped.
+
+    Examples
+    --------
+    The paper's grazing curve of fig. 6 (case B): no grazing of the period-1
+    orbit above θ̂ = 55.9° (:func:`grazing_curve` makes it):
+
+    >>> import math, grazing
+    >>> curve = grazing_curve(grazing.models.pendulum("B"), ("eta", "theta_hat"), math.radians(5),
+    ...                       search=(0.2, 1.0))
+    >>> curve.params, round(math.degrees(curve.fold.model.params["theta_hat"]), 1)
+    (('eta', 'theta_hat'), 55.9)
+    >>> theta = [p.model.params["theta_hat"] for p in curve.points]
+    >>> max(theta[curve.fold_index : curve.fold_index + 2]) < curve.fold.model.params["theta_hat"]
+    True
+    >>> curve.to_dataset().abs_lambda.dims
+    ('point',)
     """
 
     params: tuple[str, str]
@@ -184,6 +222,33 @@ def grazing_curve(
     ``start`` on the other branch or ``params[0]`` leaves ``search``.
     ``x0``: a guess of the nonimpacting orbit at time 0 with ``params[0] =
     search[0]`` and ``params[1] = start`` (see :func:`find_grazings`).
+
+    Parameters
+    ----------
+    model
+        The model, with the values of the other parameters.
+    params
+        The two parameters: the one searched for the first grazing, and the
+        one whose largest value on the curve is the fold.
+    start
+        The second parameter's value where the curve starts and ends.
+    search
+        The interval of the first parameter searched for the first grazing.
+    x0
+        A guess of the nonimpacting orbit's state (see above).
+    period
+        Period of the nonimpacting orbit, in forcing periods.
+    settings
+        The continuation's settings (default: steps of 0.02, at most 0.05).
+    progress
+        Called as ``progress(step, value)`` after each continuation step.
+    stop_name
+        The stop grazed (name or index; the first by default).
+
+    Returns
+    -------
+    GrazingCurve
+        The grazing orbits along the curve, its fold, and why it ended.
 
     Examples
     --------

@@ -110,6 +110,18 @@ class PalcSettings:
     boundary_tol
         A boundary is bracketed until the followed component (:class:`Palc`'s ``index``) differs by
         at most this (relative to ``max(1, |value|)``) across it.
+
+    Examples
+    --------
+    Smaller steps give a branch of more points, and the same grazing:
+
+    >>> import math, grazing
+    >>> from grazing.orbits import continue_orbit
+    >>> m = grazing.models.pendulum("B", theta_hat=math.radians(40))
+    >>> coarse = continue_orbit(m, "eta", 0.40, 0.47)
+    >>> fine = continue_orbit(m, "eta", 0.40, 0.47, settings=PalcSettings(ds_max=0.01))
+    >>> len(coarse) < len(fine), round(coarse.special[0].param, 8) == round(fine.special[0].param, 8)
+    (True, True)
     """
 
     ds: float = 0.01

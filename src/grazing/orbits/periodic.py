@@ -162,6 +162,24 @@ class PeriodicOrbit:
         ``(h, t, x)`` of the smallest guard value and of the closest approach
         for every stop, in the order of the model's ``stop_names`` (see
         :attr:`guard_mins` and :attr:`crossed_stops`).
+    t0
+        The time of the section the orbit is taken on (:attr:`state` is its
+        point there).
+    impact_stops
+        The stop of each of the orbit's impacts (index into the model's ``stop_names``).
+
+    Examples
+    --------
+    The paper's stable period-5 orbit at θ̂ = 40°, η = 0.446, with one
+    impact in its third forcing period:
+
+    >>> import math, numpy as np, grazing
+    >>> from grazing.orbits import find_orbit
+    >>> orbit = find_orbit(grazing.models.pendulum("B", eta=0.446, theta_hat=math.radians(40)))
+    >>> orbit.period, orbit.impacts, orbit.signature, orbit.stable, orbit.impact_stops.tolist()
+    (5, 1, (0, 0, 1, 0, 0), True, [0])
+    >>> np.abs(orbit.multipliers).round(4).tolist(), bool(orbit.residuals[-1] < 1e-11)
+    ([0.3464, 0.002], True)
     """
 
     model: HybridModel

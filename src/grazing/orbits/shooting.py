@@ -244,6 +244,14 @@ def find_orbit(
         Where Newton's method on the physical map fails, try it on the flow
         through the stops too (see ``virtual``); False: do not (a caller that
         only wants the orbit a run approaches, at the cost of one try).
+    transient
+        Forcing periods simulated from rest for the default guess.
+
+    Returns
+    -------
+    PeriodicOrbit
+        The orbit: its state on the section, period, impacts, monodromy and
+        Floquet multipliers.
 
     Raises
     ------

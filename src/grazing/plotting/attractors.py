@@ -175,6 +175,22 @@ def plot_fractions(ax: Axes, ds: Any, *, degrees: bool = True, legend: bool = Tr
     The fractions are stacked (they sum to 1 at every value), coloured as in :func:`plot_basins`;
     an attractor found only from the seeds (fraction 0) is marked at the bottom.
 
+    Parameters
+    ----------
+    ax
+        Axes to draw on.
+    ds
+        A dataset of :func:`grazing.attractors.continue_attractors`.
+    degrees
+        Show an angle parameter in degrees.
+    legend
+        Add a legend (``id: kind`` for each attractor).
+
+    Returns
+    -------
+    list
+        The artists drawn, one per attractor present.
+
     Examples
     --------
     >>> import grazing

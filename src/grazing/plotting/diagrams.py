@@ -61,6 +61,11 @@ def visible_windows(
     impacting_one
         Also keep impacting period-1 windows.
 
+    Returns
+    -------
+    list of Window
+        The windows kept, in the order given.
+
     Examples
     --------
     >>> ws = [Window(4, True, 0, 9, 0.0, 0.9, 0.0, 0.95), Window(5, True, 10, 10, 1.0, 1.0, 0.95, 1.05)]
@@ -141,6 +146,24 @@ def label_windows(
     -------
     list of Window
         The windows labelled, in the order given.
+
+    Examples
+    --------
+    Two windows far apart share the first row; one too close to the first
+    goes to the next row:
+
+    >>> from matplotlib.figure import Figure
+    >>> from grazing.sweeps.windows import Window
+    >>> ax = Figure().add_subplot()
+    >>> _ = ax.set_xlim(0.0, 1.0)
+    >>> ws = [Window(3, True, 0, 5, 0.10, 0.15, 0.10, 0.15),
+    ...       Window(5, True, 6, 7, 0.135, 0.145, 0.135, 0.145),
+    ...       Window(2, True, 8, 20, 0.5, 0.8, 0.5, 0.8)]
+    >>> [w.period for w in label_windows(ax, ws)], [t.get_text() for t in ax.texts]
+    ([3, 5, 2], ['3', '5', '2'])
+    >>> ys = [t.get_position()[1] for t in ax.texts]
+    >>> bool(ys[0] == ys[2] != ys[1])
+    True
     """
     x0, x1 = ax.get_xlim()
     trans = ax.get_xaxis_transform()  # x in data, y in axes fraction
@@ -202,6 +225,15 @@ def mark_grazings(
         One text per line (default: the value, e.g. ``"0.4451"``).
     color, fontsize
         Style of the lines and labels.
+
+    Examples
+    --------
+    >>> from matplotlib.figure import Figure
+    >>> ax = Figure().add_subplot()
+    >>> _ = ax.set_xlim(0.40, 0.60)
+    >>> mark_grazings(ax, [0.44512, 0.54729])
+    >>> [line.get_xdata()[0] for line in ax.lines], [t.get_text() for t in ax.texts]
+    ([0.44512, 0.54729], [' 0.4451', ' 0.5473'])
     """
     trans = ax.get_xaxis_transform()
     for k, v in enumerate(values):
@@ -252,7 +284,8 @@ def plot_bifurcation(
         or ``window_kw`` passed to it) with :func:`label_windows`.
     nonimpacting
         Shade the parameter ranges where the motion has no impacts (and say so
-        when the range is wide enough).
+        when the range is wide enough); for a sweep up and down, where both
+        sweeps have none, and hatch in a sweep's colour where it alone has none.
     stop
         Draw the stop where it is a level of this component (the dataset's
         ``stop_level``): a horizontal line, or a slanted one when the swept
@@ -298,15 +331,16 @@ def plot_bifurcation(
         y = samples.ravel() * yscale
         ok = np.isfinite(y)
         kw = {"ls": "none", "marker": ".", "ms": 1.2, "mew": 0.0, "color": "k", "rasterized": True}
-        if way is not None:
-            kw.update({"color": DIRECTION_COLORS[way], "label": f"swept {way}", "alpha": 0.8})
+        if way is not None:  # the sweep up as rings, the sweep down as dots inside them: both seen
+            kw.update({"color": DIRECTION_COLORS[way], "label": f"swept {way}", **DIRECTION_MARKERS[way]})
         kw.update(dot_kw or {})
         ax.plot(x[ok], y[ok], **kw)
         ys.append(y[ok])
     y = np.concatenate(ys)
     ok = np.ones(y.size, dtype=bool)
-    if ways[0] is not None:
-        ax.legend(loc="upper right", fontsize=8, markerscale=8, frameon=False)
+    both_ways = ways[0] is not None
+    if both_ways:
+        down = find_windows(ds.sel(direction="down"))
         ds = ds.sel(direction="up")
     lo, hi = float(value.min() * xscale), float(value.max() * xscale)
     pad = 0.005 * (hi - lo) if hi > lo else 0.5
@@ -322,15 +356,26 @@ def plot_bifurcation(
     runs = find_windows(ds)
     if nonimpacting:
         trans = ax.get_xaxis_transform()
-        for w in runs:
-            if w.period == 1 and not w.impacting:
-                ax.axvspan(w.lo * xscale, w.hi * xscale, color="#dfe9f3", lw=0, zorder=-1)
-                if w.width * xscale >= 0.12 * (hi - lo):
-                    ax.text(w.center * xscale, 0.03, "period 1,\nno impacts", transform=trans,
-                            ha="center", va="bottom", fontsize=9, color="#4a6b8a")  # fmt: skip
+        free = [(w.lo, w.hi) for w in runs if w.period == 1 and not w.impacting]
+        if both_ways:  # shaded where both sweeps are free of the stop; where one only, hatched in its colour
+            free_down = [(w.lo, w.hi) for w in down if w.period == 1 and not w.impacting]
+            for way, only in (("up", _minus(free, free_down)), ("down", _minus(free_down, free))):
+                for k, (a, b) in enumerate(only):
+                    ax.axvspan(a * xscale, b * xscale, facecolor="none", edgecolor=DIRECTION_COLORS[way],
+                               hatch="////", lw=0, alpha=0.35, zorder=-1,
+                               label=None if k else f"no impacts swept {way} only")  # fmt: skip
+            free = _intersect(free, free_down)
+        for a, b in free:
+            ax.axvspan(a * xscale, b * xscale, color="#dfe9f3", lw=0, zorder=-1)
+            if (b - a) * xscale >= 0.12 * (hi - lo):
+                text = "period 1, no impacts\nswept up and down" if both_ways else "period 1,\nno impacts"
+                ax.text((a + b) / 2 * xscale, 0.03, text, transform=trans,
+                        ha="center", va="bottom", fontsize=9, color="#4a6b8a")  # fmt: skip
     if windows:
         shown = visible_windows(runs, (hi - lo) / xscale if hi > lo else 1.0, **(window_kw or {}))
         label_windows(ax, shown, scale=xscale)
+    if both_ways:
+        ax.legend(loc="lower left", fontsize=8, frameon=False)
     ax.set_xlabel(label if label is not None else param_label(par, degrees))
     sym = labels[component] if labels else f"x{component + 1}"
     tname = str(ds.attrs.get("time_label", "t"))
@@ -343,6 +388,33 @@ def plot_bifurcation(
 DIRECTION_COLORS = {"up": "tab:blue", "down": "tab:orange"}
 """The colours of a sweep up and of a sweep down in :func:`plot_bifurcation`."""
 
+DIRECTION_MARKERS = {
+    "up": {"marker": "o", "ms": 4.0, "mfc": "none", "mew": 0.8},
+    "down": {"marker": "o", "ms": 2.4, "mew": 0.0},
+}
+"""The markers of a sweep up (rings) and down (dots, inside the rings where the sweeps agree)."""
+
+
+def _intersect(a: list[tuple[float, float]], b: list[tuple[float, float]]) -> list[tuple[float, float]]:
+    """The intervals common to two lists of disjoint intervals."""
+    out = [(max(lo1, lo2), min(hi1, hi2)) for lo1, hi1 in a for lo2, hi2 in b]
+    return [(lo, hi) for lo, hi in out if hi > lo]
+
+
+def _minus(a: list[tuple[float, float]], b: list[tuple[float, float]]) -> list[tuple[float, float]]:
+    """The parts of the intervals ``a`` outside all the intervals ``b`` (each list disjoint).
+
+    >>> _minus([(0.0, 1.0)], [(0.2, 0.3), (0.8, 2.0)])
+    [(0.0, 0.2), (0.3, 0.8)]
+    """
+    out = []
+    for lo, hi in a:
+        pieces = [(lo, hi)]
+        for blo, bhi in b:
+            pieces = [p for x, y in pieces for p in ((x, min(y, blo)), (max(x, bhi), y)) if p[1] > p[0]]
+        out += pieces
+    return out
+
 
 def period_classes(
     period: np.ndarray, impacts_per_period: np.ndarray, max_period: int = 8
@@ -353,6 +425,15 @@ def period_classes(
     Classes, in order: failed (period -1), aperiodic (0), period 1 without
     impacts, period 1 with impacts, periods 2 ... ``max_period``, and longer
     periods.
+
+    Parameters
+    ----------
+    period
+        The detected period of each point (-1 failed, 0 aperiodic).
+    impacts_per_period
+        The impacts per period of each point (same shape).
+    max_period
+        The longest period with a class of its own.
 
     Returns
     -------

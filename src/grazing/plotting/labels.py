@@ -24,6 +24,18 @@ def angle_scale(degrees: bool) -> float:
 def param_label(parameter: Parameter, degrees: bool = True) -> str:
     """Axis label for a model parameter: ``"η"``, ``"θ̂ (degrees)"``, ``"θ̂ (rad)"``, ``"σ (m)"``.
 
+    Parameters
+    ----------
+    parameter
+        The model's parameter (its symbol and unit).
+    degrees
+        Show an angle in degrees.
+
+    Returns
+    -------
+    str
+        Its symbol, with its unit in brackets when it has one.
+
     Examples
     --------
     >>> import grazing

@@ -105,10 +105,29 @@ DOCS = (
 def select(names: Sequence[str]) -> list[ModuleType]:
     """The figure modules named ``fig07``, ``fig7``, ``7``, ``figmap``/``map``, ``eq`` (in page order).
 
+    Parameters
+    ----------
+    names
+        Figure names, as ``grazing report --only`` takes them.
+
+    Returns
+    -------
+    list of module
+        The figure modules (each with its ``FIGURE_ID`` and ``build``), once each.
+
     Raises
     ------
     ValueError
         For a name that is no figure of the report.
+
+    Examples
+    --------
+    >>> [m.FIGURE_ID for m in select(["fig07", "7", "eq", "map"])]
+    ['7', 'map', 'eq']
+    >>> select(["fig99"])  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: no figure 'fig99' in the report (known: fig02, fig04, ...)
     """
     by_id = {m.FIGURE_ID: m for m in FIGURES}
     wanted = set()

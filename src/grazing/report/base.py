@@ -136,6 +136,21 @@ class Comparison:
         label (default :data:`REFERENCE`).
     id
         The HTML anchor of the row (set by :func:`number_rows`).
+
+    Examples
+    --------
+    The paper's first grazing at θ̂ = 40° and ours; a verdict the numbers do
+    not support is refused when the row is made:
+
+    >>> from grazing.report import Comparison
+    >>> row = Comparison("7", "(d) θ̂ = 40°: first grazing η", 0.4451, 0.445121, "paper",
+    ...                  "|ours − paper| ≤ 1e-4 (the paper's four digits)", "agree", tolerance=1e-4)
+    >>> row.verdict, Comparison.from_json(row.to_json()) == row
+    ('agree', True)
+    >>> Comparison("7", "q", 0.4451, 0.4461, "paper", "|ours − paper| ≤ 1e-4", "agree", tolerance=1e-4)
+    Traceback (most recent call last):
+    ...
+    ValueError: comparison 'q': |ours − paper| = 0.001 > tolerance 0.0001 but the verdict is agree
     """
 
     figure: str
@@ -258,6 +273,11 @@ class Image:
         What the image shows (plain text).
     alt
         Short alternative text for the ``<img>`` tag.
+
+    Examples
+    --------
+    >>> Image("fig07_bifurcation.png", "θ against η at four stop angles", alt="fig 7")
+    Image(filename='fig07_bifurcation.png', caption='θ against η at four stop angles', alt='fig 7')
     """
 
     filename: str
@@ -275,6 +295,11 @@ class DataFile:
         File name relative to the report directory.
     description
         What it holds and how to read it (plain text).
+
+    Examples
+    --------
+    >>> DataFile("fig07_sweeps.nc", "the four sweeps: xarray.open_dataset(path, group='40')").filename
+    'fig07_sweeps.nc'
     """
 
     filename: str
@@ -308,6 +333,20 @@ class FigureResult:
         :func:`grazing.report.build_report`.
     commit
         The git commit of the build (empty when unknown).
+
+    Examples
+    --------
+    A figure's result goes to JSON and back unchanged (``grazing report
+    --only`` keeps the other figures' results so):
+
+    >>> from grazing.report import Comparison
+    >>> row = Comparison("7", "(d) θ̂ = 40°: first grazing η", 0.4451, 0.445121, "paper",
+    ...                  "|ours − paper| ≤ 1e-4 (the paper's four digits)", "agree", tolerance=1e-4)
+    >>> fig = FigureResult("7", "Fig 7: bifurcation diagrams",
+    ...                    (Image("fig07_bifurcation.png", "θ against η"),), comparisons=(row,),
+    ...                    data=(DataFile("fig07_sweeps.nc", "the sweeps"),))
+    >>> FigureResult.from_json(fig.to_json()) == fig
+    True
     """
 
     figure_id: str
@@ -350,6 +389,11 @@ class Dynamics:
         Largest Lyapunov exponent per unit time.
     impacts_per_period
         Mean number of impacts per forcing period over the sampled span.
+
+    Examples
+    --------
+    >>> Dynamics(5, -0.0337, 0.2).short(), Dynamics(0, 0.0466, 0.79).short()
+    ('period-5, λ₁ = −0.0337', 'chaotic, λ₁ = +0.0466')
     """
 
     period: int

@@ -92,6 +92,15 @@ class ReportMeta:
         ``(title, relative link)`` of the documents linked from the top.
     pending
         Figure numbers of the paper not (yet) in the report.
+
+    Examples
+    --------
+    >>> from grazing.report.html import render
+    >>> meta = ReportMeta(version="0.2.0", date="2026-11-28T09:00:00+00:00", seconds=97.0, cpu="AMD EPYC",
+    ...                   cores=2, pending=("5",))
+    >>> page = render([], meta)
+    >>> "AMD EPYC" in page, "Not in this report: figure 5." in page
+    (True, True)
     """
 
     version: str

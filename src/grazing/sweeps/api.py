@@ -43,7 +43,7 @@ def run_sweep(
     notice: Callable[[str], None] | None = None,
     load: bool = True,
 ) -> Any:
-    """Run a sweep; return its :class:`xarray.Dataset`.
+    """Run a sweep; return its :class:`xarray.Dataset` (:func:`sweep` and :func:`parameter_map` call it).
 
     Parameters
     ----------
@@ -69,8 +69,33 @@ def run_sweep(
         Return the dataset; with False, return None and keep nothing of the
         results in memory (they are in ``store``: a huge sweep streams to it).
 
+    Returns
+    -------
+    xarray.Dataset or None
+        The results, in the order of the spec's points (:func:`sweep` sorts
+        them by value); None with ``load=False``.
+
     Interrupted (Ctrl-C) or failing, the chunks not yet started are cancelled
     and the local workers stopped at once; the finished chunks are in ``store``.
+
+    Examples
+    --------
+    A spec made once and run into a Zarr store; run again, nothing is
+    recomputed (the store says every chunk is done):
+
+    >>> import math, tempfile, numpy as np, grazing
+    >>> from pathlib import Path
+    >>> from grazing.sweeps import sweep_spec
+    >>> m = grazing.models.pendulum("B", theta_hat=math.radians(40))
+    >>> spec = sweep_spec(m, "eta", np.linspace(0.44, 0.45, 5), settings=grazing.SweepSettings(
+    ...     transient=300, periods=40, lyapunov=False, chunk_size=2))
+    >>> path = Path(tempfile.mkdtemp()) / "eta.zarr"
+    >>> run_sweep(spec, store=path, workers=1).period.values.tolist()
+    [1, 1, 1, 4, 0]
+    >>> calls = []
+    >>> ds = run_sweep(spec, store=path, workers=1, progress=lambda done, total: calls.append(done))
+    >>> calls, ds.period.values.tolist()
+    ([5], [1, 1, 1, 4, 0])
     """
     from grazing.sweeps.store import MemoryStore
 
@@ -124,6 +149,18 @@ def run_sweeps(specs: Sequence[SweepSpec], *, workers: int | None = None) -> lis
     same SIMD lanes: a dozen one-chunk experimenter sweeps run as fast as
     one sweep of a dozen chunks.  Each result is the one :func:`run_sweep`
     gives for that spec.
+
+    Parameters
+    ----------
+    specs
+        The sweeps (:func:`~grazing.sweeps.spec.sweep_spec`, :func:`~grazing.sweeps.spec.map_spec`).
+    workers
+        Local threads computing the chunks (default: all cores).
+
+    Returns
+    -------
+    list of xarray.Dataset
+        One dataset per spec, in the order of ``specs``.
 
     Examples
     --------
@@ -208,8 +245,17 @@ def sweep(
         Iterate the discontinuity-map Poincare map instead of the flow.
     store, workers, client, progress
         See :func:`run_sweep` (``store`` may be the path of a Zarr store).
+    **shorthands
+        Any field of :class:`~grazing.core.options.SweepSettings` by name
+        (``periods=20``, ``lyapunov=False`` ...), replacing that field of
+        ``settings``.
 
-    Returns an :class:`xarray.Dataset` with, per point (in increasing parameter
+    Returns
+    -------
+    xarray.Dataset
+        The diagram, described below.
+
+    The dataset has, per point (in increasing parameter
     order whatever the direction): ``samples`` (periods x states), ``period``
     (0: none <= 64; -1: the point failed), ``impacts_per_period``, ``lyapunov``
     (largest exponent per unit time), ``transient_used``, and ``status``: 0
@@ -263,11 +309,66 @@ def parameter_map(
 ) -> Any:
     """Two-parameter period / impact / Lyapunov map.
 
-    Each row (fixed ``param2``) is swept in increasing ``param1``; with the
-    default ``chunk_size = 0`` one row is one chunk.  ``settings`` and the
-    keyword shorthands as for :func:`sweep`.  Returns a dataset with
-    dimensions ``(param2, param1)`` and the variables of :func:`sweep`
-    (``status``: ok, or why each point failed).
+    Each row (fixed ``param2``) is swept in increasing ``param1``, each point
+    starting from the previous one's final state (unless ``fresh``); with the
+    default ``chunk_size = 0`` one row is one chunk, and the rows run in
+    parallel.
+
+    Parameters
+    ----------
+    model
+        The model, with the values of the parameters not swept.
+    param1, values1
+        The parameter along each row (the map's x axis, the dataset's last
+        dimension) and its values, in the model's units (radians for angles).
+    param2, values2
+        The parameter across the rows (y axis, first dimension) and its values.
+    x0
+        Initial state of every row (default: zeros); of every point with
+        ``fresh``.
+    settings
+        How each point is computed (:class:`~grazing.core.options.SweepSettings`;
+        default: its defaults with ``chunk_size=0``, one chunk a row).
+    store
+        A result store, or the path of a Zarr store (``*.zarr``) created or
+        resumed: each finished chunk is written to it, and a rerun computes
+        only the chunks that are missing (:func:`run_sweep`).  None: in memory.
+    workers
+        Local threads computing the chunks (default: all cores).
+    client
+        A :class:`dask.distributed.Client`: run the chunks on its cluster.
+    progress
+        Called as ``progress(points_done, points_total)``.
+    **shorthands
+        Any field of :class:`~grazing.core.options.SweepSettings` by name
+        (``transient=300``, ``periods=40``, ``lyapunov=False`` ...), replacing
+        that field of ``settings``.
+
+    Returns
+    -------
+    xarray.Dataset
+        Dimensions ``(param2, param1)`` (named after the parameters, with their
+        values as coordinates) and the variables of :func:`sweep`: ``samples``,
+        ``period`` (0: aperiodic up to 64; -1: the point failed), ``impacts``,
+        ``impacts_per_period``, ``lyapunov``, ``transient_used``, ``x_final``,
+        the impacts per stop, ``status`` (0, or why each point failed: a
+        :class:`~grazing.core.solution.Status` code) and ``stop_level``.
+
+    Examples
+    --------
+    The pendulum (case B) at two stop angles: at 30° a period-4 and a
+    period-2 motion past the grazing, at 40° period 1 longer, then chaos:
+
+    >>> import numpy as np, grazing
+    >>> m = grazing.models.pendulum("B")
+    >>> ds = parameter_map(m, "eta", np.linspace(0.40, 0.46, 4), "theta_hat", np.radians([30, 40]),
+    ...                    transient=300, periods=40, lyapunov=False, workers=1)
+    >>> ds.period.dims, ds.period.values.tolist()
+    (('theta_hat', 'eta'), [[1, 1, 4, 2], [1, 1, 1, 0]])
+    >>> ds.impacts_per_period.values.round(2).tolist()
+    [[0.0, 0.0, 2.0, 1.0], [0.0, 0.0, 0.0, 0.52]]
+
+    :func:`grazing.plotting.plot_period_map` draws it.
     """
     used: set[str] = set()
     settings = with_shorthands(settings or SweepSettings(chunk_size=0), SweepSettings, shorthands, used)

@@ -508,5 +508,31 @@ class BatchBuilder:
 
 
 def run_chunk(spec: SweepSpec, index: int) -> ChunkResult:
-    """Compute chunk ``index`` of ``spec`` (a pure function of its arguments)."""
+    """Compute chunk ``index`` of ``spec`` (a pure function of its arguments).
+
+    Parameters
+    ----------
+    spec
+        The sweep (:func:`~grazing.sweeps.sweep_spec`, :func:`~grazing.sweeps.map_spec`).
+    index
+        Which chunk, from 0 to ``spec.n_chunks - 1``.
+
+    Returns
+    -------
+    ChunkResult
+        The chunk's points: ``period``, ``samples``, ``impacts``,
+        ``lyapunov``, ``status``, ``x_final`` ... one row per point, in the
+        spec's order (what a store writes).
+
+    Examples
+    --------
+    >>> import math, numpy as np, grazing
+    >>> from grazing.sweeps import sweep_spec
+    >>> m = grazing.models.pendulum("B", theta_hat=math.radians(40))
+    >>> spec = sweep_spec(m, "eta", np.linspace(0.44, 0.45, 5), settings=grazing.SweepSettings(
+    ...     transient=300, periods=40, lyapunov=False))
+    >>> res = run_chunk(spec, 0)
+    >>> res.period.tolist(), res.samples.shape
+    ([1, 1, 1, 4, 0], (5, 40, 2))
+    """
     return run_chunks(spec, [index])[0]

@@ -90,6 +90,19 @@ class SweepSpec:
         polished by Newton's method (:mod:`grazing.sweeps.polish`): where it
         converges to a stable orbit the samples approach, the point has that
         orbit's period.  (The basins polish their end states themselves.)
+
+    Examples
+    --------
+    Made by :func:`sweep_spec` or :func:`map_spec`; a spec is a value (equal
+    specs are the same sweep, and a store keeps the one it was made for):
+
+    >>> import math, numpy as np, grazing
+    >>> m = grazing.models.pendulum("B", theta_hat=math.radians(40))
+    >>> spec = sweep_spec(m, "eta", np.linspace(0.44, 0.45, 5), settings=grazing.SweepSettings(chunk_size=2))
+    >>> spec.params, spec.n_points, spec.n_chunks, spec.points[:2]
+    (('eta',), 5, 3, ((0.44,), (0.4425,)))
+    >>> spec == sweep_spec(m, "eta", np.linspace(0.44, 0.45, 5), settings=grazing.SweepSettings(chunk_size=2))
+    True
     """
 
     model: HybridModel
@@ -286,8 +299,42 @@ def sweep_spec(
 ) -> SweepSpec:
     """The spec of a one-parameter sweep of ``param`` over ``values``, visited in ``direction``.
 
-    ``direction`` is ``"up"``, ``"down"`` or ``"both"``: up, then down from
-    ``x0`` again, as two chains (``segments = 2``) of one sweep.
+    Parameters
+    ----------
+    model
+        The model, with the values of the parameters not swept.
+    param
+        The parameter swept.
+    values
+        Its values (any order: they are visited in ``direction``), finite.
+    x0
+        Initial state (default: zeros), checked against the guard at the
+        first value.
+    direction
+        ``"up"``, ``"down"`` or ``"both"``: up, then down from ``x0`` again,
+        as two chains (``segments = 2``) of one sweep.
+    settings
+        How each point is computed (default: :class:`~grazing.core.options.SweepSettings`'s defaults).
+    zdm
+        Iterate Nordmark's discontinuity map instead of the flow (see :class:`SweepSpec`).
+
+    Returns
+    -------
+    SweepSpec
+        The sweep, to run with :func:`~grazing.sweeps.run_sweep` (or chunk by
+        chunk with :func:`~grazing.sweeps.run_chunk`).
+
+    Examples
+    --------
+    >>> import math, grazing
+    >>> m = grazing.models.pendulum("B", theta_hat=math.radians(40))
+    >>> spec = sweep_spec(m, "eta", [0.45, 0.44, 0.46], direction="both")
+    >>> [p[0] for p in spec.points], spec.segments
+    ([0.44, 0.45, 0.46, 0.46, 0.45, 0.44], 2)
+    >>> sweep_spec(m, "eta", [0.44], direction="sideways")
+    Traceback (most recent call last):
+    ...
+    grazing.errors.InvalidParameterError: direction must be 'up', 'down' or 'both', got 'sideways'
     """
     s = settings or SweepSettings()
     vals = np.asarray(values, dtype=float)
@@ -335,6 +382,33 @@ def map_spec(
 
     Each row is a chain of its own from ``x0`` (``segments``, unless fresh);
     with ``settings.chunk_size = 0`` (``parameter_map``'s default) one row is one chunk.
+
+    Parameters
+    ----------
+    model
+        The model, with the values of the parameters not swept.
+    param1, values1
+        The parameter along each row and its values (sorted increasing).
+    param2, values2
+        The parameter across the rows and its values (sorted increasing).
+    x0
+        Initial state of every row (default: zeros).
+    settings
+        How each point is computed (default: ``SweepSettings(chunk_size=0)``).
+
+    Returns
+    -------
+    SweepSpec
+        The map, ``shape = (len(values2), len(values1))``, to run with
+        :func:`~grazing.sweeps.run_sweep`.
+
+    Examples
+    --------
+    >>> import numpy as np, grazing
+    >>> m = grazing.models.pendulum("B")
+    >>> spec = map_spec(m, "eta", np.linspace(0.40, 0.46, 4), "theta_hat", np.radians([30, 40]))
+    >>> spec.shape, spec.n_points, spec.n_chunks, spec.segments
+    ((2, 4), 8, 2, 2)
     """
     s = settings or SweepSettings(chunk_size=0)
     v1 = np.sort(np.asarray(values1, dtype=float))

@@ -29,6 +29,20 @@ class Window:
     lo, hi
         The extent of the run on the parameter axis: half-way to the
         neighbouring points outside it (the end points at the ends of the sweep).
+
+    Examples
+    --------
+    :func:`find_windows` splits a sweep into windows:
+
+    >>> import math, numpy as np, grazing
+    >>> from grazing.sweeps import sweep
+    >>> m = grazing.models.pendulum("B", theta_hat=math.radians(40))
+    >>> ds = sweep(m, "eta", np.linspace(0.44, 0.45, 5), transient=300, periods=40, lyapunov=False, workers=1)
+    >>> [(w.label, w.points, w.start) for w in find_windows(ds)]
+    [('1 (no impacts)', 3, 0.44), ('4', 1, 0.4475), ('aperiodic', 1, 0.45)]
+    >>> w = find_windows(ds)[1]
+    >>> w.period, w.impacting, round(w.lo, 5), round(w.hi, 5), round(w.width, 4)
+    (4, True, 0.44625, 0.44875, 0.0025)
     """
 
     period: int
