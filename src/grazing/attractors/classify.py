@@ -674,7 +674,7 @@ def same_points(a: np.ndarray, b: np.ndarray) -> bool:
     Examples
     --------
     >>> a = np.array([[1.3e-5, 8.7e-7]])
-    >>> same_points(a, a + 5e-10), same_points(a, a + 1e-5), same_points(1e5 * a, 1e5 * a + 1e-4)
+    >>> same_points(a, a + 5e-10), same_points(a, a + 1e-5), same_points(1e10 * a, 1e10 * a + 1e-2)
     (True, False, True)
     """
     scale = max(sample_scale(a), sample_scale(b))

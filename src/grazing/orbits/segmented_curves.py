@@ -94,7 +94,7 @@ def bordered_solve(A: np.ndarray, b: np.ndarray, c: np.ndarray) -> NullVectors:
     --------
     >>> A = np.array([[1.0, 2.0], [2.0, 4.0]]) - 0j  # singular
     >>> sol = bordered_solve(A, np.array([2.0, -1.0]) + 0j, np.array([2.0, -1.0]) + 0j)
-    >>> abs(sol.g) < 1e-14, bool(np.allclose(A @ sol.v, 0)), bool(np.allclose(sol.w @ A, 0))
+    >>> bool(abs(sol.g) < 1e-14), bool(np.allclose(A @ sol.v, 0)), bool(np.allclose(sol.w @ A, 0))
     (True, True, True)
     """
     m = A.shape[0]
