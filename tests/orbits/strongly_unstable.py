@@ -29,13 +29,13 @@ TABLE_PHASE = 1.0
 """The table is ``A sin(w s - TABLE_PHASE)``."""
 
 
-def ball_beside_pendulum(**values: float) -> HybridModel:
-    """The model (see the module docstring) at ``values``."""
+def ball_beside_pendulum(table_phase: float = TABLE_PHASE, **values: float) -> HybridModel:
+    """The model (see the module docstring) at ``values``, its table ``A sin(w s - table_phase)``."""
     Hq, Hv, Yb, Ub, s = sp.symbols("Hq Hv Yb Ub s")
     k, c, a, w, r, A, g, e = sp.symbols("k c a w r A g e")
     defaults = {"k": 2.0, "c": 0.1, "a": 5.99, "w": 2.0, "r": 0.8, "A": 0.3, "g": 1.0, "e": 0.5}
     defaults.update(values)
-    table = A * sp.sin(w * s - TABLE_PHASE)
+    table = A * sp.sin(w * s - table_phase)
     wall = [Hq, -r * Hv, Yb, Ub]
     bounce = [Hq, Hv, Yb, (1 + e) * sp.diff(table, s) - e * Ub]
     return HybridModel(
@@ -64,7 +64,9 @@ def pendulum_orbit(a: float) -> PeriodicOrbit:
     return continue_orbit(model, "a", 3.0, a, orbit=start).orbits[-1]
 
 
-def strongly_unstable_orbit(a: float = 5.99, A: float = 0.3, e: float = 0.5) -> PeriodicOrbit:
+def strongly_unstable_orbit(
+    a: float = 5.99, A: float = 0.3, e: float = 0.5, table_phase: float = TABLE_PHASE
+) -> PeriodicOrbit:
     """The period-1 orbit of both bodies: the pendulum's orbit at ``a`` and the ball's stable one-impact
     orbit (its closed form: it leaves the table at phase ``phi``, ``cos phi = pi g (1 - e) / ((1 + e) A
     w^2)``, with speed ``g T / 2``)."""
@@ -72,10 +74,10 @@ def strongly_unstable_orbit(a: float = 5.99, A: float = 0.3, e: float = 0.5) -> 
     T = 2 * math.pi / w
     pend = pendulum_orbit(a)
     phi = math.acos(math.pi * g * (1 - e) / ((1 + e) * A * w**2))
-    t_imp = (phi + TABLE_PHASE) / w
+    t_imp = (phi + table_phase) / w
     dt = (pend.t0 - t_imp) % T
     ball = [A * math.sin(phi) + g * T / 2 * dt - g * dt * dt / 2, g * T / 2 - g * dt]
-    model = ball_beside_pendulum(a=a, A=A, e=e)
+    model = ball_beside_pendulum(table_phase, a=a, A=A, e=e)
     return find_orbit(model, np.concatenate([pend.state, ball]), period=1, t0=pend.t0)
 
 

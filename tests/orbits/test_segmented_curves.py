@@ -21,8 +21,9 @@ import pytest
 from grazing.errors import ConvergenceError
 from grazing.maps import flow_map
 from grazing.models import impact_damper, two_sided_oscillator
+from grazing.orbits import continuation as continuation_module
+from grazing.orbits import continue_orbit, find_orbit, follow_curve
 from grazing.orbits import curves as curves_module
-from grazing.orbits import find_orbit, follow_curve
 from grazing.orbits.curves import _Follower
 from grazing.orbits.segmented_curves import CRITICAL_MULTIPLIER, SegmentedOrbitSystem, multiplier_slope
 from tests.linear_exact import pair_closest_to_circle, six_state_matrices, six_state_model
@@ -217,3 +218,69 @@ def test_the_condition_moves_with_the_multiplier_as_its_slope_says(kind, delta):
     exact = mu[np.argmin(np.abs(mu - CRITICAL_MULTIPLIER[kind]))].real
     assert 1e-5 < abs(exact - CRITICAL_MULTIPLIER[kind]) < 1e-3  # (off the curve, to first order)
     assert predicted == pytest.approx(exact, abs=1e-2 * abs(exact - CRITICAL_MULTIPLIER[kind]))
+
+
+# --------------------------------------------------------------------------
+# Impacts that change order on the segments
+
+
+CROSSING_PHASE = 2.3812
+"""A table phase that puts the ball's impact on the pendulum's at the right wall near ``A = 0.35``."""
+
+
+def _crossing_amplitude(orbit) -> float:
+    """The ``A`` where the ball's impact (at ``w t = phi + phase``, ``cos phi = pi (1 - e) / ((1 + e) A
+    w^2)``: the closed form) coincides with the pendulum's at the right wall."""
+    right = float(orbit.impact_times[list(orbit.impact_stops).index(0)])
+    phi = (2.0 * right - CROSSING_PHASE) % (2 * np.pi)
+    return float(np.pi * 0.5 / (1.5 * 4.0 * np.cos(phi)))
+
+
+def test_a_branch_on_the_segments_goes_on_where_two_impacts_change_order():
+    orbit = strongly_unstable_orbit(table_phase=CROSSING_PHASE)
+    branch = continue_orbit(orbit.model, "A", 0.3, 0.37, orbit=orbit)
+    assert branch.values[-1] == 0.37, branch.status
+    assert "by multiple shooting from A = 0.3 on" in branch.status
+    assert list(branch.orbits[0].impact_stops) == [1, 2, 0] and list(branch.orbits[-1].impact_stops) == [
+        1,
+        0,
+        2,
+    ]
+    where = branch.status.split("the impacts on 'table' and 'right' change order between A = ")[1]
+    low, high = (float(v.split()[0]) for v in where.split(" and A = "))
+    assert low <= _crossing_amplitude(branch.orbits[-1]) <= high and high - low < 1e-6
+    for end in (low, high):  # (both points are on the branch; the status prints them to 10 digits)
+        assert np.min(np.abs(np.array(branch.values) - end)) < 1e-9
+    assert not branch.special
+    # The ball's orbit all along is its closed form: it leaves the table at speed g T / 2 = pi / 2.
+    for o in branch.orbits:
+        j = list(o.impact_stops).index(2)
+        u_after = float(o.model.reset(o.impact_states[j], o.impact_times[j], 2)[3])
+        assert u_after == pytest.approx(np.pi / 2, abs=1e-9)
+
+
+def test_without_the_reordering_the_segments_stall_at_the_change(monkeypatch):
+    monkeypatch.setattr(continuation_module, "reordered", lambda *args, **kwargs: None)
+    orbit = strongly_unstable_orbit(table_phase=CROSSING_PHASE)
+    branch = continue_orbit(orbit.model, "A", 0.3, 0.37, orbit=orbit)
+    assert (
+        branch.values[-1] < _crossing_amplitude(branch.orbits[-1]) and "step size fell below" in branch.status
+    )
+
+
+def test_a_curve_on_the_segments_goes_on_where_two_impacts_change_order():
+    # The ball's period-doubling curve in (A, e) with its impact reaching the pendulum's at the right
+    # wall near e = 0.5 (a table phase chosen for it): the closed form on both sides of the change.
+    orbit = strongly_unstable_orbit(table_phase=2.2924)
+    curve = follow_curve(orbit.model, "period-doubling", "A", 0.3, 0.5, "e", (0.4, 0.6), orbit=orbit)
+    e = curve.values("e")
+    assert e.min() == 0.4 and e.max() == 0.6, curve.status
+    assert "the impacts on 'table' and 'right' change order after A = " in curve.status
+    orders = {tuple(p.orbit.impact_stops) for p in curve.points}
+    assert orders == {(1, 2, 0), (1, 0, 2)}
+    error = np.abs(curve.values("A") - ball_period_doubling(e))
+    accuracy = np.array([p.accuracy for p in curve.points])
+    # (where the two impacts are 1e-8 apart in time the segment between them is that short, and the
+    # point is known only to 6e-10: it says so)
+    assert np.all(error <= np.maximum(1e-12, accuracy)), (error.max(), accuracy.max())
+    assert np.sum(accuracy > 1e-12) <= 4 and not curve.special

@@ -80,10 +80,17 @@ from grazing.orbits.palc import (
     PalcEnd,
     PalcPoint,
     PalcSettings,
+    correct,
     locate,
     sign_changed,
 )
-from grazing.orbits.segments import SegmentLayout, layout_of, segmented_equations
+from grazing.orbits.segments import (
+    REORDER_REACH,
+    SegmentLayout,
+    layout_of,
+    reordered,
+    segmented_equations,
+)
 from grazing.orbits.shooting import (
     SECTION_MARGIN,
     PeriodicOrbit,
@@ -714,13 +721,17 @@ class _Continuation:
 
         Its status says where it went over to multiple shooting, if it did."""
         self.handover: float | None = None
+        self.reorders: list[str] = []  # where two impacts changed order (multiple shooting)
         told = len(self.branch.segment_status)
         starts = self._segment(start)
-        if self.handover is not None and len(self.branch.segment_status) > told:
-            self.branch.segment_status[told] += (
-                f"; by multiple shooting from {self.par.show(self.handover)} on "
-                "(single shooting stalled there)"
-            )
+        if len(self.branch.segment_status) > told:
+            if self.handover is not None:
+                self.branch.segment_status[told] += (
+                    f"; by multiple shooting from {self.par.show(self.handover)} on "
+                    "(single shooting stalled there)"
+                )
+            if self.reorders:
+                self.branch.segment_status[told] += "; " + "; ".join(self.reorders)
         return starts
 
     def _segment(self, start: SegmentStart) -> list[SegmentStart]:
@@ -731,6 +742,7 @@ class _Continuation:
         orbit, sign, direction = start.orbit, start.sign, start.direction
         prev: PalcPoint | None = None
         segmented = False  # (multiple shooting, once single shooting has stalled short of a grazing)
+        across: PalcPoint | None = None  # (the last point before two impacts changed order)
         while True:
             n = orbit.period
             layout = self._layout(orbit) if segmented else None
@@ -760,14 +772,18 @@ class _Continuation:
                 margin=None if self.virtual else self.margin, direction=direction,
             )  # fmt: skip
             direction = None
-            restarted = prev is not None  # the section moved: the same orbit, already on the branch
+            restarted = prev is not None and across is None  # the section moved: the same orbit
             for k, pt in enumerate(palc):
                 if k == 0 and restarted:
                     prev = pt
                     continue
                 switch_at = None
-                if prev is not None:
+                if prev is not None and k == 0 and across is not None:
+                    self._across_reordering(prev, pt)  # (another layout: the stability account alone)
+                    across = None
+                elif prev is not None:
                     switch_at = self._special_between(evaluate, prev, pt, n, ip)
+                if prev is not None:
                     step = _reduced(pt.u, nx) - _reduced(prev.u, nx)
                     branch.arclength.append(branch.arclength[-1] + float(np.linalg.norm(step)))
                 else:
@@ -798,6 +814,16 @@ class _Continuation:
                 branch.end_segment(BranchEnd.of(palc.end), status)
                 return []
             point = self._end_grazing(palc, prev)
+            if (
+                point is None
+                and not palc.boundary.reached
+                and layout is not None
+                and len(branch) < s.max_points
+            ):
+                past = self._reorder(layout, orbit, prev, n)
+                if past is not None:  # (two impacts changed order: the segments in the other order)
+                    across, orbit = prev, past
+                    continue
             if point is None and not palc.boundary.reached and not self.segmented:
                 if self._layout(last) is not None and len(branch) < s.max_points:
                     # Single shooting stalled short of the grazing (its residual's rounding, |M| eps |x|,
@@ -806,6 +832,53 @@ class _Continuation:
                     self.handover = float(prev.u[-1])
                     continue
             return self._grazing_end(palc, prev, sign, point)
+
+    def _reorder(
+        self, layout: SegmentLayout, orbit: PeriodicOrbit, prev: PalcPoint, n: int
+    ) -> PeriodicOrbit | None:
+        """The orbit just past where two of ``prev``'s impacts on different stops change order, solved on
+        the segments in the new order at a fixed parameter (None where no two impacts meet just ahead, or
+        Newton's method fails there: then the branch ends as it stalled)."""
+        assert prev.tangent is not None
+        ahead = reordered(
+            self.model, layout, orbit.t0, prev.u, prev.tangent, (self.param,), REORDER_REACH * self.s.ds_max
+        )
+        if ahead is None:
+            return None
+        evaluate = segmented_equations(self.model, self.param, n, orbit.t0, ahead.layout, orbit.stop)
+        fixed = np.zeros(ahead.u.size)
+        fixed[-1] = 1.0
+        pt = correct(evaluate, ahead.u, fixed, self.s)
+        if pt is None:
+            return None
+        past: PeriodicOrbit = pt.payload
+        if past.crossed_stops or float(np.min(past.impact_speeds)) <= 0.0:
+            return None
+        names = self.model.stop_names
+        a, b = layout.stops[ahead.first], layout.stops[ahead.first + 1]
+        self.reorders.append(
+            f"the impacts on {names[a]!r} and {names[b]!r} change order between "
+            f"{self.par.show(float(prev.u[-1]))} and {self.par.show(float(pt.u[-1]))}"
+        )
+        return past
+
+    def _across_reordering(self, before: PalcPoint, after: PalcPoint) -> None:
+        """Two points on either side of a change of impact order (another layout, so no test function
+        is compared across it): a change of stability between them is reported, unlocated."""
+        if before.payload.unstable_count == after.payload.unstable_count:
+            return
+        p1, p2 = float(before.u[-1]), float(after.u[-1])
+        note = (
+            f"unlocated stability change between {self.par.show(p1)} and {self.par.show(p2)}, where two "
+            f"impacts change order: {before.payload.unstable_count} -> {after.payload.unstable_count} "
+            "unstable multipliers"
+        )
+        self.branch.special.append(
+            SpecialPoint(
+                kind=UNLOCATED, index=len(self.branch) - 1, param=0.5 * (p1 + p2), orbit=before.payload,
+                note=note, between=(p1, p2), interval=(min(p1, p2), max(p1, p2)),
+            )
+        )  # fmt: skip
 
     # -- how a segment ends -----------------------------------------------------------------
 

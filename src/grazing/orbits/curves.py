@@ -64,7 +64,7 @@ from grazing.orbits.palc import (
     tangent,
 )
 from grazing.orbits.segmented_curves import SegmentedOrbitSystem
-from grazing.orbits.segments import MULTIPLE_SHOOTING_NORM
+from grazing.orbits.segments import MULTIPLE_SHOOTING_NORM, REORDER_REACH, reordered
 from grazing.orbits.shooting import CROSSING_TOL, PeriodicOrbit, move_section, quiet_section
 
 CURVE_KINDS = tuple(CurveKind)
@@ -169,6 +169,7 @@ class _Direction:
         self.status = ""
         self.handover: tuple[float, float] | None = None  # where it went over to multiple shooting
         self.segmented_start: float | None = None  # the monodromy's norm where it started on the segments
+        self.reorders: list[str] = []  # where two impacts changed order (on the segments)
 
 
 class _Follower:
@@ -309,23 +310,39 @@ class _Follower:
         elif d.segmented_start is not None:
             norm = f"{d.segmented_start:.1e}"
             d.status += f"; by multiple shooting (the monodromy's norm is {norm} at the start)"
+        if d.reorders:
+            d.status += "; " + "; ".join(d.reorders)
         return d
 
     def _run(self, d: _Direction, start: PeriodicOrbit | GrazingPoint, sign: float, which: int) -> str:
         """:meth:`run` itself: fills ``d``, returns its status."""
         current = start
         segmented = False
+        # (past a change of impact order: the system in the new order, its unknowns, the note)
+        prepared: tuple[SegmentedOrbitSystem, np.ndarray, str] | None = None
+        across: PalcPoint | None = None  # (the last point before it)
         while True:
-            system = self.system(current, segmented)
-            if self.segmented and not segmented and not d.pal:
-                d.segmented_start = float(np.linalg.norm(current.monodromy, 2))  # type: ignore[union-attr]
+            if prepared is None:
+                system = self.system(current, segmented)
+                if self.segmented and not segmented and not d.pal:
+                    d.segmented_start = float(np.linalg.norm(current.monodromy, 2))  # type: ignore[union-attr]
+                u0 = system.start(current)
+            else:
+                (system, u0, note), prepared = prepared, None
+                self._offset = system.offset
             i1 = self.offset()
             index = i1 + which
             bounds = {i1: self.bounds1, i1 + 1: self.bounds2}
             names = {i1: self.params[0], i1 + 1: self.params[1]}
             shows = {i1: self.pars[0].show, i1 + 1: self.pars[1].show}
-            u0 = system.start(current)
-            first = self.first(system, u0, i1 + 1 if not d.pal else index)
+            if across is not None:
+                try:
+                    first = self.first(system, u0, index)
+                except ConvergenceError:
+                    return d.status  # (the segments in the new order do not solve: it ends as it stalled)
+                d.reorders.append(note)
+            else:
+                first = self.first(system, u0, i1 + 1 if not d.pal else index)
             palc = Palc(
                 system, first, index=index, sign=sign, bounds=bounds,
                 settings=dataclasses.replace(self.s, max_points=max(2, self.s.max_points - len(d.points))),
@@ -334,6 +351,12 @@ class _Follower:
             )  # fmt: skip
             ended = False
             for k, pt in enumerate(palc):
+                if k == 0 and across is not None:  # past the change of impact order: a new point
+                    self.across_reordering(d, across, pt)
+                    across = None
+                    self.append(d, pt)
+                    system.accept(pt.payload)
+                    continue
                 if k == 0 and d.pal:  # the same point on a moved section
                     d.pal[-1] = pt
                     system.accept(pt.payload)
@@ -365,6 +388,11 @@ class _Follower:
                 return d.status
             if self.end_at_grazing(d, palc):
                 return d.status
+            if not palc.boundary.reached and isinstance(system, SegmentedOrbitSystem):
+                prepared = self.reorder(system, last)
+                if prepared is not None and len(d.points) < self.s.max_points:
+                    across = last
+                    continue
             orbit = last.payload.orbit
             if (
                 not palc.boundary.reached and not self.segmented and self.can_segment(orbit)
@@ -376,6 +404,39 @@ class _Follower:
                 d.handover = self.curve_point(last).values
                 continue
             return d.status
+
+    def reorder(
+        self, system: SegmentedOrbitSystem, last: PalcPoint
+    ) -> tuple[SegmentedOrbitSystem, np.ndarray, str] | None:
+        """Where two of ``last``'s impacts on different stops change order just ahead: the system on the
+        segments in the new order, the point past the change in its unknowns (for :meth:`first` to
+        correct onto the curve) and a note saying so; None where no two impacts meet just ahead."""
+        assert last.tangent is not None
+        m = system.offset + 2
+        ahead = reordered(
+            self.model, system.layout, system.t0, last.u[:m], last.tangent[:m], self.params,
+            REORDER_REACH * self.s.ds_max,
+        )  # fmt: skip
+        if ahead is None:
+            return None
+        new = SegmentedOrbitSystem(
+            self.model, self.kind, self.params, self.period, system.t0, self.stop, layout=ahead.layout
+        )
+        names = self.model.stop_names
+        a, b = system.layout.stops[ahead.first], system.layout.stops[ahead.first + 1]
+        where = self.show(self.curve_point(last).values)
+        note = f"the impacts on {names[a]!r} and {names[b]!r} change order after {where}"
+        return new, np.concatenate([ahead.u, last.u[m:]]), note
+
+    def across_reordering(self, d: _Direction, before: PalcPoint, after: PalcPoint) -> None:
+        """Two points on either side of a change of impact order (two systems, so nothing is located
+        between them): a codimension-two test that changes sign there is reported, bracketed only."""
+        ta, tb = before.payload.tests, after.payload.tests
+        for name in CODIM2_TESTS[self.kind]:
+            if sign_changed(ta.get(name, math.nan), tb.get(name, math.nan)):
+                d.special.append(
+                    (len(d.points) - 1, self.special_at(name, len(d.points) - 1, before, located=False))
+                )
 
     def append(self, d: _Direction, pt: PalcPoint) -> None:
         d.pal.append(pt)

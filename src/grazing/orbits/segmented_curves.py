@@ -155,16 +155,19 @@ class SegmentedOrbitSystem:
     Unknowns ``u = (z, p1, p2)``, then ``angle`` (Neimark-Sacker) or ``shift``
     (branch point); ``evaluate(u) -> (F, DF, Evaluation)``.  The bordering vectors
     are those of the last accepted point (:meth:`accept`).  :attr:`offset` is the
-    index of ``p1`` in ``u``.
+    index of ``p1`` in ``u``.  The segments are those of ``orbit``'s impacts, or ``layout``.
     """
 
     def __init__(
         self, model: HybridModel, kind: str, params: tuple[str, str], period: int, t0: float, stop: int,
-        orbit: PeriodicOrbit,
+        orbit: PeriodicOrbit | None = None, layout: SegmentLayout | None = None,
     ):  # fmt: skip
         self.model, self.kind, self.params, self.period, self.t0 = model, kind, params, period, t0
         self.n = model.n_states
-        self.layout: SegmentLayout = layout_of(orbit)
+        if layout is None:
+            assert orbit is not None, "give the orbit or the layout of its impacts"
+            layout = layout_of(orbit)
+        self.layout: SegmentLayout = layout
         self.offset = self.layout.size
         self._equations = segmented_equations(model, params, period, t0, self.layout, stop)
         self._borders: tuple[np.ndarray, np.ndarray] | None = None

@@ -392,3 +392,91 @@ def segmented_newton(
         f"Newton's method on the segmented equations did not converge: residual {residuals[-1]:.3g} after "
         f"{len(residuals) - 1} iterations"
     )
+
+
+REORDER_REACH = 4.0
+""":func:`reordered` looks for two impacts changing order within this many of the continuation's
+largest steps ahead of the last point (where it stalled, the order changes just ahead)."""
+
+
+@dataclass(frozen=True)
+class Reordering:
+    """Two consecutive impacts on different stops that change order just ahead of a point.
+
+    Attributes
+    ----------
+    first
+        The index (from 0, in the order of the point's layout) of the earlier of the two.
+    layout
+        The layout with the two swapped.
+    u
+        The unknowns in ``layout``, past the change: the point's, moved along its tangent to twice the
+        distance at which the two impact times meet, with the two impacts' states made consistent
+        (one segment's flow and reset each).
+    """
+
+    first: int
+    layout: SegmentLayout
+    u: np.ndarray
+
+
+def reordered(
+    model: HybridModel, layout: SegmentLayout, t0: float, u: np.ndarray, tangent: np.ndarray,
+    params: tuple[str, ...], reach: float,
+) -> Reordering | None:  # fmt: skip
+    """Where two consecutive impacts on different stops are about to change order along ``tangent``.
+
+    The segments' order is fixed: where an impact on one stop comes to pass an impact on another (two
+    bodies, or two stops of one), the segmented equations break down (their times would have to
+    cross) and the continuation stalls short of it, while the orbit itself goes on, its impacts in the
+    other order.  ``t0`` is the section's time, ``u`` the last point (``params`` its last entries,
+    after ``layout.size``), ``tangent`` its unit tangent, ``reach`` how far ahead along it to look.
+    Returns the swapped layout and the point past the change in it (:class:`Reordering`), for
+    Newton's method to correct; None where no two impact times meet within ``reach``.
+
+    Examples
+    --------
+    Two impacts at ``t = 1`` and ``1.1`` whose times move apart along the tangent do not change order:
+
+    >>> import grazing
+    >>> lay = SegmentLayout(1, (0, 1))  # u = (s0, t1, s1, t2, s2, p)
+    >>> u, tangent = np.array([0.0, 1.0, 0.0, 1.1, 0.0, 0.0]), np.array([0.0, -1.0, 0.0, 1.0, 0.0, 0.0])
+    >>> reordered(grazing.models.impact_oscillator(), lay, 0.0, u, tangent, (), 1.0) is None
+    True
+    """
+    k = layout.impacts
+    if k < 2:
+        return None
+    times = np.array([u[layout.time_index(i)] for i in range(1, k + 1)])
+    rates = np.array([tangent[layout.time_index(i)] for i in range(1, k + 1)])
+    best: tuple[float, int] | None = None
+    for i in range(k - 1):
+        closing = rates[i] - rates[i + 1]
+        gap = times[i + 1] - times[i]
+        if layout.stops[i] == layout.stops[i + 1] or closing <= 0.0 or gap <= 0.0:
+            continue
+        s = gap / closing
+        if s <= reach and (best is None or s < best[0]):
+            best = (s, i)
+    if best is None:
+        return None
+    s, i = best
+    ahead = u + 2.0 * s * tangent
+    stops = list(layout.stops)
+    stops[i], stops[i + 1] = stops[i + 1], stops[i]
+    swapped = SegmentLayout(layout.n_states, tuple(stops))
+    n = layout.n_states
+    m = model.with_params(**{q: float(v) for q, v in zip(params, ahead[layout.size :])}) if params else model
+    new = ahead.copy()
+    t_a, t_b = float(ahead[layout.time_index(i + 1)]), float(ahead[layout.time_index(i + 2)])
+    if not t_b < t_a:
+        return None
+    # The pair, now in the other order: the second's time first; each state one flow and one reset on.
+    start = float(ahead[layout.time_index(i)]) if i > 0 else float(t0)
+    state = layout.state(ahead, i).copy()
+    for j, t in ((i, t_b), (i + 1, t_a)):
+        state = m.reset(segment_flow(m, state, start, t, None).end, t, swapped.stops[j])
+        new[swapped.time_index(j + 1)] = t
+        new[swapped.state_index(j + 1) : swapped.state_index(j + 1) + n] = state
+        start = t
+    return Reordering(i, swapped, new)
