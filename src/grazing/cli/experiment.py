@@ -50,6 +50,8 @@ from grazing.cli.validate import (
 )
 from grazing.core.options import DEFAULT_TRANSIENT, MAX_PERIOD
 from grazing.experiment.signal import DEFAULT_CUTOFF_MULTIPLE, DEFAULT_MAX_PERIOD
+from grazing.experiment.synthetic import NOISE, RECORDED_PERIODS
+from grazing.experiment.synthetic import SAMPLE_RATE as RIG_SAMPLE_RATE
 from grazing.models.pendulum import CASES, DEFAULT_CASE, case_values
 
 _RELATIONS = ["model", "paper", "protocol"]
@@ -560,13 +562,13 @@ def _analyze_folder(
 @click.option("--theta-hat", "theta_hat", type=ANGLE_DEG, default=40.0, show_default=True, metavar="DEG",
               help="Stop angle, degrees.")  # fmt: skip
 @_case_option
-@click.option("--periods", type=count(8), default=100, show_default=True,
+@click.option("--periods", type=count(8), default=RECORDED_PERIODS, show_default=True,
               help="Forcing periods recorded.")  # fmt: skip
 @click.option("--transient", type=count(0), default=DEFAULT_TRANSIENT, show_default=True,
               help="Forcing periods simulated before recording.")  # fmt: skip
-@click.option("--sample-rate", type=SAMPLE_RATE, default=1000.0, show_default=True,
+@click.option("--sample-rate", type=SAMPLE_RATE, default=RIG_SAMPLE_RATE, show_default=True,
               help="Samples per second, at most 1e6 (times are written to the microsecond).")  # fmt: skip
-@click.option("--noise", type=NON_NEGATIVE, default=1e-3, show_default=True, help="Sensor noise, rad.")
+@click.option("--noise", type=NON_NEGATIVE, default=NOISE, show_default=True, help="Sensor noise, rad.")
 @click.option("--seed", type=SEED, default=0, show_default=True, help="Seed of the noise (>= 0).")
 @click.option("--out", type=path_type(), required=True, metavar="FILE.csv|DIR",
               help="A .csv file (one --eta; with a sidecar .json) or a folder (several; an existing folder, "

@@ -33,7 +33,7 @@ from grazing.cli.common import (
 )
 from grazing.cli.hints import flag_hints
 from grazing.cli.validate import ANGLE_DEG, FINITE, ORBIT_PERIOD, POSITIVE, count, refuse_unused
-from grazing.core.options import DEFAULT_TRANSIENT, MAX_STEP
+from grazing.core.options import DEFAULT_TRANSIENT, GRAZING_CURVE_MAX_STEP, MAX_STEP
 from grazing.errors import GrazingWarning
 from grazing.models.pendulum import max_angle
 from grazing.orbits.periodic import multipliers_text
@@ -238,7 +238,8 @@ def graze(
 @stop_name_option
 @click.option("--eta-min", type=POSITIVE, default=0.2, show_default=True, help="Lower end of the eta range.")
 @click.option("--eta-max", type=POSITIVE, default=1.0, show_default=True, help="Upper end of the eta range.")
-@click.option("--max-step", type=POSITIVE, default=0.05, show_default=True, help="Largest continuation step.")
+@click.option("--max-step", type=POSITIVE, default=GRAZING_CURVE_MAX_STEP, show_default=True,
+              help="Largest continuation step.")  # fmt: skip
 @initial_option
 @netcdf_out_option
 @json_option

@@ -64,6 +64,11 @@ below which the two corrected points are not told apart."""
 MAX_STEP = 0.04
 """Continuation's largest step (:class:`~grazing.orbits.palc.PalcSettings` ``ds_max``; ``--max-step``)."""
 
+GRAZING_CURVE_MAX_STEP = 0.05
+"""The largest step of a grazing curve followed in two parameters from the nonimpacting orbits
+(:func:`~grazing.orbits.grazing_curve`, ``grazing graze-curve --max-step``; its first step is 0.02): the
+curve of the paper's figure 7, smooth at this scale up to its fold in the stop angle."""
+
 DEFAULT_TRANSIENT = 500
 """Forcing periods run before sampling where none is given: a periodic orbit's guess simulated from rest
 (:func:`~grazing.orbits.find_orbit`), a sweep's points (:class:`SweepSettings`), and the ``--transient``

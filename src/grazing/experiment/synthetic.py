@@ -35,6 +35,9 @@ SAMPLE_RATE = 1000.0
 NOISE = 1e-3
 """Standard deviation of the synthetic sensor noise (rad)."""
 
+RECORDED_PERIODS = 100
+"""Forcing periods in a synthetic recording (:func:`synthetic_recording`, ``grazing synthesize``)."""
+
 QUANTUM = 2.0 * math.pi / 4096
 """Quantisation step: a 12-bit converter over one turn (rad)."""
 
@@ -84,7 +87,7 @@ def synthetic_recording(
     theta_hat_deg: float,
     *,
     case: str | None = "B",
-    periods: int = 100,
+    periods: int = RECORDED_PERIODS,
     transient: int = DEFAULT_TRANSIENT,
     x0: Sequence[float] = (0.0, 0.0),
     sample_rate: float = SAMPLE_RATE,

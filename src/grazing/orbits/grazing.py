@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 
 from grazing.core.model import HybridModel, Parameter
+from grazing.core.options import GRAZING_CURVE_MAX_STEP
 from grazing.errors import ConvergenceError, GrazingWarning, InvalidParameterError
 from grazing.orbits.contact import GrazingPoint, contact_system
 from grazing.orbits.continuation import Branch, continue_orbit
@@ -262,7 +263,7 @@ def grazing_curve(
     for p in params:
         if p not in model.params:
             raise InvalidParameterError(f"unknown parameter {p!r}")
-    s = settings or PalcSettings(ds=0.02, ds_max=0.05)
+    s = settings or PalcSettings(ds=0.02, ds_max=GRAZING_CURVE_MAX_STEP)
     base = model.with_params(**{p2: start})
     first, _ = find_grazings(base, p1, search[0], search[1], x0=x0, period=period, stop_name=stop_name)
     if not first:
