@@ -237,8 +237,8 @@ def find_attractors(
     if cell is None and not np.all(cells >= smallest):
         raise InvalidParameterError(
             "the initial states' box is too narrow to tell attractors apart (cells of "
-            f"{float(cells.min()):.3g}, its extent over {CELLS}): widen the box (or give cells of at "
-            f"least {smallest:.3g})"
+            f"{float(cells.min()):.3g}, its extent over {CELLS}): widen the box (or, in Python, give cell "
+            f"sizes of at least {smallest:.3g}: cell=)"
         )
     try:
         fraction = float(cell_fraction)

@@ -53,6 +53,16 @@ CURVE_COLOURS = {
 }
 """The colours of the bifurcation curves on a period map."""
 
+CURVE_DASHES = {
+    "fold": "solid",
+    "period-doubling": "dashed",
+    "neimark-sacker": "dotdash",
+    "branch-point": "dashdot",
+    "grazing": "dotted",
+}
+"""The dash pattern of each kind of curve: a curve is told from a region of the period map in its own
+colour (the period-doubling curve's red is period 1's, say) by its pattern and its white halo."""
+
 FRAME_BELOW = 0.2
 """A continued branch narrower than this fraction of the diagram's range: the diagram is framed to it."""
 
@@ -126,7 +136,9 @@ def legend_html(codes: Any = (), *, map_view: bool = False) -> str:
     period = "<b>period:</b> " + (" ".join(items) if items else "(computing)")
     marks = [swatch("red", "special point (diamond)"), swatch("orange", "grazing (triangle)")]
     if map_view:
-        marks += [swatch(colour, f"{kind} curve") for kind, colour in CURVE_COLOURS.items()]
+        marks += [
+            swatch(colour, f"{kind} curve ({CURVE_DASHES[kind]})") for kind, colour in CURVE_COLOURS.items()
+        ]
     else:
         marks = [
             swatch("black", "stable", "circle"),
@@ -359,9 +371,13 @@ class Figures:
         self.branch = ColumnDataSource({"x": [], "y": [], "stable": [], "fill": [], "line": [], "text": []})
         self.marks = ColumnDataSource({"x": [], "y": [], "kind": [], "text": []})
         self.grazings = ColumnDataSource({"x": [], "y": [], "kind": [], "text": []})
-        self.curves = ColumnDataSource({"xs": [], "ys": [], "kind": [], "text": [], "colour": []})
+        self.curves = ColumnDataSource({"xs": [], "ys": [], "kind": [], "text": [], "colour": [], "dash": []})
         if len(view.axes) == 2:
-            rc = self.diagram.multi_line("xs", "ys", source=self.curves, line_color="colour", line_width=3)
+            halo = {"line_color": "white", "line_width": 6}
+            self.diagram.multi_line("xs", "ys", source=self.curves, **halo)
+            rc = self.diagram.multi_line(
+                "xs", "ys", source=self.curves, line_color="colour", line_dash="dash", line_width=3
+            )
             self._hover_over([rc])
         rm = self.diagram.scatter(
             "x", "y", source=self.marks, size=12, marker="diamond", fill_color="red", line_color="black"
@@ -590,6 +606,7 @@ class Figures:
             "kind": [c.kind for c in found.curves],
             "text": [c.text for c in found.curves],
             "colour": [colours.get(c.kind, "black") for c in found.curves],
+            "dash": [CURVE_DASHES.get(c.kind, "solid") for c in found.curves],
         }
 
     def show_grazings(self, found: Grazings, row: float | None = None) -> None:
