@@ -22,7 +22,7 @@ of an f-string before its value (``f"period={n}"``)."""
 PYTHON_ONLY = {
     "stops=": "HybridModel's: a model file, Python on the command line too",
     "contact_direction=": "HybridModel's, as stops=",
-    "cell=": "find_attractors' cell sizes; the command line's --cell is a fraction of the box (cell_fraction=)",
+    "cell=": "find_attractors' cell sizes (the command line's --cell is cell_fraction=)",
 }
 """Arguments the library's messages ask for that have no option: where they are given."""
 
