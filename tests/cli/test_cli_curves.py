@@ -34,6 +34,7 @@ def test_curve_json_keys_and_display_units(capsys):
         mu = np.array([complex(*z) for z in p["multipliers"]])
         assert np.min(np.abs(mu + 1)) <= p["accuracy"] < 1e-6
     assert res["special"] == [] and res["status"].count("reached the bound theta_hat = ") == 2
+    assert res["outcomes"] == ["bound", "bound"]  # (each end's CurveEnd, by its word)
     assert res["start"]["theta_hat"] == pytest.approx(40.0) and res["start"]["eta"] == pytest.approx(
         0.4453926, abs=1e-7
     )
@@ -82,6 +83,7 @@ def test_curve_says_where_its_multipliers_are_known_only_roughly(capsys, tmp_pat
     note = next(line for line in text.splitlines() if line.startswith("note: the multipliers of "))
     worst = float(note.split("known only to ")[1].split(":")[0])
     res = json.loads(run([*argv, "--json"], capsys))
+    assert res["status"].count("ended at a grazing") == 1 and "grazing" in res["outcomes"]
     accuracy = [p["accuracy"] for p in res["points"]]
     assert worst == pytest.approx(max(accuracy), rel=0.5) and worst > 1e-6
     assert int(note.split()[4]) == sum(a > 1e-6 for a in accuracy) >= 1

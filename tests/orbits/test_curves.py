@@ -27,6 +27,7 @@ from grazing.orbits import PalcSettings, continue_orbit, find_grazings, find_orb
 from grazing.orbits.bordered import Borders, bialternate, bordered
 from grazing.orbits.continuation import SPECIAL_KINDS
 from grazing.orbits.crossings import limit_condition
+from grazing.orbits.curve_data import CurveEnd
 from grazing.orbits.curves import BifurcationCurve, _follow_from
 from grazing.orbits.extended import OrbitSystem
 from tests.orbits.test_closed_forms import REST, ZETA, _impacting_orbit_closed_form, oscillator_amplitude
@@ -263,6 +264,7 @@ def test_bouncing_ball_fold_curve_is_the_closed_form():
     _condition_holds(curve, "fold")
     assert {p.impacts for p in curve.points} == {1} and curve.special == []
     assert curve.status.count("reached the bound r = ") == 2
+    assert curve.outcomes == (CurveEnd.BOUND, CurveEnd.BOUND)
 
 
 def test_bouncing_ball_period_doubling_curve_is_the_closed_form():
@@ -308,6 +310,7 @@ def test_pendulum_period_doubling_curve_passes_through_the_one_parameter_points(
         orbit=pendulum_period5,
     )
     assert curve.status.count("reached the bound theta_hat = ") == 2
+    assert curve.outcomes == (CurveEnd.BOUND, CurveEnd.BOUND)
     th = curve.values("theta_hat")
     _condition_holds(curve, "period-doubling", tol=1e-6)
     for end in (0, -1):  # the curve lands exactly on the bounds: compare with continue_orbit there
@@ -334,6 +337,7 @@ def test_pendulum_period_doubling_curve_ends_where_it_meets_the_grazing(pendulum
         m, "period-doubling", "eta", 0.446, 0.44, "theta_hat", (35.5 * DEG, 40 * DEG), orbit=pendulum_period5
     )
     assert curve.status.startswith("at the first point: ended at a grazing at eta = ")
+    assert curve.outcomes[0] is CurveEnd.GRAZING
     (meet,) = curve.special
     assert meet.kind == "grazing" and meet.located and meet.index == 0
     assert meet.grazing is not None and meet.grazing.impacts == 0
@@ -429,6 +433,7 @@ def test_neimark_sacker_curve_its_resonances_and_its_end():
     assert r11.index == 0 and curve.points[0].values == r11.values  # the curve ends there
     np.testing.assert_allclose(r11.multipliers, [1, 1], atol=1e-4)  # a double multiplier: ~sqrt(tol)
     assert curve.status.startswith("at the first point: ended at a 1:1 resonance")
+    assert curve.outcomes == (CurveEnd.RESONANCE_1_1, CurveEnd.BOUND)  # (the other end on w's bound)
     r14 = next(s for s in curve.special if s.kind == "1:4 resonance")
     np.testing.assert_allclose(np.sort_complex(r14.multipliers), [-1j, 1j], atol=1e-8)
     # at the other end (w = 1.5, on the bound) the one-parameter continuation finds it too
@@ -717,6 +722,7 @@ def test_curve_dataset_and_netcdf(tmp_path):
     with xr.open_dataset(path) as back:
         np.testing.assert_array_equal(back.param1.values, curve.values("amplitude"))
         assert back.attrs["status"] == curve.status
+        assert back.attrs["outcomes"] == "bound,bound" and type(ds.attrs["outcomes"]) is str
 
 
 def test_bad_input_is_refused_before_any_work():
@@ -909,6 +915,7 @@ def test_grazing_curve_meets_a_fold_and_ends_at_a_double_grazing():
     assert fold.located and np.min(np.abs(fold.multipliers - 1)) < 1e-7
     assert not double.located and double.index == len(curve) - 1
     assert curve.status.endswith("a double grazing, located from this side)")
+    assert curve.outcomes[1] is CurveEnd.DOUBLE_GRAZING
     last = curve.points[-1].grazing
     h_right = last.approach_by_stop[0][0]  # the right stop's closest approach in free flight
     assert 0 <= h_right < DOUBLE_GRAZING_MARGIN and last.impacts == 1 and last.stop_name == "left"
@@ -940,6 +947,7 @@ def test_a_branch_point_curve_ends_at_once_where_the_second_parameter_breaks_the
     curve = follow_curve(m, "branch-point", "omega", 1.0, 1.2, "gap_right", (0.95, 1.05), period=1)
     assert len(curve.points) == 1 and curve.points[0].values[1] == 1.0
     first, last = curve.status.split("; at the last point: ")
+    assert curve.outcomes == (CurveEnd.NOT_PERSISTENT, CurveEnd.NOT_PERSISTENT)
     for end in (first, last):
         assert "does not persist in two parameters" in end
         shift = float(end.split("shift = ")[1].split(" ")[0])

@@ -30,8 +30,10 @@ from grazing.orbits.continuation import (
     SpecialPoint,
     grazing_margin,
 )
+from grazing.orbits.curve_data import CurveEnd
 from grazing.orbits.curves import CURVE_KINDS
 from grazing.orbits.kinds import CurveKind, SpecialKind
+from grazing.orbits.palc import PalcEnd
 from tests.orbits.test_closed_forms import (
     G,
     R,
@@ -47,6 +49,23 @@ JSON_KINDS = ["fold", "branch point", "period-doubling", "neimark-sacker", "graz
 
 CLI_CURVE_KINDS = ["fold", "period-doubling", "neimark-sacker", "branch-point", "grazing"]
 """The choices of ``grazing curve --kind`` (docs/bifurcation-curves.md)."""
+
+ATTRACTOR_KINDS = ["periodic", "sticking", "neutral", "chaotic", "quasiperiodic", "aperiodic", "escaping",
+                   "failed", "invalid"]  # fmt: skip
+"""The ``kind`` of an attractor in ``grazing basins --json`` and the basins datasets (docs/attractors.md)."""
+
+CURVE_ENDS = ["bound", "grazing", "double grazing", "1:1 resonance", "1:2 resonance", "not persistent",
+              "stuck", "resection", "no section", "max points"]  # fmt: skip
+"""The ``outcomes`` of ``grazing curve --json`` (docs/bifurcation-curves.md)."""
+
+
+def assert_prints_as_its_word(kind, word: str) -> None:
+    """A string enum member is its word wherever it is printed or written."""
+    assert kind == word and hash(kind) == hash(word) and type(kind)(word) is kind
+    assert str(kind) == word and f"{kind}" == word and f"{kind:16s}" == f"{word:16s}"
+    assert json.dumps({"kind": kind}) == json.dumps({"kind": word})
+    assert np.array([kind], dtype=str)[0] == word and repr([kind]) == repr([word])
+    assert type(str(kind)) is str
 
 
 def test_the_kinds_are_the_words_that_json_prints():
@@ -67,6 +86,44 @@ def test_the_kinds_are_the_words_that_json_prints():
         CurveKind.GRAZING: SpecialKind.GRAZING,
     }
     assert SpecialKind.BRANCH_POINT.curve is CurveKind.BRANCH_POINT and SpecialKind.UNLOCATED.curve is None
+
+
+def test_attractor_kinds_and_curve_ends_are_the_words_that_json_prints():
+    from grazing.attractors import KINDS, AttractorKind
+
+    assert [k.value for k in AttractorKind] == ATTRACTOR_KINDS and list(KINDS) == ATTRACTOR_KINDS
+    assert [k.value for k in CurveEnd] == CURVE_ENDS
+    for enum, words in ((AttractorKind, ATTRACTOR_KINDS), (CurveEnd, CURVE_ENDS)):
+        for kind, word in zip(enum, words):
+            assert_prints_as_its_word(kind, word)
+        messages = [k.message for k in enum]  # (a few words each, for people: one per member)
+        assert all(m and m == m.strip() for m in messages) and len(set(messages)) == len(messages)
+    assert [k for k in AttractorKind if k.outcome] == ["escaping", "failed", "invalid"]
+    assert [k for k in AttractorKind if k.aperiodic] == ["chaotic", "quasiperiodic", "aperiodic"]
+    # A direction's last continuation, where nothing ended it, says why it stopped.
+    assert [CurveEnd.of(e) for e in PalcEnd] == [
+        CurveEnd.MAX_POINTS, CurveEnd.BOUND, CurveEnd.STUCK, CurveEnd.STUCK, CurveEnd.RESECTION
+    ]  # fmt: skip
+    # The resonances that end a Neimark-Sacker curve are the curve's codimension-two kinds' words.
+    from grazing.orbits.extended import ENDING
+
+    assert {CurveEnd(k) for k in ENDING["neimark-sacker"]} == {CurveEnd.RESONANCE_1_1, CurveEnd.RESONANCE_1_2}
+
+
+def test_every_curve_end_has_one_status_that_says_it():
+    """The words each end's status starts with (tests/orbits/curve_outcomes.py, which conftest.py checks
+    every curve the orbit tests follow against) name each outcome once."""
+    from tests.orbits.curve_outcomes import STATUS_STARTS, ends, said
+
+    assert sorted(o.value for _, o in STATUS_STARTS) == sorted(CURVE_ENDS)
+    for start, outcome in STATUS_STARTS:
+        assert said(start + " at x = 1") is outcome
+    first, last = ends(
+        "at the first point: reached the bound r = 0.3; at the last point: step size fell below 1e-08"
+    )
+    assert (said(first), said(last)) == (CurveEnd.BOUND, CurveEnd.STUCK)
+    with pytest.raises(AssertionError, match="no outcome says"):
+        said("reached a boundary of the curve's domain at x = 1")
 
 
 def test_the_cli_takes_the_curve_kinds_by_their_words():
@@ -200,3 +257,83 @@ def test_grazing_margin_of_a_nonimpacting_orbit_is_its_gap_to_the_stop():
     assert margin.stop == 0 and math.isfinite(margin.time)
     with pytest.raises(TypeError):
         GrazingMargin(1.0, None, 0.0, None, 0)  # type: ignore[misc]  (by keyword only)
+
+
+# --------------------------------------------------------------------------
+# Attractor kinds
+
+
+def _chunk(samples, period, impacts, lyapunov, status):
+    from grazing.sweeps.spec import ChunkResult
+
+    samples = np.asarray(samples, dtype=float)
+    m = samples.shape[0]
+    return ChunkResult(
+        index=0, samples=samples, period=np.asarray(period), impacts=np.asarray(impacts, dtype=float),
+        lyapunov=np.asarray(lyapunov, dtype=float), transient_used=np.zeros(m), x_final=samples[:, -1],
+        status=np.asarray(status),
+    )  # fmt: skip
+
+
+def test_the_catalogue_names_each_end_state_with_its_kind():
+    """End states made up for each kind the samples decide (neutral needs a monodromy: test_dynamics):
+    a repeating point with impacts, one at rest on the table, three aperiodic sets far apart with a
+    positive, a zero and no exponent, one beyond the bound, one that overflowed and one at the step
+    limit; and an initial state beyond a stop."""
+    from grazing.attractors import AttractorKind
+    from grazing.attractors.classify import CHAOS_THRESHOLD, Catalogue
+    from grazing.core.solution import Status
+    from grazing.models import bouncing_ball
+
+    ball = bouncing_ball(amplitude=0.1, r=0.8)
+    P = 8
+    k = np.arange(P)[:, None]
+    scatter = np.hstack([np.sin(1.3 * k * k), np.cos(2.1 * k)])  # (no period <= 8)
+    samples = [
+        np.tile([1.0, 2.0], (P, 1)),  # period 1 with impacts
+        np.zeros((P, 2)),  # on the table (y = A sin(0) = 0), at rest, no impacts
+        10.0 + scatter,
+        20.0 + scatter,
+        30.0 + scatter,
+        np.full((P, 2), 500.0),  # beyond the bound (100)
+        np.zeros((P, 2)),
+        np.zeros((P, 2)),
+    ]
+    ok, nonfinite, limit = int(Status.OK), int(Status.NONFINITE), int(Status.STEP_LIMIT)
+    res = _chunk(
+        samples,
+        period=[1, 1, 0, 0, 0, 1, 0, 0],
+        impacts=[P, 0, P, P, P, P, 0, 0],
+        lyapunov=[np.nan, np.nan, 10 * CHAOS_THRESHOLD, 0.0, np.nan, np.nan, np.nan, np.nan],
+        status=[ok, ok, ok, ok, ok, ok, nonfinite, limit],
+    )
+    cat = Catalogue(ball, 9, np.full(2, 0.01), np.zeros(2), 100.0, P, 0.0, polish=False)
+    cat.add(0, res)
+    attractors, _ = cat.attractors(invalid=1)
+    kinds = {a.first: a.kind for a in attractors}
+    assert kinds == {
+        -1: AttractorKind.INVALID, 0: AttractorKind.PERIODIC, 1: AttractorKind.STICKING,
+        2: AttractorKind.CHAOTIC, 3: AttractorKind.QUASIPERIODIC, 4: AttractorKind.APERIODIC,
+        5: AttractorKind.ESCAPING, 6: AttractorKind.ESCAPING, 7: AttractorKind.FAILED,
+    }  # fmt: skip
+    for a in attractors:
+        assert type(a.kind) is AttractorKind
+        assert type(a.to_json()["kind"]) is str and a.to_json()["kind"] == a.kind.value
+    reasons = {a.first: a.reason for a in attractors if a.kind.outcome}
+    assert reasons == {-1: "beyond a stop", 5: "left the bound", 6: "non-finite state", 7: "step limit"}
+
+
+def test_found_attractors_carry_their_kind_and_write_its_word():
+    """The ball on a vibrating table (basins' example): beyond the table, at rest on it, bouncing."""
+    from grazing.attractors import AttractorKind, basins, find_attractors
+    from grazing.models import bouncing_ball
+
+    ball = bouncing_ball(amplitude=0.8, r=0.8)
+    found = find_attractors(ball, [[0.0, 0.8], [3.6, -2.0], [-1.0, 0.0]], workers=1)
+    assert [a.kind for a in found.attractors] == [
+        AttractorKind.INVALID, AttractorKind.STICKING, AttractorKind.PERIODIC
+    ]  # fmt: skip
+    assert all(type(a.kind) is AttractorKind for a in found.attractors)
+    ds = basins(ball, (-1.0, 6.0), (-4.0, 4.0), (4, 4), workers=1)
+    assert {type(k) for k in ds.kind.values.tolist()} == {str}
+    assert set(ds.kind.values.tolist()) <= set(ATTRACTOR_KINDS)

@@ -14,10 +14,12 @@ from grazing.attractors.basins import AttractorSet, basins, find_attractors, to_
 from grazing.attractors.classify import KINDS, Attractor
 from grazing.attractors.continuation import continue_attractors
 from grazing.attractors.grid import StateGrid, state_grid
+from grazing.attractors.kinds import AttractorKind
 
 __all__ = [
     "KINDS",
     "Attractor",
+    "AttractorKind",
     "AttractorSet",
     "StateGrid",
     "basins",

@@ -497,7 +497,7 @@ def to_dataset(model: HybridModel, grid: StateGrid, found: AttractorSet) -> Any:
     ds = xr.Dataset(
         {
             "label": (("y", "x"), found.labels.reshape(grid.shape).astype(np.int32)),
-            "kind": ("attractor", np.array([a.kind for a in atts], dtype=str)),
+            "kind": ("attractor", np.array([str(a.kind) for a in atts], dtype=str)),
             "period": ("attractor", np.array([a.period for a in atts], dtype=np.int32)),
             "impacts_per_period": ("attractor", np.array([a.impacts_per_period for a in atts], dtype=float)),
             "lyapunov": ("attractor", np.array([a.lyapunov for a in atts], dtype=float)),

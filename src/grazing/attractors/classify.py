@@ -41,6 +41,7 @@ from typing import Any
 
 import numpy as np
 
+from grazing.attractors.kinds import AttractorKind
 from grazing.core.cells import group_by_cells
 from grazing.core.model import ON_STOP_TOL, HybridModel
 from grazing.core.options import (
@@ -60,9 +61,9 @@ from grazing.sweeps.polish import Polished, contracting_periods, is_neutral, pol
 from grazing.sweeps.spec import ChunkResult
 from grazing.sweeps.status import reason
 
-KINDS = ("periodic", "sticking", "neutral", "chaotic", "quasiperiodic", "aperiodic", "escaping", "failed",
-         "invalid")  # fmt: skip
-"""What an initial state can end on (``invalid``: beyond a stop, not run)."""
+KINDS = tuple(AttractorKind)
+"""What an initial state can end on (``invalid``: beyond a stop, not run): the
+:class:`~grazing.attractors.kinds.AttractorKind` members, which are the words ``--json`` prints."""
 
 MAX_POINTS = 2000
 """Most sampled points kept of an aperiodic attractor (the first end states' samples)."""
@@ -88,7 +89,8 @@ class Attractor:
     id
         Its label (1, 2, ... in the order of the first initial state on it; 0: invalid).
     kind
-        One of :data:`KINDS`.
+        One of :data:`KINDS` (an :class:`~grazing.attractors.kinds.AttractorKind`: a string equal to the
+        ``kind`` that ``--json`` and the datasets write).
     period
         Period in forcing periods (0: aperiodic; -1: an outcome without one).
     impacts_per_period
@@ -125,7 +127,7 @@ class Attractor:
     """
 
     id: int
-    kind: str
+    kind: AttractorKind
     period: int
     impacts_per_period: float
     lyapunov: float
@@ -135,11 +137,14 @@ class Attractor:
     fraction: float = 0.0
     first: int = 0
 
+    def __post_init__(self) -> None:
+        self.kind = AttractorKind(self.kind)  # (given as its word: the member)
+
     def to_json(self) -> dict[str, Any]:
         """The attractor as plain JSON data (``id``, ``kind``, ``period``, ``points``, ``lyapunov`` ...)."""
         return {
             "id": self.id,
-            "kind": self.kind,
+            "kind": str(self.kind),
             "period": self.period if self.period >= 0 else None,
             "impacts_per_period": _finite(self.impacts_per_period),
             "points": self.points.tolist(),
@@ -158,7 +163,7 @@ def _finite(v: float) -> float | None:
 class _Entry:
     """An attractor being collected (possibly merged into another: see :attr:`Catalogue.parent`)."""
 
-    family: str  # "periodic", "aperiodic", "escaping", "failed"
+    family: AttractorKind  # PERIODIC, APERIODIC, ESCAPING or FAILED (its kind: Catalogue._kind)
     first: int
     period: int = -1
     points: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
@@ -169,6 +174,9 @@ class _Entry:
     cells: set[bytes] = field(default_factory=set)
     failures: int = 0  # (failed Newton polishes of its end states)
     neutral: bool = False  # (a periodic orbit whose multiplier 1 is double)
+
+    def __post_init__(self) -> None:
+        self.family = AttractorKind(self.family)
 
 
 class Catalogue:
@@ -228,7 +236,7 @@ class Catalogue:
         self.entries: list[_Entry] = []
         self.parent: list[int] = []
         self._by_period: dict[int, list[int]] = {}
-        self._outcome: dict[tuple[str, str], int] = {}
+        self._outcome: dict[tuple[AttractorKind, str], int] = {}
         self._owner: dict[bytes, int] = {}
         self.cell_fraction = float(cell_fraction)
         self.polish = bool(polish)
@@ -304,11 +312,11 @@ class Catalogue:
             far[ok] = ~(dist <= self.escape)
         for k in np.flatnonzero(~ok | far):
             if far[k]:
-                self._outcome_label(int(index[k]), "escaping", "left the bound")
+                self._outcome_label(int(index[k]), AttractorKind.ESCAPING, "left the bound")
             elif status[k] == Status.NONFINITE:
-                self._outcome_label(int(index[k]), "escaping", reason(int(status[k])))
+                self._outcome_label(int(index[k]), AttractorKind.ESCAPING, reason(int(status[k])))
             else:
-                self._outcome_label(int(index[k]), "failed", reason(int(status[k])))
+                self._outcome_label(int(index[k]), AttractorKind.FAILED, reason(int(status[k])))
         settled = ok & ~far
         slow = unsettled(samples, period) & settled if defer else np.zeros(status.size, dtype=bool)
         if not defer:  # (the last look: an orbit closing in on a shorter period, within a match, has it)
@@ -325,7 +333,7 @@ class Catalogue:
         self._add_aperiodic(index, res, aperiodic)
         return np.flatnonzero(slow)
 
-    def _outcome_label(self, i: int, family: str, why: str) -> None:
+    def _outcome_label(self, i: int, family: AttractorKind, why: str) -> None:
         key = (family, why)
         if key not in self._outcome:
             self._outcome[key] = self._new(_Entry(family, i, reason=why))
@@ -374,7 +382,7 @@ class Catalogue:
                 self.entries[k].points, points
             ):
                 return k
-        k = self._new(_Entry("periodic", first, period=p, points=points.copy(), impacts=impacts))
+        k = self._new(_Entry(AttractorKind.PERIODIC, first, period=p, points=points.copy(), impacts=impacts))
         self._by_period.setdefault(p, []).append(k)
         return k
 
@@ -404,7 +412,9 @@ class Catalogue:
             pts = samples[members].reshape(-1, n)[:MAX_POINTS]
             owners = self._targets(cells, pts)
             mean_impacts = float(np.mean(impacts[members]))
-            k = self._new(_Entry("aperiodic", first, period=0, points=pts.copy(), impacts=mean_impacts))
+            k = self._new(
+                _Entry(AttractorKind.APERIODIC, first, period=0, points=pts.copy(), impacts=mean_impacts)
+            )
             e = self.entries[k]
             e.count = members.size
             e.exponents = [float(v) for v in lyap[members][:MAX_EXPONENTS]]
@@ -459,7 +469,11 @@ class Catalogue:
         if self.cell_fraction <= 0 or points.size == 0:
             return set()
         roots = sorted({self.root(k) for k in self._aperiodic})
-        roots = [r for r in roots if self.entries[r].family == "aperiodic" and len(self.entries[r].points)]
+        roots = [
+            r
+            for r in roots
+            if self.entries[r].family is AttractorKind.APERIODIC and len(self.entries[r].points)
+        ]
         if not roots:
             return set()
         pts = points[:MAX_POINTS]
@@ -507,7 +521,9 @@ class Catalogue:
 
     def orbits(self) -> list[int]:
         """The entries of the periodic orbits found (merged ones left out)."""
-        return [k for k, e in enumerate(self.entries) if e.family == "periodic" and self.root(k) == k]
+        return [
+            k for k, e in enumerate(self.entries) if e.family is AttractorKind.PERIODIC and self.root(k) == k
+        ]
 
     def attractors(self, invalid: int = 0) -> tuple[list[Attractor], np.ndarray]:
         """The attractors (ids 1, 2, ... by first initial state; ``invalid`` initial states as id 0) and
@@ -522,7 +538,7 @@ class Catalogue:
             out.append(
                 Attractor(
                     id=INVALID,
-                    kind="invalid",
+                    kind=AttractorKind.INVALID,
                     period=-1,
                     impacts_per_period=math.nan,
                     lyapunov=math.nan,
@@ -563,20 +579,21 @@ class Catalogue:
         labels[done] = table[self.labels[done]]
         return out, labels
 
-    def _kind(self, e: _Entry) -> tuple[str, float]:
+    def _kind(self, e: _Entry) -> tuple[AttractorKind, float]:
         exps = np.array([v for v in e.exponents if math.isfinite(v)])
         exponent = float(np.median(exps)) if exps.size else math.nan
-        if e.family in ("escaping", "failed"):
+        if e.family.outcome:
             return e.family, math.nan
-        if e.family == "periodic":
+        if e.family is AttractorKind.PERIODIC:
             if self._sticks(e):
-                return "sticking", exponent
-            return ("neutral" if e.neutral else "periodic"), exponent
+                return AttractorKind.STICKING, exponent
+            return (AttractorKind.NEUTRAL if e.neutral else AttractorKind.PERIODIC), exponent
         if not math.isfinite(exponent):
-            return "aperiodic", exponent
+            return AttractorKind.APERIODIC, exponent
         if exponent > CHAOS_THRESHOLD:
-            return "chaotic", exponent
-        return ("quasiperiodic" if exponent >= -CHAOS_THRESHOLD else "aperiodic"), exponent
+            return AttractorKind.CHAOTIC, exponent
+        quasi = exponent >= -CHAOS_THRESHOLD
+        return (AttractorKind.QUASIPERIODIC if quasi else AttractorKind.APERIODIC), exponent
 
     def examine_orbits(self) -> dict[int, float]:
         """Mark the periodic orbits found that are neutral (:func:`~grazing.sweeps.polish.is_neutral`: a

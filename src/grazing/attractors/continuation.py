@@ -27,6 +27,7 @@ import numpy as np
 from grazing.attractors.basins import AttractorSet, find_attractors
 from grazing.attractors.classify import Attractor, set_distance
 from grazing.attractors.grid import state_grid
+from grazing.attractors.kinds import AttractorKind
 from grazing.core.model import HybridModel
 from grazing.core.options import CELL_FRACTION, BasinSettings, refuse_unknown, with_shorthands
 from grazing.errors import InvalidParameterError
@@ -40,9 +41,6 @@ SEEDS = 8
 
 KEPT_POINTS = 256
 """Most points of each attractor at each value kept in the continuation's dataset."""
-
-OUTCOMES = ("escaping", "failed", "invalid")
-"""Kinds that are outcomes, not attractors: matched by kind and reason."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -98,15 +96,15 @@ def match(
         best = min(
             rivals, key=lambda q: (set_distance(_few(by_id[q].points), _few(now[c_id].points), cell), q)
         )
-        if best == p_id and c_id in now and now[c_id].kind not in OUTCOMES:
+        if best == p_id and c_id in now and not now[c_id].kind.outcome:
             out[c_id] = p_id
             taken.add(p_id)
     pairs = []
     for c in current:
         for p in previous:
-            if (c.kind in OUTCOMES) != (p.kind in OUTCOMES):
+            if c.kind.outcome != p.kind.outcome:
                 continue
-            if c.kind in OUTCOMES:
+            if c.kind.outcome:
                 if (c.kind, c.reason) == (p.kind, p.reason):
                     pairs.append((0.0, c.id, p.id))
                 continue
@@ -130,7 +128,7 @@ def _few(points: np.ndarray, most: int = 400) -> np.ndarray:
 def _seeds(attractors: Sequence[Attractor], most: int) -> tuple[np.ndarray, np.ndarray]:
     """Points of each attractor (not the outcomes), at most ``most`` each, as initial states; and the id of
     the attractor of each."""
-    chosen = [(a.id, _few(a.points, most)) for a in attractors if a.kind not in OUTCOMES and len(a.points)]
+    chosen = [(a.id, _few(a.points, most)) for a in attractors if not a.kind.outcome and len(a.points)]
     if not chosen:
         return np.zeros((0, 0)), np.zeros(0, dtype=np.int64)
     return np.concatenate([p for _, p in chosen]), np.concatenate([[i] * len(p) for i, p in chosen])
@@ -237,7 +235,7 @@ def continue_attractors(
         prev_ids = steps[-1].ids if steps else {}
         ids: dict[int, int] = {}
         for a in found.attractors:
-            if a.kind == "invalid":
+            if a.kind is AttractorKind.INVALID:
                 ids[a.id] = 0
             elif a.id in matched:
                 ids[a.id] = prev_ids[matched[a.id]]
@@ -258,7 +256,7 @@ def to_dataset(
     import xarray as xr
 
     shown = [
-        [a for a in st.found.attractors if a.kind not in OUTCOMES or st.fractions()[st.ids[a.id]] > 0]
+        [a for a in st.found.attractors if not a.kind.outcome or st.fractions()[st.ids[a.id]] > 0]
         for st in steps
     ]  # (an outcome of seeds alone, off the grid, is no attractor: left out)
     followed = sorted({st.ids[a.id] for st, atts in zip(steps, shown) for a in atts})
@@ -279,7 +277,7 @@ def to_dataset(
             j = col[st.ids[a.id]]
             present[i, j] = True
             fraction[i, j] = fr[st.ids[a.id]]
-            kind[i, j] = a.kind
+            kind[i, j] = str(a.kind)
             period[i, j] = a.period
             impacts[i, j] = a.impacts_per_period
             lyap[i, j] = a.lyapunov

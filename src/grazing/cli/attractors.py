@@ -250,18 +250,19 @@ def _settings(
 
 
 def _attractor_lines(atts: list[Any], model: grazing.HybridModel) -> list[str]:
+    from grazing.attractors.kinds import AttractorKind
     from grazing.plotting.attractors import describe
 
     lines = []
     for a in atts:
         words = describe(a.kind, a.period, a.impacts_per_period)
-        if a.reason and a.kind != "periodic":
+        if a.reason and a.kind is not AttractorKind.PERIODIC:
             words += f" ({a.reason})"
         if np.isfinite(a.lyapunov):
             words += f", lyapunov {a.lyapunov:+.4g}"
-        if a.kind == "neutral":
+        if a.kind is AttractorKind.NEUTRAL:
             words += " (a double multiplier 1: a family of motions, not an isolated attractor)"
-        if len(a.points) and a.kind not in ("chaotic", "quasiperiodic", "aperiodic"):
+        if len(a.points) and not a.kind.aperiodic:
             pt = ", ".join(f"{n} = {v:.6g}" for n, v in zip(model.state_names, a.points[0]))
             words += f"; at {pt}"
         lines.append(f"  {a.id}: {words}: {a.count} initial states ({100 * a.fraction:.2f}%)")

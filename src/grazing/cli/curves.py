@@ -186,6 +186,7 @@ def curve(
             for sp_ in result.special
         ],
         "status": result.status,
+        "outcomes": None if result.outcomes is None else [str(o) for o in result.outcomes],
         "start": {**_values(result, result.points[result.start_index].values), "index": result.start_index},
         "model": model.name,
         "model_params": model_params_json(model, case),

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from grazing.attractors.kinds import AttractorKind
 from grazing.core.model import HybridModel
 from grazing.errors import InvalidParameterError
 from grazing.explore.point import PointReport
@@ -68,7 +69,7 @@ def basins_at(point: PointReport, num: tuple[int, int] = BASIN_GRID) -> BasinVie
     lines = []
     columns = ("attractor", "kind", "period", "impacts_per_period", "fraction")
     for k, kind, period, ipp, fraction in zip(*(ds[c].values for c in columns)):
-        if kind == "invalid":
+        if kind == AttractorKind.INVALID:
             lines.append(f"beyond a stop (not run): {fraction:.1%} of the grid")
             continue
         what = f"period {period} with {ipp:g} impacts per period" if period > 0 else "no period"

@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from grazing.attractors.kinds import AttractorKind
 from grazing.core.model import HybridModel, Parameter
 from grazing.explore.basins import BasinView
 from grazing.explore.branch import Continued, Curves, Grazings, Mark
@@ -533,7 +534,7 @@ class Figures:
         }
         xs, ys, texts = [], [], []
         for k, pts in enumerate(found.points):
-            if found.kinds[k] == "invalid" or not len(pts):
+            if found.kinds[k] == AttractorKind.INVALID or not len(pts):
                 continue
             xs += (pts[:, 0] * sx).tolist()
             ys += (pts[:, 1] * sy).tolist()

@@ -15,7 +15,8 @@ import numpy as np
 from grazing.core.model import HybridModel
 from grazing.orbits.contact import GrazingPoint
 from grazing.orbits.continuation import Branch, SpecialPoint
-from grazing.orbits.kinds import CurveKind
+from grazing.orbits.kinds import CurveKind, TextEnum
+from grazing.orbits.palc import PalcEnd
 from grazing.orbits.shooting import PeriodicOrbit, unstable_count
 
 ACCURACY_NOTE = 1e-6
@@ -174,6 +175,66 @@ def bracket_between(
     return (interval[0][1] - interval[0][0], interval[1][1] - interval[1][0]), interval
 
 
+class CurveEnd(TextEnum):
+    """Why a bifurcation curve ends at one of its ends (:attr:`BifurcationCurve.outcomes`): a string equal
+    to the word ``curve --json`` writes (``outcomes``), its :attr:`message` in a few words; the curve's
+    :attr:`~BifurcationCurve.status` says it in full, with the values.
+
+    Examples
+    --------
+    >>> CurveEnd.GRAZING.message, f"{CurveEnd.RESONANCE_1_2}", CurveEnd.of(PalcEnd.BOUND)
+    ('ended at a grazing (a codimension-two point)', '1:2 resonance', 'bound')
+    """
+
+    BOUND = "bound"
+    GRAZING = "grazing"
+    """The orbit gains or loses an impact: the curve meets a grazing curve (a codimension-two point)."""
+    DOUBLE_GRAZING = "double grazing"
+    """A grazing curve's orbit meets another contact with a stop."""
+    RESONANCE_1_1 = "1:1 resonance"
+    """A Neimark-Sacker curve's pair of multipliers meets at +1 (beyond it: real, a neutral saddle)."""
+    RESONANCE_1_2 = "1:2 resonance"
+    """A Neimark-Sacker curve's pair of multipliers meets at -1."""
+    NOT_PERSISTENT = "not persistent"
+    """A branch point's shift leaves zero: the model lacks the symmetry that keeps it in two parameters."""
+    STUCK = "stuck"
+    """Newton's method failed beyond the last point: the step size fell below its minimum."""
+    RESECTION = "resection"
+    """The section had to move, with no points left to go on."""
+    NO_SECTION = "no section"
+    """The section had to move and the orbit could not be found on another one."""
+    MAX_POINTS = "max points"
+
+    @property
+    def message(self) -> str:
+        """The outcome in a few words."""
+        return _CURVE_END_MESSAGES[self]
+
+    @classmethod
+    def of(cls, end: PalcEnd | None) -> CurveEnd:
+        """The outcome of a direction whose last continuation ended with ``end`` (not at a
+        codimension-two point)."""
+        return {
+            PalcEnd.BOUND: cls.BOUND,
+            PalcEnd.STOPPED: cls.RESECTION,
+            PalcEnd.MAX_POINTS: cls.MAX_POINTS,
+        }.get(end, cls.STUCK)  # type: ignore[arg-type]
+
+
+_CURVE_END_MESSAGES = {
+    CurveEnd.BOUND: "reached a bound",
+    CurveEnd.GRAZING: "ended at a grazing (a codimension-two point)",
+    CurveEnd.DOUBLE_GRAZING: "ended at a double grazing",
+    CurveEnd.RESONANCE_1_1: "ended at a 1:1 resonance",
+    CurveEnd.RESONANCE_1_2: "ended at a 1:2 resonance",
+    CurveEnd.NOT_PERSISTENT: "the branch point does not persist in two parameters",
+    CurveEnd.STUCK: "Newton's method failed: the step size fell below its minimum",
+    CurveEnd.RESECTION: "the section had to move, with no points left",
+    CurveEnd.NO_SECTION: "the section could not be moved",
+    CurveEnd.MAX_POINTS: "maximum number of points reached",
+}
+
+
 @dataclass
 class BifurcationCurve:
     """A curve of bifurcations of a periodic orbit in two parameters (:func:`follow_curve`).
@@ -202,6 +263,9 @@ class BifurcationCurve:
         Its index among :attr:`points`.
     branch
         The one-parameter branch on which the start was found.
+    outcomes
+        What :attr:`status` says as two :class:`CurveEnd` (at the first point, at the last point); None
+        for a curve not followed by :func:`~grazing.orbits.curves.follow_curve`.
 
     Examples
     --------
@@ -231,6 +295,7 @@ class BifurcationCurve:
     start: SpecialPoint | None = None
     start_index: int = 0
     branch: Branch | None = None
+    outcomes: tuple[CurveEnd, CurveEnd] | None = None
 
     def __len__(self) -> int:
         return len(self.points)
@@ -311,6 +376,8 @@ class BifurcationCurve:
             "start_index": self.start_index,
             "grazing_version": grazing.__version__,
         }
+        if self.outcomes is not None:  # (their words, comma-separated as the params)
+            attrs["outcomes"] = ",".join(str(o) for o in self.outcomes)
         for name, v in self.model.params.items():
             if name not in self.params:
                 attrs[f"param_{name}"] = v

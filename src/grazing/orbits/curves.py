@@ -47,7 +47,7 @@ from grazing.orbits.continuation import (
     grazing_margin,
 )
 from grazing.orbits.crossings import contact_guess, meeting_point, nearest_grazing
-from grazing.orbits.curve_data import BifurcationCurve, CurvePoint, CurveSpecial, bracket_between
+from grazing.orbits.curve_data import BifurcationCurve, CurveEnd, CurvePoint, CurveSpecial, bracket_between
 from grazing.orbits.extended import CODIM2_TESTS, ENDING, Evaluation, GrazingSystem, OrbitSystem
 from grazing.orbits.kinds import CurveKind
 from grazing.orbits.palc import (
@@ -167,6 +167,7 @@ class _Direction:
         self.pal: list[PalcPoint] = []
         self.special: list[tuple[int, CurveSpecial]] = []  # (index of the point on the start's side, special)
         self.status = ""
+        self.outcome: CurveEnd | None = None  # (what the status says)
         self.handover: tuple[float, float] | None = None  # where it went over to multiple shooting
         self.segmented_start: float | None = None  # the monodromy's norm where it started on the segments
         self.reorders: list[str] = []  # where two impacts changed order (on the segments)
@@ -362,6 +363,7 @@ class _Follower:
                     system.accept(pt.payload)
                     continue
                 if abs(pt.payload.shift) > SHIFT_TOL:
+                    d.outcome = CurveEnd.NOT_PERSISTENT
                     return (
                         f"shift = {pt.payload.shift:.3g} at {self.show(self.curve_point(pt).values)}: the "
                         "branch point does not persist in two parameters (the model lacks the symmetry that "
@@ -374,7 +376,7 @@ class _Follower:
                 system.accept(pt.payload)
             if ended:
                 return d.status
-            d.status = palc.status
+            d.status, d.outcome = palc.status, CurveEnd.of(palc.end)
             last = d.pal[-1]
             assert last.tangent is not None
             sign = math.copysign(1.0, last.tangent[index]) if last.tangent[index] != 0 else sign
@@ -382,6 +384,7 @@ class _Follower:
                 try:
                     current = move_section(last.payload.orbit, quiet_section(last.payload.orbit))
                 except GrazingError as exc:
+                    d.outcome = CurveEnd.NO_SECTION
                     return f"{RESECTION} and the orbit could not be found on another section ({exc})"
                 continue
             if palc.boundary is None:
@@ -477,6 +480,7 @@ class _Follower:
                 if loc is not None:
                     self.append(d, loc)  # the curve ends at it: its last point
                 d.special.append((len(d.points) - 1, special))
+                d.outcome = CurveEnd(special.kind)  # (a resonance: its kind's word)
                 pair = "+1" if special.kind == "1:1 resonance" else "-1"
                 where = self.show(special.values) + ("" if special.located else " (bracketed only)")
                 d.status = (
@@ -616,6 +620,7 @@ class _Follower:
                         "this side)"
                     )
                 d.status = f"ended at a double grazing at {self.show(cp.values)}: {reason}"
+                d.outcome = CurveEnd.DOUBLE_GRAZING
                 return True
             return False
         orbit = before.payload.orbit
@@ -643,7 +648,7 @@ class _Follower:
             where += " (bracketed only: the grazing equations did not converge)"
         elif not exact:
             where += " (the grazing nearest the curve's last point: the meeting point did not converge)"
-        d.status = f"ended at a grazing at {where}: {reason}"
+        d.status, d.outcome = f"ended at a grazing at {where}: {reason}", CurveEnd.GRAZING
         return True
 
 
@@ -799,4 +804,6 @@ def _follow_from(
     specials += [(nb - 1 + i, s) for i, s in ahead.special]
     curve.special = [dataclasses.replace(s, index=i) for i, s in specials]
     curve.status = f"at the first point: {back.status}; at the last point: {ahead.status}"
+    assert back.outcome is not None and ahead.outcome is not None
+    curve.outcomes = (back.outcome, ahead.outcome)
     return curve

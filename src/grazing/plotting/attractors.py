@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from grazing.attractors.kinds import AttractorKind
 from grazing.plotting.labels import (
     dataset_parameter,
     param_label,
@@ -30,7 +31,8 @@ PALETTE = ("#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd", "#8c564b", "#e377c2", "#1
            "#aec7e8", "#ffbb78", "#98df8a", "#c5b0d5")  # fmt: skip
 """Colours of the attractors 1, 2, ... (then again)."""
 
-OUTCOME_COLORS = {"invalid": "#ffffff", "failed": "#d62728", "escaping": "#000000"}
+OUTCOME_COLORS = {AttractorKind.INVALID: "#ffffff", AttractorKind.FAILED: "#d62728",
+                  AttractorKind.ESCAPING: "#000000"}  # fmt: skip
 """Colours of the outcomes that are not attractors."""
 
 
@@ -57,11 +59,12 @@ def describe(kind: str, period: int, impacts: float) -> str:
     >>> describe("neutral", 1, 0.0)
     'neutral, period 1, no impacts'
     """
-    if kind in ("periodic", "neutral"):
+    if kind in (AttractorKind.PERIODIC, AttractorKind.NEUTRAL):
         n = round(float(impacts)) if np.isfinite(impacts) else -1
         imp = "no impacts" if n == 0 else ("1 impact" if n == 1 else f"{n} impacts" if n > 0 else "")
-        return ("neutral, " if kind == "neutral" else "") + f"period {period}" + (f", {imp}" if imp else "")
-    return kind
+        neutral = "neutral, " if kind == AttractorKind.NEUTRAL else ""
+        return neutral + f"period {period}" + (f", {imp}" if imp else "")
+    return str(kind)
 
 
 def _state_axes(ds: Any, degrees: bool) -> tuple[str, str, float, float]:
@@ -139,7 +142,7 @@ def plot_basins(ax: Axes, ds: Any, *, points: bool = True, legend: bool = True, 
                     mec="k", mew=0.7 if n <= 64 else 0.0, ls="none", zorder=3)  # fmt: skip
         words = describe(kind, int(ds.period.values[k]), float(ds.impacts_per_period.values[k]))
         why = str(ds.reason.values[k])
-        if why and kind != "periodic":
+        if why and kind != AttractorKind.PERIODIC:
             words += f" ({why})"
         if n and not _inside(pts[:, i] * xs, pts[:, j] * ys, box):
             words += " (outside the grid)"
@@ -212,7 +215,7 @@ def plot_fractions(ax: Axes, ds: Any, *, degrees: bool = True, legend: bool = Tr
     drawn = []
     for k, ident in enumerate(ds.attractor.values):
         kinds = [str(x) for x in ds.kind.values[:, k] if str(x)]
-        kind = max(set(kinds), key=kinds.count) if kinds else "periodic"
+        kind = max(set(kinds), key=kinds.count) if kinds else AttractorKind.PERIODIC
         if not ds.present.values[:, k].any():
             continue
         color = attractor_color(int(ident), kind)
@@ -220,7 +223,7 @@ def plot_fractions(ax: Axes, ds: Any, *, degrees: bool = True, legend: bool = Tr
         words = sorted(set(kinds), key=kinds.index)
         label = f"{int(ident)}: {', '.join(words)}"
         drawn.append(ax.fill_between(v, bottom, top, color=color, lw=0, label=label, step=None,
-                                     edgecolor="k" if kind == "invalid" else None))  # fmt: skip
+                                     edgecolor="k" if kind == AttractorKind.INVALID else None))  # fmt: skip
         only_seeds = ds.present.values[:, k] & (fr[:, k] == 0)
         if only_seeds.any():
             ax.plot(v[only_seeds], np.zeros(only_seeds.sum()), "^", color=color, mec="k", ms=6, clip_on=False)

@@ -24,6 +24,7 @@ import grazing
 from grazing.attractors import basins
 from grazing.attractors.classify import set_distance
 from grazing.attractors.grid import start_time
+from grazing.attractors.kinds import AttractorKind
 from grazing.core.options import SWEEP_TOL
 from grazing.core.period import detect_period
 from grazing.orbits import find_grazings
@@ -114,7 +115,7 @@ def _kinds(run: Run) -> dict[str, Any]:
     ds = run.basins
     out = {}
     for k in range(ds.attractor.size):
-        if str(ds.kind.values[k]) == "periodic" and int(ds.period.values[k]) == 1:
+        if str(ds.kind.values[k]) == AttractorKind.PERIODIC and int(ds.period.values[k]) == 1:
             out["impacting" if ds.impacts_per_period.values[k] > 0 else "nonimpacting"] = k
     return out
 
@@ -278,7 +279,7 @@ def cells_check(run: Run, s: Settings, cell: np.ndarray) -> Comparison:
         label = int(ds.label.values[j, i])
         k = int(np.flatnonzero(ds.attractor.values == label)[0])
         x0 = [float(ds.x.values[i]), float(ds.y.values[j])]
-        if str(ds.kind.values[k]) == "invalid":
+        if str(ds.kind.values[k]) == AttractorKind.INVALID:
             ok += 1
             continue
         sol = grazing.simulate(
