@@ -123,7 +123,7 @@ def _kinds(run: Run) -> dict[str, Any]:
 def draw(run: Run, s: Settings, path: Path) -> None:
     from matplotlib.lines import Line2D
 
-    from grazing.plotting.diagrams import DIRECTION_COLORS
+    from grazing.plotting.diagrams import DIRECTION_COLORS, DIRECTION_MARKERS
 
     fig, axes = new_figure(1, 2, (13.0, 4.8))
     ax1, ax2 = np.ravel(axes)
@@ -136,8 +136,17 @@ def draw(run: Run, s: Settings, path: Path) -> None:
     mark_grazings(ax1, [run.grazing_eta], labels=[f"grazing η = {run.grazing_eta:.4f}"])
     ax1.axvline(s.basin_eta, color="0.4", lw=0.8, ls=":")
     handles = [
-        Line2D([], [], ls="none", marker=".", ms=7, color=DIRECTION_COLORS["up"], label="swept up"),
-        Line2D([], [], ls="none", marker=".", ms=7, color=DIRECTION_COLORS["down"], label="swept down"),
+        *(
+            Line2D(
+                [],
+                [],
+                ls="none",
+                color=DIRECTION_COLORS[way],
+                label=f"swept {way}",
+                **{**DIRECTION_MARKERS[way], "ms": 1.6 * DIRECTION_MARKERS[way]["ms"]},
+            )
+            for way in ("up", "down")
+        ),  # (the plot's markers, a little larger)
         Line2D([], [], ls="none", marker="o", ms=5, mfc="none", mec="0.35", label="from rest (last sample)"),
     ]
     ax1.legend(handles=handles, loc="upper right", fontsize=8, frameon=False)
