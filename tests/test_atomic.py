@@ -68,3 +68,21 @@ def test_scratch_folders_of_dead_processes_are_removed_and_no_other(tmp_path):
     with scratch_folder(tmp_path):
         pass
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted([alive.name, mine.name])
+
+
+def test_a_temporary_left_by_a_killed_writer_is_removed_by_the_next_write(tmp_path):
+    """A process killed outright while it wrote ``t.csv`` left its temporary beside it (found by the signal
+    fuzz: ``simulate --trajectory t.csv`` killed, then run again); the next write of ``t.csv`` removes it,
+    and nothing else: a running process's temporary, a file not of grazing's form."""
+    from grazing.atomic import atomic_path
+
+    dead = tmp_path / ".t.csv.999999999-ab12.tmp"  # (a PID above any system's pid_max: gone)
+    alive = tmp_path / f".t.csv.{os.getpid()}-cd34.tmp"
+    theirs = tmp_path / ".t.csv.notes.tmp"
+    for p in (dead, alive, theirs):
+        p.write_text("x")
+    with atomic_path(tmp_path / "t.csv") as tmp:
+        assert f".t.csv.{os.getpid()}-" in tmp
+        with open(tmp, "w") as f:
+            f.write("done")
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([alive.name, theirs.name, "t.csv"])

@@ -113,6 +113,44 @@ def remove_stale_scratch(root: str | Path) -> list[Path]:
     )
 
 
+def remove_dead_temporaries(folder: str | Path, name: str, suffix: str = ".tmp") -> list[Path]:
+    """Remove the temporary files of :func:`atomic_path` for ``name`` in ``folder`` whose process is gone.
+
+    They are named ``.<name>.<pid>-<random><suffix>``: a process killed outright (SIGKILL) while it
+    wrote leaves one, which the next write of the same file removes.  Only regular files of that form
+    whose process no longer exists are touched.  Returns them.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> d = pathlib.Path(tempfile.mkdtemp())
+    >>> dead = d / ".t.csv.999999999-x1y2.tmp"; _ = dead.write_text("")     # (no such process)
+    >>> alive = d / f".t.csv.{os.getpid()}-x1y2.tmp"; _ = alive.write_text("")
+    >>> mine = d / ".t.csv.notapid.tmp"; _ = mine.write_text("")             # (not of that form)
+    >>> [p.name for p in remove_dead_temporaries(d, "t.csv")]
+    ['.t.csv.999999999-x1y2.tmp']
+    >>> alive.exists(), mine.exists(), dead.exists()
+    (True, True, False)
+    """
+    from grazing.parallel import pid_alive
+
+    prefix = f".{name}."
+    removed: list[Path] = []
+    try:
+        found = [p for p in Path(folder).iterdir() if p.name.startswith(prefix) and p.name.endswith(suffix)]
+    except OSError:
+        return removed
+    for p in found:
+        pid = p.name[len(prefix) :].split("-", 1)[0]
+        if "-" not in p.name[len(prefix) :] or not pid.isdigit() or pid_alive(int(pid)):
+            continue
+        with suppress(OSError):
+            if p.is_file() and not p.is_symlink():
+                p.unlink()
+                removed.append(p)
+    return removed
+
+
 def _temporary_folder(path: Path) -> Path:
     """The folder of ``path``'s temporary file: the scratch folder of an enclosing root, else its own."""
     folder = path.parent if str(path.parent) else Path(".")
@@ -158,8 +196,9 @@ def atomic_path(path: str | Path, suffix: str = ".tmp") -> Iterator[str]:
     shown = Path(path)
     path = resolved(shown)
     folder = _temporary_folder(path)
+    remove_dead_temporaries(folder, path.name, suffix)
     try:
-        fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{path.name}.", suffix=suffix)
+        fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{path.name}.{os.getpid()}-", suffix=suffix)
     except OSError as exc:
         raise _write_error(shown, exc) from None
     os.close(fd)

@@ -164,6 +164,26 @@ def test_sigterm_while_the_command_line_is_imported():
     assert (done.returncode, done.stderr) == (143, "grazing: terminated\n")
 
 
+def test_a_sigterm_that_an_import_turns_into_its_own_error_ends_as_terminated():
+    """A SIGTERM while an extension module is imported is raised inside its initialisation, which turns it
+    into its own error (scipy's HiGHS: ``ImportError: initialization failed``, found by the signal fuzz
+    on ``iso-damping``): one line and 143 all the same, not the import's traceback."""
+    script = (
+        "import signal, sys, _grazing_entry\n"
+        "import grazing.experiment.damping as damping\n"
+        "def importing(*args, **kwargs):\n"
+        "    try:\n"
+        "        signal.raise_signal(signal.SIGTERM)\n"
+        "    except BaseException:\n"
+        "        raise ImportError('initialization failed') from None\n"
+        "damping.iso_damping = importing\n"
+        "sys.argv = ['grazing', 'iso-damping', '--num', '10']\n"
+        "sys.exit(_grazing_entry.main())\n"
+    )
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=False)
+    assert (done.returncode, done.stderr) == (143, "grazing: terminated\n")
+
+
 def test_a_folder_left_by_a_killed_synthesize_is_removed_by_the_next_run(warm, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     dead = tmp_path / ".recs.partial-999999999-abc123"  # (a PID above any system's pid_max: gone)

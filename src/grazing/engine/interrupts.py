@@ -97,9 +97,26 @@ def interruptibly(make: Callable[[], T]) -> T:
     return done["value"]
 
 
+_TERMINATED: list[bool] = []
+"""Set when :func:`raise_terminated` has run since the last :func:`terminating_as_interrupted` block began
+(:func:`was_terminated`)."""
+
+
 def raise_terminated(_signum: int, _frame: object) -> None:
-    """The SIGTERM handler of :func:`terminating_as_interrupted`: raise :class:`Terminated`."""
+    """The SIGTERM handler of :func:`terminating_as_interrupted`: raise :class:`Terminated` (and remember
+    it: :func:`was_terminated`)."""
+    _TERMINATED.append(True)
     raise Terminated
+
+
+def was_terminated() -> bool:
+    """Has a SIGTERM been raised as :class:`Terminated` since the last :func:`terminating_as_interrupted`
+    block began (it stays known after the block, for the caller's handler)?
+
+    An extension module being imported when the signal comes turns the exception into its own (scipy's
+    HiGHS: ``ImportError: initialization failed``): the command line ends as terminated all the same.
+    """
+    return bool(_TERMINATED)
 
 
 @contextmanager
@@ -123,6 +140,7 @@ def terminating_as_interrupted() -> Iterator[None]:
     if threading.current_thread() is not threading.main_thread():
         yield
         return
+    _TERMINATED.clear()
     previous = signal.getsignal(signal.SIGTERM)
     if previous != signal.SIG_DFL:
         yield
