@@ -116,6 +116,7 @@ def simulate(
     >>> grazing.simulate(model, sol.x_final, save=save, tangent=tangent).jacobian.shape
     (2, 3)
     """
+    model.require_one_mode("simulation")
     used: set[str] = set()
     save = with_shorthands(save, SaveAt, shorthands, used)
     tangent = with_shorthands(tangent, Tangent, shorthands, used)
