@@ -87,6 +87,7 @@ class Totals(NamedTuple):
     k: int
     s: float
     mode: int
+    vf: int
     steps: int
     n_impacts: int
     samples_kept: int
@@ -115,7 +116,8 @@ def _rows(table: np.ndarray, count: int) -> np.ndarray:
 def result(out: RunOutput, t: Totals) -> Result:
     """The :class:`~grazing.engine.records.Result` of a run written into ``out`` (whose tables hold it)."""
     return Result(
-        status=t.status, x=out.x, V=out.V, k=t.k, s=t.s, mode=t.mode, steps=t.steps, n_impacts=t.n_impacts,
+        status=t.status, x=out.x, V=out.V, k=t.k, s=t.s, mode=t.mode, vf=t.vf, steps=t.steps,
+        n_impacts=t.n_impacts,
         samples=_rows(out.samples, t.samples_kept), impacts=_rows(out.impacts, t.impact_rows),
         sticking=_rows(out.sticking, t.sticking_rows), trajectory=_rows(out.trajectory, t.trajectory_rows),
         log_sums=out.log_sums, lyap_span=t.lyap_span, guard_min=out.guard_min,

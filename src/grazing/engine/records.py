@@ -35,6 +35,7 @@ RUN_TOTALS = np.dtype(
         ("k", "i8"),  # the end: whole periods ...
         ("s", "f8"),  # ... and local time
         ("mode", "i8"),  # the contact mode at the end
+        ("vf", "i8"),  # the active mode (vector field) at the end
         ("steps", "i8"),
         ("n_impacts", "i8"),  # over the whole run
         ("samples_kept", "i8"),  # rows of RunOutput.samples written
@@ -60,6 +61,7 @@ class Start(NamedTuple):
     k: int  # whole periods
     s: float  # local time in [0, T) (periodic models) or the time
     mode: int  # 0 free flight, 1 + j sticking to stop j
+    vf: int  # the active mode (vector field) of a model with modes (0 for one mode)
 
 
 class Config(NamedTuple):
@@ -125,6 +127,10 @@ class Kernels(NamedTuple):
     order: int  # of the Taylor polynomials
     sticks: BOOL_1  # bool per stop: the stop has a sticking mode
     lanes: int  # lanes of the lane functions (0: none)
+    nmodes: int  # modes (vector fields): the flow's functions take the active one as their last argument
+    rows: I8_2  # (modes, event rows): the transition (stop) of each row of a mode's kernels, -1 padding
+    targets: I8_1  # per transition (stop): the mode it enters
+    resets: BOOL_1  # per transition (stop): it has a reset (an impact); else a switch of vector field
 
 
 class Result(NamedTuple):
@@ -136,6 +142,7 @@ class Result(NamedTuple):
     k: int
     s: float
     mode: int
+    vf: int  # the active mode (vector field)
     steps: int
     n_impacts: int  # over the whole run
     samples: np.ndarray  # (kept samples, n)

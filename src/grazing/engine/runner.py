@@ -204,6 +204,7 @@ class Runner:
         T = self.T
         s_phase = (phase % (2 * math.pi)) / (2 * math.pi) * T
         self.mode = 0
+        self.vf = 0  # the active mode (vector field) of a model with modes
         self.k, self.s, self.ks, self.ss = start_times(float(t0), T, s_phase, bool(model.periodic))
         self.k_start = self.k
 
@@ -275,7 +276,7 @@ class Runner:
         T = self.T
         if max_steps is None:
             max_steps = step_limit(periods)
-        start = (self.x, self.V, self.k, self.s, self.mode)  # a records.Start, as a plain tuple
+        start = (self.x, self.V, self.k, self.s, self.mode, self.vf)  # a records.Start, as a plain tuple
         call = dict(
             max_steps=int(max_steps), n_samples=periods, ks=self.ks, ss=float(self.ss), n_keep=keep,
             lyapunov=bool(lyapunov), traj_dt=T / trajectory if trajectory else 0.0, track_min=bool(guard_min),
@@ -288,7 +289,7 @@ class Runner:
             raise SimulationError(
                 Status(int(out.status)).message(out.k * T + out.s, max_steps, self.model, out.x)
             )
-        self.x, self.V, self.k, self.s, self.mode = out.x, out.V, out.k, out.s, out.mode
+        self.x, self.V, self.k, self.s, self.mode, self.vf = out.x, out.V, out.k, out.s, out.mode, out.vf
         self.touch_start = False  # only the first call starts at the contact
         if self.model.periodic:
             self.ks += periods

@@ -29,8 +29,10 @@ from grazing.engine.stepping import append_pair, append_record, append_row, pack
 
 
 @njit(cache=True)
-def saltation(m, xm, xp, s, pv, j, V, ncol):
+def saltation(m, xm, xp, s, pv, j, V, ncol, vf_from, vf_to):
     """Apply the saltation matrix of stop ``j`` (paper eq. 14, with time and parameter terms) to V.
+
+    ``f-`` is mode ``vf_from``'s field at ``xm``, ``f+`` mode ``vf_to``'s at ``xp``.
 
     Returns False, leaving V alone, for an impact at zero normal speed (``L_f h = 0``): there the
     saltation matrix is unbounded and the flow's Jacobian does not exist.
@@ -39,8 +41,8 @@ def saltation(m, xm, xp, s, pv, j, V, ncol):
     nsens = m.nsens
     fm = np.empty(n)
     fp = np.empty(n)
-    rhs(m, xm, s, pv, fm)
-    rhs(m, xp, s, pv, fp)
+    rhs(m, xm, s, pv, fm, vf_from)
+    rhs(m, xp, s, pv, fp, vf_to)
     Gx = np.zeros((n, n))
     Gt = np.zeros(n)
     Gp = np.zeros((n, max(nsens, 1)))
@@ -133,7 +135,7 @@ def apply_impact(m, r, x, xp, pv, j, nrows, V, record, tables):
     reset(m, x, s, pv, xp, j)
     if r.use_var:
         unpack_var(x, n, ncol, V)
-        jac_ok = saltation(m, x, xp, s, pv, j, V, ncol)
+        jac_ok = saltation(m, x, xp, s, pv, j, V, ncol, r.vf, m.targets[j])
         pack_var(V, n, ncol, xp)
     else:
         jac_ok = True

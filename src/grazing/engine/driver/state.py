@@ -38,6 +38,7 @@ RUN_STATE = np.dtype(
         ("s", np.float64),
         ("mode", np.int64),  # 0 free flight, 1 sticking
         ("stuck", np.int64),  # the stop it sticks to
+        ("vf", np.int64),  # the active mode (vector field) of a model with modes (0 for one mode)
         ("defl", np.int64),  # known roots at u = 0 of the next step's event polynomial (0 none)
         ("defl_stop", np.int64),  # ... of this stop's guard
         ("steps", np.int64),
