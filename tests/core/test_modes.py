@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 import sympy as sp
 
@@ -248,6 +249,27 @@ def test_sticking_field_is_the_equivalent_control_on_the_contact_manifold():
     assert all(sp.simplify(a_ - b_) == 0 for a_, b_ in zip(s.sticking_field(), expected))
 
 
+def test_vector_field_per_mode_and_the_saltation_of_a_switch():
+    m = soft()
+    p = dict(m.params)
+    xs, ts = np.array([p["gap"], 0.7]), 0.3
+    forcing = p["a"] * np.cos(p["omega"] * ts)
+    f_free = np.array([0.7, -2 * p["zeta"] * 0.7 - p["gap"] + forcing])
+    f_contact = f_free - np.array([0.0, p["c"] * 0.7])  # (k (x - gap) = 0 on the surface)
+    assert np.allclose(m.vector_field(xs, ts), f_free, rtol=0, atol=1e-15)
+    assert np.allclose(m.vector_field(xs, ts, mode="contact"), f_contact, rtol=0, atol=1e-15)
+    hx = np.array([-1.0, 0.0])  # touch: h = gap - x
+    expected = np.eye(2) + np.outer(f_contact - f_free, hx) / (hx @ f_free)
+    assert np.allclose(m.saltation(xs, ts, "touch"), expected, rtol=0, atol=1e-14)
+    assert abs(expected[1, 0]) > 0.1  # (the damper's jump: S is not I)
+    back = np.array([p["gap"], -0.7])  # leave: h = x - gap, from contact to free
+    f_c, f_f = m.vector_field(back, ts, "contact"), m.vector_field(back, ts, "free")
+    expected = np.eye(2) + np.outer(f_f - f_c, -hx) / (-hx @ f_c)
+    assert np.allclose(m.saltation(back, ts, "leave"), expected, rtol=0, atol=1e-14)
+    with pytest.raises(InvalidParameterError, match="unknown mode 'stuck'"):
+        m.vector_field(xs, ts, mode="stuck")
+
+
 def test_check_state_per_mode():
     m = soft()
     assert m.check_state([0.0, 1.0]).tolist() == [0.0, 1.0]
@@ -278,5 +300,14 @@ def test_features_not_yet_on_modes_are_refused_in_one_line():
         InvalidParameterError, match=r"^finding a periodic orbit does not support models with modes"
     ):
         find_orbit(m, [0.0, 0.0], period=1)
-    with pytest.raises(InvalidParameterError, match=r"^simulation does not support models with modes yet"):
-        grazing.simulate(m, [0.0, 0.0], periods=1)
+    with pytest.raises(InvalidParameterError, match=r"^the discontinuity map does not support models"):
+        grazing.simulate(m, [0.0, 0.0], periods=1, zdm=object())
+    from grazing.normalform import find_grazing_point
+    from grazing.orbits import find_grazings, grazing_curve
+
+    with pytest.raises(InvalidParameterError, match=r"^the grazing analysis does not support models with"):
+        find_grazing_point(m, "omega", 1.0, 1.5)
+    with pytest.raises(InvalidParameterError, match=r"^the grazing analysis does not support models with"):
+        find_grazings(m, "omega", 1.0, 1.5)
+    with pytest.raises(InvalidParameterError, match=r"^the grazing curve does not support models with"):
+        grazing_curve(m, ("omega", "gap"), 1.0, search=(1.0, 1.5))

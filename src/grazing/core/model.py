@@ -710,6 +710,20 @@ class HybridModel:
         Where the model comes from (a paper, a book), for the reader.
     values
         Parameter values (defaults from ``parameters``).
+    modes
+        Several vector fields instead of ``vector_field``: a list of
+        :class:`Mode` (name, field, the impacts within it as stops).  Their
+        stops and then ``transitions`` and ``surfaces`` are the model's
+        transitions (:attr:`stop_names`, in that order: per mode its stops and
+        the transitions leaving it, then each surface's two).
+    transitions
+        With ``modes``: switches from one mode to another when a guard
+        reaches 0 (:class:`Transition`, with or without a reset).
+    surfaces
+        With ``modes``: switching surfaces crossed both ways without a reset
+        (:class:`Surface`).
+    initial_mode
+        With ``modes``: the mode a run starts in by default (the first).
 
     Examples
     --------
@@ -739,6 +753,18 @@ class HybridModel:
     ...     stops=[Stop("right", 1 - x, [x, -r * v]), Stop("left", x + 1, [x, -r * v])])
     >>> two.stop_names
     ('right', 'left')
+
+    A compliant stop: a second vector field beyond ``x = sigma``, entered and left without a reset:
+
+    >>> from grazing import Mode, Transition
+    >>> soft = HybridModel(
+    ...     "soft", [x, v], t, [Parameter("omega", 1.5, lower=0, lower_open=True), Parameter("sigma", 0.5)],
+    ...     modes=[Mode("free", [v, -x + sp.cos(w * t)]),
+    ...            Mode("contact", [v, -x - 20 * (x - sigma) + sp.cos(w * t)])],
+    ...     transitions=[Transition("touch", "free", "contact", sigma - x),
+    ...                  Transition("leave", "contact", "free", x - sigma)], period=2 * sp.pi / w)
+    >>> soft.mode_names, soft.stop_names, soft.transition_target
+    (('free', 'contact'), ('touch', 'leave'), ('contact', 'free'))
     """
 
     def __init__(
@@ -1170,10 +1196,15 @@ class HybridModel:
         fn = self._def.numeric(what, stop)
         return fn(list(np.asarray(x, dtype=float)), float(t), list(self.param_vector))
 
-    def vector_field(self, x: Any, t: float = 0.0) -> np.ndarray:
-        """``f(x, t)`` (evaluated by the compiled kernels)."""
+    def vector_field(self, x: Any, t: float = 0.0, mode: str | None = None) -> np.ndarray:
+        """``f(x, t)`` of ``mode`` (the initial mode by default; evaluated by the compiled kernels)."""
         out = np.empty(self.n_states)
-        self._def.scalar_kernels().rhs(np.ascontiguousarray(x, dtype=float), float(t), self.param_vector, out)
+        x = np.ascontiguousarray(x, dtype=float)
+        if self.has_modes:
+            self._def.scalar_kernels().rhs(x, float(t), self.param_vector, out, self.mode_index(mode))
+        else:
+            self.mode_index(mode)  # (only the one mode's name)
+            self._def.scalar_kernels().rhs(x, float(t), self.param_vector, out)
         return out
 
     def guard(self, x: Any, t: float = 0.0, stop: int | str | None = None) -> float:
@@ -1212,7 +1243,7 @@ class HybridModel:
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(f_x, h_x, g_x)`` at ``(x, t)`` for a stop."""
         n, j = self.n_states, self.stop_index(stop)
-        fx = np.asarray(self._call("f_x", x, t), dtype=float).reshape(n, n)
+        fx = np.asarray(self._call("f_x", x, t, j if self.has_modes else 0), dtype=float).reshape(n, n)
         hx = np.asarray(self._call("h_x", x, t, j), dtype=float).reshape(n)
         gx = np.asarray(self._call("g_x", x, t, j), dtype=float).reshape(n, n)
         return fx, hx, gx
@@ -1221,12 +1252,16 @@ class HybridModel:
         """Saltation matrix (paper eq. 14) of an impact at ``x`` on the stop.
 
         ``S = g_x + (f(g(x)) - g_x f(x) - g_t) h_x / (h_x f(x) + h_t)``; the
-        time terms vanish for autonomous guards and resets, giving eq. 14.
+        time terms vanish for autonomous guards and resets, giving eq. 14.  In
+        a model with modes ``stop`` is any transition, ``f(x)`` its source
+        mode's field and ``f(g(x))`` its target's (a switch without a reset:
+        ``S = I + (f+ - f-) h_x / (h_x f- + h_t)``).
         """
         j = self.stop_index(stop)
         _, hx, gx = self.jacobians(x, t, j)
-        fm = self.vector_field(x, t)
-        fp = self.vector_field(self.reset(x, t, j), t)
+        source, target = self.transition_source[j], self.transition_target[j]
+        fm = self.vector_field(x, t, source if self.has_modes else None)
+        fp = self.vector_field(self.reset(x, t, j), t, target if self.has_modes else None)
         gt = np.asarray(self._call("g_t", x, t, j), dtype=float).reshape(-1)
         ht = float(self._call("h_t", x, t, j))
         return gx + np.outer(fp - gx @ fm - gt, hx) / (hx @ fm + ht)

@@ -317,7 +317,7 @@ class SymbolicSystem:
     def filippov_field(self, index: int) -> tuple[sp.Expr, ...]:
         """The sliding vector field on surface ``index`` (Filippov's convex combination).
 
-        ``f_s = f_+ + a (f_- - f_+)`` with ``a = L_+ h / (L_+ h - L_- h)``, where
+        ``f_s = f_+ + w (f_- - f_+)`` with ``w = L_+ h / (L_+ h - L_- h)``, where
         ``f_+`` is the field of the side ``h > 0`` and ``f_-`` that of ``h < 0``
         and the Lie derivatives include ``dh/dt``: ``L_{f_s} h = 0`` identically,
         so the flow of ``f_s`` stays on the surface.
@@ -325,8 +325,8 @@ class SymbolicSystem:
         pos, neg = self.surface_sides(index)
         h = self.surfaces[index].h
         lp, ln = pos.lie(h), neg.lie(h)
-        alpha = lp / (lp - ln)
-        return tuple(fp + alpha * (fn - fp) for fp, fn in zip(pos.vector_field, neg.vector_field))
+        weight = lp / (lp - ln)
+        return tuple(fp + weight * (fn - fp) for fp, fn in zip(pos.vector_field, neg.vector_field))
 
     def exit_rows(self, index: int) -> tuple[sp.Expr, sp.Expr]:
         """``(-L_+ h, L_- h)`` of surface ``index``: both positive while sliding, one reaches 0 at an exit."""

@@ -186,7 +186,8 @@ class ModelSource:
         ``nx``, ``nsens``, ``nparams``, ``nstops``, ``order`` and ``sticks``
         (per stop: it has a sticking mode); with several modes also ``nmodes``,
         ``rows`` (per mode, the transition of each of its event rows, -1 for
-        padding), ``targets`` and ``resets`` (per transition).
+        padding), ``targets``, ``resets`` and ``back`` (per transition: the
+        switch back whose guard is 0 right after it, -1 none).
     """
 
     text: str
@@ -308,9 +309,17 @@ def generate_source(system: SymbolicSystem, directions: int = 0, order: int = DE
         "sticks": [j in sticky for j in every],
     }  # fmt: skip
     if nmodes > 1:  # (a model of one mode: ModelKernels' defaults)
+        back = [
+            next(
+                (i for i in every if sys_.sources[i] == sys_.targets[j] and not sys_.resets[i]
+                 and sp.simplify(guards[i] + guards[j]) == 0),
+                -1,
+            ) if not sys_.resets[j] else j
+            for j in every
+        ]  # fmt: skip
         sizes.update(
             nmodes=nmodes, rows=[r + [-1] * (width - len(r)) for r in rows], targets=list(sys_.targets),
-            resets=list(sys_.resets),
+            resets=list(sys_.resets), back=back,
         )  # fmt: skip
     return ModelSource("\n\n".join(parts), columns, dispatch, sizes)
 
@@ -555,9 +564,10 @@ class ModelKernels:
         self.ROWS = np.array(sizes.get("rows", [every]), dtype=np.int64).reshape(self.NMODES, -1)
         self.TARGETS = np.array(sizes.get("targets", [0] * self.NSTOPS), dtype=np.int64)
         self.RESETS = np.array(sizes.get("resets", [True] * self.NSTOPS), dtype=bool)
+        self.BACK = np.array(sizes.get("back", every), dtype=np.int64)
         self.table = (
             fns, self.NX, self.NSENS, self.NSTOPS, self.ORDER, sticks, self.LANES, self.NMODES, self.ROWS,
-            self.TARGETS, self.RESETS,
+            self.TARGETS, self.RESETS, self.BACK,
         )  # fmt: skip
         for name in SLOTS:
             setattr(self, name, library.function(name))

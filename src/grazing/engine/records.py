@@ -44,6 +44,7 @@ RUN_TOTALS = np.dtype(
         ("trajectory_rows", "i8"),
         ("lyap_span", "f8"),  # the time the Lyapunov sums are over
         ("jacobian_valid", "?"),
+        ("switch_rows", "i8"),  # rows the switches table needs
     ],
     align=True,
 )
@@ -131,6 +132,7 @@ class Kernels(NamedTuple):
     rows: I8_2  # (modes, event rows): the transition (stop) of each row of a mode's kernels, -1 padding
     targets: I8_1  # per transition (stop): the mode it enters
     resets: BOOL_1  # per transition (stop): it has a reset (an impact); else a switch of vector field
+    back: I8_1  # per switch: the transition whose guard is 0 just after it (-1: none)
 
 
 class Result(NamedTuple):
@@ -153,6 +155,7 @@ class Result(NamedTuple):
     lyap_span: float
     guard_min: np.ndarray  # per stop (rows): [h, t, state..., h_approach, t_approach, state...]
     jacobian_valid: bool
+    switches: np.ndarray  # rows [t, transition, state...]: switches of vector field without a reset
 
 
 class RunOutput(NamedTuple):
@@ -173,6 +176,7 @@ class RunOutput(NamedTuple):
     trajectory: F8_2  # (rows, 1 + n): [t, state...]
     log_sums: F8_1  # (n,): Lyapunov sums
     guard_min: F8_2  # (stops, 2 (2 + n)): per stop [h, t, state..., h_approach, t_approach, state...]
+    switches: F8_2  # (rows, 2 + n): [t, transition, state...] at each switch without a reset
 
 
 INTEGRATE_ARGUMENTS = (Start, ("pv", F8_1), Config, Kernels, RunOutput)

@@ -184,7 +184,8 @@ def sweep_lanes(m, cfg, work, points, out):
     imp = new_table(1, 3 + n)  # (impacts are counted, not recorded)
     sticks = new_table(1, 2)
     traj = new_table(1, 1 + n)
-    tables = (imp, sticks, traj)
+    switches = new_table(1, 2 + n)
+    tables = (imp, sticks, traj, switches)
     fbuf = np.zeros(n)
     Tp = np.zeros(0)  # (no sensitivities on lanes: end_step's period term is never taken)
     kinds = np.zeros(L, dtype=np.int64)  # 0 sticking or idle, 1 free flight, 2 with the variational equations

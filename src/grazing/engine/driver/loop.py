@@ -134,11 +134,12 @@ def integrate(start, pv, cfg, m, out):
     imp = new_table(16, 3 + n)
     sticks = new_table(4, 2)
     traj = new_table(64 if traj_dt > 0.0 else 1, 1 + n)
+    switches = new_table(16 if m.nmodes > 1 else 1, 2 + n)
     logs = out.log_sums
     logs[:] = 0.0
     scratch = np.zeros(n)
     guard_info = new_guard_info(nstops, n)  # per stop: the guard's minimum, closest approach, slopes
-    tables = (imp, sticks, traj)
+    tables = (imp, sticks, traj, switches)
     fbuf = np.empty(n)
     zdm_gh = np.zeros(n)
     zdm_gv = np.zeros(n)
@@ -237,6 +238,7 @@ def finish_run(m, runs, cfg, x, pv, guard_info, tables, out):
     tot.trajectory_rows = r.n_traj
     tot.lyap_span = r.k * T + r.s - r.lyap_t0 if (cfg.lyapunov and r.lyap_started) else 0.0
     tot.jacobian_valid = r.jac_valid
+    tot.switch_rows = r.n_switch
     for i in range(n):
         out.x[i] = x[i]
     out.V[:, :] = 0.0
@@ -245,6 +247,7 @@ def finish_run(m, runs, cfg, x, pv, guard_info, tables, out):
     copy_rows(tables[0], r.n_imp_rec, out.impacts)
     copy_rows(tables[1], r.n_stick, out.sticking)
     copy_rows(tables[2], r.n_traj, out.trajectory)
+    copy_rows(tables[3], r.n_switch, out.switches)
     out.guard_min[:, :] = guard_info[:, : out.guard_min.shape[1]]
 
 
@@ -254,7 +257,7 @@ def start_run(m, r, start, cfg, x, tables):
 
     A run whose recorded span starts at once records its first trajectory
     point, and a sticking interval if it starts sticking (``tables`` =
-    ``(impacts, sticking, trajectory)``).
+    ``(impacts, sticking, trajectory, switches)``).
     """
     n = m.nx
     T = cfg.T
@@ -283,6 +286,7 @@ def start_run(m, r, start, cfg, x, tables):
     r.n_imp_rec = 0
     r.n_stick = 0
     r.n_traj = 0
+    r.n_switch = 0
     r.kt = r.k
     r.st = r.s
     r.kz = r.k if r.s < cfg.zdm_s - SNAP * T else r.k + 1

@@ -68,6 +68,7 @@ RUN_STATE = np.dtype(
         ("n_imp_rec", np.int64),  # ... recorded
         ("n_stick", np.int64),  # sticking intervals recorded
         ("n_traj", np.int64),  # trajectory points recorded
+        ("n_switch", np.int64),  # switches of vector field recorded
         ("kt", np.int64),
         ("st", np.float64),
         # a sweep's point (lanes.sweep_lanes)
