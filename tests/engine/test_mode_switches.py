@@ -153,3 +153,18 @@ def test_parameter_sensitivities_across_switches_against_differences_of_the_exac
             name,
             fd,
         )
+
+
+def test_opposing_fields_end_in_one_line_not_a_hang():
+    """Fields pushing into each other switch at zero time: a one-line error naming the modes."""
+    model = HybridModel(
+        "opposing", [x, v], t, [Parameter("omega", 1.0, lower=0, lower_open=True)], period=2 * sp.pi / w,
+        modes=[Mode("up", [-1 + 0 * v, sp.cos(w * t)]), Mode("down", [1 + 0 * v, sp.cos(w * t)])],
+        transitions=[Transition("touch", "up", "down", x), Transition("leave", "down", "up", -x)],
+    )  # fmt: skip
+    with pytest.raises(grazing.SimulationError) as info:
+        grazing.simulate(model, [1.0, 0.0], periods=3)
+    message = str(info.value)
+    assert (
+        "modes 'down', 'up' switch back and forth at zero time at t = 1 " in message and "\n" not in message
+    )

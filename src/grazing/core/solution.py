@@ -113,6 +113,15 @@ def accumulation_message(model: HybridModel, x: Any, t: float) -> str:
     tol = ON_STOP_TOL * max(1.0, float(np.max(np.abs(state), initial=0.0)))
     on = [j for j, h in enumerate(model.guards(state, t)) if abs(h) <= tol]
     names = [repr(model.stop_names[j]) for j in on]
+    switching = [j for j in on if model.transition_source[j] != model.transition_target[j]]
+    if model.has_modes and switching:  # two modes whose fields push into each other
+        modes = sorted(
+            {m for j in switching for m in (model.transition_source[j], model.transition_target[j])}
+        )
+        return (
+            f"modes {', '.join(map(repr, modes))} switch back and forth at zero time at t = {t:.6g} (their "
+            "fields push into each other): sliding between modes is not supported yet"
+        )
     sticks = model.kernels().STICKS
     if len(on) >= 2:
         return (
