@@ -13,7 +13,7 @@ from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
 from grazing import models
-from grazing.core import HybridModel, Impacts, Parameter, Solution, Stop
+from grazing.core import HybridModel, Impacts, Mode, Parameter, Solution, Stop, Surface, Transition
 from grazing.core.model import set_kernel_loader
 from grazing.core.options import SaveAt, Solver, SweepSettings, Tangent
 from grazing.core.period import detect_period
@@ -78,14 +78,17 @@ __all__ = [
     "Impacts",
     "InvalidParameterError",
     "InvalidStateError",
+    "Mode",
     "Parameter",
     "SaveAt",
     "SimulationError",
     "Solution",
     "Solver",
     "Stop",
+    "Surface",
     "SweepSettings",
     "Tangent",
+    "Transition",
     "UnsupportedExpressionError",
     "__version__",
     "detect_period",

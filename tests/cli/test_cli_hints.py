@@ -22,6 +22,10 @@ of an f-string before its value (``f"period={n}"``)."""
 PYTHON_ONLY = {
     "stops=": "HybridModel's: a model file, Python on the command line too",
     "contact_direction=": "HybridModel's, as stops=",
+    "vector_field=": "HybridModel's, as stops=",
+    "transitions=": "HybridModel's (a model with modes), as stops=",
+    "surfaces=": "HybridModel's (a model with modes), as stops=",
+    "initial_mode=": "HybridModel's (a model with modes), as stops=",
     "cell=": "find_attractors' cell sizes (the command line's --cell is cell_fraction=)",
 }
 """Arguments the library's messages ask for that have no option: where they are given."""

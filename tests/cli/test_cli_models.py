@@ -155,6 +155,27 @@ def test_a_model_from_a_file(tmp_path, capsys):
         assert code != 0 and msg in err and err.count("\n") == 1
 
 
+def test_a_model_with_modes_is_refused_in_one_line(tmp_path, capsys):
+    path = tmp_path / "soft.py"
+    path.write_text(
+        "import sympy as sp\n"
+        "from grazing import HybridModel, Mode, Parameter, Transition\n"
+        "x, v, t, w = sp.symbols('x v t w')\n"
+        "SOFT = HybridModel('soft', [x, v], t, [Parameter('w', 1.3, lower=0, lower_open=True)],\n"
+        "    modes=[Mode('free', [v, -x + sp.cos(w * t)]), Mode('contact', [v, -5 * x + 2])],\n"
+        "    transitions=[Transition('touch', 'free', 'contact', 0.5 - x),\n"
+        "                 Transition('leave', 'contact', 'free', x - 0.5)], period=2 * sp.pi / w)\n"
+    )
+    for command in (
+        ["simulate"],
+        ["orbit"],
+        ["sweep", "--param", "w", "--start", "1", "--stop", "1.2", "--num", "3"],
+    ):
+        code, out, err = run([*command, "--model", f"{path}:SOFT"], capsys)
+        assert code != 0 and out == "" and err.count("\n") == 1, (command, err)
+        assert "has modes (free, contact): the command line does not support models with modes yet" in err
+
+
 @pytest.mark.parametrize(
     "argv, msg",
     [

@@ -261,7 +261,7 @@ def run_arguments(model, x0, periods=3, keep=3, variational=False, impacts="all"
     cfg = Config(*(call[name] for name in Config._fields[: len(call)]), *r._static, interrupts.SIGINTS, seen)
     rows = outputs.TableRows.guess(cfg)
     out = outputs.allocate(model.n_states, r.V.shape[1], model.n_stops, keep, rows)
-    return [(r.x, r.V, r.k, r.s, r.mode), r.pv, cfg, r.kern.table, out]
+    return [(r.x, r.V, r.k, r.s, r.mode, r.vf), r.pv, cfg, r.kern.table, out]
 
 
 RUNS = [

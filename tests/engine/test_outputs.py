@@ -45,7 +45,7 @@ def test_a_run_is_made_again_only_when_its_tables_were_short() -> None:
 
     def call(out):
         made.append(outputs.TableRows(*(len(t) for t in (out.impacts, out.sticking, out.trajectory))))
-        native.load_integrate()((r.x, r.V, r.k, r.s, r.mode), r.pv, cfg, r.kern.table, out)
+        native.load_integrate()((r.x, r.V, r.k, r.s, r.mode, r.vf), r.pv, cfg, r.kern.table, out)
 
     result, need = outputs.run(call, 2, 2, model.n_stops, cfg, outputs.TableRows(1, 1, 1))
     assert made == [outputs.TableRows(1, 1, 1), need] and need.impacts > 1 and need.trajectory > 1

@@ -152,6 +152,11 @@ def load_model(spec: str) -> grazing.HybridModel:
         raise InputError(
             f"--model: {name} in {path_text} is not a grazing.HybridModel (or a function returning one)"
         )
+    if obj.has_modes:
+        raise InputError(
+            f"--model: {name} in {path_text} has modes ({', '.join(obj.mode_names)}): the command line does "
+            "not support models with modes yet (use the Python API: grazing.simulate)"
+        )
     return obj
 
 

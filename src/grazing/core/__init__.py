@@ -2,6 +2,6 @@
 
 from grazing.core.model import HybridModel, Parameter
 from grazing.core.solution import Impacts, Solution
-from grazing.core.symbolic import Stop
+from grazing.core.symbolic import Mode, Stop, Surface, Transition
 
-__all__ = ["HybridModel", "Impacts", "Parameter", "Solution", "Stop"]
+__all__ = ["HybridModel", "Impacts", "Mode", "Parameter", "Solution", "Stop", "Surface", "Transition"]

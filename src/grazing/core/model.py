@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from grazing.core.expressions import check_expression
-from grazing.core.symbolic import Stop, SymbolicSystem
+from grazing.core.symbolic import Mode, Stop, Surface, SymbolicSystem, Transition
 from grazing.errors import InvalidParameterError, InvalidStateError
 
 KernelLoader = Callable[["_Definition", int, "int | None"], Any]
@@ -246,12 +246,25 @@ class _Definition:
         if len(self.state_labels) != len(self.state_names) or len(self.state_units) != len(self.state_names):
             raise ValueError("state_labels and state_units need one entry per state")
         self.time_label = time_label
-        if symbolic is not None:
+        self.mode_names: tuple[str, ...] = ("free",)
+        self.transition_modes: tuple[tuple[str, str], ...] | None = None
+        if symbolic is not None and "modes" in symbolic:
+            self.mode_names = tuple(md[0] for md in symbolic["modes"])
+            bad_modes = [nm for nm in self.mode_names if not (isinstance(nm, str) and nm.isidentifier())]
+            if not self.mode_names or bad_modes or len(set(self.mode_names)) != len(self.mode_names):
+                raise ValueError(f"mode names must be distinct identifiers, got {list(self.mode_names)}")
+            layout = _transition_layout(symbolic)
+            stop_names = [item[0] for item in layout]
+            self.transition_modes = tuple((item[1], item[2]) for item in layout)
+            if not stop_names:
+                raise ValueError("a model with modes needs at least one transition, stop or surface")
+        elif symbolic is not None:
             stop_names = [st[0] for st in symbolic["stops"]] if "stops" in symbolic else ["stop"]
         self.stop_names = tuple(stop_names or ("stop",))
         bad = [nm for nm in self.stop_names if not (isinstance(nm, str) and nm.isidentifier())]
         if bad or len(set(self.stop_names)) != len(self.stop_names):
-            raise ValueError(f"stop names must be distinct identifiers, got {list(self.stop_names)}")
+            what = "stop" if self.transition_modes is None else "stop and transition"
+            raise ValueError(f"{what} names must be distinct identifiers, got {list(self.stop_names)}")
         self.period_expr = period
         self.period_str = str(period)
         self.periodic = periodic
@@ -294,6 +307,9 @@ class _Definition:
                 # Text is read with the model's own names (a state called "E" or "pi" is that state).
                 return sp.sympify(e, locals=local) if isinstance(e, str) else sp.sympify(e)
 
+            if "modes" in pieces:
+                self._system = _modes_system(pieces, states, time, psyms, expr(self.period_expr), expr)
+                return self._system
             raw = pieces.get("stops")
             if raw is None:
                 raw = [("stop", pieces["guard"], pieces["reset"], pieces.get("contact_direction"))]
@@ -408,13 +424,172 @@ class _Definition:
         return float(self._period_fn(*values))
 
 
+def _transition_layout(symbolic: Mapping[str, Any]) -> list[tuple[str, str, str, Any, Any, Any, int]]:
+    """Every transition of a model with modes, in the order of its index ``j``: per mode its stops, then
+    the transitions leaving it, then each surface's two.
+
+    Each is ``(name, source, target, guard, reset or None, contact direction or None, sign)``, the guard
+    as given (text or sympy) to be multiplied by ``sign``.  Unknown modes are reported later (by name).
+    """
+    out = []
+    names = [md[0] for md in symbolic["modes"]]
+    for mode, _, stops in symbolic["modes"]:
+        out += [(st[0], mode, mode, st[1], st[2], st[3], 1) for st in stops]
+        out += [
+            (tr[0], tr[1], tr[2], tr[3], tr[4], tr[5], 1) for tr in symbolic["transitions"] if tr[1] == mode
+        ]
+    out += [
+        (tr[0], tr[1], tr[2], tr[3], tr[4], tr[5], 1) for tr in symbolic["transitions"] if tr[1] not in names
+    ]
+    for name, h, positive, negative, _ in symbolic["surfaces"]:
+        out.append((f"{name}_to_{negative}", positive, negative, h, None, None, 1))
+        out.append((f"{name}_to_{positive}", negative, positive, h, None, None, -1))
+    return out
+
+
+def _modes_system(
+    pieces: Mapping[str, Any],
+    states: tuple[Any, ...],
+    time: Any,
+    psyms: tuple[Any, ...],
+    period: Any,
+    expr: Callable[[Any], Any],
+) -> SymbolicSystem:
+    """The :class:`SymbolicSystem` of a model with modes, checked (one-line errors)."""
+    import sympy as sp
+
+    names = [md[0] for md in pieces["modes"]]
+    known = ", ".join(names)
+    n = len(states)
+    modes = []
+    for name, field, _ in pieces["modes"]:
+        if len(field) != n:
+            raise ValueError(f"the vector field of mode {name!r} needs one expression per state")
+        modes.append(Mode(name, tuple(expr(e) for e in field)))
+    for name, _, positive, negative, _ in pieces["surfaces"]:
+        for side in (positive, negative):
+            if side not in names:
+                raise ValueError(f"surface {name!r} has unknown mode {side!r} (modes: {known})")
+        if positive == negative:
+            raise ValueError(f"surface {name!r} needs two different modes, got {positive!r} twice")
+    stops, sources, targets, resets = [], [], [], []
+    for name, source, target, guard, reset, cd, sign in _transition_layout(pieces):
+        for end, mode in (("goes to", target), ("leaves", source)):
+            if mode not in names:
+                raise ValueError(f"transition {name!r} {end} unknown mode {mode!r} (modes: {known})")
+        if reset is not None and len(reset) != n:
+            raise ValueError(f"the reset of transition {name!r} needs one expression per state")
+        if cd is not None and len(cd) != n:
+            raise ValueError(f"the contact_direction of transition {name!r} needs one expression per state")
+        stops.append(Stop(
+            name, sign * expr(guard), tuple(states) if reset is None else tuple(expr(e) for e in reset),
+            None if cd is None else tuple(expr(e) for e in cd),
+        ))  # fmt: skip
+        sources.append(names.index(source))
+        targets.append(names.index(target))
+        resets.append(reset is not None)
+    surfaces = tuple(Surface(nm, expr(h), pos, neg, bool(sl)) for nm, h, pos, neg, sl in pieces["surfaces"])
+    initial = names.index(pieces["initial_mode"])
+    system = SymbolicSystem(
+        states=states, time=time, params=psyms, vector_field=modes[initial].vector_field,
+        guard=stops[0].guard, reset=stops[0].reset, contact_direction=stops[0].contact_direction,
+        period=period, stops=tuple(stops), modes=tuple(modes), sources=tuple(sources),
+        targets=tuple(targets), resets=tuple(resets), surfaces=surfaces,
+    )  # fmt: skip
+    allowed = set(states) | {time} | set(psyms)
+    every = [e for md in modes for e in md.vector_field] + [sf.h for sf in surfaces]
+    for e in [*every, *(e for st in stops for e in (st.guard, *st.reset, *(st.contact_direction or ())))]:
+        extra = e.free_symbols - allowed
+        if extra:
+            raise ValueError(f"unknown symbols {sorted(map(str, extra))} in {e}")
+    if period.free_symbols - set(psyms):
+        raise ValueError("the period may depend on parameters only")
+    for where, e in _expressions(system):
+        check_expression(e, where)
+    kind = {False: "transition", True: "stop"}
+    for j, st in enumerate(stops):
+        what = f"the guard of {kind[sources[j] == targets[j] and resets[j]]} {st.name!r}"
+        if not st.guard.free_symbols & (set(states) | {time}):
+            raise ValueError(f"{what} depends on neither the state nor time: it can never be crossed")
+        if sp.simplify(system.at_stop(j).normal_rate) == 0:
+            raise ValueError(
+                f"{what} is constant along mode {names[sources[j]]!r}'s flow (L_f h = 0): it can never be "
+                "crossed"
+            )
+    for k, sf in enumerate(surfaces):
+        pos, neg = system.surface_sides(k)
+        if sf.sliding and sp.simplify(pos.lie(sf.h) - neg.lie(sf.h)) == 0:
+            raise ValueError(
+                f"surface {sf.name!r} has no sliding region: modes {sf.positive!r} and {sf.negative!r} cross "
+                "it alike (L+h - L-h = 0); give sliding=False"
+            )
+    entered = {initial} | {targets[j] for j in range(len(stops))}
+    for k, name in enumerate(names):
+        if k not in entered:
+            raise ValueError(
+                f"mode {name!r} is never entered (no transition leads to it and it is not the initial mode)"
+            )
+    return system
+
+
+def _modes_pieces(
+    modes: Sequence[Mode],
+    transitions: Sequence[Transition],
+    surfaces: Sequence[Surface],
+    initial_mode: str | None,
+) -> dict[str, Any]:
+    """The ``symbolic`` entries of a model with modes (plain tuples, hashed into its identity)."""
+    if not modes or not all(isinstance(md, Mode) for md in modes):
+        raise ValueError("modes must be a non-empty list of grazing.Mode")
+    if not all(isinstance(tr, Transition) for tr in transitions):
+        raise ValueError("transitions must be a list of grazing.Transition")
+    if not all(isinstance(sf, Surface) for sf in surfaces):
+        raise ValueError("surfaces must be a list of grazing.Surface")
+    for md in modes:
+        if not all(isinstance(st, Stop) for st in md.stops):
+            raise ValueError(f"the stops of mode {md.name!r} must be a list of grazing.Stop")
+    names = [md.name for md in modes]
+    for sf in surfaces:
+        if sf.positive == sf.negative:
+            raise ValueError(f"surface {sf.name!r} needs two different modes, got {sf.positive!r} twice")
+    if initial_mode is not None and initial_mode not in names:
+        raise ValueError(f"unknown initial mode {initial_mode!r} (modes: {', '.join(map(str, names))})")
+
+    def opt(seq: Sequence[Any] | None) -> tuple[Any, ...] | None:
+        return None if seq is None else tuple(seq)
+
+    return {
+        "modes": tuple(
+            (
+                md.name,
+                tuple(md.vector_field),
+                tuple((st.name, st.guard, tuple(st.reset), opt(st.contact_direction)) for st in md.stops),
+            )
+            for md in modes
+        ),
+        "transitions": tuple(
+            (tr.name, tr.source, tr.target, tr.guard, opt(tr.reset), opt(tr.contact_direction))
+            for tr in transitions
+        ),
+        "surfaces": tuple((sf.name, sf.h, sf.positive, sf.negative, bool(sf.sliding)) for sf in surfaces),
+        "initial_mode": names[0] if initial_mode is None else initial_mode,
+    }
+
+
 def _expressions(system: SymbolicSystem) -> list[tuple[str, Any]]:
     """Every expression of a model with where it is, for messages (``"the guard of stop 'left'"``)."""
     out: list[tuple[str, Any]] = [
         (f"the vector field ({x}')", e) for x, e in zip(system.states, system.vector_field)
     ]
+    for md in system.modes:
+        out += [
+            (f"the vector field of mode {md.name!r} ({x}')", e)
+            for x, e in zip(system.states, md.vector_field)
+        ]
+    out += [(f"the function of surface {sf.name!r}", sf.h) for sf in system.surfaces]
     for st in system.stops:
         of = "" if len(system.stops) == 1 and st.name == "stop" else f" of stop {st.name!r}"
+        of = f" of transition {st.name!r}" if system.modes else of
         out += [(f"the guard{of}", st.guard)]
         out += [(f"the reset{of}", e) for e in st.reset]
         out += [(f"the contact direction{of}", e) for e in st.contact_direction or ()]
@@ -535,6 +710,20 @@ class HybridModel:
         Where the model comes from (a paper, a book), for the reader.
     values
         Parameter values (defaults from ``parameters``).
+    modes
+        Several vector fields instead of ``vector_field``: a list of
+        :class:`Mode` (name, field, the impacts within it as stops).  Their
+        stops and then ``transitions`` and ``surfaces`` are the model's
+        transitions (:attr:`stop_names`, in that order: per mode its stops and
+        the transitions leaving it, then each surface's two).
+    transitions
+        With ``modes``: switches from one mode to another when a guard
+        reaches 0 (:class:`Transition`, with or without a reset).
+    surfaces
+        With ``modes``: switching surfaces crossed both ways without a reset
+        (:class:`Surface`).
+    initial_mode
+        With ``modes``: the mode a run starts in by default (the first).
 
     Examples
     --------
@@ -564,6 +753,18 @@ class HybridModel:
     ...     stops=[Stop("right", 1 - x, [x, -r * v]), Stop("left", x + 1, [x, -r * v])])
     >>> two.stop_names
     ('right', 'left')
+
+    A compliant stop: a second vector field beyond ``x = sigma``, entered and left without a reset:
+
+    >>> from grazing import Mode, Transition
+    >>> soft = HybridModel(
+    ...     "soft", [x, v], t, [Parameter("omega", 1.5, lower=0, lower_open=True), Parameter("sigma", 0.5)],
+    ...     modes=[Mode("free", [v, -x + sp.cos(w * t)]),
+    ...            Mode("contact", [v, -x - 20 * (x - sigma) + sp.cos(w * t)])],
+    ...     transitions=[Transition("touch", "free", "contact", sigma - x),
+    ...                  Transition("leave", "contact", "free", x - sigma)], period=2 * sp.pi / w)
+    >>> soft.mode_names, soft.stop_names, soft.transition_target
+    (('free', 'contact'), ('touch', 'leave'), ('contact', 'free'))
     """
 
     def __init__(
@@ -572,7 +773,7 @@ class HybridModel:
         states: Sequence[Any],
         time: Any,
         parameters: Sequence[Parameter],
-        vector_field: Sequence[Any],
+        vector_field: Sequence[Any] | None = None,
         guard: Any = None,
         reset: Sequence[Any] | None = None,
         period: Any = None,
@@ -585,15 +786,29 @@ class HybridModel:
         reference: str = "",
         values: Mapping[str, float] | None = None,
         state_units: Sequence[str] | None = None,
+        modes: Sequence[Mode] | None = None,
+        transitions: Sequence[Transition] = (),
+        surfaces: Sequence[Surface] = (),
+        initial_mode: str | None = None,
     ):
         if period is None:
             raise ValueError("a model needs its forcing period (period=...)")
-        symbolic: dict[str, Any] = {
-            "states": tuple(states),
-            "time": time,
-            "vector_field": tuple(vector_field),
-        }
-        if stops is not None:
+        symbolic: dict[str, Any] = {"states": tuple(states), "time": time}
+        if modes is not None:
+            if vector_field is not None:
+                raise ValueError("give either vector_field= (one mode) or modes=[...], not both")
+            if any(arg is not None for arg in (guard, reset, stops, contact_direction)):
+                raise ValueError(
+                    "with modes=[...], give each mode's stops in its Mode, not guard=/reset=/stops="
+                )
+            symbolic.update(_modes_pieces(modes, transitions, surfaces, initial_mode))
+        elif vector_field is None:
+            raise ValueError("a model needs vector_field= (one mode) or modes=[...]")
+        elif transitions or surfaces or initial_mode is not None:
+            raise ValueError("transitions=, surfaces= and initial_mode= need modes=[...]")
+        else:
+            symbolic["vector_field"] = tuple(vector_field)
+        if modes is None and stops is not None:
             if guard is not None or reset is not None or contact_direction is not None:
                 raise ValueError("give either stops= or guard=/reset=/contact_direction=, not both")
             if not stops or not all(isinstance(st, Stop) for st in stops):
@@ -607,7 +822,7 @@ class HybridModel:
                 )
                 for st in stops
             )
-        else:
+        elif modes is None:
             if guard is None or reset is None:
                 raise ValueError("a model needs a guard and a reset (or stops=[...])")
             symbolic["guard"] = guard
@@ -859,6 +1074,61 @@ class HybridModel:
         )
 
     @property
+    def mode_names(self) -> tuple[str, ...]:
+        """The names of the model's modes (``("free",)`` for a model of one vector field)."""
+        return self._def.mode_names
+
+    @property
+    def n_modes(self) -> int:
+        return len(self._def.mode_names)
+
+    @property
+    def has_modes(self) -> bool:
+        """True for a model given with ``modes=[...]`` (its stops are all its transitions)."""
+        return self._def.transition_modes is not None
+
+    @property
+    def initial_mode(self) -> str:
+        """The mode a run starts in unless told otherwise."""
+        symbolic = self._def._symbolic
+        return symbolic["initial_mode"] if self.has_modes and symbolic is not None else self.mode_names[0]
+
+    @property
+    def transition_source(self) -> tuple[str, ...]:
+        """The mode each transition (each of :attr:`stop_names`) leaves."""
+        modes = self._def.transition_modes
+        return tuple(src for src, _ in modes) if modes is not None else self.mode_names * self.n_stops
+
+    @property
+    def transition_target(self) -> tuple[str, ...]:
+        """The mode each transition (each of :attr:`stop_names`) enters."""
+        modes = self._def.transition_modes
+        return tuple(tgt for _, tgt in modes) if modes is not None else self.mode_names * self.n_stops
+
+    def mode_index(self, mode: str | None) -> int:
+        """The index of a mode given by name (None: the initial mode).
+
+        Examples
+        --------
+        >>> from grazing.models import impact_oscillator
+        >>> impact_oscillator().mode_index(None)
+        0
+        """
+        name = self.initial_mode if mode is None else mode
+        if name not in self.mode_names:
+            known = ", ".join(self.mode_names)
+            raise InvalidParameterError(f"unknown mode {name!r} for model {self.name!r} (modes: {known})")
+        return self.mode_names.index(name)
+
+    def require_one_mode(self, what: str) -> None:
+        """Raise a one-line error if this model has several modes: ``what`` does not support them yet."""
+        if self.has_modes:
+            raise InvalidParameterError(
+                f"{what} does not support models with modes yet (model {self.name!r} has modes "
+                f"{', '.join(self.mode_names)})"
+            )
+
+    @property
     def period(self) -> float:
         """Forcing period (the stroboscopic sampling interval)."""
         return self._def.period(self.param_vector)
@@ -926,10 +1196,15 @@ class HybridModel:
         fn = self._def.numeric(what, stop)
         return fn(list(np.asarray(x, dtype=float)), float(t), list(self.param_vector))
 
-    def vector_field(self, x: Any, t: float = 0.0) -> np.ndarray:
-        """``f(x, t)`` (evaluated by the compiled kernels)."""
+    def vector_field(self, x: Any, t: float = 0.0, mode: str | None = None) -> np.ndarray:
+        """``f(x, t)`` of ``mode`` (the initial mode by default; evaluated by the compiled kernels)."""
         out = np.empty(self.n_states)
-        self._def.scalar_kernels().rhs(np.ascontiguousarray(x, dtype=float), float(t), self.param_vector, out)
+        x = np.ascontiguousarray(x, dtype=float)
+        if self.has_modes:
+            self._def.scalar_kernels().rhs(x, float(t), self.param_vector, out, self.mode_index(mode))
+        else:
+            self.mode_index(mode)  # (only the one mode's name)
+            self._def.scalar_kernels().rhs(x, float(t), self.param_vector, out)
         return out
 
     def guard(self, x: Any, t: float = 0.0, stop: int | str | None = None) -> float:
@@ -968,7 +1243,7 @@ class HybridModel:
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(f_x, h_x, g_x)`` at ``(x, t)`` for a stop."""
         n, j = self.n_states, self.stop_index(stop)
-        fx = np.asarray(self._call("f_x", x, t), dtype=float).reshape(n, n)
+        fx = np.asarray(self._call("f_x", x, t, j if self.has_modes else 0), dtype=float).reshape(n, n)
         hx = np.asarray(self._call("h_x", x, t, j), dtype=float).reshape(n)
         gx = np.asarray(self._call("g_x", x, t, j), dtype=float).reshape(n, n)
         return fx, hx, gx
@@ -977,12 +1252,16 @@ class HybridModel:
         """Saltation matrix (paper eq. 14) of an impact at ``x`` on the stop.
 
         ``S = g_x + (f(g(x)) - g_x f(x) - g_t) h_x / (h_x f(x) + h_t)``; the
-        time terms vanish for autonomous guards and resets, giving eq. 14.
+        time terms vanish for autonomous guards and resets, giving eq. 14.  In
+        a model with modes ``stop`` is any transition, ``f(x)`` its source
+        mode's field and ``f(g(x))`` its target's (a switch without a reset:
+        ``S = I + (f+ - f-) h_x / (h_x f- + h_t)``).
         """
         j = self.stop_index(stop)
         _, hx, gx = self.jacobians(x, t, j)
-        fm = self.vector_field(x, t)
-        fp = self.vector_field(self.reset(x, t, j), t)
+        source, target = self.transition_source[j], self.transition_target[j]
+        fm = self.vector_field(x, t, source if self.has_modes else None)
+        fp = self.vector_field(self.reset(x, t, j), t, target if self.has_modes else None)
         gt = np.asarray(self._call("g_t", x, t, j), dtype=float).reshape(-1)
         ht = float(self._call("h_t", x, t, j))
         return gx + np.outer(fp - gx @ fm - gt, hx) / (hx @ fm + ht)
@@ -1008,11 +1287,15 @@ class HybridModel:
             "accel": float(self._call("accel", x, t, j)),
         }
 
-    def check_state(self, x: Any, t: float = 0.0, allowed: bool = True) -> np.ndarray:
+    def check_state(
+        self, x: Any, t: float = 0.0, allowed: bool = True, mode: str | None = None
+    ) -> np.ndarray:
         """Return ``x`` as a float array, or raise if it is not a valid state.
 
         With ``allowed`` (the default) the state must also satisfy the guard (to
-        :data:`ON_STOP_TOL`: a state on the stop to rounding is allowed).
+        :data:`ON_STOP_TOL`: a state on the stop to rounding is allowed); in a
+        model with modes, the guards of the transitions that leave ``mode``
+        (the initial mode by default).
         """
         arr = np.asarray(x, dtype=float).reshape(-1)
         if arr.shape != (self.n_states,):
@@ -1023,9 +1306,17 @@ class HybridModel:
             raise InvalidStateError(f"state must be finite, got {arr.tolist()}")
         if not allowed:
             return arr
+        k = self.mode_index(mode)
         for j, name in enumerate(self.stop_names):
+            if self.has_modes and self.transition_source[j] != self.mode_names[k]:
+                continue
             hv = self.guard(arr, t, j)
             if hv < -ON_STOP_TOL * max(1.0, float(np.max(np.abs(arr)))):
+                if self.has_modes and self.transition_target[j] != self.mode_names[k]:
+                    raise InvalidStateError(
+                        f"initial state {arr.tolist()} is not in mode {self.mode_names[k]!r} (guard of "
+                        f"transition {name!r} h = {hv:.3g} < 0)"
+                    )
                 where = "the stop" if name == "stop" else f"stop {name!r}"
                 raise InvalidStateError(
                     f"initial state {arr.tolist()} is beyond {where} (guard h = {hv:.3g} < 0)"

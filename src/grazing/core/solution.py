@@ -113,6 +113,15 @@ def accumulation_message(model: HybridModel, x: Any, t: float) -> str:
     tol = ON_STOP_TOL * max(1.0, float(np.max(np.abs(state), initial=0.0)))
     on = [j for j, h in enumerate(model.guards(state, t)) if abs(h) <= tol]
     names = [repr(model.stop_names[j]) for j in on]
+    switching = [j for j in on if model.transition_source[j] != model.transition_target[j]]
+    if model.has_modes and switching:  # two modes whose fields push into each other
+        modes = sorted(
+            {m for j in switching for m in (model.transition_source[j], model.transition_target[j])}
+        )
+        return (
+            f"modes {', '.join(map(repr, modes))} switch back and forth at zero time at t = {t:.6g} (their "
+            "fields push into each other): sliding between modes is not supported yet"
+        )
     sticks = model.kernels().STICKS
     if len(on) >= 2:
         return (
@@ -191,6 +200,55 @@ class Impacts:
 
 
 @dataclass(frozen=True)
+class Switches:
+    """Switches of vector field without a reset (a model with modes): one row per switch.
+
+    Attributes
+    ----------
+    t
+        Switch times.
+    transition
+        Index of each switch's transition (into ``transition_names``).
+    state
+        The state at the switch (continuous across it), shape ``(n_switches, n_states)``.
+    transition_names
+        The model's transitions (:attr:`~grazing.core.model.HybridModel.stop_names`).
+    sources, targets
+        Per transition, the mode it leaves and the mode it enters.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> sw = Switches(np.array([1.0, 2.0]), np.array([0, 1]), np.zeros((2, 2)), ("touch", "leave"),
+    ...               ("free", "contact"), ("contact", "free"))
+    >>> len(sw), sw.source(1), sw.target(1), sw.name(0)
+    (2, 'contact', 'free', 'touch')
+    """
+
+    t: np.ndarray
+    transition: np.ndarray
+    state: np.ndarray
+    transition_names: tuple[str, ...] = ()
+    sources: tuple[str, ...] = ()
+    targets: tuple[str, ...] = ()
+
+    def __len__(self) -> int:
+        return int(self.t.size)
+
+    def name(self, i: int) -> str:
+        """The transition of switch ``i``."""
+        return self.transition_names[int(self.transition[i])]
+
+    def source(self, i: int) -> str:
+        """The mode switch ``i`` leaves."""
+        return self.sources[int(self.transition[i])]
+
+    def target(self, i: int) -> str:
+        """The mode switch ``i`` enters."""
+        return self.targets[int(self.transition[i])]
+
+
+@dataclass(frozen=True)
 class Solution:
     """The outcome of :func:`grazing.simulate`.
 
@@ -243,6 +301,11 @@ class Solution:
         of the samples, radians) and ``"period_gradient"`` (for each parameter
         of ``Tangent.sensitivities``, the derivative of the forcing period with
         respect to it: 0 for a parameter that does not set the period).
+    switches
+        A model with modes: its switches of vector field without a reset
+        (:class:`Switches`, recorded as the impacts are); None for a model of one mode.
+    mode_final
+        A model with modes: the mode at the end; None for a model of one mode.
 
     Examples
     --------
@@ -280,6 +343,8 @@ class Solution:
     guard_min_by_stop: tuple[tuple[float, float, np.ndarray], ...] | None = None
     approach_by_stop: tuple[tuple[float, float, np.ndarray] | None, ...] | None = None
     info: dict[str, Any] = field(default_factory=dict)
+    switches: Switches | None = None
+    mode_final: str | None = None
 
     def period(self, tol: float = DEFAULT_PERIOD_TOL, max_period: int = DEFAULT_MAX_PERIOD) -> int:
         """Smallest period of the sampled sequence (0 if none); see :func:`detect_period`."""

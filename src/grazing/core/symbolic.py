@@ -54,6 +54,100 @@ class Stop:
 
 
 @dataclass(frozen=True)
+class Mode:
+    """One mode of a model with several vector fields: its field and its impacts.
+
+    Attributes
+    ----------
+    name
+        The mode's name (an identifier: ``"free"``, ``"contact"``), used in
+        results and messages.
+    vector_field
+        ``f(x, t)`` while the motion is in this mode, one expression per state.
+    stops
+        Impacts in this mode (:class:`Stop`): transitions back to the same mode
+        with a reset.
+
+    Examples
+    --------
+    >>> import sympy as sp
+    >>> x, v = sp.symbols("x v")
+    >>> Mode("free", [v, -x]).name
+    'free'
+    """
+
+    name: str
+    vector_field: Sequence[Any]
+    stops: Sequence[Stop] = ()
+
+
+@dataclass(frozen=True)
+class Transition:
+    """A switch from one mode to another when a guard reaches zero.
+
+    Attributes
+    ----------
+    name
+        The transition's name (an identifier, distinct from every stop's).
+    source, target
+        The names of the modes it leaves and enters.
+    guard
+        ``h(x, t)``: positive while in ``source``; the switch happens when it reaches 0.
+    reset
+        ``g(x, t)``, the state after the switch; ``None``: no reset (the state
+        is continuous, only the vector field changes, as at a compliant stop).
+    contact_direction
+        As :attr:`Stop.contact_direction`, for a transition with a reset.
+
+    Examples
+    --------
+    >>> import sympy as sp
+    >>> x = sp.Symbol("x")
+    >>> Transition("touch", "free", "contact", 1 - x).reset is None
+    True
+    """
+
+    name: str
+    source: str
+    target: str
+    guard: Any
+    reset: Sequence[Any] | None = None
+    contact_direction: Sequence[Any] | None = None
+
+
+@dataclass(frozen=True)
+class Surface:
+    """A switching surface ``h(x, t) = 0`` between two modes, crossed both ways without a reset.
+
+    Attributes
+    ----------
+    name
+        The surface's name; its two transitions are ``{name}_to_{negative}``
+        (``h`` reaches 0 from above) and ``{name}_to_{positive}`` (from below).
+    h
+        The surface's function.
+    positive, negative
+        The modes on the sides ``h > 0`` and ``h < 0``.
+    sliding
+        Where both fields push towards the surface the motion slides on it
+        (Filippov's convex combination, :meth:`SymbolicSystem.filippov_field`).
+
+    Examples
+    --------
+    >>> import sympy as sp
+    >>> v = sp.Symbol("v")
+    >>> Surface("belt", v - 1, "slip_back", "slip_forward").positive
+    'slip_back'
+    """
+
+    name: str
+    h: Any
+    positive: str
+    negative: str
+    sliding: bool = True
+
+
+@dataclass(frozen=True)
 class SymbolicSystem:
     """The symbolic pieces of a hybrid model that the code generator needs.
 
@@ -77,6 +171,15 @@ class SymbolicSystem:
         Every stop (:class:`Stop`, expressions sympified); ``guard``, ``reset``
         and ``contact_direction`` are those of the first, and
         :meth:`at_stop` gives the system seen from any other.
+    modes
+        A model with several modes: each mode's name and vector field (as
+        :class:`Mode`, without stops), the first the initial mode's field
+        ``vector_field``; empty for a model of one mode.  Then ``stops`` are
+        every transition (an impact's reset, or the identity for a switch),
+        ``sources``/``targets`` their modes' indices and ``resets`` whether
+        they have a reset of their own.
+    surfaces
+        The model's switching surfaces (:class:`Surface`, ``h`` sympified).
     """
 
     states: tuple[sp.Symbol, ...]
@@ -88,6 +191,11 @@ class SymbolicSystem:
     contact_direction: tuple[sp.Expr, ...] | None = None
     period: sp.Expr | None = None
     stops: tuple[Stop, ...] = ()
+    modes: tuple[Mode, ...] = ()
+    sources: tuple[int, ...] = ()
+    targets: tuple[int, ...] = ()
+    resets: tuple[bool, ...] = ()
+    surfaces: tuple[Surface, ...] = ()
 
     def __post_init__(self) -> None:
         if not self.stops:
@@ -98,11 +206,24 @@ class SymbolicSystem:
     def stop_names(self) -> tuple[str, ...]:
         return tuple(stop.name for stop in self.stops)
 
+    @property
+    def mode_names(self) -> tuple[str, ...]:
+        return tuple(mode.name for mode in self.modes)
+
+    def at_mode(self, index: int) -> SymbolicSystem:
+        """The same system with mode ``index``'s vector field as *the* vector field (itself without modes)."""
+        if not self.modes:
+            return self
+        return dataclasses.replace(self, vector_field=tuple(self.modes[index].vector_field))
+
     def at_stop(self, index: int) -> SymbolicSystem:
-        """The same system with stop ``index``'s guard, reset and contact direction as *the* stop."""
+        """The same system with stop ``index``'s guard, reset and contact direction as *the* stop.
+
+        With several modes, a stop is any transition and the vector field is its source mode's.
+        """
         stop = self.stops[index]
         return dataclasses.replace(
-            self,
+            self.at_mode(self.sources[index]) if self.modes else self,
             guard=stop.guard,
             reset=tuple(stop.reset),
             contact_direction=None if stop.contact_direction is None else tuple(stop.contact_direction),
@@ -145,6 +266,11 @@ class SymbolicSystem:
                 Stop(st.name, tr(st.guard), tuple(tr(e) for e in st.reset), cd(st.contact_direction))
                 for st in self.stops
             ),
+            modes=tuple(Mode(md.name, tuple(tr(e) for e in md.vector_field)) for md in self.modes),
+            sources=self.sources,
+            targets=self.targets,
+            resets=self.resets,
+            surfaces=tuple(dataclasses.replace(sf, h=tr(sf.h)) for sf in self.surfaces),
         )
 
     def gradient(self, expr: sp.Expr) -> list[sp.Expr]:
@@ -181,3 +307,29 @@ class SymbolicSystem:
         den = sp.Add(*[g * ei for g, ei in zip(gr, e)])
         lam = self.normal_accel / den
         return tuple(f - lam * ei for f, ei in zip(self.vector_field, e))
+
+    def surface_sides(self, index: int) -> tuple[SymbolicSystem, SymbolicSystem]:
+        """The systems of surface ``index``'s positive and negative modes."""
+        sf = self.surfaces[index]
+        names = self.mode_names
+        return self.at_mode(names.index(sf.positive)), self.at_mode(names.index(sf.negative))
+
+    def filippov_field(self, index: int) -> tuple[sp.Expr, ...]:
+        """The sliding vector field on surface ``index`` (Filippov's convex combination).
+
+        ``f_s = f_+ + w (f_- - f_+)`` with ``w = L_+ h / (L_+ h - L_- h)``, where
+        ``f_+`` is the field of the side ``h > 0`` and ``f_-`` that of ``h < 0``
+        and the Lie derivatives include ``dh/dt``: ``L_{f_s} h = 0`` identically,
+        so the flow of ``f_s`` stays on the surface.
+        """
+        pos, neg = self.surface_sides(index)
+        h = self.surfaces[index].h
+        lp, ln = pos.lie(h), neg.lie(h)
+        weight = lp / (lp - ln)
+        return tuple(fp + weight * (fn - fp) for fp, fn in zip(pos.vector_field, neg.vector_field))
+
+    def exit_rows(self, index: int) -> tuple[sp.Expr, sp.Expr]:
+        """``(-L_+ h, L_- h)`` of surface ``index``: both positive while sliding, one reaches 0 at an exit."""
+        pos, neg = self.surface_sides(index)
+        h = self.surfaces[index].h
+        return -pos.lie(h), neg.lie(h)

@@ -184,7 +184,10 @@ class ModelSource:
         definitions it picks from by the stop index.
     sizes
         ``nx``, ``nsens``, ``nparams``, ``nstops``, ``order`` and ``sticks``
-        (per stop: it has a sticking mode).
+        (per stop: it has a sticking mode); with several modes also ``nmodes``,
+        ``rows`` (per mode, the transition of each of its event rows, -1 for
+        padding), ``targets``, ``resets`` and ``back`` (per transition: the
+        switch back whose guard is 0 right after it, -1 none).
     """
 
     text: str
@@ -218,28 +221,44 @@ def generate_source(system: SymbolicSystem, directions: int = 0, order: int = DE
         return sp.Add(*[dsyms[c][j] * sp.diff(expr, p) for j, p in enumerate(sys_.params)])
 
     ncol = n + directions
-    f = sys_.vector_field
-    guards = [stop.guard for stop in sys_.stops]  # the event rows of free flight, one per stop
-    free = taylor_kernel("tc_free", sys_.states, sys_.time, sys_.params, f, guards, order)
-    # Variational equations: V' = f_x V (+ f_p D[c] on the direction columns).
     vsyms = tuple(sp.Dummy(f"v{i}") for i in range(n * ncol))
     vmat = sp.Matrix(n, ncol, vsyms)
-    jac = sp.Matrix([[sp.diff(fi, x) for x in sys_.states] for fi in f])
-    vrhs = jac * vmat
-    for c in range(directions):
-        for i in range(n):
-            vrhs[i, n + c] += along(c, f[i])
-    var = taylor_kernel(
-        "tc_var",
-        tuple(sys_.states) + tuple(vsyms),
-        sys_.time,
-        sysd.params,
-        tuple(f) + tuple(vrhs),
-        guards,
-        order,
-    )
-    sticky = [j for j, stop in enumerate(sys_.stops) if stop.contact_direction is not None]
-    kernels = [free, var]
+
+    def flow_kernels(suffix: str, f: Sequence[sp.Expr], guards: Sequence[sp.Expr]) -> list[Any]:
+        """Free flight along ``f``, without and with the variational equations, watching ``guards``."""
+        free = taylor_kernel(f"tc_free{suffix}", sys_.states, sys_.time, sys_.params, f, guards, order)
+        # Variational equations: V' = f_x V (+ f_p D[c] on the direction columns).
+        jac = sp.Matrix([[sp.diff(fi, x) for x in sys_.states] for fi in f])
+        vrhs = jac * vmat
+        for c in range(directions):
+            for i in range(n):
+                vrhs[i, n + c] += along(c, f[i])
+        var = taylor_kernel(
+            f"tc_var{suffix}",
+            tuple(sys_.states) + tuple(vsyms),
+            sys_.time,
+            sysd.params,
+            tuple(f) + tuple(vrhs),
+            guards,
+            order,
+        )
+        return [free, var]
+
+    guards = [stop.guard for stop in sys_.stops]  # the event rows of free flight, one per stop
+    nmodes = max(1, len(sys_.modes))
+    if nmodes == 1:
+        f = sys_.vector_field
+        kernels = flow_kernels("", f, guards)
+        sticky = [j for j, stop in enumerate(sys_.stops) if stop.contact_direction is not None]
+    else:  # per mode: its field, its outgoing transitions' guards padded to as many rows as the most
+        rows = [[j for j in range(nstops) if sys_.sources[j] == k] for k in range(nmodes)]
+        width = max(len(r) for r in rows)
+        kernels = []
+        for k, mode in enumerate(sys_.modes):
+            pad = [sp.Integer(1)] * (width - len(rows[k]))
+            kernels += flow_kernels(f"_m{k}", mode.vector_field, [guards[j] for j in rows[k]] + pad)
+        f = sys_.vector_field
+        sticky = []  # (sticking in a model with modes: not yet)
     # Sticking on stop j: the event rows are the contact force (row j) and the other stops' guards.
     for j in sticky:
         on = sys_.at_stop(j)
@@ -255,9 +274,13 @@ def generate_source(system: SymbolicSystem, directions: int = 0, order: int = DE
         )
     parts = [k.source for k in kernels]
     columns: dict[str, dict[str, int]] = {k.name: {"X": order + 1, "O": order + 1} for k in kernels}
-    parts.append(
-        _scalar_function("rhs", sys_, [(f"out[{i}]", e) for i, e in enumerate(f)], extra_args=", out")
-    )
+    if nmodes == 1:
+        parts.append(
+            _scalar_function("rhs", sys_, [(f"out[{i}]", e) for i, e in enumerate(f)], extra_args=", out")
+        )
+    for k, mode in enumerate(sys_.modes if nmodes > 1 else ()):
+        assigns = [(f"out[{i}]", e) for i, e in enumerate(mode.vector_field)]
+        parts.append(_scalar_function(f"rhs_m{k}", sys_, assigns, extra_args=", out"))
     every = list(range(nstops))
     for j in every:
         parts.extend(_stop_functions(sys_.at_stop(j), sysd.at_stop(j), j, along, directions))
@@ -270,6 +293,9 @@ def generate_source(system: SymbolicSystem, directions: int = 0, order: int = DE
         )
     }  # fmt: skip
     dispatch["tc_stick"] = [f"tc_stick_s{j}" for j in (sticky or [0])]
+    if nmodes > 1:  # the flow's functions by the active mode (the driver's last argument)
+        for name in ("tc_free", "tc_var", "rhs"):
+            dispatch[name] = [f"{name}_m{k}" for k in range(nmodes)]
     # dT/dp for every parameter: a sample "one period later" moves when the period does.
     period = sp.Integer(0) if sys_.period is None else sys_.period
     parts.append(
@@ -282,6 +308,19 @@ def generate_source(system: SymbolicSystem, directions: int = 0, order: int = DE
         "nx": n, "nsens": directions, "nparams": m, "nstops": nstops, "order": order,
         "sticks": [j in sticky for j in every],
     }  # fmt: skip
+    if nmodes > 1:  # (a model of one mode: ModelKernels' defaults)
+        back = [
+            next(
+                (i for i in every if sys_.sources[i] == sys_.targets[j] and not sys_.resets[i]
+                 and sp.simplify(guards[i] + guards[j]) == 0),
+                -1,
+            ) if not sys_.resets[j] else j
+            for j in every
+        ]  # fmt: skip
+        sizes.update(
+            nmodes=nmodes, rows=[r + [-1] * (width - len(r)) for r in rows], targets=list(sys_.targets),
+            resets=list(sys_.resets), back=back,
+        )  # fmt: skip
     return ModelSource("\n\n".join(parts), columns, dispatch, sizes)
 
 
@@ -520,7 +559,16 @@ class ModelKernels:
         if not fns[: len(SLOTS)].all() or (self.LANES and not fns[len(SLOTS) :].all()):  # pragma: no cover
             raise OSError("compiled model functions are missing from the kernel cache")  # a damaged file
         sticks = np.array(self.STICKS, dtype=bool)
-        self.table = (fns, self.NX, self.NSENS, self.NSTOPS, self.ORDER, sticks, self.LANES)
+        self.NMODES = int(sizes.get("nmodes", 1))
+        every = list(range(self.NSTOPS))
+        self.ROWS = np.array(sizes.get("rows", [every]), dtype=np.int64).reshape(self.NMODES, -1)
+        self.TARGETS = np.array(sizes.get("targets", [0] * self.NSTOPS), dtype=np.int64)
+        self.RESETS = np.array(sizes.get("resets", [True] * self.NSTOPS), dtype=bool)
+        self.BACK = np.array(sizes.get("back", every), dtype=np.int64)
+        self.table = (
+            fns, self.NX, self.NSENS, self.NSTOPS, self.ORDER, sticks, self.LANES, self.NMODES, self.ROWS,
+            self.TARGETS, self.RESETS, self.BACK,
+        )  # fmt: skip
         for name in SLOTS:
             setattr(self, name, library.function(name))
         self.impacts_per_period = outputs.IMPACTS_PER_PERIOD  # (the last run's: see runner.integrate)
@@ -535,7 +583,7 @@ def compile_model(source: ModelSource, key: str) -> bytes:
 
     prefix = f"grazing_{key}"
     # Lane (SIMD) versions of the Taylor kernels for sweeps, which use no sensitivity directions.
-    lanes = llvmgen.lane_width() if source.sizes["nsens"] == 0 else 0
+    lanes = llvmgen.lane_width() if source.sizes["nsens"] == 0 and "nmodes" not in source.sizes else 0
     module = llvmgen.translate(
         source.text, prefix, columns=source.columns, dispatch=source.dispatch, lanes=lanes,
         lane_functions=("tc_free", "tc_var"),

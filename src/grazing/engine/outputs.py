@@ -47,6 +47,7 @@ class TableRows(NamedTuple):
     impacts: int
     sticking: int
     trajectory: int
+    switches: int = 0  # (switches of a model with modes: as many as impacts are guessed)
 
     @classmethod
     def guess(cls, cfg: Config, impacts_per_period: float = IMPACTS_PER_PERIOD) -> TableRows:
@@ -58,7 +59,7 @@ class TableRows(NamedTuple):
         if cfg.traj_dt > 0.0:  # a point per traj_dt (known), two per impact and one per end of sticking
             around = min(math.ceil(impacts_per_period * cfg.n_keep * 2) + sticking, MAX_GUESSED_ROWS)
             trajectory = 8 + math.ceil(cfg.n_keep * cfg.T / cfg.traj_dt) + around
-        return cls(impacts, sticking, trajectory)
+        return cls(impacts, sticking, trajectory, impacts)
 
     def fit(self, needed: TableRows) -> bool:
         """Whether tables of these rows hold ``needed`` rows."""
@@ -66,6 +67,7 @@ class TableRows(NamedTuple):
             self.impacts >= needed.impacts
             and self.sticking >= needed.sticking
             and self.trajectory >= needed.trajectory
+            and self.switches >= needed.switches
         )
 
 
@@ -76,7 +78,7 @@ def allocate(nx: int, ncol: int, nstops: int, n_keep: int, rows: TableRows) -> R
         samples=np.empty((n_keep, nx)),
         impacts=np.empty((rows.impacts, 3 + nx)), sticking=np.empty((rows.sticking, 2)),
         trajectory=np.empty((rows.trajectory, 1 + nx)), log_sums=np.empty(nx),
-        guard_min=np.empty((nstops, 2 * (2 + nx))),
+        guard_min=np.empty((nstops, 2 * (2 + nx))), switches=np.empty((rows.switches, 2 + nx)),
     )  # fmt: skip
 
 
@@ -87,6 +89,7 @@ class Totals(NamedTuple):
     k: int
     s: float
     mode: int
+    vf: int
     steps: int
     n_impacts: int
     samples_kept: int
@@ -95,6 +98,7 @@ class Totals(NamedTuple):
     trajectory_rows: int
     lyap_span: float
     jacobian_valid: bool
+    switch_rows: int
 
     @classmethod
     def of(cls, out: RunOutput) -> Totals:
@@ -104,7 +108,7 @@ class Totals(NamedTuple):
     @property
     def rows(self) -> TableRows:
         """The rows the run needed in each table."""
-        return TableRows(self.impact_rows, self.sticking_rows, self.trajectory_rows)
+        return TableRows(self.impact_rows, self.sticking_rows, self.trajectory_rows, self.switch_rows)
 
 
 def _rows(table: np.ndarray, count: int) -> np.ndarray:
@@ -115,11 +119,12 @@ def _rows(table: np.ndarray, count: int) -> np.ndarray:
 def result(out: RunOutput, t: Totals) -> Result:
     """The :class:`~grazing.engine.records.Result` of a run written into ``out`` (whose tables hold it)."""
     return Result(
-        status=t.status, x=out.x, V=out.V, k=t.k, s=t.s, mode=t.mode, steps=t.steps, n_impacts=t.n_impacts,
+        status=t.status, x=out.x, V=out.V, k=t.k, s=t.s, mode=t.mode, vf=t.vf, steps=t.steps,
+        n_impacts=t.n_impacts,
         samples=_rows(out.samples, t.samples_kept), impacts=_rows(out.impacts, t.impact_rows),
         sticking=_rows(out.sticking, t.sticking_rows), trajectory=_rows(out.trajectory, t.trajectory_rows),
         log_sums=out.log_sums, lyap_span=t.lyap_span, guard_min=out.guard_min,
-        jacobian_valid=t.jacobian_valid,
+        jacobian_valid=t.jacobian_valid, switches=_rows(out.switches, t.switch_rows),
     )  # fmt: skip
 
 
@@ -148,5 +153,7 @@ def impacts_per_period(need: TableRows, cfg: Config) -> float:
     """
     span = _recorded_periods(cfg)
     return max(
-        IMPACTS_PER_PERIOD, need.impacts / span if span else 0.0, need.sticking * 4 / max(cfg.n_keep, 1)
+        IMPACTS_PER_PERIOD,
+        max(need.impacts, need.switches) / span if span else 0.0,
+        need.sticking * 4 / max(cfg.n_keep, 1),
     )

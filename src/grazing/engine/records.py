@@ -35,6 +35,7 @@ RUN_TOTALS = np.dtype(
         ("k", "i8"),  # the end: whole periods ...
         ("s", "f8"),  # ... and local time
         ("mode", "i8"),  # the contact mode at the end
+        ("vf", "i8"),  # the active mode (vector field) at the end
         ("steps", "i8"),
         ("n_impacts", "i8"),  # over the whole run
         ("samples_kept", "i8"),  # rows of RunOutput.samples written
@@ -43,6 +44,7 @@ RUN_TOTALS = np.dtype(
         ("trajectory_rows", "i8"),
         ("lyap_span", "f8"),  # the time the Lyapunov sums are over
         ("jacobian_valid", "?"),
+        ("switch_rows", "i8"),  # rows the switches table needs
     ],
     align=True,
 )
@@ -60,6 +62,7 @@ class Start(NamedTuple):
     k: int  # whole periods
     s: float  # local time in [0, T) (periodic models) or the time
     mode: int  # 0 free flight, 1 + j sticking to stop j
+    vf: int  # the active mode (vector field) of a model with modes (0 for one mode)
 
 
 class Config(NamedTuple):
@@ -125,6 +128,11 @@ class Kernels(NamedTuple):
     order: int  # of the Taylor polynomials
     sticks: BOOL_1  # bool per stop: the stop has a sticking mode
     lanes: int  # lanes of the lane functions (0: none)
+    nmodes: int  # modes (vector fields): the flow's functions take the active one as their last argument
+    rows: I8_2  # (modes, event rows): the transition (stop) of each row of a mode's kernels, -1 padding
+    targets: I8_1  # per transition (stop): the mode it enters
+    resets: BOOL_1  # per transition (stop): it has a reset (an impact); else a switch of vector field
+    back: I8_1  # per switch: the transition whose guard is 0 just after it (-1: none)
 
 
 class Result(NamedTuple):
@@ -136,6 +144,7 @@ class Result(NamedTuple):
     k: int
     s: float
     mode: int
+    vf: int  # the active mode (vector field)
     steps: int
     n_impacts: int  # over the whole run
     samples: np.ndarray  # (kept samples, n)
@@ -146,6 +155,7 @@ class Result(NamedTuple):
     lyap_span: float
     guard_min: np.ndarray  # per stop (rows): [h, t, state..., h_approach, t_approach, state...]
     jacobian_valid: bool
+    switches: np.ndarray  # rows [t, transition, state...]: switches of vector field without a reset
 
 
 class RunOutput(NamedTuple):
@@ -166,6 +176,7 @@ class RunOutput(NamedTuple):
     trajectory: F8_2  # (rows, 1 + n): [t, state...]
     log_sums: F8_1  # (n,): Lyapunov sums
     guard_min: F8_2  # (stops, 2 (2 + n)): per stop [h, t, state..., h_approach, t_approach, state...]
+    switches: F8_2  # (rows, 2 + n): [t, transition, state...] at each switch without a reset
 
 
 INTEGRATE_ARGUMENTS = (Start, ("pv", F8_1), Config, Kernels, RunOutput)

@@ -104,6 +104,7 @@ class Segment:
     approach_min: np.ndarray  # rows per stop: [h, t, state...] at the closest approach away from contacts
     jacobian_valid: bool
     steps: int
+    switches: np.ndarray  # rows [t, transition index, state...] (models with modes)
 
 
 def step_safety(tol: float, order: int) -> float:
@@ -164,6 +165,8 @@ class Runner:
         Index of the stop a grazing analysis looks at: its guard's minimum is
         tracked (``guard_min``), the contacts of ``touching`` are on it, and
         ``zdm`` stands for its impacts.
+    mode
+        The index of the mode a model with modes starts in.
     """
 
     def __init__(
@@ -181,6 +184,7 @@ class Runner:
         zdm: DiscontinuityMap | None = None,
         touching: bool = False,
         stop: int = 0,
+        mode: int = 0,
     ):
         self.model = model
         self.zdm = zdm
@@ -204,6 +208,7 @@ class Runner:
         T = self.T
         s_phase = (phase % (2 * math.pi)) / (2 * math.pi) * T
         self.mode = 0
+        self.vf = int(mode)  # the active mode (vector field) of a model with modes
         self.k, self.s, self.ks, self.ss = start_times(float(t0), T, s_phase, bool(model.periodic))
         self.k_start = self.k
 
@@ -243,10 +248,10 @@ class Runner:
         )  # fmt: skip
         return tuple(fields[name] for name in STATIC)
 
-    def vector_field(self, x: np.ndarray, s: float) -> np.ndarray:
-        """``f(x, s)`` with the kernels this runner already loaded."""
+    def vector_field(self, x: np.ndarray, s: float, mode: int | None = None) -> np.ndarray:
+        """``f(x, s)`` of ``mode`` (by default the current one), by the kernels this runner loaded."""
         out = np.empty(self.model.n_states)
-        self.kern.rhs(np.asarray(x, dtype=float), float(s), self.pv, out)
+        self.kern.rhs(np.asarray(x, dtype=float), float(s), self.pv, out, self.vf if mode is None else mode)
         return out
 
     def period_gradient(self) -> np.ndarray:
@@ -275,7 +280,7 @@ class Runner:
         T = self.T
         if max_steps is None:
             max_steps = step_limit(periods)
-        start = (self.x, self.V, self.k, self.s, self.mode)  # a records.Start, as a plain tuple
+        start = (self.x, self.V, self.k, self.s, self.mode, self.vf)  # a records.Start, as a plain tuple
         call = dict(
             max_steps=int(max_steps), n_samples=periods, ks=self.ks, ss=float(self.ss), n_keep=keep,
             lyapunov=bool(lyapunov), traj_dt=T / trajectory if trajectory else 0.0, track_min=bool(guard_min),
@@ -288,7 +293,7 @@ class Runner:
             raise SimulationError(
                 Status(int(out.status)).message(out.k * T + out.s, max_steps, self.model, out.x)
             )
-        self.x, self.V, self.k, self.s, self.mode = out.x, out.V, out.k, out.s, out.mode
+        self.x, self.V, self.k, self.s, self.mode, self.vf = out.x, out.V, out.k, out.s, out.mode, out.vf
         self.touch_start = False  # only the first call starts at the contact
         if self.model.periodic:
             self.ks += periods
@@ -298,5 +303,5 @@ class Runner:
         gm = out.guard_min
         return Segment(
             out.samples, out.impacts, out.n_impacts, out.sticking, out.trajectory, out.log_sums,
-            out.lyap_span, gm[:, : 2 + n], gm[:, 2 + n :], out.jacobian_valid, out.steps,
+            out.lyap_span, gm[:, : 2 + n], gm[:, 2 + n :], out.jacobian_valid, out.steps, out.switches,
         )  # fmt: skip

@@ -17,7 +17,7 @@ from grazing.core.options import (
     step_limit,
     with_shorthands,
 )
-from grazing.core.solution import Impacts, Solution
+from grazing.core.solution import Impacts, Solution, Switches
 from grazing.engine.runner import DiscontinuityMap, Runner
 from grazing.errors import InvalidParameterError
 
@@ -38,6 +38,7 @@ def simulate(
     touching: bool = False,
     stop_name: int | str | None = None,
     progress: Callable[[int, int], None] | None = None,
+    mode: str | None = None,
     **shorthands: Any,
 ) -> Solution:
     """Simulate a hybrid model, never missing an impact.
@@ -100,6 +101,11 @@ def simulate(
         Called as ``progress(periods_done, periods_total)`` after every chunk
         of :data:`CHUNK_PERIODS` periods (the run is always chunked the same
         way, so results do not depend on whether progress is shown).
+    mode
+        The mode a model with modes starts in (its initial mode by default);
+        ``x0`` must lie in it.  Switches between modes are located as impacts
+        are, and the Jacobian is carried across them by their saltation
+        matrices (:attr:`Solution.switches`).
 
     Returns
     -------
@@ -129,8 +135,13 @@ def simulate(
     tol, max_steps, chatter_tol = solver.tol, solver.max_steps, solver.chatter_tol
     if zdm is not None and not model.periodic:
         raise InvalidParameterError("the discontinuity map needs a periodically forced model")
+    if model.has_modes:
+        _refuse_on_modes(model, events=events, zdm=zdm, touching=touching, guard_min=guard_min)
+    elif mode is not None:
+        model.mode_index(mode)  # (only the one mode's name)
     allowed = events and zdm is None  # (with the map, the state may be past the grazing stop)
-    x = model.check_state(np.zeros(model.n_states) if x0 is None else x0, t0, allowed=allowed)
+    x = model.check_state(np.zeros(model.n_states) if x0 is None else x0, t0, allowed=allowed, mode=mode)
+    start_mode = model.mode_index(mode)
     stop_index = model.stop_index(stop_name)
     use_var = tangent.variational
     n = model.n_states
@@ -138,6 +149,7 @@ def simulate(
     run = Runner(
         model, x, t0=float(t0), phase=float(phase), tol=tol, variational=use_var, sensitivities=sens,
         events=events, chatter_tol=chatter_tol, zdm=zdm, touching=touching, stop=stop_index,
+        mode=start_mode,
     )  # fmt: skip
     first_sample = run.next_sample_time
     ks_start = run.ks
@@ -147,7 +159,7 @@ def simulate(
     done = 0
     steps = 0
     n_imp = 0
-    parts: dict[str, list[np.ndarray]] = {"samples": [], "imp": [], "sticks": [], "traj": []}
+    parts: dict[str, list[np.ndarray]] = {"samples": [], "imp": [], "sticks": [], "traj": [], "switch": []}
     log_sum = np.zeros(n)
     lyap_span = 0.0
     gmin: np.ndarray | None = None
@@ -172,6 +184,7 @@ def simulate(
             ("imp", seg.impacts),
             ("sticks", seg.sticking),
             ("traj", traj),
+            ("switch", seg.switches),
         ):
             parts[key].append(arr)
         log_sum += seg.log_sums
@@ -185,12 +198,21 @@ def simulate(
     t_samples = first_sample + (transient + np.arange(periods)) * T
     jac = run.V if (use_var and not lyapunov) else None
     if jac is not None and sens and np.any(run.Tp):
-        jac = _sample_time_terms(run, x, float(t0), ks_start + total - 1, float(t_samples[-1]), jac)
+        jac = _sample_time_terms(
+            run, x, float(t0), ks_start + total - 1, float(t_samples[-1]), jac, start_mode
+        )
     if jac is not None:
         jac = jac[:, : n + len(sens)].copy()  # the module may have more direction columns than asked
     imp = _concat(parts["imp"], 3 + n)
     traj = _concat(parts["traj"], 1 + n)
     imp_t = imp[:, 0]
+    switches = None
+    if model.has_modes:
+        sw = _concat(parts["switch"], 2 + n)
+        switches = Switches(
+            t=sw[:, 0], transition=sw[:, 1].astype(int), state=sw[:, 2:], transition_names=model.stop_names,
+            sources=model.transition_source, targets=model.transition_target,
+        )  # fmt: skip
     return Solution(
         model=model,
         t=t_samples,
@@ -226,11 +248,44 @@ def simulate(
             "phase": phase,
             "period_gradient": dict(zip(sens, run.Tp.tolist())),
         },
+        switches=switches,
+        mode_final=model.mode_names[run.vf] if model.has_modes else None,
     )
 
 
+def _refuse_on_modes(
+    model: HybridModel, *, events: bool, zdm: DiscontinuityMap | None, touching: bool, guard_min: bool
+) -> None:
+    """One line for what ``simulate`` cannot do yet on a model with modes (``model.has_modes``)."""
+    if zdm is not None:
+        model.require_one_mode("the discontinuity map")
+    if touching:
+        model.require_one_mode("a run from a grazing contact (touching)")
+    if guard_min:
+        model.require_one_mode("the smallest guard value (guard_min)")
+    if not events:
+        model.require_one_mode("a run without events (events=False)")
+    system = model.symbolic
+    for sf in system.surfaces:
+        if sf.sliding:
+            raise InvalidParameterError(
+                f"sliding on surface {sf.name!r} is not supported yet: give it sliding=False (model "
+                f"{model.name!r})"
+            )
+    for j, name in enumerate(model.stop_names):
+        if system.resets[j] and system.sources[j] != system.targets[j]:
+            raise InvalidParameterError(
+                f"transition {name!r} has a reset and changes the mode: not supported yet (model "
+                f"{model.name!r})"
+            )
+        if system.stops[j].contact_direction is not None:
+            raise InvalidParameterError(
+                f"sticking (the contact_direction of {name!r}) in a model with modes is not supported yet"
+            )
+
+
 def _sample_time_terms(
-    run: Runner, x0: np.ndarray, t0: float, k_final: int, t_final: float, V: np.ndarray
+    run: Runner, x0: np.ndarray, t0: float, k_final: int, t_final: float, V: np.ndarray, start_mode: int = 0
 ) -> np.ndarray:
     """Parameter columns of ``V`` for samples whose time moves with a period-setting parameter.
 
@@ -250,7 +305,7 @@ def _sample_time_terms(
     f_end = run.vector_field(run.x, run.s)
     if run.model.periodic:
         end = (k_final - run.k) + run.ss / T
-        start = V[:, :n] @ run.vector_field(x0, t0) * run.k_start
+        start = V[:, :n] @ run.vector_field(x0, t0, start_mode) * run.k_start
     else:
         end = (t_final - t0) / T
         start = np.zeros(n)

@@ -93,6 +93,7 @@ def find_grazings(
     >>> [round(p.model.params["eta"], 4) for p in points]
     [0.4451, 0.5473]
     """
+    model.require_one_mode("the grazing analysis")
     branch = continue_orbit(
         model,
         param,
@@ -259,6 +260,7 @@ def grazing_curve(
     >>> round(math.degrees(curve.fold.model.params["theta_hat"]), 1)
     55.9
     """
+    model.require_one_mode("the grazing curve")
     p1, p2 = params
     for p in params:
         if p not in model.params:

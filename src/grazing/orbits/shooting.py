@@ -270,6 +270,7 @@ def find_orbit(
     >>> orbit.period, orbit.impacts, orbit.stable
     (5, 1, True)
     """
+    model.require_one_mode("finding a periodic orbit")
     if period is not None and (not isinstance(period, (int, np.integer)) or period < 1):
         raise InvalidParameterError(f"period must be a positive integer, got {period!r}")
     if t0 is None:

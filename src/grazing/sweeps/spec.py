@@ -127,6 +127,7 @@ class SweepSpec:
     polish: bool = True
 
     def __post_init__(self) -> None:
+        self.model.require_one_mode("a sweep (lanes)")
         if not self.points:
             raise InvalidParameterError("a sweep needs at least one point")
         if self.segments < 1 or len(self.points) % self.segments:

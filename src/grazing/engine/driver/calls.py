@@ -27,15 +27,15 @@ from grazing.engine.abi import (
 
 
 @njit(cache=True, inline="always")
-def tc_free(m, x, s, pv, X, O):
-    """Taylor coefficients of free flight (state rows of ``X``, every stop's guard in ``O``)."""
-    call_model(m.fns[TC_FREE], x, s, pv, X, O, None, 0)
+def tc_free(m, x, s, pv, X, O, vf):
+    """Taylor coefficients of free flight in mode ``vf`` (state rows of ``X``, its guards in ``O``)."""
+    call_model(m.fns[TC_FREE], x, s, pv, X, O, None, vf)
 
 
 @njit(cache=True, inline="always")
-def tc_var(m, x, s, pv, X, O):
-    """Taylor coefficients of free flight with the variational equations."""
-    call_model(m.fns[TC_VAR], x, s, pv, X, O, None, 0)
+def tc_var(m, x, s, pv, X, O, vf):
+    """Taylor coefficients of free flight in mode ``vf`` with the variational equations."""
+    call_model(m.fns[TC_VAR], x, s, pv, X, O, None, vf)
 
 
 @njit(cache=True, inline="always")
@@ -45,9 +45,9 @@ def tc_stick(m, x, s, pv, X, O, j):
 
 
 @njit(cache=True, inline="always")
-def rhs(m, x, s, pv, out):
-    """The vector field into ``out``."""
-    call_model(m.fns[RHS], x, s, pv, out, None, None, 0)
+def rhs(m, x, s, pv, out, vf):
+    """The vector field of mode ``vf`` into ``out``."""
+    call_model(m.fns[RHS], x, s, pv, out, None, None, vf)
 
 
 @njit(cache=True, inline="always")

@@ -96,13 +96,17 @@ def first_event(m, run, O, h, events, skip, end_contact, end_stop, a, work):
     stuck = run.stuck
     defl = run.defl
     defl_stop = run.defl_stop
-    for r in range(m.nstops):
+    vf = run.vf
+    for row in range(m.rows.shape[1]):
+        r = m.rows[vf, row]  # the row's stop (transition); -1: padding
+        if r < 0:
+            continue
         force = mode == 1 and r == stuck
         if not (events or force) or r == skip:
             continue
         defl_r = defl if r == defl_stop else 0
         end_r = end_contact and r == end_stop
-        deg, tail = event_polynomial(O, r, h, 1 if force else 0, defl_r, end_r, a, m.order)
+        deg, tail = event_polynomial(O, row, h, 1 if force else 0, defl_r, end_r, a, m.order)
         ur = event_certificate(a, tail)
         if ur > 0.0:  # rarely: the certificate cannot exclude a root on the step
             ur = confirm_first_root(a, deg, isolate_first_root(a, deg, work), work)

@@ -29,8 +29,10 @@ from grazing.engine.stepping import append_pair, append_record, append_row, pack
 
 
 @njit(cache=True)
-def saltation(m, xm, xp, s, pv, j, V, ncol):
+def saltation(m, xm, xp, s, pv, j, V, ncol, vf_from, vf_to):
     """Apply the saltation matrix of stop ``j`` (paper eq. 14, with time and parameter terms) to V.
+
+    ``f-`` is mode ``vf_from``'s field at ``xm``, ``f+`` mode ``vf_to``'s at ``xp``.
 
     Returns False, leaving V alone, for an impact at zero normal speed (``L_f h = 0``): there the
     saltation matrix is unbounded and the flow's Jacobian does not exist.
@@ -39,8 +41,8 @@ def saltation(m, xm, xp, s, pv, j, V, ncol):
     nsens = m.nsens
     fm = np.empty(n)
     fp = np.empty(n)
-    rhs(m, xm, s, pv, fm)
-    rhs(m, xp, s, pv, fp)
+    rhs(m, xm, s, pv, fm, vf_from)
+    rhs(m, xp, s, pv, fp, vf_to)
     Gx = np.zeros((n, n))
     Gt = np.zeros(n)
     Gp = np.zeros((n, max(nsens, 1)))
@@ -133,7 +135,7 @@ def apply_impact(m, r, x, xp, pv, j, nrows, V, record, tables):
     reset(m, x, s, pv, xp, j)
     if r.use_var:
         unpack_var(x, n, ncol, V)
-        jac_ok = saltation(m, x, xp, s, pv, j, V, ncol)
+        jac_ok = saltation(m, x, xp, s, pv, j, V, ncol, r.vf, m.targets[j])
         pack_var(V, n, ncol, xp)
     else:
         jac_ok = True
@@ -164,6 +166,9 @@ def at_event(m, r, x, xp, pv, j, nrows, V, chatter_time, record, tables):
     ``tables[1]`` (``r.n_stick``).
     """
     t = r.k * r.T + r.s
+    if not m.resets[j]:  # a switch of vector field: the state goes on, the field changes
+        switch_mode(m, r, x, pv, j, V, record, tables)
+        return False
     if r.mode == 1 and j == r.stuck:  # release from sticking: the contact force changes sign
         r.mode = 0
         r.defl = 3
@@ -196,6 +201,37 @@ def at_event(m, r, x, xp, pv, j, nrows, V, chatter_time, record, tables):
                 append_pair(tables[1], r.n_stick, r.k * r.T + r.s, math.nan)
                 r.n_stick += 1
     return True
+
+
+@njit(cache=True)
+def switch_mode(m, r, x, pv, j, V, record, tables):
+    """Run ``r`` (its state ``x``, on transition ``j``'s guard) switches to ``j``'s target mode, no reset.
+
+    The variational matrix is multiplied by the saltation matrix of a switch,
+    ``S = I + (f+ - f-) (h_x V + h_p) / (h_x f- + h_t)`` (:func:`saltation` with
+    the identity reset); the switch is recorded as ``[t, j, state]`` in
+    ``tables[3]`` when ``record``, and in the trajectory.  The root at ``u = 0``
+    of the transition back (``m.back[j]``, whose guard is 0 here) is known.
+    """
+    n = m.nx
+    ncol = n + m.nsens
+    s = r.s
+    t = r.k * r.T + s
+    target = m.targets[j]
+    if r.use_var:
+        unpack_var(x, n, ncol, V)
+        ok = saltation(m, x, x, s, pv, j, V, ncol, r.vf, target)
+        pack_var(V, n, ncol, x)
+        r.jac_valid = r.jac_valid and ok
+    if record:
+        append_record(tables[3], r.n_switch, t, j, x, n)
+        r.n_switch += 1
+    if r.recording and r.traj_dt > 0.0:
+        append_row(tables[2], r.n_traj, t, x, n)
+        r.n_traj += 1
+    r.vf = target
+    r.defl = 1 if m.back[j] >= 0 else 0
+    r.defl_stop = m.back[j]
 
 
 @njit(cache=True)

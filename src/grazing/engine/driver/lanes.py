@@ -184,7 +184,8 @@ def sweep_lanes(m, cfg, work, points, out):
     imp = new_table(1, 3 + n)  # (impacts are counted, not recorded)
     sticks = new_table(1, 2)
     traj = new_table(1, 1 + n)
-    tables = (imp, sticks, traj)
+    switches = new_table(1, 2 + n)
+    tables = (imp, sticks, traj, switches)
     fbuf = np.zeros(n)
     Tp = np.zeros(0)  # (no sensitivities on lanes: end_step's period term is never taken)
     kinds = np.zeros(L, dtype=np.int64)  # 0 sticking or idle, 1 free flight, 2 with the variational equations
@@ -328,18 +329,18 @@ def lane_coefficients(m, la, kinds, use_lanes, coeffs):
             call_model(m.fns[TC_FREE_LANES if kind == 1 else TC_VAR_LANES], XS, 0.0, PT, XT, OT, SI, 0)
         elif L == 1:  # one lane: the lane arrays are the scalar function's arrays
             if kind == 1:
-                tc_free(m, XS, SI[0], pl[0], XT, OT)
+                tc_free(m, XS, SI[0], pl[0], XT, OT, 0)
             else:
-                tc_var(m, XS, SI[0], pl[0], XT, OT)
+                tc_var(m, XS, SI[0], pl[0], XT, OT, 0)
         else:  # lane by lane, into the lanes' columns
             for lane in range(L):
                 if kinds[lane] == kind:
                     for i in range(rows):
                         xl[i] = XS[i, lane]
                     if kind == 1:
-                        tc_free(m, xl, SI[lane], pl[lane], Xs, Os)
+                        tc_free(m, xl, SI[lane], pl[lane], Xs, Os, 0)
                     else:
-                        tc_var(m, xl, SI[lane], pl[lane], Xs, Os)
+                        tc_var(m, xl, SI[lane], pl[lane], Xs, Os, 0)
                     to_lane(Xs, Os, rows, nstops, K, XT, OT, lane)
     return nvar
 

@@ -121,7 +121,8 @@ def integrate(start, pv, cfg, m, out):
             for c in range(ncol):
                 x[n + i * ncol + c] = start.V[i, c]
     X = np.zeros((ntot, order + 1))
-    O = np.zeros((nstops, order + 1))
+    nevents = m.rows.shape[1]  # event rows of a mode's kernels (every stop's guard, for one mode)
+    O = np.zeros((nevents, order + 1))
     work = np.zeros((ROOT_WORK_ROWS, max(order + 1, ROOT_WORK_MIN_COLS)))
     a = np.zeros(order + 1)
     gm = np.zeros(order + 1)
@@ -133,11 +134,12 @@ def integrate(start, pv, cfg, m, out):
     imp = new_table(16, 3 + n)
     sticks = new_table(4, 2)
     traj = new_table(64 if traj_dt > 0.0 else 1, 1 + n)
+    switches = new_table(16 if m.nmodes > 1 else 1, 2 + n)
     logs = out.log_sums
     logs[:] = 0.0
     scratch = np.zeros(n)
     guard_info = new_guard_info(nstops, n)  # per stop: the guard's minimum, closest approach, slopes
-    tables = (imp, sticks, traj)
+    tables = (imp, sticks, traj, switches)
     fbuf = np.empty(n)
     zdm_gh = np.zeros(n)
     zdm_gv = np.zeros(n)
@@ -164,10 +166,10 @@ def integrate(start, pv, cfg, m, out):
         # The step: Taylor coefficients of the solution (and of the event function), and the step size.
         if r.mode == 0:
             if use_var:
-                tc_var(m, x, r.s, pv, X, O)
+                tc_var(m, x, r.s, pv, X, O, r.vf)
             else:
-                tc_free(m, x, r.s, pv, X, O)
-            h = step_size(X, ntot, O, nstops, 0, GUARD_SCALE, order, max_step, factor)
+                tc_free(m, x, r.s, pv, X, O, r.vf)
+            h = step_size(X, ntot, O, nevents, 0, GUARD_SCALE, order, max_step, factor)
         else:
             tc_stick(m, x, r.s, pv, X, O, r.stuck)  # the first n rows only
             h = step_size(X, n, O, nstops, r.stuck, math.inf, order, max_step, factor)
@@ -189,7 +191,7 @@ def integrate(start, pv, cfg, m, out):
             take_samples(m, r, X, pv, h_acc, event, is_last, samples, sticks, traj, xe)
         if r.recording and traj_dt > 0.0:
             trajectory_points(m, r, X, h_acc, traj, xe, is_last and not event)
-        if r.recording and track_min and r.mode == 0 and h_acc > 0.0:
+        if r.recording and track_min and r.mode == 0 and h_acc > 0.0 and m.nmodes == 1:
             for j in range(nstops):  # every stop's closest approach
                 track_guard(m, r, O, j, X, x, h, h_acc, event, gm, guard_info[j], xe)
 
@@ -227,6 +229,7 @@ def finish_run(m, runs, cfg, x, pv, guard_info, tables, out):
     tot.k = r.k
     tot.s = r.s
     tot.mode = 0 if r.mode == 0 else 1 + r.stuck
+    tot.vf = r.vf
     tot.steps = r.steps
     tot.n_impacts = r.n_imp
     tot.samples_kept = max(0, min(cfg.n_keep, r.isamp - (cfg.n_samples - cfg.n_keep)))
@@ -235,6 +238,7 @@ def finish_run(m, runs, cfg, x, pv, guard_info, tables, out):
     tot.trajectory_rows = r.n_traj
     tot.lyap_span = r.k * T + r.s - r.lyap_t0 if (cfg.lyapunov and r.lyap_started) else 0.0
     tot.jacobian_valid = r.jac_valid
+    tot.switch_rows = r.n_switch
     for i in range(n):
         out.x[i] = x[i]
     out.V[:, :] = 0.0
@@ -243,6 +247,7 @@ def finish_run(m, runs, cfg, x, pv, guard_info, tables, out):
     copy_rows(tables[0], r.n_imp_rec, out.impacts)
     copy_rows(tables[1], r.n_stick, out.sticking)
     copy_rows(tables[2], r.n_traj, out.trajectory)
+    copy_rows(tables[3], r.n_switch, out.switches)
     out.guard_min[:, :] = guard_info[:, : out.guard_min.shape[1]]
 
 
@@ -252,7 +257,7 @@ def start_run(m, r, start, cfg, x, tables):
 
     A run whose recorded span starts at once records its first trajectory
     point, and a sticking interval if it starts sticking (``tables`` =
-    ``(impacts, sticking, trajectory)``).
+    ``(impacts, sticking, trajectory, switches)``).
     """
     n = m.nx
     T = cfg.T
@@ -267,6 +272,7 @@ def start_run(m, r, start, cfg, x, tables):
     r.s = start.s
     r.mode = 1 if start.mode > 0 else 0
     r.stuck = max(start.mode - 1, 0)  # the stop it sticks to
+    r.vf = start.vf
     r.defl = 2 if cfg.touch_start else 0
     r.defl_stop = cfg.stop  # the stop the known roots at u = 0 belong to
     r.ks = cfg.ks
@@ -280,6 +286,7 @@ def start_run(m, r, start, cfg, x, tables):
     r.n_imp_rec = 0
     r.n_stick = 0
     r.n_traj = 0
+    r.n_switch = 0
     r.kt = r.k
     r.st = r.s
     r.kz = r.k if r.s < cfg.zdm_s - SNAP * T else r.k + 1

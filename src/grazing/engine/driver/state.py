@@ -38,6 +38,7 @@ RUN_STATE = np.dtype(
         ("s", np.float64),
         ("mode", np.int64),  # 0 free flight, 1 sticking
         ("stuck", np.int64),  # the stop it sticks to
+        ("vf", np.int64),  # the active mode (vector field) of a model with modes (0 for one mode)
         ("defl", np.int64),  # known roots at u = 0 of the next step's event polynomial (0 none)
         ("defl_stop", np.int64),  # ... of this stop's guard
         ("steps", np.int64),
@@ -67,6 +68,7 @@ RUN_STATE = np.dtype(
         ("n_imp_rec", np.int64),  # ... recorded
         ("n_stick", np.int64),  # sticking intervals recorded
         ("n_traj", np.int64),  # trajectory points recorded
+        ("n_switch", np.int64),  # switches of vector field recorded
         ("kt", np.int64),
         ("st", np.float64),
         # a sweep's point (lanes.sweep_lanes)

@@ -119,7 +119,7 @@ def end_step(m, r, x, X, pv, nrows, cfg, chatter_time, record_impacts, Tp, work,
     r.s += r.h_acc
     if r.wrap and r.s >= r.T:
         if m.nsens > 0 and r.use_var and mode == 0:
-            shift_period(m, x, r.s, pv, Tp, ncol, f)
+            shift_period(m, x, r.s, pv, Tp, ncol, f, r.vf)
         r.s -= r.T
         r.k += 1
     r.steps += 1

@@ -15,7 +15,7 @@ from grazing.engine.stepping import append_record, eval_rows, orthonormalize, pa
 
 
 @njit(cache=True)
-def shift_period(m, x, s, pv, Tp, ncol, f):
+def shift_period(m, x, s, pv, Tp, ncol, f, vf):
     """Parameter columns of V at a period boundary: ``V_p += f(x, s) dT/dp``.
 
     Time is kept as ``k T + s``; the variational equations give derivatives at
@@ -24,7 +24,7 @@ def shift_period(m, x, s, pv, Tp, ncol, f):
     parameter the two labels are different instants, ``dT/dp`` apart per
     period, and the state moves by ``f dT/dp`` between them.
     """
-    rhs(m, x, s, pv, f)
+    rhs(m, x, s, pv, f, vf)
     n = m.nx
     for i in range(n):
         for c in range(m.nsens):
