@@ -135,6 +135,7 @@ def flow_map(
     >>> fm.impacts, bool(fm.solution.guard_min[0] < 0)
     (0, True)
     """
+    model.require_one_mode("the flow map")
     sol = simulate(
         model,
         x,

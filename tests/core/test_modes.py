@@ -311,3 +311,13 @@ def test_features_not_yet_on_modes_are_refused_in_one_line():
         find_grazings(m, "omega", 1.0, 1.5)
     with pytest.raises(InvalidParameterError, match=r"^the grazing curve does not support models with"):
         grazing_curve(m, ("omega", "gap"), 1.0, search=(1.0, 1.5))
+    from grazing.attractors import continue_attractors, find_attractors
+    from grazing.maps import flow_map
+
+    # (the basins' grid once called every state "invalid": a guard of the other mode is negative there)
+    with pytest.raises(InvalidParameterError, match=r"^finding attractors does not support models with"):
+        find_attractors(m, [[0.0, 0.0]])
+    with pytest.raises(InvalidParameterError, match=r"^continuing attractors does not support models with"):
+        continue_attractors(m, "omega", [1.0, 1.1], (-1.0, 0.4), (-1.0, 1.0), (2, 2))
+    with pytest.raises(InvalidParameterError, match=r"^the flow map does not support models with"):
+        flow_map(m, [0.0, 0.0])

@@ -223,6 +223,7 @@ def find_attractors(
     used: set[str] = set()
     s = with_shorthands(settings, BasinSettings, shorthands, used)
     refuse_unknown("find_attractors", shorthands, used)
+    model.require_one_mode("finding attractors")
     x = as_states(model, states)
     t0 = start_time(model, s.phase)
     invalid = beyond_stops(model, x, t0)
