@@ -1,14 +1,16 @@
-"""An exact reference for piecewise-linear forced models with modes and no resets.
+"""An exact reference for piecewise-linear forced models with modes, with or without linear resets.
 
 In mode ``k`` the state obeys ``x' = A_k x + b cos(w t) + d_k``; its solution is
 ``x(t) = exp(A_k (t - t0)) (x0 - xp_k(t0)) + xp_k(t)`` with the particular
 solution ``xp_k(t) = Re(X_k exp(i w t)) - A_k^-1 d_k``, ``X_k = (i w I - A_k)^-1 b``.
 A mode is left when a linear guard ``c . x + e`` of one of its transitions
 reaches 0: the guard is sampled densely on the exact solution and each sign
-change refined by Brent's method (to 1e-15).  The Jacobian of the flow map is the
-product of the exponentials and the saltation matrices of the switches,
-``S = I + (f+ - f-) c^T / (c^T f-)`` (no reset).  Nothing here uses grazing's
-engine.
+change refined by Brent's method (to 1e-15).  A transition may reset the state
+linearly, ``x+ = R x`` (the identity without a reset).  The Jacobian of the flow
+map is the product of the exponentials and the saltation matrices of the
+transitions, ``S = R + (f+ - R f-) c^T / (c^T f-)`` with ``f-`` the source
+mode's field at ``x`` and ``f+`` the target's at ``R x`` (no reset:
+``S = I + (f+ - f-) c^T / (c^T f-)``).  Nothing here uses grazing's engine.
 """
 
 from __future__ import annotations
@@ -25,7 +27,8 @@ SAMPLES_PER_PERIOD = 800
 
 @dataclass(frozen=True)
 class LinearMode:
-    """``x' = A x + b cos(w t) + d``, left through ``exits``: ``(c, e, target)`` with guard ``c . x + e``."""
+    """``x' = A x + b cos(w t) + d``, left through ``exits``: ``(c, e, target)`` with guard ``c . x + e``,
+    or ``(c, e, target, R)`` with the reset ``x+ = R x``."""
 
     A: np.ndarray
     b: np.ndarray
@@ -60,7 +63,7 @@ class PiecewiseLinearModel:
         n = max(8, math.ceil((t1 - t0) / self.period * SAMPLES_PER_PERIOD))
         ts = np.linspace(t0, t1, n + 1)
         best = None
-        for i, (c, e, _) in enumerate(self.modes[k].exits):
+        for i, (c, e, *_) in enumerate(self.modes[k].exits):
 
             def guard(tt: float, c: np.ndarray = c, e: float = e) -> float:
                 return float(c @ self.flow(k, x0, t0, tt) + e)
@@ -86,11 +89,12 @@ class PiecewiseLinearModel:
                 J = expm(self.modes[k].A * (t1 - t)) @ J
                 return self.flow(k, x, t, t1), k, J, switches
             tz, i = ev
-            c, _, target = self.modes[k].exits[i]
+            c, _, target, *reset = self.modes[k].exits[i]
+            R = reset[0] if reset else np.eye(len(x))
             xz = self.flow(k, x, t, tz)
             J = expm(self.modes[k].A * (tz - t)) @ J
-            fm, fp = self.f(k, xz, tz), self.f(target, xz, tz)
-            S = np.eye(len(x)) + np.outer(fp - fm, c) / (c @ fm)
+            fm, fp = self.f(k, xz, tz), self.f(target, R @ xz, tz)
+            S = R + np.outer(fp - R @ fm, c) / (c @ fm)
             J = S @ J
             switches.append((tz, i, k, target))
-            x, k, t = xz, target, tz
+            x, k, t = R @ xz, target, tz

@@ -17,7 +17,7 @@ import sympy as sp
 from scipy.optimize import brentq
 
 import grazing
-from grazing import HybridModel, InvalidParameterError, Mode, Parameter, Stop, Surface, Tangent, Transition
+from grazing import HybridModel, InvalidParameterError, Mode, Parameter, Surface, Tangent, Transition
 from tests.piecewise_exact import LinearMode, PiecewiseLinearModel
 
 x, v, t = sp.symbols("x v t")
@@ -123,14 +123,6 @@ def test_start_in_another_mode_and_one_line_refusals():
     )  # fmt: skip
     with pytest.raises(InvalidParameterError, match=r"^sliding on surface 'belt' is not supported yet"):
         grazing.simulate(sliding, [0.0, 0.0], periods=1)
-    rocking = HybridModel(
-        "rock", [x, v], t, [Parameter(nm, val) for nm, val in VALUES.items()], period=2 * sp.pi / w,
-        modes=[Mode("left", FREE), Mode("right", CONTACT, stops=[Stop("s", x + 1, [x, -v])])],
-        transitions=[Transition("hit", "left", "right", gap - x, reset=[x, -v]),
-                     Transition("back", "right", "left", x - gap)],
-    )  # fmt: skip
-    with pytest.raises(InvalidParameterError, match=r"^transition 'hit' has a reset and changes the mode"):
-        grazing.simulate(rocking, [0.0, 0.0], periods=1)
 
 
 def test_parameter_sensitivities_across_switches_against_differences_of_the_exact_flow():

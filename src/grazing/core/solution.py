@@ -201,7 +201,12 @@ class Impacts:
 
 @dataclass(frozen=True)
 class Switches:
-    """Switches of vector field without a reset (a model with modes): one row per switch.
+    """Changes of mode (a model with modes): one row per switch.
+
+    A transition with a reset that changes the mode (the rocking block's
+    impact from one corner onto the other) is both an impact (in
+    :attr:`Solution.impacts`, with the state before it) and a switch (here,
+    with the state after the reset).
 
     Attributes
     ----------
@@ -210,7 +215,7 @@ class Switches:
     transition
         Index of each switch's transition (into ``transition_names``).
     state
-        The state at the switch (continuous across it), shape ``(n_switches, n_states)``.
+        The state at the switch (after the reset, if any), shape ``(n_switches, n_states)``.
     transition_names
         The model's transitions (:attr:`~grazing.core.model.HybridModel.stop_names`).
     sources, targets
@@ -302,7 +307,7 @@ class Solution:
         of ``Tangent.sensitivities``, the derivative of the forcing period with
         respect to it: 0 for a parameter that does not set the period).
     switches
-        A model with modes: its switches of vector field without a reset
+        A model with modes: its changes of mode, with or without a reset
         (:class:`Switches`, recorded as the impacts are); None for a model of one mode.
     mode_final
         A model with modes: the mode at the end; None for a model of one mode.

@@ -309,19 +309,33 @@ def generate_source(system: SymbolicSystem, directions: int = 0, order: int = DE
         "sticks": [j in sticky for j in every],
     }  # fmt: skip
     if nmodes > 1:  # (a model of one mode: ModelKernels' defaults)
-        back = [
-            next(
-                (i for i in every if sys_.sources[i] == sys_.targets[j] and not sys_.resets[i]
-                 and sp.simplify(guards[i] + guards[j]) == 0),
-                -1,
-            ) if not sys_.resets[j] else j
-            for j in every
-        ]  # fmt: skip
+        back = [_transition_back(sys_, j) for j in every]
         sizes.update(
             nmodes=nmodes, rows=[r + [-1] * (width - len(r)) for r in rows], targets=list(sys_.targets),
             resets=list(sys_.resets), back=back,
         )  # fmt: skip
     return ModelSource("\n\n".join(parts), columns, dispatch, sizes)
+
+
+def _transition_back(system: SymbolicSystem, j: int) -> int:
+    """The transition whose guard is 0 right after transition ``j`` (its root at ``u = 0`` is known), or -1.
+
+    A reset within one mode: ``j`` itself (an impact).  Otherwise a transition
+    ``i`` leaving ``j``'s target with ``h_i(g_j(x)) = -h_j(x)`` (``g_j`` the
+    identity without a reset): a switch's way back, or the rocking block's
+    other corner after an impact.
+    """
+    import sympy as sp
+
+    if system.resets[j] and system.sources[j] == system.targets[j]:
+        return j
+    guards = [stop.guard for stop in system.stops]
+    after = dict(zip(system.states, system.stops[j].reset)) if system.resets[j] else {}
+    for i in range(len(guards)):
+        if system.sources[i] == system.targets[j] and (system.resets[j] or not system.resets[i]):
+            if sp.simplify(guards[i].subs(after, simultaneous=True) + guards[j]) == 0:
+                return i
+    return -1
 
 
 CACHE_ENV = "GRAZING_CACHE_DIR"

@@ -155,7 +155,7 @@ class Result(NamedTuple):
     lyap_span: float
     guard_min: np.ndarray  # per stop (rows): [h, t, state..., h_approach, t_approach, state...]
     jacobian_valid: bool
-    switches: np.ndarray  # rows [t, transition, state...]: switches of vector field without a reset
+    switches: np.ndarray  # rows [t, transition, state...]: changes of mode (state after any reset)
 
 
 class RunOutput(NamedTuple):
@@ -176,7 +176,7 @@ class RunOutput(NamedTuple):
     trajectory: F8_2  # (rows, 1 + n): [t, state...]
     log_sums: F8_1  # (n,): Lyapunov sums
     guard_min: F8_2  # (stops, 2 (2 + n)): per stop [h, t, state..., h_approach, t_approach, state...]
-    switches: F8_2  # (rows, 2 + n): [t, transition, state...] at each switch without a reset
+    switches: F8_2  # (rows, 2 + n): [t, transition, state...] at each change of mode (state after any reset)
 
 
 INTEGRATE_ARGUMENTS = (Start, ("pv", F8_1), Config, Kernels, RunOutput)

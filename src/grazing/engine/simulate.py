@@ -273,11 +273,6 @@ def _refuse_on_modes(
                 f"{model.name!r})"
             )
     for j, name in enumerate(model.stop_names):
-        if system.resets[j] and system.sources[j] != system.targets[j]:
-            raise InvalidParameterError(
-                f"transition {name!r} has a reset and changes the mode: not supported yet (model "
-                f"{model.name!r})"
-            )
         if system.stops[j].contact_direction is not None:
             raise InvalidParameterError(
                 f"sticking (the contact_direction of {name!r}) in a model with modes is not supported yet"

@@ -185,6 +185,8 @@ def at_event(m, r, x, xp, pv, j, nrows, V, chatter_time, record, tables):
     r.jac_valid = r.jac_valid and jac_ok  # (an impact at zero normal speed has no Jacobian)
     r.defl = 1
     r.defl_stop = j
+    if m.targets[j] != r.vf:  # a reset that also changes the mode (the rocking block's corners)
+        change_mode(m, r, x, j, record, tables)
     if m.sticks[j]:
         dt_acc = chatter_remaining(m, x, r.s, pv, j, speed, chatter_time)
         if dt_acc >= 0.0:  # complete chattering: on to the accumulation point, then sticking
@@ -230,6 +232,24 @@ def switch_mode(m, r, x, pv, j, V, record, tables):
         append_row(tables[2], r.n_traj, t, x, n)
         r.n_traj += 1
     r.vf = target
+    r.defl = 1 if m.back[j] >= 0 else 0
+    r.defl_stop = m.back[j]
+
+
+@njit(cache=True)
+def change_mode(m, r, x, j, record, tables):
+    """Run ``r``, just reset by transition ``j`` (``x`` holds the state after it), enters ``j``'s target mode.
+
+    The impact is recorded by :func:`apply_impact` (with the saltation matrix
+    between the two modes' fields); here the switch is recorded as well, as
+    ``[t, j, state after the reset]`` in ``tables[3]`` when ``record``.  The
+    root at ``u = 0`` is that of the transition back (``m.back[j]``, whose
+    guard is 0 right after the reset; -1: none known).
+    """
+    if record:
+        append_record(tables[3], r.n_switch, r.k * r.T + r.s, j, x, m.nx)
+        r.n_switch += 1
+    r.vf = m.targets[j]
     r.defl = 1 if m.back[j] >= 0 else 0
     r.defl_stop = m.back[j]
 
