@@ -100,7 +100,7 @@ class Bordered:
     Attributes
     ----------
     g
-        The test function: zero where ``A`` is singular.
+        The test function: zero where ``A`` is singular (complex for a complex ``A``).
     v, w
         ``A v = -g b`` with ``c^T v = 1``, and ``A^T w = -g c`` with ``b^T w = 1``: at
         ``g = 0`` the right and left null vectors of ``A``.
@@ -144,15 +144,20 @@ class Bordered:
 def bordered(A: np.ndarray, borders: Borders) -> Bordered:
     """Solve the bordered system of ``A`` and its transpose (see the module docstring).
 
+    A complex ``A`` (with complex borders) gives a complex ``g``, with plain transposes throughout.
+
     Examples
     --------
     >>> A = np.array([[1.0, 2.0], [2.0, 4.0]])  # singular
     >>> sol = bordered(A, Borders.of(A))
     >>> abs(sol.g) < 1e-14, bool(np.allclose(A @ sol.v, 0)), bool(np.allclose(sol.w @ A, 0))
     (True, True, True)
+    >>> z = bordered(A * 1j, Borders(np.array([2.0, -1.0]) + 0j, np.array([2.0, -1.0]) + 0j))
+    >>> bool(abs(z.g) < 1e-14), bool(np.allclose(A @ z.v, 0)), bool(np.allclose(z.w @ A, 0))
+    (True, True, True)
     """
     m = A.shape[0]
-    K = np.zeros((m + 1, m + 1))
+    K = np.zeros((m + 1, m + 1), dtype=np.result_type(A, borders.b, borders.c))
     K[:m, :m] = A
     K[:m, m] = borders.b
     K[m, :m] = borders.c
@@ -161,4 +166,5 @@ def bordered(A: np.ndarray, borders: Borders) -> Bordered:
     inv_t = np.linalg.inv(K.T)
     right = np.linalg.solve(K, rhs)
     left = inv_t @ rhs
-    return Bordered(float(right[m]), right[:m], left[:m], inv_t)
+    g = complex(right[m]) if np.iscomplexobj(right) else float(right[m])
+    return Bordered(g, right[:m], left[:m], inv_t)  # type: ignore[arg-type]

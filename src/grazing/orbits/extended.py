@@ -290,6 +290,29 @@ class Evaluation:
         return self.orbit.multipliers if self.orbit is not None else self.grazing.multipliers  # type: ignore[union-attr]
 
 
+def directional_difference(f, z: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    """``d/ds f(z + s direction)`` at ``s = 0`` by central differences, the step :data:`DIFFERENCE_STEP`
+    relative to ``max(1, |z|)``; one-sided where a step raises a :class:`~grazing.errors.GrazingError`
+    (a bound or a grazing within the step).
+
+    Examples
+    --------
+    >>> d = directional_difference(lambda z: np.outer(z, z), np.array([1.0, 2.0]), np.array([0.0, 1.0]))
+    >>> bool(np.allclose(d, [[0.0, 1.0], [1.0, 4.0]]))
+    True
+    """
+    h = DIFFERENCE_STEP * max(1.0, float(np.max(np.abs(z)))) / float(np.max(np.abs(direction)))
+    try:
+        plus = f(z + h * direction)
+    except GrazingError:
+        return (f(z) - f(z - h * direction)) / h
+    try:
+        minus = f(z - h * direction)
+    except GrazingError:
+        return (plus - f(z)) / h
+    return (plus - minus) / (2 * h)
+
+
 class OrbitSystem:
     """The extended system of a fold, period-doubling, Neimark-Sacker or branch-point curve.
 
@@ -335,21 +358,12 @@ class OrbitSystem:
         return np.hstack([fm.jacobian, fm.sensitivity])
 
     def along(self, x: np.ndarray, p: np.ndarray, dx: np.ndarray, dp: np.ndarray, impacts: int) -> np.ndarray:
-        """``d/ds [P_x, P_p](x + s dx, p + s dp)`` at ``s = 0``, by central differences.
-
-        Where a parameter's bound is within a step, a one-sided difference is used.
-        """
-        size = float(max(np.max(np.abs(dx)), np.max(np.abs(dp)) if dp.size else 0.0))
-        h = DIFFERENCE_STEP * max(1.0, float(np.max(np.abs(np.concatenate([x, p]))))) / size
-        try:
-            plus = self.jacobian(x + h * dx, p + h * dp, impacts)
-        except GrazingError:
-            return (self.jacobian(x, p, impacts) - self.jacobian(x - h * dx, p - h * dp, impacts)) / h
-        try:
-            minus = self.jacobian(x - h * dx, p - h * dp, impacts)
-        except GrazingError:
-            return (plus - self.jacobian(x, p, impacts)) / h
-        return (plus - minus) / (2 * h)
+        """``d/ds [P_x, P_p](x + s dx, p + s dp)`` at ``s = 0``, by central differences
+        (:func:`directional_difference`)."""
+        n = x.size
+        return directional_difference(
+            lambda z: self.jacobian(z[:n], z[n:], impacts), np.concatenate([x, p]), np.concatenate([dx, dp])
+        )
 
     def __call__(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray, Evaluation]:
         n, kind = self.n, self.kind

@@ -46,20 +46,19 @@ segments' ``Phi`` and the saltation matrices.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from grazing.core.model import HybridModel
-from grazing.errors import GrazingError
 from grazing.orbits.bifurcations import critical_pair, resolved_multipliers
+from grazing.orbits.bordered import Bordered, Borders, bordered
 from grazing.orbits.extended import (
-    DIFFERENCE_STEP,
     ENTRY_ROUNDING,
     INTEGRATION_ROUNDING,
     UNKNOWN_ROUNDING,
     Evaluation,
     codim2_tests,
+    directional_difference,
 )
 from grazing.orbits.periodic import PeriodicOrbit
 from grazing.orbits.segments import SegmentLayout, layout_of, segmented_equations
@@ -69,47 +68,7 @@ CRITICAL_MULTIPLIER = {"fold": 1.0, "branch-point": 1.0, "period-doubling": -1.0
 Neimark-Sacker curve's is ``exp(i angle)``, ``angle`` an unknown)."""
 
 
-@dataclass(frozen=True)
-class NullVectors:
-    """The bordered system's solution at a point of a segmented curve (the payload's ``solution``).
-
-    Attributes
-    ----------
-    g
-        The defining condition (complex on a Neimark-Sacker curve).
-    v, w
-        ``A v = -g b``, ``c^T v = 1`` and ``A^T w = -g c``, ``b^T w = 1`` (plain transposes, also
-        for complex ``A``): at ``g = 0`` the right and left null vectors of ``A``.
-    """
-
-    g: complex
-    v: np.ndarray
-    w: np.ndarray
-
-
-def bordered_solve(A: np.ndarray, b: np.ndarray, c: np.ndarray) -> NullVectors:
-    """The bordered system of ``A`` (real or complex) with borders ``b`` and ``c``.
-
-    Examples
-    --------
-    >>> A = np.array([[1.0, 2.0], [2.0, 4.0]]) - 0j  # singular
-    >>> sol = bordered_solve(A, np.array([2.0, -1.0]) + 0j, np.array([2.0, -1.0]) + 0j)
-    >>> bool(abs(sol.g) < 1e-14), bool(np.allclose(A @ sol.v, 0)), bool(np.allclose(sol.w @ A, 0))
-    (True, True, True)
-    """
-    m = A.shape[0]
-    K = np.zeros((m + 1, m + 1), dtype=np.result_type(A, b, c))
-    K[:m, :m] = A
-    K[:m, m] = b
-    K[m, :m] = c
-    rhs = np.zeros(m + 1)
-    rhs[m] = 1.0
-    right = np.linalg.solve(K, rhs)
-    left = np.linalg.solve(K.T, rhs)
-    return NullVectors(right[m], right[:m], left[:m])
-
-
-def multiplier_slope(null: NullVectors, n: int) -> complex:
+def multiplier_slope(null: Bordered, n: int) -> complex:
     """``dg/dmu = w_r^T v_0``: how the defining condition moves with the multiplier ``mu`` of ``A(mu)``.
 
     ``A(mu)`` is ``-mu`` times the identity in the return equations' (the last ``n`` rows) columns of
@@ -120,7 +79,7 @@ def multiplier_slope(null: NullVectors, n: int) -> complex:
 
 
 def multiplier_accuracy(
-    kind: str, J: np.ndarray, null: NullVectors, grad: np.ndarray, u: np.ndarray, n: int
+    kind: str, J: np.ndarray, null: Bordered, grad: np.ndarray, u: np.ndarray, n: int
 ) -> float:
     """How far the critical multiplier(s) of a segmented curve point may be from the curve's condition.
 
@@ -186,7 +145,7 @@ class SegmentedOrbitSystem:
     def accept(self, payload: Evaluation) -> None:
         """Border the next points with the null vectors of this one (same orientation as before)."""
         null = payload.solution
-        if not isinstance(null, NullVectors):
+        if not isinstance(null, Bordered):
             return
         b, c = np.conj(null.w), np.conj(null.v)
         b, c = b / np.linalg.norm(b), c / np.linalg.norm(c)
@@ -205,12 +164,12 @@ class SegmentedOrbitSystem:
         A[-n:, :n] += (1.0 - mu) * np.eye(n)
         return A
 
-    def _null(self, A: np.ndarray) -> NullVectors:
+    def _null(self, A: np.ndarray) -> Bordered:
         if self._borders is None:
             U, _, Vt = np.linalg.svd(A)
             self._borders = (U[:, -1].copy(), np.conj(Vt[-1]).copy())
         b, c = self._borders
-        return bordered_solve(A, b.astype(A.dtype), c.astype(A.dtype))
+        return bordered(A, Borders(b.astype(A.dtype), c.astype(A.dtype)))
 
     # -- derivatives ------------------------------------------------------------------------
     def _jacobian(self, u: np.ndarray) -> np.ndarray:
@@ -218,18 +177,8 @@ class SegmentedOrbitSystem:
 
     def along(self, u: np.ndarray, direction: np.ndarray) -> np.ndarray:
         """``d/ds DF(u + s direction)`` at ``s = 0`` (``u``: the segment unknowns and the parameters), by
-        central differences (one-sided where a step meets a grazing)."""
-        size = float(np.max(np.abs(direction)))
-        h = DIFFERENCE_STEP * max(1.0, float(np.max(np.abs(u)))) / size
-        try:
-            plus = self._jacobian(u + h * direction)
-        except GrazingError:
-            return (self._jacobian(u) - self._jacobian(u - h * direction)) / h
-        try:
-            minus = self._jacobian(u - h * direction)
-        except GrazingError:
-            return (plus - self._jacobian(u)) / h
-        return (plus - minus) / (2 * h)
+        central differences (:func:`~grazing.orbits.extended.directional_difference`)."""
+        return directional_difference(self._jacobian, u, direction)
 
     # -- the system ------------------------------------------------------------------------
     def __call__(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray, Evaluation]:
@@ -294,11 +243,7 @@ class SegmentedOrbitSystem:
         Q = np.array([w @ t for t in T])  # Q[j, k] = w^T d^2 F / dz_j du_k: (w^T dJ/du_k)_j
         grad_g = -v @ Q
         # The bordered transposed system, differentiated: K^T [w_u; g_u] = -[dJ^T w; 0].
-        K = np.zeros((size + 1, size + 1))
-        K[:size, :size] = J
-        K[:size, size] = self._borders[0].real
-        K[size, :size] = self._borders[1].real
-        dw = np.linalg.solve(K.T, -np.vstack([Q, np.zeros((1, m))]))[:size]
+        dw = (null.inverse_transposed @ -np.vstack([Q, np.zeros((1, m))]))[:size]
         Fp1 = DF0[:, size]
         g2 = float(w @ Fp1)
         grad_g2 = Fp1 @ dw + w @ Tp
