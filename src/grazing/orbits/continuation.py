@@ -683,17 +683,7 @@ class _Continuation:
             if first is None and self.switch and not self.switched_smooth and loc.kind in SWITCH_KINDS:
                 first = sp_
         if not step.explained:
-            p1, p2 = float(prev.u[-1]), float(pt.u[-1])
-            note = (
-                f"unlocated stability change between {self.par.show(p1)} and {self.par.show(p2)}: "
-                f"{step.describe()}"
-            )
-            branch.special.append(
-                SpecialPoint(
-                    kind=UNLOCATED, index=index, param=0.5 * (p1 + p2), orbit=prev.payload, note=note,
-                    between=(p1, p2), interval=(min(p1, p2), max(p1, p2)),
-                )
-            )  # fmt: skip
+            self._unlocated(prev, pt, step.describe())
         if SpecialKind.GRAZING in self.detect and self.virtual:  # the grazing of any stop
             for j in range(self.model.n_stops):
                 found = _detect_grazing(evaluate, j, prev, pt, self.param, n, self.s)
@@ -867,12 +857,15 @@ class _Continuation:
         is compared across it): a change of stability between them is reported, unlocated."""
         if before.payload.unstable_count == after.payload.unstable_count:
             return
+        self._unlocated(
+            before, after, f"{before.payload.unstable_count} -> {after.payload.unstable_count} unstable "
+            "multipliers, where two impacts change order",
+        )  # fmt: skip
+
+    def _unlocated(self, before: PalcPoint, after: PalcPoint, why: str) -> None:
+        """Record an unlocated change of stability between two points of the branch, saying ``why``."""
         p1, p2 = float(before.u[-1]), float(after.u[-1])
-        note = (
-            f"unlocated stability change between {self.par.show(p1)} and {self.par.show(p2)}, where two "
-            f"impacts change order: {before.payload.unstable_count} -> {after.payload.unstable_count} "
-            "unstable multipliers"
-        )
+        note = f"unlocated stability change between {self.par.show(p1)} and {self.par.show(p2)}: {why}"
         self.branch.special.append(
             SpecialPoint(
                 kind=UNLOCATED, index=len(self.branch) - 1, param=0.5 * (p1 + p2), orbit=before.payload,
