@@ -32,3 +32,15 @@ def test_the_version_is_the_installed_packages_looked_up_once() -> None:
 
     assert grazing.__version__ == version("grazing")
     assert "__version__" in vars(grazing)  # (kept: not looked up again, 2 ms a time)
+
+
+def test_the_citation_names_the_version_in_pyproject() -> None:
+    """CITATION.cff (the docs' citation page, GitHub's "cite this repository") cites this version."""
+    from importlib.metadata import version
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parent.parent
+    project = version("grazing")  # (pyproject.toml's, as installed; tomllib needs Python 3.11)
+    cited = [ln.split(":", 1)[1].strip() for ln in (root / "CITATION.cff").read_text().splitlines()
+             if ln.startswith("version:")]  # fmt: skip
+    assert cited == [project]
