@@ -125,11 +125,11 @@ def _slope(ys, values):
     return float(np.polyfit(np.log(ys), np.log(values), 1)[0])
 
 
-def _same_constant(ratios):
-    """The map's relative error is ``C y^p`` with one ``C`` over the decades (as for impacts): a leading
-    coefficient off by a relative ``eps`` adds ``eps`` at every ``y`` and breaks this where
-    ``C y^p < 20 eps``."""
-    assert ratios.max() / ratios.min() < 1.05, ratios
+def _same_constant(ratios, within=1.05):
+    """The map's relative error is ``C y^p`` with one ``C`` over the decades (as for impacts), to
+    ``within``: a leading coefficient off by a relative ``eps`` adds ``eps`` at every ``y`` and breaks
+    this where ``C y^p < eps / (within - 1)``."""
+    assert ratios.max() / ratios.min() < within, ratios
 
 
 def test_the_map_predicts_the_contact_of_the_grazing_orbit_family(zdm):
@@ -259,3 +259,38 @@ def test_one_line_refusals(grazing_point, zdm):
     strong = zdm.model.with_params(a=1.0)  # at t = 0 the forcing pushes x = gap, x' = 0 on: a = gap - 1 < 0
     _refused(InvalidStateError, r"does not turn back from the surface of transition 'touch' at", strong,
              "touch", [VALUES["gap"], 0.0], 0.0)  # fmt: skip
+
+
+def test_a_moving_wall_off_the_section():
+    """A spring on a wall that moves, ``s(t) = gap + e sin(omega t)``: the guard ``s(t) - x`` depends on
+    time (``h_t`` enters the rate, the acceleration and the jump's derivative, ``w`` from ``(D_x, D_t)``).
+    At ``t* = 0`` the motion ``x = gap``, ``x' = e omega`` touches the wall with
+    ``a = s'' - x'' = gap - a + 2 zeta e omega > 0``; states ``h = y``, ``L_f h = -sqrt(4 a y)`` on the
+    section give the 3/2 law with an ``O(y^2)`` error, as on a fixed wall.  Its constant (~4.8) drifts by
+    8% over the decades (the next order, relative ``y^(1/2)``), hence 10% here."""
+    e = sp.Symbol("e")
+    wall = gap + e * sp.sin(w * t)
+    params = [Parameter(nm, val) for nm, val in {**VALUES, "e": 0.2}.items()]
+    model = HybridModel(
+        "soft-impact-moving-wall", [x, v], t, params, period=2 * sp.pi / w,
+        modes=[Mode("free", FREE), Mode("contact", [v, FREE[1] - k * (x - wall)])],
+        transitions=[Transition("touch", "free", "contact", wall - x),
+                     Transition("leave", "contact", "free", x - wall)],
+    )  # fmt: skip
+    p = dict(model.params)
+    speed = p["e"] * p["omega"]
+    zdm = switching_map_at(model, "touch", [p["gap"], speed], 0.0)
+    assert zdm.accel == pytest.approx(p["gap"] - p["a"] + 2 * p["zeta"] * speed, rel=1e-12)
+    np.testing.assert_allclose(zdm.jump, [0.0, p["k"]], rtol=0, atol=1e-12)
+    ys = np.geomspace(1e-6, 1e-3, 7)
+    starts = []
+    for y in ys:
+        x0 = np.array([p["gap"] - y, speed + math.sqrt(4 * zdm.accel * y)])
+        starts.append((model, x0, 0.0))
+        assert zdm.penetration(x0) == pytest.approx(y, rel=1e-9)
+    actual, predicted = _compare(zdm, starts)
+    size = np.linalg.norm(actual, axis=1)
+    error = np.linalg.norm(actual - predicted, axis=1)
+    assert _slope(ys, size) == pytest.approx(1.5, abs=0.01)
+    assert _slope(ys, error) == pytest.approx(2.0, abs=0.05)
+    _same_constant(error / size / np.sqrt(ys), within=1.1)
