@@ -981,11 +981,13 @@ class _Continuation:
                 reason = f"the orbit touches the stop between its impacts: it {what}"
             reason += " (located from this side: the branch does not continue beyond it)"
         status = f"ended at a grazing at {where}: {reason}"
+        sequence = "switches of mode" if self.model.has_modes else "impact sequence"
+        other = "other switches of mode" if self.model.has_modes else "another impact sequence"
         if not self.switch:
             branch.special.append(graze)
             branch.end_segment(
                 BranchEnd.GRAZING,
-                status + "; the orbit with the new impact sequence can be followed with switch (switch=True)",
+                status + f"; the orbit with the new {sequence} can be followed with switch (switch=True)",
             )
             return []
         new = new_sequence_orbit(last, self.param, value, sign, self.virtual)
@@ -993,13 +995,11 @@ class _Continuation:
             branch.special.append(graze)
             branch.end_segment(
                 BranchEnd.GRAZING,
-                status + "; no orbit with another impact sequence was found just past it to switch to",
+                status + f"; no orbit with {other} was found just past it to switch to",
             )
             return []
         branch.special.append(dataclasses.replace(graze, switched=True))
-        branch.end_segment(
-            BranchEnd.SWITCHED, status + "; switched to the orbit with the new impact sequence"
-        )
+        branch.end_segment(BranchEnd.SWITCHED, status + f"; switched to the orbit with the new {sequence}")
         if new.section_clearance() < SECTION_MARGIN:
             new = move_section(new, quiet_section(new))
         sign = math.copysign(1.0, new.model.params[self.param] - value)
