@@ -397,6 +397,9 @@ class Branch:
         nan = np.full(len(names), np.nan)
         closest = [o.x_guard_min if o.x_guard_min is not None else nan for o in self.orbits]
         data["closest_state"] = (("point", "component"), np.array(closest).reshape(-1, len(names)))
+        if self.model.has_modes:  # (the mode on the section and the switches of mode per period)
+            data["mode"] = ("point", np.array([o.mode for o in self.orbits], dtype=str))
+            data["switches"] = ("point", np.array([o.switch_times.size for o in self.orbits], dtype=np.int32))
         ds = xr.Dataset(data, coords={"component": names, "multiplier": np.arange(len(names))})
         ds.param.attrs["long_name"] = self.param
         ds.period.attrs["long_name"] = "period of the orbit in forcing periods"
