@@ -8,7 +8,12 @@ determinant has a closed form, ``prod_k exp(tr A_k tau_k) prod_switches (h_x f+)
 (Liouville's formula in each mode, ``det S = 1 + h_x (f+ - f-) / (h_x f-)`` at each switch).  Where
 the orbit stops touching the contact (a grazing of the switching surface) it is the linear free
 response, whose amplitude ``a / |1 - w^2 + 2 i zeta w|`` equals the gap there: a closed form for the
-grazing frequency.  Nothing in the references uses grazing's engine.
+grazing frequency.
+
+The rocking block (tests/engine/test_rocking_modes.py: a reset onto the other corner that changes the
+mode) has exact rocking orbits too, whose monodromy's determinant is ``r^2`` per impact (``det R = r``,
+and ``(h_x R^-1 f+) / (h_x f-) = r``: the angular velocity after over before; ``tr A = 0``).
+Nothing in the references uses grazing's engine.
 """
 
 from __future__ import annotations
@@ -19,12 +24,15 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq, fsolve
 
+import grazing
 from grazing.errors import ConvergenceError, InvalidParameterError, InvalidStateError
 from grazing.maps import flow_map
 from grazing.orbits import continue_orbit, find_orbit, follow_curve
 from grazing.orbits.segments import segmented_newton
 from tests.engine.test_mode_switches import reference as reference_expm
 from tests.engine.test_mode_switches import soft_impact
+from tests.engine.test_rocking_modes import reference as rocking_reference
+from tests.engine.test_rocking_modes import rocking_block
 from tests.piecewise_exact import PiecewiseLinearModel
 
 
@@ -53,10 +61,11 @@ def reference(params: dict) -> Diagonalised:
     return Diagonalised(reference_expm(params))
 
 
-def exact_orbit(params: dict, x: np.ndarray, mode: int, t0: float, periods: int = 1):
-    """The exact period-``periods`` orbit near ``x`` (in ``mode`` at ``t0``): ``(x, J, switches, residual)``,
-    switches ``(t, exit, from, to)``."""
-    ref = reference(params)
+def exact_orbit(params: dict | PiecewiseLinearModel, x: np.ndarray, mode: int, t0: float, periods: int = 1):
+    """The exact period-``periods`` orbit near ``x`` (in ``mode`` at ``t0``) of the soft-impact oscillator
+    with ``params`` (or of the piecewise-linear model given): ``(x, J, switches, residual)``, switches
+    ``(t, exit, from, to)``."""
+    ref = params if isinstance(params, PiecewiseLinearModel) else reference(params)
     t1 = t0 + periods * ref.period
     for _ in range(12):
         x_end, k_end, J, _ = ref.run(x, mode, t0, t1)
@@ -241,3 +250,26 @@ def test_folds_after_a_gained_switch_against_the_exact_folds():
         assert np.abs(o.monodromy - J).max() < 1e-8 * max(1.0, np.abs(J).max())
         det = determinant_closed_form(p | {"omega": w}, x, k, o.t0, o.t0 + 2 * math.pi / w)
         assert abs(np.linalg.det(o.monodromy) - det) < 1e-9 * abs(det)
+
+
+def test_a_rocking_orbit_through_impacts_that_change_the_mode():
+    """The period-1 rocking orbit (one landing on each corner per forcing period) from a guess after a
+    transient: state, mode, impacts and switches, monodromy and its determinant ``r^4`` exactly."""
+    m = rocking_block()
+    run = grazing.simulate(m, [0.1, 0.0], periods=1, transient=40)
+    orbit = find_orbit(m, run.x_final, period=1, mode=run.mode_final)
+    k = m.mode_names.index(orbit.mode)
+    ref = Diagonalised(rocking_reference(dict(m.params)))
+    x, J, switches, res = exact_orbit(ref, orbit.state, k, orbit.t0)
+    assert res < 1e-13 and len(switches) == 2 and orbit.mode == run.mode_final
+    assert np.abs(orbit.state - x).max() < 1e-10, orbit.state - x
+    times = [s[0] for s in switches]
+    assert orbit.impacts == 2 and np.abs(orbit.impact_times - times).max() < 1e-10
+    assert np.abs(orbit.switch_times - times).max() < 1e-10
+    names = [("onto_left", "onto_right")[s[2]] for s in switches]
+    assert [m.stop_names[j] for j in orbit.switch_transitions] == names
+    assert [m.stop_names[j] for j in orbit.impact_stops] == names
+    assert np.abs(orbit.monodromy - J).max() < 1e-9 * max(1.0, np.abs(J).max()), orbit.monodromy - J
+    r = m.params["r"]
+    assert abs(np.linalg.det(orbit.monodromy) - r**4) < 1e-10 and abs(np.linalg.det(J) - r**4) < 1e-12
+    assert orbit.stable and np.allclose(np.abs(orbit.multipliers), r**2, rtol=1e-9)
