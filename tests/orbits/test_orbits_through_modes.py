@@ -28,6 +28,7 @@ import grazing
 from grazing.errors import ConvergenceError, InvalidParameterError, InvalidStateError
 from grazing.maps import flow_map
 from grazing.orbits import continue_orbit, find_orbit, follow_curve
+from grazing.orbits.palc import PalcSettings
 from grazing.orbits.segments import segmented_newton
 from tests.engine.test_mode_switches import reference as reference_expm
 from tests.engine.test_mode_switches import soft_impact
@@ -273,3 +274,49 @@ def test_a_rocking_orbit_through_impacts_that_change_the_mode():
     r = m.params["r"]
     assert abs(np.linalg.det(orbit.monodromy) - r**4) < 1e-10 and abs(np.linalg.det(J) - r**4) < 1e-12
     assert orbit.stable and np.allclose(np.abs(orbit.multipliers), r**2, rtol=1e-9)
+
+
+def test_a_period_doubling_against_the_exact_one():
+    """A stiff contact (k = 50, zeta = 0.02): the period-1 orbit's branch down in frequency has a
+    period-doubling, located where the exact orbit has a multiplier -1; ``switch`` goes on along the
+    period-2 orbit born there, as exact as the period-1 one."""
+    m = soft_impact(k=50.0, zeta=0.02)
+    p = dict(m.params)
+    br = continue_orbit(m, "omega", 1.2, 1.0)
+    [pd] = br.special
+    assert pd.kind == "period-doubling" and br.status == "reached the bound omega = 1"
+    o = pd.orbit
+    k = m.mode_names.index(o.mode)
+
+    def equations(u):
+        ref = reference({**p, "omega": u[2]})
+        x_end, k_end, J, _ = ref.run(u[:2], k, o.t0, o.t0 + ref.period)
+        assert k_end == k
+        return np.append(x_end - u[:2], np.linalg.det(J + np.eye(2)))
+
+    u, _, ok, msg = fsolve(equations, np.append(o.state, pd.param), xtol=1e-14, full_output=True)
+    assert ok == 1 and np.abs(equations(u)).max() < 1e-11, msg
+    assert abs(pd.param - u[2]) < 1e-10, (pd.param, u[2])
+    assert np.abs(o.state - u[:2]).max() < 1e-9
+    assert np.min(np.abs(o.multipliers + 1.0)) < 1e-8, o.multipliers
+    J = reference({**p, "omega": u[2]}).run(u[:2], k, o.t0, o.t0 + 2 * math.pi / u[2])[2]
+    assert np.abs(o.monodromy - J).max() < 1e-8 * max(1.0, np.abs(J).max())
+    doubled = continue_orbit(m, "omega", 1.2, 1.0, switch=True, settings=PalcSettings(max_points=24))
+    assert doubled.special[0].switched and "period-2 orbit born there" in doubled.segment_status[0]
+    twice = [orb for orb, s in zip(doubled.orbits, doubled.segments) if s == 1]
+    assert twice and all(orb.period == 2 for orb in twice)
+    checked = 0
+    for orb in twice[::2]:
+        q = {**p, "omega": orb.model.params["omega"]}
+        ref, k = reference(q), m.mode_names.index(orb.mode)
+        x_end, k_end, J, _ = ref.run(orb.state, k, orb.t0, orb.t0 + 2 * ref.period)
+        assert k_end == k and np.abs(x_end - orb.state).max() < 1e-11  # (a fixed point of the exact map)
+        assert np.abs(orb.monodromy - J).max() < 1e-7 * max(1.0, np.abs(J).max())
+        if np.min(np.abs(orb.multipliers - 1.0)) < 1e-3:
+            continue  # (next to the period-doubling the period-2 orbit's state is ill-conditioned)
+        x, J, sw, res = exact_orbit(q, orb.state, k, orb.t0, periods=2)
+        assert res < 1e-12 and np.abs(orb.state - x).max() < 1e-9
+        assert np.abs(orb.switch_times - [s[0] for s in sw]).max() < 1e-9 and len(sw) == 4
+        assert np.abs(orb.monodromy - J).max() < 1e-9 * max(1.0, np.abs(J).max())
+        checked += 1
+    assert checked >= 3
