@@ -303,8 +303,8 @@ def returning_mode_message(fm: FlowMap, n: int, t0: float) -> str:
         return ""
     return (
         f"the period-{n} map from mode {fm.mode!r} at t0 = {t0:.10g} returns in mode {fm.mode_final!r}: "
-        "a periodic orbit is in the same mode at both ends of its period; give another section time (t0=), "
-        "starting mode (mode=) or period"
+        "a periodic orbit is in the same mode at both ends of its period; give another section time, "
+        "starting mode or period"
     )
 
 

@@ -294,7 +294,7 @@ def find_orbit(
     (5, 1, True)
     """
     if virtual:
-        model.require_one_mode("a virtual orbit (virtual=True, the stops ignored)")
+        model.require_one_mode("a virtual orbit (the stops ignored)")
     if period is not None and (not isinstance(period, (int, np.integer)) or period < 1):
         raise InvalidParameterError(f"period must be a positive integer, got {period!r}")
     if t0 is None:
