@@ -45,7 +45,10 @@ class FlowMap:
     sensitivity
         ``d P^n / d p``, one column per parameter asked for.
     solution
-        The simulation that computed them (its impacts, guard minimum ...).
+        The simulation that computed them (its impacts, guard minimum, switches ...).
+    mode
+        A model with modes: the mode ``x`` is taken in (the map's image is in
+        :attr:`mode_final`); None for a model without modes.
 
     Examples
     --------
@@ -61,10 +64,16 @@ class FlowMap:
     jacobian: np.ndarray  # d P^n / d x
     sensitivity: np.ndarray  # d P^n / d p for the requested parameters (columns)
     solution: Solution
+    mode: str | None = None
 
     @property
     def impacts(self) -> int:
         return self.solution.n_impacts
+
+    @property
+    def mode_final(self) -> str | None:
+        """A model with modes: the mode of the image (None without modes)."""
+        return self.solution.mode_final
 
 
 def flow_map(
@@ -77,6 +86,7 @@ def flow_map(
     virtual: bool = False,
     touching: bool = False,
     stop_name: int | str | None = None,
+    mode: str | None = None,
 ) -> FlowMap:
     """Apply the stroboscopic map ``periods`` times from ``x`` at time ``t0``.
 
@@ -88,6 +98,11 @@ def flow_map(
     stop (``x`` on the stop with zero normal velocity), which is not an impact.
     ``stop_name`` names the stop that the contact and the solution's ``guard_min``
     refer to (the first by default).
+
+    On a model with modes the map goes from ``x`` in ``mode`` to the image in
+    the mode the flow is in then (:attr:`FlowMap.mode_final`), its Jacobian
+    carried across the switches by their saltation matrices; the guard
+    minimum is not computed there (nor ``virtual`` or ``touching`` runs).
 
     Parameters
     ----------
@@ -107,6 +122,8 @@ def flow_map(
         ``x`` is a grazing contact with the stop, not an impact.
     stop_name
         The stop the contact and the guard minimum refer to (name or index).
+    mode
+        A model with modes: the mode ``x`` is in (its initial mode by default).
 
     Returns
     -------
@@ -135,7 +152,6 @@ def flow_map(
     >>> fm.impacts, bool(fm.solution.guard_min[0] < 0)
     (0, True)
     """
-    model.require_one_mode("the flow map")
     sol = simulate(
         model,
         x,
@@ -144,10 +160,11 @@ def flow_map(
         phase=2 * math.pi * (t0 / model.period % 1.0),  # the section through t0
         jacobian=True,
         sensitivities=tuple(sensitivities),
-        guard_min=True,
+        guard_min=not model.has_modes,  # (not on models with modes yet)
         events=not virtual,
         touching=touching,
         stop_name=stop_name,
+        mode=mode,
     )
     n = model.n_states
     sens = sol.jacobian[:, n:]
@@ -155,9 +172,10 @@ def flow_map(
     if np.any(tp) and model.periodic:
         # simulate's derivative keeps the end at the forcing phase of t0, i.e. at
         # (t0/T + periods) T(p); the map's end is t0 + periods T(p).
-        f_end = model.vector_field(sol.x_final, sol.t_final)
+        f_end = model.vector_field(sol.x_final, sol.t_final, sol.mode_final)
         sens = sens - np.outer(f_end * (t0 / model.period), tp)
-    return FlowMap(sol.x_final, sol.jacobian[:, :n], sens, sol)
+    start = model.mode_names[model.mode_index(mode)] if model.has_modes else None
+    return FlowMap(sol.x_final, sol.jacobian[:, :n], sens, sol, start)
 
 
 @dataclass(frozen=True)
@@ -174,6 +192,8 @@ class StroboscopicMap:
         ``n``: forcing periods per application.
     virtual
         Ignore the stop (the flow passes through it).
+    mode
+        A model with modes: the mode the first state is in (its initial mode by default).
 
     Examples
     --------
@@ -195,6 +215,7 @@ class StroboscopicMap:
     t0: float = 0.0
     periods: int = 1
     virtual: bool = False
+    mode: str | None = None
 
     def __call__(self, x: Sequence[float] | np.ndarray) -> np.ndarray:
         """The image of ``x``."""
@@ -211,13 +232,14 @@ class StroboscopicMap:
         """The image of ``x`` with its Jacobian and parameter derivatives (see :func:`flow_map`)."""
         return flow_map(
             self.model, np.asarray(x, dtype=float), t0=self.t0, periods=self.periods,
-            sensitivities=sensitivities, virtual=self.virtual,
+            sensitivities=sensitivities, virtual=self.virtual, mode=self.mode,
         )  # fmt: skip
 
     def _run(self, x: Sequence[float] | np.ndarray, n: int) -> Solution:
         return simulate(
             self.model, x, t0=self.t0, periods=n * self.periods,
             phase=2 * math.pi * (self.t0 / self.model.period % 1.0), impacts="none", events=not self.virtual,
+            mode=self.mode,
         )  # fmt: skip
 
 

@@ -296,10 +296,8 @@ def test_features_not_yet_on_modes_are_refused_in_one_line():
         InvalidParameterError, match=r"^a sweep \(lanes\) does not support models with modes yet "
     ):
         sweep_spec(m, "omega", [1.0, 1.1])
-    with pytest.raises(
-        InvalidParameterError, match=r"^finding a periodic orbit does not support models with modes"
-    ):
-        find_orbit(m, [0.0, 0.0], period=1)
+    with pytest.raises(InvalidParameterError, match=r"^a virtual orbit \(the stops ignored\) does"):
+        find_orbit(m, [0.0, 0.0], period=1, virtual=True)
     with pytest.raises(InvalidParameterError, match=r"^the discontinuity map does not support models"):
         grazing.simulate(m, [0.0, 0.0], periods=1, zdm=object())
     from grazing.normalform import find_grazing_point
@@ -319,5 +317,7 @@ def test_features_not_yet_on_modes_are_refused_in_one_line():
         find_attractors(m, [[0.0, 0.0]])
     with pytest.raises(InvalidParameterError, match=r"^continuing attractors does not support models with"):
         continue_attractors(m, "omega", [1.0, 1.1], (-1.0, 0.4), (-1.0, 1.0), (2, 2))
-    with pytest.raises(InvalidParameterError, match=r"^the flow map does not support models with"):
-        flow_map(m, [0.0, 0.0])
+    with pytest.raises(
+        InvalidParameterError, match=r"^a run without events \(events=False\) does not support"
+    ):
+        flow_map(m, [0.0, 0.0], virtual=True)

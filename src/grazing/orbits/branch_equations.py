@@ -24,9 +24,13 @@ periodic orbit through ``x`` (its monodromy, multipliers, impacts...)."""
 
 
 def branch_equations(
-    model: HybridModel, param: str, period: int, t0: float, virtual: bool, stop: int = 0
-) -> BranchEquations:
+    model: HybridModel, param: str, period: int, t0: float, virtual: bool, stop: int = 0,
+    mode: str | None = None,
+) -> BranchEquations:  # fmt: skip
     """``u = (x, p) -> (F, DF, orbit)`` for the branch equations ``P^n(x; p) - x = 0``.
+
+    On a model with modes ``x`` is in ``mode`` on the section; a map that returns in another mode
+    raises :class:`~grazing.errors.ConvergenceError` (no orbit there).
 
     Examples
     --------
@@ -43,7 +47,9 @@ def branch_equations(
     def evaluate(u: np.ndarray) -> tuple[np.ndarray, np.ndarray, PeriodicOrbit]:
         m = model.with_params(**{param: float(u[-1])})
         x = u[:-1]
-        fm = flow_map(m, x, t0=t0, periods=period, sensitivities=[param], virtual=virtual, stop_name=stop)
+        fm = flow_map(
+            m, x, t0=t0, periods=period, sensitivities=[param], virtual=virtual, stop_name=stop, mode=mode
+        )
         if not fm.solution.jacobian_valid:
             raise ConvergenceError("the orbit sticks to the stop: no Jacobian across sticking")
         F = fm.image - x

@@ -397,6 +397,9 @@ class Branch:
         nan = np.full(len(names), np.nan)
         closest = [o.x_guard_min if o.x_guard_min is not None else nan for o in self.orbits]
         data["closest_state"] = (("point", "component"), np.array(closest).reshape(-1, len(names)))
+        if self.model.has_modes:  # (the mode on the section and the switches of mode per period)
+            data["mode"] = ("point", np.array([o.mode for o in self.orbits], dtype=str))
+            data["switches"] = ("point", np.array([o.switch_times.size for o in self.orbits], dtype=np.int32))
         ds = xr.Dataset(data, coords={"component": names, "multiplier": np.arange(len(names))})
         ds.param.attrs["long_name"] = self.param
         ds.period.attrs["long_name"] = "period of the orbit in forcing periods"
@@ -611,6 +614,47 @@ def _locate_grazing(
     return point if near_time and near_state else None
 
 
+class SwitchChange(TextEnum):
+    """What a grazing of a switching surface does to an orbit's switches of mode (a model with modes)."""
+
+    GAINS = "gains a switch"
+    LOSES = "loses a switch"
+    CHANGES = "changes the order of its switches"
+
+
+def switch_change(a: PeriodicOrbit, b: PeriodicOrbit) -> tuple[SwitchChange, int] | None:
+    """How the switches of mode of ``b`` differ from ``a``'s (their number or order in a forcing period,
+    :attr:`~grazing.orbits.periodic.PeriodicOrbit.switch_signature`), and the first transition whose
+    count differs (or, same counts, the first out of order); None where they do not differ."""
+    sa, sb = a.switch_signature, b.switch_signature
+    if sa == sb:
+        return None
+    na, nb = sum(map(len, sa)), sum(map(len, sb))
+    what = SwitchChange.GAINS if nb > na else SwitchChange.LOSES if nb < na else SwitchChange.CHANGES
+    names = a.model.stop_names
+    flat_a, flat_b = [n for p in sa for n in p], [n for p in sb for n in p]
+    counts = [j for j, nm in enumerate(names) if flat_a.count(nm) != flat_b.count(nm)]
+    if counts:
+        return what, counts[0]
+    first = next(
+        (i for i, (x, y) in enumerate(zip(flat_a, flat_b)) if x != y), min(len(flat_a), len(flat_b)) - 1
+    )
+    return what, names.index(flat_a[max(first, 0)]) if flat_a else 0
+
+
+def switch_change_reason(a: PeriodicOrbit, b: PeriodicOrbit) -> str:
+    """The boundary between two orbits of a branch whose switches of mode differ, in words."""
+    found = switch_change(a, b)
+    assert found is not None
+    what, j = found
+    before = [list(p) for p in a.switch_signature]
+    after = [list(p) for p in b.switch_signature]
+    return (
+        f"the orbit {what} ({a.model.stop_names[j]!r}; switches per forcing period {before} -> {after}): a "
+        "grazing of a switching surface"
+    )
+
+
 class _Continuation:
     """One run of :func:`continue_orbit`: its settings, the branch it fills, one segment at a time."""
 
@@ -631,6 +675,8 @@ class _Continuation:
 
     def check(self, prev: PalcPoint, cand: PalcPoint) -> tuple[str, str]:
         a, b = prev.payload, cand.payload
+        if self.model.has_modes and b.switch_signature != a.switch_signature:
+            return BOUNDARY, switch_change_reason(a, b)
         if not self.virtual and b.signature != a.signature:
             what = "loses" if sum(b.signature) < sum(a.signature) else "gains"
             if sum(b.signature) == sum(a.signature):
@@ -657,8 +703,8 @@ class _Continuation:
     def _layout(self, orbit: PeriodicOrbit) -> SegmentLayout | None:
         """The segments of ``orbit`` for multiple shooting, or None where it does not apply (a virtual
         branch, an orbit without impacts, a model without a forcing period)."""
-        if self.virtual or not orbit.impacts or not self.model.periodic:
-            return None
+        if self.virtual or not orbit.impacts or not self.model.periodic or self.model.has_modes:
+            return None  # (multiple shooting does not go through modes yet)
         return layout_of(orbit)
 
     @staticmethod
@@ -741,7 +787,9 @@ class _Continuation:
                 evaluate = segmented_equations(self.model, self.param, n, orbit.t0, layout, orbit.stop)
                 u0 = layout.pack(orbit, orbit.model.params[self.param])
             else:
-                evaluate = branch_equations(self.model, self.param, n, orbit.t0, self.virtual, orbit.stop)
+                evaluate = branch_equations(
+                    self.model, self.param, n, orbit.t0, self.virtual, orbit.stop, orbit.mode
+                )
                 u0 = np.append(orbit.state, orbit.model.params[self.param])
             ip = u0.size - 1  # (the parameter's index in u)
             try:
@@ -759,7 +807,7 @@ class _Continuation:
                 evaluate, PalcPoint(u0, F, DF, orb), index=ip, sign=sign, bounds={ip: self.bounds[nx]},
                 settings=dataclasses.replace(s, max_points=max(2, s.max_points - len(branch) + 1)),
                 names={ip: self.param}, shows={ip: self.par.show}, check=self.check,
-                margin=None if self.virtual else self.margin, direction=direction,
+                margin=None if self.virtual or self.model.has_modes else self.margin, direction=direction,
             )  # fmt: skip
             direction = None
             restarted = prev is not None and across is None  # the section moved: the same orbit
@@ -879,6 +927,8 @@ class _Continuation:
         """The grazing orbit at the boundary where ``palc`` stopped (None where none is located)."""
         boundary = palc.boundary
         assert boundary is not None
+        if self.model.has_modes:
+            return None  # (the grazing equations do not go through modes yet: the grazing is bracketed)
         beyond = boundary.after.payload if boundary.after is not None else None
         return _locate_grazing(prev.payload, beyond, self.param, self.virtual, boundary.ahead)
 
@@ -897,7 +947,12 @@ class _Continuation:
             )  # the steps beyond jumped to another orbit
             return []
         value = point.model.params[self.param] if point is not None else float(prev.u[-1])
-        where_stop = grazing_margin(last).stop if point is None else point.stop
+        after = boundary.after.payload if boundary.after is not None else None
+        switched = switch_change(last, after) if after is not None and self.model.has_modes else None
+        if switched is not None:
+            where_stop = switched[1]
+        else:
+            where_stop = grazing_margin(last).stop if point is None else point.stop
         p0 = float(prev.u[-1])
         p1 = float(boundary.after.u[-1]) if boundary.after is not None else value
         interval = (min(p0, p1), max(p0, p1)) if p1 != p0 else None
@@ -907,9 +962,16 @@ class _Continuation:
             stop=where_stop, precision=abs(precision), interval=interval,
         )  # fmt: skip
         where = par.show(value)
-        if self.model.n_stops > 1:
+        if self.model.has_modes:
+            where = f"{where} of transition {self.model.stop_names[where_stop]!r}"
+        elif self.model.n_stops > 1:
             where = f"{where} with stop {self.model.stop_names[where_stop]!r}"
-        if point is None:
+        if point is None and self.model.has_modes:
+            where += (
+                f" (bracketed only, between {par.show(prev.u[-1])} and the first orbit beyond it: the "
+                "grazing equations do not go through modes yet)"
+            )
+        elif point is None:
             where += (
                 f" (bracketed only: the grazing equations did not converge; last orbit at "
                 f"{par.show(prev.u[-1])})"
@@ -922,11 +984,13 @@ class _Continuation:
                 reason = f"the orbit touches the stop between its impacts: it {what}"
             reason += " (located from this side: the branch does not continue beyond it)"
         status = f"ended at a grazing at {where}: {reason}"
+        sequence = "switches of mode" if self.model.has_modes else "impact sequence"
+        other = "other switches of mode" if self.model.has_modes else "another impact sequence"
         if not self.switch:
             branch.special.append(graze)
             branch.end_segment(
                 BranchEnd.GRAZING,
-                status + "; the orbit with the new impact sequence can be followed with switch (switch=True)",
+                status + f"; the orbit with the new {sequence} can be followed with switch (switch=True)",
             )
             return []
         new = new_sequence_orbit(last, self.param, value, sign, self.virtual)
@@ -934,13 +998,11 @@ class _Continuation:
             branch.special.append(graze)
             branch.end_segment(
                 BranchEnd.GRAZING,
-                status + "; no orbit with another impact sequence was found just past it to switch to",
+                status + f"; no orbit with {other} was found just past it to switch to",
             )
             return []
         branch.special.append(dataclasses.replace(graze, switched=True))
-        branch.end_segment(
-            BranchEnd.SWITCHED, status + "; switched to the orbit with the new impact sequence"
-        )
+        branch.end_segment(BranchEnd.SWITCHED, status + f"; switched to the orbit with the new {sequence}")
         if new.section_clearance() < SECTION_MARGIN:
             new = move_section(new, quiet_section(new))
         sign = math.copysign(1.0, new.model.params[self.param] - value)
@@ -967,7 +1029,9 @@ class _Continuation:
             u_star = np.append(at.orbit.state, at.param)
             if self.segmented:  # (the branches through it are followed by single shooting first)
                 o = at.orbit
-                evaluate = branch_equations(self.model, self.param, o.period, o.t0, self.virtual, o.stop)
+                evaluate = branch_equations(
+                    self.model, self.param, o.period, o.t0, self.virtual, o.stop, o.mode
+                )
             for orbit, direction in crossing_starts(evaluate, u_star, at.tangent, self.s):
                 starts.append(
                     SegmentStart(orbit=orbit, sign=_sign_of(direction), direction=direction, origin=i)
@@ -1000,6 +1064,7 @@ def continue_orbit(
     switch: bool = False,
     progress: Callable[[int, float], None] | None = None,
     stop_name: int | str | None = None,
+    mode: str | None = None,
 ) -> Branch:
     """Follow a periodic orbit as ``param`` goes from ``start`` towards ``stop``.
 
@@ -1047,6 +1112,15 @@ def continue_orbit(
         :class:`~grazing.errors.InvalidParameterError`.
     progress
         Called as ``progress(points, param_value)`` after each point.
+    mode
+        A model with modes: the mode of ``x0`` (see :func:`find_orbit`).  Each
+        point's orbit records its mode on the section and its switches of mode;
+        where their number or order changes along the branch (a grazing of a
+        switching surface), the segment ends there as at a change of impacts,
+        the grazing bracketed between two points (not located by the grazing
+        equations yet), and with ``switch`` goes on along the orbit with the
+        new switches.  Branches of models with modes are physical
+        (``virtual=True`` is refused) and single-shooting only.
 
     Returns
     -------
@@ -1083,12 +1157,18 @@ def continue_orbit(
         )
     if switch and virtual is None:
         virtual = False  # a nonimpacting orbit too: followed up to its grazing, then switched
+    if model.has_modes:
+        if virtual or (orbit is not None and orbit.virtual):
+            model.require_one_mode("a virtual branch (the stops ignored)")
+        virtual = False  # (its switches of mode end it where they change, as impacts do)
     watch = model.stop_index(
         stop_name if stop_name is not None else (orbit.stop if orbit is not None else None)
     )
     if orbit is None:
         if virtual is None:
-            probe = find_orbit(m0, x0, period=period, t0=0.0 if t0 is None else t0, stop_name=watch)
+            probe = find_orbit(
+                m0, x0, period=period, t0=0.0 if t0 is None else t0, stop_name=watch, mode=mode
+            )
             virtual = probe.impacts == 0
             orbit = (
                 probe
@@ -1099,8 +1179,9 @@ def continue_orbit(
             )
         else:
             orbit = find_orbit(
-                m0, x0, period=period, t0=0.0 if t0 is None else t0, virtual=virtual, stop_name=watch
-            )
+                m0, x0, period=period, t0=0.0 if t0 is None else t0, virtual=virtual, stop_name=watch,
+                mode=mode,
+            )  # fmt: skip
         if t0 is None and orbit.section_clearance() < SECTION_MARGIN:
             orbit = move_section(orbit, quiet_section(orbit))
     elif virtual is None:

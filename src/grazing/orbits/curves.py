@@ -715,7 +715,8 @@ def follow_curve(
         the special points met instead.
     InvalidParameterError
         An unknown kind or parameter, ``param2`` equal to ``param``, a
-        ``range2`` without the value of ``param2``.
+        ``range2`` without the value of ``param2``; a model with modes (not
+        supported yet: its branches are followed by :func:`continue_orbit`).
 
     Examples
     --------
@@ -729,6 +730,7 @@ def follow_curve(
     >>> bool(np.allclose(a, np.pi * (1 - r) / (1 + r), atol=1e-8)), float(r.min()), float(r.max())
     (True, 0.45, 0.55)
     """
+    model.require_one_mode("curves in two parameters (follow_curve)")
     if kind not in CURVE_KINDS:
         raise InvalidParameterError(f"unknown curve kind {kind!r} (known: {', '.join(CURVE_KINDS)})")
     kind = CurveKind(kind)

@@ -167,6 +167,14 @@ class PeriodicOrbit:
         point there).
     impact_stops
         The stop of each of the orbit's impacts (index into the model's ``stop_names``).
+    mode
+        A model with modes: the mode of :attr:`state` on the section (the same
+        at both ends of the period); None for a model without modes.
+    switch_times, switch_transitions
+        A model with modes: the orbit's changes of mode over one period
+        ``[t0, t0 + n T)``, their times and transitions (indices into the model's
+        ``stop_names``; a reset that changes the mode is both an impact and a
+        switch); see :attr:`switch_signature`.
 
     Examples
     --------
@@ -203,6 +211,9 @@ class PeriodicOrbit:
     impact_stops: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
     guard_min_by_stop: tuple[tuple[float, float, np.ndarray], ...] = ()
     approach_by_stop: tuple[tuple[float, float, np.ndarray] | None, ...] = ()
+    mode: str | None = None
+    switch_times: np.ndarray = field(default_factory=lambda: np.empty(0))
+    switch_transitions: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
 
     @property
     def guard_mins(self) -> np.ndarray:
@@ -227,11 +238,28 @@ class PeriodicOrbit:
             counts[min(self.period - 1, max(0, math.floor((t - self.t0) / T)))] += 1
         return tuple(counts)
 
+    @property
+    def switch_signature(self) -> tuple[tuple[str, ...], ...]:
+        """The transitions of the orbit's switches in each of its ``period`` forcing periods after ``t0``,
+        in order (a model with modes; empty tuples without switches).
+
+        As :attr:`signature` for impacts: a branch of periodic orbits keeps its switches, in number and
+        order, up to a grazing of a switching surface.
+        """
+        T = self.model.period
+        per: list[list[str]] = [[] for _ in range(self.period)]
+        names = self.model.stop_names
+        for t, j in zip(self.switch_times, self.switch_transitions):
+            per[min(self.period - 1, max(0, math.floor((t - self.t0) / T)))].append(names[int(j)])
+        return tuple(tuple(p) for p in per)
+
     def section_clearance(self) -> float:
-        """Distance, in periods, from the section ``t0 (mod T)`` to the nearest impact (0.5 if none)."""
-        if not self.impact_times.size:
+        """Distance, in periods, from the section ``t0 (mod T)`` to the nearest impact or switch of mode
+        (0.5 if none)."""
+        events = np.concatenate([self.impact_times, self.switch_times])
+        if not events.size:
             return 0.5
-        d = np.mod((self.impact_times - self.t0) / self.model.period, 1.0)
+        d = np.mod((events - self.t0) / self.model.period, 1.0)
         return float(np.min(np.minimum(d, 1.0 - d)))
 
     @property
@@ -268,6 +296,18 @@ def sorted_multipliers(mono: np.ndarray) -> np.ndarray:
     return mu[order]
 
 
+def returning_mode_message(fm: FlowMap, n: int, t0: float) -> str:
+    """Why the period-``n`` map ``fm`` of a model with modes has no fixed point there: it returns in
+    another mode than it started in (empty where it returns in the same mode)."""
+    if fm.mode == fm.mode_final:
+        return ""
+    return (
+        f"the period-{n} map from mode {fm.mode!r} at t0 = {t0:.10g} returns in mode {fm.mode_final!r}: "
+        "a periodic orbit is in the same mode at both ends of its period; give another section time, "
+        "starting mode or period"
+    )
+
+
 def _orbit_from(model: HybridModel, x: np.ndarray, t0: float, n: int, fm: FlowMap, virtual: bool,
                 residuals: list[float], stop: int = 0) -> PeriodicOrbit:  # fmt: skip
     sol = fm.solution
@@ -275,8 +315,13 @@ def _orbit_from(model: HybridModel, x: np.ndarray, t0: float, n: int, fm: FlowMa
         raise ConvergenceError(
             f"the period-{n} orbit sticks to the stop; its Jacobian across sticking is not available"
         )
+    returns_elsewhere = returning_mode_message(fm, n, t0)
+    if returns_elsewhere:
+        raise ConvergenceError(returns_elsewhere)
     gmin = sol.guard_min
-    assert gmin is not None
+    if gmin is None:  # (a model with modes: not computed yet)
+        gmin = (math.nan, math.nan, None)
+    sw = sol.switches
     speeds = sol.impacts.speed
     return PeriodicOrbit(
         model=model,
@@ -300,4 +345,7 @@ def _orbit_from(model: HybridModel, x: np.ndarray, t0: float, n: int, fm: FlowMa
         impact_stops=sol.impacts.stop.copy(),
         guard_min_by_stop=sol.guard_min_by_stop or (),
         approach_by_stop=sol.approach_by_stop or (),
+        mode=fm.mode,
+        switch_times=sw.t.copy() if sw is not None else np.empty(0),
+        switch_transitions=sw.transition.copy() if sw is not None else np.zeros(0, dtype=int),
     )

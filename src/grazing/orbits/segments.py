@@ -196,6 +196,7 @@ def segmented_equations(
     column of ``DF`` is zero (:func:`segmented_newton`).  With a tuple of parameters (a curve
     in two parameters, :mod:`grazing.orbits.segmented_curves`) they are the last entries of
     ``u``, in order, and ``DF`` has a column for each.
+    Models with modes are refused in one line (multiple shooting does not go through modes yet).
 
     Examples
     --------
@@ -208,6 +209,7 @@ def segmented_equations(
     >>> bool(abs(F).max() < 1e-10), DF.shape, bool(np.allclose(orbit.multipliers, o.multipliers))
     (True, (8, 9), True)
     """
+    model.require_one_mode("multiple shooting")
     n, k = layout.n_states, layout.impacts
     names = () if param is None else (param,) if isinstance(param, str) else tuple(param)
     order = [p.name for p in model.parameters]
@@ -366,6 +368,7 @@ def segmented_newton(
         Where the run has no impact, Newton's method does not reach ``tol``, or the orbit it finds is
         not a motion of the system (an impact speed not positive, a segment through a stop).
     """
+    model.require_one_mode("multiple shooting")
     start = run_layout(model, x, t0, period, stop)
     if start is None:
         raise ConvergenceError("the run from the guess has no impact to make segments of")

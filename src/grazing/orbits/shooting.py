@@ -41,6 +41,7 @@ from grazing.orbits.periodic import (  # noqa: F401 (the record and its tests, h
     kept_directions,
     multiplier_one_multiplicity,
     not_isolated_message,
+    returning_mode_message,
     sorted_multipliers,
     unstable_count,
 )
@@ -52,11 +53,13 @@ stroboscopic section, an automatic section (``t0=None``) moves to a quiet phase.
 
 
 def quiet_section(orbit: PeriodicOrbit) -> float:
-    """A section time in ``[0, T)`` as far as possible (in phase) from every impact of ``orbit``."""
+    """A section time in ``[0, T)`` as far as possible (in phase) from every impact and switch of mode
+    of ``orbit``."""
     T = orbit.model.period
-    if not orbit.impact_times.size:
+    events = np.concatenate([orbit.impact_times, orbit.switch_times]) if orbit.mode else orbit.impact_times
+    if not events.size:
         return orbit.t0 % T
-    phases = np.sort(np.mod(orbit.impact_times / T, 1.0))
+    phases = np.sort(np.mod(events / T, 1.0))
     gaps = np.diff(np.append(phases, phases[0] + 1.0))
     i = int(np.argmax(gaps))
     return float((phases[i] + gaps[i] / 2) % 1.0 * T)
@@ -67,20 +70,23 @@ def move_section(orbit: PeriodicOrbit, t_new: float, *, tol: float = NEWTON_TOL)
 
     The orbit is followed from its section to the next time ``t_new (mod T)``
     and Newton's method is run again there (the monodromy and the point
-    change with the section; the multipliers do not).
+    change with the section; the multipliers do not).  On a model with modes,
+    in the mode the orbit is in at ``t_new``.
     """
     T = orbit.model.period
     lag = (t_new - orbit.t0) % T
-    x = orbit.state
+    x, mode = orbit.state, orbit.mode
     if lag > 0:
         phase = 2 * math.pi * ((orbit.t0 + lag) / T % 1.0)
-        x = simulate(
+        sol = simulate(
             orbit.model, orbit.state, t0=orbit.t0, periods=1, phase=phase, impacts="none",
-            events=not orbit.virtual,
-        ).x_final  # fmt: skip
+            events=not orbit.virtual, mode=orbit.mode,
+        )  # fmt: skip
+        x, mode = sol.x_final, sol.mode_final
     return find_orbit(
-        orbit.model, x, period=orbit.period, t0=t_new, virtual=orbit.virtual, tol=tol, stop_name=orbit.stop
-    )
+        orbit.model, x, period=orbit.period, t0=t_new, virtual=orbit.virtual, tol=tol, stop_name=orbit.stop,
+        mode=mode,
+    )  # fmt: skip
 
 
 GUESS = "an initial guess (x0=)"
@@ -103,12 +109,15 @@ class InitialGuess:
         How the motion sticks to a stop over the sampled periods: ``""`` (it
         does not), or a phrase such as ``"ends riding on the stop"`` (see
         :func:`sticking_phrase`).
+    mode
+        A model with modes: the mode of :attr:`state` (None without modes).
     """
 
     state: np.ndarray
     period: int
     transient: int
     sticking: str = ""
+    mode: str | None = None
 
 
 def _stop_phrase(name: str) -> str:
@@ -159,8 +168,11 @@ def initial_guess(
     transient: int = DEFAULT_TRANSIENT,
     samples: int = 128,
     virtual: bool = False,
+    mode: str | None = None,
 ) -> InitialGuess:
-    """A point near an attractor and its period, from simulation starting at rest.
+    """A point near an attractor and its period, from simulation starting at rest (on a model with
+    modes, in ``mode``, its initial mode by default; the guess is then in the mode the run ends in,
+    :attr:`InitialGuess.mode`).
 
     Raises
     ------
@@ -178,6 +190,7 @@ def initial_guess(
             phase=2 * math.pi * (t0 / model.period % 1.0),
             impacts="sampled",  # (they name the stop of each sticking interval)
             events=not virtual,
+            mode=mode,
         )
     except (SimulationError, InvalidStateError) as exc:
         flow = " with the stops ignored" if virtual else ""
@@ -191,6 +204,7 @@ def initial_guess(
         period=detect_period(sol.samples, tol=1e-6),
         transient=transient,
         sticking=sticking_phrase(sol, samples),
+        mode=sol.mode_final,
     )
 
 
@@ -206,6 +220,7 @@ def find_orbit(
     transient: int = DEFAULT_TRANSIENT,
     stop_name: int | str | None = None,
     through_stops: bool = True,
+    mode: str | None = None,
 ) -> PeriodicOrbit:
     """Find a periodic orbit by Newton's method on the stroboscopic map.
 
@@ -246,6 +261,14 @@ def find_orbit(
         only wants the orbit a run approaches, at the cost of one try).
     transient
         Forcing periods simulated from rest for the default guess.
+    mode
+        A model with modes: the mode of ``x0`` on the section (its initial
+        mode by default), which the orbit must be in again one period later.
+        Without ``x0``, the guess is simulated from rest in ``mode`` and the
+        orbit is sought in the mode that run ends in.  The monodromy carries
+        the saltation matrices of the switches (a switch of mode without a
+        reset too); multiple shooting, ``virtual`` orbits and the guard
+        minimum are not available on models with modes yet.
 
     Returns
     -------
@@ -270,13 +293,14 @@ def find_orbit(
     >>> orbit.period, orbit.impacts, orbit.stable
     (5, 1, True)
     """
-    model.require_one_mode("finding a periodic orbit")
+    if virtual:
+        model.require_one_mode("a virtual orbit (the stops ignored)")
     if period is not None and (not isinstance(period, (int, np.integer)) or period < 1):
         raise InvalidParameterError(f"period must be a positive integer, got {period!r}")
     if t0 is None:
         orbit = find_orbit(
             model, x0, period=period, t0=0.0, virtual=virtual, tol=tol, max_iter=max_iter,
-            transient=transient, stop_name=stop_name, through_stops=through_stops,
+            transient=transient, stop_name=stop_name, through_stops=through_stops, mode=mode,
         )  # fmt: skip
         if orbit.section_clearance() >= SECTION_MARGIN:
             return orbit
@@ -286,8 +310,8 @@ def find_orbit(
     note = ""  # why the default guess's period was not used, if it was not
     if x0 is None:
         advice = "try another period (period=), an initial guess (x0=) or a longer transient"
-        guess = initial_guess(model, t0=t0, transient=transient, virtual=virtual)
-        x, detected = guess.state, guess.period
+        guess = initial_guess(model, t0=t0, transient=transient, virtual=virtual, mode=mode)
+        x, detected, mode = guess.state, guess.period, guess.mode
         n = int(period or detected or 1)
         if not (period or detected):
             note = (
@@ -300,13 +324,15 @@ def find_orbit(
             )
     else:
         advice = "try another initial guess or another period"
-        x = model.check_state(x0, t0, allowed=not virtual)
+        x = model.check_state(x0, t0, allowed=not virtual, mode=mode)
         n = int(period or 1)
-    newton = _Newton(model, t0, n, stop, tol, max_iter)
+    mode = model.mode_names[model.mode_index(mode)] if model.has_modes else None
+    newton = _Newton(model, t0, n, stop, tol, max_iter, mode)
     try:
         return newton.solve(x, virtual, advice, guess, note)
     except ConvergenceError:
-        inside = None if virtual or not through_stops else newton.nonimpacting(x)
+        nonimpacting = not (virtual or not through_stops or model.has_modes)  # (no virtual runs with modes)
+        inside = newton.nonimpacting(x) if nonimpacting else None
         if inside is None:
             raise
         return inside
@@ -322,6 +348,8 @@ class _Newton:
     stop: int
     tol: float
     max_iter: int
+    mode: str | None = None
+    """A model with modes: the mode on the section (None without modes)."""
 
     def solve(
         self, x: np.ndarray, virtual: bool, advice: str, guess: InitialGuess | None, note: str = ""
@@ -333,20 +361,24 @@ class _Newton:
         why = ""
         for it in range(self.max_iter + 1):
             try:
-                fm = flow_map(model, x, t0=t0, periods=n, virtual=virtual, stop_name=stop)
+                fm = flow_map(model, x, t0=t0, periods=n, virtual=virtual, stop_name=stop, mode=self.mode)
             except SimulationError as exc:
                 raise ConvergenceError(
                     f"Newton's method for a period-{n} orbit failed at iterate {it} ({exc}); {advice}"
                 ) from None
             except InvalidStateError:
+                where = f"is not in mode {self.mode!r}" if self.mode else "is beyond the stop"
                 raise ConvergenceError(
-                    f"Newton's method for a period-{n} orbit left the allowed region (iterate {it} is "
-                    f"beyond the stop); {advice}"
+                    f"Newton's method for a period-{n} orbit left the allowed region (iterate {it} "
+                    f"{where}); {advice}"
                 ) from None
             if not fm.solution.jacobian_valid:
                 raise ConvergenceError(
                     _sticking_message(model, n, it, fm, guess) + (f"; {note}" if note else "")
                 )
+            returns_elsewhere = returning_mode_message(fm, n, t0)
+            if returns_elsewhere:
+                raise ConvergenceError(f"{returns_elsewhere} (Newton iterate {it})")
             F = fm.image - x
             res = float(np.max(np.abs(F)))
             residuals.append(res)
@@ -373,7 +405,7 @@ class _Newton:
             lam = 1.0
             for _ in range(30):
                 trial = x + lam * dx
-                if virtual or np.min(model.guards(trial, t0)) >= 0:
+                if virtual or self._allowed(trial):
                     break
                 lam *= 0.5
             x = trial
@@ -382,6 +414,17 @@ class _Newton:
             f"{len(residuals) - 1} iterations{why}; {advice}"
         )
 
+    def _allowed(self, x: np.ndarray) -> bool:
+        """Does ``x`` satisfy the guards (on a model with modes, those of the transitions that leave the
+        section's mode)?"""
+        if self.mode is None:
+            return bool(np.min(self.model.guards(x, self.t0)) >= 0)
+        try:
+            self.model.check_state(x, self.t0, mode=self.mode)
+        except InvalidStateError:
+            return False
+        return True
+
     def segments_from_guess(self, fm: FlowMap, virtual: bool) -> bool:
         """Is the guess's run to be solved by multiple shooting (:mod:`grazing.orbits.segments`): a
         physical run with impacts of a periodic model whose monodromy exceeds
@@ -389,6 +432,8 @@ class _Newton:
         (:data:`~grazing.orbits.segments.GRAZING_SPEED_RATIO`)?"""
         if virtual or not fm.impacts or not self.model.periodic or not fm.solution.jacobian_valid:
             return False
+        if self.model.has_modes:
+            return False  # (multiple shooting does not go through modes yet)
         speeds = np.abs(fm.solution.impacts.speed)
         if float(speeds.min()) < GRAZING_SPEED_RATIO * float(speeds.max()):
             return False  # (an impact of the guess's run at a grazing: single shooting's orbit, without it)

@@ -87,8 +87,8 @@ def doubled_start(
     v /= np.linalg.norm(v)
     row = np.append(v, 0.0)
     u_star = np.append(orbit.state, orbit.model.params[param])
-    doubled = branch_equations(orbit.model, param, 2 * n, orbit.t0, orbit.virtual, orbit.stop)
-    single = branch_equations(orbit.model, param, n, orbit.t0, orbit.virtual, orbit.stop)
+    doubled = branch_equations(orbit.model, param, 2 * n, orbit.t0, orbit.virtual, orbit.stop, orbit.mode)
+    single = branch_equations(orbit.model, param, n, orbit.t0, orbit.virtual, orbit.stop, orbit.mode)
     scale = max(1.0, float(np.linalg.norm(u_star)))
     for step in SWITCH_STEPS:
         eps = step * scale
@@ -147,7 +147,8 @@ def crossing_starts(
 def new_sequence_orbit(
     last: PeriodicOrbit, param: str, value: float, direction: float, virtual: bool
 ) -> PeriodicOrbit | None:
-    """An orbit with another impact signature than ``last``, just past the grazing at ``value``."""
+    """An orbit with another impact signature than ``last`` (or, on a model with modes, other switches:
+    :attr:`~grazing.orbits.periodic.PeriodicOrbit.switch_signature`), just past the grazing at ``value``."""
     p = last.model.params[param]
     par = next(q for q in last.model.parameters if q.name == param)
     for sign in (direction, -direction):
@@ -157,10 +158,11 @@ def new_sequence_orbit(
                 par.check(trial)
                 orbit = find_orbit(
                     last.model.with_params(**{param: trial}), last.state, period=last.period, t0=last.t0,
-                    virtual=virtual, stop_name=last.stop,
+                    virtual=virtual, stop_name=last.stop, mode=last.mode,
                 )  # fmt: skip
             except GrazingError:
                 continue
-            if orbit.signature != last.signature and abs(trial - p) > 0:
+            other = orbit.signature != last.signature or orbit.switch_signature != last.switch_signature
+            if other and abs(trial - p) > 0:
                 return orbit
     return None
