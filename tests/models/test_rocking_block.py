@@ -120,3 +120,40 @@ def test_small_angles_tend_to_the_linearised_block():
     e1, e2, e3 = (scaled_difference(s) for s in (0.2, 0.1, 0.05))
     assert e1 < 1e-3
     assert 3.8 < e1 / e2 < 4.2 and 3.8 < e2 / e3 < 4.2, (e1, e2, e3)
+
+
+def test_forced_rocking_against_scipy():
+    """The forced nonlinear equations (Makris & Konstantinidis 2003, eq. 1), written here from the
+    source, integrated by scipy (DOP853 at rtol 1e-13) from impact to impact: samples to 1e-9."""
+    from scipy.integrate import solve_ivp
+
+    m = rocking_block(a=0.35, omega=3.5, alpha=0.3, p=1.5)
+    q = dict(m.params)
+    rho = housner_restitution(q["alpha"])
+
+    def field(t, y):
+        sgn = 1.0 if y[0] > 0 or (y[0] == 0 and y[1] > 0) else -1.0
+        phi = q["alpha"] * sgn - y[0]
+        return [y[1], -(q["p"] ** 2) * (math.sin(phi) + q["a"] * math.cos(q["omega"] * t) * math.cos(phi))]
+
+    def landing(t, y):
+        return y[0]
+
+    landing.terminal = True
+    sol = grazing.simulate(m, [0.1, 0.0], periods=6, impacts="all")
+    assert np.abs(sol.samples[:, 0]).max() < q["alpha"]  # (rocking, not overturning)
+    y, t, times = [0.1, 0.0], 0.0, []
+    for ts, xs in zip(sol.t, sol.samples):
+        while True:
+            run = solve_ivp(field, (t, ts), y, method="DOP853", rtol=1e-13, atol=1e-15, events=landing)
+            if run.status == 1 and run.t_events[0][0] < ts:
+                t = float(run.t_events[0][0])
+                speed = rho * run.y_events[0][0][1]
+                y = [math.copysign(1e-300, speed), speed]  # theta = 0 on the new corner's side
+                times.append(t)
+                continue
+            y, t = list(run.y[:, -1]), ts
+            break
+        assert np.abs(np.array(y) - xs).max() < 1e-9, (ts, y, xs)
+    assert len(times) == len(sol.impacts) >= 4
+    assert np.abs(np.array(times) - sol.impacts.t).max() < 1e-9
