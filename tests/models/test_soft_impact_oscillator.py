@@ -54,12 +54,18 @@ def test_against_the_exact_solution(values):
     assert np.allclose(sol.jacobian, J, rtol=0, atol=1e-9 * max(1.0, np.abs(J).max()))
 
 
-def test_mode_spans_follow_the_switches():
-    """Each stay's mode is the side of x = gap that the dense trajectory is on inside it."""
+@pytest.mark.parametrize(
+    "start", [(3, [0.0, 0.0], None), (0, [1.0, 0.0], "contact")], ids=["settled", "contact"]
+)
+def test_mode_spans_follow_the_switches(start):
+    """Each stay's mode is the side of x = gap that the dense trajectory is on inside it (from a start in
+    contact, too, where the first sample is in free flight)."""
     m = soft_impact_oscillator()
-    sol = grazing.simulate(m, [0.0, 0.0], transient=3, periods=4, trajectory=400)
+    transient, x0, mode = start
+    sol = grazing.simulate(m, x0, transient=transient, periods=4, trajectory=400, mode=mode)
     spans = sol.mode_spans()
     assert len(spans) == len(sol.switches) + 1 >= 5
+    assert transient or spans[0][2] == m.mode_index(mode)  # the mode it starts in
     assert spans[0][0] == sol.trajectory_t[0] and spans[-1][1] == sol.t_final
     assert next(k for _, end, k in spans if end > sol.t[0]) == sol.modes[0]  # the first sample's stay
     gap = m.params["gap"]
