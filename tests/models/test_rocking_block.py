@@ -157,3 +157,21 @@ def test_forced_rocking_against_scipy():
         assert np.abs(np.array(y) - xs).max() < 1e-9, (ts, y, xs)
     assert len(times) == len(sol.impacts) >= 4
     assert np.abs(np.array(times) - sol.impacts.t).max() < 1e-9
+
+
+def test_free_rocking_comes_to_rest_in_one_line():
+    """Unforced, the impacts accumulate (their intervals fall geometrically) at the sum of the half-cycles
+    of the quadrature: a one-line error there, not a hang."""
+    import re
+
+    p, alpha, rho, amp = 1.0, 0.2, housner_restitution(0.2), 0.1
+    t_rest = fall_time(amp, p, alpha)
+    while amp > 1e-12:
+        speed = math.sqrt(2 * p**2 * (math.cos(alpha - amp) - math.cos(alpha)))
+        amp = alpha - math.acos(math.cos(alpha) + (rho * speed) ** 2 / (2 * p**2))
+        t_rest += 2 * fall_time(amp, p, alpha)
+    with pytest.raises(grazing.SimulationError, match=r"^impacts from mode to mode accumulate") as info:
+        grazing.simulate(rocking_block(a=0.0, p=p, alpha=alpha), [0.1, 0.0], periods=20)
+    assert "\n" not in str(info.value) and "'onto_left', 'onto_right'" in str(info.value)
+    t = float(re.search(r"at t = (\S+) ", str(info.value)).group(1))
+    assert abs(t - t_rest) < 1e-4 * t_rest, (t, t_rest)

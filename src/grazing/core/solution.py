@@ -114,6 +114,12 @@ def accumulation_message(model: HybridModel, x: Any, t: float) -> str:
     on = [j for j, h in enumerate(model.guards(state, t)) if abs(h) <= tol]
     names = [repr(model.stop_names[j]) for j in on]
     switching = [j for j in on if model.transition_source[j] != model.transition_target[j]]
+    if model.has_modes and switching and all(model.symbolic.resets[j] for j in switching):
+        return (  # landings from one mode onto another that accumulate (a rocking block coming to rest)
+            f"impacts from mode to mode accumulate at t = {t:.6g} (transitions "
+            f"{', '.join(repr(model.stop_names[j]) for j in switching)}): the motion comes to rest on "
+            "their guard, and a model with modes cannot continue that yet"
+        )
     if model.has_modes and switching:  # two modes whose fields push into each other
         modes = sorted(
             {m for j in switching for m in (model.transition_source[j], model.transition_target[j])}
