@@ -155,7 +155,7 @@ def test_a_model_from_a_file(tmp_path, capsys):
         assert code != 0 and msg in err and err.count("\n") == 1
 
 
-def test_a_model_with_modes_is_refused_in_one_line(tmp_path, capsys):
+def test_a_model_with_modes_is_simulated_and_refused_elsewhere_in_one_line(tmp_path, capsys):
     path = tmp_path / "soft.py"
     path.write_text(
         "import sympy as sp\n"
@@ -166,14 +166,74 @@ def test_a_model_with_modes_is_refused_in_one_line(tmp_path, capsys):
         "    transitions=[Transition('touch', 'free', 'contact', 0.5 - x),\n"
         "                 Transition('leave', 'contact', 'free', x - 0.5)], period=2 * sp.pi / w)\n"
     )
+    out = run_json(["simulate", "--model", f"{path}:SOFT", "--periods", "3"], capsys)
+    assert set(out["modes"]) <= {"free", "contact"} and len(out["modes"]) == 3
     for command in (
-        ["simulate"],
         ["orbit"],
         ["sweep", "--param", "w", "--start", "1", "--stop", "1.2", "--num", "3"],
     ):
-        code, out, err = run([*command, "--model", f"{path}:SOFT"], capsys)
-        assert code != 0 and out == "" and err.count("\n") == 1, (command, err)
-        assert "has modes (free, contact): the command line does not support models with modes yet" in err
+        for model in (f"{path}:SOFT", "soft-impact-oscillator"):
+            code, out, err = run([*command, "--model", model], capsys)
+            assert code != 0 and out == "" and err.count("\n") == 1, (command, err)
+            assert "has modes (free, contact): " in err and "does not support models with modes yet" in err
+
+
+ONE_MODE_KEYS = [
+    "params", "initial", "transient", "periods", "phase", "samples", "impacts", "impacts_sampled",
+    "impact_map", "impact_stops", "impacts_per_stop", "sticking_intervals", "period", "t_final", "x_final",
+    "steps", "elapsed_s", "trajectory_file", "version",
+]  # fmt: skip
+"""The keys of ``simulate --json`` for a model of one mode, in order (what they were before modes)."""
+
+
+def test_simulate_json_of_a_model_with_modes_against_the_api(capsys):
+    import numpy as np
+
+    import grazing
+
+    argv = [
+        "simulate",
+        "--model",
+        "soft-impact-oscillator",
+        "--set",
+        "k=20",
+        "--transient",
+        "7",
+        "--periods",
+        "5",
+    ]
+    out = run_json(argv, capsys)
+    assert list(out)[: len(ONE_MODE_KEYS)] == ONE_MODE_KEYS
+    assert list(out)[len(ONE_MODE_KEYS) :] == ["modes", "switches", "mode_final"]
+    sol = grazing.simulate(grazing.models.soft_impact_oscillator(k=20.0), [0.0, 0.0], transient=7, periods=5)
+    assert out["modes"] == [sol.mode_names[k] for k in sol.modes] and out["mode_final"] == sol.mode_final
+    assert len(out["switches"]) == len(sol.switches) >= 8
+    assert [s["t"] for s in out["switches"]] == sol.switches.t.tolist()
+    first = out["switches"][0]
+    assert (first["transition"], first["from"], first["to"]) == (
+        sol.switches.name(0), sol.switches.source(0), sol.switches.target(0)
+    )  # fmt: skip
+    assert np.array_equal(first["state"], sol.switches.state[0])
+    # --mode: start in contact (x = 1 > gap is not in the initial mode, free)
+    argv = ["simulate", "--model", "soft-impact-oscillator", "--initial", "1,0", "--transient", "0"]
+    started = run_json([*argv, "--periods", "1", "--mode", "contact"], capsys)
+    assert started["switches"][0]["from"] == "contact"
+    for bad, msg in ((["--mode", "stuck"], "--mode: unknown mode 'stuck'"), ([], "is not in mode 'free'")):
+        code, out, err = run([*argv, *bad], capsys)
+        assert code != 0 and out == "" and err.count("\n") == 1 and msg in err, err
+
+
+def test_simulate_json_of_a_model_of_one_mode_is_unchanged(capsys):
+    """No key added for one mode, and the values those of the API (``--mode free`` changes nothing)."""
+    import grazing
+
+    argv = ["simulate", *TWO, "--transient", "20", "--periods", "4"]
+    out = run_json(argv, capsys)
+    assert list(out) == ONE_MODE_KEYS
+    again = run_json([*argv, "--mode", "free"], capsys)
+    assert {**again, "elapsed_s": 0} == {**out, "elapsed_s": 0}
+    sol = grazing.simulate(grazing.models.two_sided_oscillator(), [0.0, 0.0], transient=20, periods=4)
+    assert out["samples"] == sol.samples.tolist() and out["steps"] == sol.n_steps
 
 
 @pytest.mark.parametrize(

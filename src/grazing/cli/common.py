@@ -152,11 +152,6 @@ def load_model(spec: str) -> grazing.HybridModel:
         raise InputError(
             f"--model: {name} in {path_text} is not a grazing.HybridModel (or a function returning one)"
         )
-    if obj.has_modes:
-        raise InputError(
-            f"--model: {name} in {path_text} has modes ({', '.join(obj.mode_names)}): the command line does "
-            "not support models with modes yet (use the Python API: grazing.simulate)"
-        )
     return obj
 
 
@@ -190,16 +185,19 @@ def apply_sets(model: grazing.HybridModel, sets: tuple[str, ...]) -> grazing.Hyb
     return model.with_params(**changes) if changes else model
 
 
-def model_options(func: Callable[..., Any] | None = None, *, any_model: bool = False) -> Any:
+def model_options(
+    func: Callable[..., Any] | None = None, *, any_model: bool = False, modes: bool = False
+) -> Any:
     """Options selecting the model: ``--model``, ``--set``, and the pendulum's case and overrides.
 
     The decorated command receives the validated model as ``model`` and the
     pendulum case name as ``case`` (for its JSON output).  Commands decorated
     with ``any_model=True`` take every model; the others refuse any model but
-    the pendulum in one line.
+    the pendulum in one line.  A model with modes is refused in one line but
+    by the commands decorated with ``modes=True``.
     """
     if func is None:
-        return functools.partial(model_options, any_model=any_model)
+        return functools.partial(model_options, any_model=any_model, modes=modes)
 
     @functools.wraps(func)
     def wrapper(
@@ -225,6 +223,12 @@ def model_options(func: Callable[..., Any] | None = None, *, any_model: bool = F
                 PENDULUM_OPTIONS, True, "with a model other than the pendulum (use --set NAME=VALUE)"
             )
             model = load_model(model_spec)
+            if model.has_modes and not modes:
+                command = click.get_current_context().info_name
+                raise InputError(
+                    f"--model: {model.name} has modes ({', '.join(model.mode_names)}): {command} does not "
+                    "support models with modes yet (simulate does)"
+                )
             if not any_model:
                 raise InputError(
                     f"--model {model_spec}: this command works on the pendulum only so far "
@@ -240,7 +244,8 @@ def model_options(func: Callable[..., Any] | None = None, *, any_model: bool = F
             show_default=True,
             metavar="NAME|FILE.py:OBJECT",
             help="A built-in model (pendulum, two-sided-oscillator, impact-oscillator, bouncing-ball, "
-            "impact-damper) or a HybridModel (or a function returning one) in a Python file.",
+            "impact-damper; with modes, for simulate: soft-impact-oscillator, rocking-block) "
+            "or a HybridModel (or a function returning one) in a Python file.",
         ),
         click.option(
             "--set",
@@ -319,8 +324,9 @@ def model_params_json(model: grazing.HybridModel, case: str) -> dict[str, Any]:
     return p
 
 
-def parse_state(text: str | None, model: grazing.HybridModel) -> np.ndarray:
-    """``--initial``: one number per state, comma-separated (default: zero), inside every stop."""
+def parse_state(text: str | None, model: grazing.HybridModel, mode: str | None = None) -> np.ndarray:
+    """``--initial``: one number per state, comma-separated (default: zero), inside every stop (of ``mode``,
+    the initial mode by default, for a model with modes)."""
     n = model.n_states
     if text is None:
         return np.zeros(n)
@@ -342,7 +348,7 @@ def parse_state(text: str | None, model: grazing.HybridModel) -> np.ndarray:
             f"({th:.6g} rad)"
         )
     try:
-        model.check_state(values)
+        model.check_state(values, mode=mode)
     except grazing.InvalidStateError as exc:
         raise InputError(f"--initial: {exc}") from None
     return values

@@ -12,6 +12,7 @@ import numpy as np
 
 import grazing
 from grazing.cli.common import (
+    InputError,
     Progress,
     check_out,
     emit_json,
@@ -29,9 +30,11 @@ from grazing.core.options import DEFAULT_TRANSIENT
 
 
 @click.command()
-@model_options(any_model=True)
+@model_options(any_model=True, modes=True)
 @click.option("--initial", default=None, metavar="X1,X2,...",
               help="Initial state at time 0, one per state (default: zero; pendulum: rad).")  # fmt: skip
+@click.option("--mode", default=None, metavar="NAME",
+              help="A model with modes: the mode to start in (default: its initial mode).")  # fmt: skip
 @click.option("--transient", type=count(0), default=DEFAULT_TRANSIENT, show_default=True,
               help="Forcing periods run and discarded first.")  # fmt: skip
 @click.option("--periods", type=count(1), default=100, show_default=True,
@@ -48,6 +51,7 @@ def simulate(
     model: grazing.HybridModel,
     case: str,
     initial: str,
+    mode: str | None,
     transient: int,
     periods: int,
     phase: float,
@@ -58,7 +62,12 @@ def simulate(
 ) -> None:
     """Simulate a model (the pendulum by default); print stroboscopic samples, impacts, period."""
     refuse_unused(["points_per_period"], trajectory is None, "without --trajectory")
-    x0 = parse_state(initial, model)
+    if mode is not None:
+        try:
+            model.mode_index(mode)
+        except grazing.InvalidParameterError as exc:
+            raise InputError(f"--mode: {exc}") from None
+    x0 = parse_state(initial, model, mode)
     check_out(trajectory, ".csv", "--trajectory", overwrite)
     points = periods * points_per_period + 1 if trajectory is not None else 0
     check_memory(
@@ -79,6 +88,7 @@ def simulate(
             phase=phase,
             trajectory=points_per_period if trajectory is not None else 0,
             progress=bar,
+            mode=mode,
         )
     finally:
         bar.close()
@@ -107,10 +117,32 @@ def simulate(
         "trajectory_file": str(trajectory) if trajectory is not None else None,
         "version": grazing.__version__,
     }
+    if model.has_modes:  # (the JSON of a model of one mode stays as it was)
+        result.update(_modes_json(sol))
     if as_json:
         emit_json(result)
         return
     _print_simulation(model, sol, period, elapsed, trajectory)
+
+
+def _modes_json(sol: grazing.Solution) -> dict[str, Any]:
+    """The modes of a run of a model with modes: each sample's, the switches and the final mode."""
+    sw = sol.switches
+    assert sol.modes is not None and sw is not None
+    return {
+        "modes": [sol.mode_names[k] for k in sol.modes],
+        "switches": [
+            {
+                "t": float(sw.t[i]),
+                "transition": sw.name(i),
+                "from": sw.source(i),
+                "to": sw.target(i),
+                "state": sw.state[i],
+            }
+            for i in range(len(sw))
+        ],
+        "mode_final": sol.mode_final,
+    }
 
 
 def _write_trajectory_csv(sol: grazing.Solution, fh: Any) -> None:
@@ -138,16 +170,24 @@ def _print_simulation(
         f"impacts: {sol.n_impacts} in the whole run, {len(sol.impacts)} in the sampled span; "
         f"sticking intervals: {len(sol.sticking)}"
     )
+    if sol.modes is not None and sol.switches is not None:
+        counts = np.bincount(sol.modes, minlength=model.n_modes)
+        con.print(
+            f"modes: {len(sol.switches)} switches in the sampled span, ending in {sol.mode_final}; "
+            "samples per mode: " + ", ".join(f"{name} {c}" for name, c in zip(model.mode_names, counts))
+        )
     con.print(f"{sol.n_steps} steps in {elapsed:.3f} s")
-    if model.n_stops > 1:
+    if model.n_stops > 1 and (sol.n_impacts or not model.has_modes):  # (not switches without a reset)
         con.print(
             "impacts per stop in the sampled span: "
             + ", ".join(f"{k} {v}" for k, v in sol.impacts.per_stop().items())
         )
-    table = Table("k", model.time_label, *model.state_labels, title="last stroboscopic samples")
+    mode = ("mode",) if sol.modes is not None else ()
+    table = Table("k", model.time_label, *model.state_labels, *mode, title="last stroboscopic samples")
     show = min(n, max(period, 5) if period else 8)
     for i in range(n - show, n):
-        table.add_row(str(i), f"{sol.t[i]:.6f}", *(f"{v: .10f}" for v in sol.samples[i]))
+        shown = (sol.mode_names[sol.modes[i]],) if sol.modes is not None else ()
+        table.add_row(str(i), f"{sol.t[i]:.6f}", *(f"{v: .10f}" for v in sol.samples[i]), *shown)
     con.print(table)
     if trajectory is not None:
         con.print(f"trajectory written to {trajectory}")

@@ -114,6 +114,12 @@ def accumulation_message(model: HybridModel, x: Any, t: float) -> str:
     on = [j for j, h in enumerate(model.guards(state, t)) if abs(h) <= tol]
     names = [repr(model.stop_names[j]) for j in on]
     switching = [j for j in on if model.transition_source[j] != model.transition_target[j]]
+    if model.has_modes and switching and all(model.symbolic.resets[j] for j in switching):
+        return (  # landings from one mode onto another that accumulate (a rocking block coming to rest)
+            f"impacts from mode to mode accumulate at t = {t:.6g} (transitions "
+            f"{', '.join(repr(model.stop_names[j]) for j in switching)}): the motion comes to rest on "
+            "their guard, and a model with modes cannot continue that yet"
+        )
     if model.has_modes and switching:  # two modes whose fields push into each other
         modes = sorted(
             {m for j in switching for m in (model.transition_source[j], model.transition_target[j])}
@@ -311,6 +317,10 @@ class Solution:
         (:class:`Switches`, recorded as the impacts are); None for a model of one mode.
     mode_final
         A model with modes: the mode at the end; None for a model of one mode.
+    modes
+        A model with modes: the mode of every sample (an index into
+        :attr:`mode_names`, the mode after any switch at the sample's time);
+        None for a model of one mode.
 
     Examples
     --------
@@ -350,6 +360,45 @@ class Solution:
     info: dict[str, Any] = field(default_factory=dict)
     switches: Switches | None = None
     mode_final: str | None = None
+    modes: np.ndarray | None = None
+
+    @property
+    def mode_names(self) -> tuple[str, ...]:
+        """The model's modes (:attr:`modes` indexes them); ``("free",)`` for a model of one mode."""
+        return self.model.mode_names
+
+    def mode_spans(self) -> list[tuple[float, float, int]]:
+        """The modes over the recorded span: ``(start, end, mode index)``, one per stay.
+
+        The span is the dense trajectory's when there is one, else the sampled
+        periods' (from one period before the first sample) to :attr:`t_final`.
+        Read from the switches (so it needs them recorded: ``impacts="sampled"``,
+        the default, or ``"all"``) and the mode of the first sample; empty for
+        a model of one mode or without samples.
+
+        Examples
+        --------
+        >>> import grazing
+        >>> sol = grazing.simulate(grazing.models.soft_impact_oscillator(), [0.0, 0.0], periods=2)
+        >>> [sol.mode_names[k] for _, _, k in sol.mode_spans()]
+        ['free', 'contact', 'free', 'contact', 'free']
+        """
+        if self.modes is None or self.switches is None or not len(self.modes):
+            return []
+        if self.trajectory_t is not None and self.trajectory_t.size:
+            start = float(self.trajectory_t[0])
+        else:
+            start = float(self.t[0]) - self.model.period
+        after = np.flatnonzero(self.switches.t > start)
+        index = {name: k for k, name in enumerate(self.mode_names)}
+        mode = index[self.switches.source(int(after[0]))] if after.size else int(self.modes[0])
+        spans = []
+        for i in after:
+            t = float(self.switches.t[i])
+            spans.append((start, t, mode))
+            start, mode = t, index[self.switches.target(int(i))]
+        spans.append((start, float(self.t_final), mode))
+        return spans
 
     def period(self, tol: float = DEFAULT_PERIOD_TOL, max_period: int = DEFAULT_MAX_PERIOD) -> int:
         """Smallest period of the sampled sequence (0 if none); see :func:`detect_period`."""

@@ -449,7 +449,7 @@ INTEGRATE = (
      ("RunOutput.impacts", "(RunOutput_impacts.shape[0], 3 + nx)"),
      ("RunOutput.sticking", "(RunOutput_sticking.shape[0], 2)"),
      ("RunOutput.trajectory", "(RunOutput_trajectory.shape[0], 1 + nx)"), ("RunOutput.log_sums", "(nx,)"),
-     ("RunOutput.guard_min", "(nstops, 2 * (2 + nx))")),
+     ("RunOutput.guard_min", "(nstops, 2 * (2 + nx))"), ("RunOutput.sample_modes", "(keep,)")),
 )  # fmt: skip
 """The sizes and shapes of the arrays of ``integrate`` (its tables' rows are the caller's to choose)."""
 

@@ -79,6 +79,7 @@ def allocate(nx: int, ncol: int, nstops: int, n_keep: int, rows: TableRows) -> R
         impacts=np.empty((rows.impacts, 3 + nx)), sticking=np.empty((rows.sticking, 2)),
         trajectory=np.empty((rows.trajectory, 1 + nx)), log_sums=np.empty(nx),
         guard_min=np.empty((nstops, 2 * (2 + nx))), switches=np.empty((rows.switches, 2 + nx)),
+        sample_modes=np.empty(n_keep, dtype=np.int64),
     )  # fmt: skip
 
 
@@ -125,6 +126,7 @@ def result(out: RunOutput, t: Totals) -> Result:
         sticking=_rows(out.sticking, t.sticking_rows), trajectory=_rows(out.trajectory, t.trajectory_rows),
         log_sums=out.log_sums, lyap_span=t.lyap_span, guard_min=out.guard_min,
         jacobian_valid=t.jacobian_valid, switches=_rows(out.switches, t.switch_rows),
+        sample_modes=_rows(out.sample_modes, t.samples_kept),
     )  # fmt: skip
 
 

@@ -156,6 +156,7 @@ class Result(NamedTuple):
     guard_min: np.ndarray  # per stop (rows): [h, t, state..., h_approach, t_approach, state...]
     jacobian_valid: bool
     switches: np.ndarray  # rows [t, transition, state...]: changes of mode (state after any reset)
+    sample_modes: np.ndarray  # (kept samples,): the mode (vector field) of each kept sample
 
 
 class RunOutput(NamedTuple):
@@ -177,6 +178,7 @@ class RunOutput(NamedTuple):
     log_sums: F8_1  # (n,): Lyapunov sums
     guard_min: F8_2  # (stops, 2 (2 + n)): per stop [h, t, state..., h_approach, t_approach, state...]
     switches: F8_2  # (rows, 2 + n): [t, transition, state...] at each change of mode (state after any reset)
+    sample_modes: I8_1  # (n_keep,): the mode (vector field) of each kept sample, as samples
 
 
 INTEGRATE_ARGUMENTS = (Start, ("pv", F8_1), Config, Kernels, RunOutput)

@@ -159,7 +159,9 @@ def simulate(
     done = 0
     steps = 0
     n_imp = 0
-    parts: dict[str, list[np.ndarray]] = {"samples": [], "imp": [], "sticks": [], "traj": [], "switch": []}
+    parts: dict[str, list[np.ndarray]] = {
+        k: [] for k in ("samples", "imp", "sticks", "traj", "switch", "modes")
+    }
     log_sum = np.zeros(n)
     lyap_span = 0.0
     gmin: np.ndarray | None = None
@@ -185,6 +187,7 @@ def simulate(
             ("sticks", seg.sticking),
             ("traj", traj),
             ("switch", seg.switches),
+            ("modes", seg.sample_modes),
         ):
             parts[key].append(arr)
         log_sum += seg.log_sums
@@ -250,6 +253,7 @@ def simulate(
         },
         switches=switches,
         mode_final=model.mode_names[run.vf] if model.has_modes else None,
+        modes=np.concatenate([np.empty(0, np.int64), *parts["modes"]]) if model.has_modes else None,
     )
 
 

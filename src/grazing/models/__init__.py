@@ -4,6 +4,8 @@ from grazing.models.bouncing_ball import bouncing_ball
 from grazing.models.impact_damper import impact_damper
 from grazing.models.impact_oscillator import impact_oscillator
 from grazing.models.pendulum import CASES, DEFAULT_CASE, case_values, pendulum
+from grazing.models.rocking_block import rocking_block
+from grazing.models.soft_impact_oscillator import soft_impact_oscillator
 from grazing.models.two_sided_oscillator import two_sided_oscillator
 
 BUILT_IN = {
@@ -12,6 +14,8 @@ BUILT_IN = {
     "impact-oscillator": impact_oscillator,
     "bouncing-ball": bouncing_ball,
     "impact-damper": impact_damper,
+    "soft-impact-oscillator": soft_impact_oscillator,
+    "rocking-block": rocking_block,
 }
 """The built-in models by their command-line names (each a function of parameter overrides)."""
 
@@ -24,5 +28,7 @@ __all__ = [
     "impact_damper",
     "impact_oscillator",
     "pendulum",
+    "rocking_block",
+    "soft_impact_oscillator",
     "two_sided_oscillator",
 ]

@@ -18,6 +18,7 @@ __all__ = [
     "IMPACTING_ONE_COLOUR",
     "LONGER_COLOUR",
     "MAX_PERIOD",
+    "MODE_COLOURS",
     "NONIMPACTING_ONE_COLOUR",
     "PERIOD_COLOURS",
     "class_colours",
@@ -31,6 +32,9 @@ MAX_PERIOD = 8
 PERIOD_COLOURS = ("#d62728", "#1f77b4", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2",
                   "#17becf", "#bcbd22", "#7f7f7f", "#aec7e8", "#ffbb78", "#98df8a")  # fmt: skip
 """The colours of periods 2, 3, 4, ... in turn (repeated past the 13th)."""
+
+MODE_COLOURS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd", "#8c564b", "#e377c2", "#17becf", "#bcbd22")
+"""The shading of the modes of a model with modes, in the order of its ``mode_names`` (repeated)."""
 
 FAILED_COLOUR = "#ffffff"
 """A point whose simulation failed (white: no data)."""

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Any
 
 from grazing.experiment.signal import delay_coordinates
 from grazing.plotting.labels import period_text, state_scale, state_unit, with_unit
+from grazing.plotting.palette import MODE_COLOURS
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
@@ -30,6 +31,7 @@ def plot_time_series(
     time_unit: str = "periods",
     stop: bool = True,
     samples: bool = True,
+    modes: bool = True,
     line_kw: dict[str, Any] | None = None,
     sample_kw: dict[str, Any] | None = None,
     stop_kw: dict[str, Any] | None = None,
@@ -57,6 +59,10 @@ def plot_time_series(
         component (:meth:`~grazing.core.model.HybridModel.stop_level`).
     samples
         Mark the stroboscopic samples ``sol.t, sol.samples``.
+    modes
+        A model with modes: shade each stay in a mode (:meth:`~grazing.Solution.mode_spans`) in
+        that mode's colour (:data:`~grazing.plotting.palette.MODE_COLOURS`), labelled with its
+        name.  Nothing is drawn for a model of one mode.
     line_kw, sample_kw, stop_kw
         Extra keyword arguments for the trajectory line, the sample markers and
         the stop line.
@@ -71,6 +77,14 @@ def plot_time_series(
     >>> plot_time_series(ax, sol, degrees=True)
     >>> len(ax.lines) >= 2
     True
+
+    A model with modes: the stays in each mode shaded.
+
+    >>> sol = grazing.simulate(grazing.models.soft_impact_oscillator(), [0, 0], periods=2, trajectory=100)
+    >>> ax = Figure().add_subplot()
+    >>> plot_time_series(ax, sol)
+    >>> [p.get_label() for p in ax.patches][:3]
+    ["mode 'free'", "mode 'contact'", '_nolegend_']
     """
     if sol.trajectory is None or sol.trajectory_t is None:
         raise ValueError("the solution has no dense trajectory; simulate with trajectory=N")
@@ -89,6 +103,8 @@ def plot_time_series(
         t, y = t[sel], y[sel]
         sel_s = (ts >= lo) & (ts <= hi)
         ts, ys = ts[sel_s], ys[sel_s]
+    if modes:
+        _shade_modes(ax, sol, tscale, span)
     ax.plot(t, y, **{"color": "tab:blue", "lw": 0.8, "label": "trajectory", **(line_kw or {})})
     level = sol.model.stop_level(component) if stop else None
     if level is not None:
@@ -106,6 +122,20 @@ def plot_time_series(
         ax.set_xlabel(f"{tname} / {period_text(sol.model.period)} (forcing periods)")
     else:
         ax.set_xlabel(tname)
+
+
+def _shade_modes(ax: Axes, sol: Solution, tscale: float, span: tuple[float, float] | None) -> None:
+    """Shade the stays of ``sol`` in each mode (times scaled by ``tscale``, within ``span``)."""
+    labelled: set[int] = set()
+    for start, end, k in sol.mode_spans():
+        lo, hi = start * tscale, end * tscale
+        if span is not None:
+            lo, hi = max(lo, span[0]), min(hi, span[1])
+        if hi <= lo:
+            continue
+        label = f"mode {sol.mode_names[k]!r}" if k not in labelled else "_nolegend_"
+        labelled.add(k)
+        ax.axvspan(lo, hi, color=MODE_COLOURS[k % len(MODE_COLOURS)], alpha=0.15, lw=0, label=label, zorder=0)
 
 
 def plot_delay(

@@ -40,6 +40,7 @@ from grazing.engine.driver.impacts import close_sticking
 from grazing.engine.driver.recording import (
     finish_guard,
     new_guard_info,
+    sample_modes,
     take_samples,
     track_guard,
     trajectory_points,
@@ -188,7 +189,9 @@ def integrate(start, pv, cfg, m, out):
 
         # What the step records within (0, h_acc].
         if (r.ks - r.k) * T + (r.ss - r.s) <= h_acc:  # a sample is due on this step (about once a period)
+            first = r.isamp
             take_samples(m, r, X, pv, h_acc, event, is_last, samples, sticks, traj, xe)
+            sample_modes(r, first, out.sample_modes)
         if r.recording and traj_dt > 0.0:
             trajectory_points(m, r, X, h_acc, traj, xe, is_last and not event)
         if r.recording and track_min and r.mode == 0 and h_acc > 0.0 and m.nmodes == 1:

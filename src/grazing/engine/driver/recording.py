@@ -77,6 +77,18 @@ def take_samples(m, r, X, pv, h_acc, event, is_last, samples, sticks, traj, xe):
 
 
 @njit(cache=True, inline="always")
+def sample_modes(r, first, modes):
+    """The mode of run ``r`` for the kept samples its last :func:`take_samples` took: ``modes[i]`` for the
+    samples ``first <= i < r.isamp`` (counted from the first kept one).
+
+    A step ends at an event, so the mode is the step's (a sample at the event's time is the next step's).
+    """
+    keep_from = r.n_samples - r.n_keep
+    for i in range(max(first, keep_from), r.isamp):
+        modes[i - keep_from] = r.vf
+
+
+@njit(cache=True, inline="always")
 def trajectory_points(m, r, X, h_acc, traj, xe, run_end):
     """Trajectory points of run ``r`` within the step, every ``r.traj_dt``, from ``(r.kt, r.st)`` on.
 
