@@ -1,0 +1,129 @@
+"""Sweeps on SIMD lanes through modes: the lanes give the scalar Runner's numbers, bit for bit.
+
+The two models with modes of the engine's tests: the soft-impact oscillator with its contact damper
+(switches of vector field without a reset, the saltation matrix of a switch in the Lyapunov exponents)
+and the linearised rocking block (resets that change the mode).  Each sweep is checked against the
+independent Runner oracle of ``tests/engine/test_lanes.py`` (samples, impacts by transition, Lyapunov
+exponent, transient used, final state and final mode of every point), on vectors of lanes and lane by
+lane, chunk by chunk and shared by three threads; a chunk continued from a state in the other mode; and
+a sweep against :func:`grazing.simulate` point by point.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+import grazing
+from grazing.core.options import SweepSettings
+from grazing.engine.codegen import taylor_order
+from grazing.sweeps.run import LaneBatch, run_chunks, stream_chunks
+from grazing.sweeps.spec import sweep_spec
+from tests.engine.test_lanes import assert_chunks_equal, check_lane_functions
+from tests.engine.test_mode_switches import soft_impact
+from tests.engine.test_rocking_modes import rocking_block
+
+SWEEPS = {
+    "soft impact, continuation, Lyapunov": (
+        soft_impact,
+        "gap",
+        np.linspace(0.5, 3.0, 20),
+        SweepSettings(transient=40, periods=12, chunk_size=2),
+    ),
+    "soft impact, fresh, no Lyapunov": (
+        soft_impact,
+        "omega",
+        np.linspace(0.8, 1.6, 20),
+        SweepSettings(transient=30, periods=10, chunk_size=5, fresh=True, lyapunov=False, adaptive=False),
+    ),
+    "rocking block, continuation, Lyapunov": (
+        rocking_block,
+        "a",
+        np.linspace(0.2, 0.32, 18),
+        SweepSettings(transient=12, periods=6, chunk_size=2),
+    ),
+}
+
+
+def test_lane_functions_of_each_mode_equal_the_scalar_kernels() -> None:
+    for make in (soft_impact, rocking_block):
+        check_lane_functions(make(), np.random.default_rng(3), trials=2)
+
+
+@pytest.mark.parametrize("name", list(SWEEPS))
+def test_sweep_through_modes_on_lanes_equals_the_runner_oracle(name: str) -> None:
+    make, param, values, settings_ = SWEEPS[name]
+    spec = dataclasses.replace(sweep_spec(make(), param, values, settings=settings_), polish=False)
+    kern = spec.model.kernels(0, taylor_order(spec.tol))
+    assert kern.NMODES == 2 and kern.LANES > 1
+    saved = kern.LANES
+    results = {}
+    try:
+        for lanes in (saved, 1):  # (1: every Taylor kernel called lane by lane, scalar)
+            kern.LANES = lanes
+            results[lanes] = run_chunks(spec, list(range(spec.n_chunks)))
+            assert_chunks_equal(spec, results[lanes], f"{lanes} lanes")
+    finally:
+        kern.LANES = saved
+    res = results[saved]
+    if name.startswith("soft"):
+        modes = np.concatenate([r.mode_final for r in res])
+        assert set(modes.tolist()) == {0, 1}, modes  # (points end in either mode)
+    else:  # (the block lands on its other corner: resets that change the mode)
+        assert sum(int(r.impacts.sum()) for r in res) > 0
+    assert_chunks_equal(spec, [run_chunks(spec, [i])[0] for i in range(spec.n_chunks)], "one chunk")
+    streamed = list(stream_chunks([(spec, i) for i in range(spec.n_chunks)], 3))
+    assert_chunks_equal(spec, [r for _, r in streamed], "three threads")
+
+
+def test_a_chunk_continued_in_the_other_mode() -> None:
+    """A chain continued from a state in contact (mode 1): the lane starts in that mode, beside others."""
+    m = soft_impact()
+    settings_ = SweepSettings(transient=20, periods=8, chunk_size=3, lyapunov=True)
+    base = dataclasses.replace(sweep_spec(m, "a", np.linspace(0.8, 1.2, 12), settings=settings_), polish=False)
+    gap = m.params["gap"]
+    resumed = dataclasses.replace(base, points=base.points[:3], resume=(0.3, (gap + 0.2, -0.5), 1), chunk_size=0)
+    parts = [(resumed, 0)] + [(base, i) for i in range(base.n_chunks)]
+    batch = LaneBatch(parts)
+    batch.run()
+    assert_chunks_equal(resumed, [batch.result(0)], "resumed in contact")
+    assert_chunks_equal(base, [batch.result(k) for k in range(1, len(parts))], "beside it")
+    # Its first point from the other mode differs from one from the initial mode (the mode is used).
+    wrong = dataclasses.replace(resumed, resume=(0.3, (gap + 0.2, -0.5), 0))
+    with pytest.raises(grazing.InvalidStateError):
+        m.check_state((gap + 0.2, -0.5))
+    assert not np.array_equal(run_chunks(wrong, [0])[0].samples[0], batch.result(0).samples[0])
+
+
+def test_sweep_equals_simulate_point_by_point() -> None:
+    """A fresh sweep over a parameter of the soft-impact oscillator: each point as grazing.simulate runs it."""
+    m = soft_impact()
+    values = np.linspace(0.9, 1.5, 10)
+    settings_ = SweepSettings(transient=30, periods=8, chunk_size=5, fresh=True, adaptive=False, lyapunov=False)
+    spec = dataclasses.replace(sweep_spec(m, "omega", values, settings=settings_), polish=False)
+    res = run_chunks(spec, list(range(spec.n_chunks)))
+    samples = np.concatenate([r.samples for r in res])
+    modes = np.concatenate([r.mode_final for r in res])
+    for i, w in enumerate(values):
+        point = m.with_params(omega=float(w))
+        sol = grazing.simulate(point, spec.x0, transient=30, periods=8)
+        np.testing.assert_allclose(samples[i], sol.samples, rtol=0, atol=1e-8)  # (a run in blocks: rounding)
+        assert point.mode_names[modes[i]] == sol.mode_final, i
+
+
+def test_sliding_is_refused_in_one_line() -> None:
+    import sympy as sp
+
+    from grazing import HybridModel, Mode, Parameter, Surface
+
+    x, v, t = sp.symbols("x v t")
+    belt = HybridModel(
+        "belt", [x, v], t, [Parameter("w", 1.0)], period=2 * sp.pi,
+        modes=[Mode("slip_right", [v, -x - 1]), Mode("slip_left", [v, -x + 1])],
+        surfaces=[Surface("belt", v, "slip_right", "slip_left", sliding=True)],
+    )  # fmt: skip
+    with pytest.raises(grazing.InvalidParameterError, match="does not support sliding") as info:
+        sweep_spec(belt, "w", [1.0, 1.1])
+    assert "\n" not in str(info.value)
