@@ -12,18 +12,23 @@ a sweep against :func:`grazing.simulate` point by point.
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 import pytest
+from scipy.linalg import expm
+from scipy.optimize import brentq
 
 import grazing
-from grazing.core.options import SweepSettings
+from grazing.core.options import LYAPUNOV_ALIGN, SweepSettings
 from grazing.engine.codegen import taylor_order
 from grazing.sweeps.run import LaneBatch, run_chunks, stream_chunks
 from grazing.sweeps.spec import sweep_spec
 from tests.engine.test_lanes import assert_chunks_equal, check_lane_functions
+from tests.engine.test_mode_switches import reference as mode_switches_reference
 from tests.engine.test_mode_switches import soft_impact
 from tests.engine.test_rocking_modes import rocking_block
+from tests.piecewise_exact import SAMPLES_PER_PERIOD, PiecewiseLinearModel
 
 SWEEPS = {
     "soft impact, continuation, Lyapunov": (
@@ -127,3 +132,79 @@ def test_sliding_is_refused_in_one_line() -> None:
     with pytest.raises(grazing.InvalidParameterError, match="does not support sliding") as info:
         sweep_spec(belt, "w", [1.0, 1.1])
     assert "\n" not in str(info.value)
+
+
+def test_lyapunov_exponents_across_switches_against_the_exact_jacobian() -> None:
+    """The largest exponent of a fresh sweep point from the exact Jacobians (the saltation of each switch).
+
+    The point runs ``transient - align`` periods, then ``align`` periods aligning the tangent vectors from
+    the identity (Gram-Schmidt: the first is ``J_align e1``), then the sampled span, over which the first
+    vector grows by ``|J_span v1|`` and the second by ``|det J_span| / |J_span v1|``.
+    """
+    m = soft_impact()
+    values = np.linspace(0.9, 1.5, 3)
+    transient, periods = 24, 6
+    settings_ = SweepSettings(transient=transient, periods=periods, chunk_size=3, fresh=True, adaptive=False)
+    spec = dataclasses.replace(sweep_spec(m, "omega", values, settings=settings_), polish=False)
+    res = run_chunks(spec, list(range(spec.n_chunks)))
+    lyap = np.concatenate([r.lyapunov for r in res])
+    align = min(LYAPUNOV_ALIGN, transient)
+    switched = 0
+    for i, w in enumerate(values):
+        p = dict(m.with_params(omega=float(w)).params)
+        exact = mode_switches_reference(p)
+        ref, T = GridModel(exact.modes, exact.w), 2 * np.pi / w
+        t1, t2, t3 = (transient - align) * T, transient * T, (transient + periods) * T
+        x, mode, _, _ = by_periods(ref, np.zeros(2), 0, 0.0, t1, T)
+        x, mode, J_align, _ = by_periods(ref, x, mode, t1, t2, T)
+        _, _, J_span, sw = by_periods(ref, x, mode, t2, t3, T)
+        switched += sw
+        v1 = J_align[:, 0] / np.linalg.norm(J_align[:, 0])
+        first = np.log(np.linalg.norm(J_span @ v1))
+        second = np.log(abs(np.linalg.det(J_span))) - first
+        assert lyap[i] == pytest.approx(max(first, second) / (t3 - t2), abs=1e-9), i
+    assert switched > 0
+
+
+class GridModel(PiecewiseLinearModel):
+    """The exact reference, its search for a switch on the grid by powers of one exponential (the same
+    grid and the same Brent refinement as :meth:`PiecewiseLinearModel.first_exit`, a few times faster)."""
+
+    def first_exit(self, k, x0, t0, t1):
+        n = max(8, math.ceil((t1 - t0) / self.period * SAMPLES_PER_PERIOD))
+        ts = np.linspace(t0, t1, n + 1)
+        md = self.modes[k]
+        n_x = md.A.shape[0]
+        P = np.linalg.solve(1j * self.w * np.eye(n_x) - md.A, md.b.astype(complex))
+        xps = (P[None, :] * np.exp(1j * self.w * ts)[:, None]).real - np.linalg.solve(md.A, md.d)
+        E = expm(md.A * (ts[1] - ts[0]))
+        ys = np.empty((n + 1, n_x))
+        ys[0] = x0 - xps[0]
+        for i in range(n):
+            ys[i + 1] = E @ ys[i]
+        states = ys + xps
+        best = None
+        for i, (c, e, *_) in enumerate(md.exits):
+            g = states @ c + e
+            crossing = np.flatnonzero((g[1:] < 0.0) & (g[:-1] >= 0.0))
+            crossing = crossing[~((crossing == 0) & (g[0] == 0.0))]
+            if crossing.size:
+                a = int(crossing[0]) + 1
+
+                def guard(tt: float, c: np.ndarray = c, e: float = e) -> float:
+                    return float(c @ self.flow(k, x0, t0, tt) + e)
+
+                tz = brentq(guard, ts[a - 1], ts[a], xtol=1e-15, rtol=4 * np.finfo(float).eps)
+                if best is None or tz < best[0]:
+                    best = (tz, i)
+        return best
+
+
+def by_periods(ref, x, mode, t0, t1, T):
+    """``ref.run`` from ``t0`` to ``t1`` one period at a time (its search for a switch scans to the end)."""
+    J, switches = np.eye(len(x)), 0
+    for k in range(round((t1 - t0) / T)):
+        end = t1 if t0 + (k + 1) * T >= t1 - 1e-9 * T else t0 + (k + 1) * T
+        x, mode, Jk, sw = ref.run(x, mode, t0 + k * T, end)
+        J, switches = Jk @ J, switches + len(sw)
+    return x, mode, J, switches
