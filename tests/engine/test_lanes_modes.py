@@ -87,9 +87,13 @@ def test_a_chunk_continued_in_the_other_mode() -> None:
     """A chain continued from a state in contact (mode 1): the lane starts in that mode, beside others."""
     m = soft_impact()
     settings_ = SweepSettings(transient=20, periods=8, chunk_size=3, lyapunov=True)
-    base = dataclasses.replace(sweep_spec(m, "a", np.linspace(0.8, 1.2, 12), settings=settings_), polish=False)
+    base = dataclasses.replace(
+        sweep_spec(m, "a", np.linspace(0.8, 1.2, 12), settings=settings_), polish=False
+    )
     gap = m.params["gap"]
-    resumed = dataclasses.replace(base, points=base.points[:3], resume=(0.3, (gap + 0.2, -0.5), 1), chunk_size=0)
+    resumed = dataclasses.replace(
+        base, points=base.points[:3], resume=(0.3, (gap + 0.2, -0.5), 1), chunk_size=0
+    )
     parts = [(resumed, 0)] + [(base, i) for i in range(base.n_chunks)]
     batch = LaneBatch(parts)
     batch.run()
@@ -103,10 +107,13 @@ def test_a_chunk_continued_in_the_other_mode() -> None:
 
 
 def test_sweep_equals_simulate_point_by_point() -> None:
-    """A fresh sweep over a parameter of the soft-impact oscillator: each point as grazing.simulate runs it."""
+    """A fresh sweep over a parameter of the soft-impact oscillator: each point as grazing.simulate runs
+    it."""
     m = soft_impact()
     values = np.linspace(0.9, 1.5, 10)
-    settings_ = SweepSettings(transient=30, periods=8, chunk_size=5, fresh=True, adaptive=False, lyapunov=False)
+    settings_ = SweepSettings(
+        transient=30, periods=8, chunk_size=5, fresh=True, adaptive=False, lyapunov=False
+    )
     spec = dataclasses.replace(sweep_spec(m, "omega", values, settings=settings_), polish=False)
     res = run_chunks(spec, list(range(spec.n_chunks)))
     samples = np.concatenate([r.samples for r in res])
@@ -208,3 +215,30 @@ def by_periods(ref, x, mode, t0, t1, T):
         x, mode, Jk, sw = ref.run(x, mode, t0 + k * T, end)
         J, switches = Jk @ J, switches + len(sw)
     return x, mode, J, switches
+
+
+def test_continuation_sweep_in_chunks_equals_simulate_point_by_point(tmp_path) -> None:
+    """A continuation sweep in chunks (a chain, grazing.sweeps.chain) of the soft-impact oscillator, into
+    a store: each point as grazing.simulate continues it from the previous point's end and mode; the store
+    keeps each chunk's end mode, from which the chain goes on."""
+    from grazing.sweeps import sweep
+    from grazing.sweeps.spec import sweep_spec as make_spec
+    from grazing.sweeps.store import open_store
+
+    m = soft_impact()
+    values = np.linspace(0.6, 1.95, 10)  # (omega: the samples in contact, then free)
+    kw = dict(transient=150, periods=6, chunk_size=3, adaptive=False, lyapunov=False)
+    ds = sweep(m, "omega", values, store=tmp_path / "s.zarr", workers=1, **kw)
+    x, t0, mode, modes = np.zeros(2), 0.0, None, []
+    for i, g in enumerate(values):
+        point = m.with_params(omega=float(g))
+        sol = grazing.simulate(point, x, t0=t0, transient=150, periods=6, mode=mode)
+        np.testing.assert_allclose(ds.samples.values[i], sol.samples, rtol=0, atol=1e-8)
+        x, mode = sol.x_final, sol.mode_final
+        modes.append(mode)
+    assert set(modes) == {"free", "contact"}
+    spec = make_spec(m, "omega", values, settings=SweepSettings(**kw))
+    with open_store(tmp_path / "s.zarr", spec) as store:
+        starts = [store.chain_start(i) for i in range(spec.n_chunks - 1)]
+    last = [spec.chunk(i).stop - 1 for i in range(spec.n_chunks - 1)]
+    assert [m.mode_names[s[2]] for s in starts] == [modes[k] for k in last]

@@ -192,7 +192,13 @@ class LaneBatch:
         work = LaneJobs(self.jobs, self.control, self.x0, self.firsts, self.first_vf, self.x0_vf)
         points = LanePoints(self.pvs, self.Ts, self.sphase, self.tcarry, self.zdms)
         out = LaneResults(
-            self.samples, self.by_stop, self.lyap, self.used, self.x_final, self.t_final, self.status,
+            self.samples,
+            self.by_stop,
+            self.lyap,
+            self.used,
+            self.x_final,
+            self.t_final,
+            self.status,
             self.vf_final,
         )
         self._driver(kern.table, tuple(settings), tuple(work), tuple(points), tuple(out))
@@ -266,7 +272,7 @@ class LaneBatch:
             impacts_by_stop=np.where(good[:, None], self.by_stop[part], -1).astype(np.int32),
             status=status.astype(STATUS_DTYPE),
             t_final=np.where(good, self.t_final[part], np.nan),
-            mode_final=np.where(good, self.vf_final[part], -1) if self._spec0.model.has_modes else None,
+            mode_final=np.where(good, self.vf_final[part], -1),
         )
 
 

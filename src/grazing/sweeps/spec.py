@@ -268,7 +268,7 @@ class ChunkResult:
     impacts_by_stop: np.ndarray | None = None  # (points, n_stops) impacts on each stop in the sampled span
     seconds: float = 0.0
     t_final: np.ndarray | None = None  # (points,) time of x_final (not stored: a chain continues from it)
-    mode_final: np.ndarray | None = None  # (points,) the mode index x_final is in (models with modes; -1 failed)
+    mode_final: np.ndarray | None = None  # (points,) the index of the mode x_final is in (-1: failed)
 
 
 def spec_summary(spec: SweepSpec) -> dict[str, Any]:
@@ -284,8 +284,8 @@ def _refuse_on_modes(model: HybridModel) -> None:
     for sf in system.surfaces:
         if sf.sliding:
             raise InvalidParameterError(
-                f"a sweep does not support sliding yet (surface {sf.name!r} of model {model.name!r}): give it "
-                "sliding=False"
+                f"a sweep does not support sliding yet (surface {sf.name!r} of model {model.name!r}): "
+                "give it sliding=False"
             )
     for j, name in enumerate(model.stop_names):
         if system.stops[j].contact_direction is not None:

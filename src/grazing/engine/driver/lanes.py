@@ -305,7 +305,7 @@ def lane_coefficients(m, la, kinds, use_lanes, coeffs):
     the lanes' coefficients, their local times, one lane's coefficients and
     state, and (a model with modes) the lanes' coefficients in one mode.
     """
-    XT, OT, SI, Xs, Os, xl, XM, OM = coeffs
+    XT, OT, SI, Xs, Os, xl, _, _ = coeffs
     ls, XS, pl, PT = la.ls, la.XS, la.pl, la.PT
     n = m.nx
     nev = m.rows.shape[1]
