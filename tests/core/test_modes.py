@@ -289,13 +289,8 @@ def test_check_state_per_mode():
 
 def test_features_not_yet_on_modes_are_refused_in_one_line():
     from grazing.orbits import find_orbit
-    from grazing.sweeps.spec import sweep_spec
 
     m = soft()
-    with pytest.raises(
-        InvalidParameterError, match=r"^a sweep \(lanes\) does not support models with modes yet "
-    ):
-        sweep_spec(m, "omega", [1.0, 1.1])
     with pytest.raises(
         InvalidParameterError, match=r"^finding a periodic orbit does not support models with modes"
     ):
