@@ -289,14 +289,11 @@ def test_check_state_per_mode():
 
 def test_features_not_yet_on_modes_are_refused_in_one_line():
     from grazing.orbits import find_orbit
-    from grazing.sweeps.spec import sweep_spec
 
     m = soft()
     with pytest.raises(
-        InvalidParameterError, match=r"^a sweep \(lanes\) does not support models with modes yet "
+        InvalidParameterError, match=r"^a virtual orbit \(the stops ignored\) does"
     ):
-        sweep_spec(m, "omega", [1.0, 1.1])
-    with pytest.raises(InvalidParameterError, match=r"^a virtual orbit \(the stops ignored\) does"):
         find_orbit(m, [0.0, 0.0], period=1, virtual=True)
     with pytest.raises(InvalidParameterError, match=r"^the discontinuity map does not support models"):
         grazing.simulate(m, [0.0, 0.0], periods=1, zdm=object())

@@ -15,6 +15,7 @@
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import math
 
 import numpy as np
@@ -45,23 +46,24 @@ CFUNC = llvmgen._CFUNC
 
 def check_lane_functions(model: grazing.HybridModel, rng: np.random.Generator, trials: int = 5) -> None:
     kern = model.kernels()
-    L, n, K, nstops = kern.LANES, kern.NX, kern.ORDER + 1, kern.NSTOPS
+    L, n, K, nstops = kern.LANES, kern.NX, kern.ORDER + 1, kern.ROWS.shape[1]
     assert L == llvmgen.lane_width()
     fns = kern.table[0]
     p0 = model.param_vector
-    for slot, scalar, rows in ((TC_FREE_LANES, kern.tc_free, n), (TC_VAR_LANES, kern.tc_var, n + n * n)):
+    slots = ((TC_FREE_LANES, kern.tc_free, n), (TC_VAR_LANES, kern.tc_var, n + n * n))
+    for (slot, scalar, rows), mode in itertools.product(slots, range(kern.NMODES)):  # (each mode's kernels)
         lanes = CFUNC(int(fns[slot]))
         for _ in range(trials):
             x = np.ascontiguousarray(rng.normal(size=(rows, L)))
             s = rng.uniform(0.0, 2 * model.period, L)
             pv = np.ascontiguousarray(p0[:, None] * rng.uniform(0.8, 1.2, (len(p0), L)))
             XL, OL = np.full((rows, K, L), np.nan), np.full((nstops, K, L), np.nan)
-            lanes(x.ctypes.data, 0.0, pv.ctypes.data, XL.ctypes.data, OL.ctypes.data, s.ctypes.data, 0)
+            lanes(x.ctypes.data, 0.0, pv.ctypes.data, XL.ctypes.data, OL.ctypes.data, s.ctypes.data, mode)
             for lane in range(L):
                 X, O = np.zeros((rows, K)), np.zeros((nstops, K))
-                scalar(x[:, lane].copy(), s[lane], pv[:, lane].copy(), X, O)
-                assert np.array_equal(X, XL[:, :, lane], equal_nan=True), (model.name, slot, lane)
-                assert np.array_equal(O, OL[:, :, lane], equal_nan=True), (model.name, slot, lane)
+                scalar(x[:, lane].copy(), s[lane], pv[:, lane].copy(), X, O, mode)
+                assert np.array_equal(X, XL[:, :, lane], equal_nan=True), (model.name, slot, lane, mode)
+                assert np.array_equal(O, OL[:, :, lane], equal_nan=True), (model.name, slot, lane, mode)
 
 
 @pytest.mark.parametrize(
@@ -108,9 +110,11 @@ def test_lane_ir_is_vector_code() -> None:
 BLOCK, MAX_P, TOL, ALIGN = 32, 16, 1e-9, 16
 
 
-def oracle_point(spec: SweepSpec, model, x, t0):
-    """A sweep point over Runner, period block by period block (the protocol of grazing.sweeps.run)."""
-    run = Runner(model, x, t0=t0, phase=spec.phase, tol=spec.tol, zdm=spec.zdm)
+def oracle_point(spec: SweepSpec, model, x, t0, mode=0):
+    """A sweep point over Runner, period block by period block (the protocol of grazing.sweeps.run), from
+    ``x`` at ``t0`` in mode ``mode``; its samples, impacts by stop, exponent, transient used and end (state,
+    time, mode)."""
+    run = Runner(model, x, t0=t0, phase=spec.phase, tol=spec.tol, zdm=spec.zdm, mode=mode)
     align = min(ALIGN, spec.transient) if spec.lyapunov else 0
     budget, used = spec.transient - align, 0
     while used < budget:
@@ -127,7 +131,7 @@ def oracle_point(spec: SweepSpec, model, x, t0):
                 break
     if spec.lyapunov:
         final = Runner(model, run.x, t0=run.t, phase=spec.phase, tol=spec.tol, variational=True, zdm=spec.zdm)
-        final.mode = run.mode
+        final.mode, final.vf = run.mode, run.vf
         seg = final.advance(align + spec.periods, spec.periods, lyapunov=True, impacts="sampled")
         lyap = (
             float(np.max(seg.log_sums / seg.lyap_span)) if seg.jacobian_valid and seg.lyap_span else math.nan
@@ -138,21 +142,30 @@ def oracle_point(spec: SweepSpec, model, x, t0):
         lyap = math.nan
     n = model.n_states
     by_stop = np.bincount(seg.impacts[:, 2 + n].astype(np.int64), minlength=model.n_stops)
-    return seg.samples, by_stop, lyap, used + align, final.x, final.t
+    return seg.samples, by_stop, lyap, used + align, final.x, final.t, final.vf
 
 
 def oracle_chunk(spec: SweepSpec, index: int) -> dict[str, np.ndarray]:
     pts = spec.points[spec.chunk(index)]
-    out: dict[str, list] = {k: [] for k in ("samples", "period", "by_stop", "lyapunov", "used", "x_final")}
+    keys = ("samples", "period", "by_stop", "lyapunov", "used", "x_final", "mode_final")
+    out: dict[str, list] = {k: [] for k in keys}
     x0 = np.asarray(spec.x0, dtype=float)
-    x, t0, carried = x0.copy(), 0.0, False
+    mode0 = spec.model.mode_index(None)
+    x, t0, mode, carried = x0.copy(), 0.0, mode0, False
+    if spec.resume is not None and index == 0 and not spec.fresh:  # (a chain continued: its start)
+        t0, x, carried = spec.resume[0], np.asarray(spec.resume[1], dtype=float), True
+        mode = spec.resume[2] if len(spec.resume) > 2 else mode0
+    first = True
     for pt in pts:
         model = spec.model_at(pt)
-        if carried and model.periodic:
+        if carried and model.periodic and not first:
             t0 = (spec.phase / (2 * math.pi)) % 1.0 * model.period
-        start_x, start_t = (x0, 0.0) if spec.fresh or not carried else (x, t0)
+        first = False
+        start_x, start_t, start_mode = (x0, 0.0, mode0) if spec.fresh or not carried else (x, t0, mode)
         try:
-            samples, by_stop, lyap, used, x, t0 = oracle_point(spec, model, start_x, start_t)
+            samples, by_stop, lyap, used, x, t0, mode = oracle_point(
+                spec, model, start_x, start_t, start_mode
+            )
         except SimulationError:
             n = model.n_states
             samples, by_stop, lyap, used = (
@@ -162,10 +175,12 @@ def oracle_chunk(spec: SweepSpec, index: int) -> dict[str, np.ndarray]:
                 -1,
             )
             out["x_final"].append(np.full(n, np.nan))
+            out["mode_final"].append(-1)
             out["period"].append(-1)
             carried = False
         else:
             out["x_final"].append(x)
+            out["mode_final"].append(mode)
             out["period"].append(detect_period(samples, DEFAULT_PERIOD_TOL, DEFAULT_MAX_PERIOD))
             carried = True
         out["samples"].append(samples)
@@ -185,6 +200,7 @@ def assert_chunks_equal(spec: SweepSpec, results, lanes: str) -> None:
             "lyapunov": res.lyapunov,
             "used": res.transient_used,
             "x_final": res.x_final,
+            "mode_final": res.mode_final,
         }
         for key, value in ref.items():
             assert np.array_equal(np.asarray(got[key], dtype=float), value.astype(float), equal_nan=True), (

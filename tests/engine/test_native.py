@@ -96,7 +96,8 @@ def sweep_arguments() -> list:
     )  # fmt: skip
     work = LaneJobs(
         jobs=np.array([[0, 1]], dtype=np.int64), control=np.zeros(3, dtype=np.int64),
-        x0=np.array([[0.5, 0.0]]), firsts=np.array([[0.0, 0.5, 0.0]]),
+        x0=np.array([[0.5, 0.0]]), firsts=np.array([[0.0, 0.5, 0.0]]), first_vf=np.zeros(1, dtype=np.int64),
+        x0_vf=np.zeros(1, dtype=np.int64),
     )  # fmt: skip
     points = LanePoints(
         pvs=model.param_vector.reshape(1, -1).copy(), Ts=np.array([float(model.period)]), sphase=np.zeros(1),
@@ -105,7 +106,7 @@ def sweep_arguments() -> list:
     out = LaneResults(
         samples=np.full((1, periods, n), np.nan), by_stop=np.zeros((1, model.n_stops), dtype=np.int64),
         lyap=np.zeros(1), used=np.zeros(1, dtype=np.int64), x=np.zeros((1, n)), t=np.zeros(1),
-        status=np.full(1, -1, dtype=np.int64),
+        status=np.full(1, -1, dtype=np.int64), vf=np.zeros(1, dtype=np.int64),
     )  # fmt: skip
     return [list(kern.table), list(settings), list(work), list(points), list(out)]
 

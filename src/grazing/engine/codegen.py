@@ -596,11 +596,20 @@ def compile_model(source: ModelSource, key: str) -> bytes:
     from grazing.engine import llvmgen
 
     prefix = f"grazing_{key}"
-    # Lane (SIMD) versions of the Taylor kernels for sweeps, which use no sensitivity directions.
-    lanes = llvmgen.lane_width() if source.sizes["nsens"] == 0 and "nmodes" not in source.sizes else 0
+    # Lane (SIMD) versions of the Taylor kernels for sweeps, which use no sensitivity directions; with
+    # several modes one per mode, behind a dispatcher by the active mode as the scalar kernels'.
+    lanes = llvmgen.lane_width() if source.sizes["nsens"] == 0 else 0
+    nmodes = int(source.sizes.get("nmodes", 1))
+    dispatch, lane_functions = source.dispatch, ("tc_free", "tc_var")
+    if nmodes > 1:
+        lane_functions = tuple(f"{name}_m{k}" for name in lane_functions for k in range(nmodes))
+        if lanes:
+            dispatch = {**dispatch}
+            for name in ("tc_free", "tc_var"):
+                dispatch[f"{name}_lanes"] = [f"{name}_m{k}_lanes" for k in range(nmodes)]
     module = llvmgen.translate(
-        source.text, prefix, columns=source.columns, dispatch=source.dispatch, lanes=lanes,
-        lane_functions=("tc_free", "tc_var"),
+        source.text, prefix, columns=source.columns, dispatch=dispatch, lanes=lanes,
+        lane_functions=lane_functions,
     )  # fmt: skip
     sizes = {**source.sizes, "lanes": lanes}
     return json.dumps(sizes).encode() + b"\n" + llvmgen.compile_object(module)

@@ -213,6 +213,8 @@ class LaneJobs(NamedTuple):
     control: I8_1  # (3,): the next job, stop (1), most jobs at a time per thread (0: one per lane)
     x0: F8_2  # (jobs, nx): a point's start after a failed one (and every point's when fresh), at time 0
     firsts: F8_2  # (jobs, 1 + nx): the time and state each job's first point starts from
+    first_vf: I8_1  # (jobs,): the mode (vector field) each job's first point starts in
+    x0_vf: I8_1  # (jobs,): the mode of x0 (a point's start after a failed one, or when fresh)
 
 
 class LanePoints(NamedTuple):
@@ -235,6 +237,7 @@ class LaneResults(NamedTuple):
     x: F8_2  # (points, nx): the final state ...
     t: F8_1  # ... and time
     status: I8_1  # the point's grazing.core.solution.Status code once finished (the caller sets -1)
+    vf: I8_1  # the mode (vector field) the point ends in
 
 
 SWEEP_RECORDS = (Kernels, LaneSettings, LaneJobs, LanePoints, LaneResults)

@@ -74,8 +74,9 @@ Part = tuple[SweepSpec, int]
 Compute = Callable[[list[Part]], Iterable[tuple[Part, ChunkResult]]]
 """Computes chunks (on the local cores, on a Dask cluster), each with its result, in any order."""
 
-ChainStart = tuple[float, tuple[float, ...]] | None
-"""Where a chunk starts: ``(t, x)``, or None: ``x0`` at time 0 (a chain's start; after a failed point)."""
+ChainStart = tuple[float, tuple[float, ...]] | tuple[float, tuple[float, ...], int] | None
+"""Where a chunk starts: ``(t, x)`` (a model with modes: ``(t, x, mode)``, the index of the mode ``x`` is
+in), or None: ``x0`` at time 0 (a chain's start; after a failed point)."""
 
 
 def next_start(spec: SweepSpec, res: ChunkResult, index: int) -> ChainStart:
@@ -84,11 +85,13 @@ def next_start(spec: SweepSpec, res: ChunkResult, index: int) -> ChainStart:
     See :func:`start_after`.
     """
     t = math.nan if res.t_final is None else float(res.t_final[-1])
-    return start_after(spec, index, int(res.status[-1]), res.x_final[-1], t)
+    mode = -1 if res.mode_final is None else int(res.mode_final[-1])
+    return start_after(spec, index, int(res.status[-1]), res.x_final[-1], t, mode)
 
 
-def start_after(spec: SweepSpec, index: int, status: int, x: Any, t: float) -> ChainStart:
-    """Where the chain goes on after chunk ``index``, whose last point ended (``status``) in ``x`` at ``t``.
+def start_after(spec: SweepSpec, index: int, status: int, x: Any, t: float, mode: int = -1) -> ChainStart:
+    """Where the chain goes on after chunk ``index``, whose last point ended (``status``) in ``x`` at ``t``
+    (a model with modes: in mode ``mode``).
 
     At the time the driver continues a chain with (the next point's sampling
     phase for a periodic model, else the final time ``t``); None after a failed
@@ -99,10 +102,14 @@ def start_after(spec: SweepSpec, index: int, status: int, x: Any, t: float) -> C
     state = tuple(float(v) for v in x)
     if spec.model.periodic:
         T = float(spec.model_at(spec.points[spec.chunk(index).stop]).period)
-        return ((spec.phase / (2 * math.pi)) % 1.0 * T, state)  # (as grazing.sweeps.run.LaneBatch's tcarry)
-    if not math.isfinite(t):
+        t = (spec.phase / (2 * math.pi)) % 1.0 * T  # (as grazing.sweeps.run.LaneBatch's tcarry)
+    elif not math.isfinite(t):
         raise ValueError(f"the final time of chunk {index} is not known")
-    return (t, state)
+    if not spec.model.has_modes:
+        return (t, state)
+    if mode < 0:
+        raise ValueError(f"the final mode of chunk {index} is not known")
+    return (t, state, mode)
 
 
 def from_start(spec: SweepSpec, index: int, start: ChainStart, points: int | None = None) -> Part:
@@ -236,6 +243,8 @@ def orbit_period(spec: SweepSpec, res: ChunkResult | None) -> int:
     that orbit (:func:`shifted_starts`): 2 to :data:`~grazing.core.options.CHAIN_SHIFTS`, a periodic model;
     else 0."""
     if res is None or not spec.model.periodic or int(res.status[0]) != Status.OK:
+        return 0
+    if spec.model.has_modes:  # (the modes of the orbit's points are not known: no shifts along it)
         return 0
     p = int(res.period[0])
     return p if 2 <= p <= CHAIN_SHIFTS and repeats(res.samples[0], p) else 0

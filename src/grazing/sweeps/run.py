@@ -108,7 +108,8 @@ class LaneBatch:
         pvs, Ts = _point_table(parts, slices, npts)
         two_pi = 2 * math.pi
         sphase, tcarry, zdms = np.empty(npts), np.empty(npts), np.zeros(npts)
-        jobs, x0s, firsts = [], [], []
+        jobs, x0s, firsts, first_vfs = [], [], [], []
+        vf0 = model.mode_index(None)  # (x0's mode: the model's initial one)
         for (spec, i), sl, (a, b) in zip(parts, slices, bounds):
             size, T = b - a, Ts[a:b]
             sphase[a:b] = (spec.phase % two_pi) / two_pi * T
@@ -120,6 +121,7 @@ class LaneBatch:
             # Jobs: runs of points, each continuing from the previous (a chunk; every point when fresh).
             if spec.fresh:
                 jobs.append(np.column_stack([np.arange(a, b), np.arange(a + 1, b + 1)]))
+                first_vfs.append([vf0] * size)
                 x0s.append(np.broadcast_to(x0, (size, n)))
                 if spec.starts is not None:  # (each from its own state, at its sampling phase)
                     firsts.append(np.column_stack([carry, spec.starts[sl]]))
@@ -129,10 +131,12 @@ class LaneBatch:
                 jobs.append(np.array([[a, b]]))
                 x0s.append(x0[None])
                 if i == 0 and spec.resume is not None:  # (continuing a chain: grazing.sweeps.chain)
-                    t, x = spec.resume
+                    t, x = spec.resume[:2]
                     firsts.append(np.array([[float(t), *x]]))
+                    first_vfs.append([spec.resume[2] if len(spec.resume) > 2 else vf0])
                 else:
                     firsts.append(np.concatenate([[0.0], x0])[None])
+                    first_vfs.append([vf0])
         self._bounds = bounds
         order = taylor_order(spec0.tol)
         self._kern = model.kernels(0, order)
@@ -142,6 +146,8 @@ class LaneBatch:
         self.jobs = np.ascontiguousarray(np.concatenate(jobs), dtype=np.int64).reshape(-1, 2)
         self.x0 = np.ascontiguousarray(np.concatenate(x0s), dtype=float).reshape(-1, n)
         self.firsts = np.ascontiguousarray(np.concatenate(firsts), dtype=float).reshape(-1, n + 1)
+        self.first_vf = np.ascontiguousarray(np.concatenate(first_vfs), dtype=np.int64)  # (their modes)
+        self.x0_vf = np.full(len(self.jobs), vf0, dtype=np.int64)
         self.pvs = pvs
         self.Ts = Ts
         self.sphase = sphase
@@ -155,6 +161,7 @@ class LaneBatch:
         self.used = np.zeros(npts, dtype=np.int64)
         self.x_final = np.full((npts, n), np.nan)
         self.t_final = np.zeros(npts)
+        self.vf_final = np.zeros(npts, dtype=np.int64)
         self.status = np.full(npts, NOT_COMPUTED, dtype=np.int64)  # then each point's Status code
         self._starts = np.array([a for a, _ in bounds], dtype=np.int64)
         self._taken = np.zeros(len(parts), dtype=bool)
@@ -182,10 +189,17 @@ class LaneBatch:
             zdm_window=float(z.window) if z is not None else 0.0,
             stop=int(z.stop) if z is not None else 0,
         )
-        work = LaneJobs(self.jobs, self.control, self.x0, self.firsts)
+        work = LaneJobs(self.jobs, self.control, self.x0, self.firsts, self.first_vf, self.x0_vf)
         points = LanePoints(self.pvs, self.Ts, self.sphase, self.tcarry, self.zdms)
         out = LaneResults(
-            self.samples, self.by_stop, self.lyap, self.used, self.x_final, self.t_final, self.status
+            self.samples,
+            self.by_stop,
+            self.lyap,
+            self.used,
+            self.x_final,
+            self.t_final,
+            self.status,
+            self.vf_final,
         )
         self._driver(kern.table, tuple(settings), tuple(work), tuple(points), tuple(out))
 
@@ -258,6 +272,7 @@ class LaneBatch:
             impacts_by_stop=np.where(good[:, None], self.by_stop[part], -1).astype(np.int32),
             status=status.astype(STATUS_DTYPE),
             t_final=np.where(good, self.t_final[part], np.nan),
+            mode_final=np.where(good, self.vf_final[part], -1),
         )
 
 

@@ -77,6 +77,8 @@ _STORED = {
 _VARIABLES = tuple(_STORED)
 
 END_TIME = "chunk_end_time"
+END_MODE = "chunk_end_mode"
+"""Per chunk of a model with modes: the mode its last point ends in (-1: failed), where a chain goes on."""
 """Per chunk: the time its last point ended at, where a chain goes on from (a model that is not periodic)."""
 
 
@@ -250,6 +252,7 @@ class MemoryStore:
         self._set = np.zeros(spec.n_chunks, dtype=bool)  # (the chunks whose part of the arrays holds values)
         self.done = np.zeros(spec.n_chunks, dtype=bool)
         self.end_time = np.full(spec.n_chunks, np.nan)
+        self.end_mode = np.full(spec.n_chunks, -1, dtype=np.int64)
         self.attrs = attrs or {}
         self._levels: np.ndarray | None = None  # (the stop levels, once prepared)
 
@@ -272,6 +275,7 @@ class MemoryStore:
         for key, array in self._arrays.items():
             array[sl] = getattr(res, key)
         self.end_time[res.index] = _end_time(res)
+        self.end_mode[res.index] = _end_mode(res)
         self._set[res.index] = True
         self.done[res.index] = True
 
@@ -279,7 +283,7 @@ class MemoryStore:
         """Where the chain goes on after chunk ``i`` (written): :func:`~grazing.sweeps.chain.start_after`."""
         last = self.spec.chunk(i).stop - 1
         x, status = self.arrays["x_final"][last], int(self.arrays["status"][last])
-        return start_after(self.spec, i, status, x, float(self.end_time[i]))
+        return start_after(self.spec, i, status, x, float(self.end_time[i]), int(self.end_mode[i]))
 
     def prepare(self) -> None:
         """Do, once, what :meth:`dataset` needs that the results do not: import xarray and make its first
@@ -359,6 +363,7 @@ class ZarrStore:
             if self._done.shape != (spec.n_chunks,):
                 raise StoreDamagedError(self._damaged("chunk_done has the wrong shape"))
             self._has_end_time = (self.path / END_TIME).is_dir()  # (not in earlier fresh sweeps' stores)
+            self._has_end_mode = (self.path / END_MODE).is_dir()  # (models with modes only)
         except BaseException:
             self.close()
             raise
@@ -444,6 +449,9 @@ class ZarrStore:
         encoding["chunk_done"] = {"chunks": (1,), "fill_value": 0}
         data[END_TIME] = ("chunk", da.full(nc, np.nan, dtype=np.float64, chunks=min(nc, 1 << 20)))
         encoding[END_TIME] = {"chunks": (1,), "fill_value": np.nan}
+        if self.spec.model.has_modes:
+            data[END_MODE] = ("chunk", da.full(nc, -1, dtype=np.int64, chunks=min(nc, 1 << 20)))
+            encoding[END_MODE] = {"chunks": (1,), "fill_value": -1}
         ds = xr.Dataset(data)
         ds["status"].attrs.update(status_attrs())
         summary = spec_summary(self.spec)
@@ -469,6 +477,8 @@ class ZarrStore:
         flag = xr.Dataset({"chunk_done": ("chunk", np.ones(1, dtype=np.int8))})
         if self._has_end_time:
             flag[END_TIME] = ("chunk", np.array([_end_time(res)]))
+        if self._has_end_mode:
+            flag[END_MODE] = ("chunk", np.array([_end_mode(res)], dtype=np.int64))
         try:
             part.to_zarr(str(self.path), region={"point": sl}, consolidated=False)
             flag.to_zarr(
@@ -488,7 +498,11 @@ class ZarrStore:
         t = float(self._read(END_TIME, lambda z: z[i])) if self._has_end_time else math.nan
         t_final = np.full(sl.stop - sl.start, np.nan)
         t_final[-1] = t
-        return ChunkResult(index=i, t_final=t_final, **got)
+        mode_final = None
+        if self._has_end_mode:  # (the mode of the last point only: where the chain goes on)
+            mode_final = np.full(sl.stop - sl.start, -1, dtype=np.int64)
+            mode_final[-1] = int(self._read(END_MODE, lambda z: z[i]))
+        return ChunkResult(index=i, t_final=t_final, mode_final=mode_final, **got)
 
     def chain_start(self, i: int) -> ChainStart:
         """Where the chain goes on after chunk ``i`` (done): :func:`~grazing.sweeps.chain.start_after`."""
@@ -496,7 +510,8 @@ class ZarrStore:
         x = self._read("x_final", lambda z: np.asarray(z[last], dtype=float))
         status = int(self._read("status", lambda z: z[last]))
         t = float(self._read(END_TIME, lambda z: z[i])) if self._has_end_time else math.nan
-        return start_after(self.spec, i, status, x, t)
+        mode = int(self._read(END_MODE, lambda z: z[i])) if self._has_end_mode else -1
+        return start_after(self.spec, i, status, x, t, mode)
 
     def _check_complete(self) -> None:
         missing = int((~self._done).sum())
@@ -512,6 +527,11 @@ class ZarrStore:
         arrays = {k: self.read(k) for k in _VARIABLES}
         attrs = {k: v for k, v in self._read_attrs().items() if k not in ("initialized",)}
         return build_dataset(self.spec, arrays, {**attrs, **self.attrs})
+
+
+def _end_mode(res: ChunkResult) -> int:
+    """The mode a chunk's last point ended in (-1: failed, or a model of one mode)."""
+    return -1 if res.mode_final is None else int(res.mode_final[-1])
 
 
 def _end_time(res: ChunkResult) -> float:

@@ -150,6 +150,7 @@ def sweep_lanes(m, cfg, work, points, out):
     n = m.nx
     order = m.order
     nstops = m.nstops
+    nev = m.rows.shape[1]  # event rows of a mode's kernels (every stop's guard, for one mode)
     K = order + 1
     L = cfg.lanes
     ncol = n
@@ -163,7 +164,7 @@ def sweep_lanes(m, cfg, work, points, out):
     ls = new_state(L)  # the lanes' runs and where each is in its point's protocol
     XS = np.zeros((ntot, L))  # the lanes' states (and variational matrices), lane by lane
     Xs = np.zeros((ntot, K))  # one lane's coefficients from a scalar function
-    Os = np.zeros((nstops, K))
+    Os = np.zeros((nev, K))
     xl = np.zeros(ntot)  # one lane's state, for the scalar functions
     pl = np.zeros((L, npv))
     logs = np.zeros((L, n))
@@ -172,7 +173,10 @@ def sweep_lanes(m, cfg, work, points, out):
     SI = np.zeros(L)
     PT = np.zeros((npv, L))
     XT = np.zeros((ntot, K, L))
-    OT = np.zeros((nstops, K, L))
+    OT = np.zeros((nev, K, L))
+    nscratch = L if m.nmodes > 1 and use_lanes else 0  # (a mode's lane function writes every lane)
+    XM = np.zeros((ntot, K, nscratch))
+    OM = np.zeros((nev, K, nscratch))
     roots = np.zeros((LANE_ROOT_ROWS, max(K, LANE_ROOT_MIN_COLS)))
     a = np.zeros(K)
     xe = np.empty(ntot)
@@ -200,7 +204,7 @@ def sweep_lanes(m, cfg, work, points, out):
     acc = np.zeros(L, dtype=np.int64)  # (advance_lanes: which lanes advance)
 
     la = LaneArrays(ls, XS, pl, PT, logs, buf, counts)
-    coeffs = (XT, OT, SI, Xs, Os, xl)
+    coeffs = (XT, OT, SI, Xs, Os, xl, XM, OM)
     active = 0
     for lane in range(L):
         ls[lane].stage = IDLE
@@ -297,13 +301,14 @@ def lane_coefficients(m, la, kinds, use_lanes, coeffs):
     ``kinds[lane]`` becomes 0 (idle or sticking), 1 (free flight) or 2 (with
     the variational equations); a kind with at least ``VECTOR_MIN_LANES``
     lanes is computed by the model's lane function (``use_lanes``), the
-    others lane by lane.  ``coeffs`` = ``(XT, OT, SI, Xs, Os, xl)``: the lanes'
-    coefficients, their local times, one lane's coefficients and state.
+    others lane by lane.  ``coeffs`` = ``(XT, OT, SI, Xs, Os, xl, XM, OM)``:
+    the lanes' coefficients, their local times, one lane's coefficients and
+    state, and (a model with modes) the lanes' coefficients in one mode.
     """
-    XT, OT, SI, Xs, Os, xl = coeffs
+    XT, OT, SI, Xs, Os, xl, _, _ = coeffs
     ls, XS, pl, PT = la.ls, la.XS, la.pl, la.PT
     n = m.nx
-    nstops = m.nstops
+    nev = m.rows.shape[1]
     K = m.order + 1
     L = ls.shape[0]
     ntot = n + n * n
@@ -320,6 +325,9 @@ def lane_coefficients(m, la, kinds, use_lanes, coeffs):
                 nfree += 1
     for lane in range(L):
         SI[lane] = ls[lane].s
+    if m.nmodes > 1:
+        mode_coefficients(m, la, kinds, use_lanes, coeffs)
+        return nvar
     for kind in (1, 2):
         count = nfree if kind == 1 else nvar
         rows = n if kind == 1 else ntot
@@ -341,8 +349,55 @@ def lane_coefficients(m, la, kinds, use_lanes, coeffs):
                         tc_free(m, xl, SI[lane], pl[lane], Xs, Os, 0)
                     else:
                         tc_var(m, xl, SI[lane], pl[lane], Xs, Os, 0)
-                    to_lane(Xs, Os, rows, nstops, K, XT, OT, lane)
+                    to_lane(Xs, Os, rows, nev, K, XT, OT, lane)
     return nvar
+
+
+@njit(cache=True)
+def mode_coefficients(m, la, kinds, use_lanes, coeffs):
+    """:func:`lane_coefficients` of a model with modes: the lanes grouped by kind and active mode.
+
+    A group of at least ``VECTOR_MIN_LANES`` lanes is computed by the mode's
+    lane function, which writes every lane: into ``XM``, ``OM``, from which
+    the group's columns are copied; the others lane by lane, each in its
+    own mode.
+    """
+    XT, OT, SI, Xs, Os, xl, XM, OM = coeffs
+    ls, XS, pl, PT = la.ls, la.XS, la.pl, la.PT
+    n = m.nx
+    nev = m.rows.shape[1]
+    K = m.order + 1
+    L = ls.shape[0]
+    ntot = n + n * n
+    for kind in (1, 2):
+        rows = n if kind == 1 else ntot
+        for vf in range(m.nmodes):
+            count = 0
+            for lane in range(L):
+                if kinds[lane] == kind and ls[lane].vf == vf:
+                    count += 1
+            if count == 0:
+                continue
+            if use_lanes and count >= VECTOR_MIN_LANES:
+                call_model(m.fns[TC_FREE_LANES if kind == 1 else TC_VAR_LANES], XS, 0.0, PT, XM, OM, SI, vf)
+                for lane in range(L):
+                    if kinds[lane] == kind and ls[lane].vf == vf:
+                        for i in range(rows):
+                            for c in range(K):
+                                XT[i, c, lane] = XM[i, c, lane]
+                        for r in range(nev):
+                            for c in range(K):
+                                OT[r, c, lane] = OM[r, c, lane]
+                continue
+            for lane in range(L):
+                if kinds[lane] == kind and ls[lane].vf == vf:
+                    for i in range(rows):
+                        xl[i] = XS[i, lane]
+                    if kind == 1:
+                        tc_free(m, xl, SI[lane], pl[lane], Xs, Os, vf)
+                    else:
+                        tc_var(m, xl, SI[lane], pl[lane], Xs, Os, vf)
+                    to_lane(Xs, Os, rows, nev, K, XT, OT, lane)
 
 
 @njit(cache=True, inline="always")
@@ -365,13 +420,13 @@ def _lane_norms(m, ls, XT, OT, kinds, nvar, factor, norms, nl):
     """:func:`lane_norms` over ``nl`` lanes (a constant: the rows' values stay in vector registers)."""
     n = m.nx
     order = m.order
-    nstops = m.nstops
+    nev = m.rows.shape[1]  # (a mode's event rows: every stop's guard for one mode)
     ntot = n + n * n
     for lane in range(nl):
         norms[lane] = 0.0
         norms[nl + lane] = 0.0
         norms[2 * nl + lane] = 0.0
-    for r in range(nstops):
+    for r in range(nev):
         for lane in range(nl):
             norms[nl + lane] = max(norms[nl + lane], abs(OT[r, order - 1, lane]))
             norms[2 * nl + lane] = max(norms[2 * nl + lane], abs(OT[r, order, lane]))
@@ -402,7 +457,7 @@ def no_events_certain(m, cfg, OT, hs, plain, certs):
     if L == 1:
         plain[0] = 0
     elif L == LANE_WIDTH:  # (on vectors: the loop over the coefficients keeps the lanes in registers)
-        for r in range(m.nstops):
+        for r in range(m.rows.shape[1]):  # (a mode's event rows; a padding row is a constant 1)
             if not (cfg.zdm and r == cfg.stop):
                 certify_stop(OT, r, m.order + 1, hs, plain)
     else:
@@ -412,11 +467,11 @@ def no_events_certain(m, cfg, OT, hs, plain, certs):
 @njit(cache=True, inline="always")
 def _no_events_certain(m, cfg, OT, hs, plain, certs):
     """:func:`no_events_certain` lane by lane in numba, for a lane count other than ``LANE_WIDTH``."""
-    nstops = m.nstops
+    nev = m.rows.shape[1]
     K = m.order + 1
     nl = hs.shape[0]
     a1, a2, tl, hk = nl, 2 * nl, 3 * nl, 4 * nl
-    for r in range(nstops):
+    for r in range(nev):
         if cfg.zdm and r == cfg.stop:
             continue
         for lane in range(nl):
@@ -480,11 +535,11 @@ def plan_steps(m, cfg, la, zdms, norms, coeffs, factor, plan):
     (free flight, no known root at its start: :func:`no_events_certain`).
     """
     hs, flags, todo, plain = plan
-    XT, OT, _, Xs, Os, xl = coeffs
+    XT, OT, _, Xs, Os, xl, _, _ = coeffs
     ls, XS, pl = la.ls, la.XS, la.pl
     n = m.nx
     order = m.order
-    nstops = m.nstops
+    nev = m.rows.shape[1]
     K = order + 1
     L = ls.shape[0]
     hfree = norms[3 * L : 4 * L]
@@ -513,8 +568,8 @@ def plan_steps(m, cfg, la, zdms, norms, coeffs, factor, plan):
             for i in range(n):
                 xl[i] = XS[i, lane]
             tc_stick(m, xl, s, pl[lane], Xs, Os, stuck)
-            to_lane(Xs, Os, n, nstops, K, XT, OT, lane)
-            h = step_size(Xs, n, Os, nstops, stuck, math.inf, order, T, factor)
+            to_lane(Xs, Os, n, nev, K, XT, OT, lane)
+            h = step_size(Xs, n, Os, nev, stuck, math.inf, order, T, factor)
         else:
             h = hfree[lane]
         h, ends = step_end(ls[lane], h, cfg.zdm, zdms[p])
@@ -561,11 +616,13 @@ def take_point(m, cfg, work, points, out, la, lane, budget, align, active):
             for i in range(n):
                 XS[i, lane] = work.firsts[ls[lane].job, 1 + i]
             t0 = work.firsts[ls[lane].job, 0]
+            ls[lane].vf = work.first_vf[ls[lane].job]
         elif cfg.fresh or not carried:
             for i in range(n):
                 XS[i, lane] = work.x0[ls[lane].job, i]
             t0 = 0.0
-        else:
+            ls[lane].vf = work.x0_vf[ls[lane].job]
+        else:  # (the previous point's end: its state, time and mode)
             t0 = tcarry[p] if cfg.periodic else out.t[p - 1]
         k0, s0, ks0, ss0 = start_times(t0, T, sphase[p], cfg.periodic)
         ls[lane].k = k0
@@ -684,6 +741,7 @@ def finish_point(m, cfg, out, la, lane, align):
     for i in range(n):
         out.x[p, i] = XS[i, lane]
     out.t[p] = k * T + s
+    out.vf[p] = ls[lane].vf
     store_release(out.status, p, STATUS_OK)  # (after its results: another thread may read them now)
     ls[lane].stage = IDLE
     return True
