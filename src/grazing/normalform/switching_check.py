@@ -26,6 +26,7 @@ import numpy as np
 
 from grazing.core.model import HybridModel
 from grazing.core.solution import Solution
+from grazing.engine.simulate import simulate
 from grazing.errors import InvalidParameterError, InvalidStateError
 from grazing.normalform.switching import SwitchingMap, _way_back
 
@@ -99,12 +100,10 @@ def state_at(model: HybridModel, x0: Sequence[float] | np.ndarray, t0: float, t1
     InvalidParameterError
         One line: ``t1`` is not within a period after ``t0``.
     """
-    import grazing
-
     T = model.period
     if not 0 < t1 - t0 < T:
         raise InvalidParameterError(f"t1 = {t1:.10g} must be within a period ({T:.6g}) after t0 = {t0:.10g}")
-    sol = grazing.simulate(model, x0, t0=t0, periods=1, phase=2 * math.pi * (t1 / T % 1), impacts="all")
+    sol = simulate(model, x0, t0=t0, periods=1, phase=2 * math.pi * (t1 / T % 1), impacts="all")
     if abs(sol.t_final - t1) > TIME_TOL * T:  # (the sample of that phase is the next one after t0)
         raise InvalidStateError(f"the run ended at t = {sol.t_final:.12g}, not at t1 = {t1:.12g}")
     return sol
