@@ -33,6 +33,7 @@ from grazing import (
     Transition,
 )
 from grazing.normalform import find_grazing_point, switching_map_at
+from grazing.normalform.switching_check import compare_with_flow, loglog_slope, state_at
 from tests.piecewise_exact import LinearMode, PiecewiseLinearModel
 
 x, v, t = sp.symbols("x v t")
@@ -96,33 +97,19 @@ def test_the_grazing_orbit_and_the_map_against_the_closed_form(grazing_point, zd
 
 def _one_sample(model, x0, t0, t1):
     """The state at ``t1`` (within a period after ``t0``) of a run from ``x0`` at ``t0``."""
-    sol = grazing.simulate(model, x0, t0=t0, periods=1, phase=2 * math.pi * (t1 / model.period % 1),
-                           impacts="all")  # fmt: skip
+    sol = state_at(model, x0, t0, t1)
     assert sol.t_final == pytest.approx(t1, abs=1e-9)
     return sol
 
 
 def _compare(zdm, starts):
-    """For each ``(y, model, x0, t0)``: the flow through the contact minus the free flow at
+    """For each ``(model, x0, t0)``: the flow through the contact minus the free flow at
     ``t* + T/4``, and the map's prediction of it (free flow of ``D(x)`` minus free flow of ``x``,
-    ``x`` the free flow's state on the section ``t*``)."""
-    ts = zdm.t_graze
-    t1 = ts + zdm.model.period / 4
-    free_model = zdm.model.with_params(gap=FAR)
-    actual, predicted = [], []
-    for model, x0, t0 in starts:
-        through = _one_sample(model, x0, t0, t1)
-        assert [through.switches.name(i) for i in range(len(through.switches))] == ["touch", "leave"]
-        on_section = x0 if t0 == ts else free_orbit(dict(model.params), ts)
-        free = _one_sample(free_model, on_section, ts, t1).x_final
-        mapped = _one_sample(free_model, zdm.zdm(on_section, model=model), ts, t1).x_final
-        actual.append(through.x_final - free)
-        predicted.append(mapped - free)
-    return np.array(actual), np.array(predicted)
-
-
-def _slope(ys, values):
-    return float(np.polyfit(np.log(ys), np.log(values), 1)[0])
+    ``x`` the free flow's state on the section ``t*``): :func:`compare_with_flow`, which also checks
+    that every run switches across ``touch`` and back once."""
+    check = compare_with_flow(zdm, starts, zdm.model.with_params(gap=FAR))
+    assert check.t_end == zdm.t_graze + zdm.model.period / 4
+    return check.actual, check.predicted
 
 
 def _same_constant(ratios, within=1.05):
@@ -153,8 +140,8 @@ def test_the_map_predicts_the_contact_of_the_grazing_orbit_family(zdm):
     actual, predicted = _compare(zdm, starts)
     size = np.linalg.norm(actual, axis=1)
     error = np.linalg.norm(actual - predicted, axis=1)
-    assert _slope(ys, size) == pytest.approx(1.5, abs=0.01)
-    assert _slope(ys, error) == pytest.approx(2.5, abs=0.05)
+    assert loglog_slope(ys, size) == pytest.approx(1.5, abs=0.01)
+    assert loglog_slope(ys, error) == pytest.approx(2.5, abs=0.05)
     _same_constant(error / size / ys)
     assert np.all(actual[:, 1] < 0)  # the spring slows the motion out: the velocity drops
 
@@ -174,8 +161,8 @@ def test_the_map_predicts_contacts_off_the_section(zdm):
     actual, predicted = _compare(zdm, starts)
     size = np.linalg.norm(actual, axis=1)
     error = np.linalg.norm(actual - predicted, axis=1)
-    assert _slope(ys, size) == pytest.approx(1.5, abs=0.01)
-    assert _slope(ys, error) == pytest.approx(2.0, abs=0.05)
+    assert loglog_slope(ys, size) == pytest.approx(1.5, abs=0.01)
+    assert loglog_slope(ys, error) == pytest.approx(2.0, abs=0.05)
     _same_constant(error / size / np.sqrt(ys))
 
 
@@ -291,8 +278,8 @@ def test_a_moving_wall_off_the_section():
     actual, predicted = _compare(zdm, starts)
     size = np.linalg.norm(actual, axis=1)
     error = np.linalg.norm(actual - predicted, axis=1)
-    assert _slope(ys, size) == pytest.approx(1.5, abs=0.01)
-    assert _slope(ys, error) == pytest.approx(2.0, abs=0.05)
+    assert loglog_slope(ys, size) == pytest.approx(1.5, abs=0.01)
+    assert loglog_slope(ys, error) == pytest.approx(2.0, abs=0.05)
     _same_constant(error / size / np.sqrt(ys), within=1.1)
 
 
@@ -326,5 +313,5 @@ def test_the_periodic_orbit_past_grazing_from_the_map(grazing_point, zdm):
         moved.append(np.linalg.norm(settled.x_final - free_orbit(p, half)))
         errors.append(np.linalg.norm(settled.x_final - predicted))
     moved, errors = np.array(moved), np.array(errors)
-    assert _slope(ys, moved) == pytest.approx(1.5, abs=0.05)
-    assert _slope(ys, errors / moved) == pytest.approx(1.0, abs=0.1)
+    assert loglog_slope(ys, moved) == pytest.approx(1.5, abs=0.05)
+    assert loglog_slope(ys, errors / moved) == pytest.approx(1.0, abs=0.1)

@@ -17,7 +17,7 @@ from grazing.cli.validate import path_type
               "grazing's, an empty folder, or a new one in an existing folder.")  # fmt: skip
 @click.option("--only", "only", multiple=True, metavar="FIGURE",
               help="Rebuild only this figure or section (fig02, fig04, fig06 ... fig12, map, adding, "
-                   "stops, attractors, eq; repeatable) and re-render the page with the other figures "
+                   "stops, attractors, switch, eq; repeatable) and re-render the page with the other figures "
                    "of earlier builds in --out.")  # fmt: skip
 @click.option("--overwrite", is_flag=True,
               help="Build into a folder that is not a report folder of grazing's, replacing the files of "

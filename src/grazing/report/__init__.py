@@ -15,7 +15,7 @@ Examples
 --------
 >>> from grazing.report import FIGURES, PAPER_FIGURES
 >>> [m.FIGURE_ID for m in FIGURES]
-['2', '4', '6', '7', '8', '9', '10', '11', '12', 'map', 'adding', 'stops', 'attractors', 'eq']
+['2', '4', '6', '7', '8', '9', '10', '11', '12', 'map', 'adding', 'stops', 'attractors', 'switch', 'eq']
 >>> set(PAPER_FIGURES) <= {m.FIGURE_ID for m in FIGURES}
 True
 >>> [m.FIGURE_ID for m in select(["fig07", "10", "figmap"])]
@@ -50,6 +50,7 @@ from grazing.report import (
     figattractors,  # issue 28
     figmap,
     figstops,
+    figswitch,  # issue 45
     paper,
 )
 from grazing.report.base import Comparison, DataFile, Dynamics, FigureResult, Image, Say
@@ -85,6 +86,7 @@ FIGURES: tuple[ModuleType, ...] = (
     figadding,  # issue 27
     figstops,
     figattractors,  # issue 28
+    figswitch,  # issue 45
     errata,
 )
 """The figure modules, in the order the page shows them."""
