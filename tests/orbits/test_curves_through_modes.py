@@ -20,7 +20,10 @@ import pytest
 from scipy.linalg import expm
 from scipy.optimize import fsolve
 
+from grazing.errors import ConvergenceError
+from grazing.normalform.discontinuity import find_grazing_point
 from grazing.orbits import continue_orbit, find_orbit, follow_curve
+from grazing.orbits.grazing import find_grazings, grazing_curve
 from grazing.orbits.shooting import move_section
 from tests.engine.test_mode_switches import soft_impact
 from tests.orbits.test_orbits_through_modes import grazing_frequency, reference
@@ -131,3 +134,23 @@ def test_a_period_doubling_curve_against_the_exact_period_doublings(section):
         assert abs(q["omega"] - u[2]) < 1e-9, (q["omega"], u[2])
         assert np.abs(o.state - u[:2]).max() < 1e-9
         assert np.min(np.abs(o.multipliers + 1.0)) < 1e-8, o.multipliers
+
+
+def test_the_grazing_analysis_and_the_grazing_curve_through_modes():
+    """find_grazing_point and grazing_curve on the soft-impact oscillator: the branch followed through
+    its switches of mode (switched across the grazing), the grazing at the closed-form frequency, and the
+    grazing curve in (omega, a) the closed form."""
+    m = soft_impact()
+    p = dict(m.params)
+    w = grazing_frequency(p, 1.3, 3.0)
+    g = find_grazing_point(m, "omega", 1.2, 2.0, stop_name="touch")
+    assert abs(g.model.params["omega"] - w) < 1e-10 and g.mode == "free" and g.stop_name == "touch"
+    points, branch = find_grazings(m, "omega", 1.2, 2.0)
+    assert [q.model.params["omega"] for q in points] == [g.model.params["omega"]]
+    assert branch.values[-1] == pytest.approx(2.0) and branch.orbits[-1].switch_signature == ((),)
+    with pytest.raises(ConvergenceError, match="no second grazing"):
+        find_grazing_point(m, "omega", 1.2, 2.0, "second")
+    curve = grazing_curve(m, ("omega", "a"), 1.0, search=(1.2, 2.0))
+    wc, a = curve.values("omega"), curve.values("a")
+    assert len(curve.points) > 5 and a.min() == pytest.approx(1.0) and curve.fold is None
+    assert np.abs(a - p["gap"] * np.abs(1 - wc * wc + 2j * p["zeta"] * wc)).max() < 1e-10
