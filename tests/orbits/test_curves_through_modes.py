@@ -26,7 +26,7 @@ from grazing.orbits import continue_orbit, find_orbit, follow_curve
 from grazing.orbits.grazing import find_grazings, grazing_curve
 from grazing.orbits.shooting import move_section
 from tests.engine.test_mode_switches import soft_impact
-from tests.orbits.test_orbits_through_modes import grazing_frequency, reference
+from tests.orbits.test_orbits_through_modes import exact_fold, grazing_frequency, reference
 
 
 def free_matrix(p: dict) -> np.ndarray:
@@ -154,3 +154,21 @@ def test_the_grazing_analysis_and_the_grazing_curve_through_modes():
     wc, a = curve.values("omega"), curve.values("a")
     assert len(curve.points) > 5 and a.min() == pytest.approx(1.0) and curve.fold is None
     assert np.abs(a - p["gap"] * np.abs(1 - wc * wc + 2j * p["zeta"] * wc)).max() < 1e-10
+
+
+def test_a_fold_curve_after_a_gained_switch_against_the_exact_folds():
+    """At a = 2 the orbit with two contacts per period (past the grazing where it gains the second) folds;
+    its fold curve in (omega, a), at a few points, is the exact fold at that ``a``."""
+    m = soft_impact(a=2.0)
+    br = continue_orbit(m, "omega", 1.2, 0.6, switch=True)
+    start = next(o for o, s in zip(br.orbits, br.segments) if s == 1)
+    assert len(sum(start.switch_signature, ())) == 4
+    curve = follow_curve(m, "fold", "omega", start.model.params["omega"], 0.6, "a", (1.8, 2.2), orbit=start)
+    assert len(curve.points) > 6 and curve.values("a").min() == pytest.approx(1.8)
+    for pt in curve.points[:: max(1, len(curve.points) // 4)]:
+        o = pt.orbit
+        q = dict(o.model.params)
+        x, w = exact_fold(q, o.state, q["omega"], m.mode_names.index(o.mode), o.t0)
+        assert abs(q["omega"] - w) < 1e-9, (q["omega"], w)
+        assert np.abs(o.state - x).max() < 1e-9, o.state - x
+        assert np.min(np.abs(o.multipliers - 1.0)) < 1e-8, o.multipliers

@@ -223,7 +223,7 @@ def exact_fold(params: dict, x: np.ndarray, w: float, mode: int, t0: float) -> t
         return np.append(x_end - u[:2], np.linalg.det(J - np.eye(2)))
 
     u, _, ok, msg = fsolve(equations, np.append(x, w), xtol=1e-14, full_output=True)
-    assert ok == 1, msg
+    assert ok in (1, 3), msg  # (3: no further improvement at xtol, below rounding; the residual decides)
     assert np.abs(equations(u)).max() < 1e-11
     return u[:2], float(u[2])
 
