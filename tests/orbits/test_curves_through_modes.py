@@ -22,6 +22,7 @@ from scipy.optimize import fsolve
 
 from grazing.errors import ConvergenceError
 from grazing.normalform.discontinuity import find_grazing_point
+from grazing.normalform.switching import switching_map_at
 from grazing.orbits import continue_orbit, find_orbit, follow_curve
 from grazing.orbits.grazing import find_grazings, grazing_curve
 from grazing.orbits.shooting import move_section
@@ -53,7 +54,8 @@ def test_the_grazing_of_the_switching_surface_is_located_at_the_closed_form():
     assert g.precision < 1e-10 and abs(sp.precision) < 1e-10
     assert np.abs(g.contact - [p["gap"], 0.0]).max() < 1e-10, g.contact
     assert np.abs(g.contact - free_response(p, w, g.t_graze)).max() < 1e-10
-    assert g.accel > 0 and g.switches == 0 and g.impacts == 0
+    assert g.switches == 0 and g.impacts == 0
+    assert abs(g.accel - w * w * p["gap"]) < 1e-10  # (L_f^2 h = -x'' = w^2 x on the free response)
     J = expm(free_matrix(p) * 2 * math.pi / w)
     assert np.abs(g.monodromy - J).max() < 1e-9, g.monodromy - J
 
@@ -172,3 +174,17 @@ def test_a_fold_curve_after_a_gained_switch_against_the_exact_folds():
         assert abs(q["omega"] - w) < 1e-9, (q["omega"], w)
         assert np.abs(o.state - x).max() < 1e-9, o.state - x
         assert np.min(np.abs(o.multipliers - 1.0)) < 1e-8, o.multipliers
+
+
+def test_the_located_grazing_feeds_the_discontinuity_map_of_the_switch():
+    """Without the contact damper the field is continuous across the surface: the grazing located by
+    find_grazing_point is a contact the switch's discontinuity map accepts, with ``a = w^2 gap`` and the
+    jump of the field per unit guard ``(0, k)``."""
+    m = soft_impact(c=0.0)
+    p = dict(m.params)
+    w = grazing_frequency(p, 1.3, 3.0)
+    g = find_grazing_point(m, "omega", 1.2, 2.0, stop_name="touch")
+    assert abs(g.model.params["omega"] - w) < 1e-10
+    zdm = switching_map_at(g.model, g.stop, g.contact, g.t_graze)
+    assert zdm.transition_name == "touch" and abs(zdm.accel - w * w * p["gap"]) < 1e-10
+    assert np.abs(zdm.jump - [0.0, p["k"]]).max() < 1e-12
