@@ -297,15 +297,7 @@ def test_features_not_yet_on_modes_are_refused_in_one_line():
         find_orbit(m, [0.0, 0.0], period=1, virtual=True)
     with pytest.raises(InvalidParameterError, match=r"^the discontinuity map does not support models"):
         grazing.simulate(m, [0.0, 0.0], periods=1, zdm=object())
-    from grazing.normalform import find_grazing_point
-    from grazing.orbits import find_grazings, grazing_curve
-
-    with pytest.raises(InvalidParameterError, match=r"^the grazing analysis does not support models with"):
-        find_grazing_point(m, "omega", 1.0, 1.5)
-    with pytest.raises(InvalidParameterError, match=r"^the grazing analysis does not support models with"):
-        find_grazings(m, "omega", 1.0, 1.5)
-    with pytest.raises(InvalidParameterError, match=r"^the grazing curve does not support models with"):
-        grazing_curve(m, ("omega", "gap"), 1.0, search=(1.0, 1.5))
+    # (the grazing analysis and the grazing curve go through modes: tests/orbits/test_curves_through_modes.py)
     from grazing.attractors import continue_attractors, find_attractors
     from grazing.maps import flow_map
 

@@ -110,12 +110,15 @@ def test_start_in_another_mode_and_one_line_refusals():
     refused = {
         "(guard_min)": dict(guard_min=True),
         "events=False": dict(events=False),
-        "(touching)": dict(touching=True),
     }
     for what, kw in refused.items():
         with pytest.raises(InvalidParameterError, match="does not support models with modes yet") as info:
             grazing.simulate(m, [0.0, 0.0], periods=1, **kw)
         assert what in str(info.value) and "\n" not in str(info.value)
+    # a run from a grazing contact starts in the source mode of the transition touched
+    with pytest.raises(InvalidParameterError, match=r"^a run from a grazing contact with transition 'leave' "
+                       r"starts in its source mode 'contact', not in 'free'$"):  # fmt: skip
+        grazing.simulate(m, [0.0, 0.0], periods=1, touching=True, stop_name="leave")
     sliding = HybridModel(
         "belt", [x, v], t, [Parameter(nm, val) for nm, val in VALUES.items()], period=2 * sp.pi / w,
         modes=[Mode("back", [v, -x - k]), Mode("forward", [v, -x + k])],

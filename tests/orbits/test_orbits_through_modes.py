@@ -27,7 +27,7 @@ from scipy.optimize import brentq, fsolve
 import grazing
 from grazing.errors import ConvergenceError, InvalidParameterError, InvalidStateError
 from grazing.maps import flow_map
-from grazing.orbits import continue_orbit, find_orbit, follow_curve
+from grazing.orbits import continue_orbit, find_orbit
 from grazing.orbits.palc import PalcSettings
 from grazing.orbits.segments import segmented_newton
 from tests.engine.test_mode_switches import reference as reference_expm
@@ -166,7 +166,6 @@ def test_a_map_that_returns_in_another_mode_and_other_refusals_in_one_line():
         lambda: find_orbit(m, virtual=True),
         lambda: continue_orbit(m, "omega", 1.2, 1.3, virtual=True),
         lambda: segmented_newton(m, orbit.state, 0.0, 1, tol=1e-10, max_iter=5),  # (multiple shooting)
-        lambda: follow_curve(m, "fold", "omega", 1.2, 0.6, "a", (0.5, 1.5)),
     ):
         with pytest.raises(InvalidParameterError, match="does not support models with modes yet") as info:
             call()
@@ -181,11 +180,12 @@ def test_a_change_of_switches_along_a_branch_ends_it_at_the_exact_grazing():
     w_graze = grazing_frequency(p, 1.3, 3.0)
     br = continue_orbit(m, "omega", 1.2, 2.0)
     [sp] = br.special
-    assert sp.kind == "grazing" and m.stop_names[sp.stop] == "touch" and sp.grazing is None
+    assert sp.kind == "grazing" and m.stop_names[sp.stop] == "touch" and sp.grazing is not None
     assert "loses a switch ('touch'" in br.status and "\n" not in br.status
+    assert "bracketed only" not in br.status
     lo, hi = sp.interval
     assert lo - 1e-12 <= w_graze <= hi + 1e-12 and hi - lo < 1e-8, (lo, w_graze, hi)
-    assert abs(sp.param - w_graze) < 1e-8
+    assert abs(sp.param - w_graze) < 1e-10  # (located: tests/orbits/test_curves_through_modes.py)
     ds = br.to_dataset()
     assert set(ds.mode.values) <= {"free", "contact"} and (ds.switches.values == 2).all()
     assert all(o.switch_signature == (("touch", "leave"),) for o in br.orbits) or all(
@@ -223,7 +223,7 @@ def exact_fold(params: dict, x: np.ndarray, w: float, mode: int, t0: float) -> t
         return np.append(x_end - u[:2], np.linalg.det(J - np.eye(2)))
 
     u, _, ok, msg = fsolve(equations, np.append(x, w), xtol=1e-14, full_output=True)
-    assert ok == 1, msg
+    assert ok in (1, 3), msg  # (3: no further improvement at xtol, below rounding; the residual decides)
     assert np.abs(equations(u)).max() < 1e-11
     return u[:2], float(u[2])
 

@@ -136,7 +136,15 @@ def simulate(
     if zdm is not None and not model.periodic:
         raise InvalidParameterError("the discontinuity map needs a periodically forced model")
     if model.has_modes:
-        _refuse_on_modes(model, events=events, zdm=zdm, touching=touching, guard_min=guard_min)
+        _refuse_on_modes(
+            model,
+            events=events,
+            zdm=zdm,
+            touching=touching,
+            guard_min=guard_min,
+            stop_name=stop_name,
+            mode=mode,
+        )
     elif mode is not None:
         model.mode_index(mode)  # (only the one mode's name)
     allowed = events and zdm is None  # (with the map, the state may be past the grazing stop)
@@ -258,13 +266,25 @@ def simulate(
 
 
 def _refuse_on_modes(
-    model: HybridModel, *, events: bool, zdm: DiscontinuityMap | None, touching: bool, guard_min: bool
+    model: HybridModel,
+    *,
+    events: bool,
+    zdm: DiscontinuityMap | None,
+    touching: bool,
+    guard_min: bool,
+    stop_name: int | str | None,
+    mode: str | None,
 ) -> None:
     """One line for what ``simulate`` cannot do yet on a model with modes (``model.has_modes``)."""
     if zdm is not None:
         model.require_one_mode("the discontinuity map")
-    if touching:
-        model.require_one_mode("a run from a grazing contact (touching)")
+    if touching:  # (a contact with a transition's guard, in the transition's source mode)
+        j, start = model.stop_index(stop_name), model.mode_names[model.mode_index(mode)]
+        if model.transition_source[j] != start:
+            raise InvalidParameterError(
+                f"a run from a grazing contact with transition {model.stop_names[j]!r} starts in its source "
+                f"mode {model.transition_source[j]!r}, not in {start!r}"
+            )
     if guard_min:
         model.require_one_mode("the smallest guard value (guard_min)")
     if not events:

@@ -299,7 +299,6 @@ def find_grazing_point(
     ...  for which in ("first", "second")]
     [0.4451, 0.5473]
     """
-    model.require_one_mode("the grazing analysis")
     from grazing.errors import ConvergenceError, InvalidParameterError
     from grazing.orbits.grazing import find_grazings
 

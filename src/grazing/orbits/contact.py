@@ -80,6 +80,12 @@ class GrazingPoint:
         step that would follow the last); for a codimension-two meeting point
         (:func:`~grazing.orbits.crossings.meeting_point`), the larger parameter component of its last
         Newton step; nan otherwise.
+    mode
+        A model with modes: the mode the orbit is in at the contact, the source of the transition
+        whose guard it touches (:attr:`stop_name`); None without modes.
+    switches
+        A model with modes: its switches of mode over one period from the contact (the contact itself
+        is none); 0 without modes.
 
     Examples
     --------
@@ -110,6 +116,8 @@ class GrazingPoint:
     other_impacts: Impacts | None = None
     approach_by_stop: tuple[tuple[float, float, np.ndarray] | None, ...] = ()
     precision: float = math.nan
+    mode: str | None = None
+    switches: int = 0
 
     @property
     def stop_name(self) -> str:
@@ -140,10 +148,19 @@ def contact_system(
     With ``events`` the flow applies the orbit's other impacts (a grazing of an
     orbit that already impacts); the contact itself is never an impact.
     ``stop`` is the index of the stop touched.
+
+    On a model with modes ``stop`` is a transition and the orbit is in its
+    source mode at the contact: it touches the guard there without switching
+    (for a switch without a reset, an orbit of the source mode tangent to the
+    switching surface); its other switches of mode (and impacts) are applied,
+    whatever ``events``, and the orbit must be back in the source mode one
+    period later.
     """
     n = model.n_states
     eye = np.eye(n)
     pidx = [[p.name for p in model.parameters].index(name) for name in names]
+    modes = model.has_modes
+    source = model.transition_source[stop] if modes else None
 
     def evaluate(u: np.ndarray) -> tuple[np.ndarray, np.ndarray, GrazingPoint]:
         y, tg = u[:n], float(u[n])
@@ -154,13 +171,19 @@ def contact_system(
             t0=tg,
             periods=period,
             sensitivities=names,
-            virtual=not events,
-            touching=events,
+            virtual=not (events or modes),
+            touching=events or modes,
             stop_name=stop,
+            mode=source,
         )
+        if modes and fm.mode_final != source:
+            raise ConvergenceError(
+                f"the orbit touching transition {model.stop_names[stop]!r} in mode {source!r} returns in "
+                f"mode {fm.mode_final!r} {period} forcing period(s) later: no grazing orbit there"
+            )
         J, S = fm.jacobian, fm.sensitivity
-        fy = m.vector_field(y, tg)
-        fend = m.vector_field(fm.image, fm.solution.t_final)
+        fy = m.vector_field(y, tg, source)
+        fend = m.vector_field(fm.image, fm.solution.t_final, source)
         cd = m.contact_derivatives(y, tg, stop)
         F = np.concatenate([fm.image - y, [cd["h"], cd["rate"]]])
         DF = np.zeros((n + 2, n + 1 + len(names)))
@@ -179,10 +202,12 @@ def contact_system(
             period=period,
             impacts=fm.impacts,
             stop=stop,
-            crossed=() if events else _crossed(m, fm.solution.guard_min_by_stop, stop),
+            crossed=() if events or modes else _crossed(m, fm.solution.guard_min_by_stop, stop),
             guard_mins=tuple(g[0] for g in fm.solution.guard_min_by_stop or ()),
             other_impacts=fm.solution.impacts,
             approach_by_stop=fm.solution.approach_by_stop or (),
+            mode=source,
+            switches=len(fm.solution.switches) if modes else 0,
         )
         return F, DF, point
 

@@ -100,6 +100,7 @@ from grazing.orbits.shooting import (
     not_isolated_message,
     quiet_section,
 )
+from grazing.orbits.switch_grazing import locate_switch_grazing
 from grazing.orbits.switching import SegmentStart, crossing_starts, doubled_start, new_sequence_orbit
 
 SPECIAL_KINDS = tuple(k for k in SpecialKind if k is not SpecialKind.UNLOCATED)
@@ -927,9 +928,12 @@ class _Continuation:
         """The grazing orbit at the boundary where ``palc`` stopped (None where none is located)."""
         boundary = palc.boundary
         assert boundary is not None
-        if self.model.has_modes:
-            return None  # (the grazing equations do not go through modes yet: the grazing is bracketed)
         beyond = boundary.after.payload if boundary.after is not None else None
+        if self.model.has_modes:  # (a grazing of a switching surface: the switches of mode differ)
+            found = switch_change(prev.payload, beyond) if beyond is not None else None
+            if found is None:
+                return None
+            return locate_switch_grazing(prev.payload, beyond, self.param, found[1], BETWEEN_SLACK)
         return _locate_grazing(prev.payload, beyond, self.param, self.virtual, boundary.ahead)
 
     def _grazing_end(
@@ -969,7 +973,7 @@ class _Continuation:
         if point is None and self.model.has_modes:
             where += (
                 f" (bracketed only, between {par.show(prev.u[-1])} and the first orbit beyond it: the "
-                "grazing equations do not go through modes yet)"
+                "grazing equations did not converge)"
             )
         elif point is None:
             where += (

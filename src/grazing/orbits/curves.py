@@ -45,6 +45,8 @@ from grazing.orbits.continuation import (
     SpecialPoint,
     continue_orbit,
     grazing_margin,
+    switch_change,
+    switch_change_reason,
 )
 from grazing.orbits.crossings import contact_guess, meeting_point, nearest_grazing
 from grazing.orbits.curve_data import BifurcationCurve, CurveEnd, CurvePoint, CurveSpecial, bracket_between
@@ -201,7 +203,10 @@ class _Follower:
     def can_segment(self, orbit: PeriodicOrbit) -> bool:
         """Can the curve through ``orbit`` be followed on the segmented equations (it has impacts, it is
         not virtual, the model has a forcing period)?"""
-        return self.kind != "grazing" and not self.virtual and orbit.impacts > 0 and self.model.periodic
+        return (
+            self.kind != "grazing" and not self.virtual and orbit.impacts > 0 and self.model.periodic
+            and not self.model.has_modes  # (multiple shooting does not go through modes yet)
+        )  # fmt: skip
 
     def system(
         self, start: PeriodicOrbit | GrazingPoint, segmented: bool = False
@@ -230,6 +235,7 @@ class _Follower:
             self.virtual,
             self.stop,
             start.monodromy,
+            start.mode,
         )
 
     def curve_point(self, pt: PalcPoint) -> CurvePoint:
@@ -254,10 +260,17 @@ class _Follower:
             ga, gb = a.grazing, b.grazing
             if gb.impacts != ga.impacts or _crossing(gb) != _crossing(ga) or gb.accel <= 0:
                 return BOUNDARY, "the grazing orbit meets another contact with a stop (a double grazing)"
+            if gb.switches != ga.switches:
+                return BOUNDARY, (
+                    f"the grazing orbit's other switches of mode change ({ga.switches} -> {gb.switches} per "
+                    "period): it meets another contact with a switching surface (a double grazing)"
+                )
             return ACCEPT, ""
         if self.virtual:
             return ACCEPT, ""
         oa, ob = a.orbit, b.orbit
+        if self.model.has_modes and ob.switch_signature != oa.switch_signature:
+            return BOUNDARY, f"{switch_change_reason(oa, ob)}: the curve meets it"
         if ob.signature != oa.signature:
             what = "loses" if sum(ob.signature) < sum(oa.signature) else "gains"
             if sum(ob.signature) == sum(oa.signature):
@@ -348,7 +361,8 @@ class _Follower:
                 system, first, index=index, sign=sign, bounds=bounds,
                 settings=dataclasses.replace(self.s, max_points=max(2, self.s.max_points - len(d.points))),
                 names=names, shows=shows, check=self.check,
-                margin=None if self.virtual and self.kind != "grazing" else self.margin,
+                margin=self.margin if self.kind == "grazing" or not (self.virtual or self.model.has_modes)
+                else None,
             )  # fmt: skip
             ended = False
             for k, pt in enumerate(palc):
@@ -623,6 +637,8 @@ class _Follower:
                 d.outcome = CurveEnd.DOUBLE_GRAZING
                 return True
             return False
+        if self.model.has_modes:
+            return self.end_at_switch_grazing(d, palc)
         orbit = before.payload.orbit
         margin = grazing_margin(orbit)
         y, t, what, stop = margin.contact, margin.time, margin.change or "", margin.stop
@@ -651,6 +667,26 @@ class _Follower:
         d.status, d.outcome = f"ended at a grazing at {where}: {reason}", CurveEnd.GRAZING
         return True
 
+    def end_at_switch_grazing(self, d: _Direction, palc: Palc) -> bool:
+        """The curve ends where its orbit's switches of mode change (a model with modes): a grazing of a
+        switching surface, bracketed between the last point and the first beyond it (False where no
+        orbit beyond was found: nothing is recorded)."""
+        boundary = palc.boundary
+        assert boundary is not None
+        if not boundary.reached or boundary.after is None:
+            return False
+        before = d.pal[-1]
+        index = len(d.points) - 1
+        found = switch_change(before.payload.orbit, boundary.after.payload.orbit)
+        special = self.grazing_special(index, before, None, False, self.bracket(before, boundary.after))
+        d.special.append((index, special))
+        where = self.show(special.values)
+        if found is not None:
+            where += f" of transition {self.model.stop_names[found[1]]!r}"
+        d.status = f"ended at a grazing at {where} (bracketed only): {boundary.reason}"
+        d.outcome = CurveEnd.GRAZING
+        return True
+
 
 def follow_curve(
     model: HybridModel,
@@ -677,6 +713,12 @@ def follow_curve(
     leaves its own interval, or the curve ends at a codimension-two point that
     ends it (a grazing, where the orbit's impact sequence changes; a 1:1 or 1:2
     resonance on a Neimark-Sacker curve), or Newton's method fails.
+
+    On a model with modes the orbits go through their switches of mode (single
+    shooting only); a fold or period-doubling curve ends where its orbits'
+    switches change (a grazing of a switching surface, bracketed), and the
+    grazing curve of a transition is the orbit of its source mode tangent to
+    its guard (:func:`~grazing.orbits.contact.contact_system`).
 
     Parameters
     ----------
@@ -715,8 +757,8 @@ def follow_curve(
         the special points met instead.
     InvalidParameterError
         An unknown kind or parameter, ``param2`` equal to ``param``, a
-        ``range2`` without the value of ``param2``; a model with modes (not
-        supported yet: its branches are followed by :func:`continue_orbit`).
+        ``range2`` without the value of ``param2``.
+
 
     Examples
     --------
@@ -730,7 +772,6 @@ def follow_curve(
     >>> bool(np.allclose(a, np.pi * (1 - r) / (1 + r), atol=1e-8)), float(r.min()), float(r.max())
     (True, 0.45, 0.55)
     """
-    model.require_one_mode("curves in two parameters (follow_curve)")
     if kind not in CURVE_KINDS:
         raise InvalidParameterError(f"unknown curve kind {kind!r} (known: {', '.join(CURVE_KINDS)})")
     kind = CurveKind(kind)

@@ -323,10 +323,11 @@ class OrbitSystem:
 
     def __init__(
         self, model: HybridModel, kind: str, params: tuple[str, str], period: int, t0: float,
-        virtual: bool, stop: int, monodromy: np.ndarray,
+        virtual: bool, stop: int, monodromy: np.ndarray, mode: str | None = None,
     ):  # fmt: skip
         self.model, self.kind, self.params = model, kind, params
         self.period, self.t0, self.virtual, self.stop = period, t0, virtual, stop
+        self.mode = mode  # (a model with modes: the mode on the section)
         self.n = model.n_states
         self.borders = Borders.of(defining_matrix(kind, monodromy))
 
@@ -344,7 +345,7 @@ class OrbitSystem:
         m = self.model.with_params(**{q: float(v) for q, v in zip(self.params, p)})
         fm = flow_map(
             m, x, t0=self.t0, periods=self.period, sensitivities=self.params, virtual=self.virtual,
-            stop_name=self.stop,
+            stop_name=self.stop, mode=self.mode,
         )  # fmt: skip
         if not fm.solution.jacobian_valid:
             raise ConvergenceError("the orbit sticks to the stop: no Jacobian across sticking")

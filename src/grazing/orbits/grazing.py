@@ -61,6 +61,12 @@ def find_grazings(
     (:attr:`GrazingPoint.crossed`) is not a motion of the system: it is
     returned, with a :class:`~grazing.errors.GrazingWarning`.
 
+    On a model with modes the branch is the orbit itself, followed through its
+    switches of mode (no virtual orbit): each grazing of a transition's guard
+    where its switches change is located (the orbit of the transition's source
+    mode tangent to the guard) and the branch goes on along the orbit with the
+    new switches (``switch``); ``stop_name`` names the transition.
+
     Parameters
     ----------
     model
@@ -93,7 +99,6 @@ def find_grazings(
     >>> [round(p.model.params["eta"], 4) for p in points]
     [0.4451, 0.5473]
     """
-    model.require_one_mode("the grazing analysis")
     branch = continue_orbit(
         model,
         param,
@@ -101,11 +106,12 @@ def find_grazings(
         stop,
         x0=None if x0 is None else np.asarray(x0, dtype=float),
         period=period,
-        virtual=True,
+        virtual=not model.has_modes,
         settings=settings,
         detect=(SpecialKind.FOLD, SpecialKind.GRAZING),
         progress=progress,
-        stop_name=stop_name,
+        stop_name=None if model.has_modes else stop_name,
+        switch=model.has_modes,  # (through modes: the orbit with the new switches past each grazing)
     )
     watch = model.stop_index(stop_name)
     par = model.parameter(param)
@@ -224,6 +230,9 @@ def grazing_curve(
     ``start`` on the other branch or ``params[0]`` leaves ``search``.
     ``x0``: a guess of the nonimpacting orbit at time 0 with ``params[0] =
     search[0]`` and ``params[1] = start`` (see :func:`find_grazings`).
+    On a model with modes the curve is that of a transition's guard
+    (``stop_name``) touched by an orbit of its source mode, found on the orbit's
+    own branch (see :func:`find_grazings`).
 
     Parameters
     ----------
@@ -260,7 +269,6 @@ def grazing_curve(
     >>> round(math.degrees(curve.fold.model.params["theta_hat"]), 1)
     55.9
     """
-    model.require_one_mode("the grazing curve")
     p1, p2 = params
     for p in params:
         if p not in model.params:
