@@ -311,6 +311,13 @@ class Solution:
         (:class:`Switches`, recorded as the impacts are); None for a model of one mode.
     mode_final
         A model with modes: the mode at the end; None for a model of one mode.
+    sliding
+        A model with modes: its sliding intervals during the sampled span, rows
+        ``[t_start, t_end, surface]`` (``surface`` an index into
+        :attr:`~grazing.HybridModel.surface_names`; the motion on a surface with
+        ``sliding=True``, in its pseudo-mode ``"sliding on 'name'"``, entered and
+        left by the switches in :attr:`switches`); None for a model of one mode
+        or a run that records no impacts (``SaveAt(impacts="none")``: no switches either).
 
     Examples
     --------
@@ -350,6 +357,7 @@ class Solution:
     info: dict[str, Any] = field(default_factory=dict)
     switches: Switches | None = None
     mode_final: str | None = None
+    sliding: np.ndarray | None = None
 
     def period(self, tol: float = DEFAULT_PERIOD_TOL, max_period: int = DEFAULT_MAX_PERIOD) -> int:
         """Smallest period of the sampled sequence (0 if none); see :func:`detect_period`."""

@@ -105,6 +105,7 @@ class Segment:
     jacobian_valid: bool
     steps: int
     switches: np.ndarray  # rows [t, transition index, state...] (models with modes)
+    vf_span: int = 0  # the active mode when the recorded span started
 
 
 def step_safety(tol: float, order: int) -> float:
@@ -304,4 +305,5 @@ class Runner:
         return Segment(
             out.samples, out.impacts, out.n_impacts, out.sticking, out.trajectory, out.log_sums,
             out.lyap_span, gm[:, : 2 + n], gm[:, 2 + n :], out.jacobian_valid, out.steps, out.switches,
+            out.vf_span,
         )  # fmt: skip

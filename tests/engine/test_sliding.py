@@ -1,0 +1,250 @@
+"""Filippov sliding in the scalar engine: the friction oscillator's stick-slip against its exact solution.
+
+x'' + x = a cos(w t) - mu sgn(x' - v_b) (grazing.models.friction_oscillator).  Slipping, the motion is
+linear (matrix exponentials, tests/piecewise_exact.py); the stick phase is sliding on h = x' - v_b = 0,
+where x = x0 + v_b (t - t0) exactly until |a cos(w t) - x| reaches mu (Brent's method).  The Jacobian
+is the product of the exponentials, the entry saltation I + (f_s - f-) h_x / (h_x f-) and the stick's
+exact variational flow [[1, dt], [0, 1]] (the exit, at a tangency, has S = I), and is checked against
+central differences of the exact flow too.  Nothing in the reference uses grazing's engine.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import sympy as sp
+from scipy.linalg import expm
+from scipy.optimize import brentq
+
+import grazing
+from grazing import HybridModel, Mode, Parameter, Surface, Tangent, Transition
+from grazing.models import friction_oscillator
+from tests.piecewise_exact import LinearMode, PiecewiseLinearModel
+
+BEHIND, AHEAD, STICK = 0, 1, 2  # the engine's mode indices (slip_behind, slip_ahead, sliding on 'belt')
+VALUES = {"a": 1.0, "omega": 0.5, "mu": 0.5, "v_belt": 0.2}  # stick, slip both ways, crossings
+SAMPLES_PER_PERIOD = 800
+
+
+class FrictionReference:
+    """The exact stick-slip flow of the friction oscillator with parameters ``p``."""
+
+    def __init__(self, p: dict[str, float]):
+        self.p = p
+        A = np.array([[0.0, 1.0], [-1.0, 0.0]])
+        b = np.array([0.0, p["a"]])
+        vb = p["v_belt"]
+        behind = LinearMode(A, b, np.array([0.0, p["mu"]]), ((np.array([0.0, -1.0]), vb, AHEAD),))
+        ahead = LinearMode(A, b, np.array([0.0, -p["mu"]]), ((np.array([0.0, 1.0]), -vb, BEHIND),))
+        self.slip = PiecewiseLinearModel([behind, ahead], p["omega"])
+
+    def force(self, x: float, t: float) -> float:
+        """``a cos(w t) - x``: the force the friction balances while sticking."""
+        return self.p["a"] * math.cos(self.p["omega"] * t) - x
+
+    def stick_end(self, x0: float, t0: float, t1: float) -> tuple[float, int] | None:
+        """The end of a stick from ``(x0, t0)`` before ``t1``: (time, the mode it slips into)."""
+        vb, mu = self.p["v_belt"], self.p["mu"]
+
+        def g(t: float, sign: float) -> float:
+            return sign * self.force(x0 + vb * (t - t0), t) - mu  # 0 when friction can hold no more
+
+        n = max(8, math.ceil((t1 - t0) * self.p["omega"] / (2 * math.pi) * SAMPLES_PER_PERIOD))
+        ts = np.linspace(t0, t1, n + 1)
+        best = None
+        for sign, mode in ((1.0, AHEAD), (-1.0, BEHIND)):
+            vals = [g(t, sign) for t in ts]
+            for i in range(1, n + 1):
+                if vals[i] >= 0.0 > vals[i - 1]:
+                    tz = brentq(g, ts[i - 1], ts[i], args=(sign,), xtol=1e-15, rtol=4 * np.finfo(float).eps)
+                    if best is None or tz < best[0]:
+                        best = (tz, mode)
+                    break
+        return best
+
+    def run(self, x0, mode: int, t0: float, t1: float):
+        """From ``x0`` in ``mode`` at ``t0`` to ``t1``: ``(x, mode, J, events)``, events ``(t, kind)`` with
+        kind ``"stick"``, ``"cross"`` or ``"slip"`` (a stick's end)."""
+        x, t, J = np.asarray(x0, dtype=float), t0, np.eye(2)
+        vb = self.p["v_belt"]
+        events = []
+        while True:
+            if mode == STICK:
+                end = self.stick_end(x[0], t, t1)
+                stop = t1 if end is None else end[0]
+                J = np.array([[1.0, stop - t], [0.0, 1.0]]) @ J
+                x = np.array([x[0] + vb * (stop - t), vb])
+                if end is None:
+                    return x, mode, J, events
+                events.append((stop, "slip"))
+                t, mode = stop, end[1]
+                continue
+            ev = self.slip.first_exit(mode, x, t, t1)
+            if ev is None:
+                J = expm(self.slip.modes[mode].A * (t1 - t)) @ J
+                return self.slip.flow(mode, x, t, t1), mode, J, events
+            tz = ev[0]
+            xz = self.slip.flow(mode, x, t, tz)
+            xz[1] = vb  # (on the surface, to rounding)
+            J = expm(self.slip.modes[mode].A * (tz - t)) @ J
+            far = 1 - mode
+            pushes_back = (self.slip.f(far, xz, tz)[1] < 0.0) if mode == BEHIND else (self.slip.f(far, xz, tz)[1] > 0.0)
+            fm = self.slip.f(mode, xz, tz)
+            fp = np.array([vb, 0.0]) if pushes_back else self.slip.f(far, xz, tz)
+            hx = np.array([0.0, 1.0])
+            J = (np.eye(2) + np.outer(fp - fm, hx) / (hx @ fm)) @ J
+            events.append((tz, "stick" if pushes_back else "cross"))
+            x, t, mode = xz, tz, STICK if pushes_back else far
+
+
+def _simulate(m, x0, periods, **kw):
+    return grazing.simulate(m, x0, periods=periods, impacts="all", **kw)
+
+
+def test_stick_slip_against_the_exact_solution():
+    m = friction_oscillator(**VALUES)
+    ref = FrictionReference(dict(m.params))
+    periods = 6
+    sol = _simulate(m, [0.0, 0.0], periods, tangent=Tangent(jacobian=True))
+    x_ref, mode, t_prev, J, events = np.zeros(2), BEHIND, 0.0, np.eye(2), []
+    for i, ts in enumerate(sol.t):
+        x_ref, mode, Jstep, ev = ref.run(x_ref, mode, t_prev, ts)
+        J, t_prev = Jstep @ J, ts
+        events += ev
+        assert np.allclose(sol.samples[i], x_ref, rtol=0, atol=1e-10), (i, sol.samples[i] - x_ref)
+    kinds = [kind for _, kind in events]
+    assert kinds.count("stick") >= 3 and kinds.count("slip") >= 3 and kinds.count("cross") >= 1
+    sw = sol.switches
+    assert len(sw) == len(events)
+    assert np.abs(sw.t - [tz for tz, _ in events]).max() < 1e-12
+    names = [sw.target(i) if sw.target(i).startswith("sliding") else "cross/slip" for i in range(len(sw))]
+    assert names == ["sliding on 'belt'" if k == "stick" else "cross/slip" for k in kinds]
+    slips = [i for i, k in enumerate(kinds) if k == "slip"]
+    assert {sw.target(i) for i in slips} == {"slip_ahead", "slip_behind"}  # both exits
+    # The stick intervals: from each entry to the following exit (or the end), on surface 0.
+    starts = [tz for tz, k in events if k == "stick"]
+    ends = [tz for tz, k in events if k == "slip"] + ([sol.t_final] if mode == STICK else [])
+    assert sol.sliding.shape == (len(starts), 3) and np.all(sol.sliding[:, 2] == 0)
+    assert np.abs(sol.sliding[:, 0] - starts).max() < 1e-12 and np.abs(sol.sliding[:, 1] - ends).max() < 1e-12
+    assert sol.mode_final == m.mode_names[mode]
+    assert sol.jacobian_valid
+    assert np.allclose(sol.jacobian, J, rtol=0, atol=1e-9 * max(1.0, np.abs(J).max())), sol.jacobian - J
+
+
+def test_the_stick_phase_is_exact_and_on_the_belt():
+    """Dense samples in a stick: x = x0 + v_b (t - t0) and x' = v_b (the projection onto h = 0)."""
+    m = friction_oscillator(**VALUES)
+    sol = _simulate(m, [0.0, 0.0], 3, save=grazing.SaveAt(periods=3, trajectory=400))
+    (t0, t1, _), *_ = sol.sliding
+    x0 = sol.switches.state[np.argmin(np.abs(sol.switches.t - t0)), 0]  # (where the stick starts)
+    inside = (sol.trajectory_t > t0) & (sol.trajectory_t < t1)
+    assert inside.sum() > 10
+    x_exact = x0 + VALUES["v_belt"] * (sol.trajectory_t[inside] - t0)
+    assert np.abs(sol.trajectory[inside, 0] - x_exact).max() < 1e-12
+    assert np.abs(sol.trajectory[inside, 1] - VALUES["v_belt"]).max() < 1e-12
+
+
+def test_jacobian_and_sensitivities_against_differences_of_the_exact_flow():
+    m = friction_oscillator(**VALUES)
+    periods = 4
+    names = ("mu", "v_belt")
+    sol = _simulate(m, [0.3, -0.2], periods, tangent=Tangent(sensitivities=names))
+    assert sol.sliding.shape[0] >= 2 and sol.jacobian_valid
+
+    def final(x0, **changes):
+        p = {**dict(m.params), **changes}
+        return FrictionReference(p).run(np.asarray(x0, dtype=float), BEHIND, 0.0, sol.t_final)[0]
+
+    eps = 1e-6
+    fd = np.empty((2, 4))
+    for c in range(2):
+        dx = np.zeros(2)
+        dx[c] = eps
+        fd[:, c] = (final(np.array([0.3, -0.2]) + dx) - final(np.array([0.3, -0.2]) - dx)) / (2 * eps)
+    for c, name in enumerate(names, start=2):
+        value = m.params[name]
+        fd[:, c] = (final([0.3, -0.2], **{name: value + eps}) - final([0.3, -0.2], **{name: value - eps})) / (
+            2 * eps
+        )
+    assert np.allclose(sol.jacobian, fd, rtol=0, atol=1e-7 * max(1.0, np.abs(fd).max())), sol.jacobian - fd
+
+
+def test_the_entry_saltation_matters_here():
+    """A Jacobian that skipped the entry saltation (S = I) would be far off: the tests above see it."""
+    ref = FrictionReference(dict(VALUES))
+    _, _, J, events = ref.run(np.zeros(2), BEHIND, 0.0, 6 * 2 * math.pi / VALUES["omega"])
+    assert any(k == "stick" for _, k in events)
+    plain = FrictionReference(dict(VALUES))
+    hx = np.array([0.0, 1.0])
+    # With S = I at a stick's entry the variation of x' survives into the stick: dv stays nonzero.
+    x, t, J0 = np.zeros(2), 0.0, np.eye(2)
+    tz = next(tz for tz, k in events if k == "stick")
+    x = plain.slip.flow(BEHIND, x, 0.0, tz)
+    J0 = expm(plain.slip.modes[BEHIND].A * tz)
+    assert abs((hx @ J0)).max() > 1e-2  # before the entry the variations leave the surface ...
+    S = np.eye(2) + np.outer(np.array([VALUES["v_belt"], 0.0]) - plain.slip.f(BEHIND, x, tz), hx) / (
+        hx @ plain.slip.f(BEHIND, x, tz)
+    )
+    assert np.abs(hx @ S @ J0).max() < 1e-12  # ... the entry saltation puts them on it
+
+
+def test_lyapunov_exponents_through_sliding():
+    """On the periodic stick-slip orbit: the largest exponent is the exact monodromy matrix's, per unit
+    time; sticking collapses the other direction (rank one: -inf)."""
+    m = friction_oscillator(**VALUES)
+    sol = grazing.simulate(m, [0.0, 0.0], transient=60, periods=40, lyapunov=True)
+    p = sol.period()
+    assert p >= 1 and sol.sliding.shape[0] >= 10
+    ref = FrictionReference(dict(VALUES))
+    mode = m.mode_names.index(sol.mode_final)
+    _, _, J, _ = ref.run(sol.x_final, mode, sol.t_final, sol.t_final + p * m.period)
+    exact = math.log(np.abs(np.linalg.eigvals(J)).max()) / (p * m.period)
+    assert abs(sol.lyapunov[0] - exact) < 1e-3 * max(1.0, abs(exact)), (sol.lyapunov, exact)
+    assert sol.lyapunov[1] == -math.inf
+
+
+def test_filippov_field_keeps_the_surface():
+    """h_x f_s + h_t == 0 identically (symbolically), and the compiled pseudo-mode's field is f_s."""
+    m = friction_oscillator(**VALUES)
+    system = m.symbolic
+    (sl,) = system.sliding_modes()
+    sf = system.surfaces[sl.surface]
+    fs = system.filippov_field(sl.surface)
+    assert sp.simplify(sum(sp.diff(sf.h, s) * f for s, f in zip(system.states, fs)) + sp.diff(sf.h, system.time)) == 0
+    x = np.array([0.3, VALUES["v_belt"]])
+    assert np.allclose(m.vector_field(x, 1.0, "sliding on 'belt'"), [VALUES["v_belt"], 0.0], rtol=0, atol=1e-15)
+
+
+x_, v_, t_ = sp.symbols("x v t")
+w_ = sp.Symbol("omega")
+
+
+def opposing(surface: bool) -> HybridModel:
+    """Two fields pushing into x = 0 from both sides, as transitions or as a surface with sliding."""
+    modes = [Mode("up", [-1 + 0 * v_, sp.cos(w_ * t_)]), Mode("down", [1 + 0 * v_, sp.cos(w_ * t_)])]
+    if surface:
+        kw = {"surfaces": [Surface("wall", x_, "up", "down")]}
+    else:
+        kw = {"transitions": [Transition("touch", "up", "down", x_), Transition("leave", "down", "up", -x_)]}
+    params = [Parameter("omega", 1.0, lower=0, lower_open=True)]
+    return HybridModel("opposing", [x_, v_], t_, params, period=2 * sp.pi / w_, modes=modes, **kw)
+
+
+def test_opposing_fields_slide_once_the_surface_is_declared():
+    """Without a surface they end in one line (test_mode_switches); with it they slide, x = 0, v' = cos t."""
+    sol = grazing.simulate(opposing(True), [1.0, 0.0], periods=3, jacobian=True)
+    assert sol.mode_final == "sliding on 'wall'"
+    assert sol.sliding.shape == (1, 3) and abs(sol.sliding[0, 0] - 1.0) < 1e-12
+    assert abs(sol.sliding[0, 1] - sol.t_final) < 1e-12
+    assert np.abs(sol.samples[:, 0]).max() < 1e-15
+    assert np.allclose(sol.samples[:, 1], np.sin(sol.t), rtol=0, atol=1e-12)
+    # d x_final / d x0: x0 moves the arrival time (x = 0 at t = x0), not the sliding state x = 0, v = sin t.
+    assert np.allclose(sol.jacobian, [[0.0, 0.0], [0.0, 1.0]], rtol=0, atol=1e-12)
+
+
+def test_no_sliding_pseudo_mode_to_start_in():
+    m = friction_oscillator()
+    with pytest.raises(grazing.InvalidParameterError, match="cannot start in mode \"sliding on 'belt'\""):
+        grazing.simulate(m, [0.0, 0.5], periods=1, mode="sliding on 'belt'")
