@@ -120,7 +120,8 @@ def accumulation_message(model: HybridModel, x: Any, t: float) -> str:
         )
         return (
             f"modes {', '.join(map(repr, modes))} switch back and forth at zero time at t = {t:.6g} (their "
-            "fields push into each other): sliding between modes is not supported yet"
+            "fields push into each other): declare their boundary as a Surface with sliding=True to slide "
+            "on it"
         )
     sticks = model.kernels().STICKS
     if len(on) >= 2:

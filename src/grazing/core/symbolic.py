@@ -149,7 +149,7 @@ class Surface:
 
 @dataclass(frozen=True)
 class SlidingMode:
-    """Where a sliding pseudo-mode sits among a model's modes and transitions (:meth:`SymbolicSystem.sliding_modes`).
+    """Where a sliding pseudo-mode sits among modes and transitions (:meth:`SymbolicSystem.sliding_modes`).
 
     Attributes
     ----------

@@ -261,7 +261,9 @@ def generate_source(system: SymbolicSystem, directions: int = 0, order: int = DE
         row_exprs = [[guards[j] for j in rows[k]] for k in range(nmodes)]
         for sl in sliding:  # a pseudo-mode: Filippov's field, its exits, then both sides' other transitions
             others = [
-                j for j in range(nstops) if sys_.sources[j] in (sl.positive, sl.negative) and j not in (sl.down, sl.up)
+                j
+                for j in range(nstops)
+                if sys_.sources[j] in (sl.positive, sl.negative) and j not in (sl.down, sl.up)
             ]
             rows.append([sl.base, sl.base + 1, *others])
             fields.append(sys_.filippov_field(sl.surface))
