@@ -277,6 +277,43 @@ def test_opposing_fields_slide_once_the_surface_is_declared():
     assert np.allclose(sol.jacobian, [[0.0, 0.0], [0.0, 1.0]], rtol=0, atol=1e-12)
 
 
+def test_sliding_stays_on_a_surface_that_its_rounded_field_leaves():
+    """x' = -1 - x^2 above the diagonal h = x - y, 2 + sin(x)/2 below, y' = 1: from (1, 0) the motion reaches
+    the diagonal where tan(pi/4 - t) = t and slides on it for good, x = y = t.  Filippov's field does not
+    simplify here: its rounding drifts off the surface (3e-11 in 300 steps) unless the samples (and each
+    step's end) are put back on it."""
+    xs, ys, ts = sp.symbols("x y t")
+    model = HybridModel(
+        "diagonal", [xs, ys], ts, [Parameter("c", 1.0)], period=1, periodic=False,
+        modes=[Mode("above", [-1 - xs**2 + 0 * sp.Symbol("c"), 1]), Mode("below", [2 + sp.sin(xs) / 2, 1])],
+        surfaces=[Surface("diag", xs - ys, "above", "below")],
+    )  # fmt: skip
+    sol = grazing.simulate(model, [1.0, 0.0], periods=300)
+    entry = brentq(lambda tt: math.tan(math.pi / 4 - tt) - tt, 0.1, 0.7, xtol=1e-15)
+    assert sol.sliding.shape == (1, 3) and abs(sol.sliding[0, 0] - entry) < 1e-12
+    assert sol.sliding[0, 1] == sol.t_final and sol.mode_final == "sliding on 'diag'"
+    assert np.all(sol.samples[:, 0] == sol.samples[:, 1])  # on the surface, to the last bit
+    assert np.abs(sol.samples[:, 0] - sol.t).max() < 1e-12 * sol.t[-1]  # (the time steps' rounding)
+
+
+def test_sliding_intervals_of_the_sampled_span_across_chunks(monkeypatch):
+    """After a transient and in chunks of two periods, the intervals are those of one whole run within
+    the recorded span (it starts a period before the first sample), a stick split by a chunk joined."""
+    from grazing.engine import simulate as simulate_module
+
+    m = friction_oscillator(**VALUES)
+    whole = _simulate(m, [0.0, 0.0], 13, phase=0.25)  # (samples, and chunks' ends, inside sticks)
+    monkeypatch.setattr(simulate_module, "CHUNK_PERIODS", 2)
+    part = grazing.simulate(m, [0.0, 0.0], transient=3, periods=10, phase=0.25)
+    span = part.t[0] - m.period
+    expected = whole.sliding[whole.sliding[:, 1] > span].copy()
+    expected[0, 0] = max(expected[0, 0], span)
+    assert part.sliding.shape == expected.shape and np.abs(part.sliding - expected).max() < 1e-9
+    chunk_ends = part.t[0] + (np.arange(2, 13, 2) - 4) * m.period  # (at every second sample)
+    assert any(a < tc < b for a, b, _ in part.sliding for tc in chunk_ends)  # a stick across a chunk's end
+    assert np.array_equal(part.sliding, part.sliding[np.argsort(part.sliding[:, 0])])
+
+
 def test_no_sliding_pseudo_mode_to_start_in():
     m = friction_oscillator()
     with pytest.raises(grazing.InvalidParameterError, match="cannot start in mode \"sliding on 'belt'\""):
