@@ -218,7 +218,10 @@ class Switches:
     state
         The state at the switch (after the reset, if any), shape ``(n_switches, n_states)``.
     transition_names
-        The model's transitions (:attr:`~grazing.core.model.HybridModel.stop_names`).
+        The model's transitions (:attr:`~grazing.core.model.HybridModel.stop_names`), then its
+        sliding pseudo-modes' exits and entries
+        (:attr:`~grazing.core.model.HybridModel.switch_names`: ``belt_slide_from_slip_ahead`` enters
+        ``"sliding on 'belt'"``, ``belt_exit_to_slip_behind`` leaves it).
     sources, targets
         Per transition, the mode it leaves and the mode it enters.
 
