@@ -23,6 +23,7 @@ PYTHON_ONLY = {
     "stops=": "HybridModel's: a model file, Python on the command line too",
     "contact_direction=": "HybridModel's, as stops=",
     "vector_field=": "HybridModel's, as stops=",
+    "sliding=True": "Surface's, as stops=",
     "transitions=": "HybridModel's (a model with modes), as stops=",
     "surfaces=": "HybridModel's (a model with modes), as stops=",
     "initial_mode=": "HybridModel's (a model with modes), as stops=",

@@ -119,13 +119,6 @@ def test_start_in_another_mode_and_one_line_refusals():
     with pytest.raises(InvalidParameterError, match=r"^a run from a grazing contact with transition 'leave' "
                        r"starts in its source mode 'contact', not in 'free'$"):  # fmt: skip
         grazing.simulate(m, [0.0, 0.0], periods=1, touching=True, stop_name="leave")
-    sliding = HybridModel(
-        "belt", [x, v], t, [Parameter(nm, val) for nm, val in VALUES.items()], period=2 * sp.pi / w,
-        modes=[Mode("back", [v, -x - k]), Mode("forward", [v, -x + k])],
-        surfaces=[Surface("belt", v - 1, "back", "forward")],
-    )  # fmt: skip
-    with pytest.raises(InvalidParameterError, match=r"^sliding on surface 'belt' is not supported yet"):
-        grazing.simulate(sliding, [0.0, 0.0], periods=1)
 
 
 def test_parameter_sensitivities_across_switches_against_differences_of_the_exact_flow():
@@ -163,3 +156,4 @@ def test_opposing_fields_end_in_one_line_not_a_hang():
     assert (
         "modes 'down', 'up' switch back and forth at zero time at t = 1 " in message and "\n" not in message
     )
+    assert "declare their boundary as a Surface with sliding=True" in message

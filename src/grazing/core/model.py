@@ -248,6 +248,9 @@ class _Definition:
         self.time_label = time_label
         self.mode_names: tuple[str, ...] = ("free",)
         self.transition_modes: tuple[tuple[str, str], ...] | None = None
+        self.sliding_switches: tuple[tuple[str, str, str], ...] = ()
+        self.surface_names: tuple[str, ...] = ()
+        self.sliding_surfaces: tuple[int, ...] = ()  # the surfaces with sliding=True (indices)
         if symbolic is not None and "modes" in symbolic:
             self.mode_names = tuple(md[0] for md in symbolic["modes"])
             bad_modes = [nm for nm in self.mode_names if not (isinstance(nm, str) and nm.isidentifier())]
@@ -256,6 +259,10 @@ class _Definition:
             layout = _transition_layout(symbolic)
             stop_names = [item[0] for item in layout]
             self.transition_modes = tuple((item[1], item[2]) for item in layout)
+            self.surface_names = tuple(sf[0] for sf in symbolic["surfaces"])
+            self.sliding_surfaces = tuple(i for i, sf in enumerate(symbolic["surfaces"]) if sf[4])
+            pseudo, self.sliding_switches = _sliding_layout(symbolic)
+            self.mode_names += pseudo
             if not stop_names:
                 raise ValueError("a model with modes needs at least one transition, stop or surface")
         elif symbolic is not None:
@@ -445,6 +452,31 @@ def _transition_layout(symbolic: Mapping[str, Any]) -> list[tuple[str, str, str,
         out.append((f"{name}_to_{negative}", positive, negative, h, None, None, 1))
         out.append((f"{name}_to_{positive}", negative, positive, h, None, None, -1))
     return out
+
+
+def _sliding_layout(symbolic: Mapping[str, Any]) -> tuple[tuple[str, ...], tuple[tuple[str, str, str], ...]]:
+    """The sliding pseudo-modes of a model with modes and their virtual transitions, by name.
+
+    Returns the pseudo-modes' names (``"sliding on 'belt'"``, one per surface
+    with ``sliding=True``, after the real modes) and per pseudo-mode four
+    virtual transitions ``(name, source, target)`` after the real ones: the exits
+    to the positive and the negative side, the entries from the positive and
+    the negative side (the order of
+    :meth:`~grazing.core.symbolic.SymbolicSystem.sliding_modes`).
+    """
+    names, switches = [], []
+    for name, _, positive, negative, sliding in symbolic["surfaces"]:
+        if not sliding:
+            continue
+        mode = f"sliding on {name!r}"
+        names.append(mode)
+        switches += [
+            (f"{name}_exit_to_{positive}", mode, positive),
+            (f"{name}_exit_to_{negative}", mode, negative),
+            (f"{name}_slide_from_{positive}", positive, mode),
+            (f"{name}_slide_from_{negative}", negative, mode),
+        ]
+    return tuple(names), tuple(switches)
 
 
 def _modes_system(
@@ -1075,12 +1107,51 @@ class HybridModel:
 
     @property
     def mode_names(self) -> tuple[str, ...]:
-        """The names of the model's modes (``("free",)`` for a model of one vector field)."""
+        """The names of the model's modes (``("free",)`` for a model of one vector field), then its sliding
+        pseudo-modes (``"sliding on 'belt'"``, :attr:`sliding_modes`)."""
         return self._def.mode_names
 
     @property
     def n_modes(self) -> int:
         return len(self._def.mode_names)
+
+    @property
+    def surface_names(self) -> tuple[str, ...]:
+        """The names of the model's switching surfaces (:class:`Surface`; empty without any)."""
+        return self._def.surface_names
+
+    @property
+    def sliding_modes(self) -> dict[int, int]:
+        """The sliding pseudo-modes: each one's mode index (into :attr:`mode_names`) to its surface's index.
+
+        A surface with ``sliding=True`` has a pseudo-mode ``"sliding on 'name'"``
+        after the real modes: the motion on the surface, along Filippov's
+        convex combination of the two sides' fields.
+        """
+        sliding = self._def.sliding_surfaces
+        first = len(self.mode_names) - len(sliding)
+        return {first + k: i for k, i in enumerate(sliding)}
+
+    @property
+    def sliding_names(self) -> tuple[str, ...]:
+        """The names of the sliding pseudo-modes (the last of :attr:`mode_names`)."""
+        return tuple(self.mode_names[k] for k in self.sliding_modes)
+
+    @property
+    def switch_names(self) -> tuple[str, ...]:
+        """Every transition a switch may be on: :attr:`stop_names`, then the sliding pseudo-modes' exits
+        and entries (``belt_exit_to_slip``, ``belt_slide_from_slip``; see :attr:`sliding_modes`)."""
+        return self.stop_names + tuple(sw[0] for sw in self._def.sliding_switches)
+
+    @property
+    def switch_sources(self) -> tuple[str, ...]:
+        """The mode each of :attr:`switch_names` leaves."""
+        return self.transition_source + tuple(sw[1] for sw in self._def.sliding_switches)
+
+    @property
+    def switch_targets(self) -> tuple[str, ...]:
+        """The mode each of :attr:`switch_names` enters."""
+        return self.transition_target + tuple(sw[2] for sw in self._def.sliding_switches)
 
     @property
     def has_modes(self) -> bool:
@@ -1115,8 +1186,14 @@ class HybridModel:
         0
         """
         name = self.initial_mode if mode is None else mode
-        if name not in self.mode_names:
-            known = ", ".join(self.mode_names)
+        real = self.mode_names[: len(self.mode_names) - len(self.sliding_modes)]
+        if name not in real:
+            known = ", ".join(real)
+            if name in self.mode_names:
+                raise InvalidParameterError(
+                    f"a run cannot start in mode {name!r} of model {self.name!r}: start on the surface in "
+                    f"either side's mode (modes: {known}); it slides from there"
+                )
             raise InvalidParameterError(f"unknown mode {name!r} for model {self.name!r} (modes: {known})")
         return self.mode_names.index(name)
 
@@ -1197,11 +1274,13 @@ class HybridModel:
         return fn(list(np.asarray(x, dtype=float)), float(t), list(self.param_vector))
 
     def vector_field(self, x: Any, t: float = 0.0, mode: str | None = None) -> np.ndarray:
-        """``f(x, t)`` of ``mode`` (the initial mode by default; evaluated by the compiled kernels)."""
+        """``f(x, t)`` of ``mode`` (the initial mode by default; a sliding pseudo-mode's is Filippov's field;
+        evaluated by the compiled kernels)."""
         out = np.empty(self.n_states)
         x = np.ascontiguousarray(x, dtype=float)
         if self.has_modes:
-            self._def.scalar_kernels().rhs(x, float(t), self.param_vector, out, self.mode_index(mode))
+            k = self.mode_names.index(mode) if mode in self.sliding_names else self.mode_index(mode)
+            self._def.scalar_kernels().rhs(x, float(t), self.param_vector, out, k)
         else:
             self.mode_index(mode)  # (only the one mode's name)
             self._def.scalar_kernels().rhs(x, float(t), self.param_vector, out)

@@ -126,7 +126,8 @@ def accumulation_message(model: HybridModel, x: Any, t: float) -> str:
         )
         return (
             f"modes {', '.join(map(repr, modes))} switch back and forth at zero time at t = {t:.6g} (their "
-            "fields push into each other): sliding between modes is not supported yet"
+            "fields push into each other): declare their boundary as a Surface with sliding=True to slide "
+            "on it"
         )
     sticks = model.kernels().STICKS
     if len(on) >= 2:
@@ -223,7 +224,10 @@ class Switches:
     state
         The state at the switch (after the reset, if any), shape ``(n_switches, n_states)``.
     transition_names
-        The model's transitions (:attr:`~grazing.core.model.HybridModel.stop_names`).
+        The model's transitions (:attr:`~grazing.core.model.HybridModel.stop_names`), then its
+        sliding pseudo-modes' exits and entries
+        (:attr:`~grazing.core.model.HybridModel.switch_names`: ``belt_slide_from_slip_ahead`` enters
+        ``"sliding on 'belt'"``, ``belt_exit_to_slip_behind`` leaves it).
     sources, targets
         Per transition, the mode it leaves and the mode it enters.
 
@@ -321,6 +325,13 @@ class Solution:
         A model with modes: the mode of every sample (an index into
         :attr:`mode_names`, the mode after any switch at the sample's time);
         None for a model of one mode.
+    sliding
+        A model with modes: its sliding intervals during the sampled span, rows
+        ``[t_start, t_end, surface]`` (``surface`` an index into
+        :attr:`~grazing.HybridModel.surface_names`; the motion on a surface with
+        ``sliding=True``, in its pseudo-mode ``"sliding on 'name'"``, entered and
+        left by the switches in :attr:`switches`); None for a model of one mode
+        or a run that records no impacts (``SaveAt(impacts="none")``: no switches either).
 
     Examples
     --------
@@ -361,6 +372,7 @@ class Solution:
     switches: Switches | None = None
     mode_final: str | None = None
     modes: np.ndarray | None = None
+    sliding: np.ndarray | None = None
 
     @property
     def mode_names(self) -> tuple[str, ...]:

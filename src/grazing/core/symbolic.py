@@ -148,6 +148,39 @@ class Surface:
 
 
 @dataclass(frozen=True)
+class SlidingMode:
+    """Where a sliding pseudo-mode sits among modes and transitions (:meth:`SymbolicSystem.sliding_modes`).
+
+    Attributes
+    ----------
+    surface
+        The index of its surface (into :attr:`SymbolicSystem.surfaces`).
+    name
+        ``"sliding on 'belt'"``.
+    mode
+        Its mode index (after the real modes).
+    base
+        The index of its first virtual transition (exit to the positive side;
+        then the exit to the negative side, the entry from the positive side and
+        the entry from the negative side).
+    positive, negative
+        The indices of the modes on the sides ``h > 0`` and ``h < 0``.
+    down, up
+        The surface's transitions from the positive side (guard ``h``) and from
+        the negative side (guard ``-h``).
+    """
+
+    surface: int
+    name: str
+    mode: int
+    base: int
+    positive: int
+    negative: int
+    down: int
+    up: int
+
+
+@dataclass(frozen=True)
 class SymbolicSystem:
     """The symbolic pieces of a hybrid model that the code generator needs.
 
@@ -327,6 +360,30 @@ class SymbolicSystem:
         lp, ln = pos.lie(h), neg.lie(h)
         weight = lp / (lp - ln)
         return tuple(fp + weight * (fn - fp) for fp, fn in zip(pos.vector_field, neg.vector_field))
+
+    def sliding_modes(self) -> tuple[SlidingMode, ...]:
+        """The sliding pseudo-modes of a model with modes, one per surface with ``sliding=True``.
+
+        Pseudo-mode ``i`` has the mode index ``len(modes) + i`` (after the real
+        modes) and the transition indices ``len(stops) + 4 i + c`` after the real
+        transitions: ``c = 0, 1`` the exits to the positive and to the negative
+        side (its first two event rows, :meth:`exit_rows`), ``c = 2, 3`` the
+        entries from the positive and from the negative side (recorded as
+        switches; located as the crossings of the surface's transitions).
+        """
+        out = []
+        names = self.mode_names
+        stops = self.stop_names
+        for k, sf in enumerate(self.surfaces):
+            if not sf.sliding:
+                continue
+            out.append(SlidingMode(
+                surface=k, name=f"sliding on {sf.name!r}", mode=len(self.modes) + len(out),
+                base=len(self.stops) + 4 * len(out), positive=names.index(sf.positive),
+                negative=names.index(sf.negative), down=stops.index(f"{sf.name}_to_{sf.negative}"),
+                up=stops.index(f"{sf.name}_to_{sf.positive}"),
+            ))  # fmt: skip
+        return tuple(out)
 
     def exit_rows(self, index: int) -> tuple[sp.Expr, sp.Expr]:
         """``(-L_+ h, L_- h)`` of surface ``index``: both positive while sliding, one reaches 0 at an exit."""

@@ -187,7 +187,11 @@ class ModelSource:
         (per stop: it has a sticking mode); with several modes also ``nmodes``,
         ``rows`` (per mode, the transition of each of its event rows, -1 for
         padding), ``targets``, ``resets`` and ``back`` (per transition: the
-        switch back whose guard is 0 right after it, -1 none).
+        switch back whose guard is 0 right after it, -1 none) and
+        ``slide_entry`` (per transition: the virtual transition into a sliding
+        pseudo-mode that replaces its crossing where the far side pushes back,
+        -1 none); the transitions are the real ones, then four virtual ones per
+        sliding pseudo-mode (:meth:`~grazing.core.symbolic.SymbolicSystem.sliding_modes`).
     """
 
     text: str
@@ -252,11 +256,24 @@ def generate_source(system: SymbolicSystem, directions: int = 0, order: int = DE
         sticky = [j for j, stop in enumerate(sys_.stops) if stop.contact_direction is not None]
     else:  # per mode: its field, its outgoing transitions' guards padded to as many rows as the most
         rows = [[j for j in range(nstops) if sys_.sources[j] == k] for k in range(nmodes)]
+        sliding = sys_.sliding_modes()
+        fields = [mode.vector_field for mode in sys_.modes]
+        row_exprs = [[guards[j] for j in rows[k]] for k in range(nmodes)]
+        for sl in sliding:  # a pseudo-mode: Filippov's field, its exits, then both sides' other transitions
+            others = [
+                j
+                for j in range(nstops)
+                if sys_.sources[j] in (sl.positive, sl.negative) and j not in (sl.down, sl.up)
+            ]
+            rows.append([sl.base, sl.base + 1, *others])
+            fields.append(sys_.filippov_field(sl.surface))
+            row_exprs.append([*sys_.exit_rows(sl.surface), *(guards[j] for j in others)])
+        nmodes += len(sliding)
         width = max(len(r) for r in rows)
         kernels = []
-        for k, mode in enumerate(sys_.modes):
+        for k in range(nmodes):
             pad = [sp.Integer(1)] * (width - len(rows[k]))
-            kernels += flow_kernels(f"_m{k}", mode.vector_field, [guards[j] for j in rows[k]] + pad)
+            kernels += flow_kernels(f"_m{k}", fields[k], row_exprs[k] + pad)
         f = sys_.vector_field
         sticky = []  # (sticking in a model with modes: not yet)
     # Sticking on stop j: the event rows are the contact force (row j) and the other stops' guards.
@@ -278,8 +295,8 @@ def generate_source(system: SymbolicSystem, directions: int = 0, order: int = DE
         parts.append(
             _scalar_function("rhs", sys_, [(f"out[{i}]", e) for i, e in enumerate(f)], extra_args=", out")
         )
-    for k, mode in enumerate(sys_.modes if nmodes > 1 else ()):
-        assigns = [(f"out[{i}]", e) for i, e in enumerate(mode.vector_field)]
+    for k, field in enumerate(fields if nmodes > 1 else ()):
+        assigns = [(f"out[{i}]", e) for i, e in enumerate(field)]
         parts.append(_scalar_function(f"rhs_m{k}", sys_, assigns, extra_args=", out"))
     every = list(range(nstops))
     for j in every:
@@ -310,9 +327,15 @@ def generate_source(system: SymbolicSystem, directions: int = 0, order: int = DE
     }  # fmt: skip
     if nmodes > 1:  # (a model of one mode: ModelKernels' defaults)
         back = [_transition_back(sys_, j) for j in every]
+        targets, resets, entry = list(sys_.targets), list(sys_.resets), [-1] * nstops
+        for sl in sliding:  # its virtual transitions: the exits to either side, the entries from either side
+            targets += [sl.positive, sl.negative, sl.mode, sl.mode]
+            back += [sl.down, sl.up, -1, -1]
+            resets += [False] * 4
+            entry[sl.down], entry[sl.up] = sl.base + 2, sl.base + 3
         sizes.update(
-            nmodes=nmodes, rows=[r + [-1] * (width - len(r)) for r in rows], targets=list(sys_.targets),
-            resets=list(sys_.resets), back=back,
+            nmodes=nmodes, rows=[r + [-1] * (width - len(r)) for r in rows], targets=targets,
+            resets=resets, back=back, slide_entry=entry + [-1] * (4 * len(sliding)),
         )  # fmt: skip
     return ModelSource("\n\n".join(parts), columns, dispatch, sizes)
 
@@ -579,9 +602,10 @@ class ModelKernels:
         self.TARGETS = np.array(sizes.get("targets", [0] * self.NSTOPS), dtype=np.int64)
         self.RESETS = np.array(sizes.get("resets", [True] * self.NSTOPS), dtype=bool)
         self.BACK = np.array(sizes.get("back", every), dtype=np.int64)
+        self.SLIDE_ENTRY = np.array(sizes.get("slide_entry", [-1] * self.NSTOPS), dtype=np.int64)
         self.table = (
             fns, self.NX, self.NSENS, self.NSTOPS, self.ORDER, sticks, self.LANES, self.NMODES, self.ROWS,
-            self.TARGETS, self.RESETS, self.BACK,
+            self.TARGETS, self.RESETS, self.BACK, self.SLIDE_ENTRY,
         )  # fmt: skip
         for name in SLOTS:
             setattr(self, name, library.function(name))

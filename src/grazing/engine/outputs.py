@@ -100,6 +100,7 @@ class Totals(NamedTuple):
     lyap_span: float
     jacobian_valid: bool
     switch_rows: int
+    vf_span: int
 
     @classmethod
     def of(cls, out: RunOutput) -> Totals:
@@ -125,7 +126,7 @@ def result(out: RunOutput, t: Totals) -> Result:
         samples=_rows(out.samples, t.samples_kept), impacts=_rows(out.impacts, t.impact_rows),
         sticking=_rows(out.sticking, t.sticking_rows), trajectory=_rows(out.trajectory, t.trajectory_rows),
         log_sums=out.log_sums, lyap_span=t.lyap_span, guard_min=out.guard_min,
-        jacobian_valid=t.jacobian_valid, switches=_rows(out.switches, t.switch_rows),
+        jacobian_valid=t.jacobian_valid, switches=_rows(out.switches, t.switch_rows), vf_span=t.vf_span,
         sample_modes=_rows(out.sample_modes, t.samples_kept),
     )  # fmt: skip
 

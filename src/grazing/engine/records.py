@@ -45,6 +45,7 @@ RUN_TOTALS = np.dtype(
         ("lyap_span", "f8"),  # the time the Lyapunov sums are over
         ("jacobian_valid", "?"),
         ("switch_rows", "i8"),  # rows the switches table needs
+        ("vf_span", "i8"),  # the active mode when the recorded span started
     ],
     align=True,
 )
@@ -133,6 +134,7 @@ class Kernels(NamedTuple):
     targets: I8_1  # per transition (stop): the mode it enters
     resets: BOOL_1  # per transition (stop): it has a reset (an impact); else a switch of vector field
     back: I8_1  # per switch: the transition whose guard is 0 just after it (-1: none)
+    slide_entry: I8_1  # per transition: the virtual transition into sliding replacing its crossing (-1: none)
 
 
 class Result(NamedTuple):
@@ -157,6 +159,7 @@ class Result(NamedTuple):
     jacobian_valid: bool
     switches: np.ndarray  # rows [t, transition, state...]: changes of mode (state after any reset)
     sample_modes: np.ndarray  # (kept samples,): the mode (vector field) of each kept sample
+    vf_span: int  # the active mode when the recorded span started
 
 
 class RunOutput(NamedTuple):

@@ -106,6 +106,7 @@ class Segment:
     steps: int
     switches: np.ndarray  # rows [t, transition index, state...] (models with modes)
     sample_modes: np.ndarray  # the mode of each sample (as samples)
+    vf_span: int = 0  # the active mode when the recorded span started
 
 
 def step_safety(tol: float, order: int) -> float:
@@ -306,4 +307,5 @@ class Runner:
             out.samples, out.impacts, out.n_impacts, out.sticking, out.trajectory, out.log_sums,
             out.lyap_span, gm[:, : 2 + n], gm[:, 2 + n :], out.jacobian_valid, out.steps, out.switches,
             out.sample_modes,
+            out.vf_span,
         )  # fmt: skip

@@ -170,6 +170,7 @@ def simulate(
     parts: dict[str, list[np.ndarray]] = {
         k: [] for k in ("samples", "imp", "sticks", "traj", "switch", "modes")
     }
+    slides: list[np.ndarray] = []
     log_sum = np.zeros(n)
     lyap_span = 0.0
     gmin: np.ndarray | None = None
@@ -178,6 +179,7 @@ def simulate(
     while done < total:
         chunk = min(CHUNK_PERIODS, total - done)
         keep = max(0, done + chunk - transient) - max(0, done - transient)
+        t_chunk = run.t
         run.touch_end = touching and done + chunk == total
         seg = run.advance(
             chunk, keep, lyapunov=lyapunov, guard_min=guard_min, impacts=impacts,
@@ -198,6 +200,9 @@ def simulate(
             ("modes", seg.sample_modes),
         ):
             parts[key].append(arr)
+        if keep and model.sliding_modes:  # the recorded span's sliding intervals in this chunk
+            t_span = t_chunk if done >= transient else first_sample + (transient - 1) * T
+            slides.append(_sliding_intervals(model, seg.switches, seg.vf_span, t_span, run.vf, run.t))
         log_sum += seg.log_sums
         lyap_span += seg.lyap_span
         if guard_min and keep:  # the smallest over the chunks, for each stop
@@ -221,8 +226,8 @@ def simulate(
     if model.has_modes:
         sw = _concat(parts["switch"], 2 + n)
         switches = Switches(
-            t=sw[:, 0], transition=sw[:, 1].astype(int), state=sw[:, 2:], transition_names=model.stop_names,
-            sources=model.transition_source, targets=model.transition_target,
+            t=sw[:, 0], transition=sw[:, 1].astype(int), state=sw[:, 2:], transition_names=model.switch_names,
+            sources=model.switch_sources, targets=model.switch_targets,
         )  # fmt: skip
     return Solution(
         model=model,
@@ -262,6 +267,7 @@ def simulate(
         switches=switches,
         mode_final=model.mode_names[run.vf] if model.has_modes else None,
         modes=np.concatenate([np.empty(0, np.int64), *parts["modes"]]) if model.has_modes else None,
+        sliding=_merge_intervals(_concat(slides, 3)) if model.has_modes and impacts != "none" else None,
     )
 
 
@@ -290,12 +296,6 @@ def _refuse_on_modes(
     if not events:
         model.require_one_mode("a run without events (events=False)")
     system = model.symbolic
-    for sf in system.surfaces:
-        if sf.sliding:
-            raise InvalidParameterError(
-                f"sliding on surface {sf.name!r} is not supported yet: give it sliding=False (model "
-                f"{model.name!r})"
-            )
     for j, name in enumerate(model.stop_names):
         if system.stops[j].contact_direction is not None:
             raise InvalidParameterError(
@@ -356,13 +356,45 @@ def _concat(arrays: list[np.ndarray], width: int) -> np.ndarray:
 
 
 def _merge_intervals(iv: np.ndarray) -> np.ndarray:
-    """Join sticking intervals that a chunk boundary split in two."""
+    """Join sticking (or sliding) intervals that a chunk boundary split in two.
+
+    Rows ``[start, end]``, or ``[start, end, surface]``: then only intervals
+    on the same surface are joined.
+    """
     if iv.shape[0] < 2:
         return iv
     out = [iv[0].copy()]
-    for a, b in iv[1:]:
-        if a <= out[-1][1]:
-            out[-1][1] = max(out[-1][1], b)
+    for row in iv[1:]:
+        same = row.shape[0] < 3 or row[2] == out[-1][2]
+        if same and row[0] <= out[-1][1]:
+            out[-1][1] = max(out[-1][1], row[1])
         else:
-            out.append(np.array([a, b]))
+            out.append(row.copy())
     return np.array(out)
+
+
+def _sliding_intervals(
+    model: HybridModel, switches: np.ndarray, vf_start: int, t_start: float, vf_end: int, t_end: float
+) -> np.ndarray:
+    """Rows ``[start, end, surface]`` of the sliding of a recorded span from ``t_start`` to ``t_end``.
+
+    The span starts in mode ``vf_start`` and ends in ``vf_end``; ``switches``
+    are its rows ``[t, transition, state...]`` (:attr:`HybridModel.switch_names`).
+    Sliding is the time spent in a sliding pseudo-mode (:attr:`HybridModel.sliding_modes`).
+    """
+    sliding = model.sliding_modes
+    modes = model.mode_names
+    target = [modes.index(name) for name in model.switch_targets]
+    rows = []
+    mode, since = vf_start, t_start
+    for t, j in switches[:, :2]:
+        if t <= t_start:  # (impacts="all": the switches before the span are recorded too)
+            continue
+        new = target[int(j)]
+        if new != mode:
+            if mode in sliding:
+                rows.append((since, t, sliding[mode]))
+            mode, since = new, t
+    if mode in sliding and vf_end == mode:
+        rows.append((since, t_end, sliding[mode]))
+    return np.array(rows, dtype=float).reshape(-1, 3)

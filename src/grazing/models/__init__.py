@@ -1,6 +1,7 @@
 """Built-in models, each citing its source."""
 
 from grazing.models.bouncing_ball import bouncing_ball
+from grazing.models.friction_oscillator import friction_oscillator
 from grazing.models.impact_damper import impact_damper
 from grazing.models.impact_oscillator import impact_oscillator
 from grazing.models.pendulum import CASES, DEFAULT_CASE, case_values, pendulum
@@ -16,6 +17,7 @@ BUILT_IN = {
     "impact-damper": impact_damper,
     "soft-impact-oscillator": soft_impact_oscillator,
     "rocking-block": rocking_block,
+    "friction-oscillator": friction_oscillator,
 }
 """The built-in models by their command-line names (each a function of parameter overrides)."""
 
@@ -25,6 +27,7 @@ __all__ = [
     "DEFAULT_CASE",
     "bouncing_ball",
     "case_values",
+    "friction_oscillator",
     "impact_damper",
     "impact_oscillator",
     "pendulum",

@@ -87,8 +87,8 @@ def saltation(m, xm, xp, s, pv, j, V, ncol, vf_from, vf_to):
 
 
 @njit(cache=True)
-def enter_contact(m, x, s, pv, j):
-    """Project x onto the contact manifold {h = 0, L_f h = 0} of stop ``j``."""
+def onto_guard(m, x, s, pv, j):
+    """Project x onto the zero set of stop ``j``'s guard (Newton along its gradient, three steps at most)."""
     n = m.nx
     gx = np.zeros(n)
     for _ in range(3):
@@ -101,6 +101,13 @@ def enter_contact(m, x, s, pv, j):
             break
         for i in range(n):
             x[i] -= hval * gx[i] / nn
+
+
+@njit(cache=True)
+def enter_contact(m, x, s, pv, j):
+    """Project x onto the contact manifold {h = 0, L_f h = 0} of stop ``j``."""
+    n = m.nx
+    onto_guard(m, x, s, pv, j)
     e = np.zeros(n)
     contact_dir(m, x, s, pv, e, j)
     gr = np.zeros(n)
@@ -166,6 +173,13 @@ def at_event(m, r, x, xp, pv, j, nrows, V, chatter_time, record, tables):
     ``tables[1]`` (``r.n_stick``).
     """
     t = r.k * r.T + r.s
+    if j >= m.nstops:  # sliding ends at a tangency: to that side (f_s = f there, S = I)
+        leave_sliding(m, r, x, j, record, tables)
+        return False
+    entry = m.slide_entry[j]
+    if entry >= 0 and r.surface == 0 and normal_rate(m, x, r.s, pv, m.back[j]) < 0.0:
+        enter_sliding(m, r, x, pv, j, V, record, tables)  # (the far side's field pushes back)
+        return False
     if not m.resets[j]:  # a switch of vector field: the state goes on, the field changes
         switch_mode(m, r, x, pv, j, V, record, tables)
         return False
@@ -232,7 +246,76 @@ def switch_mode(m, r, x, pv, j, V, record, tables):
         append_row(tables[2], r.n_traj, t, x, n)
         r.n_traj += 1
     r.vf = target
+    r.surface = 0
     r.defl = 1 if m.back[j] >= 0 else 0
+    r.defl_stop = m.back[j]
+
+
+@njit(cache=True)
+def sliding_guard(m, vf):
+    """The transition whose guard is 0 on the surface of sliding pseudo-mode ``vf``, or -1 (a real mode).
+
+    A pseudo-mode's first event row is its exit to the positive side, a virtual
+    transition (``>= m.nstops``) whose way back is the surface's transition
+    from that side.
+    """
+    first = m.rows[vf, 0]
+    return m.back[first] if first >= m.nstops else -1
+
+
+@njit(cache=True)
+def enter_sliding(m, r, x, pv, j, V, record, tables):
+    """Run ``r``, crossing the surface of transition ``j`` where the far side's field pushes back, slides.
+
+    The crossing is replaced by the virtual transition ``m.slide_entry[j]``
+    into the sliding pseudo-mode (Filippov's field ``f_s``): the variational
+    matrix is multiplied by the saltation matrix of a switch with ``f+ = f_s``
+    (after which ``h_x V + h_p = 0``: the variations stay on the surface), the
+    state put onto the surface, and the entry recorded as ``[t, entry, state]``
+    in ``tables[3]`` when ``record``.  No root at ``u = 0`` is known: the exit
+    rows are nonzero in strict sliding.
+    """
+    n = m.nx
+    ncol = n + m.nsens
+    s = r.s
+    entry = m.slide_entry[j]
+    target = m.targets[entry]
+    if r.use_var:
+        unpack_var(x, n, ncol, V)
+        ok = saltation(m, x, x, s, pv, j, V, ncol, r.vf, target)
+        pack_var(V, n, ncol, x)
+        r.jac_valid = r.jac_valid and ok
+    onto_guard(m, x, s, pv, j)
+    if record:
+        append_record(tables[3], r.n_switch, r.k * r.T + s, entry, x, n)
+        r.n_switch += 1
+    if r.recording and r.traj_dt > 0.0:
+        append_row(tables[2], r.n_traj, r.k * r.T + s, x, n)
+        r.n_traj += 1
+    r.vf = target
+    r.surface = 1 + j
+    r.defl = 0
+
+
+@njit(cache=True)
+def leave_sliding(m, r, x, j, record, tables):
+    """Run ``r`` leaves its sliding pseudo-mode by the virtual exit ``j`` (an exit row reached 0).
+
+    There ``f_s`` equals the field of the side it leaves to, so the saltation
+    matrix is the identity.  The guard of the surface's transition from that
+    side (``m.back[j]``) starts with a double root at ``u = 0`` (``h = 0`` and
+    ``L_f h = 0``).  Recorded as ``[t, j, state]`` in ``tables[3]`` when ``record``.
+    """
+    t = r.k * r.T + r.s
+    if record:
+        append_record(tables[3], r.n_switch, t, j, x, m.nx)
+        r.n_switch += 1
+    if r.recording and r.traj_dt > 0.0:
+        append_row(tables[2], r.n_traj, t, x, m.nx)
+        r.n_traj += 1
+    r.vf = m.targets[j]
+    r.surface = 0
+    r.defl = 2
     r.defl_stop = m.back[j]
 
 
@@ -250,6 +333,7 @@ def change_mode(m, r, x, j, record, tables):
         append_record(tables[3], r.n_switch, r.k * r.T + r.s, j, x, m.nx)
         r.n_switch += 1
     r.vf = m.targets[j]
+    r.surface = 0
     r.defl = 1 if m.back[j] >= 0 else 0
     r.defl_stop = m.back[j]
 

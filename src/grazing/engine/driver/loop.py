@@ -36,7 +36,7 @@ from numba import njit
 from grazing.engine.driver.atomics import load_acquire
 from grazing.engine.driver.calls import tc_free, tc_stick, tc_var
 from grazing.engine.driver.events import first_event
-from grazing.engine.driver.impacts import close_sticking
+from grazing.engine.driver.impacts import close_sticking, sliding_guard
 from grazing.engine.driver.recording import (
     finish_guard,
     new_guard_info,
@@ -242,6 +242,7 @@ def finish_run(m, runs, cfg, x, pv, guard_info, tables, out):
     tot.lyap_span = r.k * T + r.s - r.lyap_t0 if (cfg.lyapunov and r.lyap_started) else 0.0
     tot.jacobian_valid = r.jac_valid
     tot.switch_rows = r.n_switch
+    tot.vf_span = r.vf_span
     for i in range(n):
         out.x[i] = x[i]
     out.V[:, :] = 0.0
@@ -276,12 +277,14 @@ def start_run(m, r, start, cfg, x, tables):
     r.mode = 1 if start.mode > 0 else 0
     r.stuck = max(start.mode - 1, 0)  # the stop it sticks to
     r.vf = start.vf
+    r.surface = 1 + sliding_guard(m, r.vf)  # (a run continued while sliding)
     r.defl = 2 if cfg.touch_start else 0
     r.defl_stop = cfg.stop  # the stop the known roots at u = 0 belong to
     r.ks = cfg.ks
     r.ss = cfg.ss
     r.isamp = 0
     r.recording = cfg.n_samples - cfg.n_keep == 0
+    r.vf_span = r.vf
     r.lyap_t0 = r.k * T + r.s
     r.lyap_started = r.recording
     r.span_dt = math.nan

@@ -13,7 +13,7 @@ import numpy as np
 from numba import njit
 
 from grazing.engine.driver.calls import guard
-from grazing.engine.driver.impacts import enter_contact
+from grazing.engine.driver.impacts import enter_contact, onto_guard
 from grazing.engine.polyroots import horner
 from grazing.engine.stepping import append_pair, append_row, eval_rows, poly_derivative, set_row, set_slice
 
@@ -47,11 +47,14 @@ def take_samples(m, r, X, pv, h_acc, event, is_last, samples, sticks, traj, xe):
             dt = h_acc
         if r.isamp >= keep_from:
             eval_rows(X, n, order, dt, xe)
-            if r.mode == 1:
+            if r.mode == 1 or r.surface > 0:
                 s = r.s + dt
                 if r.wrap and s >= T:
                     s -= T
-                enter_contact(m, xe, s, pv, r.stuck)
+                if r.mode == 1:
+                    enter_contact(m, xe, s, pv, r.stuck)
+                else:  # sliding: on the surface, as the step's end is put
+                    onto_guard(m, xe, s, pv, r.surface - 1)
             set_row(samples, r.isamp - keep_from, 0, xe, n)
         r.isamp += 1
         if r.wrap:
@@ -60,6 +63,7 @@ def take_samples(m, r, X, pv, h_acc, event, is_last, samples, sticks, traj, xe):
             r.ss += T
         if r.isamp == keep_from and not r.recording and r.n_keep > 0:
             r.recording = True
+            r.vf_span = r.vf
             r.span_dt = dt  # (where the Lyapunov sums start: tangent.lyapunov_step)
             r.lyap_t0 = r.k * T + r.s + dt
             if r.mode == 1:  # recording starts while sticking: the interval starts here

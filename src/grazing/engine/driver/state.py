@@ -41,6 +41,7 @@ RUN_STATE = np.dtype(
         ("vf", np.int64),  # the active mode (vector field) of a model with modes (0 for one mode)
         ("defl", np.int64),  # known roots at u = 0 of the next step's event polynomial (0 none)
         ("defl_stop", np.int64),  # ... of this stop's guard
+        ("surface", np.int64),  # sliding: 1 + the transition whose guard (0 on the surface) it is kept on
         ("steps", np.int64),
         ("max_steps", np.int64),
         ("zero_events", np.int64),  # consecutive events at u = 0
@@ -54,6 +55,7 @@ RUN_STATE = np.dtype(
         ("n_samples", np.int64),
         ("n_keep", np.int64),
         ("recording", np.bool_),  # the recorded span has started
+        ("vf_span", np.int64),  # the active mode when it started
         ("lyap_started", np.bool_),  # the Lyapunov sums have started, at lyap_t0
         ("lyap_t0", np.float64),
         ("span_dt", np.float64),  # the recorded span started this long into this step (nan: not in this step)

@@ -8,7 +8,7 @@ import math
 
 from numba import njit
 
-from grazing.engine.driver.impacts import at_event, enter_contact
+from grazing.engine.driver.impacts import at_event, enter_contact, onto_guard
 from grazing.engine.driver.state import STATUS_ZENO
 from grazing.engine.driver.tangent import discontinuity_map, lyapunov_step, shift_period
 
@@ -80,7 +80,7 @@ def end_plain_step(r, lyapunov, sensitivities):
     decrement), which at every step cost :func:`end_step`'s callers a tenth of
     their time; :func:`end_step` is called only where it has work to do.
     """
-    if r.event or r.zdm_hit or r.mode == 1:  # (sticking: the state is put back on its stop)
+    if r.event or r.zdm_hit or r.mode == 1 or r.surface > 0:  # (sticking, sliding: put back on the stop)
         return False
     if r.use_var and r.mode == 0 and (lyapunov or (sensitivities and r.wrap and r.s + r.h_acc >= r.T)):
         return False
@@ -124,6 +124,8 @@ def end_step(m, r, x, X, pv, nrows, cfg, chatter_time, record_impacts, Tp, work,
         r.k += 1
     r.steps += 1
     r.defl = 0
+    if r.surface > 0:  # sliding: back onto the surface, off which the integration drifts
+        onto_guard(m, x, r.s, pv, r.surface - 1)
     if cfg.lyapunov and r.use_var and mode == 0:
         lyapunov_step(m, r, x, X, V, ncol, r.k * r.T + r.s, scratch, logs, xe)
     r.span_dt = math.nan

@@ -61,6 +61,8 @@ def lyapunov_step(m, r, x, X, V, ncol, t, scratch, logs, xe):
             orthonormalize(V, n, logs)
             for c in range(n):
                 logs[c] -= before[c]  # ... is not the span's (the diagonal of R1^-1 R: log R - log R1)
+                if before[c] == -math.inf:  # a direction already collapsed (sliding): it stays collapsed
+                    logs[c] = -math.inf
     elif r.lyap_started:
         unpack_var(x, n, ncol, V)
         orthonormalize(V, n, logs)
