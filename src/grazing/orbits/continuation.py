@@ -100,6 +100,7 @@ from grazing.orbits.shooting import (
     not_isolated_message,
     quiet_section,
 )
+from grazing.orbits.sliding_bifurcations import bisect_switches, sliding_kind
 from grazing.orbits.switch_grazing import locate_switch_grazing
 from grazing.orbits.switching import SegmentStart, crossing_starts, doubled_start, new_sequence_orbit
 
@@ -632,7 +633,7 @@ def switch_change(a: PeriodicOrbit, b: PeriodicOrbit) -> tuple[SwitchChange, int
         return None
     na, nb = sum(map(len, sa)), sum(map(len, sb))
     what = SwitchChange.GAINS if nb > na else SwitchChange.LOSES if nb < na else SwitchChange.CHANGES
-    names = a.model.stop_names
+    names = a.model.switch_names
     flat_a, flat_b = [n for p in sa for n in p], [n for p in sb for n in p]
     counts = [j for j, nm in enumerate(names) if flat_a.count(nm) != flat_b.count(nm)]
     if counts:
@@ -651,7 +652,7 @@ def switch_change_reason(a: PeriodicOrbit, b: PeriodicOrbit) -> str:
     before = [list(p) for p in a.switch_signature]
     after = [list(p) for p in b.switch_signature]
     return (
-        f"the orbit {what} ({a.model.stop_names[j]!r}; switches per forcing period {before} -> {after}): a "
+        f"the orbit {what} ({a.model.switch_names[j]!r}; switches per forcing period {before} -> {after}): a "
         "grazing of a switching surface"
     )
 
@@ -931,8 +932,8 @@ class _Continuation:
         beyond = boundary.after.payload if boundary.after is not None else None
         if self.model.has_modes:  # (a grazing of a switching surface: the switches of mode differ)
             found = switch_change(prev.payload, beyond) if beyond is not None else None
-            if found is None:
-                return None
+            if found is None or found[1] >= self.model.n_stops or sliding_kind(prev.payload, beyond):
+                return None  # (a sliding bifurcation: bisected in _grazing_end)
             return locate_switch_grazing(prev.payload, beyond, self.param, found[1], BETWEEN_SLACK)
         return _locate_grazing(prev.payload, beyond, self.param, self.virtual, boundary.ahead)
 
@@ -953,6 +954,10 @@ class _Continuation:
         value = point.model.params[self.param] if point is not None else float(prev.u[-1])
         after = boundary.after.payload if boundary.after is not None else None
         switched = switch_change(last, after) if after is not None and self.model.has_modes else None
+        kind = sliding_kind(last, after) if switched is not None else None
+        if kind is not None:
+            assert after is not None and switched is not None
+            return self._sliding_end(kind, last, after, switched[1], sign)
         if switched is not None:
             where_stop = switched[1]
         else:
@@ -1007,6 +1012,50 @@ class _Continuation:
             return []
         branch.special.append(dataclasses.replace(graze, switched=True))
         branch.end_segment(BranchEnd.SWITCHED, status + f"; switched to the orbit with the new {sequence}")
+        if new.section_clearance() < SECTION_MARGIN:
+            new = move_section(new, quiet_section(new))
+        sign = math.copysign(1.0, new.model.params[self.param] - value)
+        return [SegmentStart(orbit=new, sign=sign, origin=len(branch.special) - 1)]
+
+    def _sliding_end(
+        self, kind: SpecialKind, last: PeriodicOrbit, after: PeriodicOrbit, switch: int, sign: float
+    ) -> list[SegmentStart]:
+        """The segment ends at a sliding bifurcation of ``kind`` between ``last`` and ``after`` (the first
+        orbit beyond), narrowed by bisection on the switches (:func:`bisect_switches`) and reported."""
+        branch, par, name = self.branch, self.par, self.model.switch_names[switch]
+        bracket = bisect_switches(last, after, self.param)
+        lo, hi = bracket.interval(self.param)
+        value = 0.5 * (lo + hi)
+        point = SpecialPoint(
+            kind=kind, index=len(branch) - 1, param=value, orbit=bracket.before, stop=switch,
+            precision=0.5 * (hi - lo), interval=(lo, hi),
+        )  # fmt: skip
+        how = "located" if bracket.complete else "bracketed only"
+        where = (
+            f"{par.show(value)} of {name!r} ({how}, between {par.show(lo)} and {par.show(hi)}, by bisection "
+            f"on the switches)"
+        )
+        status = f"ended at a {kind} bifurcation at {where}: {switch_change_reason(last, after)}"
+        status = status.replace(": a grazing of a switching surface", f": a {kind} bifurcation")
+        if not self.switch:
+            branch.special.append(point)
+            branch.end_segment(
+                BranchEnd.GRAZING,
+                status + "; the orbit with the new switches of mode can be followed with switch",
+            )
+            return []
+        new = new_sequence_orbit(bracket.before, self.param, value, sign, self.virtual)
+        if new is None:
+            branch.special.append(point)
+            branch.end_segment(
+                BranchEnd.GRAZING,
+                status + "; no orbit with other switches of mode was found just past it to switch to",
+            )
+            return []
+        branch.special.append(dataclasses.replace(point, switched=True))
+        branch.end_segment(
+            BranchEnd.SWITCHED, status + "; switched to the orbit with the new switches of mode"
+        )
         if new.section_clearance() < SECTION_MARGIN:
             new = move_section(new, quiet_section(new))
         sign = math.copysign(1.0, new.model.params[self.param] - value)

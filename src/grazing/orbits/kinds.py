@@ -52,6 +52,15 @@ class SpecialKind(TextEnum):
     PERIOD_DOUBLING = "period-doubling"
     NEIMARK_SACKER = "neimark-sacker"
     GRAZING = "grazing"
+    GRAZING_SLIDING = "grazing-sliding"
+    """A sliding segment appears where the orbit touches a sliding surface from outside
+    (:mod:`grazing.orbits.sliding_bifurcations`, as the three that follow)."""
+    CROSSING_SLIDING = "crossing-sliding"
+    """An entry into sliding turns into a crossing of the surface."""
+    SWITCHING_SLIDING = "switching-sliding"
+    """A crossing of the surface appears right after an exit from sliding."""
+    ADDING_SLIDING = "adding-sliding"
+    """A second sliding segment appears right after an exit from sliding."""
     UNLOCATED = "unlocated"
     """A stability change that no located point explains (never silent)."""
 

@@ -248,7 +248,7 @@ class PeriodicOrbit:
         """
         T = self.model.period
         per: list[list[str]] = [[] for _ in range(self.period)]
-        names = self.model.stop_names
+        names = self.model.switch_names  # (a sliding pseudo-mode's entries and exits after the transitions)
         for t, j in zip(self.switch_times, self.switch_transitions):
             per[min(self.period - 1, max(0, math.floor((t - self.t0) / T)))].append(names[int(j)])
         return tuple(tuple(p) for p in per)
