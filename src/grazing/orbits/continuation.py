@@ -65,7 +65,7 @@ from typing import Any
 import numpy as np
 
 from grazing.core.model import HybridModel
-from grazing.core.options import MAX_PERIOD
+from grazing.core.options import BOUNDARY_TOL, MAX_PERIOD
 from grazing.errors import ConvergenceError, GrazingError, InvalidParameterError
 from grazing.orbits.bifurcations import Located, between, neimark_sacker_angle
 from grazing.orbits.branch_equations import branch_equations
@@ -1026,9 +1026,12 @@ class _Continuation:
         bracket = bisect_switches(last, after, self.param)
         lo, hi = bracket.interval(self.param)
         value = 0.5 * (lo + hi)
+        # (whether an orbit sticks is decided from the far field's sign, to rounding: the boundary that the
+        # bisection brackets lies within BOUNDARY_TOL of the exact one, not within its bracket)
+        precision = max(0.5 * (hi - lo), BOUNDARY_TOL * max(1.0, abs(value)))
         point = SpecialPoint(
             kind=kind, index=len(branch) - 1, param=value, orbit=bracket.before, stop=switch,
-            precision=0.5 * (hi - lo), interval=(lo, hi),
+            precision=precision, interval=(min(lo, value - precision), max(hi, value + precision)),
         )  # fmt: skip
         how = "located" if bracket.complete else "bracketed only"
         where = (

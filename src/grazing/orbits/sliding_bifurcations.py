@@ -14,8 +14,9 @@ Chaos* 13, 2003).  How the switches differ across it names the bifurcation (:fun
   segment (an entry from a mode and an exit) appears where there was none;
 * **adding-sliding**: the same, on the segment that leaves a sliding segment: the orbit leaving sliding
   comes back to the surface, a second sliding segment is added right after an exit to that mode;
-* **switching-sliding**: the orbit leaving sliding at the tangency point grazes the surface once more
-  and crosses it: a crossing appears (or goes) right after an exit from sliding.
+* **switching-sliding**: the orbit leaves sliding at the boundary of the sliding region: on one side
+  it leaves into the far side at once, on the other into the near side and crosses the surface soon
+  after (an exit to ``Y`` replaced by an exit to ``X`` and a crossing from ``X`` to ``Y``).
 
 The boundary itself is bracketed by the continuation (its parameter to
 :data:`~grazing.core.options.BOUNDARY_TOL`) and narrowed by bisection on the switches of the orbits found
@@ -68,15 +69,13 @@ def kind_of_change(
     The rules are tried in this order on the switches per period, ``a``'s and ``b``'s, in either order:
     an entry from a mode replaced by a crossing out of it (crossing-sliding); one sequence is the other
     with an entry and an exit more (adding-sliding where the entry follows an exit to its mode,
-    grazing-sliding otherwise); one is the other with a crossing more, right after an exit
-    (switching-sliding).
+    grazing-sliding otherwise); an exit to a mode ``Y`` replaced by an exit to ``X`` followed by a
+    crossing from ``X`` to ``Y``, or such a crossing gained right after an exit (switching-sliding).
     """
     roles = _roles(model)
     flat = [[n for p in sig for n in p] for sig in (a, b)]
     count = [Counter(f) for f in flat]
     diff = (count[0] - count[1], count[1] - count[0])
-    if not any(roles[n][0] != "cross" for d in diff for n in d):
-        return None
     for less, more in ((0, 1), (1, 0)):
         lost, gained = diff[less], diff[more]  # (what ``more`` lacks of ``less``; what it has more)
         lost_entries = {roles[n][1] for n in lost if roles[n][0] == "entry"}
@@ -84,22 +83,26 @@ def kind_of_change(
         if lost_entries & gained_crossings:
             return SpecialKind.CROSSING_SLIDING
     for less, more in ((0, 1), (1, 0)):
-        lost, gained = diff[less], diff[more]
-        if lost:
-            continue
-        kinds = sorted(roles[n][0] for n in gained.elements())
-        seq = flat[more]
-        if kinds == ["entry", "exit"]:
+        lost, gained, seq = diff[less], diff[more], flat[more]
+        after = {n: [seq[i - 1] for i, m in enumerate(seq) if m == n] for n in gained}  # (cyclically)
+        if not lost and sorted(roles[n][0] for n in gained.elements()) == ["entry", "exit"]:
             (entry,) = [n for n in gained if roles[n][0] == "entry"]
             source = roles[entry][1]
-            before = [seq[i - 1] for i, n in enumerate(seq) if n == entry]  # (cyclically: i - 1 = -1 is last)
-            after_exit = any(roles[p][0] == "exit" and roles[p][2] == source for p in before)
+            after_exit = any(roles[p][0] == "exit" and roles[p][2] == source for p in after[entry])
             return SpecialKind.ADDING_SLIDING if after_exit else SpecialKind.GRAZING_SLIDING
-        if kinds == ["cross"]:
-            (cross,) = list(gained)
-            before = [seq[i - 1] for i, n in enumerate(seq) if n == cross]
-            if any(roles[p][0] == "exit" and roles[p][2] == roles[cross][1] for p in before):
-                return SpecialKind.SWITCHING_SLIDING
+        crossings = [n for n in gained if roles[n][0] == "cross"]
+        if len(crossings) != 1 or sum(gained.values()) > 2 or sum(lost.values()) > 1:
+            continue
+        (cross,) = crossings
+        _, source, target = roles[cross]
+        exits = [p for p in after[cross] if roles[p][0] == "exit" and roles[p][2] == source]
+        others = [n for n in gained if n != cross]
+        # exit_to_Y replaced by exit_to_X then a crossing X -> Y (or that crossing alone gained)
+        replaced = all(roles[n][0] == "exit" and roles[n][2] == target for n in lost) and all(
+            n in exits for n in others
+        )
+        if exits and replaced and len(others) == len(lost):
+            return SpecialKind.SWITCHING_SLIDING
     return None
 
 

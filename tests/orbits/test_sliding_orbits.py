@@ -1,0 +1,211 @@
+"""Periodic orbits through sliding and the sliding bifurcations: the friction oscillator against its exact
+stick-slip orbits.
+
+The reference is tests/engine/test_sliding.py's closed form (slips exact, a stick x = x0 + v_b (t - t0)
+until |a cos(w t) - x| reaches mu, by Brent's method), whose period map's fixed point is solved here by
+Newton's method with its exact Jacobian (the product of the slips' rotations, the entry saltation and
+the stick's [[1, dt], [0, 1]]).  A stick collapses a direction (the entry's saltation projects onto the
+belt), so the monodromy matrix has rank one: one multiplier is exactly zero.
+
+The sliding bifurcations are located from their own equations on the closed form, independently of the
+engine: a crossing-sliding where the slip behind the belt reaches it exactly where the friction just
+balances the force, a cos(w t) - x = mu (the stick it starts has zero length); an adding-sliding where
+the force during the stick touches mu at its maximum, d/dt (a cos(w t) - x) = -a w sin(w t) - v_b = 0
+(the slip ahead that followed the stick shrinks to nothing).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.optimize import fsolve
+
+from grazing.models import friction_oscillator
+from grazing.orbits import continue_orbit, find_orbit
+from grazing.orbits.kinds import SpecialKind
+from grazing.orbits.sliding_bifurcations import kind_of_change
+from tests.engine.test_sliding import AHEAD, BEHIND, FrictionReference
+
+VALUES = {"a": 1.0, "omega": 0.5, "mu": 0.5, "v_belt": 0.2}
+BEHIND_IN, AHEAD_IN = "belt_slide_from_slip_behind", "belt_slide_from_slip_ahead"  # (entries into the stick)
+
+
+def exact_orbit(p: dict, x: np.ndarray, mode: int, t0: float):
+    """The exact period-1 orbit near ``x`` (in ``mode`` at ``t0``): ``(x, J, events, residual)``."""
+    ref = FrictionReference(p)
+    t1 = t0 + 2 * math.pi / p["omega"]
+    for _ in range(20):
+        x_end, k_end, J, _ = ref.run(x, mode, t0, t1)
+        assert k_end == mode
+        step = np.linalg.solve(J - np.eye(2), x_end - x)
+        x = x - step
+        if np.abs(step).max() < 1e-15 * max(1.0, np.abs(x).max()):
+            break
+    x_end, _, J, events = ref.run(x, mode, t0, t1)
+    return x, J, events, float(np.abs(x_end - x).max())
+
+
+def test_the_stick_slip_orbit_is_the_exact_one():
+    m = friction_oscillator(**VALUES)
+    o = find_orbit(m)
+    assert o.mode in ("slip_ahead", "slip_behind") and o.period == 1
+    x, J, events, res = exact_orbit(dict(m.params), o.state, m.mode_names.index(o.mode), o.t0)
+    assert res < 1e-13
+    assert np.abs(o.state - x).max() < 1e-10, o.state - x
+    kinds = [k for _, k in events]
+    assert kinds.count("stick") == 2 and kinds.count("slip") == 2  # (a stick on each side, no crossing)
+    assert np.abs(o.switch_times - [t for t, _ in events]).max() < 1e-10
+    ((*names,),) = o.switch_signature
+    assert [n.startswith("belt_slide_from") for n in names] == [k == "stick" for k in kinds]
+    assert sorted(names) == sorted(n for n in m.switch_names if "slide" in n or "exit" in n)
+    assert np.abs(o.monodromy - J).max() < 1e-9 * max(1.0, np.abs(J).max()), o.monodromy - J
+    # rank one: a zero multiplier (the entry saltation's projection), the other the trace
+    mults = np.sort(np.abs(o.multipliers))
+    assert mults[0] < 1e-12 and abs(abs(np.trace(J)) - mults[1]) < 1e-10
+    assert abs(np.linalg.det(J)) < 1e-14
+
+
+def test_continuation_in_omega_along_stick_slip_orbits():
+    """Each orbit of the branch is the exact one (state, monodromy), with the same stick-slip switches."""
+    m = friction_oscillator(**VALUES)
+    br = continue_orbit(m, "omega", 0.5, 0.45)
+    assert br.status.startswith("reached") and len(br) >= 3
+    sig = br.orbits[0].switch_signature
+    assert all(o.switch_signature == sig for o in br.orbits)
+    for o in br.orbits[:: max(1, len(br) // 4)]:
+        q = {**VALUES, "omega": o.model.params["omega"]}
+        x, J, events, res = exact_orbit(q, o.state, m.mode_names.index(o.mode), o.t0)
+        assert res < 1e-13 and np.abs(o.state - x).max() < 1e-10
+        assert np.abs(o.monodromy - J).max() < 1e-9 * max(1.0, np.abs(J).max())
+        assert np.abs(o.switch_times - [t for t, _ in events]).max() < 1e-10
+
+
+def _slip(ref: FrictionReference, mode: int, x: float, t: float, tt: float) -> np.ndarray:
+    return ref.flow(mode, np.array([x, ref.p["v_belt"]]), t, tt)
+
+
+def exact_crossing_sliding(p: dict, guess: np.ndarray) -> np.ndarray:
+    """``(x_e, t_e, t_1, t_2, t_3, mu)``: behind the belt the slip reaches it at ``(x_e, t_e)`` where the
+    force is exactly mu (the field ahead of the belt is tangent to it there), sticks until the force is mu
+    again at ``t_1``, slips ahead back to the belt at ``t_2``, sticks until the force is -mu at ``t_3``
+    and slips behind back to the belt at ``t_e + T``."""
+    T, vb = 2 * math.pi / p["omega"], p["v_belt"]
+
+    def equations(u):
+        xe, te, t1, t2, t3, mu = u
+        ref = FrictionReference({**p, "mu": mu})
+        x1 = xe + vb * (t1 - te)
+        x2, v2 = _slip(ref, AHEAD, x1, t1, t2)
+        x3 = x2 + vb * (t3 - t2)
+        xT, vT = _slip(ref, BEHIND, x3, t3, te + T)
+        return [
+            ref.force(xe, te) - mu,
+            ref.force(x1, t1) - mu,
+            v2 - vb,
+            ref.force(x3, t3) + mu,
+            vT - vb,
+            xT - xe,
+        ]
+
+    u, _, ier, msg = fsolve(equations, guess, xtol=1e-14, full_output=True)
+    assert ier in (1, 3) and np.abs(equations(u)).max() < 1e-13, (msg, equations(u))  # (3: xtol too small)
+    return u
+
+
+def exact_adding_sliding(p: dict, guess: np.ndarray) -> np.ndarray:
+    """``(x_e, t_e, t_x, mu)``: the slip behind the belt reaches it at ``(x_e, t_e)``, the stick's force
+    reaches mu at its maximum (-a w sin(w t) = v_b) and -mu at ``t_x``, and the slip behind returns to
+    the belt at ``t_e + T``."""
+    T, w, a, vb = 2 * math.pi / p["omega"], p["omega"], p["a"], p["v_belt"]
+
+    def equations(u):
+        xe, te, tx, mu = u
+        ref = FrictionReference({**p, "mu": mu})
+        k = round((w * te - math.asin(-vb / (a * w))) / (2 * math.pi))  # the maximum just after the entry
+        ts = (math.asin(-vb / (a * w)) + 2 * math.pi * k) / w
+        while ts < te:
+            ts += T
+        xs, xx = xe + vb * (ts - te), xe + vb * (tx - te)
+        xT, vT = _slip(ref, BEHIND, xx, tx, te + T)
+        return [ref.force(xs, ts) - mu, ref.force(xx, tx) + mu, vT - vb, xT - xe]
+
+    u, _, ier, msg = fsolve(equations, guess, xtol=1e-14, full_output=True)
+    assert ier in (1, 3) and np.abs(equations(u)).max() < 1e-13, (msg, equations(u))  # (3: xtol too small)
+    return u
+
+
+def test_a_crossing_sliding_located_at_the_exact_one():
+    """Down in mu the stick entered from behind shortens to nothing: the slip crosses the belt instead."""
+    m = friction_oscillator(**VALUES)
+    br = continue_orbit(m, "mu", 0.5, 0.3)
+    [sp] = br.special
+    assert sp.kind is SpecialKind.CROSSING_SLIDING and sp.kind == "crossing-sliding"
+    assert "crossing-sliding bifurcation" in br.status and "located" in br.status and "\n" not in br.status
+    assert m.switch_names[sp.stop] == "belt_to_slip_ahead"
+    o = sp.orbit
+    assert o.switch_signature == (
+        (BEHIND_IN, "belt_exit_to_slip_ahead", AHEAD_IN, "belt_exit_to_slip_behind"),
+    )
+    te, t1, t2, t3 = o.switch_times
+    ref = FrictionReference(dict(o.model.params))
+    xe = ref.run(o.state, m.mode_names.index(o.mode), o.t0, te)[0][0]
+    exact = exact_crossing_sliding(dict(VALUES), np.array([xe, te, t1, t2, t3, sp.param]))
+    lo, hi = sp.interval
+    assert hi - lo <= 2.1e-10 and lo <= exact[-1] <= hi, (lo, exact[-1], hi)
+    assert abs(sp.param - exact[-1]) < 1e-10 and sp.precision <= 1.1e-10
+
+
+def test_an_adding_sliding_located_at_the_exact_one():
+    """Up in mu the slip ahead between the two sticks shrinks to nothing: one stick remains."""
+    m = friction_oscillator(**VALUES)
+    br = continue_orbit(m, "mu", 0.5, 1.2)
+    [sp] = br.special
+    assert sp.kind is SpecialKind.ADDING_SLIDING and "adding-sliding bifurcation" in br.status
+    o = sp.orbit
+    names = o.switch_signature[0]
+    [te] = [t for t, n in zip(o.switch_times, names) if n == "belt_slide_from_slip_behind"]
+    [tx] = [t for t, n in zip(o.switch_times, names) if n == "belt_exit_to_slip_behind"]
+    ref = FrictionReference(dict(o.model.params))
+    xe = ref.run(o.state, m.mode_names.index(o.mode), o.t0, te)[0][0]
+    exact = exact_adding_sliding(dict(VALUES), np.array([xe, te, tx, sp.param]))
+    lo, hi = sp.interval
+    assert hi - lo <= 2.1e-10 and lo <= exact[-1] <= hi, (lo, exact[-1], hi)
+    assert abs(sp.param - exact[-1]) < 1e-10 and sp.precision <= 1.1e-10
+
+
+TO_A, TO_B = "belt_to_slip_ahead", "belt_to_slip_behind"  # (crossings of the belt)
+OUT = ("belt_exit_to_slip_ahead", "belt_exit_to_slip_behind")  # (exits from the stick)
+
+
+@pytest.mark.parametrize(
+    ("before", "after", "kind"),
+    [
+        # an entry from behind replaced by a crossing out of slip_behind (and a stick further on)
+        ((BEHIND_IN, OUT[0], AHEAD_IN, OUT[1]), (TO_A, AHEAD_IN, OUT[0], AHEAD_IN, OUT[1]),
+         SpecialKind.CROSSING_SLIDING),
+        # a new stick where the slip ahead touched the belt
+        ((TO_A, TO_B), (TO_A, AHEAD_IN, OUT[0], TO_B),
+         SpecialKind.GRAZING_SLIDING),
+        # the slip ahead that leaves the stick comes back to it
+        ((BEHIND_IN, OUT[0], AHEAD_IN, OUT[1]), (BEHIND_IN, OUT[0], AHEAD_IN, OUT[0], AHEAD_IN, OUT[1]),
+         SpecialKind.ADDING_SLIDING),
+        # the slip ahead that leaves the stick crosses the belt before sticking again
+        ((BEHIND_IN, OUT[0], AHEAD_IN, OUT[1]), (BEHIND_IN, OUT[0], TO_B, BEHIND_IN, OUT[1]),
+         SpecialKind.CROSSING_SLIDING),
+        # the stick is left behind the belt and the slip crosses it at once, or it is left ahead
+        ((AHEAD_IN, OUT[0]), (AHEAD_IN, OUT[1], TO_A), SpecialKind.SWITCHING_SLIDING),
+        ((AHEAD_IN, OUT[1]), (AHEAD_IN, OUT[1], TO_A), SpecialKind.SWITCHING_SLIDING),
+        # a crossing gained after a crossing, an exit that changes side alone: none of the four
+        ((AHEAD_IN, OUT[0], TO_B), (AHEAD_IN, OUT[0], TO_B, TO_A),
+         None),
+        ((AHEAD_IN, OUT[0]), (AHEAD_IN, OUT[1]), None),
+        ((TO_A, TO_B), (TO_A,), None),  # (no sliding)
+    ],
+)  # fmt: skip
+def test_the_change_of_switches_names_the_sliding_bifurcation(before, after, kind):
+    """The patterns of the module's docstring, both ways (a bifurcation is met from either side)."""
+    m = friction_oscillator()
+    assert kind_of_change(m, (before,), (after,)) is kind
+    assert kind_of_change(m, (after,), (before,)) is kind
