@@ -22,10 +22,12 @@ import numpy as np
 import pytest
 from scipy.optimize import fsolve
 
+from grazing.errors import InvalidParameterError
 from grazing.models import friction_oscillator
 from grazing.orbits import continue_orbit, find_orbit
 from grazing.orbits.kinds import SpecialKind
 from grazing.orbits.sliding_bifurcations import kind_of_change
+from grazing.orbits.sliding_curves import sliding_curve
 from tests.engine.test_sliding import AHEAD, BEHIND, FrictionReference
 
 VALUES = {"a": 1.0, "omega": 0.5, "mu": 0.5, "v_belt": 0.2}
@@ -86,28 +88,27 @@ def _slip(ref: FrictionReference, mode: int, x: float, t: float, tt: float) -> n
     return ref.flow(mode, np.array([x, ref.p["v_belt"]]), t, tt)
 
 
+def exact_crossing_sliding_residual(p: dict, u: np.ndarray) -> list[float]:
+    """The equations of :func:`exact_crossing_sliding` at ``u = (x_e, t_e, t_1, t_2, t_3)`` with the
+    parameters ``p``."""
+    T, vb, mu = 2 * math.pi / p["omega"], p["v_belt"], p["mu"]
+    xe, te, t1, t2, t3 = u
+    ref = FrictionReference(p)
+    x1 = xe + vb * (t1 - te)
+    x2, v2 = _slip(ref, AHEAD, x1, t1, t2)
+    x3 = x2 + vb * (t3 - t2)
+    xT, vT = _slip(ref, BEHIND, x3, t3, te + T)
+    return [ref.force(xe, te) - mu, ref.force(x1, t1) - mu, v2 - vb, ref.force(x3, t3) + mu, vT - vb, xT - xe]
+
+
 def exact_crossing_sliding(p: dict, guess: np.ndarray) -> np.ndarray:
     """``(x_e, t_e, t_1, t_2, t_3, mu)``: behind the belt the slip reaches it at ``(x_e, t_e)`` where the
     force is exactly mu (the field ahead of the belt is tangent to it there), sticks until the force is mu
     again at ``t_1``, slips ahead back to the belt at ``t_2``, sticks until the force is -mu at ``t_3``
     and slips behind back to the belt at ``t_e + T``."""
-    T, vb = 2 * math.pi / p["omega"], p["v_belt"]
 
     def equations(u):
-        xe, te, t1, t2, t3, mu = u
-        ref = FrictionReference({**p, "mu": mu})
-        x1 = xe + vb * (t1 - te)
-        x2, v2 = _slip(ref, AHEAD, x1, t1, t2)
-        x3 = x2 + vb * (t3 - t2)
-        xT, vT = _slip(ref, BEHIND, x3, t3, te + T)
-        return [
-            ref.force(xe, te) - mu,
-            ref.force(x1, t1) - mu,
-            v2 - vb,
-            ref.force(x3, t3) + mu,
-            vT - vb,
-            xT - xe,
-        ]
+        return exact_crossing_sliding_residual({**p, "mu": u[-1]}, u[:-1])
 
     u, _, ier, msg = fsolve(equations, guess, xtol=1e-14, full_output=True)
     assert ier in (1, 3) and np.abs(equations(u)).max() < 1e-13, (msg, equations(u))  # (3: xtol too small)
@@ -209,3 +210,56 @@ def test_the_change_of_switches_names_the_sliding_bifurcation(before, after, kin
     m = friction_oscillator()
     assert kind_of_change(m, (before,), (after,)) is kind
     assert kind_of_change(m, (after,), (before,)) is kind
+
+
+def _guess_adding(o, m) -> np.ndarray:
+    names = o.switch_signature[0]
+    [te] = [t for t, n in zip(o.switch_times, names) if n == BEHIND_IN]
+    [tx] = [t for t, n in zip(o.switch_times, names) if n == OUT[1]]
+    xe = FrictionReference(dict(o.model.params)).run(o.state, m.mode_names.index(o.mode), o.t0, te)[0][0]
+    return np.array([xe, te, tx, o.model.params["mu"]])
+
+
+def test_the_adding_sliding_curve_in_mu_and_omega_is_the_exact_one():
+    m = friction_oscillator(**VALUES)
+    br = continue_orbit(m, "mu", 0.5, 1.2)
+    curve = sliding_curve(br, "omega", 0.55, steps=4)
+    assert curve.kind is SpecialKind.ADDING_SLIDING and curve.status == "reached omega = 0.55"
+    assert len(curve) == 5 and [w for _, w in curve.values] == pytest.approx(
+        [0.5, 0.5125, 0.525, 0.5375, 0.55]
+    )
+    for (mu, w), (lo, hi), o in zip(curve.values, curve.intervals, curve.orbits):
+        exact = exact_adding_sliding({**VALUES, "omega": w}, _guess_adding(o, m))[-1]
+        assert abs(mu - exact) < 1e-10 and hi - lo <= 2.1e-10, (w, mu - exact)
+    mus = [mu for mu, _ in curve.values]
+    assert mus[-1] - mus[0] > 0.02  # (it moves: not the start repeated)
+
+
+def test_the_crossing_sliding_curve_in_omega_and_mu_is_the_exact_one():
+    """Followed from a branch in omega, as mu goes down (the curve is steep the other way round)."""
+    m = friction_oscillator(**VALUES)
+    br = continue_orbit(m, "omega", 0.5, 0.9)
+    [sp] = br.special
+    assert sp.kind is SpecialKind.CROSSING_SLIDING
+    curve = sliding_curve(br, "mu", 0.45, steps=2)
+    assert curve.status == "reached mu = 0.45" and len(curve) >= 3 and curve.values[-1][1] == 0.45
+    for (w, mu), o in zip(curve.values, curve.orbits):
+        assert o.switch_signature == ((BEHIND_IN, OUT[0], AHEAD_IN, OUT[1]),)
+        te, t1, t2, t3 = o.switch_times
+        p = {**VALUES, "omega": w, "mu": mu}
+        xe = FrictionReference(p).run(o.state, m.mode_names.index(o.mode), o.t0, te)[0][0]
+
+        def equations(u, mu=mu, o=o):
+            q = {**VALUES, "mu": mu, "omega": u[-1]}
+            return exact_crossing_sliding_residual(q, u[:-1])
+
+        u, _, ier, msg = fsolve(equations, np.array([xe, te, t1, t2, t3, w]), xtol=1e-14, full_output=True)
+        assert ier in (1, 3) and np.abs(equations(u)).max() < 1e-13, msg
+        assert abs(w - u[-1]) < 1e-10, (mu, w - u[-1])
+
+
+def test_a_sliding_curve_needs_a_sliding_bifurcation():
+    m = friction_oscillator(**VALUES)
+    br = continue_orbit(m, "omega", 0.5, 0.45)
+    with pytest.raises(InvalidParameterError, match="no sliding bifurcation"):
+        sliding_curve(br, "mu", 0.4)
