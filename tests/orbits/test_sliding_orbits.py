@@ -163,7 +163,7 @@ def test_an_adding_sliding_located_at_the_exact_one():
     m = friction_oscillator(**VALUES)
     br = continue_orbit(m, "mu", 0.5, 1.2)
     [sp] = br.special
-    assert sp.kind is SpecialKind.ADDING_SLIDING and "adding-sliding bifurcation" in br.status
+    assert sp.kind is SpecialKind.ADDING_SLIDING and "ended at an adding-sliding bifurcation" in br.status
     o = sp.orbit
     names = o.switch_signature[0]
     [te] = [t for t, n in zip(o.switch_times, names) if n == "belt_slide_from_slip_behind"]

@@ -1038,8 +1038,9 @@ class _Continuation:
             f"{par.show(value)} of {name!r} ({how}, between {par.show(lo)} and {par.show(hi)}, by bisection "
             f"on the switches)"
         )
-        status = f"ended at a {kind} bifurcation at {where}: {switch_change_reason(last, after)}"
-        status = status.replace(": a grazing of a switching surface", f": a {kind} bifurcation")
+        article = "an" if str(kind)[0] in "aeiou" else "a"
+        status = f"ended at {article} {kind} bifurcation at {where}: {switch_change_reason(last, after)}"
+        status = status.replace(": a grazing of a switching surface", f": {article} {kind} bifurcation")
         if not self.switch:
             branch.special.append(point)
             branch.end_segment(
