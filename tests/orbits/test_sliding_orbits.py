@@ -263,3 +263,23 @@ def test_a_sliding_curve_needs_a_sliding_bifurcation():
     br = continue_orbit(m, "omega", 0.5, 0.45)
     with pytest.raises(InvalidParameterError, match="no sliding bifurcation"):
         sliding_curve(br, "mu", 0.4)
+
+
+def test_switched_past_the_crossing_sliding_onto_the_exact_orbits():
+    """With ``switch`` the branch goes on with the new switches (the slip crosses the belt, sticks ahead of
+    it, slips ahead and sticks again), each orbit the exact one."""
+    m = friction_oscillator(**VALUES)
+    br = continue_orbit(m, "mu", 0.5, 0.4, switch=True)
+    first = br.special[0]
+    assert first.kind is SpecialKind.CROSSING_SLIDING and first.switched
+    after = [o for o, s in zip(br.orbits, br.segments) if s == 1]
+    assert len(after) >= 3
+    assert all(o.switch_signature == ((TO_A, AHEAD_IN, OUT[0], AHEAD_IN, OUT[1]),) for o in after)
+    # (the first, 1e-7 past the bifurcation, slips ahead for 1e-6: too short for the reference's sampled
+    # search of the return to the belt)
+    for o in after[1:][:: max(1, len(after) // 4)]:
+        q = {**VALUES, "mu": o.model.params["mu"]}
+        x, J, events, res = exact_orbit(q, o.state, m.mode_names.index(o.mode), o.t0)
+        assert res < 1e-13 and np.abs(o.state - x).max() < 1e-10 and o.model.params["mu"] < first.param
+        assert [k for _, k in events] == ["cross", "stick", "slip", "stick", "slip"]
+        assert np.abs(o.monodromy - J).max() < 1e-9 * max(1.0, np.abs(J).max())
