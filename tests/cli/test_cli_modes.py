@@ -95,6 +95,12 @@ def test_continue_json_is_continue_orbits_with_each_points_mode(capsys):
     assert list(out)[-2:] == ["modes", "switches"]
     assert out["modes"] == [o.mode for o in branch.orbits]
     assert all(sorted(s) == ["leave", "touch"] for s in out["switches"])
+    # --mode with --initial: the branch starts from that guess in that mode (here the orbit's own state)
+    x0 = ",".join(repr(v) for v in out["states"][0])
+    argv = ["continue", *SOFT, "--param", "a", "--start", "1", "--stop", "1.1", "--initial", x0]
+    started = run_json([*argv, "--mode", out["modes"][0]], capsys)
+    assert started["modes"][0] == out["modes"][0] == "contact"
+    assert np.abs(np.array(started["states"][0]) - out["states"][0]).max() < 1e-9
     # the free response grazes the contact at a = gap |1 - w^2 + 2 i zeta w|: below it, no switch
     p = soft().params
     a = grazing_amplitude(p)
