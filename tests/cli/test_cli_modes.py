@@ -123,7 +123,7 @@ def test_graze_and_its_curve_meet_the_closed_form(capsys):
     p = soft().params
     out = run_json(["graze", *SOFT, "--param", "a", "--range", "0.1,0.5"], capsys)
     (g,) = out["grazings"]
-    assert abs(g["value"] - grazing_amplitude(p)) < 1e-8 and g["stop"] == "touch"
+    assert abs(g["value"] - grazing_amplitude(p)) < 1e-8 and (g["stop"], g["mode"]) == ("touch", "free")
     points, _ = find_grazings(soft(), "a", 0.1, 0.5, stop_name=0)
     assert g["value"] == points[0].model.params["a"]
     assert abs(g["accel"] - p["omega"] ** 2 * p["gap"]) < 1e-8  # (x'' = -w^2 x at the top of a sine)
@@ -200,3 +200,8 @@ def test_what_the_library_does_not_run_is_refused_in_one_line(command, capsys):
     code, out, err = run([*command, *SOFT], capsys)
     assert code != 0 and out == "" and err.count("\n") == 1, err
     assert f"{command[0]} does not support models with modes yet" in err
+
+
+def test_graze_json_of_a_model_of_one_mode_has_no_mode(capsys):
+    out = run_json(["graze", *TWO, "--param", "amp", "--range", "0.1,2"], capsys)
+    assert out["grazings"] and all("mode" not in g for g in out["grazings"])

@@ -186,6 +186,8 @@ def _grazing_json(g: Any, param: str | None = None) -> dict[str, Any]:
             "crossed": list(g.crossed),
         }
     )
+    if g.model.has_modes:  # the mode whose orbit touches the transition's guard (one mode: no key)
+        out["mode"] = g.model.transition_source[g.model.stop_index(g.stop_name)]
     return out
 
 
@@ -254,7 +256,11 @@ def graze(
         click.echo(f"no grazing with stop {model.stop_names[stop]!r} for {par.show_range(lo, hi)}")
     for point, g in zip(points, res["grazings"]):
         mu = multipliers_text(g["multipliers"])
-        where = "" if g["stop"] == "stop" else f" (stop {g['stop']})"
+        where = (
+            ""
+            if g["stop"] == "stop"
+            else f" (stop {g['stop']}{', from mode ' + g['mode'] if 'mode' in g else ''})"
+        )
         click.echo(f"{par.show(point.model.params[par.name], '.6f')}{where}: multipliers {mu}, "
                    f"|lambda| = {g['abs_lambda']:.4f}, t_graze = {g['t_graze']:.4f}")  # fmt: skip
         if g["crossed"]:
