@@ -205,3 +205,13 @@ def test_what_the_library_does_not_run_is_refused_in_one_line(command, capsys):
 def test_graze_json_of_a_model_of_one_mode_has_no_mode(capsys):
     out = run_json(["graze", *TWO, "--param", "amp", "--range", "0.1,2"], capsys)
     assert out["grazings"] and all("mode" not in g for g in out["grazings"])
+
+
+def test_graze_curve_meets_the_closed_form(capsys):
+    p = soft().params
+    argv = ["graze-curve", *SOFT, "--params", "omega,a", "--range", "1.0,1.5", "--start-value", "0.2"]
+    out = run_json(argv, capsys)
+    assert len(out["curve"]) >= 5 and out["stop"] == "touch"
+    for g in out["curve"]:
+        assert abs(g["a"] - grazing_amplitude({**p, "omega": g["omega"]})) < 1e-7
+        assert g["mode"] == "free" and abs(g["accel"] - g["omega"] ** 2 * p["gap"]) < 1e-7
