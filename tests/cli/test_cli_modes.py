@@ -95,6 +95,9 @@ def test_continue_json_is_continue_orbits_with_each_points_mode(capsys):
     assert list(out)[-2:] == ["modes", "switches"]
     assert out["modes"] == [o.mode for o in branch.orbits]
     assert all(sorted(s) == ["leave", "touch"] for s in out["switches"])
+    code, text, _ = run(["continue", *SOFT, "--param", "a", "--start", "1", "--stop", "1.5"], capsys)
+    first = f"first point: mode {out['modes'][0]}, switches per period: {', '.join(out['switches'][0])}"
+    assert code == 0 and first in text
     # --mode with --initial: the branch starts from that guess in that mode (here the orbit's own state)
     x0 = ",".join(repr(v) for v in out["states"][0])
     argv = ["continue", *SOFT, "--param", "a", "--start", "1", "--stop", "1.1", "--initial", x0]
@@ -133,6 +136,8 @@ def test_graze_and_its_curve_meet_the_closed_form(capsys):
     for pt in curve["points"]:
         assert abs(pt["a"] - grazing_amplitude({**p, "omega": pt["omega"]})) < 1e-7
         assert pt["mode"] == "free" and pt["switches"] == []
+    code, text, _ = run(["curve", *SOFT, "--kind", "grazing", *argv], capsys)
+    assert code == 0 and "at the start: mode free, switches per period: none" in text
 
 
 def test_normal_form_of_the_switching_surface_is_the_switch_map(capsys):
