@@ -169,8 +169,8 @@ def test_a_model_with_modes_is_simulated_and_refused_elsewhere_in_one_line(tmp_p
     out = run_json(["simulate", "--model", f"{path}:SOFT", "--periods", "3"], capsys)
     assert set(out["modes"]) <= {"free", "contact"} and len(out["modes"]) == 3
     for command in (
-        ["orbit"],
-        ["sweep", "--param", "w", "--start", "1", "--stop", "1.2", "--num", "3"],
+        ["explore"],
+        ["basins", "--x-range", "0,1", "--y-range", "0,1", "--num", "2"],
     ):
         for model in (f"{path}:SOFT", "soft-impact-oscillator"):
             code, out, err = run([*command, "--model", model], capsys)
@@ -204,7 +204,8 @@ def test_simulate_json_of_a_model_with_modes_against_the_api(capsys):
     ]
     out = run_json(argv, capsys)
     assert list(out)[: len(ONE_MODE_KEYS)] == ONE_MODE_KEYS
-    assert list(out)[len(ONE_MODE_KEYS) :] == ["modes", "switches", "mode_final"]
+    assert list(out)[len(ONE_MODE_KEYS) :] == ["modes", "switches", "mode_final", "sliding_intervals"]
+    assert out["sliding_intervals"] == []  # (no surface to slide on: its stops are transitions)
     sol = grazing.simulate(grazing.models.soft_impact_oscillator(k=20.0), [0.0, 0.0], transient=7, periods=5)
     assert out["modes"] == [sol.mode_names[k] for k in sol.modes] and out["mode_final"] == sol.mode_final
     assert len(out["switches"]) == len(sol.switches) >= 8

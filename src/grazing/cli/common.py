@@ -227,7 +227,8 @@ def model_options(
                 command = click.get_current_context().info_name
                 raise InputError(
                     f"--model: {model.name} has modes ({', '.join(model.mode_names)}): {command} does not "
-                    "support models with modes yet (simulate does)"
+                    "support models with modes yet (simulate, orbit, continue, curve, graze, graze-curve, "
+                    "sweep, map and normal-form do)"
                 )
             if not any_model:
                 raise InputError(
@@ -244,7 +245,7 @@ def model_options(
             show_default=True,
             metavar="NAME|FILE.py:OBJECT",
             help="A built-in model (pendulum, two-sided-oscillator, impact-oscillator, bouncing-ball, "
-            "impact-damper; with modes, for simulate: soft-impact-oscillator, rocking-block) "
+            "impact-damper; with modes: soft-impact-oscillator, rocking-block, friction-oscillator) "
             "or a HybridModel (or a function returning one) in a Python file.",
         ),
         click.option(
@@ -308,6 +309,23 @@ def stop_option_index(model: grazing.HybridModel, name: str | None) -> int:
         return model.stop_index(name)
     except grazing.InvalidParameterError as exc:
         raise InputError(f"--stop-name: {exc}") from None
+
+
+mode_option = click.option(
+    "--mode",
+    default=None,
+    metavar="NAME",
+    help="A model with modes: the mode to start in (default: its initial mode).",
+)
+
+
+def check_mode(model: grazing.HybridModel, mode: str | None) -> None:
+    """``--mode``: one line unless it names a mode a run of ``model`` can start in."""
+    if mode is not None:
+        try:
+            model.mode_index(mode)
+        except grazing.InvalidParameterError as exc:
+            raise InputError(f"--mode: {exc}") from None
 
 
 stop_name_option = click.option(

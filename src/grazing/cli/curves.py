@@ -14,10 +14,12 @@ import grazing
 from grazing.cli.common import (
     InputError,
     Progress,
+    check_mode,
     check_out,
     complex_list,
     emit_json,
     json_option,
+    mode_option,
     model_options,
     model_parameter,
     model_params_json,
@@ -34,6 +36,17 @@ from grazing.core.options import MAX_STEP
 from grazing.errors import NotFoundError
 from grazing.orbits.curves import CURVE_KINDS
 from grazing.orbits.periodic import multipliers_text
+
+
+def _point_modes(pt: Any) -> dict[str, Any]:
+    """A point of a curve of a model with modes: its orbit's mode on the section and switches per period
+    (a grazing curve: the grazed transition's source mode; its contact is not a switch)."""
+    if pt.orbit is not None:
+        m = pt.orbit.model
+        return {"mode": pt.orbit.mode, "switches": [m.switch_names[j] for j in pt.orbit.switch_transitions]}
+    g = pt.grazing
+    m = g.model
+    return {"mode": m.transition_source[m.stop_index(g.stop_name)], "switches": []}
 
 
 def _range(text: str, par: grazing.Parameter, model: grazing.HybridModel) -> tuple[float, float]:
@@ -73,7 +86,7 @@ def _parameters(curve: Any) -> tuple[grazing.Parameter, grazing.Parameter]:
 
 
 @click.command("curve")
-@model_options(any_model=True)
+@model_options(any_model=True, modes=True)
 @click.option(
     "--kind",
     type=click.Choice([str(k) for k in CURVE_KINDS]),  # (the words: click takes an enum by its names)
@@ -101,6 +114,7 @@ def _parameters(curve: Any) -> tuple[grazing.Parameter, grazing.Parameter]:
     show_default=True,
     help="Largest continuation step.",
 )
+@mode_option
 @netcdf_out_option
 @json_option
 def curve(
@@ -116,6 +130,7 @@ def curve(
     initial: str | None,
     stop_name: str | None,
     max_step: float,
+    mode: str | None,
     out: Path | None,
     overwrite: bool,
     as_json: bool,
@@ -133,6 +148,7 @@ def curve(
         raise InputError(f"--param2 must differ from --param (both are {p1.name})")
     refuse_varied([p1.name], f"with --param {cparam}: the branch starts at --start")
     watch = stop_option_index(model, stop_name)
+    check_mode(model, mode)
     if start == stop:
         raise InputError(f"--start and --stop must differ, got {start:g} and {stop:g}")
     if p1.name == "theta_hat" and model.name == "pendulum":
@@ -144,7 +160,7 @@ def curve(
         model.with_params(**{p1.name: v})
     lo, hi = _range(prange, p2, model)
     check_out(out, ".nc", overwrite=overwrite)
-    x0 = parse_state(initial, model.with_params(**{p1.name: a})) if initial is not None else None
+    x0 = parse_state(initial, model.with_params(**{p1.name: a}), mode) if initial is not None else None
     bars = {"branch": Progress("continuing", enabled=not as_json),
             "curve": Progress("following the curve", enabled=not as_json)}  # fmt: skip
     seen = [model.params[p2.name]] * 2
@@ -158,9 +174,14 @@ def curve(
             bars[stage](int(1000 * (seen[1] - seen[0]) / (hi - lo)), 1000)
 
     try:
+        orbit = None
+        if mode is not None:  # (follow_curve starts from an orbit in the mode asked for)
+            from grazing.orbits import find_orbit
+
+            orbit = find_orbit(model.with_params(**{p1.name: a}), x0, period=period, mode=mode)
         result = follow_curve(
-            model, kind, p1.name, a, b, p2.name, (lo, hi), x0=None if x0 is None else np.array(x0),
-            period=period, stop_name=watch if stop_name is not None else None,
+            model, kind, p1.name, a, b, p2.name, (lo, hi), x0=None if x0 is None or orbit else np.array(x0),
+            orbit=orbit, period=period, stop_name=watch if stop_name is not None else None,
             settings=PalcSettings(ds=min(0.01, max_step), ds_max=max_step), progress=progress,
         )  # fmt: skip
     except NotFoundError as exc:
@@ -193,6 +214,9 @@ def curve(
         "virtual": result.virtual,
         "out": str(out) if out else None,
     }  # fmt: skip
+    if model.has_modes:  # (the JSON of a model of one mode stays as it was)
+        for row, pt in zip(res["points"], result.points):
+            row.update(_point_modes(pt))
     if as_json:
         emit_json(res)
         return
@@ -201,6 +225,10 @@ def curve(
         f"{len(result)} points of the {kind} curve of the period-{result.period} orbit in ({p1.name}, "
         f"{p2.name}) from {where}; {result.status}"
     )
+    if model.has_modes and len(result):
+        first = _point_modes(result.points[result.start_index])
+        switches = ", ".join(first["switches"]) or "none"
+        click.echo(f"  at the start: mode {first['mode']}, switches per period: {switches}")
     for sp_ in result.special:
         at = ", ".join(p.show(v, ".8g") for p, v in zip((p1, p2), sp_.values))
         mu = multipliers_text(sp_.multipliers)

@@ -26,7 +26,7 @@ from grazing.orbits.periodic import multipliers_text
 
 
 @click.command("normal-form")
-@model_options(any_model=True)
+@model_options(any_model=True, modes=True)
 @click.option(
     "--which",
     type=click.Choice(["first", "second"]),
@@ -62,6 +62,9 @@ def normal_form_cmd(
     from grazing.normalform.discontinuity import no_contact_direction
 
     stop = stop_option_index(model, stop_name)
+    if model.has_modes and not model.symbolic.resets[stop]:  # a switching surface: the switch's map
+        _switching_form(model, case, which, eta_min, eta_max, gparam, prange, stop, initial, check, as_json)
+        return
     if model.symbolic.stops[stop].contact_direction is None:  # (before the search, not after it)
         raise InputError(f"--model: {no_contact_direction(model, stop)}")
     par, lo, hi, pendulum = search_range(model, "normal-form", gparam, prange, eta_min, eta_max)
@@ -110,3 +113,57 @@ def normal_form_cmd(
     if check:
         verdict = "agrees" if res["agrees"] else "differs"
         click.echo(f"  direct simulation just past grazing: {res['observed']['scenario']} ({verdict})")
+
+
+def _switching_form(
+    model: grazing.HybridModel, case: str, which: str, eta_min: float, eta_max: float, gparam: str | None,
+    prange: str | None, stop: int, initial: str | None, check: bool, as_json: bool,
+) -> None:  # fmt: skip
+    """``normal-form`` at a grazing of a switching surface without a reset (a model with modes): the
+    switch's discontinuity map ``D(x) = x - (4/3) sqrt(2 / a) delta^(3/2) w`` (no impact law, so no
+    prediction of the scenario past grazing yet)."""
+    from grazing.normalform import find_grazing_point
+    from grazing.normalform.switching import switching_map_at
+
+    name = model.stop_names[stop]
+    if check:
+        raise InputError(
+            f"--check: the scenario past the grazing of switching surface {name!r} (no reset) is not "
+            "predicted yet, so there is nothing to check; its discontinuity map is printed without --check"
+        )
+    par, lo, hi, _ = search_range(model, "normal-form", gparam, prange, eta_min, eta_max)
+    x0 = range_start_state(initial, model, {par.name: lo})
+    point = find_grazing_point(model, par.name, lo, hi, which, stop_name=stop, x0=x0)
+    try:
+        zdm = switching_map_at(point.model, point.stop, point.contact, point.t_graze)
+    except (grazing.InvalidParameterError, grazing.InvalidStateError) as exc:
+        raise InputError(f"--stop-name {name}: {exc}") from None
+    res: dict[str, Any] = {
+        "params": model_params_json(point.model, case),
+        "which": which,
+        "param": par.name,
+        "value": par.to_display(point.model.params[par.name]),
+        "stop": point.stop_name,
+        "t_graze": point.phase,
+        "multipliers": complex_list(point.multipliers),
+        "abs_lambda": point.abs_lambda,
+        "mode": model.transition_source[stop],
+        "switching_map": {
+            "contact_state": zdm.contact,
+            "accel": zdm.accel,
+            "jump": zdm.jump,
+            "coefficient": zdm.coefficient,
+        },
+    }
+    if as_json:
+        emit_json(res)
+        return
+    mu = multipliers_text(point.multipliers)
+    click.echo(f"{which} grazing of switching surface {name!r} (from mode {res['mode']}) at "
+               f"{par.show(point.model.params[par.name], '.6f')}, t_graze = {point.phase:.4f}")  # fmt: skip
+    click.echo(f"  multipliers {mu}, |lambda| = {point.abs_lambda:.4f}")
+    click.echo(
+        f"  switch's discontinuity map: x -> x - {zdm.coefficient:.6f} delta^(3/2) w, a = {zdm.accel:.6f}, "
+        f"w = {np.round(zdm.jump, 6).tolist()} (no reset: a 3/2-power correction)"
+    )
+    click.echo("  prediction: not available yet for a switching surface (an impact's rule does not apply)")

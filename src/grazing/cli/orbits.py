@@ -15,10 +15,12 @@ from grazing.cli.common import (
     InputError,
     Progress,
     check_eta_range,
+    check_mode,
     check_out,
     complex_list,
     emit_json,
     json_option,
+    mode_option,
     model_options,
     model_parameter,
     model_params_json,
@@ -68,7 +70,39 @@ def _orbit_json(orbit: Any) -> dict[str, Any]:
     }
     if orbit.model.name == "pendulum":
         out["max_theta_deg"] = math.degrees(max_angle(orbit))
+    if orbit.model.has_modes:  # (the JSON of a model of one mode stays as it was)
+        out.update(orbit_modes_json(orbit))
     return out
+
+
+def orbit_modes_json(orbit: Any) -> dict[str, Any]:
+    """A model with modes: the orbit's mode on the section and its switches of mode over one period."""
+    m = orbit.model
+    return {
+        "mode": orbit.mode,
+        "switches": [
+            {
+                "t": float(t),
+                "transition": m.switch_names[j],
+                "from": m.switch_sources[j],
+                "to": m.switch_targets[j],
+            }
+            for t, j in zip(orbit.switch_times, orbit.switch_transitions)
+        ],
+    }
+
+
+def orbit_modes_text(orbit: Any) -> str:
+    """One line on the mode and switches of an orbit of a model with modes."""
+    m = orbit.model
+    n = len(orbit.switch_times)
+    switches = ", ".join(
+        f"{m.switch_names[j]} at {m.time_label} = {t:.6f}"
+        for t, j in zip(orbit.switch_times, orbit.switch_transitions)
+    )
+    return f"mode {orbit.mode} on the section; {n} switch{'es' * (n != 1)} per period" + (
+        f": {switches}" if n else ""
+    )
 
 
 initial_option = click.option(
@@ -88,7 +122,7 @@ def range_start_state(
 
 
 @click.command()
-@model_options(any_model=True)
+@model_options(any_model=True, modes=True)
 @click.option("--period", type=ORBIT_PERIOD, help="Period in forcing periods (default: detected).")
 @click.option(
     "--initial",
@@ -98,6 +132,7 @@ def range_start_state(
 )
 @click.option("--transient", type=count(0), default=DEFAULT_TRANSIENT, show_default=True,
               help="Forcing periods simulated for the initial guess (without --initial).")  # fmt: skip
+@mode_option
 @json_option
 def orbit(
     model: grazing.HybridModel,
@@ -105,25 +140,29 @@ def orbit(
     period: int | None,
     initial: str | None,
     transient: int,
+    mode: str | None,
     as_json: bool,
 ) -> None:
     """Find a periodic orbit by Newton shooting; print its multipliers and stability."""
     from grazing.orbits import find_orbit
 
     refuse_unused(["transient"], initial is not None, "with --initial (it runs the simulation that guesses)")
-    x0 = parse_state(initial, model) if initial is not None else None
-    orb = find_orbit(model, x0, period=period, transient=transient)
+    check_mode(model, mode)
+    x0 = parse_state(initial, model, mode) if initial is not None else None
+    orb = find_orbit(model, x0, period=period, transient=transient, mode=mode)
     res = {"params": model_params_json(model, case), **_orbit_json(orb)}
     if as_json:
         emit_json(res)
         return
     kind = "stable" if orb.stable else ("unstable" if orb.isolated else "not isolated")
     extra = f"; max theta {res['max_theta_deg']:.6f} deg" if "max_theta_deg" in res else ""
-    if model.n_stops > 1:
+    if model.n_stops > 1 and (orb.impacts or not model.has_modes):  # (not switches without a reset)
         extra += " (" + ", ".join(f"{k}: {v}" for k, v in res["impacts_per_stop"].items()) + ")"
     click.echo(f"period-{orb.period} orbit with {orb.impacts} impact(s) per period, {kind}{extra}")
     state = ", ".join(f"{nm} = {v:.12f}" for nm, v in zip(model.state_names, orb.state))
     click.echo(f"state at {model.time_label} = 0: {state}")
+    if model.has_modes:
+        click.echo(orbit_modes_text(orb))
     for z in orb.multipliers:
         click.echo(f"  multiplier {z.real:+.6f} {z.imag:+.6f}i   |mu| = {abs(z):.6f}")
     if not orb.isolated:
@@ -147,11 +186,13 @@ def _grazing_json(g: Any, param: str | None = None) -> dict[str, Any]:
             "crossed": list(g.crossed),
         }
     )
+    if g.model.has_modes:  # the mode whose orbit touches the transition's guard (one mode: no key)
+        out["mode"] = g.model.transition_source[g.model.stop_index(g.stop_name)]
     return out
 
 
 @click.command()
-@model_options(any_model=True)
+@model_options(any_model=True, modes=True)
 @click.option("--eta-min", type=POSITIVE, default=0.2, show_default=True, help="Lower end of the eta range.")
 @click.option("--eta-max", type=POSITIVE, default=1.0, show_default=True, help="Upper end of the eta range.")
 @click.option(
@@ -215,7 +256,11 @@ def graze(
         click.echo(f"no grazing with stop {model.stop_names[stop]!r} for {par.show_range(lo, hi)}")
     for point, g in zip(points, res["grazings"]):
         mu = multipliers_text(g["multipliers"])
-        where = "" if g["stop"] == "stop" else f" (stop {g['stop']})"
+        where = (
+            ""
+            if g["stop"] == "stop"
+            else f" (stop {g['stop']}{', from mode ' + g['mode'] if 'mode' in g else ''})"
+        )
         click.echo(f"{par.show(point.model.params[par.name], '.6f')}{where}: multipliers {mu}, "
                    f"|lambda| = {g['abs_lambda']:.4f}, t_graze = {g['t_graze']:.4f}")  # fmt: skip
         if g["crossed"]:
@@ -224,7 +269,7 @@ def graze(
 
 
 @click.command("graze-curve")
-@model_options(any_model=True)
+@model_options(any_model=True, modes=True)
 @click.option(
     "--start-deg", type=ANGLE_DEG, default=5.0, show_default=True, help="theta-hat where the curve starts."
 )
@@ -328,7 +373,7 @@ def graze_curve(
 
 
 @click.command("continue")
-@model_options(any_model=True)
+@model_options(any_model=True, modes=True)
 @click.option("--param", "cparam", required=True, metavar="NAME",
               help="Parameter to vary: any of the model's (the pendulum's eta, theta-hat, alpha, beta, r); "
               "angles in degrees.")  # fmt: skip
@@ -353,6 +398,7 @@ def graze_curve(
               "branch through it (both ways); at every grazing where the impact sequence changes, onto "
               "the orbit with the new sequence instead of ending there (a physical branch only: not "
               "with --virtual).")  # fmt: skip
+@mode_option
 @netcdf_out_option
 @json_option
 def continue_(
@@ -367,6 +413,7 @@ def continue_(
     virtual: bool | None,
     max_step: float,
     switch: bool,
+    mode: str | None,
     out: Path | None,
     overwrite: bool,
     as_json: bool,
@@ -386,6 +433,7 @@ def continue_(
         "physical orbit",
     )  # fmt: skip
     watch = stop_option_index(model, stop_name)
+    check_mode(model, mode)
     if start == stop:
         raise InputError(f"--start and --stop must be finite and differ, got {start:g} and {stop:g}")
     if name == "theta_hat" and model.name == "pendulum":
@@ -394,7 +442,7 @@ def continue_(
                 raise InputError(f"{opt} for theta-hat must be {ANGLE_DEG.describe()}, got {v:g}")
     check_out(out, ".nc", overwrite=overwrite)
     x0 = (
-        parse_state(initial, model.with_params(**{name: par.from_display(start)}))
+        parse_state(initial, model.with_params(**{name: par.from_display(start)}), mode)
         if initial is not None
         else None
     )
@@ -406,7 +454,7 @@ def continue_(
         branch = continue_orbit(
             model, name, a, b, x0=None if x0 is None else np.array(x0), period=period, virtual=virtual,
             settings=PalcSettings(ds=min(0.01, max_step), ds_max=max_step), switch=switch, stop_name=watch,
-            progress=lambda n, v: bar(int(1000 * abs(v - a) / abs(b - a)), 1000),
+            mode=mode, progress=lambda n, v: bar(int(1000 * abs(v - a) / abs(b - a)), 1000),
         )  # fmt: skip
     finally:
         bar.close()
@@ -450,6 +498,9 @@ def continue_(
     }
     if model.name == "pendulum":
         res["max_theta_deg"] = [math.degrees(max_angle(o)) for o in branch.orbits]
+    if model.has_modes:  # (the JSON of a model of one mode stays as it was)
+        res["modes"] = [o.mode for o in branch.orbits]
+        res["switches"] = [[model.switch_names[j] for j in o.switch_transitions] for o in branch.orbits]
     if as_json:
         emit_json(res)
         return
@@ -462,6 +513,11 @@ def continue_(
         listed = f"period{'s' * (len(periods) > 1)} {', '.join(map(str, periods))}"
         more = f" in {segs} segments (switched at: {', '.join(kinds)}; {listed})"
     click.echo(f"{len(branch)} points of the period-{branch.period} orbit{more}, {kind}; {res['status']}")
+    if model.has_modes and len(branch):
+        ends = (("first", 0), ("last", -1)) if len(branch) > 1 else (("first", 0),)
+        shown = [f"{w} point: mode {res['modes'][i]}, switches per period: "
+                 f"{', '.join(res['switches'][i]) or 'none'}" for w, i in ends]  # fmt: skip
+        click.echo("  " + "; ".join(shown))
     for point, sp_ in zip(branch.special, res["special"]):
         if point.between is not None:  # an unlocated stability change: what was seen, in words
             click.echo(f"  {sp_['kind']:16s} {point.note}")

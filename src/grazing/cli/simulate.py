@@ -12,11 +12,12 @@ import numpy as np
 
 import grazing
 from grazing.cli.common import (
-    InputError,
     Progress,
+    check_mode,
     check_out,
     emit_json,
     json_option,
+    mode_option,
     model_options,
     model_params_json,
     overwrite_option,
@@ -33,8 +34,7 @@ from grazing.core.options import DEFAULT_TRANSIENT
 @model_options(any_model=True, modes=True)
 @click.option("--initial", default=None, metavar="X1,X2,...",
               help="Initial state at time 0, one per state (default: zero; pendulum: rad).")  # fmt: skip
-@click.option("--mode", default=None, metavar="NAME",
-              help="A model with modes: the mode to start in (default: its initial mode).")  # fmt: skip
+@mode_option
 @click.option("--transient", type=count(0), default=DEFAULT_TRANSIENT, show_default=True,
               help="Forcing periods run and discarded first.")  # fmt: skip
 @click.option("--periods", type=count(1), default=100, show_default=True,
@@ -62,11 +62,7 @@ def simulate(
 ) -> None:
     """Simulate a model (the pendulum by default); print stroboscopic samples, impacts, period."""
     refuse_unused(["points_per_period"], trajectory is None, "without --trajectory")
-    if mode is not None:
-        try:
-            model.mode_index(mode)
-        except grazing.InvalidParameterError as exc:
-            raise InputError(f"--mode: {exc}") from None
+    check_mode(model, mode)
     x0 = parse_state(initial, model, mode)
     check_out(trajectory, ".csv", "--trajectory", overwrite)
     points = periods * points_per_period + 1 if trajectory is not None else 0
@@ -142,7 +138,31 @@ def _modes_json(sol: grazing.Solution) -> dict[str, Any]:
             for i in range(len(sw))
         ],
         "mode_final": sol.mode_final,
+        "sliding_intervals": [
+            {"t_start": float(a), "t_end": float(b), "surface": sol.model.surface_names[int(k)]}
+            for a, b, k in (sol.sliding if sol.sliding is not None else np.empty((0, 3)))
+        ],
     }
+
+
+def _switch_lines(sol: grazing.Solution) -> list[str]:
+    """A run of a model with modes: its switches per transition, and its time sliding on each surface."""
+    sw = sol.switches
+    assert sw is not None
+    per = {name: 0 for name in dict.fromkeys(sw.name(i) for i in range(len(sw)))}
+    for i in range(len(sw)):
+        per[sw.name(i)] += 1
+    lines = ["switches per transition: " + ", ".join(f"{k} {v}" for k, v in per.items())] if per else []
+    if sol.sliding is not None and len(sol.sliding):
+        for k, surface in enumerate(sol.model.surface_names):
+            rows = sol.sliding[sol.sliding[:, 2] == k]
+            if len(rows):
+                total = float(np.sum(rows[:, 1] - rows[:, 0]))
+                lines.append(
+                    f"sliding on {surface!r}: {len(rows)} intervals, {total:.6g} "
+                    f"time units in all (the first from t = {rows[0, 0]:.6f} to {rows[0, 1]:.6f})"
+                )
+    return lines
 
 
 def _write_trajectory_csv(sol: grazing.Solution, fh: Any) -> None:
@@ -166,9 +186,10 @@ def _print_simulation(
     n = sol.samples.shape[0]
     kind = f"period {period}" if period else "no period <= 64 (chaotic, quasi-periodic or not settled)"
     con.print(f"{n} sampled periods after {sol.info['transient']} transient: [bold]{kind}[/bold]")
+    sliding = f"; sliding intervals: {len(sol.sliding)}" if sol.sliding is not None else ""
     con.print(
         f"impacts: {sol.n_impacts} in the whole run, {len(sol.impacts)} in the sampled span; "
-        f"sticking intervals: {len(sol.sticking)}"
+        f"sticking intervals: {len(sol.sticking)}{sliding}"
     )
     if sol.modes is not None and sol.switches is not None:
         counts = np.bincount(sol.modes, minlength=model.n_modes)
@@ -176,6 +197,8 @@ def _print_simulation(
             f"modes: {len(sol.switches)} switches in the sampled span, ending in {sol.mode_final}; "
             "samples per mode: " + ", ".join(f"{name} {c}" for name, c in zip(model.mode_names, counts))
         )
+        for line in _switch_lines(sol):
+            con.print(line)
     con.print(f"{sol.n_steps} steps in {elapsed:.3f} s")
     if model.n_stops > 1 and (sol.n_impacts or not model.has_modes):  # (not switches without a reset)
         con.print(

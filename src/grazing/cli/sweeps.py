@@ -277,7 +277,7 @@ def _outcomes(period: np.ndarray, status: np.ndarray) -> tuple[int, int, str]:
 
 
 @click.command("sweep")
-@model_options(any_model=True)
+@model_options(any_model=True, modes=True)
 @click.option("--param", "sparam", required=True, metavar="NAME",
               help="Parameter to sweep: any of the model's (the pendulum's eta, theta-hat, alpha, beta, r); "
               "angles in degrees.")  # fmt: skip
@@ -437,7 +437,7 @@ def _map_for_sweep(model: Any, name: str, lo: float, hi: float, which: str) -> t
 
 
 @click.command("map")
-@model_options(any_model=True)
+@model_options(any_model=True, modes=True)
 @click.option("--param1", required=True, metavar="NAME", help="Horizontal parameter (any of the model's).")
 @click.option("--start1", type=FINITE, required=True)
 @click.option("--stop1", type=FINITE, required=True)
