@@ -448,8 +448,8 @@ def plot_amplitudes(points: Sequence[AmplitudePoint], ax=None) -> Figure:
         pts = [p for p in points if p.mu_ratio == r]
         w_min, w_max = min(p.omega for p in pts), max(p.omega for p in pts)
         ws = np.linspace(w_min, w_max, 2000)
-        ws = ws[np.abs(ws - 1.0) > 1e-3]
-        xs = np.array([amplitude(w, r) if boundary(w) >= r else math.nan for w in ws])
+        xs = np.array([amplitude(w, r) if nonstop_boundary(w) >= r else math.nan for w in ws])
+        xs[np.abs(ws - 1.0) < 0.02] = math.nan  # resonance: no line across it
         ax.plot(ws, xs, color=colour, lw=1, label=f"Den Hartog, μ/a = {r:g}")
         free = [p for p in pts if not p.sticks]
         stuck = [p for p in pts if p.sticks]
@@ -460,6 +460,7 @@ def plot_amplitudes(points: Sequence[AmplitudePoint], ax=None) -> Figure:
     ax.set_xlabel("forcing frequency ω")
     ax.set_ylabel("amplitude X / a")
     ax.set_yscale("log")
+    ax.set_ylim(0.05, 30.0)
     ax.legend(fontsize=8)
     return ax.figure
 
@@ -490,10 +491,21 @@ def plot_boundary(omegas: Sequence[float], computed: Sequence[float], ax=None) -
     ws = np.linspace(min(omegas), max(omegas), 3000)
     ws = ws[np.abs(ws - 1.0) > 1e-4]
     ax.plot(ws, [boundary(w) for w in ws], "k-", lw=1, label="Den Hartog (1931), re-derived")
+    low = ws[ws < 0.7]
+    ax.plot(low, [nonstop_boundary(w) for w in low], "k--", lw=1, label="with x′ > 0 between reversals")
     ax.plot(omegas, computed, "o", color="C3", ms=4, label="grazing: the orbit first sticks")
     ax.axhline(math.pi / 4, color="0.6", lw=0.8, ls=":")
+    ax.text(max(omegas), math.pi / 4 + 0.01, "π/4", ha="right", va="bottom", fontsize=8, color="0.4")
     ax.set_xlabel("forcing frequency ω")
     ax.set_ylabel("friction μ / a")
-    ax.text(max(omegas), 0.02, "no stops below the line", ha="right", fontsize=8)
-    ax.legend(fontsize=8)
+    ax.set_ylim(0.0, 0.95)
+    ax.text(
+        0.98,
+        0.3,
+        "stick-slip above the line\nno stops below it",
+        ha="right",
+        fontsize=8,
+        transform=ax.transAxes,
+    )
+    ax.legend(fontsize=8, loc="lower right")
     return ax.figure
