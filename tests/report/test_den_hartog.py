@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
+from grazing.errors import ConvergenceError
 from grazing.report import den_hartog as dh
 
 OMEGAS = [0.6, 0.8, 0.9, 1.2, 1.5, 2.0, 3.0]
@@ -92,3 +93,9 @@ def test_above_the_boundary_the_orbit_sticks_and_below_it_does_not():
     assert dh.reversals(dh.orbit_at(1.5, 0.98 * b)).margin > 0
     above = dh.reversals(dh.orbit_at(1.5, 1.02 * b))
     assert above.margin < 0 and above.sticks.all()
+
+
+def test_a_jump_of_the_margin_is_not_reported_as_a_boundary():
+    # at omega = 1/2 on a moving belt the orbit found changes between the scan's values
+    with pytest.raises(ConvergenceError, match="jumps"):
+        dh.computed_boundary(0.5, v_belt=0.2)

@@ -50,6 +50,9 @@ AMPLITUDE_RULE = 1e-9
 SECTION_TRIES = 8
 """Sections ``t0 = k T / 8`` tried in turn by :func:`orbit_at` (find_orbit cannot start sticking)."""
 
+MARGIN_TOL = 1e-9
+"""The stick margin at a located boundary must be this close to zero (else the margin jumped)."""
+
 BOUNDARY_RULE = 1e-9
 """The rule for the boundary of non-stop motion: ``|mu/a (grazing) - mu/a (Den Hartog)| <= 1e-9``."""
 
@@ -324,13 +327,15 @@ class AmplitudePoint:
         return self.computed - self.closed
 
 
-def orbit_at(omega: float, mu_ratio: float) -> PeriodicOrbit:
-    """grazing's periodic orbit at ``(omega, mu / a)``, ``a = 1``, ``v_belt = 0``, found from rest.
+def orbit_at(omega: float, mu_ratio: float, v_belt: float = 0.0) -> PeriodicOrbit:
+    """grazing's periodic orbit at ``(omega, mu / a)``, ``a = 1``, found from rest.
 
     Parameters
     ----------
     omega, mu_ratio
         As :func:`amplitude`.
+    v_belt
+        The belt's speed (Den Hartog's oscillator: 0).
 
     Returns
     -------
@@ -342,7 +347,7 @@ def orbit_at(omega: float, mu_ratio: float) -> PeriodicOrbit:
     >>> orbit_at(2.0, 0.1).period
     1
     """
-    model = friction_oscillator(a=1.0, omega=omega, mu=mu_ratio, v_belt=0.0)
+    model = friction_oscillator(a=1.0, omega=omega, mu=mu_ratio, v_belt=v_belt)
     period = 2.0 * math.pi / omega
     for k in range(SECTION_TRIES):
         try:
@@ -380,7 +385,9 @@ def compare_amplitudes(omegas: Sequence[float], mu_ratio: float) -> list[Amplitu
     return out
 
 
-def computed_boundary(omega: float, bracket: tuple[float, float] = (0.02, 2.0), n_scan: int = 25) -> float:
+def computed_boundary(
+    omega: float, bracket: tuple[float, float] = (0.02, 2.0), n_scan: int = 25, v_belt: float = 0.0
+) -> float:
     """The boundary of non-stop motion on grazing's orbits: the ``mu / a`` where the orbit first sticks.
 
     The stick margin of :func:`reversals` (positive without stops, negative with) is scanned on
@@ -395,11 +402,18 @@ def computed_boundary(omega: float, bracket: tuple[float, float] = (0.02, 2.0), 
         The range of ``mu / a`` searched.
     n_scan
         Values of the scan.
+    v_belt
+        The belt's speed (Den Hartog's oscillator: 0).
 
     Returns
     -------
     float
         The boundary; nan where the margin does not change sign in ``bracket``.
+
+    Raises
+    ------
+    ConvergenceError
+        Where the margin changes sign by a jump (the orbit found changes), not through zero.
 
     Examples
     --------
@@ -408,14 +422,19 @@ def computed_boundary(omega: float, bracket: tuple[float, float] = (0.02, 2.0), 
     """
 
     def margin(mu: float) -> float:
-        return reversals(orbit_at(omega, mu)).margin
+        return reversals(orbit_at(omega, mu, v_belt)).margin
 
     grid = np.linspace(bracket[0], bracket[1], n_scan)
     prev = margin(float(grid[0]))
     for lo, hi in itertools.pairwise(grid):
         cur = margin(float(hi))
         if prev > 0.0 >= cur:
-            return float(brentq(margin, float(lo), float(hi), xtol=1e-13, rtol=1e-13))
+            root = float(brentq(margin, float(lo), float(hi), xtol=1e-13, rtol=1e-13))
+            if abs(margin(root)) > MARGIN_TOL:  # a jump of the margin (another orbit), not its zero
+                raise ConvergenceError(
+                    f"the stick margin jumps at mu/a = {root:.12g} (omega = {omega:g}): no boundary located"
+                )
+            return root
         prev = cur
     return math.nan
 
