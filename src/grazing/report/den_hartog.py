@@ -51,7 +51,7 @@ SECTION_TRIES = 8
 """Sections ``t0 = k T / 8`` tried in turn by :func:`orbit_at` (find_orbit cannot start sticking)."""
 
 MARGIN_TOL = 1e-9
-"""The stick margin at a located boundary must be this close to zero (else the margin jumped)."""
+"""At a crossing-sliding the stick margin passes through zero: within this of it at the located boundary."""
 
 BOUNDARY_RULE = 1e-9
 """The rule for the boundary of non-stop motion: ``|mu/a (grazing) - mu/a (Den Hartog)| <= 1e-9``."""
@@ -410,11 +410,6 @@ def computed_boundary(
     float
         The boundary; nan where the margin does not change sign in ``bracket``.
 
-    Raises
-    ------
-    ConvergenceError
-        Where the margin changes sign by a jump (the orbit found changes), not through zero.
-
     Examples
     --------
     >>> abs(computed_boundary(2.0) - boundary(2.0)) < 1e-9
@@ -430,13 +425,39 @@ def computed_boundary(
         cur = margin(float(hi))
         if prev > 0.0 >= cur:
             root = float(brentq(margin, float(lo), float(hi), xtol=1e-13, rtol=1e-13))
-            if abs(margin(root)) > MARGIN_TOL:  # a jump of the margin (another orbit), not its zero
-                raise ConvergenceError(
-                    f"the stick margin jumps at mu/a = {root:.12g} (omega = {omega:g}): no boundary located"
-                )
             return root
         prev = cur
     return math.nan
+
+
+def transition_kind(omega: float, mu_ratio: float, v_belt: float = 0.0) -> str:
+    """Which sliding bifurcation starts the sticking at a located boundary ``mu_ratio``.
+
+    At a crossing-sliding the orbit crosses the surface where the sliding region begins: the stick
+    margin of :func:`reversals` passes through zero there.  At a grazing-sliding the orbit touches
+    the surface tangentially inside a slip, at the sliding region's edge: no reversal is there
+    below the boundary, and the margin jumps from a positive value to about zero.
+
+    Parameters
+    ----------
+    omega, mu_ratio
+        The frequency and the boundary there (:func:`computed_boundary`).
+    v_belt
+        The belt's speed.
+
+    Returns
+    -------
+    str
+        ``"crossing-sliding"`` where the margin just below ``mu_ratio`` is within :data:`MARGIN_TOL`
+        of zero, else ``"grazing-sliding"``.
+
+    Examples
+    --------
+    >>> transition_kind(2.0, computed_boundary(2.0))
+    'crossing-sliding'
+    """
+    below = reversals(orbit_at(omega, mu_ratio * (1.0 - 1e-12), v_belt)).margin
+    return "crossing-sliding" if abs(below) <= MARGIN_TOL else "grazing-sliding"
 
 
 def plot_amplitudes(points: Sequence[AmplitudePoint], ax=None) -> Figure:
