@@ -15,9 +15,9 @@ contact over four decades of the penetration ``delta``
 ``delta^(3/2)``, the map's error as ``delta^(5/2)`` on the grazing orbit's
 family and ``delta^2`` off the section, each with one constant.
 
-The model is built here with the public API (:func:`soft_impact_oscillator`);
-the built-in ``soft-impact-oscillator`` (parameters ``zeta``, ``a``, ``omega``,
-``gap``, ``k``) can replace it once it is merged.
+The model is the built-in ``soft-impact-oscillator`` (parameters ``zeta``, ``a``,
+``omega``, ``gap``, ``k``); its grazing is located on the free mode alone with
+the surface as a stop (:func:`free_oscillator_with_stop`).
 """
 
 from __future__ import annotations
@@ -30,7 +30,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from grazing.core.model import HybridModel, Mode, Parameter, Transition
+from grazing import models
+from grazing.core.model import HybridModel, Parameter
 from grazing.errors import InvalidParameterError
 from grazing.normalform import SwitchingMap, find_grazing_point, switching_map_at
 from grazing.normalform.switching_check import FlowCheck, compare_with_flow, loglog_slope, state_at
@@ -110,24 +111,11 @@ def _parameters(values: dict[str, float]) -> list[Parameter]:
 
 
 def soft_impact_oscillator(**values: float) -> HybridModel:
-    """The soft-impact oscillator: modes ``free`` and ``contact``, transitions ``touch`` and ``leave``
-    across ``x = gap`` without a reset (parameters :data:`DEFAULTS`, replaced by ``values``).
-
-    Built here with the public API; the built-in ``soft-impact-oscillator`` can replace it once merged.
-    """
-    x, v, t, gap, k, free, period = _definition()
-    return HybridModel(
-        "soft-impact-oscillator-report",
-        [x, v],
-        t,
-        _parameters(values),
-        period=period,
-        modes=[Mode("free", free), Mode("contact", [v, free[1] - k * (x - gap)])],
-        transitions=[
-            Transition("touch", "free", "contact", gap - x),
-            Transition("leave", "contact", "free", x - gap),
-        ],
-    )
+    """The built-in soft-impact oscillator (:func:`grazing.models.soft_impact_oscillator`: modes ``free``
+    and ``contact``, transitions ``touch`` and ``leave`` across ``x = gap`` without a reset) at the
+    section's parameters :data:`DEFAULTS`, replaced by ``values``."""
+    _parameters(values)  # (the section's parameters only)
+    return models.soft_impact_oscillator(**{**DEFAULTS, **values})
 
 
 def free_oscillator_with_stop(**values: float) -> HybridModel:
@@ -539,11 +527,8 @@ def build(out_dir: Path, progress: Say | None = None, settings: Settings | None 
         f"The same check for impacts (a square-root map) is tests/normalform/test_normal_form.py's; the "
         f"simulated contact itself agrees with matrix exponentials to 1e-12 "
         f"(tests/normalform/test_switching_zdm.py). Computed in {run.seconds:.1f} s.",
-        "The model is built in this section with the public API (two modes, transitions touch and leave "
-        "without "
-        "a reset); the built-in soft-impact-oscillator model (parameters zeta, a, omega, gap, k) can "
-        "replace it "
-        "once merged. Its grazing is located on the free mode with the surface taken as a stop.",
+        "The model is the built-in soft-impact-oscillator (two modes, transitions touch and leave without a "
+        "reset); its grazing is located on the free mode with the surface taken as a stop.",
     )
     return FigureResult(
         figure_id=FIGURE_ID,
