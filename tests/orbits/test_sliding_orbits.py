@@ -144,6 +144,7 @@ def test_a_crossing_sliding_located_at_the_exact_one():
     [sp] = br.special
     assert sp.kind is SpecialKind.CROSSING_SLIDING and sp.kind == "crossing-sliding"
     assert "crossing-sliding bifurcation" in br.status and "located" in br.status and "\n" not in br.status
+    assert br.status.endswith("can be followed with switch (switch=True)")  # (the command line: --switch)
     assert m.switch_names[sp.stop] == "belt_to_slip_ahead"
     o = sp.orbit
     assert o.switch_signature == (
