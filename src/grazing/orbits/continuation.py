@@ -1045,7 +1045,8 @@ class _Continuation:
             branch.special.append(point)
             branch.end_segment(
                 BranchEnd.GRAZING,
-                status + "; the orbit with the new switches of mode can be followed with switch (switch=True)",
+                status + "; the orbit with the new switches of mode can be followed with switch "
+                "(switch=True)",
             )
             return []
         new = new_sequence_orbit(bracket.before, self.param, value, sign, self.virtual)
