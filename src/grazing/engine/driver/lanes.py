@@ -9,7 +9,10 @@ free flight come from one call of the model's lane function (``tc_free`` or
 is where a step spends most of its time.  A lane that sticks, or the only
 lane of its kind (with or without variational equations), calls the scalar
 function; a lane whose point is finished takes the next one, so a lane that
-impacts or sticks holds up no other.  Every lane's arithmetic is the scalar
+impacts or sticks holds up no other.  A lane of a model with modes carries
+its active mode (its kernels; switches and sliding through the scalar
+driver's functions: a sliding lane is put back on its surface at each step's
+end and sample as a scalar run is).  Every lane's arithmetic is the scalar
 path's: the results are the same numbers, bit for bit.
 
 A point is run as :mod:`grazing.sweeps.run` describes: the transient in
