@@ -118,7 +118,7 @@ def test_random_models_with_modes(kind: str, data: st.DataObject) -> None:
 
 
 @pytest.mark.slow
-@settings(max_examples=12, suppress_health_check=[HealthCheck.filter_too_much, HealthCheck.too_slow])
+@settings(max_examples=24, suppress_health_check=[HealthCheck.filter_too_much, HealthCheck.too_slow])
 @given(spec=modes_specs(), fresh=st.booleans(), lyapunov=st.booleans())
 def test_random_models_with_modes_many(spec: ModesSpec, fresh: bool, lyapunov: bool) -> None:
     check_lanes(spec, fresh, lyapunov, scalar_lanes=True)
