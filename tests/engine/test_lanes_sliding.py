@@ -21,7 +21,7 @@ import grazing
 from grazing import HybridModel, Mode, Parameter, Surface
 from grazing.core.options import SweepSettings
 from grazing.engine.codegen import taylor_order
-from grazing.models import friction_oscillator
+from grazing.models import BUILT_IN, friction_oscillator
 from grazing.sweeps.run import run_chunks, stream_chunks
 from grazing.sweeps.spec import sweep_spec
 from tests.engine.test_lanes import assert_chunks_equal
@@ -139,3 +139,21 @@ def test_sweep_through_sliding_equals_simulate_point_by_point() -> None:
         assert point.mode_names[modes[i]] == sol.mode_final, i
     print(modes)
     assert STICK in modes.tolist()
+
+
+X0 = {"rocking-block": (0.05, 0.0)}  # (tilted: it rocks from the start)
+WITH_MODES = [name for name, make in BUILT_IN.items() if make().has_modes]
+
+
+@pytest.mark.parametrize("name", WITH_MODES)
+def test_every_built_in_model_with_modes_on_lanes_equals_the_runner_oracle(name: str) -> None:
+    """A continuation sweep over the forcing frequency with Lyapunov exponents, on lanes, of each built-in
+    model with modes (the soft-impact oscillator, the rocking block, the friction oscillator)."""
+    model = BUILT_IN[name]()
+    w = model.params["omega"]
+    settings_ = SweepSettings(transient=20, periods=8, chunk_size=2)
+    spec = sweep_spec(model, "omega", w * np.linspace(0.9, 1.1, 8), x0=X0.get(name), settings=settings_)
+    spec = dataclasses.replace(spec, polish=False)
+    res = run_chunks(spec, list(range(spec.n_chunks)))
+    assert_chunks_equal(spec, res, name)
+    assert all((r.status == 0).all() for r in res)
