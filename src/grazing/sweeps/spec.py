@@ -279,14 +279,8 @@ def spec_summary(spec: SweepSpec) -> dict[str, Any]:
 
 
 def _refuse_on_modes(model: HybridModel) -> None:
-    """One line for what a sweep (lanes) cannot do yet on a model with modes: sliding, sticking."""
+    """One line for what a sweep (lanes) cannot do yet on a model with modes: sticking."""
     system = model.symbolic
-    for sf in system.surfaces:
-        if sf.sliding:
-            raise InvalidParameterError(
-                f"a sweep does not support sliding yet (surface {sf.name!r} of model {model.name!r}): "
-                "give it sliding=False"
-            )
     for j, name in enumerate(model.stop_names):
         if system.stops[j].contact_direction is not None:
             raise InvalidParameterError(

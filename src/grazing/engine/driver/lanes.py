@@ -9,7 +9,10 @@ free flight come from one call of the model's lane function (``tc_free`` or
 is where a step spends most of its time.  A lane that sticks, or the only
 lane of its kind (with or without variational equations), calls the scalar
 function; a lane whose point is finished takes the next one, so a lane that
-impacts or sticks holds up no other.  Every lane's arithmetic is the scalar
+impacts or sticks holds up no other.  A lane of a model with modes carries
+its active mode (its kernels; switches and sliding through the scalar
+driver's functions: a sliding lane is put back on its surface at each step's
+end and sample as a scalar run is).  Every lane's arithmetic is the scalar
 path's: the results are the same numbers, bit for bit.
 
 A point is run as :mod:`grazing.sweeps.run` describes: the transient in
@@ -41,6 +44,7 @@ from grazing.engine.abi import TC_FREE_LANES, TC_VAR_LANES, call_model
 from grazing.engine.driver.atomics import fetch_add, load_acquire, store_release
 from grazing.engine.driver.calls import tc_free, tc_stick, tc_var
 from grazing.engine.driver.events import first_event
+from grazing.engine.driver.impacts import sliding_guard
 from grazing.engine.driver.recording import take_samples
 from grazing.engine.driver.state import STATUS_NONFINITE, STATUS_OK, STATUS_STEP_LIMIT, new_state
 from grazing.engine.driver.step import STEP_LAST, accept_step, end_plain_step, end_step, step_end
@@ -95,8 +99,12 @@ def to_lane(X, O, rows, nstops, K, XT, OT, lane):
 
 
 @njit(cache=True)
-def begin_request(st, periods, keep, use_var, T, zdm_s):
-    """Start a lane (state ``st``) on ``periods`` samples keeping the last ``keep`` (``Runner.advance``)."""
+def begin_request(m, st, periods, keep, use_var, T, zdm_s):
+    """Start a lane (state ``st``) on ``periods`` samples keeping the last ``keep`` (``Runner.advance``).
+
+    As :func:`.loop.start_run` does, a lane in a sliding pseudo-mode is kept on its surface's transition
+    from the positive side (the one it entered by within the previous request).
+    """
     st.n_samples = periods
     st.n_keep = keep
     st.isamp = 0
@@ -109,6 +117,7 @@ def begin_request(st, periods, keep, use_var, T, zdm_s):
     st.jac_valid = True
     st.use_var = use_var
     st.defl = 0
+    st.surface = 1 + sliding_guard(m, st.vf)  # (0: not sliding)
     st.ks = st.req_ks
     st.ss = st.req_ss
     k = st.k
@@ -644,10 +653,10 @@ def take_point(m, cfg, work, points, out, la, lane, budget, align, active):
             blk = min(ADAPTIVE_BLOCK, budget)
             ls[lane].block = blk
             ls[lane].stage = TRANSIENT
-            begin_request(ls[lane], blk, blk if cfg.adaptive else 0, False, T, zdms[p])
+            begin_request(m, ls[lane], blk, blk if cfg.adaptive else 0, False, T, zdms[p])
         else:
             ls[lane].stage = FINAL
-            final_request(ls[lane], XS, n, lane, align, cfg, sphase[p], zdms[p])
+            final_request(m, ls[lane], XS, n, lane, align, cfg, sphase[p], zdms[p])
         active += 1
     return active
 
@@ -681,20 +690,20 @@ def end_request(m, cfg, points, out, la, lane, budget, align):
                 if extra:
                     ls[lane].used += extra
                     ls[lane].stage = EXTRA
-                    begin_request(ls[lane], extra, 0, False, T, zdms[p])
+                    begin_request(m, ls[lane], extra, 0, False, T, zdms[p])
                     return False
                 nxt = 0
         if nxt < 0 and used < budget:
             blk = min(ADAPTIVE_BLOCK, budget - used)
             ls[lane].block = blk
-            begin_request(ls[lane], blk, blk if cfg.adaptive else 0, False, T, zdms[p])
+            begin_request(m, ls[lane], blk, blk if cfg.adaptive else 0, False, T, zdms[p])
             return False
         ls[lane].stage = FINAL
-        final_request(ls[lane], XS, n, lane, align, cfg, sphase[p], zdms[p])
+        final_request(m, ls[lane], XS, n, lane, align, cfg, sphase[p], zdms[p])
         return False
     if stage == EXTRA:
         ls[lane].stage = FINAL
-        final_request(ls[lane], XS, n, lane, align, cfg, sphase[p], zdms[p])
+        final_request(m, ls[lane], XS, n, lane, align, cfg, sphase[p], zdms[p])
         return False
     return finish_point(m, cfg, out, la, lane, align)
 
@@ -748,7 +757,7 @@ def finish_point(m, cfg, out, la, lane, align):
 
 
 @njit(cache=True)
-def final_request(st, XS, n, lane, align, cfg, s_phase, zdm_s):
+def final_request(m, st, XS, n, lane, align, cfg, s_phase, zdm_s):
     """The recorded stage of a point: with the variational equations (from the identity) for Lyapunov."""
     T = st.T
     if cfg.lyapunov:  # a new Runner at the current time, with the variational equations
@@ -761,6 +770,6 @@ def final_request(st, XS, n, lane, align, cfg, s_phase, zdm_s):
         for i in range(n):
             for c in range(n):
                 XS[n + i * n + c, lane] = 1.0 if i == c else 0.0
-        begin_request(st, align + cfg.periods, cfg.periods, True, T, zdm_s)
+        begin_request(m, st, align + cfg.periods, cfg.periods, True, T, zdm_s)
     else:
-        begin_request(st, cfg.periods, cfg.periods, False, T, zdm_s)
+        begin_request(m, st, cfg.periods, cfg.periods, False, T, zdm_s)
