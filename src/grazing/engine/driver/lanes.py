@@ -277,30 +277,47 @@ def sweep_lanes(m, cfg, work, points, out):
             if todo[lane] == 0:
                 continue
             run = ls[lane]
-            recording = run.recording  # (before the step's end)
             if not end_plain_step(run, cfg.lyapunov, m.nsens > 0):  # (the step's end has work to do)
-                nrows = ntot if (run.mode == 0 and run.use_var) else n
-                for i in range(ntot):
-                    xl[i] = XS[i, lane]
-                buffers = (xp, V, scratch, logs[lane], xe, gh, gv, fbuf)
-                chatter_time = cfg.chatter_tol * run.T
-                kicked, impact = end_step(
-                    m, run, xl, XT[:, :, lane], pl[lane], nrows, cfg, chatter_time, 0, Tp, buffers, tables
+                end_lane_step(
+                    m, cfg, la, lane, XT[:, :, lane], (xl, Tp, xp, V, scratch, xe, gh, gv, fbuf), tables
                 )
-                if recording and run.stage == FINAL:
-                    if kicked:
-                        counts[lane, cfg.stop] += 1
-                    if impact:
-                        counts[lane, run.ev_stop] += 1
-                run.n_stick = 0  # (sticking intervals are not recorded)
-                for i in range(ntot):
-                    XS[i, lane] = xl[i]
             n_samples = ls[lane].n_samples
             if ls[lane].isamp < n_samples:
                 continue
             # The request is done (Runner.advance returns): on to the next stage of the point.
             if end_request(m, cfg, points, out, la, lane, budget, align):
                 active -= 1
+
+
+@njit(cache=True, inline="always")
+def end_lane_step(m, cfg, la, lane, X, work, tables):
+    """The end of a lane's step that has work to do (an event, a sample, the request's end, sliding):
+    the scalar driver's :func:`~grazing.engine.driver.step.end_step` on the lane's state and
+    coefficients ``X``, its impacts counted in ``la.counts`` while the point records.
+
+    ``work`` = ``(xl, Tp, xp, V, scratch, xe, gh, gv, fbuf)``: one lane's state, the (empty) period
+    terms and end_step's buffers; ``tables`` its (unused) tables.
+    """
+    xl, Tp, xp, V, scratch, xe, gh, gv, fbuf = work
+    run = la.ls[lane]
+    XS = la.XS
+    n = m.nx
+    ntot = xl.shape[0]
+    recording = run.recording  # (before the step's end)
+    nrows = ntot if (run.mode == 0 and run.use_var) else n
+    for i in range(ntot):
+        xl[i] = XS[i, lane]
+    buffers = (xp, V, scratch, la.logs[lane], xe, gh, gv, fbuf)
+    chatter_time = cfg.chatter_tol * run.T
+    kicked, impact = end_step(m, run, xl, X, la.pl[lane], nrows, cfg, chatter_time, 0, Tp, buffers, tables)
+    if recording and run.stage == FINAL:
+        if kicked:
+            la.counts[lane, cfg.stop] += 1
+        if impact:
+            la.counts[lane, run.ev_stop] += 1
+    run.n_stick = 0  # (sticking intervals are not recorded)
+    for i in range(ntot):
+        XS[i, lane] = xl[i]
 
 
 @njit(cache=True, inline="always")
