@@ -284,3 +284,22 @@ def test_switched_past_the_crossing_sliding_onto_the_exact_orbits():
         assert res < 1e-13 and np.abs(o.state - x).max() < 1e-10 and o.model.params["mu"] < first.param
         assert [k for _, k in events] == ["cross", "stick", "slip", "stick", "slip"]
         assert np.abs(o.monodromy - J).max() < 1e-9 * max(1.0, np.abs(J).max())
+
+
+def test_where_sticking_begins_with_the_belt_at_rest_is_den_hartogs_boundary():
+    """From the public API: the non-stop orbit's crossing-sliding, followed in omega across resonance,
+    on Den Hartog's closed form mu / a = omega^2 / (|1 - omega^2| sqrt(1 + omega^2 tan^2(pi / 2 omega)))."""
+    from grazing.orbits import SlidingCurve
+    from grazing.orbits import sliding_curve as public_sliding_curve
+    from grazing.report.den_hartog import boundary
+
+    br = continue_orbit(friction_oscillator(omega=1.2, mu=0.1, v_belt=0.0), "mu", 0.1, 0.9)
+    [sp] = br.special
+    assert sp.kind is SpecialKind.CROSSING_SLIDING and sorted(sp.orbit.switch_signature[0]) == [TO_A, TO_B]
+    curve = public_sliding_curve(br, "omega", 0.9, steps=6)
+    assert isinstance(curve, SlidingCurve) and curve.status == "reached omega = 0.9"
+    assert curve.params == ("mu", "omega") and curve.kind is SpecialKind.CROSSING_SLIDING
+    assert len(curve) >= 7 and min(w for _, w in curve.values) < 1.0 < max(w for _, w in curve.values)
+    for (mu, w), (lo, hi) in zip(curve.values, curve.intervals):
+        exact = boundary(w) if abs(w - 1.0) > 1e-9 else math.pi / 4
+        assert hi - lo <= 2.1e-10 and abs(mu - exact) < 1e-9, (w, mu - exact)

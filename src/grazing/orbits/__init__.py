@@ -1,4 +1,4 @@
-"""Periodic orbits: shooting, Floquet multipliers, continuation, grazing and bifurcation curves."""
+"""Periodic orbits: shooting, Floquet multipliers, continuation, grazing, sliding and bifurcation curves."""
 
 from grazing.maps import flow_map
 from grazing.orbits.contact import GrazingPoint, refine_grazing
@@ -8,6 +8,7 @@ from grazing.orbits.curves import follow_curve
 from grazing.orbits.grazing import GrazingCurve, find_grazings, grazing_curve
 from grazing.orbits.palc import PalcSettings
 from grazing.orbits.shooting import PeriodicOrbit, find_orbit
+from grazing.orbits.sliding_curves import SlidingCurve, sliding_curve
 
 __all__ = [
     "BifurcationCurve",
@@ -19,6 +20,7 @@ __all__ = [
     "GrazingPoint",
     "PalcSettings",
     "PeriodicOrbit",
+    "SlidingCurve",
     "SpecialPoint",
     "continue_orbit",
     "find_grazings",
@@ -27,4 +29,5 @@ __all__ = [
     "follow_curve",
     "grazing_curve",
     "refine_grazing",
+    "sliding_curve",
 ]

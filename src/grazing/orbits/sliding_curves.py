@@ -61,6 +61,15 @@ class SlidingCurve:
         The orbit on the branch's side of each bracket.
     status
         Why the curve ended, in one line.
+
+    Examples
+    --------
+    >>> from grazing.models import friction_oscillator
+    >>> from grazing.orbits import continue_orbit
+    >>> branch = continue_orbit(friction_oscillator(omega=2.0, mu=0.1, v_belt=0.0), "mu", 0.1, 0.9)
+    >>> curve = sliding_curve(branch, "omega", 2.1, steps=2)
+    >>> curve.kind, curve.params, len(curve)
+    ('crossing-sliding', ('mu', 'omega'), 3)
     """
 
     kind: SpecialKind
@@ -125,6 +134,26 @@ def sliding_curve(branch: Branch, param2: str, stop: float, *, steps: int = 10) 
     ------
     InvalidParameterError
         Without a sliding bifurcation on the branch, or with ``param2`` the branch's parameter.
+
+    Examples
+    --------
+    Where the friction oscillator with the belt at rest first sticks (a crossing-sliding), in ``mu``
+    and then in ``omega``; Den Hartog's closed form of that boundary (``a = 1``) is
+    :func:`grazing.report.den_hartog.boundary`:
+
+    >>> from grazing.models import friction_oscillator
+    >>> from grazing.orbits import continue_orbit
+    >>> from grazing.report.den_hartog import boundary
+    >>> branch = continue_orbit(friction_oscillator(omega=2.0, mu=0.1, v_belt=0.0), "mu", 0.1, 0.9)
+    >>> branch.special[0].kind
+    'crossing-sliding'
+    >>> curve = sliding_curve(branch, "omega", 1.8, steps=2)
+    >>> curve.status
+    'reached omega = 1.8'
+    >>> [round(w, 3) for _, w in curve.values]
+    [2.0, 1.9, 1.8]
+    >>> max(abs(mu - boundary(w)) for mu, w in curve.values) < 1e-9
+    True
     """
     found: list[SpecialPoint] = [sp for sp in branch.special if sp.kind in SLIDING_KINDS]
     if not found:
