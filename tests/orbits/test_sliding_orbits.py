@@ -145,6 +145,7 @@ def test_a_crossing_sliding_located_at_the_exact_one():
     assert sp.kind is SpecialKind.CROSSING_SLIDING and sp.kind == "crossing-sliding"
     assert "crossing-sliding bifurcation" in br.status and "located" in br.status and "\n" not in br.status
     assert br.status.endswith("can be followed with switch (switch=True)")  # (the command line: --switch)
+    assert f"(located to +-{sp.precision:.1g} by bisection on the switches)" in br.status  # (a width)
     assert m.switch_names[sp.stop] == "belt_to_slip_ahead"
     o = sp.orbit
     assert o.switch_signature == (

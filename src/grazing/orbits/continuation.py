@@ -1034,10 +1034,7 @@ class _Continuation:
             precision=precision, interval=(min(lo, value - precision), max(hi, value + precision)),
         )  # fmt: skip
         how = "located" if bracket.complete else "bracketed only"
-        where = (
-            f"{par.show(value)} of {name!r} ({how}, between {par.show(lo)} and {par.show(hi)}, by bisection "
-            f"on the switches)"
-        )
+        where = f"{par.show(value)} of {name!r} ({how} to +-{precision:.1g} by bisection on the switches)"
         article = "an" if str(kind)[0] in "aeiou" else "a"
         status = f"ended at {article} {kind} bifurcation at {where}: {switch_change_reason(last, after)}"
         status = status.replace(": a grazing of a switching surface", f": {article} {kind} bifurcation")
