@@ -222,8 +222,8 @@ def test_basins_of_a_model_with_modes_and_their_store(tmp_path, capsys, monkeypa
 
 
 def test_attractors_of_a_model_with_modes_are_followed(capsys):
-    argv = ["attractors", *SOFT, "--x-range=-1.5,1.5", "--y-range=-1.5,1.5", "--param", "a", "--start", "0.15", "--stop", "0.2", "--num", "2",
-            "--num-grid", "6,6"]  # fmt: skip
+    argv = ["attractors", *SOFT, "--x-range=-1.5,1.5", "--y-range=-1.5,1.5", "--param", "a",
+            "--start", "0.15", "--stop", "0.2", "--num", "2", "--num-grid", "6,6"]  # fmt: skip
     code, text, err = run(argv, capsys)
     assert code == 0 and err == "" and "2 attractors and outcomes followed" in text, (text, err)
     assert text.count("periodic; a in [0.15, 0.2] (2 values)") == 2, text  # (both at both values)
