@@ -192,19 +192,41 @@ def test_simulate_of_a_model_of_one_mode_shows_no_sliding(capsys):
     )
 
 
-@pytest.mark.parametrize(
-    "command",
-    [
-        ["explore"],
-        ["basins", "--x-range", "0,1", "--y-range", "0,1", "--num", "2"],
-        ["attractors", "--param", "a", "--start", "1", "--stop", "2", "--num", "2", "--num-grid", "2",
-         "--x-range", "0,1", "--y-range", "0,1"],
-    ],
-)  # fmt: skip
+@pytest.mark.parametrize("command", [["explore"]])
 def test_what_the_library_does_not_run_is_refused_in_one_line(command, capsys):
     code, out, err = run([*command, *SOFT], capsys)
     assert code != 0 and out == "" and err.count("\n") == 1, err
     assert f"{command[0]} does not support models with modes yet" in err
+
+
+# Below the fold of its resonance the soft-impact oscillator has a small free orbit and a large one in
+# contact each period (tests/attractors/test_basins_modes.py); the grid reaches into the contact region.
+COEXISTING = [*SOFT, "--set", "a=0.15", "--x-range=-1.5,1.5", "--y-range=-1.5,1.5"]
+
+
+def test_basins_of_a_model_with_modes_and_their_store(tmp_path, capsys, monkeypatch):
+    store = tmp_path / "b.zarr"
+    res = run_json(["basins", *COEXISTING, "--num", "8,8", "--out", str(store), "--chunk-size", "16"], capsys)
+    assert [a["kind"] for a in res["attractors"]] == ["periodic", "periodic"]
+    labels = np.array(res["labels"])
+    assert labels.min() >= 1 and set(labels.ravel()) == {1, 2}  # (no state invalid: each in its mode)
+    import grazing.sweeps.executor as executor
+
+    monkeypatch.setattr(
+        executor, "chunk_results", lambda *a, **k: (_ for _ in ()).throw(AssertionError("again"))
+    )
+    again = run_json(
+        ["basins", *COEXISTING, "--num", "8,8", "--out", str(store), "--chunk-size", "16"], capsys
+    )
+    assert again["labels"] == res["labels"]
+
+
+def test_attractors_of_a_model_with_modes_are_followed(capsys):
+    argv = ["attractors", *SOFT, "--x-range=-1.5,1.5", "--y-range=-1.5,1.5", "--param", "a",
+            "--start", "0.15", "--stop", "0.2", "--num", "2", "--num-grid", "6,6"]  # fmt: skip
+    code, text, err = run(argv, capsys)
+    assert code == 0 and err == "" and "2 attractors and outcomes followed" in text, (text, err)
+    assert text.count("periodic; a in [0.15, 0.2] (2 values)") == 2, text  # (both at both values)
 
 
 def test_graze_json_of_a_model_of_one_mode_has_no_mode(capsys):

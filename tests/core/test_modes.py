@@ -296,14 +296,9 @@ def test_features_not_yet_on_modes_are_refused_in_one_line():
     with pytest.raises(InvalidParameterError, match=r"^the discontinuity map does not support models"):
         grazing.simulate(m, [0.0, 0.0], periods=1, zdm=object())
     # (the grazing analysis and the grazing curve go through modes: tests/orbits/test_curves_through_modes.py)
-    from grazing.attractors import continue_attractors, find_attractors
+    # (the attractors and basins go through modes: tests/attractors/test_basins_modes.py)
     from grazing.maps import flow_map
 
-    # (the basins' grid once called every state "invalid": a guard of the other mode is negative there)
-    with pytest.raises(InvalidParameterError, match=r"^finding attractors does not support models with"):
-        find_attractors(m, [[0.0, 0.0]])
-    with pytest.raises(InvalidParameterError, match=r"^continuing attractors does not support models with"):
-        continue_attractors(m, "omega", [1.0, 1.1], (-1.0, 0.4), (-1.0, 1.0), (2, 2))
     with pytest.raises(
         InvalidParameterError, match=r"^a run without events \(events=False\) does not support"
     ):

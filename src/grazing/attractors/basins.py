@@ -27,7 +27,7 @@ import numpy as np
 
 from grazing.attractors.classify import Attractor, Catalogue
 from grazing.attractors.grid import StateGrid, as_states, beyond_stops, default_cell, start_time, state_grid
-from grazing.core.model import HybridModel
+from grazing.core.model import HybridModel, mode_of_states
 from grazing.core.options import (
     BASIN_ADAPTIVE_TOL,
     BASIN_CLOSING_ROUNDS,
@@ -110,8 +110,10 @@ class AttractorSet:
         raise KeyError(ident)
 
 
-def basin_spec(model: HybridModel, states: np.ndarray, settings: BasinSettings, lyapunov: bool) -> SweepSpec:
-    """The fresh sweep whose points are the initial states ``states``, each from its own at the phase."""
+def basin_spec(model: HybridModel, states: np.ndarray, settings: BasinSettings, lyapunov: bool,
+               modes: np.ndarray | None = None) -> SweepSpec:  # fmt: skip
+    """The fresh sweep whose points are the initial states ``states``, each from its own at the phase (a
+    model with modes: in its mode, ``modes``, by default the one it lies in: :func:`start_modes`)."""
     return SweepSpec(
         model=model,
         params=(),
@@ -128,7 +130,22 @@ def basin_spec(model: HybridModel, states: np.ndarray, settings: BasinSettings, 
         starts=states,
         adaptive_tol=BASIN_ADAPTIVE_TOL,
         polish=False,  # (the catalogue polishes the end states, a few per attractor)
+        start_modes=start_modes(model, states, start_time(model, settings.phase)) if modes is None else modes,
     )
+
+
+def start_modes(model: HybridModel, states: np.ndarray, t: float) -> np.ndarray | None:
+    """The index of the mode each initial state lies in at time ``t``
+    (:func:`~grazing.core.model.mode_of_states`); None for a model without modes (its one mode)."""
+    return mode_of_states(model, states, t) if model.has_modes else None
+
+
+def outside(model: HybridModel, states: np.ndarray, t: float) -> np.ndarray:
+    """Which initial states are ``invalid``: beyond a stop (:func:`~grazing.attractors.grid.beyond_stops`),
+    or, in a model with modes, in no mode's region (:meth:`HybridModel.mode_at`)."""
+    if model.has_modes:
+        return mode_of_states(model, states, t) < 0
+    return beyond_stops(model, states, t)
 
 
 @dataclass(frozen=True)
@@ -223,10 +240,9 @@ def find_attractors(
     used: set[str] = set()
     s = with_shorthands(settings, BasinSettings, shorthands, used)
     refuse_unknown("find_attractors", shorthands, used)
-    model.require_one_mode("finding attractors")
     x = as_states(model, states)
     t0 = start_time(model, s.phase)
-    invalid = beyond_stops(model, x, t0)
+    invalid = outside(model, x, t0)
     valid = np.flatnonzero(~invalid)
     box = x[valid] if valid.size else x
     cells = default_cell(box) if cell is None else np.broadcast_to(np.asarray(cell, dtype=float), x.shape[1:])
@@ -321,6 +337,7 @@ class _Deferred:
 
     index: np.ndarray
     states: np.ndarray
+    modes: np.ndarray | None = None  # (a model with modes: the mode each end state is in)
 
 
 class _InOrder:
@@ -335,6 +352,7 @@ class _InOrder:
         self.counted = 0
         self.index: list[np.ndarray] = []
         self.states: list[np.ndarray] = []
+        self.modes: list[np.ndarray] = []
 
     def take(self, res: ChunkResult | None = None) -> None:
         """Keep ``res``; classify every chunk now ready in order (computed, or in the store)."""
@@ -349,6 +367,8 @@ class _InOrder:
             if later.size:
                 self.index.append(self.which[sl][later])
                 self.states.append(np.asarray(part.x_final, dtype=float)[later])
+                ended = part.mode_final if part.mode_final is not None else np.full(sl.stop - sl.start, -1)
+                self.modes.append(np.asarray(ended, dtype=np.int64)[later])
             self.counted += sl.stop - sl.start
             self.next += 1
 
@@ -357,6 +377,7 @@ class _InOrder:
         return _Deferred(
             np.concatenate(self.index) if self.index else np.zeros(0, dtype=np.int64),
             np.concatenate(self.states) if self.states else np.zeros((0, n)),
+            np.concatenate(self.modes) if self.spec.model.has_modes and self.modes else None,
         )
 
 
@@ -396,8 +417,22 @@ def _refine(model: HybridModel, catalogue: Catalogue, deferred: _Deferred, s: Ba
     """Run the deferred end states on for another transient, from where they ended; classify them."""
     if deferred.index.size == 0:
         return deferred
-    spec = basin_spec(model, deferred.states, s, s.lyapunov and not look.defer)
+    modes = None if deferred.modes is None else _end_modes(model, deferred, start_time(model, s.phase))
+    spec = basin_spec(model, deferred.states, s, s.lyapunov and not look.defer, modes)
     return _run(spec, deferred.index, catalogue, look, run, 0, 0)
+
+
+def _end_modes(model: HybridModel, deferred: _Deferred, t: float) -> np.ndarray:
+    """The mode each deferred end state is run on in: the mode its run ended in, where known and not a
+    sliding pseudo-mode (a chunk read back from a store keeps only its last point's), else the one it
+    lies in (:func:`start_modes`; it slides on from a surface), else the initial mode (its run then
+    says what it does there)."""
+    assert deferred.modes is not None
+    real = len(model.mode_names) - len(model.sliding_modes)
+    ended = np.asarray(deferred.modes, dtype=np.int64)
+    known = (ended >= 0) & (ended < real)
+    there = mode_of_states(model, deferred.states, t)
+    return np.where(known, ended, np.where(there >= 0, there, model.mode_index(None)))
 
 
 def basins(

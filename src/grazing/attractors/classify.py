@@ -57,7 +57,7 @@ from grazing.core.options import (
 from grazing.core.period import orbit_impacts, sample_scale
 from grazing.core.solution import Status
 from grazing.errors import GrazingError
-from grazing.sweeps.polish import Polished, contracting_periods, is_neutral, polish
+from grazing.sweeps.polish import Polished, contracting_periods, is_neutral, mode_there, polish
 from grazing.sweeps.spec import ChunkResult
 from grazing.sweeps.status import reason
 
@@ -607,7 +607,8 @@ class Catalogue:
             if self._sticks(e):
                 continue
             try:
-                fm = flow_map(self.model, e.points[0], t0=self.t_sample, periods=e.period)
+                mode = mode_there(self.model, e.points[0], self.t_sample)
+                fm = flow_map(self.model, e.points[0], t0=self.t_sample, periods=e.period, mode=mode)
             except (GrazingError, ArithmeticError):
                 continue
             if not (fm.solution.jacobian_valid and np.all(np.isfinite(fm.jacobian))):

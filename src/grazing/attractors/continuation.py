@@ -210,7 +210,6 @@ def continue_attractors(
     used: set[str] = set()
     s = with_shorthands(settings, BasinSettings, shorthands, used)
     refuse_unknown("continue_attractors", shorthands, used)
-    model.require_one_mode("continuing attractors")
     par = model.parameter(param)
     vals = np.asarray(values, dtype=float).ravel()
     if vals.size == 0 or not np.all(np.isfinite(vals)):

@@ -270,7 +270,7 @@ def _attractor_lines(atts: list[Any], model: grazing.HybridModel) -> list[str]:
 
 
 @click.command("basins")
-@model_options(any_model=True)
+@model_options(any_model=True, modes=True)
 @_grid_options("--num")
 @click.option(
     "--chunk-size",
@@ -336,12 +336,12 @@ def basins_cmd(
     start = time.perf_counter()
     try:
         if zarr_out:
-            from grazing.attractors.basins import basin_spec
-            from grazing.attractors.grid import beyond_stops, start_time
+            from grazing.attractors.basins import basin_spec, outside
+            from grazing.attractors.grid import start_time
             from grazing.sweeps.store import ZarrStore
 
             x = grid.states_array()
-            valid = x[~beyond_stops(model, x, start_time(model, phase))]
+            valid = x[~outside(model, x, start_time(model, phase))]
             if valid.size:
                 spec = basin_spec(model, valid, settings, not no_lyapunov and refine == 0)
                 store = ZarrStore(
@@ -412,7 +412,7 @@ def basins_cmd(
 
 
 @click.command("attractors")
-@model_options(any_model=True)
+@model_options(any_model=True, modes=True)
 @click.option(
     "--param", "aparam", required=True, metavar="NAME", help="Parameter to vary (angles in degrees)."
 )

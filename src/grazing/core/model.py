@@ -1197,6 +1197,29 @@ class HybridModel:
             raise InvalidParameterError(f"unknown mode {name!r} for model {self.name!r} (modes: {known})")
         return self.mode_names.index(name)
 
+    def mode_at(self, x: Any, t: float = 0.0) -> str:
+        """The mode a state ``x`` at time ``t`` lies in: the first (the initial mode first) whose outgoing
+        transitions' guards are all >= 0 there (to :data:`ON_STOP_TOL`, as :meth:`check_state` allows).
+
+        A model without modes: its one mode.  A state in no mode's region raises a one-line
+        :class:`~grazing.errors.InvalidStateError`.
+
+        Examples
+        --------
+        >>> import grazing
+        >>> m = grazing.models.soft_impact_oscillator()
+        >>> m.mode_at([0.0, 0.0]), m.mode_at([m.params["gap"] + 0.1, 0.0])
+        ('free', 'contact')
+        """
+        arr = self.check_state(x, t, allowed=False)
+        if not self.has_modes:
+            return self.mode_names[0]
+        k = mode_of_states(self, arr[None], float(t))[0]
+        if k < 0:
+            raise InvalidStateError(f"state {arr.tolist()} is in no mode of model {self.name!r} (every mode "
+                                    "has a transition whose guard is negative there)")  # fmt: skip
+        return self.mode_names[int(k)]
+
     def require_one_mode(self, what: str) -> None:
         """Raise a one-line error if this model has several modes: ``what`` does not support them yet."""
         if self.has_modes:
@@ -1401,3 +1424,37 @@ class HybridModel:
                     f"initial state {arr.tolist()} is beyond {where} (guard h = {hv:.3g} < 0)"
                 )
         return arr
+
+
+def mode_of_states(model: HybridModel, states: np.ndarray, t: float) -> np.ndarray:
+    """The index of the mode each row of ``states`` lies in at time ``t`` (:meth:`HybridModel.mode_at`),
+    -1 where none: the first mode (the initial one first) whose outgoing transitions' guards are all
+    above ``-ON_STOP_TOL * max(1, |x|)``.
+
+    Examples
+    --------
+    >>> import grazing
+    >>> m = grazing.models.soft_impact_oscillator(gap=0.5)
+    >>> mode_of_states(m, np.array([[0.0, 1.0], [0.7, 0.0], [0.5, 0.0]]), 0.0).tolist()
+    [0, 1, 0]
+    """
+    x = np.asarray(states, dtype=float)
+    out = np.full(x.shape[0], -1, dtype=np.int64)
+    if x.shape[0] == 0:
+        return out
+    params = list(model.param_vector)
+    scale = np.maximum(1.0, np.max(np.abs(x), axis=1))
+    columns = [x[:, c] for c in range(x.shape[1])]
+    real = model.mode_names[: len(model.mode_names) - len(model.sliding_modes)]
+    first = model.mode_index(None)
+    for k in [first] + [i for i in range(len(real)) if i != first]:
+        inside = np.ones(x.shape[0], dtype=bool)
+        for j in range(model.n_stops):
+            if model.has_modes and model.transition_source[j] != real[k]:
+                continue
+            h = np.broadcast_to(
+                np.asarray(model.numeric("h", j)(columns, float(t), params), dtype=float), inside.shape
+            )
+            inside &= h >= -ON_STOP_TOL * scale
+        out[(out < 0) & inside] = k
+    return out

@@ -160,13 +160,20 @@ def is_neutral(monodromy: np.ndarray, multipliers: np.ndarray | None = None) -> 
     return not is_isolated(np.asarray(monodromy, dtype=float))
 
 
+def mode_there(model: HybridModel, state: np.ndarray, t: float) -> str | None:
+    """The mode a run from ``state`` at time ``t`` starts in (:meth:`HybridModel.mode_at`); None
+    without modes."""
+    return model.mode_at(state, t) if model.has_modes else None
+
+
 def cycle_points(model: HybridModel, state: np.ndarray, t0: float, period: int) -> np.ndarray:
     """The points of the period-``period`` orbit through ``state`` at times ``t0 + j T``, ``j = 1 ..
     period`` (the last is ``state`` again, to the orbit's accuracy)."""
     from grazing.engine.simulate import simulate
 
     phase = 2 * math.pi * (t0 / float(model.period) % 1.0)
-    sol = simulate(model, state, t0=t0, transient=0, periods=period, phase=phase)
+    sol = simulate(model, state, t0=t0, transient=0, periods=period, phase=phase,
+                   mode=mode_there(model, state, t0))  # fmt: skip
     return np.asarray(sol.samples, dtype=float)[-period:]
 
 
@@ -206,8 +213,9 @@ def polish(
     for p in tries:
         try:
             orbit = find_orbit(
-                model, s[-1], period=int(p), t0=float(t0), max_iter=max_iter, through_stops=False
-            )
+                model, s[-1], period=int(p), t0=float(t0), max_iter=max_iter, through_stops=False,
+                mode=mode_there(model, s[-1], float(t0)),
+            )  # fmt: skip
         except (GrazingError, ArithmeticError, np.linalg.LinAlgError):
             continue
         if not orbit.stable or is_neutral(orbit.monodromy, orbit.multipliers):

@@ -121,7 +121,7 @@ class LaneBatch:
             # Jobs: runs of points, each continuing from the previous (a chunk; every point when fresh).
             if spec.fresh:
                 jobs.append(np.column_stack([np.arange(a, b), np.arange(a + 1, b + 1)]))
-                first_vfs.append([vf0] * size)
+                first_vfs.append([vf0] * size if spec.start_modes is None else spec.start_modes[sl])
                 x0s.append(np.broadcast_to(x0, (size, n)))
                 if spec.starts is not None:  # (each from its own state, at its sampling phase)
                     firsts.append(np.column_stack([carry, spec.starts[sl]]))

@@ -74,6 +74,10 @@ class SweepSpec:
         ``n_points`` rows), at the sampling phase of its forcing period (a
         grid of initial states, :mod:`grazing.attractors`); None: ``x0`` at
         time 0.
+    start_modes
+        With ``starts`` on a model with modes: the index of the mode each
+        point's initial state is in (:func:`grazing.core.model.mode_of_states`);
+        None: the model's initial mode.
     adaptive_tol
         The tolerance to which the samples must repeat for an adaptive transient to end.
     resume
@@ -123,6 +127,7 @@ class SweepSpec:
     zdm: DiscontinuityMapLike = None
     segments: int = 1
     starts: Any = field(default=None, compare=False, repr=False)
+    start_modes: Any = field(default=None, compare=False, repr=False)
     adaptive_tol: float = ADAPTIVE_TOL
     resume: tuple[float, tuple[float, ...]] | tuple[float, tuple[float, ...], int] | None = None
     chatter_tol: float = CHATTER_TOL
@@ -142,6 +147,18 @@ class SweepSpec:
             if not self.fresh or starts.shape != (len(self.points), self.model.n_states):
                 raise InvalidParameterError("starts needs a fresh sweep and one initial state per point")
             object.__setattr__(self, "starts", starts)
+        if self.start_modes is not None:
+            modes = np.ascontiguousarray(self.start_modes, dtype=np.int64)
+            real = len(self.model.mode_names) - len(self.model.sliding_modes)
+            if (
+                self.starts is None
+                or modes.shape != (len(self.points),)
+                or np.any((modes < 0) | (modes >= real))
+            ):
+                raise InvalidParameterError(
+                    "start_modes needs starts and one mode index of the model per point"
+                )
+            object.__setattr__(self, "start_modes", modes)
         for p in self.params:
             if p not in self.model.params:
                 raise InvalidParameterError(
@@ -231,6 +248,8 @@ class SweepSpec:
             d["segments"] = self.segments
         if self.starts is not None:
             d["starts_sha256"] = hashlib.sha256(self.starts.tobytes()).hexdigest()
+        if self.start_modes is not None:
+            d["start_modes_sha256"] = hashlib.sha256(self.start_modes.tobytes()).hexdigest()
         if self.resume is not None:
             d["resume"] = [self.resume[0], list(self.resume[1]), *self.resume[2:]]
         if self.adaptive_tol != ADAPTIVE_TOL:
