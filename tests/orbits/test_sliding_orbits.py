@@ -304,3 +304,18 @@ def test_where_sticking_begins_with_the_belt_at_rest_is_den_hartogs_boundary():
     for (mu, w), (lo, hi) in zip(curve.values, curve.intervals):
         exact = boundary(w) if abs(w - 1.0) > 1e-9 else math.pi / 4
         assert hi - lo <= 2.1e-10 and abs(mu - exact) < 1e-9, (w, mu - exact)
+
+
+@pytest.mark.parametrize("stop, steps", [(0.6, 28), (2.5, 10)])
+def test_the_sliding_curve_goes_on_where_a_switch_reaches_the_section(stop, steps):
+    """From omega = 2 down past resonance and up to 2.5 a switch of the orbits comes to the section on
+    the way (the period map from it returned in another mode, and the curve ended at omega = 0.875 and
+    2.25): both curves reach their end, on Den Hartog's boundary."""
+    from grazing.report.den_hartog import boundary
+
+    br = continue_orbit(friction_oscillator(omega=2.0, mu=0.05, v_belt=0.0), "mu", 0.05, 0.95)
+    curve = sliding_curve(br, "omega", stop, steps=steps)
+    assert curve.status == f"reached omega = {stop:g}" and len(curve) >= steps + 1
+    for mu, w in curve.values:
+        exact = boundary(w) if abs(w - 1.0) > 1e-9 else math.pi / 4
+        assert abs(mu - exact) < 1e-9, (w, mu - exact)

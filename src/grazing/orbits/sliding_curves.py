@@ -18,7 +18,7 @@ from grazing.errors import GrazingError, InvalidParameterError
 from grazing.orbits.continuation import Branch, SpecialPoint
 from grazing.orbits.kinds import SpecialKind
 from grazing.orbits.periodic import PeriodicOrbit
-from grazing.orbits.shooting import find_orbit
+from grazing.orbits.shooting import find_orbit, move_section, quiet_section
 from grazing.orbits.sliding_bifurcations import bisect_switches, kind_of_change
 
 SLIDING_KINDS = (
@@ -84,12 +84,17 @@ class SlidingCurve:
 
 
 def _orbit_at(like: PeriodicOrbit, **values: float) -> PeriodicOrbit | None:
-    try:
-        return find_orbit(
-            like.model.with_params(**values), like.state, period=like.period, t0=like.t0, mode=like.mode
-        )
-    except GrazingError:
-        return None
+    """The orbit near ``like`` at ``values``; where a switch has come to its section (the map returns in
+    another mode, or Newton's method fails), tried again from ``like`` on its quietest section."""
+    for guess in (like, None):
+        try:
+            if guess is None:
+                guess = move_section(like, quiet_section(like))
+            model = like.model.with_params(**values)
+            return find_orbit(model, guess.state, period=like.period, t0=guess.t0, mode=guess.mode)
+        except GrazingError:
+            continue
+    return None
 
 
 def _bracket(
