@@ -243,25 +243,38 @@ SWEEPS = {
 }
 
 
+def assert_lanes_equal_the_oracle(
+    spec: SweepSpec, label: str = "", *, scalar: bool = True, regroup: bool = True
+) -> list:
+    """Every chunk of ``spec`` on the model's lanes equals the Runner oracle (:func:`assert_chunks_equal`),
+    and with ``scalar`` lane by lane too (every Taylor kernel called scalar); with ``regroup`` also one
+    chunk at a time and the jobs shared by three threads.  Returns the chunks run on the lanes."""
+    kern = spec.model.kernels(0, taylor_order(spec.tol))
+    saved = kern.LANES
+    results = {}
+    try:
+        for lanes in dict.fromkeys((saved, 1) if scalar else (saved,)):  # (1: lane by lane, scalar)
+            kern.LANES = lanes
+            results[lanes] = run_chunks(spec, list(range(spec.n_chunks)))
+            assert_chunks_equal(spec, results[lanes], f"{label}{lanes} lanes")
+    finally:
+        kern.LANES = saved
+    if regroup:
+        # grouped differently: one chunk at a time
+        assert_chunks_equal(spec, [run_chunks(spec, [i])[0] for i in range(spec.n_chunks)], "one chunk")
+        # the jobs shared by three threads (the chunks reported as they finish)
+        streamed = list(stream_chunks([(spec, i) for i in range(spec.n_chunks)], 3))
+        assert sorted(k for k, _ in streamed) == list(range(spec.n_chunks))
+        assert_chunks_equal(spec, [res for _, res in streamed], "three threads")
+    return results[saved]
+
+
 @pytest.mark.parametrize("name", list(SWEEPS))
 def test_sweep_on_lanes_equals_the_runner_oracle(name: str) -> None:
     make, param, values, settings_ = SWEEPS[name]
     # (the engine against its oracle: without the Newton polish of runs that have no period, a layer above)
     spec = dataclasses.replace(sweep_spec(make(), param, values, settings=settings_), polish=False)
-    kern = spec.model.kernels(0, taylor_order(spec.tol))
-    saved = kern.LANES
-    try:
-        for lanes in sorted({saved, 1}):  # (1: every Taylor kernel called lane by lane, scalar)
-            kern.LANES = lanes
-            assert_chunks_equal(spec, run_chunks(spec, list(range(spec.n_chunks))), f"{lanes} lanes")
-    finally:
-        kern.LANES = saved
-    # grouped differently: one chunk at a time
-    assert_chunks_equal(spec, [run_chunks(spec, [i])[0] for i in range(spec.n_chunks)], "one chunk")
-    # the jobs shared by three threads (the chunks reported as they finish)
-    streamed = list(stream_chunks([(spec, i) for i in range(spec.n_chunks)], 3))
-    assert sorted(k for k, _ in streamed) == list(range(spec.n_chunks))
-    assert_chunks_equal(spec, [res for _, res in streamed], "three threads")
+    assert_lanes_equal_the_oracle(spec)
 
 
 def test_chunks_of_several_sweeps_in_one_batch_equal_each_sweep_alone() -> None:

@@ -22,9 +22,9 @@ from scipy.optimize import brentq
 import grazing
 from grazing.core.options import LYAPUNOV_ALIGN, SweepSettings
 from grazing.engine.codegen import taylor_order
-from grazing.sweeps.run import LaneBatch, run_chunks, stream_chunks
+from grazing.sweeps.run import LaneBatch, run_chunks
 from grazing.sweeps.spec import sweep_spec
-from tests.engine.test_lanes import assert_chunks_equal, check_lane_functions
+from tests.engine.test_lanes import assert_chunks_equal, assert_lanes_equal_the_oracle, check_lane_functions
 from tests.engine.test_mode_switches import reference as mode_switches_reference
 from tests.engine.test_mode_switches import soft_impact
 from tests.engine.test_rocking_modes import rocking_block
@@ -63,24 +63,12 @@ def test_sweep_through_modes_on_lanes_equals_the_runner_oracle(name: str) -> Non
     spec = dataclasses.replace(sweep_spec(make(), param, values, settings=settings_), polish=False)
     kern = spec.model.kernels(0, taylor_order(spec.tol))
     assert kern.NMODES == 2 and kern.LANES > 1
-    saved = kern.LANES
-    results = {}
-    try:
-        for lanes in (saved, 1):  # (1: every Taylor kernel called lane by lane, scalar)
-            kern.LANES = lanes
-            results[lanes] = run_chunks(spec, list(range(spec.n_chunks)))
-            assert_chunks_equal(spec, results[lanes], f"{lanes} lanes")
-    finally:
-        kern.LANES = saved
-    res = results[saved]
+    res = assert_lanes_equal_the_oracle(spec)
     if name.startswith("soft"):
         modes = np.concatenate([r.mode_final for r in res])
         assert set(modes.tolist()) == {0, 1}, modes  # (points end in either mode)
     else:  # (the block lands on its other corner: resets that change the mode)
         assert sum(int(r.impacts.sum()) for r in res) > 0
-    assert_chunks_equal(spec, [run_chunks(spec, [i])[0] for i in range(spec.n_chunks)], "one chunk")
-    streamed = list(stream_chunks([(spec, i) for i in range(spec.n_chunks)], 3))
-    assert_chunks_equal(spec, [r for _, r in streamed], "three threads")
 
 
 def test_a_chunk_continued_in_the_other_mode() -> None:

@@ -22,9 +22,9 @@ from grazing import HybridModel, Mode, Parameter, Surface
 from grazing.core.options import SweepSettings
 from grazing.engine.codegen import taylor_order
 from grazing.models import BUILT_IN, friction_oscillator
-from grazing.sweeps.run import run_chunks, stream_chunks
+from grazing.sweeps.run import run_chunks
 from grazing.sweeps.spec import sweep_spec
-from tests.engine.test_lanes import assert_chunks_equal
+from tests.engine.test_lanes import assert_chunks_equal, assert_lanes_equal_the_oracle
 
 STICK = 2  # the sliding pseudo-mode's index ("sliding on 'belt'")
 
@@ -98,16 +98,7 @@ def test_sweep_through_sliding_on_lanes_equals_the_runner_oracle(name: str) -> N
     spec = dataclasses.replace(spec, polish=False)
     kern = spec.model.kernels(0, taylor_order(spec.tol))
     assert kern.NMODES == 3 and kern.LANES > 1
-    saved = kern.LANES
-    results = {}
-    try:
-        for lanes in (saved, 1):  # (1: every Taylor kernel called lane by lane, scalar)
-            kern.LANES = lanes
-            results[lanes] = run_chunks(spec, list(range(spec.n_chunks)))
-            assert_chunks_equal(spec, results[lanes], f"{lanes} lanes")
-    finally:
-        kern.LANES = saved
-    res = results[saved]
+    res = assert_lanes_equal_the_oracle(spec)
     modes = np.concatenate([r.mode_final for r in res])
     print(name, modes)
     assert STICK in modes.tolist()  # (points end sliding)
@@ -115,9 +106,6 @@ def test_sweep_through_sliding_on_lanes_equals_the_runner_oracle(name: str) -> N
         assert all(np.array_equal(r.samples[..., 0], r.samples[..., 1]) for r in res)
     else:  # (and slipping)
         assert set(modes.tolist()) - {STICK}
-    assert_chunks_equal(spec, [run_chunks(spec, [i])[0] for i in range(spec.n_chunks)], "one chunk")
-    streamed = list(stream_chunks([(spec, i) for i in range(spec.n_chunks)], 3))
-    assert_chunks_equal(spec, [r for _, r in streamed], "three threads")
 
 
 def test_sweep_through_sliding_equals_simulate_point_by_point() -> None:

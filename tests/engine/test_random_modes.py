@@ -34,9 +34,8 @@ import grazing
 from grazing.core.options import SweepSettings
 from grazing.engine.codegen import taylor_order
 from grazing.errors import SimulationError
-from grazing.sweeps.run import run_chunks
 from grazing.sweeps.spec import sweep_spec
-from tests.engine.test_lanes import assert_chunks_equal
+from tests.engine.test_lanes import assert_lanes_equal_the_oracle
 from tests.random_models import MODE_KINDS, ModesSpec, modes_specs
 
 PERIODS = 3
@@ -56,13 +55,7 @@ def check_lanes(spec: ModesSpec, fresh: bool, lyapunov: bool, scalar_lanes: bool
     sw = dataclasses.replace(sweep_spec(model, w, values, settings=settings_), polish=False)
     kern = model.kernels(0, taylor_order(sw.tol))
     assert kern.NMODES == len(model.mode_names) >= 2
-    saved = kern.LANES
-    try:
-        for lanes in (saved, 1) if scalar_lanes else (saved,):
-            kern.LANES = lanes
-            assert_chunks_equal(sw, run_chunks(sw, list(range(sw.n_chunks))), f"{spec.kind}, {lanes} lanes")
-    finally:
-        kern.LANES = saved
+    assert_lanes_equal_the_oracle(sw, f"{spec.kind}, ", scalar=scalar_lanes, regroup=False)
 
 
 def _events(sol: grazing.Solution) -> tuple[np.ndarray, list[int]]:
