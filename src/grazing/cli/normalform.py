@@ -58,7 +58,7 @@ def normal_form_cmd(
 ) -> None:  # fmt: skip
     """Grazing normal form at a grazing of the period-1 orbit: multipliers, the
     discontinuity map's coefficients and the predicted scenario past grazing."""
-    from grazing.normalform import find_grazing_point, normal_form_at, observe, predict
+    from grazing.normalform import normal_form_at, observe, predict
     from grazing.normalform.discontinuity import no_contact_direction
 
     stop = stop_option_index(model, stop_name)
@@ -67,20 +67,12 @@ def normal_form_cmd(
         return
     if model.symbolic.stops[stop].contact_direction is None:  # (before the search, not after it)
         raise InputError(f"--model: {no_contact_direction(model, stop)}")
-    par, lo, hi, pendulum = search_range(model, "normal-form", gparam, prange, eta_min, eta_max)
-    x0 = range_start_state(initial, model, {par.name: lo})
-    point = find_grazing_point(model, par.name, lo, hi, which, stop_name=stop, x0=x0)
+    par, pendulum, point, res = _located_grazing(
+        model, case, which, eta_min, eta_max, gparam, prange, stop, initial
+    )
     nf = normal_form_at(point, PENDULUM_UNFOLDING if pendulum else (par.name,))
     pred = predict(nf, par.name)
-    res: dict[str, Any] = {
-        "params": model_params_json(point.model, case),
-        "which": which,
-        "param": par.name,
-        "value": par.to_display(point.model.params[par.name]),
-        "stop": point.stop_name,
-        "t_graze": point.phase,
-        "multipliers": complex_list(point.multipliers),
-        "abs_lambda": point.abs_lambda,
+    res |= {
         "prediction": pred.to_json(),
         "coefficients": {
             "contact_state": nf.contact,
@@ -115,30 +107,19 @@ def normal_form_cmd(
         click.echo(f"  direct simulation just past grazing: {res['observed']['scenario']} ({verdict})")
 
 
-def _switching_form(
+def _located_grazing(
     model: grazing.HybridModel, case: str, which: str, eta_min: float, eta_max: float, gparam: str | None,
-    prange: str | None, stop: int, initial: str | None, check: bool, as_json: bool,
-) -> None:  # fmt: skip
-    """``normal-form`` at a grazing of a switching surface without a reset (a model with modes): the
-    switch's discontinuity map ``D(x) = x - (4/3) sqrt(2 / a) delta^(3/2) w`` (no impact law, so no
-    prediction of the scenario past grazing yet)."""
+    prange: str | None, stop: int, initial: str | None,
+) -> tuple[Any, bool, Any, dict[str, Any]]:  # fmt: skip
+    """The grazing of stop ``stop`` searched over ``--param``/``--range`` (the pendulum's eta by default):
+    the parameter, whether it is the pendulum's search, the :class:`~grazing.normalform.GrazingPoint`, and
+    the ``--json`` fields every normal form begins with."""
     from grazing.normalform import find_grazing_point
-    from grazing.normalform.switching import switching_map_at
 
-    name = model.stop_names[stop]
-    if check:
-        raise InputError(
-            f"--check: the scenario past the grazing of switching surface {name!r} (no reset) is not "
-            "predicted yet, so there is nothing to check; its discontinuity map is printed without --check"
-        )
-    par, lo, hi, _ = search_range(model, "normal-form", gparam, prange, eta_min, eta_max)
+    par, lo, hi, pendulum = search_range(model, "normal-form", gparam, prange, eta_min, eta_max)
     x0 = range_start_state(initial, model, {par.name: lo})
     point = find_grazing_point(model, par.name, lo, hi, which, stop_name=stop, x0=x0)
-    try:
-        zdm = switching_map_at(point.model, point.stop, point.contact, point.t_graze)
-    except (grazing.InvalidParameterError, grazing.InvalidStateError) as exc:
-        raise InputError(f"--stop-name {name}: {exc}") from None
-    res: dict[str, Any] = {
+    head: dict[str, Any] = {
         "params": model_params_json(point.model, case),
         "which": which,
         "param": par.name,
@@ -147,6 +128,31 @@ def _switching_form(
         "t_graze": point.phase,
         "multipliers": complex_list(point.multipliers),
         "abs_lambda": point.abs_lambda,
+    }
+    return par, pendulum, point, head
+
+
+def _switching_form(
+    model: grazing.HybridModel, case: str, which: str, eta_min: float, eta_max: float, gparam: str | None,
+    prange: str | None, stop: int, initial: str | None, check: bool, as_json: bool,
+) -> None:  # fmt: skip
+    """``normal-form`` at a grazing of a switching surface without a reset (a model with modes): the
+    switch's discontinuity map ``D(x) = x - (4/3) sqrt(2 / a) delta^(3/2) w`` (no impact law, so no
+    prediction of the scenario past grazing yet)."""
+    from grazing.normalform.switching import switching_map_at
+
+    name = model.stop_names[stop]
+    if check:
+        raise InputError(
+            f"--check: the scenario past the grazing of switching surface {name!r} (no reset) is not "
+            "predicted yet, so there is nothing to check; its discontinuity map is printed without --check"
+        )
+    par, _, point, res = _located_grazing(model, case, which, eta_min, eta_max, gparam, prange, stop, initial)
+    try:
+        zdm = switching_map_at(point.model, point.stop, point.contact, point.t_graze)
+    except (grazing.InvalidParameterError, grazing.InvalidStateError) as exc:
+        raise InputError(f"--stop-name {name}: {exc}") from None
+    res |= {
         "mode": model.transition_source[stop],
         "switching_map": {
             "contact_state": zdm.contact,
