@@ -106,6 +106,15 @@ def boundary(omega: float) -> float:
     return omega * omega / (abs(1.0 - omega * omega) * math.sqrt(1.0 + (omega * u) ** 2))
 
 
+def _half_period_constants(omega: float, mu_ratio: float) -> tuple[float, float, float]:
+    """``K = 1 / (1 - omega^2)``, ``U = tan(pi / 2 omega)`` and the phase ``psi`` (``K cos psi = -X``) of
+    Den Hartog's motion after a reversal (:func:`closed_form_velocity`)."""
+    k = 1.0 / (1.0 - omega * omega)
+    u = math.tan(math.pi / (2.0 * omega))
+    x = amplitude(omega, mu_ratio)
+    return k, u, math.atan2(mu_ratio * u / (k * omega), -x / k)
+
+
 def closed_form_velocity(omega: float, mu_ratio: float, s: np.ndarray) -> np.ndarray:
     """The velocity ``x'(s) / a`` of Den Hartog's motion, ``s`` after a reversal at ``x = -X``.
 
@@ -129,10 +138,7 @@ def closed_form_velocity(omega: float, mu_ratio: float, s: np.ndarray) -> np.nda
     >>> float(closed_form_velocity(2.0, 0.1, np.array([0.0]))[0]) == 0.0
     True
     """
-    k = 1.0 / (1.0 - omega * omega)
-    u = math.tan(math.pi / (2.0 * omega))
-    x = amplitude(omega, mu_ratio)
-    psi = math.atan2(mu_ratio * u / (k * omega), -x / k)
+    k, u, psi = _half_period_constants(omega, mu_ratio)
     s = np.asarray(s, dtype=float)
     return -k * omega * np.sin(omega * s + psi) - mu_ratio * np.sin(s) + mu_ratio * u * np.cos(s)
 
@@ -158,10 +164,7 @@ def closed_form_acceleration(omega: float, mu_ratio: float, s: np.ndarray) -> np
     >>> bool(abs(closed_form_acceleration(w, r, np.array([0.0]))[0] - (w * w * amplitude(w, r) - r)) < 1e-12)
     True
     """
-    k = 1.0 / (1.0 - omega * omega)
-    u = math.tan(math.pi / (2.0 * omega))
-    x = amplitude(omega, mu_ratio)
-    psi = math.atan2(mu_ratio * u / (k * omega), -x / k)
+    k, u, psi = _half_period_constants(omega, mu_ratio)
     s = np.asarray(s, dtype=float)
     return -k * omega * omega * np.cos(omega * s + psi) - mu_ratio * np.cos(s) - mu_ratio * u * np.sin(s)
 
