@@ -8,10 +8,12 @@ the stick's [[1, dt], [0, 1]]).  A stick collapses a direction (the entry's salt
 belt), so the monodromy matrix has rank one: one multiplier is exactly zero.
 
 The sliding bifurcations are located from their own equations on the closed form, independently of the
-engine: a crossing-sliding where the slip behind the belt reaches it exactly where the friction just
-balances the force, a cos(w t) - x = mu (the stick it starts has zero length); an adding-sliding where
-the force during the stick touches mu at its maximum, d/dt (a cos(w t) - x) = -a w sin(w t) - v_b = 0
-(the slip ahead that followed the stick shrinks to nothing).
+engine: a switching-sliding where the slip behind the belt reaches it exactly where the friction just
+balances the force, a cos(w t) - x = mu, while that force is falling (the field ahead of the belt is
+tangent there and its tangency invisible: past it the slip crosses the belt, slips ahead for a moment and
+sticks; before it, it sticks at once); an adding-sliding where the force during the stick touches mu at
+its maximum, d/dt (a cos(w t) - x) = -a w sin(w t) - v_b = 0 (the slip ahead that followed the stick
+shrinks to nothing).
 """
 
 from __future__ import annotations
@@ -88,8 +90,8 @@ def _slip(ref: FrictionReference, mode: int, x: float, t: float, tt: float) -> n
     return ref.flow(mode, np.array([x, ref.p["v_belt"]]), t, tt)
 
 
-def exact_crossing_sliding_residual(p: dict, u: np.ndarray) -> list[float]:
-    """The equations of :func:`exact_crossing_sliding` at ``u = (x_e, t_e, t_1, t_2, t_3)`` with the
+def exact_switching_sliding_residual(p: dict, u: np.ndarray) -> list[float]:
+    """The equations of :func:`exact_switching_sliding` at ``u = (x_e, t_e, t_1, t_2, t_3)`` with the
     parameters ``p``."""
     T, vb, mu = 2 * math.pi / p["omega"], p["v_belt"], p["mu"]
     xe, te, t1, t2, t3 = u
@@ -101,14 +103,14 @@ def exact_crossing_sliding_residual(p: dict, u: np.ndarray) -> list[float]:
     return [ref.force(xe, te) - mu, ref.force(x1, t1) - mu, v2 - vb, ref.force(x3, t3) + mu, vT - vb, xT - xe]
 
 
-def exact_crossing_sliding(p: dict, guess: np.ndarray) -> np.ndarray:
+def exact_switching_sliding(p: dict, guess: np.ndarray) -> np.ndarray:
     """``(x_e, t_e, t_1, t_2, t_3, mu)``: behind the belt the slip reaches it at ``(x_e, t_e)`` where the
     force is exactly mu (the field ahead of the belt is tangent to it there), sticks until the force is mu
     again at ``t_1``, slips ahead back to the belt at ``t_2``, sticks until the force is -mu at ``t_3``
     and slips behind back to the belt at ``t_e + T``."""
 
     def equations(u):
-        return exact_crossing_sliding_residual({**p, "mu": u[-1]}, u[:-1])
+        return exact_switching_sliding_residual({**p, "mu": u[-1]}, u[:-1])
 
     u, _, ier, msg = fsolve(equations, guess, xtol=1e-14, full_output=True)
     assert ier in (1, 3) and np.abs(equations(u)).max() < 1e-13, (msg, equations(u))  # (3: xtol too small)
@@ -137,13 +139,15 @@ def exact_adding_sliding(p: dict, guess: np.ndarray) -> np.ndarray:
     return u
 
 
-def test_a_crossing_sliding_located_at_the_exact_one():
-    """Down in mu the stick entered from behind shortens to nothing: the slip crosses the belt instead."""
+def test_a_switching_sliding_located_at_the_exact_one():
+    """Down in mu the slip behind reaches the belt where the force, falling, is just mu: past it the slip
+    crosses the belt and sticks after a moment ahead of it (a real switching-sliding; it was named a
+    crossing-sliding before)."""
     m = friction_oscillator(**VALUES)
     br = continue_orbit(m, "mu", 0.5, 0.3)
     [sp] = br.special
-    assert sp.kind is SpecialKind.CROSSING_SLIDING and sp.kind == "crossing-sliding"
-    assert "crossing-sliding bifurcation" in br.status and "located" in br.status and "\n" not in br.status
+    assert sp.kind is SpecialKind.SWITCHING_SLIDING and sp.kind == "switching-sliding"
+    assert "switching-sliding bifurcation" in br.status and "located" in br.status and "\n" not in br.status
     assert br.status.endswith("can be followed with switch (switch=True)")  # (the command line: --switch)
     assert f"(located to +-{sp.precision:.1g} by bisection on the switches)" in br.status  # (a width)
     assert m.switch_names[sp.stop] == "belt_to_slip_ahead"
@@ -154,10 +158,14 @@ def test_a_crossing_sliding_located_at_the_exact_one():
     te, t1, t2, t3 = o.switch_times
     ref = FrictionReference(dict(o.model.params))
     xe = ref.run(o.state, m.mode_names.index(o.mode), o.t0, te)[0][0]
-    exact = exact_crossing_sliding(dict(VALUES), np.array([xe, te, t1, t2, t3, sp.param]))
+    exact = exact_switching_sliding(dict(VALUES), np.array([xe, te, t1, t2, t3, sp.param]))
     lo, hi = sp.interval
     assert hi - lo <= 2.1e-10 and lo <= exact[-1] <= hi, (lo, exact[-1], hi)
     assert abs(sp.param - exact[-1]) < 1e-10 and sp.precision <= 1.1e-10
+    # the name, from the closed form: the force is falling at the entry (the tangency ahead is invisible)
+    # and the stick that starts there lasts (it is not a short one, as at a crossing-sliding)
+    w, a, vb = VALUES["omega"], VALUES["a"], VALUES["v_belt"]
+    assert -a * w * math.sin(w * exact[1]) - vb < -0.1 and exact[2] - exact[1] > 1.0
 
 
 def test_an_adding_sliding_located_at_the_exact_one():
@@ -185,26 +193,27 @@ OUT = ("belt_exit_to_slip_ahead", "belt_exit_to_slip_behind")  # (exits from the
 @pytest.mark.parametrize(
     ("before", "after", "kind"),
     [
-        # an entry from behind replaced by a crossing out of slip_behind (and a stick further on)
+        # a crossing from behind the belt to ahead of it becomes a short stick (one, or both of a symmetric
+        # orbit's crossings at once)
+        ((TO_A, TO_B), (BEHIND_IN, OUT[0], TO_B), SpecialKind.CROSSING_SLIDING),
+        ((TO_A, TO_B), (BEHIND_IN, OUT[0], AHEAD_IN, OUT[1]), SpecialKind.CROSSING_SLIDING),
+        # an entry from behind becomes a crossing and a short slip ahead before the entry (or the other way)
         ((BEHIND_IN, OUT[0], AHEAD_IN, OUT[1]), (TO_A, AHEAD_IN, OUT[0], AHEAD_IN, OUT[1]),
-         SpecialKind.CROSSING_SLIDING),
-        # a new stick where the slip ahead touched the belt
-        ((TO_A, TO_B), (TO_A, AHEAD_IN, OUT[0], TO_B),
-         SpecialKind.GRAZING_SLIDING),
-        # the slip ahead that leaves the stick comes back to it
-        ((BEHIND_IN, OUT[0], AHEAD_IN, OUT[1]), (BEHIND_IN, OUT[0], AHEAD_IN, OUT[0], AHEAD_IN, OUT[1]),
-         SpecialKind.ADDING_SLIDING),
-        # the slip ahead that leaves the stick crosses the belt before sticking again
+         SpecialKind.SWITCHING_SLIDING),
         ((BEHIND_IN, OUT[0], AHEAD_IN, OUT[1]), (BEHIND_IN, OUT[0], TO_B, BEHIND_IN, OUT[1]),
-         SpecialKind.CROSSING_SLIDING),
-        # the stick is left behind the belt and the slip crosses it at once, or it is left ahead
-        ((AHEAD_IN, OUT[0]), (AHEAD_IN, OUT[1], TO_A), SpecialKind.SWITCHING_SLIDING),
-        ((AHEAD_IN, OUT[1]), (AHEAD_IN, OUT[1], TO_A), SpecialKind.SWITCHING_SLIDING),
-        # a crossing gained after a crossing, an exit that changes side alone: none of the four
-        ((AHEAD_IN, OUT[0], TO_B), (AHEAD_IN, OUT[0], TO_B, TO_A),
-         None),
+         SpecialKind.SWITCHING_SLIDING),
+        # a short stick inside the slip ahead
+        ((TO_A, TO_B), (TO_A, AHEAD_IN, OUT[0], TO_B), SpecialKind.GRAZING_SLIDING),
+        # a short slip ahead inside the stick entered from behind
+        ((BEHIND_IN, OUT[1]), (BEHIND_IN, OUT[0], AHEAD_IN, OUT[1]), SpecialKind.ADDING_SLIDING),
+        # an exit that changes side, with or without a crossing; a crossing alone; a short stick and a short
+        # excursion at once (ambiguous without the times): none of the four
+        ((AHEAD_IN, OUT[0]), (AHEAD_IN, OUT[1], TO_A), None),
         ((AHEAD_IN, OUT[0]), (AHEAD_IN, OUT[1]), None),
+        ((AHEAD_IN, OUT[0], TO_B), (AHEAD_IN, OUT[0], TO_B, TO_A), None),
         ((TO_A, TO_B), (TO_A,), None),  # (no sliding)
+        ((BEHIND_IN, OUT[0], AHEAD_IN, OUT[1]), (BEHIND_IN, OUT[0], AHEAD_IN, OUT[0], AHEAD_IN, OUT[1]),
+         None),
     ],
 )  # fmt: skip
 def test_the_change_of_switches_names_the_sliding_bifurcation(before, after, kind):
@@ -212,6 +221,20 @@ def test_the_change_of_switches_names_the_sliding_bifurcation(before, after, kin
     m = friction_oscillator()
     assert kind_of_change(m, (before,), (after,)) is kind
     assert kind_of_change(m, (after,), (before,)) is kind
+
+
+@pytest.mark.parametrize(("stick", "slip", "kind"), [(1e-6, 9.0, SpecialKind.GRAZING_SLIDING),
+                                                      (9.0, 1e-6, SpecialKind.ADDING_SLIDING)])  # fmt: skip
+def test_the_window_that_vanishes_tells_grazing_from_adding_sliding(stick, slip, kind):
+    """No switches against one stick (or one slip) a period: a short stick appeared inside a slip
+    (grazing-sliding) or a short slip inside a stick (adding-sliding); the names cannot tell, the times
+    between the switches do."""
+    m = friction_oscillator()
+    one = ((BEHIND_IN, OUT[1]),)
+    assert kind_of_change(m, ((),), one) is None
+    gaps = (np.empty(0), np.array([stick, slip]))
+    assert kind_of_change(m, ((),), one, gaps=gaps) is kind
+    assert kind_of_change(m, one, ((),), gaps=gaps[::-1]) is kind
 
 
 def _guess_adding(o, m) -> np.ndarray:
@@ -237,14 +260,15 @@ def test_the_adding_sliding_curve_in_mu_and_omega_is_the_exact_one():
     assert mus[-1] - mus[0] > 0.02  # (it moves: not the start repeated)
 
 
-def test_the_crossing_sliding_curve_in_omega_and_mu_is_the_exact_one():
+def test_the_switching_sliding_curve_in_omega_and_mu_is_the_exact_one():
     """Followed from a branch in omega, as mu goes down (the curve is steep the other way round)."""
     m = friction_oscillator(**VALUES)
     br = continue_orbit(m, "omega", 0.5, 0.9)
     [sp] = br.special
-    assert sp.kind is SpecialKind.CROSSING_SLIDING
+    assert sp.kind is SpecialKind.SWITCHING_SLIDING
     curve = sliding_curve(br, "mu", 0.45, steps=2)
-    assert curve.status == "reached mu = 0.45" and len(curve) >= 3 and curve.values[-1][1] == 0.45
+    assert curve.kind is SpecialKind.SWITCHING_SLIDING and curve.status == "reached mu = 0.45"
+    assert len(curve) >= 3 and curve.values[-1][1] == 0.45
     for (w, mu), o in zip(curve.values, curve.orbits):
         assert o.switch_signature == ((BEHIND_IN, OUT[0], AHEAD_IN, OUT[1]),)
         te, t1, t2, t3 = o.switch_times
@@ -253,7 +277,7 @@ def test_the_crossing_sliding_curve_in_omega_and_mu_is_the_exact_one():
 
         def equations(u, mu=mu, o=o):
             q = {**VALUES, "mu": mu, "omega": u[-1]}
-            return exact_crossing_sliding_residual(q, u[:-1])
+            return exact_switching_sliding_residual(q, u[:-1])
 
         u, _, ier, msg = fsolve(equations, np.array([xe, te, t1, t2, t3, w]), xtol=1e-14, full_output=True)
         assert ier in (1, 3) and np.abs(equations(u)).max() < 1e-13, msg
@@ -267,13 +291,13 @@ def test_a_sliding_curve_needs_a_sliding_bifurcation():
         sliding_curve(br, "mu", 0.4)
 
 
-def test_switched_past_the_crossing_sliding_onto_the_exact_orbits():
+def test_switched_past_the_switching_sliding_onto_the_exact_orbits():
     """With ``switch`` the branch goes on with the new switches (the slip crosses the belt, sticks ahead of
     it, slips ahead and sticks again), each orbit the exact one."""
     m = friction_oscillator(**VALUES)
     br = continue_orbit(m, "mu", 0.5, 0.4, switch=True)
     first = br.special[0]
-    assert first.kind is SpecialKind.CROSSING_SLIDING and first.switched
+    assert first.kind is SpecialKind.SWITCHING_SLIDING and first.switched
     after = [o for o, s in zip(br.orbits, br.segments) if s == 1]
     assert len(after) >= 3
     assert all(o.switch_signature == ((TO_A, AHEAD_IN, OUT[0], AHEAD_IN, OUT[1]),) for o in after)

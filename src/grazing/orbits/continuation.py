@@ -1024,6 +1024,7 @@ class _Continuation:
         orbit beyond), narrowed by bisection on the switches (:func:`bisect_switches`) and reported."""
         branch, par, name = self.branch, self.par, self.model.switch_names[switch]
         bracket = bisect_switches(last, after, self.param)
+        kind = sliding_kind(bracket.before, bracket.after) or kind  # (the narrowest bracket tells best)
         lo, hi = bracket.interval(self.param)
         value = 0.5 * (lo + hi)
         # (whether an orbit sticks is decided from the far field's sign, to rounding: the boundary that the

@@ -56,11 +56,11 @@ class SpecialKind(TextEnum):
     """A sliding segment appears where the orbit touches a sliding surface from outside
     (:mod:`grazing.orbits.sliding_bifurcations`, as the three that follow)."""
     CROSSING_SLIDING = "crossing-sliding"
-    """An entry into sliding turns into a crossing of the surface."""
+    """A crossing of the surface turns into a short sliding segment between the two sides."""
     SWITCHING_SLIDING = "switching-sliding"
-    """A crossing of the surface appears right after an exit from sliding."""
+    """An entry into sliding turns into a crossing and a short excursion before the entry."""
     ADDING_SLIDING = "adding-sliding"
-    """A second sliding segment appears right after an exit from sliding."""
+    """A short excursion off the surface splits a sliding segment in two."""
     UNLOCATED = "unlocated"
     """A stability change that no located point explains (never silent)."""
 

@@ -3,20 +3,29 @@
 On a model with a sliding surface (a Filippov system) a branch of periodic orbits keeps its switches of
 mode (:attr:`~grazing.orbits.periodic.PeriodicOrbit.switch_signature`: the transitions, then each sliding
 pseudo-mode's entries and exits) up to a boundary where the orbit meets the boundary of the sliding
-region, where the far side's field is tangent to the surface (di Bernardo, Budd, Champneys & Kowalczyk,
-*Piecewise-smooth Dynamical Systems*, 2008, ch. 8; Kuznetsov, Rinaldi & Gragnani, *Int. J. Bifurcation
-Chaos* 13, 2003).  How the switches differ across it names the bifurcation (:func:`sliding_kind`):
+region, a point where the field of one side, ``A``, is tangent to the surface (di Bernardo, Kowalczyk &
+Nordmark, *Physica D* 170, 2002; di Bernardo, Budd, Champneys & Kowalczyk, *Piecewise-smooth Dynamical
+Systems*, 2008, ch. 8; Kuznetsov, Rinaldi & Gragnani, *Int. J. Bifurcation Chaos* 13, 2003).  Across it
+the switches change by a local move, a window of two consecutive switches (cyclically) that shrinks to
+nothing at the bifurcation; which move names the bifurcation (:func:`kind_of_change`):
 
-* **crossing-sliding**: the orbit reaches the surface at the tangency point; on one side it enters
-  sliding there, on the other it crosses (and comes back to the surface further on): an entry into
-  sliding from a mode is replaced by a crossing out of that mode;
-* **grazing-sliding**: the orbit touches the surface from outside at the tangency point: a sliding
-  segment (an entry from a mode and an exit) appears where there was none;
-* **adding-sliding**: the same, on the segment that leaves a sliding segment: the orbit leaving sliding
-  comes back to the surface, a second sliding segment is added right after an exit to that mode;
-* **switching-sliding**: the orbit leaves sliding at the boundary of the sliding region: on one side
-  it leaves into the far side at once, on the other into the near side and crosses the surface soon
-  after (an exit to ``Y`` replaced by an exit to ``X`` and a crossing from ``X`` to ``Y``).
+* **crossing-sliding**: the orbit arrives from the other side, ``B``, at the boundary point, where ``A``'s
+  tangency is visible (the sliding flow leaves there): on one side it crosses into ``A``, on the other
+  it slides for a short time first: a crossing ``B -> A`` against an entry from ``B`` and an exit to
+  ``A`` (a short stick);
+* **switching-sliding**: the same arrival at a boundary point where ``A``'s tangency is invisible (the
+  sliding flow moves away from it): on one side the orbit slides at once, on the other it crosses into
+  ``A``, makes a short excursion there and comes back to slide: an entry from ``B`` against a crossing
+  ``B -> A`` and an entry from ``A`` (a short excursion);
+* **grazing-sliding**: the orbit touches the surface from inside ``A`` at the boundary point: a short
+  sliding segment (an entry from ``A`` and an exit to ``A``) appears inside a phase in ``A``;
+* **adding-sliding**: the sliding orbit reaches the boundary point where the trajectory that leaves
+  is tangent to the surface to higher order: a short excursion into ``A`` (an exit to ``A`` and an
+  entry from ``A``) appears inside a sliding phase.
+
+The window that vanishes tells the moves apart where the names alone do not (an orbit with a single
+stick and none: a short stick inside a slip, grazing-sliding, or a short slip inside a stick,
+adding-sliding): :func:`sliding_kind` takes the window with the shortest duration.
 
 The boundary itself is bracketed by the continuation (its parameter to
 :data:`~grazing.core.options.BOUNDARY_TOL`) and narrowed by bisection on the switches of the orbits found
@@ -25,8 +34,9 @@ between (:func:`bisect_switches`).
 
 from __future__ import annotations
 
-from collections import Counter
 from dataclasses import dataclass
+
+import numpy as np
 
 from grazing.core.model import HybridModel
 from grazing.errors import GrazingError
@@ -41,6 +51,12 @@ BISECTION_TOL = 1e-12
 BISECTION_STEPS = 60
 """At most this many bisection steps (each a :func:`~grazing.orbits.shooting.find_orbit`)."""
 
+MAX_MOVES = 4
+"""At most this many simultaneous moves (a symmetric orbit meets the boundary twice a period)."""
+
+Signature = tuple[tuple[str, ...], ...]
+Item = tuple[int | None, str]  # (the switch's index in the longer sequence, or None if put in; its name)
+
 
 def _roles(m: HybridModel) -> dict[str, tuple[str, str, str]]:
     """Each switch name's ``(role, source, target)``: role ``"entry"`` (into a sliding pseudo-mode),
@@ -53,57 +69,122 @@ def _roles(m: HybridModel) -> dict[str, tuple[str, str, str]]:
     return roles
 
 
-def sliding_kind(a: PeriodicOrbit, b: PeriodicOrbit) -> SpecialKind | None:
-    """The sliding bifurcation between two orbits of a branch whose switches differ: :func:`kind_of_change`
-    of their :attr:`~grazing.orbits.periodic.PeriodicOrbit.switch_signature`."""
-    return kind_of_change(a.model, a.switch_signature, b.switch_signature)
+def _moves(m: HybridModel) -> dict[tuple[str, str], tuple[SpecialKind, tuple[str, ...]]]:
+    """The local moves of the module's docstring: each window of two switches that shrinks to nothing,
+    with the bifurcation it names and what is left of it on the other side."""
+    roles = _roles(m)
+    by_ends = {(src, tgt): name for name, (role, src, tgt) in roles.items()}
+    entries = [(n, src, tgt) for n, (r, src, tgt) in roles.items() if r == "entry"]
+    exits = [(n, src, tgt) for n, (r, src, tgt) in roles.items() if r == "exit"]
+    crossings = [(n, src, tgt) for n, (r, src, tgt) in roles.items() if r == "cross"]
+    moves: dict[tuple[str, str], tuple[SpecialKind, tuple[str, ...]]] = {}
+    for entry, side_b, slide in entries:
+        for exit_, slide2, side_a in exits:
+            if slide2 != slide:
+                continue
+            if side_a == side_b:  # a short stick inside a phase in A, or a short slip inside a stick
+                moves[(entry, exit_)] = (SpecialKind.GRAZING_SLIDING, ())
+                moves[(exit_, entry)] = (SpecialKind.ADDING_SLIDING, ())
+            elif (side_b, side_a) in by_ends:  # a short stick between B and A, or the crossing
+                moves[(entry, exit_)] = (SpecialKind.CROSSING_SLIDING, (by_ends[(side_b, side_a)],))
+    for cross, side_b, side_a in crossings:
+        for entry, side, slide in entries:
+            if side == side_a and (side_b, slide) in by_ends:  # a short excursion into A, or the entry
+                moves[(cross, entry)] = (SpecialKind.SWITCHING_SLIDING, (by_ends[(side_b, slide)],))
+    return moves
+
+
+def _same_cycle(x: tuple[str, ...], y: tuple[str, ...]) -> bool:
+    """Whether ``x`` and ``y`` are the same cyclic sequence (one a rotation of the other)."""
+    return len(x) == len(y) and (not x or any(x[i:] + x[:i] == y for i in range(len(x))))
+
+
+def _reductions(
+    moves: dict[tuple[str, str], tuple[SpecialKind, tuple[str, ...]]],
+    less: tuple[str, ...],
+    more: tuple[str, ...],
+) -> list[tuple[SpecialKind, list[tuple[int, int]]]]:
+    """Every way of reducing the cyclic sequence ``more`` to ``less`` by at most :data:`MAX_MOVES` moves
+    of one kind: ``(kind, windows)``, each window the indices in ``more`` of its two switches (where it
+    holds switches of ``more``)."""
+    found: list[tuple[SpecialKind, list[tuple[int, int]]]] = []
+
+    def walk(seq: list[Item], kind: SpecialKind | None, windows: list[tuple[int, int]], depth: int) -> None:
+        if kind is not None and _same_cycle(tuple(n for _, n in seq), less):
+            found.append((kind, windows))
+            return
+        if depth == MAX_MOVES or len(seq) <= len(less) or len(seq) < 2:
+            return
+        for i in range(len(seq)):
+            j = (i + 1) % len(seq)
+            move = moves.get((seq[i][1], seq[j][1]))
+            if move is None or (kind is not None and move[0] is not kind):
+                continue
+            rest = [seq[k] for k in range(len(seq)) if k not in (i, j)]
+            at = i if j > i else i - 1  # (where the window was, in ``rest``)
+            left = rest[:at] + [(None, n) for n in move[1]] + rest[at:]
+            first, second = seq[i][0], seq[j][0]
+            window = [(first, second)] if first is not None and second is not None else []
+            walk(left, move[0], windows + window, depth + 1)
+
+    walk(list(enumerate(more)), None, [], 0)
+    return found
 
 
 def kind_of_change(
-    model: HybridModel, a: tuple[tuple[str, ...], ...], b: tuple[tuple[str, ...], ...]
+    model: HybridModel, a: Signature, b: Signature, *, gaps: tuple[np.ndarray, np.ndarray] | None = None
 ) -> SpecialKind | None:
     """The sliding bifurcation where the switches per period of ``model``'s orbits change from ``a`` to
-    ``b`` (see the module's docstring), or None where the change involves no entry into or exit from
-    sliding, or fits none of the four patterns.
+    ``b`` (see the module's docstring), or None where the change involves no sliding, fits none of the
+    four moves, or fits moves of several kinds that ``gaps`` do not tell apart.
 
-    The rules are tried in this order on the switches per period, ``a``'s and ``b``'s, in either order:
-    an entry from a mode replaced by a crossing out of it (crossing-sliding); one sequence is the other
-    with an entry and an exit more (adding-sliding where the entry follows an exit to its mode,
-    grazing-sliding otherwise); an exit to a mode ``Y`` replaced by an exit to ``X`` followed by a
-    crossing from ``X`` to ``Y``, or such a crossing gained right after an exit (switching-sliding).
+    Parameters
+    ----------
+    model
+        The model.
+    a, b
+        The switches of the two orbits (:attr:`~grazing.orbits.periodic.PeriodicOrbit.switch_signature`).
+    gaps
+        The time from each switch to the next (cyclically over the orbit's period), of ``a`` and of
+        ``b``, in their order: where the names fit moves of several kinds, the kind whose windows last
+        shortest (the window that vanishes at the bifurcation).
+
+    Returns
+    -------
+    SpecialKind or None
+        The bifurcation's kind.
     """
-    roles = _roles(model)
-    flat = [[n for p in sig for n in p] for sig in (a, b)]
-    count = [Counter(f) for f in flat]
-    diff = (count[0] - count[1], count[1] - count[0])
+    moves = _moves(model)
+    flat = [tuple(n for p in sig for n in p) for sig in (a, b)]
+    best: tuple[float, SpecialKind] | None = None
+    kinds = set()
     for less, more in ((0, 1), (1, 0)):
-        lost, gained = diff[less], diff[more]  # (what ``more`` lacks of ``less``; what it has more)
-        lost_entries = {roles[n][1] for n in lost if roles[n][0] == "entry"}
-        gained_crossings = {roles[n][1] for n in gained if roles[n][0] == "cross"}
-        if lost_entries & gained_crossings:
-            return SpecialKind.CROSSING_SLIDING
-    for less, more in ((0, 1), (1, 0)):
-        lost, gained, seq = diff[less], diff[more], flat[more]
-        after = {n: [seq[i - 1] for i, m in enumerate(seq) if m == n] for n in gained}  # (cyclically)
-        if not lost and sorted(roles[n][0] for n in gained.elements()) == ["entry", "exit"]:
-            (entry,) = [n for n in gained if roles[n][0] == "entry"]
-            source = roles[entry][1]
-            after_exit = any(roles[p][0] == "exit" and roles[p][2] == source for p in after[entry])
-            return SpecialKind.ADDING_SLIDING if after_exit else SpecialKind.GRAZING_SLIDING
-        crossings = [n for n in gained if roles[n][0] == "cross"]
-        if len(crossings) != 1 or sum(gained.values()) > 2 or sum(lost.values()) > 1:
-            continue
-        (cross,) = crossings
-        _, source, target = roles[cross]
-        exits = [p for p in after[cross] if roles[p][0] == "exit" and roles[p][2] == source]
-        others = [n for n in gained if n != cross]
-        # exit_to_Y replaced by exit_to_X then a crossing X -> Y (or that crossing alone gained)
-        replaced = all(roles[n][0] == "exit" and roles[n][2] == target for n in lost) and all(
-            n in exits for n in others
-        )
-        if exits and replaced and len(others) == len(lost):
-            return SpecialKind.SWITCHING_SLIDING
-    return None
+        for kind, windows in _reductions(moves, flat[less], flat[more]):
+            kinds.add(kind)
+            if gaps is not None and windows:
+                width = max(float(gaps[more][i]) for i, _ in windows)
+                if best is None or width < best[0]:
+                    best = (width, kind)
+    if len(kinds) == 1:
+        return kinds.pop()
+    return best[1] if best is not None and len(kinds) > 1 else None
+
+
+def switch_gaps(orbit: PeriodicOrbit) -> np.ndarray:
+    """The time from each of ``orbit``'s switches to the next, cyclically over its period."""
+    t = np.asarray(orbit.switch_times, dtype=float)
+    if not t.size:
+        return t
+    return np.diff(np.append(t, t[0] + orbit.period * orbit.model.period))
+
+
+def sliding_kind(a: PeriodicOrbit, b: PeriodicOrbit) -> SpecialKind | None:
+    """The sliding bifurcation between two orbits of a branch whose switches differ: :func:`kind_of_change`
+    of their :attr:`~grazing.orbits.periodic.PeriodicOrbit.switch_signature`, told apart by the duration
+    of the windows where the names fit several kinds (:func:`switch_gaps`)."""
+    return kind_of_change(
+        a.model, a.switch_signature, b.switch_signature, gaps=(switch_gaps(a), switch_gaps(b))
+    )
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -19,7 +19,7 @@ from grazing.orbits.continuation import Branch, SpecialPoint
 from grazing.orbits.kinds import SpecialKind
 from grazing.orbits.periodic import PeriodicOrbit
 from grazing.orbits.shooting import find_orbit, move_section, quiet_section
-from grazing.orbits.sliding_bifurcations import bisect_switches, kind_of_change
+from grazing.orbits.sliding_bifurcations import bisect_switches, sliding_kind
 
 SLIDING_KINDS = (
     SpecialKind.GRAZING_SLIDING,
@@ -193,11 +193,7 @@ def sliding_curve(branch: Branch, param2: str, stop: float, *, steps: int = 10) 
             guess = q1 + (q1 - q0) * (trial - r1) / (r1 - r0)
         pair = _bracket(before, after, param, guess, {param2: trial})
         bracket = bisect_switches(*pair, param) if pair is not None else None
-        kind = (
-            kind_of_change(before.model, bracket.before.switch_signature, bracket.after.switch_signature)
-            if bracket is not None
-            else None
-        )
+        kind = sliding_kind(bracket.before, bracket.after) if bracket is not None else None
         if bracket is None or kind is not curve.kind:
             if halvings < MAX_HALVINGS:
                 h, halvings = 0.5 * h, halvings + 1
