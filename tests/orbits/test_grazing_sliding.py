@@ -25,6 +25,7 @@ from grazing.models import friction_oscillator
 from grazing.orbits import continue_orbit, sliding_curve
 from grazing.orbits.kinds import SpecialKind
 from tests.cli.test_cli_models import run_json
+from tests.orbits.test_sliding_orbits import exact_orbit
 
 VALUES = {"a": 0.05, "omega": 0.7, "mu": 0.5, "v_belt": 0.2}
 STICK = ("belt_slide_from_slip_behind", "belt_exit_to_slip_behind")
@@ -81,6 +82,16 @@ def test_switched_past_the_grazing_sliding_onto_one_stick_a_period():
         te, tx = o.switch_times
         sticks.append(tx - te)
     assert all(d > 0 for d in sticks) and sticks == sorted(sticks)  # (longer as a grows)
+    # each the exact stick-slip orbit (the first, with its stick of ~1e-4, too short for the reference's
+    # sampled search of the return to the belt)
+    for o in after[1:][:: max(1, len(after) // 3)]:
+        q = dict(o.model.params)
+        x, J, events, res = exact_orbit(q, o.state, m.mode_names.index(o.mode), o.t0)
+        assert res < 1e-13 and np.abs(o.state - x).max() < 1e-10
+        assert np.abs(o.monodromy - J).max() < 1e-8 * max(1.0, np.abs(J).max())
+        assert [k for _, k in events] == ["stick", "slip"]
+        # (the entry is slow near the grazing, x'' ~ 0.1 there: a time is a state's error over that)
+        assert np.abs(o.switch_times - [t for t, _ in events]).max() < 1e-8
 
 
 def test_the_grazing_sliding_curve_in_a_and_omega_is_the_closed_form(branch):
@@ -102,3 +113,37 @@ def test_continue_on_the_command_line_reports_the_grazing_sliding(capsys):
     [special] = out["special"]
     assert special["kind"] == "grazing-sliding"
     assert abs(special["value"] - grazing_amplitude(VALUES["omega"], VALUES["v_belt"])) < 1e-10
+
+
+@pytest.mark.parametrize(
+    ("omega", "v_belt", "kind"),
+    [(0.45, 0.0, SpecialKind.GRAZING_SLIDING), (2.0, 0.2, SpecialKind.CROSSING_SLIDING)],
+)
+def test_where_the_non_stop_orbit_first_sticks_is_named_as_the_stick_margin_says(omega, v_belt, kind):
+    """Up in mu from weak friction the non-stop orbit first sticks by a grazing-sliding at low omega (a
+    slip touches the belt's speed inside it) and by a crossing-sliding at high omega: the name and the
+    place as :mod:`grazing.report.den_hartog` finds them from the orbits alone, without switches (the
+    stick margin's change of sign by Brent's method, and whether that margin passes through zero or
+    jumps)."""
+    from grazing.report import den_hartog as dh
+
+    br = continue_orbit(friction_oscillator(omega=omega, mu=0.05, v_belt=v_belt), "mu", 0.05, 0.95)
+    sp = br.special[0]
+    exact = dh.computed_boundary(omega, v_belt=v_belt)
+    assert sp.kind is kind and str(kind) == dh.transition_kind(omega, exact, v_belt)
+    assert abs(sp.param - exact) < 1e-10, sp.param - exact
+    assert sorted(sp.orbit.switch_signature[0]) == ["belt_to_slip_ahead", "belt_to_slip_behind"]
+
+
+def test_the_grazing_sliding_curve_with_the_belt_at_rest_is_on_the_stick_margins_boundary():
+    """Both slips of the symmetric non-stop orbit graze at once; the curve is bracketed again from a guess
+    already past the change (its first step, without a slope yet), and reaches omega = 0.4 on the
+    boundary that the stick margin gives."""
+    from grazing.report import den_hartog as dh
+
+    br = continue_orbit(friction_oscillator(omega=0.45, mu=0.05, v_belt=0.0), "mu", 0.05, 0.95)
+    curve = sliding_curve(br, "omega", 0.4, steps=2)
+    assert curve.kind is SpecialKind.GRAZING_SLIDING and curve.status == "reached omega = 0.4"
+    mu, w = curve.values[-1]
+    assert w == 0.4 and abs(mu - dh.computed_boundary(0.4)) < 1e-10
+    assert curve.values[0][0] - mu > 0.05

@@ -10,6 +10,7 @@ bracket widened until it holds the change, then narrowed by bisection
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -100,17 +101,27 @@ def _orbit_at(like: PeriodicOrbit, **values: float) -> PeriodicOrbit | None:
 def _bracket(
     before: PeriodicOrbit, after: PeriodicOrbit, param: str, guess: float, changes: dict[str, float]
 ) -> tuple[PeriodicOrbit, PeriodicOrbit] | None:
-    """Orbits with ``before``'s and ``after``'s switches on either side of ``guess`` (with ``changes`` to
-    the other parameters), the narrowest of :data:`BRACKET_STEPS` that holds them; None if none does."""
-    side = np.sign(after.model.params[param] - before.model.params[param])
+    """Orbits with ``before``'s and ``after``'s switches at two neighbouring values of ``param`` (with
+    ``changes`` to the other parameters), ``before``'s on its side: the values tried are ``guess`` plus and
+    minus each of :data:`BRACKET_STEPS` in turn, and the first pair of neighbours among those tried so far
+    that holds the change is returned (so a guess already past the change, or short of it, is bracketed
+    on one side); None if none does."""
+    side = float(np.sign(after.model.params[param] - before.model.params[param]))
+    # (each value tried: its position from the guess towards ``after``'s side, the orbits found with
+    # ``before``'s and with ``after``'s switches there)
+    tried: list[tuple[float, PeriodicOrbit | None, PeriodicOrbit | None]] = []
     for step in BRACKET_STEPS:
         eps = step * max(1.0, abs(guess))
-        a = _orbit_at(before, **changes, **{param: guess - side * eps})
-        b = _orbit_at(after, **changes, **{param: guess + side * eps})
-        if a is None or b is None:
-            continue
-        if a.switch_signature == before.switch_signature and b.switch_signature == after.switch_signature:
-            return a, b
+        for sign in (-1.0, 1.0):
+            value = guess + sign * side * eps
+            found = [o for like in (before, after) if (o := _orbit_at(like, **changes, **{param: value}))]
+            ours = [o for o in found if o.switch_signature == before.switch_signature]
+            theirs = [o for o in found if o.switch_signature == after.switch_signature]
+            tried.append((sign * eps, ours[0] if ours else None, theirs[0] if theirs else None))
+        tried.sort(key=lambda t: t[0])
+        for (_, a, _), (_, _, b) in itertools.pairwise(tried):
+            if a is not None and b is not None:
+                return a, b
     return None
 
 
