@@ -1,9 +1,10 @@
 """A sliding bifurcation followed in two parameters, from the special point where a branch ends.
 
 At each value of the second parameter the bifurcation is bracketed again in the branch's parameter: the
-orbits with the two sides' switches (:attr:`~grazing.orbits.periodic.PeriodicOrbit.switch_signature`) are
-found on either side of the predicted value (the last point, or the line through the last two), the
-bracket widened until it holds the change, then narrowed by bisection
+orbits are found at values widening out on both sides of the predicted one (the last point, or the line
+through the last two) until two neighbouring values hold the two sides' switches
+(:attr:`~grazing.orbits.periodic.PeriodicOrbit.switch_signature`), a guess past the change or short of it
+alike; that bracket is then narrowed by bisection
 (:func:`~grazing.orbits.sliding_bifurcations.bisect_switches`).  The curve ends, with its reason in
 :attr:`SlidingCurve.status`, where the change is no longer bracketed or is of another kind.
 """
