@@ -192,11 +192,37 @@ def test_simulate_of_a_model_of_one_mode_shows_no_sliding(capsys):
     )
 
 
-@pytest.mark.parametrize("command", [["explore"]])
-def test_what_the_library_does_not_run_is_refused_in_one_line(command, capsys):
-    code, out, err = run([*command, *SOFT], capsys)
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--mode", "stuck"], "--mode: unknown mode 'stuck'"),
+        (["--mode", "sliding on 'belt'"], "--mode: unknown mode"),
+        (["--set", "k=-1"], "k = -1 is outside"),
+    ],
+)
+def test_explore_s_bad_modes_are_one_line_before_it_serves(args, message, capsys):
+    """``explore`` takes models with modes (tests/explore/test_explore_modes.py); its ``--mode`` is checked
+    as ``simulate``'s, before the page is served."""
+    code, out, err = run(["explore", *SOFT, "--param", "omega", "--range", "0.8,1.6", *args], capsys)
     assert code != 0 and out == "" and err.count("\n") == 1, err
-    assert f"{command[0]} does not support models with modes yet" in err
+    assert message in err
+
+
+def test_explore_of_a_model_with_modes_that_a_sweep_does_not_run_is_one_line(tmp_path, capsys):
+    """Sticking to a stop in a model with modes: its diagram (a sweep) cannot be drawn, said at once."""
+    path = tmp_path / "belt.py"
+    path.write_text(
+        "import sympy as sp\n"
+        "from grazing import HybridModel, Mode, Parameter, Stop, Surface\n"
+        "x, v, t, r = sp.symbols('x v t r')\n"
+        "table = Stop('table', x, [x, -r * v], contact_direction=[0, 1])\n"
+        "BELT = HybridModel('belt', [x, v], t, [Parameter('r', 0.5)], period=2 * sp.pi,\n"
+        "    modes=[Mode('slip_right', [v, -x - 1], stops=[table]), Mode('slip_left', [v, -x + 1])],\n"
+        "    surfaces=[Surface('belt', v, 'slip_right', 'slip_left', sliding=True)])\n"
+    )
+    code, out, err = run(["explore", "--model", f"{path}:BELT", "--param", "r", "--range", "0.4,0.6"], capsys)
+    assert code != 0 and out == "" and err.count("\n") == 1, err
+    assert "--model: explore draws a sweep, and a sweep does not support sticking" in err
 
 
 # Below the fold of its resonance the soft-impact oscillator has a small free orbit and a large one in

@@ -228,7 +228,7 @@ def model_options(
                 raise InputError(
                     f"--model: {model.name} has modes ({', '.join(model.mode_names)}): {command} does not "
                     "support models with modes yet (simulate, orbit, continue, curve, graze, graze-curve, "
-                    "sweep, map, normal-form, basins and attractors do)"
+                    "sweep, map, normal-form, basins, attractors and explore do)"
                 )
             if not any_model:
                 raise InputError(

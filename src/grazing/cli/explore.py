@@ -5,7 +5,14 @@ from __future__ import annotations
 import click
 
 import grazing
-from grazing.cli.common import InputError, model_options, model_parameter, parse_pair, refuse_varied
+from grazing.cli.common import (
+    InputError,
+    check_mode,
+    model_options,
+    model_parameter,
+    parse_pair,
+    refuse_varied,
+)
 from grazing.cli.validate import count, refuse_unused
 
 PENDULUM_DEFAULT = {"eta": (0.44, 0.49)}
@@ -28,6 +35,13 @@ def explore_view(
     from grazing.explore import ModelSource, View
 
     refuse_unused(["params"], param is not None, "with --param (give one of them)")
+    if model.has_modes:  # (the diagram is a sweep: a model with modes it does not run, before the ranges)
+        from grazing.sweeps.spec import refuse_on_modes
+
+        try:
+            refuse_on_modes(model)
+        except grazing.GrazingError as exc:
+            raise InputError(f"--model: explore draws a sweep, and {exc}") from None
     if param is None and params is None:
         if model.name != "pendulum" or model_spec != "pendulum" or ranges:
             raise InputError(
@@ -75,7 +89,7 @@ def explore_view(
 
 
 @click.command("explore")
-@model_options(any_model=True)
+@model_options(any_model=True, modes=True)
 @click.option(
     "--param",
     "param",
@@ -107,6 +121,13 @@ def explore_view(
     help="The port to listen on, on 127.0.0.1 (0: any free port).",
 )
 @click.option("--no-browser", is_flag=True, help="Do not open the page in a browser.")
+@click.option(
+    "--mode",
+    default=None,
+    metavar="NAME",
+    help="A model with modes: the mode a click's simulation starts in, from the diagram's state there "
+    "(default: the mode whose region that state lies in; the page's Start mode).",
+)
 def explore(
     model: grazing.HybridModel,
     case: str,
@@ -117,11 +138,13 @@ def explore(
     component: str | None,
     port: int,
     no_browser: bool,
+    mode: str | None,
 ) -> None:
     """The bifurcation diagram you can click: a local web page (127.0.0.1) where a click on a
     point shows its orbit, continues it and finds the grazings; Ctrl-C stops it."""
     model_spec = click.get_current_context().params.get("model_spec", "pendulum")
     view = explore_view(model, model_spec, param, params, ranges, num, component)
+    check_mode(model, mode)
     try:
         import bokeh  # noqa: F401
         import panel  # noqa: F401
@@ -134,4 +157,4 @@ def explore(
     def ready(url: str) -> None:
         click.echo(f"grazing explore: {url} (Ctrl-C stops it)")
 
-    serve(view, port=port, open_browser=not no_browser, ready=ready)  # type: ignore[arg-type]
+    serve(view, port=port, open_browser=not no_browser, ready=ready, mode=mode)  # type: ignore[arg-type]

@@ -64,7 +64,9 @@ def explorer(model: Any, ranges: dict[str, tuple[float, float]] | None = None, *
         ``{"eta": (0.44, 0.49)}``.
     **kwargs
         ``num`` (points per parameter), ``component`` (the state on the
-        vertical axis) and ``source`` (the model as ``--model`` takes it).
+        vertical axis), ``source`` (the model as ``--model`` takes it) and, for a
+        model with modes, ``mode`` (the mode a click starts in; default: the one
+        the diagram's state there lies in).
 
     Returns
     -------

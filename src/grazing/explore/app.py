@@ -40,6 +40,10 @@ REFINE_BELOW = 0.5
 
 CLICK_HINT = "Click a point of the diagram (or type a value below) to see its orbit."
 
+WHERE_IT_LIES = "where its state lies"
+"""The start-mode choice of a model with modes that starts a click's simulation in the mode whose region
+the diagram's state there lies in (:meth:`~grazing.HybridModel.mode_at`, the library's default)."""
+
 NARROW = 560
 """The least width (CSS pixels) of the diagram's column and the orbit's beside it: on a narrower screen
 (a phone) the page's columns stack, one above the other."""
@@ -92,13 +96,23 @@ class Explorer:
         server session's next tick when there is a session, else a direct call).
     compute
         Start computing the diagram at once (default).
+    mode
+        A model with modes: the mode a click's simulation starts in, from the diagram's state there
+        (default: the one whose region that state lies in); the page's "Start mode" choice.
     """
 
     def __init__(
-        self, view: View, *, deliver: Callable[[Callable[[], None]], None] | None = None, compute: bool = True
+        self,
+        view: View,
+        *,
+        deliver: Callable[[Callable[[], None]], None] | None = None,
+        compute: bool = True,
+        mode: str | None = None,
     ) -> None:
         import panel as pn
 
+        if mode is not None:
+            view.model.mode_index(mode)  # (a mode a run can start in: one line)
         self.view = view
         self.doc = pn.state.curdoc
         self.jobs = Jobs(deliver or self._deliver)
@@ -117,9 +131,10 @@ class Explorer:
             model.parameter(n).show(v, ".6g") for n, v in model.params.items() if n not in view.names
         )
         ranges = "; ".join(p.show_range(a.lo, a.hi, ".6g") for p, a in zip(names, view.axes))
+        modes = f"; modes: {', '.join(model.mode_names)}" if model.has_modes else ""
         self.header = pn.pane.Markdown(
             f"### grazing explore: {model.name}\n{ranges} ({' x '.join(str(a.num) for a in view.axes)} "
-            f"points); {fixed}",
+            f"points); {fixed}{modes}",
             sizing_mode="stretch_width",
         )
         self.progress = pn.indicators.Progress(value=0, max=100, width=240, bar_color="primary")
@@ -137,6 +152,11 @@ class Explorer:
             )
             for p in names
         ]
+        real = [m for m in model.mode_names if m not in model.sliding_names]
+        self.mode_select = pn.widgets.Select(
+            label="Start mode", options=[WHERE_IT_LIES, *real], value=mode or WHERE_IT_LIES, width=180,
+            visible=model.has_modes,
+        )  # fmt: skip
         self.show_button = pn.widgets.Button(label="Show this point")
         self.continue_button = pn.widgets.Button(label="Continue this orbit", disabled=True)
         self.grazings_button = pn.widgets.Button(label="Find the grazings")
@@ -176,7 +196,7 @@ class Explorer:
                     pn.pane.Bokeh(self.figures.diagram, sizing_mode="stretch_width"),
                     pn.pane.Bokeh(self.figures.readout, sizing_mode="stretch_width"),
                     pn.pane.Bokeh(self.figures.legend, sizing_mode="stretch_width"),
-                    wrap(*self.inputs, self.show_button),
+                    wrap(*self.inputs, self.mode_select, self.show_button),
                     sizing_mode="stretch_width",
                 ),
                 pn.Column(
@@ -332,14 +352,22 @@ class Explorer:
         self.orbit.object = f"computing the orbit at {text} ..."
         self.continue_button.disabled = True
 
+        mode = self.start_mode
+
         def work(cancelled: Callable[[], bool]) -> PointReport:
-            return inspect_click(diagram, values, cancelled=cancelled)
+            return inspect_click(diagram, values, mode=mode, cancelled=cancelled)
 
         def done(rep: PointReport) -> None:
             self.point_diagram = diagram  # (the one its simulation started from: copy as code sweeps it)
             self._point_done(rep)
 
         self.jobs.submit("point", work, done, self._point_failed)
+
+    @property
+    def start_mode(self) -> str | None:
+        """The mode a click's simulation starts in (None: where the diagram's state lies; no modes)."""
+        value = self.mode_select.value
+        return None if value == WHERE_IT_LIES or not self.view.model.has_modes else str(value)
 
     def _diagram_for(self, values: list[float]) -> Diagram:
         """The finest computed diagram containing the point (the refined one when zoomed)."""
@@ -493,6 +521,7 @@ def explorer(
     num: int | None = None,
     component: int | str = 0,
     source: str | None = None,
+    mode: str | None = None,
 ) -> Any:
     """The explorer of ``model`` over ``ranges`` as a Panel component: display it in a Jupyter notebook.
 
@@ -510,6 +539,9 @@ def explorer(
         The state on the diagram's vertical axis (index or name).
     source
         How the model was made, as ``--model`` takes it (for "copy as code").
+    mode
+        A model with modes: the mode a click's simulation starts in (default: the one whose region
+        the diagram's state there lies in).
 
     Examples
     --------
@@ -526,4 +558,4 @@ def explorer(
             raise GrazingError("give the ranges explored: {name: (lo, hi)}")
         ranges = {"eta": (0.44, 0.49)}
     view = View.of(model, ranges, num=num, source=ModelSource.of(model, source), component=component)
-    return Explorer(view).panel
+    return Explorer(view, mode=mode).panel

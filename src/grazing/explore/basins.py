@@ -94,7 +94,8 @@ Ranges = list[tuple[float, float]]
 def within_stops(model: HybridModel, ranges: Ranges, num: tuple[int, int]) -> Ranges:
     """``ranges`` (of the first two states) less the columns and rows of initial states that all lie
     beyond a stop (not run: the basins would show them blank), on a probe grid :data:`CLIP_PROBE`
-    times finer; unchanged where none or all do.
+    times finer; unchanged where none or all do.  In a model with modes, beyond a stop is in no mode's
+    region (:func:`grazing.attractors.basins.outside`: a soft stop's contact is a mode, not beyond it).
 
     Examples
     --------
@@ -103,11 +104,12 @@ def within_stops(model: HybridModel, ranges: Ranges, num: tuple[int, int]) -> Ra
     >>> [round(v, 3) for v in within_stops(m, [(-1.4, 1.4), (-2.0, 2.0)], (40, 40))[0]]
     [-1.4, 0.698]
     """
-    from grazing.attractors.grid import beyond_stops, start_time, state_grid
+    from grazing.attractors.basins import outside
+    from grazing.attractors.grid import start_time, state_grid
 
     probe = tuple(CLIP_PROBE * max(2, int(n)) for n in num)
     grid = state_grid(model, ranges[0], ranges[1], probe)
-    beyond = beyond_stops(model, grid.states_array(), start_time(model, 0.0)).reshape(grid.shape)
+    beyond = outside(model, grid.states_array(), start_time(model, 0.0)).reshape(grid.shape)
     if beyond.all() or not beyond.any():
         return ranges
     xs, ys = grid.x[~beyond.all(axis=0)], grid.y[~beyond.all(axis=1)]

@@ -45,11 +45,13 @@ def section_states(orbit: PeriodicOrbit) -> np.ndarray:
     """The orbit's states at forcing phase 0, one per forcing period of its period: ``(period, n_states)``.
 
     A branch's orbits are solved on sections chosen away from their impacts; the
-    diagram samples at phase 0, so each is simulated over one period from its section.
+    diagram samples at phase 0, so each is simulated over one period from its section
+    (on a model with modes, in the orbit's mode there).
     """
     sol = simulate(
-        orbit.model, orbit.state, t0=orbit.t0, periods=orbit.period, impacts="none", events=not orbit.virtual
-    )
+        orbit.model, orbit.state, t0=orbit.t0, periods=orbit.period, impacts="none", events=not orbit.virtual,
+        mode=orbit.mode,
+    )  # fmt: skip
     return sol.samples
 
 
@@ -175,6 +177,7 @@ def continue_click(view: View, point: PointReport, *, cancelled: IsCancelled | N
             x0=point.orbit.state,
             period=point.orbit.period,
             progress=lambda _n, _v: checkpoint(cancelled),
+            mode=point.orbit.mode,
         )
         states = []
         for o in branch.orbits:
@@ -400,6 +403,7 @@ def follow_click_curves(
     a, b = view.axes
     par = view.model.parameter(a.name)
     start = point.values[a.name]
+    modes = point.model.has_modes
     curves, lines = [], []
     for piece in continued.pieces:
         done = set()
@@ -418,7 +422,8 @@ def follow_click_curves(
                     piece.end,
                     b.name,
                     (b.lo, b.hi),
-                    x0=point.orbit.state,
+                    x0=None if modes else point.orbit.state,
+                    orbit=point.orbit if modes else None,  # (in its mode: follow_curve starts from it)
                     period=point.orbit.period,
                     progress=lambda *_: checkpoint(cancelled),
                 )

@@ -8,7 +8,9 @@ point and the same branch as the page: the diagram with
 settings; the clicked point with :func:`grazing.simulate` (``grazing
 simulate``) from the diagram's state there, and its orbit with
 :func:`~grazing.orbits.find_orbit` (``grazing orbit``); the branch with
-:func:`~grazing.orbits.continue_orbit` (``grazing continue``), both ways.
+:func:`~grazing.orbits.continue_orbit` (``grazing continue``), both ways.  On a
+model with modes every run, orbit and branch names the mode it starts in (``mode=``,
+``--mode``), as the page started them.
 """
 
 from __future__ import annotations
@@ -66,6 +68,16 @@ def _state_arg(x: np.ndarray) -> str:
 
 def _linspace(lo: float, hi: float, num: int) -> str:
     return f"np.linspace({lo!r}, {hi!r}, {num})"
+
+
+def _mode_kw(mode: str | None) -> str:
+    """``, mode='name'`` for a run of a model with modes starting in ``mode``; "" without modes."""
+    return "" if mode is None else f", mode={mode!r}"
+
+
+def _mode_arg(mode: str | None) -> list[str]:
+    """``--mode NAME`` for a run of a model with modes starting in ``mode``; nothing without modes."""
+    return [] if mode is None else ["--mode", mode]
 
 
 def view_code(
@@ -212,17 +224,19 @@ def _point_code(
     ``point_args``."""
     a = view.axes[0]
     p = point.settings
+    m = point.modes
+    first, then, guess = (None, None, None) if m is None else (m.start, m.shown_start, m.guess)
     values = ", ".join(f"{k}={v!r}" for k, v in point.values.items())
     py += [
         "",
         "# the clicked point, from the diagram's state there",
         f"point = model.with_params({values})",
         f"sol = grazing.simulate(point, {_floats(point.x0)}, transient={p.transient}, periods={p.periods}, "
-        'impacts="none")',
+        f'impacts="none"{_mode_kw(first)})',
         "period = sol.period()",
         f"shown = period if period > 0 else {p.shown_periods}",
         "run = grazing.simulate(point, sol.x_final, t0=sol.t_final, periods=shown, "
-        f"trajectory={p.points_per_period})",
+        f"trajectory={p.points_per_period}{_mode_kw(then)})",
         'print("period", period, "impacts", len(run.impacts) / (1 if period > 0 else shown))',
     ]
     if point_args is not None:
@@ -237,13 +251,14 @@ def _point_code(
                     str(p.transient),
                     "--periods",
                     str(p.periods),
+                    *_mode_arg(first),
                 ]
             )
         )
     if point.orbit_guess is None:
         return
     py += [
-        "orbit = find_orbit(point, run.x_final, period=period, t0=0.0)",
+        f"orbit = find_orbit(point, run.x_final, period=period, t0=0.0{_mode_kw(guess)})",
         'print("orbit", orbit.period, orbit.impacts, orbit.multipliers)',
     ]
     if point_args is not None:
@@ -256,6 +271,7 @@ def _point_code(
                     _state_arg(point.orbit_guess),
                     "--period",
                     str(point.period),
+                    *_mode_arg(guess),
                 ]
             )
         )
@@ -268,7 +284,7 @@ def _point_code(
         "# its branch, both ways to the ends of the range",
         f"for end in {ends!r}:",
         f"    branch = continue_orbit(point, {a.name!r}, {start!r}, end, x0=orbit.state, "
-        "period=orbit.period)",
+        f"period=orbit.period{', mode=orbit.mode' if m is not None else ''})",
         '    print("branch", len(branch), [(s.kind, round(s.param, 8)) for s in branch.special])',
     ]
     if point_args is not None:
@@ -290,6 +306,7 @@ def _point_code(
                         _state_arg(point.orbit.state),
                         "--period",
                         str(point.orbit.period),
+                        *_mode_arg(point.orbit.mode),
                     ]
                 )
             )
@@ -356,13 +373,15 @@ def _curves_code(
     a, b = view.axes
     start, period = point.values[a.name], point.orbit.period
     asked = [(str(c.kind), c.stop) for c in found.curves]
+    mode = point.orbit.mode
+    start_at = "x0=x0" if mode is None else "orbit=orbit"  # (with modes: from the orbit, in its mode)
     py += [
         "",
         f"# the bifurcation curves through the branch's special points, in ({a.name}, {b.name})",
         f"x0 = {_floats(point.orbit.state)}",
         f"for kind, stop in {asked!r}:",
         f"    curve = follow_curve(point, kind, {a.name!r}, {start!r}, stop, {b.name!r}, {(b.lo, b.hi)!r}, "
-        f"x0=x0, period={period})",
+        f"{start_at}, period={period})",
         '    print("curve", kind, len(curve.points), curve.status)',
     ]
     if not with_cli:
@@ -390,6 +409,7 @@ def _curves_code(
                     str(period),
                     "--initial",
                     _state_arg(point.orbit.state),
+                    *_mode_arg(mode),
                 ]
             )
         )

@@ -7,7 +7,10 @@ replacing those columns.  Labels come from the parameters' and states' metadata 
 display unit: degrees for angles, states included, as in the page's header).  Periods are
 coloured by the palette of the report and the docs (:mod:`grazing.plotting.palette`), named
 in a legend under the diagram; what the mouse is over is read in a line under the diagram
-(:data:`HOVER_JS`), never in a tooltip over the plot.
+(:data:`HOVER_JS`), never in a tooltip over the plot.  On a model with modes the time series
+shades each stay in a mode as the static plots do (:func:`mode_span_columns`, the colours of
+:data:`~grazing.plotting.palette.MODE_COLOURS`), and both plots mark the switches of mode and
+the sliding intervals (:func:`switch_columns`, :func:`sliding_columns`).
 """
 
 from __future__ import annotations
@@ -25,7 +28,7 @@ from grazing.explore.branch import Continued, Curves, Grazings, Mark
 from grazing.explore.diagram import Diagram, View
 from grazing.explore.point import PointReport
 from grazing.plotting.labels import state_scale, state_unit
-from grazing.plotting.palette import MAX_PERIOD, class_colours, class_labels, period_codes
+from grazing.plotting.palette import MAX_PERIOD, MODE_COLOURS, class_colours, class_labels, period_codes
 
 __all__ = [
     "FRAME_BELOW",
@@ -35,8 +38,17 @@ __all__ = [
     "diagram_columns",
     "legend_html",
     "mark_columns",
+    "mode_span_columns",
     "period_label",
+    "sliding_columns",
+    "switch_columns",
 ]
+
+MODE_ALPHA = 0.15
+"""The opacity of a mode's shading on the time series (the static plots' ``axvspan`` alpha)."""
+
+SWITCH_COLOUR = "#7b3294"
+"""The marks of the switches of mode (purple: not a period's colour, nor an impact's black)."""
 
 PERIOD_COLOURS = tuple(class_colours(MAX_PERIOD)[3 : 3 + MAX_PERIOD])
 """The colours of periods 1 (with impacts) to 8, from the shared palette (:mod:`grazing.plotting.palette`:
@@ -190,6 +202,67 @@ def diagram_columns(diagram: Diagram, component: int) -> dict[str, list[Any]]:
         cs += [int(codes[i])] * s.size
         texts += [text] * s.size
     return {"x": xs, "y": ys, "period": labels, "colour": colours, "impacts": ipp, "code": cs, "text": texts}
+
+
+def mode_span_columns(rep: PointReport) -> dict[str, list[Any]]:
+    """The shown motion's stays in each mode (a model with modes; empty without): ``x0``, ``x1`` (times as
+    the time series'), ``mode`` (the legend's ``mode 'name'``, as the static plots label it), ``colour``
+    (the mode's in :data:`~grazing.plotting.palette.MODE_COLOURS`, by its index in ``mode_names``).
+
+    Examples
+    --------
+    >>> import grazing
+    >>> from grazing.explore import inspect_point
+    >>> rep = inspect_point(grazing.models.soft_impact_oscillator(), {"omega": 1.2}, [0.0, 0.0])
+    >>> mode_span_columns(rep)["mode"]
+    ["mode 'contact'", "mode 'free'", "mode 'contact'"]
+    """
+    out: dict[str, list[Any]] = {"x0": [], "x1": [], "mode": [], "colour": []}
+    if rep.modes is None:
+        return out
+    names = rep.model.mode_names
+    for a, b, name in rep.modes.spans:
+        out["x0"].append(float(a))
+        out["x1"].append(float(b))
+        out["mode"].append(f"mode {name!r}")
+        out["colour"].append(MODE_COLOURS[names.index(name) % len(MODE_COLOURS)])
+    return out
+
+
+def switch_columns(rep: PointReport, scales: np.ndarray, j: int) -> dict[str, list[Any]]:
+    """The shown motion's switches of mode (empty without modes): ``t`` and ``x`` (the first state, display
+    units) for the time series, ``px``, ``py`` (states 0 and ``j``) for the phase portrait, ``name`` (the
+    transition)."""
+    if rep.modes is None:
+        return {"t": [], "x": [], "px": [], "py": [], "name": []}
+    x = rep.modes.switch_states * scales
+    return {
+        "t": rep.modes.switch_t.tolist(),
+        "x": x[:, 0].tolist(),
+        "px": x[:, 0].tolist(),
+        "py": x[:, j].tolist(),
+        "name": list(rep.modes.switch_names),
+    }
+
+
+def sliding_columns(rep: PointReport, scales: np.ndarray, j: int) -> dict[str, list[Any]]:
+    """The shown motion during each sliding interval (empty without): ``xs``, ``ys`` (states 0 and ``j``,
+    display units) for the phase portrait, ``t0``, ``t1`` the interval, ``surface`` its surface, ``colour``
+    its sliding pseudo-mode's (as the time series shades it)."""
+    out: dict[str, list[Any]] = {"xs": [], "ys": [], "t0": [], "t1": [], "surface": [], "colour": []}
+    if rep.modes is None:
+        return out
+    x = rep.trajectory * scales
+    pseudo = {rep.model.surface_names[i]: k for k, i in rep.model.sliding_modes.items()}
+    for a, b, surface in rep.modes.sliding:
+        inside = (rep.t >= a) & (rep.t <= b)
+        out["xs"].append(x[inside, 0].tolist())
+        out["ys"].append(x[inside, j].tolist())
+        out["t0"].append(float(a))
+        out["t1"].append(float(b))
+        out["surface"].append(surface)
+        out["colour"].append(MODE_COLOURS[pseudo[surface] % len(MODE_COLOURS)])
+    return out
 
 
 def map_image(diagram: Diagram) -> dict[str, list[Any]]:
@@ -422,6 +495,16 @@ class Figures:
             tools="pan,wheel_zoom,box_zoom,reset,save",
             title="time series",
         )
+        self.series_modes = ColumnDataSource({"x0": [], "x1": [], "mode": [], "colour": []})
+        self.series_switches = ColumnDataSource({"t": [], "x": [], "px": [], "py": [], "name": []})
+        self.phase_sliding = ColumnDataSource(
+            {"xs": [], "ys": [], "t0": [], "t1": [], "surface": [], "colour": []}
+        )
+        if model.has_modes:  # (the stays in each mode shaded under the lines, as the static plots do)
+            self.series.vstrip(
+                x0="x0", x1="x1", source=self.series_modes, fill_color="colour", fill_alpha=MODE_ALPHA,
+                line_alpha=0, legend_field="mode", level="underlay",
+            )  # fmt: skip
         self.series_sources = []
         for i, colour in zip(range(model.n_states), LINE_COLOURS):
             src = ColumnDataSource({"t": [], "x": []})
@@ -431,6 +514,11 @@ class Figures:
         self.series.scatter(
             "t", "x", source=self.series_impacts, marker="x", size=9, color="black", legend_label="impact"
         )
+        if model.has_modes:
+            self.series.scatter(
+                "t", "x", source=self.series_switches, marker="triangle", size=9, color=SWITCH_COLOUR,
+                legend_label="switch of mode",
+            )  # fmt: skip
         self.series.legend.click_policy = "hide"
         self.series.legend.orientation = "horizontal"
         self.series.add_layout(self.series.legend[0], "above")  # (outside the plot: it hides no data)
@@ -453,6 +541,16 @@ class Figures:
         self.phase.scatter(
             "x", "y", source=self.phase_impacts, marker="x", size=10, color="black", legend_label="impacts"
         )
+        if model.has_modes:
+            if model.sliding_modes:
+                self.phase.multi_line(
+                    "xs", "ys", source=self.phase_sliding, line_width=6, line_alpha=0.5, line_color="colour",
+                    legend_label="sliding",
+                )  # fmt: skip
+            self.phase.scatter(
+                "px", "py", source=self.series_switches, marker="triangle", size=10, color=SWITCH_COLOUR,
+                legend_label="switches of mode",
+            )  # fmt: skip
         self.phase.legend.click_policy = "hide"
         self.phase.legend.orientation = "horizontal"
         self.phase.add_layout(self.phase.legend[0], "above")
@@ -578,6 +676,9 @@ class Figures:
         strobe = (rep.samples[-rep.period :] if rep.period > 0 else rep.samples) * self.scales
         self.phase_strobe.data = {"x": strobe[:, 0].tolist(), "y": strobe[:, j].tolist()}
         self.phase_impacts.data = {"x": impacts[:, 0].tolist(), "y": impacts[:, j].tolist()}
+        self.series_modes.data = mode_span_columns(rep)
+        self.series_switches.data = switch_columns(rep, self.scales, j)
+        self.phase_sliding.data = sliding_columns(rep, self.scales, j)
         for k, (_, span) in enumerate(self.stop_spans):
             level = rep.model.stop_level(0, 0.0, k)
             if level is not None:

@@ -7,7 +7,10 @@ of the motion densely (time series, phase portrait, impacts), and runs Newton's
 method on the stroboscopic map (:func:`grazing.orbits.find_orbit`) from the
 last sample for the orbit's Floquet multipliers.  Where there is no period or
 Newton's method fails, :attr:`PointReport.message` says so; the simulation is
-still shown.
+still shown.  On a model with modes the simulation starts in the mode asked for, else
+in the mode whose region the state lies in (:meth:`~grazing.HybridModel.mode_at`, as
+the library does), and :attr:`PointReport.modes` records the shown motion's stays in
+each mode, its switches and its sliding intervals (:class:`ModeTrace`).
 """
 
 from __future__ import annotations
@@ -19,13 +22,22 @@ import numpy as np
 
 from grazing.core.model import HybridModel
 from grazing.core.options import MAX_PERIOD
+from grazing.core.solution import Solution
 from grazing.engine.simulate import simulate
 from grazing.errors import GrazingError
 from grazing.explore.diagram import Diagram, IsCancelled, View, checkpoint
 from grazing.orbits.periodic import multipliers_text
 from grazing.orbits.shooting import PeriodicOrbit, find_orbit
 
-__all__ = ["INSPECT_SETTINGS", "InspectSettings", "PointReport", "inspect_click", "inspect_point"]
+__all__ = [
+    "INSPECT_SETTINGS",
+    "InspectSettings",
+    "ModeTrace",
+    "PointReport",
+    "inspect_click",
+    "inspect_point",
+    "start_mode",
+]
 
 
 @dataclass(frozen=True)
@@ -65,6 +77,79 @@ INSPECT_SETTINGS = InspectSettings()
 
 
 @dataclass(frozen=True)
+class ModeTrace:
+    """The modes of a clicked point's shown motion (a model with modes), its times as :attr:`PointReport.t`.
+
+    Attributes
+    ----------
+    start
+        The mode the click's simulation started in (from :attr:`PointReport.x0`).
+    shown_start
+        The mode the shown motion starts in (where the detection run ended; a run ending on a
+        sliding surface goes on in the mode :meth:`~grazing.HybridModel.mode_at` gives there).
+    guess
+        The mode Newton's method started in (where the shown motion ends, at time 0 mod the forcing
+        period).
+    spans
+        Each stay in a mode: ``(start, end, mode name)`` (:meth:`~grazing.Solution.mode_spans`; a
+        sliding pseudo-mode ``"sliding on 'belt'"`` is a stay of its own).
+    switch_t, switch_states, switch_names
+        The switches of mode: times, states (after any reset), transition names
+        (:attr:`~grazing.Solution.switches`).
+    sliding
+        The sliding intervals: ``(start, end, surface name)`` (:attr:`~grazing.Solution.sliding`).
+    """
+
+    start: str
+    shown_start: str
+    guess: str
+    spans: tuple[tuple[float, float, str], ...]
+    switch_t: np.ndarray
+    switch_states: np.ndarray
+    switch_names: tuple[str, ...]
+    sliding: tuple[tuple[float, float, str], ...]
+
+    @classmethod
+    def of(cls, start: str, shown_start: str, guess: str, run: Solution, t0: float) -> ModeTrace:
+        """The trace of the shown run ``run``, its times less ``t0``."""
+        sw, names = run.switches, run.mode_names
+        assert sw is not None
+        surfaces = run.model.surface_names
+        sliding = () if run.sliding is None else run.sliding
+        return cls(
+            start=start,
+            shown_start=shown_start,
+            guess=guess,
+            spans=tuple((a - t0, b - t0, names[k]) for a, b, k in run.mode_spans()),
+            switch_t=sw.t - t0,
+            switch_states=sw.state,
+            switch_names=tuple(sw.name(i) for i in range(len(sw))),
+            sliding=tuple((float(a) - t0, float(b) - t0, surfaces[int(j)]) for a, b, j in sliding),
+        )
+
+    def lines(self, scale: float) -> list[str]:
+        """What the orbit panel says of the modes (counts per period: ``scale`` = 1 / shown periods
+        without a period)."""
+        total = sum(b - a for a, b, _ in self.spans) or 1.0
+        share: dict[str, float] = {}
+        for a, b, name in self.spans:
+            share[name] = share.get(name, 0.0) + (b - a) / total
+        n = len(self.switch_t) * scale
+        lines = [
+            f"modes: started in {self.start}; {_count(n)} switch{'es' * (n != 1)} per period; time in each "
+            "mode: " + ", ".join(f"{k} {v:.1%}" for k, v in share.items())
+        ]
+        if self.sliding:
+            slid = sum(b - a for a, b, _ in self.sliding)
+            on = ", ".join(dict.fromkeys(s for _, _, s in self.sliding))
+            lines.append(
+                f"sliding on {on}: {_count(len(self.sliding) * scale)} interval(s) per period, "
+                f"{slid / total:.1%} of the time"
+            )
+        return lines
+
+
+@dataclass(frozen=True)
 class PointReport:
     """What the explorer shows of a clicked point.
 
@@ -101,6 +186,9 @@ class PointReport:
         :attr:`InspectSettings.shown_periods` without one).
     settings
         How the point was simulated.
+    modes
+        A model with modes: the shown motion's modes, switches and sliding (:class:`ModeTrace`);
+        None for a model of one mode.
 
     Examples
     --------
@@ -132,6 +220,7 @@ class PointReport:
     message: str
     orbit_guess: np.ndarray | None = None
     settings: InspectSettings = INSPECT_SETTINGS
+    modes: ModeTrace | None = None
 
     def summary(self) -> str:
         """The point in a few lines of text (what the orbit panel says).
@@ -159,8 +248,10 @@ class PointReport:
                 f"Newton: period-{o.period} orbit with {o.impacts} impact{'s' * (o.impacts != 1)}, "
                 f"{'stable' if o.stable else 'unstable'}, max |multiplier| = {o.abs_lambda:.4f}",
                 f"Floquet multipliers: {multipliers_text(o.multipliers)}",
-                f"state at time 0: {state}",
+                f"state at time 0: {state}" + (f" (mode {o.mode})" if o.mode is not None else ""),
             ]
+        if self.modes is not None:
+            lines[1:1] = self.modes.lines(1.0 if self.period > 0 else 1.0 / self.shown_periods)
         if self.message:
             lines.append(self.message)
         return "\n".join(lines)
@@ -170,11 +261,33 @@ def _count(v: float) -> str:
     return f"{v:g}" if float(v).is_integer() else f"{v:.3g}"
 
 
+def start_mode(model: HybridModel, x: np.ndarray, t: float, mode: str | None = None) -> str | None:
+    """The mode a run of ``model`` from ``x`` at time ``t`` starts in: ``mode`` where given, else the one
+    whose region ``x`` lies in (:meth:`~grazing.HybridModel.mode_at`, the library's default for a given
+    state); None for a model of one mode (its one mode).  A sliding pseudo-mode (a run that ended sliding)
+    is not a mode a run starts in: it starts on the surface in the mode ``mode_at`` gives, and slides.
+
+    Examples
+    --------
+    >>> import grazing
+    >>> m = grazing.models.friction_oscillator()
+    >>> on_belt, ahead = np.array([0.5, 0.2]), np.array([0.0, 1.0])  # (v_belt = 0.2)
+    >>> start_mode(m, on_belt, 0.0, "sliding on 'belt'"), start_mode(m, ahead, 0.0)
+    ('slip_behind', 'slip_ahead')
+    """
+    if not model.has_modes:
+        return None if mode is None else model.mode_names[model.mode_index(mode)]
+    if mode is None or mode in model.sliding_names:
+        return model.mode_at(x, t)
+    return mode
+
+
 def inspect_point(
     model: HybridModel,
     values: dict[str, float],
     x0: Sequence[float] | np.ndarray,
     *,
+    mode: str | None = None,
     settings: InspectSettings = INSPECT_SETTINGS,
     cancelled: IsCancelled | None = None,
 ) -> PointReport:
@@ -188,6 +301,9 @@ def inspect_point(
         The explored parameters' values at the point (model units), by name.
     x0
         The state the simulation starts from, at time 0.
+    mode
+        A model with modes: the mode ``x0`` is in (default: the one whose region it lies in,
+        :func:`start_mode`).
     settings
         How the point is simulated.
     cancelled
@@ -218,18 +334,23 @@ def inspect_point(
     here = model.with_params(**values)
     x0 = np.array(x0, dtype=float)
     s = settings
-    sol = simulate(here, x0, transient=s.transient, periods=s.periods, impacts="none")
+    first = start_mode(here, x0, 0.0, mode)
+    sol = simulate(here, x0, transient=s.transient, periods=s.periods, impacts="none", mode=first)
     period = sol.period()
     checkpoint(cancelled)
     shown = period if period > 0 else s.shown_periods
-    run = simulate(here, sol.x_final, t0=sol.t_final, periods=shown, trajectory=s.points_per_period)
+    then = start_mode(here, sol.x_final, sol.t_final, sol.mode_final)
+    run = simulate(
+        here, sol.x_final, t0=sol.t_final, periods=shown, trajectory=s.points_per_period, mode=then
+    )
     per_stop = run.impacts.per_stop()
     scale = 1.0 if period > 0 else 1.0 / shown
     orbit, message = None, ""
+    guess = start_mode(here, run.x_final, 0.0, run.mode_final)
     if period > 0:
         checkpoint(cancelled)
         try:
-            orbit = find_orbit(here, run.x_final, period=period, t0=0.0)
+            orbit = find_orbit(here, run.x_final, period=period, t0=0.0, mode=guess)
         except GrazingError as exc:
             message = f"Newton's method on the period-{period} orbit failed: {exc}"
     else:
@@ -252,6 +373,9 @@ def inspect_point(
         message=message,
         orbit_guess=run.x_final.copy() if period > 0 else None,
         settings=settings,
+        modes=None
+        if first is None or then is None or guess is None
+        else ModeTrace.of(first, then, guess, run, sol.t_final),
     )
 
 
@@ -259,6 +383,7 @@ def inspect_click(
     diagram: Diagram,
     values: Sequence[float],
     *,
+    mode: str | None = None,
     settings: InspectSettings = INSPECT_SETTINGS,
     cancelled: IsCancelled | None = None,
 ) -> PointReport:
@@ -273,6 +398,9 @@ def inspect_click(
         The computed diagram (:func:`~grazing.explore.compute_diagram`).
     values
         The point clicked, one value per explored parameter (model units).
+    mode
+        A model with modes: the mode the diagram's state there is in (default: the one whose
+        region it lies in).
     settings
         How the point is simulated.
     cancelled
@@ -308,4 +436,4 @@ def inspect_click(
     named = dict(zip(view.names, (float(v) for v in values)))
     view.model.with_params(**named)  # (a value outside its interval: one line)
     x0 = diagram.start_state(values)
-    return inspect_point(view.model, named, x0, settings=settings, cancelled=cancelled)
+    return inspect_point(view.model, named, x0, mode=mode, settings=settings, cancelled=cancelled)

@@ -101,11 +101,13 @@ def serve(
     address: str = DEFAULT_ADDRESS,
     open_browser: bool = True,
     ready: Callable[[str], None] | None = None,
+    mode: str | None = None,
 ) -> None:
     """Serve the explorer of ``view`` at ``http://address:port/`` until Ctrl-C (then ``KeyboardInterrupt``).
 
     ``ready(url)`` is called once the server listens (``port`` 0: a free port
     is chosen, and ``url`` says which); ``open_browser`` then opens the page.
+    ``mode``: a model with modes, the page's start mode of a click (see :class:`~.app.Explorer`).
     Only pages served from that address and port may open the server's websocket.
     """
     import panel as pn
@@ -116,7 +118,7 @@ def serve(
     pages: list[Explorer] = []
 
     def page() -> object:
-        explorer = Explorer(view)
+        explorer = Explorer(view, mode=mode)
         pages.append(explorer)
         pn.state.curdoc.template = PAGE_TEMPLATE  # (a viewport: a phone lays the page out at its width)
         pn.state.on_session_destroyed(lambda _ctx: explorer.close())

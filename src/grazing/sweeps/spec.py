@@ -135,7 +135,7 @@ class SweepSpec:
 
     def __post_init__(self) -> None:
         if self.model.has_modes:
-            _refuse_on_modes(self.model)
+            refuse_on_modes(self.model)
         if not self.points:
             raise InvalidParameterError("a sweep needs at least one point")
         if self.segments < 1 or len(self.points) % self.segments:
@@ -297,7 +297,7 @@ def spec_summary(spec: SweepSpec) -> dict[str, Any]:
     return d
 
 
-def _refuse_on_modes(model: HybridModel) -> None:
+def refuse_on_modes(model: HybridModel) -> None:
     """One line for what a sweep (lanes) cannot do yet on a model with modes: sticking."""
     system = model.symbolic
     for j, name in enumerate(model.stop_names):
