@@ -70,6 +70,17 @@ def stick_spring() -> HybridModel:
     )  # fmt: skip
 
 
+def stick_spring_floor_second() -> HybridModel:
+    """:func:`stick_spring`, its modes the other way round: the floor is transition 1, row 0 of its mode."""
+    return HybridModel(
+        "stick-spring-2", [x, v], t, FORCED, period=2 * sp.pi / w, initial_mode="free",
+        modes=[Mode("spring", [v, FORCE - k * (x - d)]), Mode("free", [v, FORCE], stops=[FLOOR])],
+        transitions=[
+            Transition("touch", "free", "spring", d - x), Transition("leave", "spring", "free", x - d),
+        ],
+    )  # fmt: skip
+
+
 def stick_lift() -> HybridModel:
     """A forced mass on a rigid floor, pulled up by ``P`` while ``cos(omega t - phi) > c`` (switches in time
     only, which fire while the mass sticks; the pull lifts it, ``a cos + P - g > 0``, so it has no floor)."""
@@ -236,6 +247,21 @@ def test_sticking_and_switches_against_the_closed_form(make, name) -> None:
     assert np.all(sol.samples[:, 0] >= -1e-12)  # (never below the floor)
 
 
+def test_the_order_of_the_modes_changes_no_bit() -> None:
+    """The floor in the second mode (transition 1, its mode's event row 0): the same run, bit for bit (the
+    contact force's row, not the stop's index, sets the sticking step's scale)."""
+    runs = [
+        grazing.simulate(make(), START["x0"], t0=START["t0"], transient=0, periods=6, impacts="all")
+        for make in (stick_spring, stick_spring_floor_second)
+    ]
+    assert stick_spring_floor_second().stop_names == ("leave", "floor", "touch")
+    assert len(runs[0].sticking) == 6
+    assert np.array_equal(runs[0].samples, runs[1].samples)
+    assert np.array_equal(runs[0].sticking, runs[1].sticking)
+    assert np.array_equal(runs[0].switches.t, runs[1].switches.t)
+    assert np.array_equal(runs[0].impacts.t, runs[1].impacts.t)
+
+
 def test_sticking_marks_the_jacobian_invalid_and_a_smooth_run_keeps_it() -> None:
     """Sticking (through modes as in one) has no variational equations: the Jacobian is marked invalid."""
     stuck = Runner(stick_lift(), START["x0"], t0=START["t0"], variational=True)
@@ -262,25 +288,25 @@ def test_sweep_with_sticking_on_lanes_equals_the_runner_oracle(make) -> None:
 
 
 def test_sticking_kernels_per_mode_and_by_stop() -> None:
-    """A sticking kernel per sticking stop, with its mode's event rows; dispatched by the stop's index."""
+    """A sticking kernel per sticking stop, with its mode's event rows, dispatched by the stop's index:
+    with a stop that does not stick first, the floor (stop 1) sticks by its own kernel, not the roof's
+    (the dispatch's cases are positions in its list), as the same mass with its floor alone does."""
     src = generate_source(stick_spring().symbolic)
     assert src.sizes["sticks"] == [True, False, False]
     assert src.dispatch["tc_stick"] == ["tc_stick_s0"] * 3
-    # a stop without sticking first, then two with it: each stop's own kernel (the switch's cases are
-    # positions, so the list must be indexed by the stop)
     y, yv, tt = sp.symbols("y v t")
     wall = Stop("wall", 5 - y, [y, -yv])
     floor = Stop("floor", y, [y, -0.5 * yv], contact_direction=[0, 1])
     roof = Stop("roof", 4 - y, [y, -0.5 * yv], contact_direction=[0, 1])
-    three = HybridModel(
-        "three",
-        [y, yv],
-        tt,
-        [Parameter("om", 1.0)],
-        [yv, sp.cos(tt) - 1],
-        period=2 * sp.pi,
-        stops=[wall, floor, roof],
-    )
+    field = [yv, 2 * sp.cos(tt) - 1]
+    runs = []
+    for stops in ([wall, floor, roof], [floor]):
+        model = HybridModel("three", [y, yv], tt, [], field, period=2 * sp.pi, stops=stops)
+        runs.append(grazing.simulate(model, [0.3, 0.0], t0=math.pi, transient=0, periods=4, impacts="all"))
+    assert len(runs[1].sticking) >= 1 and len(runs[1].impacts) > 20  # (it chatters, sticks and is released)
+    np.testing.assert_allclose(runs[0].sticking, runs[1].sticking, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(runs[0].impacts.t, runs[1].impacts.t, rtol=0, atol=1e-12)
+    three = HybridModel("three", [y, yv], tt, [], field, period=2 * sp.pi, stops=[wall, floor, roof])
     assert generate_source(three.symbolic).dispatch["tc_stick"] == [
         "tc_stick_s1",
         "tc_stick_s1",
