@@ -287,6 +287,16 @@ def test_sweep_with_sticking_on_lanes_equals_the_runner_oracle(make) -> None:
         assert len(sol.sticking) > 0
 
 
+def test_a_sweep_through_sticking_has_no_lyapunov_exponent() -> None:
+    """Sticking has no variational equations: a sweep point that sticks in its sampled span reports NaN
+    (as in a model of one mode), on lanes as in the scalar oracle."""
+    settings_ = SweepSettings(transient=12, periods=6, chunk_size=4, adaptive=False, lyapunov=True)
+    values = [1.8, 2.0, 2.2, 2.4]
+    spec = sweep_spec(stick_spring(), "a", values, x0=(0.3, 0.0), settings=settings_)
+    res = assert_lanes_equal_the_oracle(dataclasses.replace(spec, polish=False), scalar=False, regroup=False)
+    assert np.all(np.isnan(np.concatenate([r.lyapunov for r in res])))
+
+
 def test_sticking_kernels_per_mode_and_by_stop() -> None:
     """A sticking kernel per sticking stop, with its mode's event rows, dispatched by the stop's index:
     with a stop that does not stick first, the floor (stop 1) sticks by its own kernel, not the roof's

@@ -165,11 +165,11 @@ def apply_impact(m, r, x, xp, pv, j, nrows, V, record, tables):
 def at_event(m, r, x, xp, pv, j, nrows, V, chatter_time, record, tables):
     """The event that ends the step of run ``r``, on stop ``j``; returns True for an impact.
 
-    Sticking to stop ``j``, its contact force changes sign: the release; sticking
-    to another, the contact ends first.  Then a switch of mode (sliding's
-    entry and exit among them), or an impact (:func:`apply_impact`), and on a
-    stop with a sticking mode a chattering sequence shorter
-    than ``chatter_time`` is summed to its accumulation point and continued as
+    Sticking to stop ``j``, its contact force changes sign: the release;
+    sticking to another, the contact ends first.  Then a switch of mode
+    (sliding's entry and exit among them), or an impact (:func:`apply_impact`),
+    and on a stop with a sticking mode a chattering sequence shorter than
+    ``chatter_time`` is summed to its accumulation point and continued as
     sticking.  The sticking intervals of the recorded span go into
     ``tables[1]`` (``r.n_stick``).
     """
