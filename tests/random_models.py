@@ -167,6 +167,7 @@ class ModesSpec:
     belt: float
     cubic: float
     curved: bool
+    sticky: bool = False  # (the impact stop has a contact direction)
 
     @property
     def param_names(self) -> tuple[str, ...]:
@@ -191,7 +192,8 @@ class ModesSpec:
         transitions: list = []
         surfaces: list = []
         if self.kind == "soft stop and impact":
-            stop = Stop(lab[4], q + 2 * g, [q, -r * p])  # (an impact on the far side)
+            contact = [0, 1] if self.sticky else None  # (with it, chattering on the stop sticks)
+            stop = Stop(lab[4], q + 2 * g, [q, -r * p], contact_direction=contact)  # (on the far side)
             modes = [Mode(lab[0], [p, accel], stops=[stop]), Mode(lab[1], [p, accel - kc * (q - g + p / 8)])]
             transitions = [
                 Transition(lab[2], lab[0], lab[1], g - q),
@@ -251,4 +253,5 @@ def modes_specs(draw: st.DrawFn, kinds: tuple[str, ...] = MODE_KINDS) -> ModesSp
         belt=draw(st.floats(0.1, 0.4)),
         cubic=draw(st.sampled_from([0.0, 0.2])),
         curved=draw(st.booleans()),
+        sticky=draw(st.booleans()),  # (drawn last: the other values as before)
     )

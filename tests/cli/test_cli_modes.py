@@ -208,8 +208,12 @@ def test_explore_s_bad_modes_are_one_line_before_it_serves(args, message, capsys
     assert message in err
 
 
-def test_explore_of_a_model_with_modes_that_a_sweep_does_not_run_is_one_line(tmp_path, capsys):
-    """Sticking to a stop in a model with modes: its diagram (a sweep) cannot be drawn, said at once."""
+def test_explore_draws_a_model_with_modes_that_sticks(tmp_path):
+    """Sticking to a stop in a model with modes: its diagram (a sweep) is drawn as any other (sweeps stick
+    through modes, tests/engine/test_sticking_modes.py), not refused."""
+    from grazing.cli.common import load_model
+    from grazing.explore import View
+
     path = tmp_path / "belt.py"
     path.write_text(
         "import sympy as sp\n"
@@ -220,9 +224,8 @@ def test_explore_of_a_model_with_modes_that_a_sweep_does_not_run_is_one_line(tmp
         "    modes=[Mode('slip_right', [v, -x - 1], stops=[table]), Mode('slip_left', [v, -x + 1])],\n"
         "    surfaces=[Surface('belt', v, 'slip_right', 'slip_left', sliding=True)])\n"
     )
-    code, out, err = run(["explore", "--model", f"{path}:BELT", "--param", "r", "--range", "0.4,0.6"], capsys)
-    assert code != 0 and out == "" and err.count("\n") == 1, err
-    assert "--model: explore draws a sweep, and a sweep does not support sticking" in err
+    view = View.of(load_model(f"{path}:BELT"), {"r": (0.4, 0.6)}, num=2)
+    assert view.names == ("r",)
 
 
 # Below the fold of its resonance the soft-impact oscillator has a small free orbit and a large one in

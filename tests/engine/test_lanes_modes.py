@@ -113,24 +113,6 @@ def test_sweep_equals_simulate_point_by_point() -> None:
         assert point.mode_names[modes[i]] == sol.mode_final, i
 
 
-def test_sticking_in_a_model_with_modes_is_refused_in_one_line() -> None:
-    """Sliding runs on lanes (tests/engine/test_lanes_sliding.py); sticking in a model with modes not yet."""
-    import sympy as sp
-
-    from grazing import HybridModel, Mode, Parameter, Stop, Surface
-
-    x, v, t, r = sp.symbols("x v t r")
-    table = Stop("table", x, [x, -r * v], contact_direction=[0, 1])
-    belt = HybridModel(
-        "belt", [x, v], t, [Parameter("r", 0.5)], period=2 * sp.pi,
-        modes=[Mode("slip_right", [v, -x - 1], stops=[table]), Mode("slip_left", [v, -x + 1])],
-        surfaces=[Surface("belt", v, "slip_right", "slip_left", sliding=True)],
-    )  # fmt: skip
-    with pytest.raises(grazing.InvalidParameterError, match="does not support sticking") as info:
-        sweep_spec(belt, "r", [0.5, 0.6], x0=(1.0, 0.0))
-    assert "\n" not in str(info.value)
-
-
 def test_lyapunov_exponents_across_switches_against_the_exact_jacobian() -> None:
     """The largest exponent of a fresh sweep point from the exact Jacobians (the saltation of each switch).
 

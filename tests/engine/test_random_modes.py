@@ -1,9 +1,9 @@
 """Property tests over random models with two and three modes (:class:`tests.random_models.ModesSpec`).
 
 Soft contacts (switches of vector field without a reset, a contact damper making the field jump), an
-impact stop, a reset that changes the mode, a sliding surface (flat or curved) of a belt with Coulomb
-friction, with modes, transitions, parameters, states and time named like the engine's and the
-generated code's own words.  For each drawn model:
+impact stop (with or without a contact direction for sticking), a reset that changes the mode, a
+sliding surface (flat or curved) of a belt with Coulomb friction, with modes, transitions, parameters,
+states and time named like the engine's and the generated code's own words.  For each drawn model:
 
 1. A sweep over the forcing frequency on SIMD lanes equals the independent Runner oracle of
    ``tests/engine/test_lanes.py`` bit for bit (samples, impacts by transition, Lyapunov exponent,

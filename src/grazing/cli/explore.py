@@ -35,13 +35,6 @@ def explore_view(
     from grazing.explore import ModelSource, View
 
     refuse_unused(["params"], param is not None, "with --param (give one of them)")
-    if model.has_modes:  # (the diagram is a sweep: a model with modes it does not run, before the ranges)
-        from grazing.sweeps.spec import refuse_on_modes
-
-        try:
-            refuse_on_modes(model)
-        except grazing.GrazingError as exc:
-            raise InputError(f"--model: explore draws a sweep, and {exc}") from None
     if param is None and params is None:
         if model.name != "pendulum" or model_spec != "pendulum" or ranges:
             raise InputError(

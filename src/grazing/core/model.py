@@ -513,6 +513,11 @@ def _modes_system(
             raise ValueError(f"the reset of transition {name!r} needs one expression per state")
         if cd is not None and len(cd) != n:
             raise ValueError(f"the contact_direction of transition {name!r} needs one expression per state")
+        if cd is not None and (reset is None or target != source):
+            raise ValueError(
+                f"the contact_direction of transition {name!r} is for sticking to a stop: it needs a reset "
+                f"back to its own mode (a stop of mode {source!r}), not a switch to {target!r}"
+            )
         stops.append(Stop(
             name, sign * expr(guard), tuple(states) if reset is None else tuple(expr(e) for e in reset),
             None if cd is None else tuple(expr(e) for e in cd),

@@ -275,14 +275,24 @@ def generate_source(system: SymbolicSystem, directions: int = 0, order: int = DE
             pad = [sp.Integer(1)] * (width - len(rows[k]))
             kernels += flow_kernels(f"_m{k}", fields[k], row_exprs[k] + pad)
         f = sys_.vector_field
-        sticky = []  # (sticking in a model with modes: not yet)
-    # Sticking on stop j: the event rows are the contact force (row j) and the other stops' guards.
+        sticky = [  # a mode's own impact stop (a reset back to its mode) with a contact direction
+            j
+            for j, stop in enumerate(sys_.stops)
+            if stop.contact_direction is not None and sys_.resets[j] and sys_.targets[j] == sys_.sources[j]
+        ]
+    # Sticking on stop j: the event rows are those of its mode (every stop's guard, for one mode), the
+    # contact force in stop j's row (sticking_field and the force are those of j's source mode: at_stop).
     for j in sticky:
         on = sys_.at_stop(j)
-        rows = [on.normal_accel if i == j else g for i, g in enumerate(guards)]
+        if nmodes == 1:
+            stick_rows = [on.normal_accel if i == j else g for i, g in enumerate(guards)]
+        else:
+            mode_rows = rows[sys_.sources[j]]
+            stick_rows = [on.normal_accel if i == j else guards[i] for i in mode_rows]
+            stick_rows += [sp.Integer(1)] * (width - len(mode_rows))
         kernels.append(
             taylor_kernel(
-                f"tc_stick_s{j}", sys_.states, sys_.time, sys_.params, on.sticking_field(), rows, order
+                f"tc_stick_s{j}", sys_.states, sys_.time, sys_.params, on.sticking_field(), stick_rows, order
             )
         )
     if not sticky:
@@ -309,7 +319,10 @@ def generate_source(system: SymbolicSystem, directions: int = 0, order: int = DE
             "normal_rate_grad", "contact_dir",
         )
     }  # fmt: skip
-    dispatch["tc_stick"] = [f"tc_stick_s{j}" for j in (sticky or [0])]
+    # (by the stop's index: the switch's cases are the list's positions, its default the last entry)
+    dispatch["tc_stick"] = (
+        [f"tc_stick_s{j if j in sticky else sticky[0]}" for j in every] if sticky else ["tc_stick_s0"]
+    )
     if nmodes > 1:  # the flow's functions by the active mode (the driver's last argument)
         for name in ("tc_free", "tc_var", "rhs"):
             dispatch[name] = [f"{name}_m{k}" for k in range(nmodes)]

@@ -295,12 +295,6 @@ def _refuse_on_modes(
         model.require_one_mode("the smallest guard value (guard_min)")
     if not events:
         model.require_one_mode("a run without events (events=False)")
-    system = model.symbolic
-    for j, name in enumerate(model.stop_names):
-        if system.stops[j].contact_direction is not None:
-            raise InvalidParameterError(
-                f"sticking (the contact_direction of {name!r}) in a model with modes is not supported yet"
-            )
 
 
 def _sample_time_terms(

@@ -148,8 +148,7 @@ class View:
     ------
     InvalidParameterError
         An unknown or repeated parameter, an empty range, a range end outside the
-        parameter's interval, fewer than 2 points; a model with modes that a sweep
-        does not run (sticking to a stop, :func:`grazing.sweeps.spec.refuse_on_modes`).
+        parameter's interval, fewer than 2 points.
 
     Examples
     --------
@@ -173,10 +172,6 @@ class View:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "axes", tuple(self.axes))
-        if self.model.has_modes:  # (the diagram is a sweep: what a sweep refuses, at once)
-            from grazing.sweeps.spec import refuse_on_modes
-
-            refuse_on_modes(self.model)
         if len(self.axes) not in (1, 2):
             raise InvalidParameterError(f"a view has one or two parameters, got {len(self.axes)}")
         names = [a.name for a in self.axes]

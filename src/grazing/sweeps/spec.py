@@ -134,8 +134,6 @@ class SweepSpec:
     polish: bool = True
 
     def __post_init__(self) -> None:
-        if self.model.has_modes:
-            refuse_on_modes(self.model)
         if not self.points:
             raise InvalidParameterError("a sweep needs at least one point")
         if self.segments < 1 or len(self.points) % self.segments:
@@ -295,16 +293,6 @@ def spec_summary(spec: SweepSpec) -> dict[str, Any]:
     d = spec.description()
     d["fingerprint"] = spec.fingerprint()
     return d
-
-
-def refuse_on_modes(model: HybridModel) -> None:
-    """One line for what a sweep (lanes) cannot do yet on a model with modes: sticking."""
-    system = model.symbolic
-    for j, name in enumerate(model.stop_names):
-        if system.stops[j].contact_direction is not None:
-            raise InvalidParameterError(
-                f"a sweep does not support sticking (the contact_direction of {name!r}) in a model with modes"
-            )
 
 
 def _checked_start(first: HybridModel, x0: Sequence[float] | None, tol: float) -> tuple[float, ...]:

@@ -114,3 +114,15 @@ def first_event(m, run, O, h, events, skip, end_contact, end_stop, a, work):
             u = ur
             stop = r
     return u, stop
+
+
+@njit(cache=True, inline="always")
+def contact_row(m, vf, j):
+    """The event row of stop ``j`` in mode ``vf``'s kernels: the contact force's while sticking to it.
+
+    For a model of one mode, ``j`` itself (every stop's guard is a row).
+    """
+    for row in range(m.rows.shape[1]):
+        if m.rows[vf, row] == j:
+            return row
+    return 0

@@ -165,23 +165,17 @@ def apply_impact(m, r, x, xp, pv, j, nrows, V, record, tables):
 def at_event(m, r, x, xp, pv, j, nrows, V, chatter_time, record, tables):
     """The event that ends the step of run ``r``, on stop ``j``; returns True for an impact.
 
-    Sticking to stop ``j``, its contact force changes sign: the release.
-    Otherwise an impact (:func:`apply_impact`; a contact with another stop
-    ends), and on a stop with a sticking mode a chattering sequence shorter
-    than ``chatter_time`` is summed to its accumulation point and continued as
+    Sticking to stop ``j``, its contact force changes sign: the release;
+    sticking to another, the contact ends first.  Then a switch of mode
+    (sliding's entry and exit among them), or an impact (:func:`apply_impact`),
+    and on a stop with a sticking mode a chattering sequence shorter than
+    ``chatter_time`` is summed to its accumulation point and continued as
     sticking.  The sticking intervals of the recorded span go into
     ``tables[1]`` (``r.n_stick``).
     """
     t = r.k * r.T + r.s
     if j >= m.nstops:  # sliding ends at a tangency: to that side (f_s = f there, S = I)
         leave_sliding(m, r, x, j, record, tables)
-        return False
-    entry = m.slide_entry[j]
-    if entry >= 0 and r.surface == 0 and normal_rate(m, x, r.s, pv, m.back[j]) < 0.0:
-        enter_sliding(m, r, x, pv, j, V, record, tables)  # (the far side's field pushes back)
-        return False
-    if not m.resets[j]:  # a switch of vector field: the state goes on, the field changes
-        switch_mode(m, r, x, pv, j, V, record, tables)
         return False
     if r.mode == 1 and j == r.stuck:  # release from sticking: the contact force changes sign
         r.mode = 0
@@ -190,10 +184,19 @@ def at_event(m, r, x, xp, pv, j, nrows, V, chatter_time, record, tables):
         if r.recording:
             close_sticking(tables[1], r.n_stick, t)
         return False
-    if r.mode == 1:  # sticking to one stop, it hits another: the contact ends
+    if r.mode == 1:  # sticking to one stop, another transition fires (an impact, a switch): the contact ends
         r.mode = 0
         if r.recording:
             close_sticking(tables[1], r.n_stick, t)
+        if not m.resets[j]:  # (a switch: from the contact, off which the step drifted by rounding)
+            enter_contact(m, x, r.s, pv, r.stuck)
+    entry = m.slide_entry[j]
+    if entry >= 0 and r.surface == 0 and normal_rate(m, x, r.s, pv, m.back[j]) < 0.0:
+        enter_sliding(m, r, x, pv, j, V, record, tables)  # (the far side's field pushes back)
+        return False
+    if not m.resets[j]:  # a switch of vector field: the state goes on, the field changes
+        switch_mode(m, r, x, pv, j, V, record, tables)
+        return False
     # Impact: x holds the state on stop j, just before its reset.
     speed, jac_ok = apply_impact(m, r, x, xp, pv, j, nrows, V, record, tables)
     r.jac_valid = r.jac_valid and jac_ok  # (an impact at zero normal speed has no Jacobian)

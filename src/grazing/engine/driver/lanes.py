@@ -43,7 +43,7 @@ from grazing.engine import timebase
 from grazing.engine.abi import TC_FREE_LANES, TC_VAR_LANES, call_model
 from grazing.engine.driver.atomics import fetch_add, load_acquire, store_release
 from grazing.engine.driver.calls import tc_free, tc_stick, tc_var
-from grazing.engine.driver.events import first_event
+from grazing.engine.driver.events import contact_row, first_event
 from grazing.engine.driver.impacts import sliding_guard
 from grazing.engine.driver.recording import take_samples
 from grazing.engine.driver.state import STATUS_NONFINITE, STATUS_OK, STATUS_STEP_LIMIT, new_state
@@ -595,7 +595,7 @@ def plan_steps(m, cfg, la, zdms, norms, coeffs, factor, plan):
                 xl[i] = XS[i, lane]
             tc_stick(m, xl, s, pl[lane], Xs, Os, stuck)
             to_lane(Xs, Os, n, nev, K, XT, OT, lane)
-            h = step_size(Xs, n, Os, nev, stuck, math.inf, order, T, factor)
+            h = step_size(Xs, n, Os, nev, contact_row(m, ls[lane].vf, stuck), math.inf, order, T, factor)
         else:
             h = hfree[lane]
         h, ends = step_end(ls[lane], h, cfg.zdm, zdms[p])

@@ -35,7 +35,7 @@ from numba import njit
 
 from grazing.engine.driver.atomics import load_acquire
 from grazing.engine.driver.calls import tc_free, tc_stick, tc_var
-from grazing.engine.driver.events import first_event
+from grazing.engine.driver.events import contact_row, first_event
 from grazing.engine.driver.impacts import close_sticking, sliding_guard
 from grazing.engine.driver.recording import (
     finish_guard,
@@ -173,7 +173,7 @@ def integrate(start, pv, cfg, m, out):
             h = step_size(X, ntot, O, nevents, 0, GUARD_SCALE, order, max_step, factor)
         else:
             tc_stick(m, x, r.s, pv, X, O, r.stuck)  # the first n rows only
-            h = step_size(X, n, O, nstops, r.stuck, math.inf, order, max_step, factor)
+            h = step_size(X, n, O, nevents, contact_row(m, r.vf, r.stuck), math.inf, order, max_step, factor)
         h, ends = step_end(r, h, zdm_on, sz)  # (at the last sample, at the map's phase)
         is_last = (ends & STEP_LAST) != 0
 
