@@ -408,6 +408,7 @@ class Explorer:
         def done(c: Continued) -> None:
             if self.point is not point:
                 return  # another point was clicked meanwhile
+            self.continued, self.curves = c, None  # (before the text that says it is done)
             frame = self.figures.show_branch(c, self._row(point))
             lines = list(c.lines)
             if frame is not None:
@@ -419,7 +420,6 @@ class Explorer:
                 self.refine(*frame)  # (computed again there, as a zoom there would)
             self.actions_text.object = "\n\n".join(lines)
             self.curves_button.disabled = False
-            self.continued, self.curves = c, None
             if self.code_python.visible:
                 self.show_code()
 
@@ -437,12 +437,13 @@ class Explorer:
             return follow_click_curves(self.view, point, continued, cancelled=cancelled)
 
         def done(found: Curves) -> None:
+            current = self.point is point and self.continued is continued  # (else superseded meanwhile)
+            if current:
+                self.curves = found  # (before the text that says it is done)
             self.figures.show_curves(found)
             self.curves_text.object = "\n\n".join(found.lines)
-            if self.point is point and self.continued is continued:  # (else superseded meanwhile)
-                self.curves = found
-                if self.code_python.visible:
-                    self.show_code()
+            if current and self.code_python.visible:
+                self.show_code()
 
         self.jobs.submit("curves", work, done, lambda e: setattr(self.curves_text, "object", message_of(e)))
 
@@ -455,12 +456,13 @@ class Explorer:
         self.basins_text.object = "finding the attractors and their basins ..."
 
         def done(found: BasinView) -> None:
+            current = self.point is point  # (else another point was clicked meanwhile)
+            if current:
+                self.basins = found  # (before the text that says it is done)
             self.figures.show_basins(found)
             self.basins_text.object = "\n\n".join(found.lines)
-            if self.point is point:  # (else another point was clicked meanwhile)
-                self.basins = found
-                if self.code_python.visible:
-                    self.show_code()
+            if current and self.code_python.visible:
+                self.show_code()
 
         self.jobs.submit(
             "basins",
