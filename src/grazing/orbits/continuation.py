@@ -705,8 +705,8 @@ class _Continuation:
     def _layout(self, orbit: PeriodicOrbit) -> SegmentLayout | None:
         """The segments of ``orbit`` for multiple shooting, or None where it does not apply (a virtual
         branch, an orbit without impacts, a model without a forcing period)."""
-        if self.virtual or not orbit.impacts or not self.model.periodic or self.model.has_modes:
-            return None  # (multiple shooting does not go through modes yet)
+        if self.virtual or not orbit.impacts or not self.model.periodic:
+            return None
         return layout_of(orbit)
 
     @staticmethod

@@ -205,7 +205,6 @@ class _Follower:
         not virtual, the model has a forcing period)?"""
         return (
             self.kind != "grazing" and not self.virtual and orbit.impacts > 0 and self.model.periodic
-            and not self.model.has_modes  # (multiple shooting does not go through modes yet)
         )  # fmt: skip
 
     def system(
