@@ -189,3 +189,16 @@ def test_the_stick_slip_orbit_on_a_segment_that_slides():
     u[:2] += 1e-4
     assert_jacobian_is_the_differences(evaluate, u)
     assert math.isnan(ms.guard_min) and ms.impacts == 0
+
+
+def test_a_segment_through_the_wall_is_told():
+    """The orbit's run without its impact (one segment, no reset) passes through the wall: the physical
+    run of that segment hits it, and the orbit says so; with its impact it passes through nothing."""
+    m = soft_hard()
+    orbit = find_orbit(m, t0=None)
+    through = segmented_equations(m, None, 1, orbit.t0, SegmentLayout(2, (), orbit.mode), 0)
+    _, _, passing = through(np.append(orbit.state, 0.0))
+    assert passing.passed_stops == ("wall",) and passing.crossed_stops == ("wall",)
+    layout = layout_of(orbit)
+    _, _, same = segmented_equations(m, None, 1, orbit.t0, layout, 0)(layout.pack(orbit, 0.0))
+    assert same.crossed_stops == ()

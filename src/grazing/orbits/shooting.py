@@ -332,7 +332,7 @@ def find_orbit(
     try:
         return newton.solve(x, virtual, advice, guess, note)
     except ConvergenceError:
-        nonimpacting = not (virtual or not through_stops or model.has_modes)  # (no virtual runs with modes)
+        nonimpacting = not (virtual or not through_stops or model.has_modes)  # (no guard minima with modes)
         inside = newton.nonimpacting(x) if nonimpacting else None
         if inside is None:
             raise
