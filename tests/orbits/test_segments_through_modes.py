@@ -31,7 +31,7 @@ from scipy.optimize import fsolve
 
 import grazing
 from grazing.models import friction_oscillator
-from grazing.orbits import find_orbit
+from grazing.orbits import continue_orbit, find_orbit
 from grazing.orbits.segments import SegmentLayout, layout_of, segmented_equations, segmented_newton
 from tests.engine.test_events_off_modes import reference, soft_hard
 from tests.engine.test_rocking_modes import reference as rocking_reference
@@ -202,3 +202,42 @@ def test_a_segment_through_the_wall_is_told():
     layout = layout_of(orbit)
     _, _, same = segmented_equations(m, None, 1, orbit.t0, layout, 0)(layout.pack(orbit, 0.0))
     assert same.crossed_stops == ()
+
+
+def exact_wall_grazing(p: dict, guess) -> np.ndarray:
+    """``(x, v, t_touch, t_wall, t_leave, omega)`` where soft_hard's orbit meets the wall at zero speed."""
+
+    def equations(u):
+        q = {**p, "omega": u[5]}
+        ref = reference(q)
+        x0, t1, t2, t3 = u[:2], u[2], u[3], u[4]
+        y1 = ref.flow(0, x0, 0.0, t1)
+        y2 = ref.flow(1, y1, t1, t2)
+        y3 = ref.flow(1, np.diag([1.0, -q["r"]]) @ y2, t2, t3)
+        y4 = ref.flow(0, y3, t3, ref.period)
+        return [y1[0] - q["gap"], y2[0] - q["wall"], y2[1], y3[0] - q["gap"], *(y4 - x0)]
+
+    u, _, _, msg = fsolve(equations, guess, xtol=1e-15, full_output=True)
+    assert np.abs(equations(u)).max() < 1e-13, msg
+    return u
+
+
+def test_continuation_hands_over_to_multiple_shooting_and_ends_at_the_exact_grazing_of_the_wall():
+    """Down the unstable branch towards the wall's grazing the multiplier grows past 1e5: single shooting
+    stalls, multiple shooting takes over (as on a model of one mode) and the branch ends where the wall
+    impact's speed vanishes, at the exact grazing frequency."""
+    start = 1.5926184272441661
+    m = soft_hard(omega=start)
+    u, _ = exact_wall_orbit(dict(m.params), GUESS)
+    orbit = find_orbit(m, u[:2], period=1, mode="free")
+    assert orbit.impacts == 1 and np.abs(orbit.state - u[:2]).max() < 1e-10
+    branch = continue_orbit(m, "omega", start, 1.59, orbit=orbit)
+    assert "by multiple shooting from omega = " in branch.status, branch.status
+    [graze] = branch.special
+    exact = exact_wall_grazing(dict(m.params), [*GUESS, start])
+    assert graze.kind == "grazing" and abs(graze.param - exact[5]) < 1e-9, (graze.param, exact[5])
+    for o in branch.orbits[1:]:
+        q = o.model.params["omega"]
+        if q > exact[5] + 1e-7:  # (the exact boundary-value problem is well posed off the grazing)
+            ux, _ = exact_wall_orbit(dict(o.model.params), [*o.state, *u[2:]])
+            assert np.abs(o.state - ux[:2]).max() < 1e-10, (q, o.state - ux[:2])

@@ -809,7 +809,8 @@ class _Continuation:
                 evaluate, PalcPoint(u0, F, DF, orb), index=ip, sign=sign, bounds={ip: self.bounds[nx]},
                 settings=dataclasses.replace(s, max_points=max(2, s.max_points - len(branch) + 1)),
                 names={ip: self.param}, shows={ip: self.par.show}, check=self.check,
-                margin=None if self.virtual or self.model.has_modes else self.margin, direction=direction,
+                margin=None if self.virtual or not any(self.model.transition_resets) else self.margin,
+                direction=direction,
             )  # fmt: skip
             direction = None
             restarted = prev is not None and across is None  # the section moved: the same orbit
