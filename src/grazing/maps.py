@@ -102,7 +102,8 @@ def flow_map(
     On a model with modes the map goes from ``x`` in ``mode`` to the image in
     the mode the flow is in then (:attr:`FlowMap.mode_final`), its Jacobian
     carried across the switches by their saltation matrices; the guard
-    minimum is not computed there (nor ``virtual`` or ``touching`` runs).
+    minimum is not computed there, and a ``virtual`` map ignores only the
+    transitions with a reset (it still switches and slides).
 
     Parameters
     ----------

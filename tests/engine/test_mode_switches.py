@@ -109,7 +109,6 @@ def test_start_in_another_mode_and_one_line_refusals():
         grazing.simulate(m, [0.0, 0.0], periods=1, mode="stuck")
     refused = {
         "(guard_min)": dict(guard_min=True),
-        "events=False": dict(events=False),
     }
     for what, kw in refused.items():
         with pytest.raises(InvalidParameterError, match="does not support models with modes yet") as info:

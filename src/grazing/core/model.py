@@ -248,6 +248,7 @@ class _Definition:
         self.time_label = time_label
         self.mode_names: tuple[str, ...] = ("free",)
         self.transition_modes: tuple[tuple[str, str], ...] | None = None
+        self.transition_resets: tuple[bool, ...] | None = None  # (a model with modes: per transition)
         self.sliding_switches: tuple[tuple[str, str, str], ...] = ()
         self.surface_names: tuple[str, ...] = ()
         self.sliding_surfaces: tuple[int, ...] = ()  # the surfaces with sliding=True (indices)
@@ -259,6 +260,7 @@ class _Definition:
             layout = _transition_layout(symbolic)
             stop_names = [item[0] for item in layout]
             self.transition_modes = tuple((item[1], item[2]) for item in layout)
+            self.transition_resets = tuple(item[4] is not None for item in layout)
             self.surface_names = tuple(sf[0] for sf in symbolic["surfaces"])
             self.sliding_surfaces = tuple(i for i, sf in enumerate(symbolic["surfaces"]) if sf[4])
             pseudo, self.sliding_switches = _sliding_layout(symbolic)
@@ -1181,6 +1183,20 @@ class HybridModel:
         modes = self._def.transition_modes
         return tuple(tgt for _, tgt in modes) if modes is not None else self.mode_names * self.n_stops
 
+    @property
+    def transition_resets(self) -> tuple[bool, ...]:
+        """Whether each transition (each of :attr:`stop_names`) resets the state (an impact); a switch of
+        vector field does not.  A model without modes: every stop resets.
+
+        Examples
+        --------
+        >>> import grazing
+        >>> grazing.models.soft_impact_oscillator().transition_resets
+        (False, False)
+        """
+        resets = self._def.transition_resets
+        return resets if resets is not None else (True,) * self.n_stops
+
     def mode_index(self, mode: str | None) -> int:
         """The index of a mode given by name (None: the initial mode).
 
@@ -1395,14 +1411,15 @@ class HybridModel:
         }
 
     def check_state(
-        self, x: Any, t: float = 0.0, allowed: bool = True, mode: str | None = None
+        self, x: Any, t: float = 0.0, allowed: bool = True, mode: str | None = None, *, resets: bool = True
     ) -> np.ndarray:
         """Return ``x`` as a float array, or raise if it is not a valid state.
 
         With ``allowed`` (the default) the state must also satisfy the guard (to
         :data:`ON_STOP_TOL`: a state on the stop to rounding is allowed); in a
         model with modes, the guards of the transitions that leave ``mode``
-        (the initial mode by default).
+        (the initial mode by default), those with a reset only if ``resets``
+        (a run without events passes through them, not through the others).
         """
         arr = np.asarray(x, dtype=float).reshape(-1)
         if arr.shape != (self.n_states,):
@@ -1416,6 +1433,8 @@ class HybridModel:
         k = self.mode_index(mode)
         for j, name in enumerate(self.stop_names):
             if self.has_modes and self.transition_source[j] != self.mode_names[k]:
+                continue
+            if not (resets or not self.transition_resets[j]):
                 continue
             hv = self.guard(arr, t, j)
             if hv < -ON_STOP_TOL * max(1.0, float(np.max(np.abs(arr)))):

@@ -84,6 +84,8 @@ def simulate(
     events
         If False, the guard is ignored: the flow passes through the stop (no
         impacts).  ``guard_min`` then tells how far past the stop it reaches.
+        On a model with modes only the transitions with a reset are ignored:
+        the run still switches its vector field and slides.
     zdm
         A :class:`~grazing.engine.runner.DiscontinuityMap`: ignore the stop and
         apply Nordmark's discontinuity map once per period at the grazing
@@ -138,7 +140,6 @@ def simulate(
     if model.has_modes:
         _refuse_on_modes(
             model,
-            events=events,
             zdm=zdm,
             touching=touching,
             guard_min=guard_min,
@@ -147,8 +148,9 @@ def simulate(
         )
     elif mode is not None:
         model.mode_index(mode)  # (only the one mode's name)
-    allowed = events and zdm is None  # (with the map, the state may be past the grazing stop)
-    x = model.check_state(np.zeros(model.n_states) if x0 is None else x0, t0, allowed=allowed, mode=mode)
+    allowed = (events or model.has_modes) and zdm is None  # (with the map, it may be past the grazing stop)
+    x0 = np.zeros(model.n_states) if x0 is None else x0
+    x = model.check_state(x0, t0, allowed=allowed, mode=mode, resets=events)
     start_mode = model.mode_index(mode)
     stop_index = model.stop_index(stop_name)
     use_var = tangent.variational
@@ -274,7 +276,6 @@ def simulate(
 def _refuse_on_modes(
     model: HybridModel,
     *,
-    events: bool,
     zdm: DiscontinuityMap | None,
     touching: bool,
     guard_min: bool,
@@ -293,8 +294,6 @@ def _refuse_on_modes(
             )
     if guard_min:
         model.require_one_mode("the smallest guard value (guard_min)")
-    if not events:
-        model.require_one_mode("a run without events (events=False)")
 
 
 def _sample_time_terms(

@@ -705,8 +705,8 @@ class _Continuation:
     def _layout(self, orbit: PeriodicOrbit) -> SegmentLayout | None:
         """The segments of ``orbit`` for multiple shooting, or None where it does not apply (a virtual
         branch, an orbit without impacts, a model without a forcing period)."""
-        if self.virtual or not orbit.impacts or not self.model.periodic or self.model.has_modes:
-            return None  # (multiple shooting does not go through modes yet)
+        if self.virtual or not orbit.impacts or not self.model.periodic:
+            return None
         return layout_of(orbit)
 
     @staticmethod
@@ -809,7 +809,8 @@ class _Continuation:
                 evaluate, PalcPoint(u0, F, DF, orb), index=ip, sign=sign, bounds={ip: self.bounds[nx]},
                 settings=dataclasses.replace(s, max_points=max(2, s.max_points - len(branch) + 1)),
                 names={ip: self.param}, shows={ip: self.par.show}, check=self.check,
-                margin=None if self.virtual or self.model.has_modes else self.margin, direction=direction,
+                margin=None if self.virtual or not any(self.model.transition_resets) else self.margin,
+                direction=direction,
             )  # fmt: skip
             direction = None
             restarted = prev is not None and across is None  # the section moved: the same orbit

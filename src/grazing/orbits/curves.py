@@ -200,12 +200,16 @@ class _Follower:
         """Index of ``p1`` in the unknowns of the system in hand (``p2`` follows it)."""
         return self._offset
 
+    @property
+    def no_impacts(self) -> bool:
+        """The model has no transition with a reset (only switches of mode): no impact's grazing margin."""
+        return not any(self.model.transition_resets)
+
     def can_segment(self, orbit: PeriodicOrbit) -> bool:
         """Can the curve through ``orbit`` be followed on the segmented equations (it has impacts, it is
         not virtual, the model has a forcing period)?"""
         return (
             self.kind != "grazing" and not self.virtual and orbit.impacts > 0 and self.model.periodic
-            and not self.model.has_modes  # (multiple shooting does not go through modes yet)
         )  # fmt: skip
 
     def system(
@@ -361,7 +365,7 @@ class _Follower:
                 system, first, index=index, sign=sign, bounds=bounds,
                 settings=dataclasses.replace(self.s, max_points=max(2, self.s.max_points - len(d.points))),
                 names=names, shows=shows, check=self.check,
-                margin=self.margin if self.kind == "grazing" or not (self.virtual or self.model.has_modes)
+                margin=self.margin if self.kind == "grazing" or not (self.virtual or self.no_impacts)
                 else None,
             )  # fmt: skip
             ended = False

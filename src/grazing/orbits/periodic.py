@@ -175,6 +175,10 @@ class PeriodicOrbit:
         ``[t0, t0 + n T)``, their times and transitions (indices into the model's
         ``stop_names``; a reset that changes the mode is both an impact and a
         switch); see :attr:`switch_signature`.
+    passed_stops
+        A segmented orbit on a model with modes (multiple shooting, which keeps no guard minima
+        there): the transitions with a reset its segments pass through between its impacts, found
+        by running them with the resets watched (see :attr:`crossed_stops`).
 
     Examples
     --------
@@ -214,6 +218,7 @@ class PeriodicOrbit:
     mode: str | None = None
     switch_times: np.ndarray = field(default_factory=lambda: np.empty(0))
     switch_transitions: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+    passed_stops: tuple[str, ...] = ()
 
     @property
     def guard_mins(self) -> np.ndarray:
@@ -222,8 +227,10 @@ class PeriodicOrbit:
 
     @property
     def crossed_stops(self) -> tuple[str, ...]:
-        """The stops a virtual orbit passes through (where any are, it is not a physical motion)."""
-        return tuple(name for name, g in zip(self.model.stop_names, self.guard_mins) if g < -CROSSING_TOL)
+        """The stops a virtual orbit passes through (where any are, it is not a physical motion): those
+        whose guard minimum is below ``-CROSSING_TOL``, and :attr:`passed_stops`."""
+        below = [name for name, g in zip(self.model.stop_names, self.guard_mins) if g < -CROSSING_TOL]
+        return tuple(dict.fromkeys([*below, *self.passed_stops]))
 
     @property
     def signature(self) -> tuple[int, ...]:

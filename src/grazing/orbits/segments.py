@@ -30,6 +30,17 @@ from its guard minimum, so a branch can tell where its impact sequence ends.
 The orbit's monodromy is the product of the segments' ``Phi`` and the saltation
 matrices (its multipliers are the same as single shooting's); the payload of
 each point is a :class:`~grazing.orbits.shooting.PeriodicOrbit`.
+
+On a model with modes the impacts are its transitions with a reset (a same-mode
+impact or one that changes the mode, as the rocking block's); each segment
+starts in a mode (the section's, then each impact's target mode) and is run
+without events (``events=False``), which ignores the resets only: within a
+segment the motion switches its vector field and slides as it does in a
+simulation, and the segment's ``Phi`` carries those switches' saltation matrices
+(the engine's).  A segment must end in the source mode of the impact that ends
+it, and the last in the section's mode.  Whether a segment passes through a
+reset's guard is told by the same run with the resets watched (the engine keeps
+no guard minima through modes).
 """
 
 from __future__ import annotations
@@ -44,7 +55,7 @@ from grazing.core.model import HybridModel
 from grazing.core.solution import Solution
 from grazing.engine.simulate import simulate
 from grazing.engine.timebase import SNAP, start_times
-from grazing.errors import ConvergenceError
+from grazing.errors import ConvergenceError, InvalidStateError, SimulationError
 from grazing.orbits.periodic import PeriodicOrbit, sorted_multipliers
 
 GRAZING_SPEED_RATIO = 1e-3
@@ -81,14 +92,33 @@ class SegmentFlow:
     solution: Solution
 
 
+def _segment_span(model: HybridModel, ta: float, tb: float) -> tuple[int, float]:
+    """The periods and the sampling phase of a run from ``ta`` whose last sample is at ``tb``."""
+    T = model.period
+    s_phase = tb % T
+    if s_phase >= T * (1.0 - 1e-12):
+        s_phase = 0.0
+    kb = round((tb - s_phase) / T)
+    _, _, ks, _ = start_times(ta, T, s_phase, True)  # (the engine's first sample, as it finds it)
+    periods = kb - ks + 1
+    if periods < 1 or tb - ta < SNAP * T:
+        raise ConvergenceError(f"a segment of the orbit has no length (from t = {ta:.12g} to {tb:.12g})")
+    return periods, 2 * math.pi * s_phase / T
+
+
 def segment_flow(
-    model: HybridModel, x: np.ndarray, ta: float, tb: float, param: str | tuple[str, ...] | None
-) -> SegmentFlow:
+    model: HybridModel, x: np.ndarray, ta: float, tb: float, param: str | tuple[str, ...] | None,
+    mode: str | None = None,
+) -> SegmentFlow:  # fmt: skip
     """Free flight (the stops ignored) from state ``x`` at time ``ta`` to time ``tb > ta``.
 
     ``param``: the parameter (or a tuple of them) whose sensitivities are computed (None: none).
     The engine samples at a forcing phase: the run's last sample is the phase of
-    ``tb`` after as many periods as it takes to reach it.
+    ``tb`` after as many periods as it takes to reach it.  On a model with modes
+    the segment starts in ``mode`` (the initial mode by default) and ignores the
+    transitions with a reset only: it switches and slides on the way (its
+    solution's ``mode_final`` and ``switches``), its Jacobian through the
+    switches' saltation matrices.
 
     Examples
     --------
@@ -102,18 +132,12 @@ def segment_flow(
     (True, (2, 2), (2,))
     """
     T = model.period
-    s_phase = tb % T
-    if s_phase >= T * (1.0 - 1e-12):
-        s_phase = 0.0
-    kb = round((tb - s_phase) / T)
-    _, _, ks, _ = start_times(ta, T, s_phase, True)  # (the engine's first sample, as it finds it)
-    periods = kb - ks + 1
-    if periods < 1 or tb - ta < SNAP * T:
-        raise ConvergenceError(f"a segment of the orbit has no length (from t = {ta:.12g} to {tb:.12g})")
+    periods, phase = _segment_span(model, ta, tb)
     names = () if param is None else (param,) if isinstance(param, str) else tuple(param)
     sol = simulate(
-        model, x, t0=ta, periods=periods, phase=2 * math.pi * s_phase / T, jacobian=True,
-        sensitivities=names, guard_min=True, events=False, impacts="none",
+        model, x, t0=ta, periods=periods, phase=phase, jacobian=True, sensitivities=names,
+        guard_min=not model.has_modes, events=False, impacts="all" if model.has_modes else "none",
+        mode=mode,
     )  # fmt: skip
     n = model.n_states
     end = sol.x_final
@@ -124,7 +148,7 @@ def segment_flow(
         sens = sol.jacobian[:, n + i]
         tp = sol.info["period_gradient"][name]
         if tp:  # (the engine's end (kb + s_phase/T) T(p) moves with T; the segment's end tb does not)
-            sens = sens - model.vector_field(end, sol.t_final) * (sol.t_final / T) * tp
+            sens = sens - model.vector_field(end, sol.t_final, sol.mode_final) * (sol.t_final / T) * tp
         columns.append(sens)
     sensitivity = columns[0] if isinstance(param, str) else np.stack(columns, axis=1)
     return SegmentFlow(end, sol.jacobian[:, :n], sensitivity, sol)
@@ -140,10 +164,20 @@ class SegmentLayout:
         States of the model (``N``).
     stops
         The stop of each impact, in order over one period from the section.
+    mode
+        A model with modes: the mode on the section, which the first segment starts in (each other
+        starts in its impact's target mode, :meth:`start_mode`); None without modes.
     """
 
     n_states: int
     stops: tuple[int, ...]
+    mode: str | None = None
+
+    def start_mode(self, model: HybridModel, i: int) -> str | None:
+        """The mode segment ``i`` starts in: the section's (``i = 0``), else impact ``i``'s target mode."""
+        if self.mode is None or i == 0:
+            return self.mode
+        return model.transition_target[self.stops[i - 1]]
 
     @property
     def impacts(self) -> int:
@@ -180,7 +214,7 @@ class SegmentLayout:
 
 def layout_of(orbit: PeriodicOrbit) -> SegmentLayout:
     """The segment layout of an orbit's impacts."""
-    return SegmentLayout(orbit.model.n_states, tuple(int(j) for j in orbit.impact_stops))
+    return SegmentLayout(orbit.model.n_states, tuple(int(j) for j in orbit.impact_stops), orbit.mode)
 
 
 def segmented_equations(
@@ -195,8 +229,10 @@ def segmented_equations(
     ``param`` None the parameters are fixed: the last entry of ``u`` is ignored and the last
     column of ``DF`` is zero (:func:`segmented_newton`).  With a tuple of parameters (a curve
     in two parameters, :mod:`grazing.orbits.segmented_curves`) they are the last entries of
-    ``u``, in order, and ``DF`` has a column for each.
-    Models with modes are refused in one line (multiple shooting does not go through modes yet).
+    ``u``, in order, and ``DF`` has a column for each.  On a model with modes each segment
+    starts in :meth:`SegmentLayout.start_mode` and follows the switches and sliding of the
+    vector fields (:func:`segment_flow`); a segment that ends in another mode than its impact
+    leaves (or the last in another than the section's) is a :class:`ConvergenceError`.
 
     Examples
     --------
@@ -209,8 +245,8 @@ def segmented_equations(
     >>> bool(abs(F).max() < 1e-10), DF.shape, bool(np.allclose(orbit.multipliers, o.multipliers))
     (True, (8, 9), True)
     """
-    model.require_one_mode("multiple shooting")
     n, k = layout.n_states, layout.impacts
+    modes = model.has_modes
     names = () if param is None else (param,) if isinstance(param, str) else tuple(param)
     order = [p.name for p in model.parameters]
     pidx = [order.index(name) for name in names]
@@ -235,13 +271,18 @@ def segmented_equations(
         for i in range(k + 1):
             s_i = layout.state(u, i)
             ta, tb = times[i], times[i + 1]
-            seg = segment_flow(m, s_i, ta, tb, names)
+            start_mode = layout.start_mode(m, i)
+            seg = segment_flow(m, s_i, ta, tb, names, start_mode)
             runs.append(seg.solution)
             y = seg.end
+            end_mode = seg.solution.mode_final
+            if modes:
+                _check_segment_modes(m, layout, i, end_mode)
             si, col_t_end = layout.state_index(i), (layout.time_index(i + 1) if i < k else None)
-            # d y = Phi d s_i - Phi f(s_i, ta) d ta + f(y, tb) d tb + S d p
-            f_start = m.vector_field(s_i, ta)
-            f_end = m.vector_field(y, tb)
+            # d y = Phi d s_i - Phi f(s_i, ta) d ta + f(y, tb) d tb + S d p (the fields of the modes the
+            # segment starts and ends in: Phi carries any switch between them, a sliding entry at ta too)
+            f_start = m.vector_field(s_i, ta, start_mode)
+            f_end = m.vector_field(y, tb, end_mode)
             dy = np.zeros((n, size + extra))
             dy[:, si : si + n] = seg.jacobian
             if i > 0:
@@ -287,6 +328,23 @@ def segmented_equations(
     return evaluate
 
 
+def _check_segment_modes(m: HybridModel, layout: SegmentLayout, i: int, end_mode: str | None) -> None:
+    """Raise :class:`ConvergenceError` where segment ``i`` ends in another mode than its impact leaves
+    (the last segment: than the section's mode)."""
+    k = layout.impacts
+    want = layout.mode if i == k else m.transition_source[layout.stops[i]]
+    if end_mode != want:
+        what = (
+            "returns to the section"
+            if i == k
+            else f"reaches impact {i + 1} ({m.stop_names[layout.stops[i]]!r})"
+        )
+        raise ConvergenceError(
+            f"segment {i} of the orbit {what} in mode {end_mode!r}, not in {want!r}: its switches of mode "
+            "have changed"
+        )
+
+
 def _least(rows) -> tuple[float, float, np.ndarray] | None:
     rows = [r for r in rows if r is not None]
     return min(rows, key=lambda r: r[0]) if rows else None
@@ -296,6 +354,8 @@ def _segmented_orbit(
     m: HybridModel, layout: SegmentLayout, u, t0, period, times, pre, speeds, runs, M, F, stop
 ) -> PeriodicOrbit:
     """The payload: the orbit's section state, monodromy, impacts and guard minima over the segments."""
+    if m.has_modes:
+        return _segmented_orbit_modes(m, layout, u, t0, period, times, pre, speeds, runs, M, F, stop)
     n_stops = m.n_stops
     by_stop = []
     approach = []
@@ -336,20 +396,83 @@ def _segmented_orbit(
     )
 
 
-def run_layout(model: HybridModel, x: np.ndarray, t0: float, period: int, stop: int = 0):
+def _segmented_orbit_modes(
+    m: HybridModel, layout: SegmentLayout, u, t0, period, times, pre, speeds, runs, M, F, stop
+) -> PeriodicOrbit:
+    """:func:`_segmented_orbit` on a model with modes: no guard minima (the engine keeps none through
+    modes), the switches of the segments and of the impacts that change the mode, and the transitions
+    with a reset that the segments pass through (:func:`_passed_stops`)."""
+    sw_t: list[float] = []
+    sw_j: list[int] = []
+    for i, r in enumerate(runs):
+        if r.switches is not None and len(r.switches):
+            keep = r.switches.t < times[i + 1]
+            sw_t += r.switches.t[keep].tolist()
+            sw_j += r.switches.transition[keep].tolist()
+        if i < layout.impacts:
+            j = layout.stops[i]
+            if m.transition_source[j] != m.transition_target[j]:  # (an impact that changes the mode)
+                sw_t.append(times[i + 1])
+                sw_j.append(j)
+    order = np.argsort(sw_t, kind="stable")
+    v = np.array(speeds)
+    return PeriodicOrbit(
+        model=m, state=np.array(layout.state(u, 0), dtype=float), t0=float(t0), period=period,
+        impacts=layout.impacts, monodromy=M, multipliers=sorted_multipliers(M), guard_min=math.nan,
+        t_guard_min=math.nan, min_impact_speed=float(v.min()) if v.size else math.nan, virtual=False,
+        residuals=(float(np.max(np.abs(F))),), impact_times=np.array(times[1:-1]), impact_speeds=v,
+        impact_states=np.array(pre).reshape(-1, layout.n_states), stop=stop,
+        impact_stops=np.array(layout.stops, dtype=int), mode=layout.mode,
+        switch_times=np.array(sw_t, dtype=float)[order], switch_transitions=np.array(sw_j, dtype=int)[order],
+        passed_stops=_passed_stops(m, layout, u, times),
+    )  # fmt: skip
+
+
+def _passed_stops(
+    m: HybridModel, layout: SegmentLayout, u: np.ndarray, times: list[float]
+) -> tuple[str, ...]:
+    """The transitions with a reset that the segments of ``u`` pass through before their ends: each
+    segment run again with the resets watched, to just short of its end (an impact there is one the
+    orbit does not have)."""
+    passed: list[str] = []
+    edge = 1e-9 * m.period
+    for i in range(layout.impacts + 1):
+        s_i, mode = layout.state(u, i), layout.start_mode(m, i)
+        ta, tb = times[i], times[i + 1] - edge
+        try:
+            periods, phase = _segment_span(m, ta, tb)
+            sol = simulate(m, s_i, t0=ta, periods=periods, phase=phase, impacts="all", mode=mode)
+        except InvalidStateError:  # (it starts beyond a reset's guard of its mode)
+            passed += [
+                name for j, name in enumerate(m.stop_names)
+                if m.transition_source[j] == mode and m.transition_resets[j] and m.guard(s_i, ta, j) < 0.0
+            ]  # fmt: skip
+            continue
+        except (ConvergenceError, SimulationError):
+            continue
+        passed += [m.stop_names[int(j)] for j in sol.impacts.stop]
+    return tuple(dict.fromkeys(passed))
+
+
+def run_layout(
+    model: HybridModel, x: np.ndarray, t0: float, period: int, stop: int = 0, mode: str | None = None
+):  # fmt: skip
     """The segments of the run of ``period`` forcing periods from ``x`` at ``t0`` (its impacts) and its ``u``.
 
-    Returns ``(layout, u)`` (``u`` with a trailing 0 for the parameter), or None where the run has no
-    impact or sticks.
+    ``mode``: a model with modes, the mode of ``x`` (its initial mode by default).  Returns
+    ``(layout, u)`` (``u`` with a trailing 0 for the parameter), or None where the run has no
+    impact, sticks or returns in another mode.
     """
+    if model.has_modes:
+        mode = model.mode_names[model.mode_index(mode)]
     sol = simulate(
         model, x, t0=t0, periods=period, phase=2 * math.pi * (t0 / model.period % 1.0), impacts="all",
-        stop_name=stop,
+        stop_name=stop, mode=mode,
     )  # fmt: skip
     imp = sol.impacts
-    if not len(imp) or len(sol.sticking):
+    if not len(imp) or len(sol.sticking) or sol.mode_final != (mode if model.has_modes else None):
         return None
-    layout = SegmentLayout(model.n_states, tuple(int(j) for j in imp.stop))
+    layout = SegmentLayout(model.n_states, tuple(int(j) for j in imp.stop), mode)
     parts = [np.asarray(x, dtype=float)]
     for t, y, j in zip(imp.t, imp.state, imp.stop):
         parts += [np.array([t]), model.reset(y, t, int(j))]
@@ -357,10 +480,12 @@ def run_layout(model: HybridModel, x: np.ndarray, t0: float, period: int, stop: 
 
 
 def segmented_newton(
-    model: HybridModel, x: np.ndarray, t0: float, period: int, *, tol: float, max_iter: int, stop: int = 0
-) -> PeriodicOrbit:
+    model: HybridModel, x: np.ndarray, t0: float, period: int, *, tol: float, max_iter: int, stop: int = 0,
+    mode: str | None = None,
+) -> PeriodicOrbit:  # fmt: skip
     """The period-``period`` orbit near the run from ``x`` at ``t0``, by Newton's method on the segmented
-    equations (the run's impacts give the segments).
+    equations (the run's impacts give the segments; on a model with modes, from ``x`` in ``mode``, its
+    impacts those of its transitions with a reset).
 
     Raises
     ------
@@ -368,8 +493,7 @@ def segmented_newton(
         Where the run has no impact, Newton's method does not reach ``tol``, or the orbit it finds is
         not a motion of the system (an impact speed not positive, a segment through a stop).
     """
-    model.require_one_mode("multiple shooting")
-    start = run_layout(model, x, t0, period, stop)
+    start = run_layout(model, x, t0, period, stop, mode)
     if start is None:
         raise ConvergenceError("the run from the guess has no impact to make segments of")
     layout, u = start
@@ -467,7 +591,7 @@ def reordered(
     ahead = u + 2.0 * s * tangent
     stops = list(layout.stops)
     stops[i], stops[i + 1] = stops[i + 1], stops[i]
-    swapped = SegmentLayout(layout.n_states, tuple(stops))
+    swapped = SegmentLayout(layout.n_states, tuple(stops), layout.mode)
     n = layout.n_states
     m = model.with_params(**{q: float(v) for q, v in zip(params, ahead[layout.size :])}) if params else model
     new = ahead.copy()
@@ -478,7 +602,8 @@ def reordered(
     start = float(ahead[layout.time_index(i)]) if i > 0 else float(t0)
     state = layout.state(ahead, i).copy()
     for j, t in ((i, t_b), (i + 1, t_a)):
-        state = m.reset(segment_flow(m, state, start, t, None).end, t, swapped.stops[j])
+        flow = segment_flow(m, state, start, t, None, swapped.start_mode(m, j))
+        state = m.reset(flow.end, t, swapped.stops[j])
         new[swapped.time_index(j + 1)] = t
         new[swapped.state_index(j + 1) : swapped.state_index(j + 1) + n] = state
         start = t

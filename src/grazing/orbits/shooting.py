@@ -267,8 +267,9 @@ def find_orbit(
         Without ``x0``, the guess is simulated from rest in ``mode`` and the
         orbit is sought in the mode that run ends in.  The monodromy carries
         the saltation matrices of the switches (a switch of mode without a
-        reset too); multiple shooting, ``virtual`` orbits and the guard
-        minimum are not available on models with modes yet.
+        reset too); multiple shooting splits the orbit at its transitions
+        with a reset (:mod:`grazing.orbits.segments`); ``virtual`` orbits
+        and the guard minimum are not available on models with modes yet.
 
     Returns
     -------
@@ -331,7 +332,7 @@ def find_orbit(
     try:
         return newton.solve(x, virtual, advice, guess, note)
     except ConvergenceError:
-        nonimpacting = not (virtual or not through_stops or model.has_modes)  # (no virtual runs with modes)
+        nonimpacting = not (virtual or not through_stops or model.has_modes)  # (no guard minima with modes)
         inside = newton.nonimpacting(x) if nonimpacting else None
         if inside is None:
             raise
@@ -388,7 +389,9 @@ class _Newton:
                 # A large monodromy: single shooting's residual cannot fall below |M| eps |x|, and its
                 # steps may land on another orbit; the segments of the guess's own run are solved.
                 try:
-                    return segmented_newton(model, x, t0, n, tol=tol, max_iter=self.max_iter, stop=stop)
+                    return segmented_newton(
+                        model, x, t0, n, tol=tol, max_iter=self.max_iter, stop=stop, mode=self.mode
+                    )
                 except (GrazingError, np.linalg.LinAlgError):
                     pass  # (then single shooting, as for any other guess)
             if res <= tol:
@@ -432,8 +435,6 @@ class _Newton:
         (:data:`~grazing.orbits.segments.GRAZING_SPEED_RATIO`)?"""
         if virtual or not fm.impacts or not self.model.periodic or not fm.solution.jacobian_valid:
             return False
-        if self.model.has_modes:
-            return False  # (multiple shooting does not go through modes yet)
         speeds = np.abs(fm.solution.impacts.speed)
         if float(speeds.min()) < GRAZING_SPEED_RATIO * float(speeds.max()):
             return False  # (an impact of the guess's run at a grazing: single shooting's orbit, without it)

@@ -87,8 +87,10 @@ def first_event(m, run, O, h, events, skip, end_contact, end_stop, a, work):
     sticking to stop ``run.stuck`` (its row is the contact force); the known
     roots at ``u = 0`` (``run.defl``) belong to stop ``run.defl_stop``, a
     final grazing contact (``end_contact``) to ``end_stop``.  Without
-    ``events`` only the contact force is watched; stop ``skip`` (the one the
-    discontinuity map stands for; -1: none) is not.
+    ``events`` the transitions with a reset (impacts) are not watched: the
+    contact force, the switches of vector field without a reset and the exits
+    of sliding are; stop ``skip`` (the one the discontinuity map stands for;
+    -1: none) is not.
     """
     u = -1.0
     stop = 0
@@ -102,7 +104,7 @@ def first_event(m, run, O, h, events, skip, end_contact, end_stop, a, work):
         if r < 0:
             continue
         force = mode == 1 and r == stuck
-        if not (events or force) or r == skip:
+        if not (events or force or not m.resets[r]) or r == skip:  # (no events: no reset transitions)
             continue
         defl_r = defl if r == defl_stop else 0
         end_r = end_contact and r == end_stop

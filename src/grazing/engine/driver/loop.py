@@ -23,8 +23,9 @@ is 0 in free flight, ``1 + j`` when sticking to stop ``j``; the final mode is
 returned so that a run can be continued.  ``cfg.stop`` is the stop a grazing
 analysis looks at: its guard's minimum is tracked, a grazing contact at the
 start or end of the run is on it, and the discontinuity map stands for it.
-With ``cfg.events`` false the guards are ignored (the "virtual" flow through
-the stops), which is how nonimpacting orbits are continued past grazing.  The
+With ``cfg.events`` false the guards of the transitions with a reset are ignored (the "virtual" flow
+through the stops; a model with modes still switches its vector field and slides), which is how
+nonimpacting orbits are continued past grazing.  The
 parameter columns of the variational matrix are derivatives at fixed ``(k, s)``, the instant ``k T(p) + s``.
 """
 
