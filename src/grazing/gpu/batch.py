@@ -139,8 +139,8 @@ def run_parts_gpu(parts: Sequence[tuple[SweepSpec, int]], threads: int | None = 
     >>> from grazing.sweeps.spec import sweep_spec
     >>> spec = sweep_spec(grazing.models.pendulum("B"), "eta", [0.44, 0.45],
     ...                   settings=grazing.SweepSettings(lyapunov=True))
-    >>> run_parts_gpu([(spec, 0)])
-    Traceback (most recent call last):  # doctest: +ELLIPSIS
+    >>> run_parts_gpu([(spec, 0)])  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
     ...
     grazing.errors.InvalidParameterError: Lyapunov exponents are not computed on the GPU yet: ...
     """
