@@ -38,18 +38,29 @@ def cases() -> dict[str, list[tuple[object, int]]]:
             (spec, i)
             for spec in [
                 sweep_spec(
-                    grazing.models.pendulum("C", theta_hat=math.radians(30)), "eta",
-                    np.linspace(0.40, 0.50, 6), settings=chained,
+                    grazing.models.pendulum("C", theta_hat=math.radians(30)),
+                    "eta",
+                    np.linspace(0.40, 0.50, 6),
+                    settings=chained,
                 )
             ]
             for i in range(2)
-        ],  # fmt: skip
+        ],
         # the equal-work map's settings (no adaptive transient, tol 1e-10), eta x theta_hat, case A
         "pendulum A map": [
-            (map_spec(grazing.models.pendulum("A"), "eta", [0.44, 0.47], "theta_hat",
-                      [math.radians(30), math.radians(40)], settings=equal_work), i)
+            (
+                map_spec(
+                    grazing.models.pendulum("A"),
+                    "eta",
+                    [0.44, 0.47],
+                    "theta_hat",
+                    [math.radians(30), math.radians(40)],
+                    settings=equal_work,
+                ),
+                i,
+            )
             for i in range(2)
-        ],  # fmt: skip
+        ],
         # a point that blows up (status non-finite) between two that do not
         "pendulum huge forcing": [
             (sweep_spec(B40, "alpha", [0.2254, 1e300], settings=fresh), 0),
@@ -60,9 +71,17 @@ def cases() -> dict[str, list[tuple[object, int]]]:
         # chattering continued as sticking from the third point on: the GPU hands the rest of the chain to the
         # CPU lanes, from the state it carried
         "bouncing ball": [
-            (sweep_spec(grazing.models.bouncing_ball(), "amplitude", [1.2, 1.5, 2.0, 2.5], x0=[0.0, 3.0],
-                        settings=grazing.SweepSettings(**SHORT, chunk_size=4)), 0)
-        ],  # fmt: skip
+            (
+                sweep_spec(
+                    grazing.models.bouncing_ball(),
+                    "amplitude",
+                    [1.2, 1.5, 2.0, 2.5],
+                    x0=[0.0, 3.0],
+                    settings=grazing.SweepSettings(**SHORT, chunk_size=4),
+                ),
+                0,
+            )
+        ],
     }
     return out
 
@@ -114,10 +133,23 @@ def foreign_names() -> list[str]:
     return sorted(found)
 
 
+def api_map() -> dict[str, object]:
+    """``parameter_map(device="gpu")`` against ``device="cpu"``: every variable of the two datasets."""
+    from grazing.sweeps import parameter_map
+
+    args = (grazing.models.pendulum("B"), "eta", [0.44, 0.46], "theta_hat", np.radians([30.0, 40.0]))
+    kw = {"transient": 64, "periods": 16, "lyapunov": False, "workers": 1}
+    cpu = parameter_map(*args, **kw, device="cpu")
+    gpu = parameter_map(*args, **kw, device="gpu")
+    differ = sorted(name for name in cpu.data_vars if not cpu[name].equals(gpu[name]))
+    return {"differ": differ, "variables": sorted(cpu.data_vars), "period": cpu.period.values.tolist()}
+
+
 def main(names: list[str]) -> None:
     table = cases()
     out: dict[str, object] = {name: compare(table[name]) for name in (names or list(table))}
     out["foreign names"] = foreign_names()
+    out["api map"] = api_map()
     print(json.dumps(out))
 
 

@@ -44,7 +44,9 @@ def compared() -> dict[str, dict[str, object]]:
 
 
 @pytest.mark.parametrize("case", CASES)
-def test_the_gpu_equals_the_cpu_lanes_at_every_point(compared: dict[str, dict[str, object]], case: str) -> None:
+def test_the_gpu_equals_the_cpu_lanes_at_every_point(
+    compared: dict[str, dict[str, object]], case: str
+) -> None:
     row = compared[case]
     for name in ("period", "impacts_by_stop", "status", "transient_used", "impacts"):
         assert row[f"gpu_{name}"] == row[f"cpu_{name}"], name
@@ -73,6 +75,14 @@ def test_the_ported_code_calls_only_device_functions(compared: dict[str, dict[st
     assert compared["foreign names"] == []
 
 
+def test_parameter_map_on_the_gpu_is_the_same_dataset(compared: dict[str, dict[str, object]]) -> None:
+    """``parameter_map(device="gpu")``: every variable equals ``device="cpu"``'s (shared downstream)."""
+    row = compared["api map"]
+    assert {"period", "samples", "status", "impacts"} <= set(row["variables"])
+    assert row["differ"] == []
+    assert len({p for line in row["period"] for p in line}) >= 2  # (not all alike)
+
+
 def test_the_simulator_does_not_leak_into_this_process() -> None:
     from numba import config
 
@@ -86,15 +96,34 @@ def test_what_the_gpu_does_not_do_yet_is_refused_in_one_line() -> None:
     from grazing.sweeps.spec import sweep_spec
 
     spec = sweep_spec(grazing.models.pendulum("B"), "eta", [0.44], settings=grazing.SweepSettings())
-    with pytest.raises(InvalidParameterError, match="^Lyapunov exponents are not computed on the GPU yet"):
+    with pytest.raises(InvalidParameterError, match=r"^Lyapunov exponents are not computed on the GPU yet"):
         GpuLaneBatch([(spec, 0)])
 
 
 def test_no_device_is_one_line() -> None:
-    from grazing.gpu.target import NoDeviceError, device_present, require_target
+    import grazing
+    from grazing.gpu.target import NoDeviceError, device_present
+    from grazing.sweeps import sweep
 
     if device_present():
         pytest.skip("a CUDA device is present")
     with pytest.raises(NoDeviceError) as info:
-        require_target()
+        sweep(grazing.models.pendulum("B"), "eta", [0.44], lyapunov=False, fresh=True, device="gpu")
     assert "\n" not in str(info.value) and "device='cpu'" in str(info.value)
+
+
+def test_device_auto_without_a_gpu_is_the_cpu_and_a_chain_of_chunks_is_refused() -> None:
+    import grazing
+    from grazing.gpu.device import resolve_device
+    from grazing.sweeps import sweep
+    from grazing.sweeps.spec import sweep_spec
+
+    m = grazing.models.pendulum("B")
+    ds = sweep(m, "eta", [0.44, 0.45], transient=40, periods=10, lyapunov=False, workers=1, device="auto")
+    assert ds.status.values.tolist() == [0, 0]
+    chained = sweep_spec(m, "eta", [0.44, 0.45, 0.46], settings=grazing.SweepSettings(
+        lyapunov=False, chunk_size=2))  # fmt: skip
+    with pytest.raises(InvalidParameterError, match=r"^a chain of several chunks"):
+        resolve_device("gpu", chained)
+    with pytest.raises(InvalidParameterError, match=r"^device must be"):
+        sweep(m, "eta", [0.44], device="GPU")

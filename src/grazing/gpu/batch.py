@@ -18,33 +18,25 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 
 import numpy as np
 
 from grazing.core.solution import Status
 from grazing.engine.records import LaneJobs
 from grazing.errors import InvalidParameterError
+from grazing.gpu.device import gpu_refusal
 from grazing.sweeps.run import LaneBatch
 from grazing.sweeps.spec import ChunkResult, SweepSpec
 from grazing.sweeps.status import NOT_COMPUTED
 
 THREADS_PER_BLOCK = 128
 """CUDA threads per block of the sweep kernel."""
+BATCH_POINTS = 1 << 20
+"""Most points of one launch of :func:`gpu_results` (their samples: 1.6 GB at 100 periods of 2 states)."""
 MAX_THREADS = 1 << 17
 """Most threads of one launch: each takes jobs until none is left, with a root-search work array of its
 own (33 kB: 4.4 GB for this many)."""
-
-
-def gpu_refusal(spec: SweepSpec) -> str | None:
-    """Why ``spec`` cannot run on the GPU yet (one line), or None."""
-    if spec.lyapunov:
-        return "Lyapunov exponents are not computed on the GPU yet: use lyapunov=False or device='cpu'"
-    if spec.zdm is not None:
-        return "the discontinuity map is not on the GPU yet: use device='cpu'"
-    if spec.model.n_modes > 1:
-        return "models with several modes are not on the GPU yet: use device='cpu'"
-    return None
 
 
 class GpuLaneBatch(LaneBatch):
@@ -68,8 +60,8 @@ class GpuLaneBatch(LaneBatch):
 
     def run(self) -> None:
         """Compute the batch's points on the GPU (the rest of a job that sticks on the CPU lanes)."""
-        from grazing.engine.stepping import step_factor
         from grazing.engine.runner import step_safety
+        from grazing.engine.stepping import step_factor
         from grazing.gpu.kernel import ROOT_WORK, keep_rows, sweep_kernel
         from grazing.gpu.target import cuda_module
 
@@ -84,8 +76,8 @@ class GpuLaneBatch(LaneBatch):
         factor = step_factor(step_safety(spec.tol, self._order), self._order)
         fset = np.array([spec.adaptive_tol, factor, spec.chatter_tol], dtype=np.float64)
         outputs = (self.samples, self.by_stop, self.used, self.x_final, self.t_final, self.status)
-        inputs = (self.jobs, np.zeros(1, dtype=np.int64), self.x0, self.firsts, self.pvs, self.Ts, self.sphase,
-                  self.tcarry)  # fmt: skip
+        counter = np.zeros(1, dtype=np.int64)  # (the next job)
+        inputs = (self.jobs, counter, self.x0, self.firsts, self.pvs, self.Ts, self.sphase, self.tcarry)
         d_in = [cuda.to_device(np.ascontiguousarray(a)) for a in inputs]
         d_out = [cuda.to_device(a) for a in outputs]
         work = cuda.device_array((threads, *ROOT_WORK), dtype=np.float64)
@@ -152,6 +144,24 @@ def run_parts_gpu(parts: Sequence[tuple[SweepSpec, int]], threads: int | None = 
     for res in results:
         res.seconds = seconds / len(results)
     return results
+
+
+def gpu_results(
+    spec: SweepSpec, indices: Sequence[int], max_points: int = BATCH_POINTS
+) -> Iterator[ChunkResult]:
+    """The results of the chunks ``indices`` of ``spec`` computed on the GPU, in that order, a batch of
+    at most ``max_points`` points at a time (at least one chunk)."""
+    group: list[int] = []
+    size = 0
+    for i in indices:
+        chunk = spec.chunk(i)
+        group.append(i)
+        size += chunk.stop - chunk.start
+        if size >= max_points:
+            yield from run_chunks_gpu(spec, group)
+            group, size = [], 0
+    if group:
+        yield from run_chunks_gpu(spec, group)
 
 
 def run_chunks_gpu(spec: SweepSpec, indices: Sequence[int], threads: int | None = None) -> list[ChunkResult]:

@@ -82,7 +82,7 @@ def sweep_kernel(definition: Any, order: int, keep: int) -> Any:
     return _kernels[key]
 
 
-def build_kernel(dm: Any, keep: int) -> Any:  # noqa: C901 - the kernel is one closure over the model
+def build_kernel(dm: Any, keep: int) -> Any:
     """The sweep kernel of the device model ``dm`` (:class:`~grazing.gpu.model.DeviceModel`).
 
     ``kernel[blocks, threads](jobs, control, x0, firsts, pvs, Ts, sphase,

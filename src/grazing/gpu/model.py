@@ -106,7 +106,7 @@ _cache: dict[tuple[str, int], DeviceModel] = {}
 
 
 def model_functions(definition: Any, order: int) -> DeviceModel:
-    """The device functions of a model definition (a model's ``_def``) at Taylor ``order``, once per process."""
+    """The device functions of a model definition (a model's ``_def``) at Taylor ``order``, made once."""
     key = (definition.identity(), int(order))
     found = _cache.get(key)
     if found is None:
