@@ -145,11 +145,26 @@ def api_map() -> dict[str, object]:
     return {"differ": differ, "variables": sorted(cpu.data_vars), "period": cpu.period.values.tolist()}
 
 
+def api_basins() -> dict[str, object]:
+    """``basins(device="gpu")`` against ``device="cpu"`` (the refined runs with Lyapunov exponents on the
+    CPU either way): every variable of the two datasets."""
+    from grazing.attractors import basins
+
+    model = grazing.models.pendulum("B", eta=0.446, theta_hat=math.radians(40))
+    args = (model, (-1.5, math.radians(40)), (-2.0, 2.0), (3, 3))
+    kw = {"transient": 64, "periods": 16, "workers": 1}
+    cpu = basins(*args, **kw, device="cpu")
+    gpu = basins(*args, **kw, device="gpu")
+    differ = sorted(name for name in cpu.data_vars if not cpu[name].equals(gpu[name]))
+    return {"differ": differ, "variables": sorted(cpu.data_vars), "kinds": cpu.kind.values.tolist()}
+
+
 def main(names: list[str]) -> None:
     table = cases()
     out: dict[str, object] = {name: compare(table[name]) for name in (names or list(table))}
     out["foreign names"] = foreign_names()
     out["api map"] = api_map()
+    out["api basins"] = api_basins()
     print(json.dumps(out))
 
 

@@ -83,6 +83,13 @@ def test_parameter_map_on_the_gpu_is_the_same_dataset(compared: dict[str, dict[s
     assert len({p for line in row["period"] for p in line}) >= 2  # (not all alike)
 
 
+def test_basins_on_the_gpu_are_the_same_dataset(compared: dict[str, dict[str, object]]) -> None:
+    """``basins(device="gpu")``: every variable equals ``device="cpu"``'s."""
+    row = compared["api basins"]
+    assert {"label", "fraction", "kind", "period"} <= set(row["variables"])
+    assert row["differ"] == []
+
+
 def test_the_simulator_does_not_leak_into_this_process() -> None:
     from numba import config
 

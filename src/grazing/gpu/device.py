@@ -41,6 +41,33 @@ def chain_refusal(spec: Any) -> str | None:
     return None
 
 
+def check_device(device: str, client: Any = None) -> None:
+    """One line (:class:`~grazing.errors.InvalidParameterError`, or
+    :class:`~grazing.gpu.target.NoDeviceError`) unless ``device`` can be used at all."""
+    from grazing.gpu.target import require_target
+
+    if device not in DEVICES:
+        raise InvalidParameterError(f"device must be 'cpu', 'gpu' or 'auto', got {device!r}")
+    if device == "gpu":
+        if client is not None:
+            raise InvalidParameterError("device='gpu' runs on this machine's GPU: give no Dask client")
+        require_target()
+
+
+def spec_device(device: str, spec: Any, client: Any = None) -> str:
+    """``"cpu"`` or ``"gpu"``: where one of several sweeps of a computation runs (``device`` checked by
+    :func:`check_device`): the GPU for ``"gpu"``, or ``"auto"`` with a device present and a large sweep,
+    unless it has what the GPU does not do yet (:func:`gpu_refusal`, :func:`chain_refusal`: then the CPU).
+    """
+    from grazing.gpu.target import device_present
+
+    if device == "cpu" or client is not None or (gpu_refusal(spec) or chain_refusal(spec)) is not None:
+        return "cpu"
+    if device == "gpu":
+        return "gpu"
+    return "gpu" if spec.n_points >= AUTO_MIN_POINTS and device_present() else "cpu"
+
+
 def resolve_device(device: str, spec: Any, client: Any = None) -> str:
     """``"cpu"`` or ``"gpu"``: where ``spec`` runs for ``device`` (see the module).
 
@@ -56,19 +83,9 @@ def resolve_device(device: str, spec: Any, client: Any = None) -> str:
     ...
     grazing.errors.InvalidParameterError: device must be 'cpu', 'gpu' or 'auto', got 'tpu'
     """
-    from grazing.gpu.target import device_present, require_target
-
-    if device not in DEVICES:
-        raise InvalidParameterError(f"device must be 'cpu', 'gpu' or 'auto', got {device!r}")
-    if device == "cpu":
-        return "cpu"
-    why = gpu_refusal(spec) or chain_refusal(spec)
-    if device == "auto":
-        large = spec.n_points >= AUTO_MIN_POINTS
-        return "gpu" if why is None and client is None and large and device_present() else "cpu"
-    if client is not None:
-        raise InvalidParameterError("device='gpu' runs on this machine's GPU: give no Dask client")
-    if why is not None:
-        raise InvalidParameterError(why)
-    require_target()
-    return "gpu"
+    if device == "gpu" and client is None:
+        why = gpu_refusal(spec) or chain_refusal(spec)
+        if why is not None:
+            raise InvalidParameterError(why)
+    check_device(device, client)
+    return spec_device(device, spec, client)
