@@ -10,8 +10,10 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
-MAP = ("map --param1 eta --start1 0.44 --stop1 0.45 --num1 2 --param2 theta_hat --start2 30 --stop2 40 "
-       "--num2 2 --periods 10 --transient 20").split()
+MAP = (
+    "map --param1 eta --start1 0.44 --stop1 0.45 --num1 2 --param2 theta_hat --start2 30 --stop2 40 "
+    "--num2 2 --periods 10 --transient 20"
+).split()
 
 
 def grazing(args: list[str], cwd: Path, simulator: bool = False) -> subprocess.CompletedProcess[str]:
