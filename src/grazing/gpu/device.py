@@ -23,11 +23,14 @@ AUTO_MIN_POINTS = 20_000
 def gpu_refusal(spec: Any) -> str | None:
     """Why the sweep ``spec`` cannot run on the GPU yet (one line), or None."""
     if spec.lyapunov:
-        return "Lyapunov exponents are not computed on the GPU yet: use lyapunov=False or device='cpu'"
+        return (
+            "Lyapunov exponents are not computed on the GPU yet: go without them (lyapunov=False) or run on "
+            "the CPU (device=)"
+        )
     if spec.zdm is not None:
-        return "the discontinuity map is not on the GPU yet: use device='cpu'"
+        return "the discontinuity map is not on the GPU yet: run on the CPU (device=)"
     if spec.model.n_modes > 1:
-        return "models with several modes are not on the GPU yet: use device='cpu'"
+        return "models with several modes are not on the GPU yet: run on the CPU (device=)"
     return None
 
 
@@ -35,8 +38,8 @@ def chain_refusal(spec: Any) -> str | None:
     """Why ``spec``'s chunks cannot run on the GPU (chains of several chunks, one line), or None."""
     if spec.carried and spec.n_chunks > spec.segments:
         return (
-            "a chain of several chunks runs one chunk after the other: on the GPU use fresh=True or "
-            "chunk_size=0 (one chunk a chain), or device='cpu'"
+            "a chain of several chunks runs one chunk after the other: on the GPU start every point afresh "
+            "(fresh=True) or make each chain one chunk (chunk_size=: 0), or run on the CPU (device=)"
         )
     return None
 
@@ -50,7 +53,7 @@ def check_device(device: str, client: Any = None) -> None:
         raise InvalidParameterError(f"device must be 'cpu', 'gpu' or 'auto', got {device!r}")
     if device == "gpu":
         if client is not None:
-            raise InvalidParameterError("device='gpu' runs on this machine's GPU: give no Dask client")
+            raise InvalidParameterError("the GPU runs on this machine: give no Dask client (client=)")
         require_target()
 
 

@@ -65,8 +65,8 @@ def require_target() -> None:
     if simulated() or device_present():
         return
     raise NoDeviceError(
-        "device='gpu' needs an NVIDIA GPU with CUDA and numba-cuda (pip install 'grazing[gpu]'); none is "
-        "available here: use device='cpu' (or 'auto')"
+        "the GPU device needs an NVIDIA GPU with CUDA and numba-cuda (pip install 'grazing[gpu]'); none is "
+        "available here: run on the CPU (device=)"
     )
 
 
