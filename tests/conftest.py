@@ -46,3 +46,18 @@ def period5_orbit(pendulum_b):
 def period5_trajectory(pendulum_b) -> grazing.Solution:
     """Twenty periods of the period-5 orbit with dense output (200 points per period)."""
     return grazing.simulate(pendulum_b, [0.0, 0.0], transient=600, periods=20, trajectory=200)
+
+
+def pytest_addoption(parser: pytest.Parser) -> None:
+    """``--gpu``: also run the tests marked ``gpu`` (they need an NVIDIA GPU with numba-cuda)."""
+    parser.addoption("--gpu", action="store_true", help="run the tests marked gpu (they need a CUDA device)")
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Deselect the tests marked ``gpu`` unless ``--gpu`` is given (CI has no GPU)."""
+    if config.getoption("--gpu"):
+        return
+    gpu = [item for item in items if item.get_closest_marker("gpu") is not None]
+    if gpu:
+        config.hook.pytest_deselected(items=gpu)
+        items[:] = [item for item in items if item.get_closest_marker("gpu") is None]

@@ -34,6 +34,7 @@ LAYERS = {
     "grazing.orbits": 5,
     "grazing.normalform": 6,
     "grazing.sweeps": 6,
+    "grazing.gpu": 6,
     "grazing.experiment": 7,
     "grazing.attractors": 7,
     "grazing.plotting": 8,
@@ -44,7 +45,8 @@ LAYERS = {
 """The layer of every part of the package (the facade ``grazing/__init__`` is above them all)."""
 
 GENERIC = ("grazing.core", "grazing.engine", "grazing.maps", "grazing.orbits", "grazing.sweeps",
-           "grazing.normalform", "grazing.plotting", "grazing.parallel", "grazing.attractors")  # fmt: skip
+           "grazing.normalform", "grazing.plotting", "grazing.parallel", "grazing.attractors",
+           "grazing.gpu")  # fmt: skip
 """The layers that know no particular model."""
 
 PENDULUM_NAMES = {"eta", "theta_hat", "theta", "dtheta", "tau", "alpha", "beta"}

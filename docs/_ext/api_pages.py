@@ -33,6 +33,7 @@ API_MODULES = (
 INTERNAL = {
     "grazing.core": "its public names are grazing's (HybridModel, Parameter, Stop, Solution, Impacts)",
     "grazing.engine": "the integrator's machinery; grazing.simulate is its interface",
+    "grazing.gpu": "the GPU backend's machinery; device= of sweep, parameter_map and basins is its interface",
     "grazing.cli": "the command line, documented by `grazing --help` and the README",
     "grazing.atomic": "files written all at once (used by outputs)",
     "grazing.parallel": "the pool of worker processes",

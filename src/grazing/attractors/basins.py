@@ -40,6 +40,7 @@ from grazing.core.options import (
     with_shorthands,
 )
 from grazing.errors import InvalidParameterError
+from grazing.gpu.device import DEFAULT_DEVICE, check_device, spec_device
 from grazing.sweeps.spec import ChunkResult, SweepSpec
 
 BasinsProgress = Callable[[int, int], None]
@@ -156,6 +157,7 @@ class _Run:
     client: Any
     store: Any
     progress: BasinsProgress | None
+    device: str = DEFAULT_DEVICE
 
 
 def find_attractors(
@@ -170,6 +172,7 @@ def find_attractors(
     client: Any = None,
     store: Any = None,
     progress: BasinsProgress | None = None,
+    device: str = DEFAULT_DEVICE,
     **shorthands: Any,
 ) -> AttractorSet:
     """The attractors reached from the initial states ``states`` (rows), and which one each reaches.
@@ -206,6 +209,10 @@ def find_attractors(
         run: interrupted and run again, it computes only the chunks missing.
     progress
         Called as ``progress(done, total)``.
+    device
+        ``"cpu"`` (the default), ``"gpu"`` or ``"auto"`` (:mod:`grazing.gpu.device`): the runs without
+        Lyapunov exponents on an NVIDIA GPU, one CUDA thread per initial state; those with them (the
+        refined runs' last, each orbit's exponent) on the CPU lanes.
     **shorthands
         Any field of :class:`~grazing.core.options.BasinSettings` by name
         (``transient=200``, ``lyapunov=False`` ...), replacing that field of
@@ -240,6 +247,7 @@ def find_attractors(
     used: set[str] = set()
     s = with_shorthands(settings, BasinSettings, shorthands, used)
     refuse_unknown("find_attractors", shorthands, used)
+    check_device(device, client)
     x = as_states(model, states)
     t0 = start_time(model, s.phase)
     invalid = outside(model, x, t0)
@@ -269,7 +277,7 @@ def find_attractors(
         raise InvalidParameterError(f"escape must be a positive distance, got {escape!r}")
     catalogue = Catalogue(model, x.shape[0], cells, box.min(axis=0), reach + side, s.periods, t0, fraction)
     if valid.size:
-        run = _Run(workers, client, store, progress)
+        run = _Run(workers, client, store, progress, device)
         spec = basin_spec(model, x[valid], s, s.lyapunov and s.refine == 0)
         looks = _looks(s.refine)
         deferred = _run(spec, valid, catalogue, next(looks), run, x.shape[0] - valid.size, x.shape[0])
@@ -399,7 +407,12 @@ def _run(spec: SweepSpec, which: np.ndarray, catalogue: Catalogue, look: _Look, 
     if run.progress is not None:
         run.progress(offset + order.counted, total)
     if todo:
-        results = chunk_results(spec, todo, run.workers, run.client)
+        if spec_device(run.device, spec, run.client) == "gpu":
+            from grazing.gpu.batch import gpu_results
+
+            results = gpu_results(spec, todo)
+        else:
+            results = chunk_results(spec, todo, run.workers, run.client)
         try:
             for res in results:
                 if store is not None:

@@ -24,6 +24,10 @@ FLAGS: dict[str, str] = {
     "timeout=": "--timeout",
     "port=": "--port",
     "overwrite=True": "--overwrite",
+    "fresh=True": "--fresh",
+    "chunk_size=": "--chunk-size",
+    "lyapunov=False": "--no-lyapunov",
+    "device=": "--device",
 }
 """Each argument as the library's messages name it, and the option that gives it on the command line."""
 

@@ -37,6 +37,7 @@ from grazing.cli.limits import POINT_OVERHEAD, check_memory, count_text, sweep_b
 from grazing.cli.validate import FINITE, POSITIVE, TOLERANCE, WORKERS, count, path_type, refuse_unused
 from grazing.core.options import CHUNK_SIZE, SweepSettings
 from grazing.core.solution import Status
+from grazing.gpu.device import DEFAULT_DEVICE, DEVICES
 
 ONE_VALUE = "with {num} 1 (its one value is {start}: give the same value to both, or {num} 2 or more)"
 """Why the last value is refused with one value: ``--stop is not used with --num 1 (...)``."""
@@ -63,6 +64,10 @@ def _sweep_options(func: Callable[..., Any]) -> Callable[..., Any]:
         click.option("--timeout", type=POSITIVE, metavar="SECONDS",
                      help="With --scheduler: give up after this long without any Dask worker "
                           "(default: wait; a message after 5 s)."),
+        click.option("--device", type=click.Choice(DEVICES), default=DEFAULT_DEVICE, show_default=True,
+                     help="Where the points run: the CPU lanes, an NVIDIA GPU (one CUDA thread per point; "
+                     "not with Lyapunov exponents yet: add --no-lyapunov), or the GPU when one is present "
+                     "and the sweep is large (auto)."),
         click.option("--no-lyapunov", is_flag=True, help="Skip the Lyapunov exponents."),
         click.option("--no-adaptive", is_flag=True, help="Always run the full transient."),
         click.option("--tol", type=TOLERANCE, default=SWEEP_DEFAULTS.tol, show_default=True,
@@ -140,6 +145,7 @@ class _SweepRun:
 def _run_sweep_spec(
     spec: Any, out: Path | None, scheduler: str | None, workers: int | None, as_json: bool,
     wait: bool = False, timeout: float | None = None, arrays: bool = False, overwrite: bool = False,
+    device: str = DEFAULT_DEVICE,
 ) -> _SweepRun:  # fmt: skip
     """Run a sweep spec with the CLI's storage, cluster and progress options.
 
@@ -149,8 +155,10 @@ def _run_sweep_spec(
     arrays and no xarray dataset is built unless a NetCDF file is asked for
     (importing xarray, and the dask it imports, costs about a second).
     """
+    from grazing.gpu.device import resolve_device
     from grazing.sweeps.api import run_sweep
 
+    device = resolve_device(device, spec, scheduler)  # (before a store or a cluster: an error writes nothing)
     zarr_out = out is not None and out.suffix.lower() == ".zarr"
     streamed = zarr_out and not as_json
     memory = arrays and not zarr_out
@@ -186,7 +194,7 @@ def _run_sweep_spec(
         ds = run_sweep(
             spec, store=store, workers=workers, client=client, progress=bar, timeout=timeout,
             notice=lambda msg: click.echo(f"grazing: {flag_hints(msg)}", err=True),
-            load=not (streamed or memory),
+            load=not (streamed or memory), device=device,
         )  # fmt: skip
         flat = {name: store.read(name) for name in ("period", "status", "impacts")} if streamed else None
     finally:
@@ -301,8 +309,8 @@ def sweep_cmd(
     model: grazing.HybridModel, case: str,
     sparam: str, start: float, stop: float, num: int, direction: str, method: str, which: str,
     transient: int, periods: int, initial: str, fresh: bool, chunk_size: int | None, workers: int | None,
-    scheduler: str | None, timeout: float | None, no_lyapunov: bool, no_adaptive: bool, tol: float,
-    out: Path | None, wait: bool, overwrite: bool, as_json: bool,
+    scheduler: str | None, timeout: float | None, device: str, no_lyapunov: bool, no_adaptive: bool,
+    tol: float, out: Path | None, wait: bool, overwrite: bool, as_json: bool,
 ) -> None:  # fmt: skip
     """Brute-force bifurcation diagram: stroboscopic samples, periods, impacts and
     Lyapunov exponents along a parameter range."""
@@ -337,7 +345,7 @@ def sweep_cmd(
     spec = sweep_spec(model, name, vals, x0=x0, direction=direction, settings=settings, zdm=zdm)
     t0 = time.perf_counter()
     run = _run_sweep_spec(
-        spec, out, scheduler, workers, as_json, wait, timeout, arrays=True, overwrite=overwrite
+        spec, out, scheduler, workers, as_json, wait, timeout, arrays=True, overwrite=overwrite, device=device
     )
     elapsed = time.perf_counter() - t0
     if as_json:
@@ -451,8 +459,8 @@ def map_cmd(
     model: grazing.HybridModel, case: str,
     param1: str, start1: float, stop1: float, num1: int, param2: str, start2: float, stop2: float, num2: int,
     transient: int, periods: int, initial: str, fresh: bool, chunk_size: int | None, workers: int | None,
-    scheduler: str | None, timeout: float | None, no_lyapunov: bool, no_adaptive: bool, tol: float,
-    out: Path | None, wait: bool, overwrite: bool, as_json: bool,
+    scheduler: str | None, timeout: float | None, device: str, no_lyapunov: bool, no_adaptive: bool,
+    tol: float, out: Path | None, wait: bool, overwrite: bool, as_json: bool,
 ) -> None:  # fmt: skip
     """Two-parameter map of periods, impacts and Lyapunov exponents."""
     from grazing.sweeps.spec import map_spec
@@ -482,7 +490,9 @@ def map_cmd(
     )  # fmt: skip
     spec = map_spec(model, n1, v1, n2, v2, x0=x0, settings=settings)
     t0 = time.perf_counter()
-    run = _run_sweep_spec(spec, out, scheduler, workers, as_json, wait, timeout, overwrite=overwrite)
+    run = _run_sweep_spec(
+        spec, out, scheduler, workers, as_json, wait, timeout, overwrite=overwrite, device=device
+    )
     elapsed = time.perf_counter() - t0
     if as_json:
         ds = run.ds

@@ -17,6 +17,7 @@ from typing import Any, TypeVar
 from grazing.core.model import HybridModel
 from grazing.core.options import SweepSettings, refuse_unknown, with_shorthands
 from grazing.errors import InvalidParameterError
+from grazing.gpu.device import DEFAULT_DEVICE, resolve_device
 from grazing.sweeps.chain import ChainLine, settle
 from grazing.sweeps.executor import (
     DASK_NOTICE_AFTER,
@@ -42,6 +43,7 @@ def run_sweep(
     timeout: float | None = None,
     notice: Callable[[str], None] | None = None,
     load: bool = True,
+    device: str = DEFAULT_DEVICE,
 ) -> Any:
     """Run a sweep; return its :class:`xarray.Dataset` (:func:`sweep` and :func:`parameter_map` call it).
 
@@ -68,6 +70,12 @@ def run_sweep(
     load
         Return the dataset; with False, return None and keep nothing of the
         results in memory (they are in ``store``: a huge sweep streams to it).
+    device
+        ``"cpu"`` (the default): the CPU lanes; ``"gpu"``: an NVIDIA GPU, one
+        CUDA thread per point (:mod:`grazing.gpu`: not yet with Lyapunov
+        exponents, the discontinuity map, models with modes or chains of
+        several chunks; sticking is finished on the CPU); ``"auto"``: the GPU
+        when one is present and the sweep is large (:mod:`grazing.gpu.device`).
 
     Returns
     -------
@@ -99,13 +107,14 @@ def run_sweep(
     """
     from grazing.sweeps.store import MemoryStore
 
+    where = resolve_device(device, spec, client)  # (before a store is opened: nothing written on an error)
     if isinstance(store, (str, Path)):
         from grazing.sweeps.store import open_store
 
         with open_store(store, spec) as opened:
             return run_sweep(
                 spec, store=opened, workers=workers, client=client, progress=progress, timeout=timeout,
-                notice=notice, load=load,
+                notice=notice, load=load, device=where,
             )  # fmt: skip
     if store is None and not load:
         raise InvalidParameterError("load=False needs a store to keep the results")
@@ -116,6 +125,15 @@ def run_sweep(
         progress(done_points, spec.n_points)
     # (what the dataset needs besides the results, done while the cores compute: MemoryStore.prepare)
     prepare = sink.prepare if load and isinstance(sink, MemoryStore) else None
+    if where == "gpu":  # (chunks of whole chains or single points: resolve_device refused the rest)
+        from grazing.gpu.batch import gpu_results
+
+        for res in then(gpu_results(spec, todo), prepare):
+            sink.write(res)
+            done_points += res.period.size
+            if progress is not None:
+                progress(done_points, spec.n_points)
+        return sink.dataset() if load else None
     if is_chained(spec):  # (the chunks of a chain: settled into the one chain's results)
         counted = [done_points]
 
@@ -222,6 +240,7 @@ def sweep(
     workers: int | None = None,
     client: Any = None,
     progress: Callable[[int, int], None] | None = None,
+    device: str = DEFAULT_DEVICE,
     **shorthands: Any,
 ) -> Any:
     """One-parameter brute-force bifurcation diagram.
@@ -243,7 +262,7 @@ def sweep(
         keyword arguments.
     zdm
         Iterate the discontinuity-map Poincare map instead of the flow.
-    store, workers, client, progress
+    store, workers, client, progress, device
         See :func:`run_sweep` (``store`` may be the path of a Zarr store).
     **shorthands
         Any field of :class:`~grazing.core.options.SweepSettings` by name
@@ -288,7 +307,7 @@ def sweep(
     settings = with_shorthands(settings, SweepSettings, shorthands, used)
     refuse_unknown("sweep", shorthands, used)
     spec = sweep_spec(model, param, values, x0=x0, direction=direction, settings=settings, zdm=zdm)
-    ds = run_sweep(spec, store=store, workers=workers, client=client, progress=progress)
+    ds = run_sweep(spec, store=store, workers=workers, client=client, progress=progress, device=device)
     return ds.sortby("value")
 
 
@@ -305,6 +324,7 @@ def parameter_map(
     workers: int | None = None,
     client: Any = None,
     progress: Callable[[int, int], None] | None = None,
+    device: str = DEFAULT_DEVICE,
     **shorthands: Any,
 ) -> Any:
     """Two-parameter period / impact / Lyapunov map.
@@ -339,6 +359,8 @@ def parameter_map(
         A :class:`dask.distributed.Client`: run the chunks on its cluster.
     progress
         Called as ``progress(points_done, points_total)``.
+    device
+        ``"cpu"`` (the default), ``"gpu"`` or ``"auto"``: see :func:`run_sweep`.
     **shorthands
         Any field of :class:`~grazing.core.options.SweepSettings` by name
         (``transient=300``, ``periods=40``, ``lyapunov=False`` ...), replacing
@@ -374,4 +396,4 @@ def parameter_map(
     settings = with_shorthands(settings or SweepSettings(chunk_size=0), SweepSettings, shorthands, used)
     refuse_unknown("parameter_map", shorthands, used)
     spec = map_spec(model, param1, values1, param2, values2, x0=x0, settings=settings)
-    return run_sweep(spec, store=store, workers=workers, client=client, progress=progress)
+    return run_sweep(spec, store=store, workers=workers, client=client, progress=progress, device=device)

@@ -168,12 +168,15 @@ class LaneBatch:
 
     def run(self) -> None:
         """Compute the batch's points (or, with other threads running it too, its share of them)."""
+        work = LaneJobs(self.jobs, self.control, self.x0, self.firsts, self.first_vf, self.x0_vf)
+        self.run_jobs(work)
+
+    def settings(self, jobs: int) -> LaneSettings:
+        """The driver's settings for a call over ``jobs`` jobs of this batch."""
         spec, kern, z = self._spec0, self._kern, self._spec0.zdm
         n = spec.model.n_states
-        settings = LaneSettings(
-            lanes=1
-            if len(self.jobs) == 1
-            else max(1, kern.LANES),  # (the lane functions' width, or one lane)
+        return LaneSettings(
+            lanes=1 if jobs == 1 else max(1, kern.LANES),  # (the lane functions' width, or one lane)
             fresh=self.fresh,
             periodic=bool(spec.model.periodic),
             transient=int(spec.transient),
@@ -189,7 +192,11 @@ class LaneBatch:
             zdm_window=float(z.window) if z is not None else 0.0,
             stop=int(z.stop) if z is not None else 0,
         )
-        work = LaneJobs(self.jobs, self.control, self.x0, self.firsts, self.first_vf, self.x0_vf)
+
+    def run_jobs(self, work: LaneJobs) -> None:
+        """Compute the points of the jobs ``work`` (this batch's, or some of its points as jobs of their own:
+        :mod:`grazing.gpu.batch`) into the batch's results."""
+        settings = self.settings(len(work.jobs))
         points = LanePoints(self.pvs, self.Ts, self.sphase, self.tcarry, self.zdms)
         out = LaneResults(
             self.samples,
@@ -201,7 +208,7 @@ class LaneBatch:
             self.status,
             self.vf_final,
         )
-        self._driver(kern.table, tuple(settings), tuple(work), tuple(points), tuple(out))
+        self._driver(self._kern.table, tuple(settings), tuple(work), tuple(points), tuple(out))
 
     def stop(self) -> None:
         """Have the threads running the batch return at their next step (unfinished points stay so)."""

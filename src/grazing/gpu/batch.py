@@ -1,0 +1,169 @@
+"""A sweep's chunks on the GPU: the CPU lanes' batch, its points computed by the CUDA kernel.
+
+:class:`GpuLaneBatch` is a :class:`~grazing.sweeps.run.LaneBatch` (the same
+table of points, jobs and result arrays, the same :meth:`results`: period
+detection, polishing and the :class:`~grazing.sweeps.spec.ChunkResult` records
+are the CPU's, not a copy) whose :meth:`run` launches
+:func:`grazing.gpu.kernel.build_kernel`'s kernel, one thread per job.  A job
+that reaches what the kernel does not do (complete chattering continued as
+sticking: :data:`~grazing.gpu.kernel.NEEDS_CPU`) is finished on the CPU lanes
+from that point on, from the state the GPU had reached there.
+
+Refused in one line (:class:`~grazing.errors.InvalidParameterError`) before
+anything runs: Lyapunov exponents, the discontinuity map and models with
+several modes (not on the GPU yet).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Iterator, Sequence
+
+import numpy as np
+
+from grazing.core.solution import Status
+from grazing.engine.records import LaneJobs
+from grazing.errors import InvalidParameterError
+from grazing.gpu.device import gpu_refusal
+from grazing.sweeps.run import LaneBatch
+from grazing.sweeps.spec import ChunkResult, SweepSpec
+from grazing.sweeps.status import NOT_COMPUTED
+
+THREADS_PER_BLOCK = 128
+"""CUDA threads per block of the sweep kernel."""
+BATCH_POINTS = 1 << 20
+"""Most points of one launch of :func:`gpu_results` (their samples: 1.6 GB at 100 periods of 2 states)."""
+MAX_THREADS = 1 << 17
+"""Most threads of one launch: each takes jobs until none is left, with a root-search work array of its
+own (33 kB: 4.4 GB for this many)."""
+
+
+class GpuLaneBatch(LaneBatch):
+    """A :class:`~grazing.sweeps.run.LaneBatch` computed by the GPU kernel (see the module).
+
+    ``threads`` caps the threads of a launch (default :data:`MAX_THREADS`).
+    """
+
+    def __init__(self, parts: Sequence[tuple[SweepSpec, int]], threads: int | None = None) -> None:
+        for spec, _ in parts:
+            why = gpu_refusal(spec)
+            if why is not None:
+                raise InvalidParameterError(why)
+        from grazing.gpu.target import require_target
+
+        require_target()
+        super().__init__(parts)
+        self.max_threads = MAX_THREADS if threads is None else max(1, int(threads))
+        self.cpu_points = 0
+        """Points the CPU lanes computed (from the first one that sticks to the end of its job)."""
+
+    def run(self) -> None:
+        """Compute the batch's points on the GPU (the rest of a job that sticks on the CPU lanes)."""
+        from grazing.engine.runner import step_safety
+        from grazing.engine.stepping import step_factor
+        from grazing.gpu.kernel import ROOT_WORK, keep_rows, sweep_kernel
+        from grazing.gpu.target import cuda_module
+
+        spec = self._spec0
+        cuda = cuda_module()
+        kernel = sweep_kernel(spec.model._def, self._order, keep_rows(spec.periods))
+        njobs = len(self.jobs)
+        threads = min(njobs, self.max_threads)
+        iset = np.array(
+            [self.fresh, spec.model.periodic, spec.transient, spec.periods, spec.adaptive], dtype=np.int64
+        )
+        factor = step_factor(step_safety(spec.tol, self._order), self._order)
+        fset = np.array([spec.adaptive_tol, factor, spec.chatter_tol], dtype=np.float64)
+        outputs = (self.samples, self.by_stop, self.used, self.x_final, self.t_final, self.status)
+        counter = np.zeros(1, dtype=np.int64)  # (the next job)
+        inputs = (self.jobs, counter, self.x0, self.firsts, self.pvs, self.Ts, self.sphase, self.tcarry)
+        d_in = [cuda.to_device(np.ascontiguousarray(a)) for a in inputs]
+        d_out = [cuda.to_device(a) for a in outputs]
+        work = cuda.device_array((threads, *ROOT_WORK), dtype=np.float64)
+        per_block = min(THREADS_PER_BLOCK, threads)
+        blocks = math.ceil(threads / per_block)
+        kernel[blocks, per_block](*d_in, *d_out, work, cuda.to_device(iset), cuda.to_device(fset))
+        cuda.synchronize()
+        for host, dev in zip(outputs, d_out):
+            dev.copy_to_host(host)
+        self._finish_on_cpu()
+
+    def _finish_on_cpu(self) -> None:
+        """The jobs the kernel left at a point that sticks: from that point on, on the CPU lanes."""
+        from grazing.gpu.kernel import NEEDS_CPU
+
+        stuck = np.flatnonzero(self.status == NEEDS_CPU)
+        if stuck.size == 0:
+            return
+        n = self.x0.shape[1]
+        job_of = np.searchsorted(self.jobs[:, 0], stuck, side="right") - 1
+        jobs = np.empty((stuck.size, 2), dtype=np.int64)
+        firsts = np.empty((stuck.size, 1 + n))
+        first_vf = np.zeros(stuck.size, dtype=np.int64)
+        for row, (p, job) in enumerate(zip(stuck, job_of)):
+            jobs[row] = (p, self.jobs[job, 1])
+            if p == self.jobs[job, 0]:
+                firsts[row] = self.firsts[job]
+                first_vf[row] = self.first_vf[job]
+            elif self.fresh or self.status[p - 1] != Status.OK:
+                firsts[row] = (0.0, *self.x0[job])
+                first_vf[row] = self.x0_vf[job]
+            else:  # (carried from the previous point's end, as the lanes carry it)
+                t0 = self.tcarry[p] if self._spec0.model.periodic else self.t_final[p - 1]
+                firsts[row] = (t0, *self.x_final[p - 1])
+                first_vf[row] = self.vf_final[p - 1]
+        self.status[stuck] = NOT_COMPUTED
+        self.cpu_points = int(sum(int(b - a) for a, b in jobs))
+        work = LaneJobs(
+            jobs, np.zeros(3, dtype=np.int64), np.ascontiguousarray(self.x0[job_of]), firsts, first_vf,
+            np.ascontiguousarray(self.x0_vf[job_of]),
+        )  # fmt: skip
+        self.run_jobs(work)
+
+
+def run_parts_gpu(parts: Sequence[tuple[SweepSpec, int]], threads: int | None = None) -> list[ChunkResult]:
+    """:func:`grazing.sweeps.run.run_parts` on the GPU: the chunks ``parts`` computed together; in order.
+
+    Examples
+    --------
+    >>> import grazing
+    >>> from grazing.sweeps.spec import sweep_spec
+    >>> spec = sweep_spec(grazing.models.pendulum("B"), "eta", [0.44, 0.45],
+    ...                   settings=grazing.SweepSettings(lyapunov=True))
+    >>> run_parts_gpu([(spec, 0)])  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    grazing.errors.InvalidParameterError: Lyapunov exponents are not computed on the GPU yet: ...
+    """
+    start = time.perf_counter()
+    batch = GpuLaneBatch(parts, threads)
+    batch.run()
+    results = batch.results(range(len(parts)))
+    seconds = time.perf_counter() - start
+    for res in results:
+        res.seconds = seconds / len(results)
+    return results
+
+
+def gpu_results(
+    spec: SweepSpec, indices: Sequence[int], max_points: int = BATCH_POINTS
+) -> Iterator[ChunkResult]:
+    """The results of the chunks ``indices`` of ``spec`` computed on the GPU, in that order, a batch of
+    at most ``max_points`` points at a time (at least one chunk)."""
+    group: list[int] = []
+    size = 0
+    for i in indices:
+        chunk = spec.chunk(i)
+        group.append(i)
+        size += chunk.stop - chunk.start
+        if size >= max_points:
+            yield from run_chunks_gpu(spec, group)
+            group, size = [], 0
+    if group:
+        yield from run_chunks_gpu(spec, group)
+
+
+def run_chunks_gpu(spec: SweepSpec, indices: Sequence[int], threads: int | None = None) -> list[ChunkResult]:
+    """:func:`grazing.sweeps.run.run_chunks` on the GPU: the chunks ``indices`` of ``spec``, in that order."""
+    return run_parts_gpu([(spec, i) for i in indices], threads)

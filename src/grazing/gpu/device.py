@@ -1,0 +1,94 @@
+"""Where a sweep runs: ``device="cpu"`` (the default), ``"gpu"`` or ``"auto"``, and what the GPU refuses.
+
+``"auto"`` is the CPU unless a CUDA device is present, the sweep has at least
+:data:`AUTO_MIN_POINTS` points and nothing in it is refused on the GPU
+(:func:`gpu_refusal`).  ``"gpu"`` where no device (and no simulator) is
+available, or on a sweep the GPU does not do yet, is an error of one line.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from grazing.errors import InvalidParameterError
+
+DEVICES = ("cpu", "gpu", "auto")
+"""The values of ``device``."""
+DEFAULT_DEVICE = "cpu"
+"""Where a sweep runs unless told otherwise."""
+AUTO_MIN_POINTS = 20_000
+"""Fewest points for which ``device="auto"`` takes a present GPU (fewer finish in seconds on the cores)."""
+
+
+def gpu_refusal(spec: Any) -> str | None:
+    """Why the sweep ``spec`` cannot run on the GPU yet (one line), or None."""
+    if spec.lyapunov:
+        return (
+            "Lyapunov exponents are not computed on the GPU yet: go without them (lyapunov=False) or run on "
+            "the CPU (device=)"
+        )
+    if spec.zdm is not None:
+        return "the discontinuity map is not on the GPU yet: run on the CPU (device=)"
+    if spec.model.n_modes > 1:
+        return "models with several modes are not on the GPU yet: run on the CPU (device=)"
+    return None
+
+
+def chain_refusal(spec: Any) -> str | None:
+    """Why ``spec``'s chunks cannot run on the GPU (chains of several chunks, one line), or None."""
+    if spec.carried and spec.n_chunks > spec.segments:
+        return (
+            "a chain of several chunks runs one chunk after the other: on the GPU start every point afresh "
+            "(fresh=True) or make each chain one chunk (chunk_size=: 0), or run on the CPU (device=)"
+        )
+    return None
+
+
+def check_device(device: str, client: Any = None) -> None:
+    """One line (:class:`~grazing.errors.InvalidParameterError`, or
+    :class:`~grazing.gpu.target.NoDeviceError`) unless ``device`` can be used at all."""
+    from grazing.gpu.target import require_target
+
+    if device not in DEVICES:
+        raise InvalidParameterError(f"device must be 'cpu', 'gpu' or 'auto', got {device!r}")
+    if device == "gpu":
+        if client is not None:
+            raise InvalidParameterError("the GPU runs on this machine: give no Dask client (client=)")
+        require_target()
+
+
+def spec_device(device: str, spec: Any, client: Any = None) -> str:
+    """``"cpu"`` or ``"gpu"``: where one of several sweeps of a computation runs (``device`` checked by
+    :func:`check_device`): the GPU for ``"gpu"``, or ``"auto"`` with a device present and a large sweep,
+    unless it has what the GPU does not do yet (:func:`gpu_refusal`, :func:`chain_refusal`: then the CPU).
+    """
+    from grazing.gpu.target import device_present
+
+    if device == "cpu" or client is not None or (gpu_refusal(spec) or chain_refusal(spec)) is not None:
+        return "cpu"
+    if device == "gpu":
+        return "gpu"
+    return "gpu" if spec.n_points >= AUTO_MIN_POINTS and device_present() else "cpu"
+
+
+def resolve_device(device: str, spec: Any, client: Any = None) -> str:
+    """``"cpu"`` or ``"gpu"``: where ``spec`` runs for ``device`` (see the module).
+
+    Examples
+    --------
+    >>> import grazing
+    >>> from grazing.sweeps.spec import sweep_spec
+    >>> spec = sweep_spec(grazing.models.pendulum("B"), "eta", [0.44, 0.45])
+    >>> resolve_device("auto", spec), resolve_device("cpu", spec)
+    ('cpu', 'cpu')
+    >>> resolve_device("tpu", spec)
+    Traceback (most recent call last):
+    ...
+    grazing.errors.InvalidParameterError: device must be 'cpu', 'gpu' or 'auto', got 'tpu'
+    """
+    if device == "gpu" and client is None:
+        why = gpu_refusal(spec) or chain_refusal(spec)
+        if why is not None:
+            raise InvalidParameterError(why)
+    check_device(device, client)
+    return spec_device(device, spec, client)

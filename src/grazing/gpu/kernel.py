@@ -1,0 +1,368 @@
+"""The sweep kernel: one CUDA thread per job (a run of points, one point in a fresh sweep).
+
+A thread takes the next job from a counter (as the CPU lanes take theirs) and
+computes its points with the CPU lanes' protocol
+(:mod:`grazing.engine.driver.lanes`): the transient in blocks of
+:data:`~grazing.core.options.ADAPTIVE_BLOCK` periods, stopped once the samples
+repeat (``adaptive``), then ``periods`` sampled periods; each point of a job
+from the previous one's final state unless ``fresh`` or the previous point
+failed.  A step is the CPU's: the model's Taylor coefficients (its generated
+``tc_free``), the Jorba-Zou step from their last two terms (``step_size``),
+the step cut at the request's last sample, every guard's Taylor polynomial
+over the step searched for its certified first root (``event_polynomial``,
+the quadratic certificate, then Bernstein subdivision and the check that the
+root is the first), samples from the step's polynomials, the state advanced
+to the accepted part, and at an event the stop's reset.  The helpers are the
+CPU's own code as device functions (:mod:`grazing.gpu.ported`).
+
+Not on the GPU yet: sticking (a chattering sequence that the CPU would sum
+and continue as sticking ends the thread's job with :data:`NEEDS_CPU` at that
+point; :mod:`grazing.gpu.batch` computes the rest of the job on the CPU
+lanes), Lyapunov exponents, the discontinuity map and models with several
+modes (refused before a launch).
+
+Each thread's arrays are local (sized by the model: constants of the
+compiled kernel) except the root search's work array, one slice per thread of
+a global array the caller allocates; nothing is allocated in a kernel.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from numba import cuda  # (the simulator's, where NUMBA_ENABLE_CUDASIM=1: a global, which it swaps in kernels)
+
+from grazing.core.options import ADAPTIVE_BLOCK, ADAPTIVE_MAX_PERIOD
+from grazing.core.solution import Status
+from grazing.engine.polyroots import work_shape
+from grazing.engine.stepping import GUARD_SCALE
+
+NEEDS_CPU = -2
+"""A point's status when it needs what the kernel does not do (sticking): the CPU lanes compute it."""
+
+# The run state of a thread: integer fields of ``st``, float fields of ``sf`` (lanes' RUN_STATE names).
+K, KS, ISAMP, N_SAMPLES, N_KEEP, RECORDING, STEPS, MAX_STEPS, ZERO_EVENTS, DEFL, DEFL_STOP = range(11)
+STAGE, BLOCK, USED, REQ_KS = 11, 12, 13, 14
+INT_FIELDS = 15
+S, SS, REQ_SS = 0, 1, 2
+FLOAT_FIELDS = 3
+TRANSIENT, EXTRA, FINAL = 1, 2, 3
+"""A point's stages (as the lanes')."""
+
+# The settings arrays: integers, floats.
+FRESH, PERIODIC, TRANSIENT_PERIODS, PERIODS, ADAPTIVE = range(5)
+ADAPTIVE_TOL, FACTOR, CHATTER_TOL = range(3)
+
+STATUS_OK = int(Status.OK)
+STATUS_STEP_LIMIT = int(Status.STEP_LIMIT)
+STATUS_NONFINITE = int(Status.NONFINITE)
+STATUS_ZENO = int(Status.ZENO)
+
+ROOT_WORK = work_shape(0)
+"""The shape of one thread's work array of the root search."""
+
+
+def keep_rows(periods: int) -> int:
+    """Rows of a thread's sample buffer: the sampled periods, or an adaptive block (as the lanes')."""
+    return max(int(periods), ADAPTIVE_BLOCK)
+
+
+_kernels: dict[tuple[str, int, int], Any] = {}
+
+
+def sweep_kernel(definition: Any, order: int, keep: int) -> Any:
+    """The kernel of a model definition at Taylor ``order`` with ``keep`` sample rows, built once."""
+    from grazing.gpu.model import model_functions
+
+    key = (definition.identity(), int(order), int(keep))
+    if key not in _kernels:
+        _kernels[key] = build_kernel(model_functions(definition, order), keep)
+    return _kernels[key]
+
+
+def build_kernel(dm: Any, keep: int) -> Any:
+    """The sweep kernel of the device model ``dm`` (:class:`~grazing.gpu.model.DeviceModel`).
+
+    ``kernel[blocks, threads](jobs, control, x0, firsts, pvs, Ts, sphase,
+    tcarry, samples, by_stop, used, x_final, t_final, status, work, iset,
+    fset)``: the arrays of :class:`~grazing.engine.records.LaneJobs`,
+    :class:`~grazing.engine.records.LanePoints` and
+    :class:`~grazing.engine.records.LaneResults` (``control[0]`` the next job,
+    0 at the start), ``work`` the root search's arrays (one per thread),
+    ``iset`` and ``fset`` the settings (the module's ``FRESH ...`` and
+    ``ADAPTIVE_TOL ...`` positions).
+    """
+    from grazing.gpu.ported import device_helpers
+
+    dj = cuda.jit(device=True)
+    helpers = device_helpers()
+    step_size = helpers["step_size"]
+    event_polynomial = helpers["event_polynomial"]
+    event_certificate = helpers["event_certificate"]
+    isolate_first_root = helpers["isolate_first_root"]
+    confirm_first_root = helpers["confirm_first_root"]
+    eval_rows = helpers["eval_rows"]
+    repeats_with_period = helpers["repeats_with_period"]
+    step_limit = helpers["step_limit"]
+    start_times = helpers["start_times"]
+    tc_free = dm.functions["tc_free"]
+    reset = dm.functions["reset"]
+    normal_rate = dm.functions["normal_rate"]
+    normal_accel = dm.functions["normal_accel"]
+    NX, NSTOPS, ORDER = dm.nx, dm.nstops, dm.order
+    KC = ORDER + 1
+    KEEP = int(keep)
+    STICKS = np.array(dm.sticks, dtype=np.int64)
+    from numba import types
+
+    float64, int64 = types.float64, types.int64
+
+    @dj
+    def first_event(O, h, defl, defl_stop, a, work):
+        """The first event on the step over every stop: ``(u, stop)``, ``u < 0`` none (``events.first_event``
+        for one mode, free flight, nothing skipped)."""
+        u = -1.0
+        stop = 0
+        for r in range(NSTOPS):
+            defl_r = defl if r == defl_stop else 0
+            deg, tail = event_polynomial(O, r, h, 0, defl_r, False, a, ORDER)
+            ur = event_certificate(a, tail)
+            if ur > 0.0:
+                ur = confirm_first_root(a, deg, isolate_first_root(a, deg, work), work)
+            if ur >= 0.0 and (u < 0.0 or ur < u):
+                u = ur
+                stop = r
+        return u, stop
+
+    @dj
+    def chatter_remaining(x, s, pv, j, speed, chatter_time):
+        """The time to the accumulation point of chattering on stop ``j``, or -1 (``impacts``')."""
+        w = normal_rate(x, s, pv, j)
+        acc = normal_accel(x, s, pv, j)
+        if not acc < 0.0:
+            return -1.0
+        if speed <= 0.0 or w <= 0.0:
+            return 0.0
+        ratio = w / speed
+        if ratio < 1.0:
+            dt_acc = 2.0 * w / (-acc * (1.0 - ratio))
+            if dt_acc < chatter_time:
+                return dt_acc
+        return -1.0
+
+    @dj
+    def begin_request(st, sf, periods, keep_n):
+        """Start a request of ``periods`` samples keeping the last ``keep_n`` (``lanes.begin_request``)."""
+        st[N_SAMPLES] = periods
+        st[N_KEEP] = keep_n
+        st[ISAMP] = 0
+        st[RECORDING] = 1 if periods - keep_n == 0 else 0
+        st[STEPS] = 0
+        st[MAX_STEPS] = step_limit(periods)
+        st[ZERO_EVENTS] = 0
+        st[DEFL] = 0
+        st[KS] = st[REQ_KS]
+        sf[SS] = sf[REQ_SS]
+
+    @dj
+    def take_samples(st, sf, X, T, h_acc, event, is_last, buf, xe, wrap):
+        """The samples within ``(0, h_acc]`` of the step (``recording.take_samples`` in free flight)."""
+        n_samples = st[N_SAMPLES]
+        keep_from = n_samples - st[N_KEEP]
+        while st[ISAMP] < n_samples:
+            dt = (st[KS] - st[K]) * T + (sf[SS] - sf[S])
+            if dt > h_acc or (event and dt == h_acc and not is_last):
+                break
+            if is_last and st[ISAMP] == n_samples - 1:
+                dt = h_acc
+            if st[ISAMP] >= keep_from:
+                eval_rows(X, NX, ORDER, dt, xe)
+                for i in range(NX):
+                    buf[st[ISAMP] - keep_from, i] = xe[i]
+            st[ISAMP] += 1
+            if wrap:
+                st[KS] += 1
+            else:
+                sf[SS] += T
+            if st[ISAMP] == keep_from and st[RECORDING] == 0 and st[N_KEEP] > 0:
+                st[RECORDING] = 1
+
+    @dj
+    def run_request(st, sf, x, pv, T, wrap, final, fset, X, O, a, xe, xp, buf, counts, work):
+        """Steps until the request's last sample; returns the point's status (OK: go on)."""
+        factor = fset[FACTOR]
+        chatter_time = fset[CHATTER_TOL] * T
+        while st[ISAMP] < st[N_SAMPLES]:
+            if st[STEPS] >= st[MAX_STEPS]:
+                return STATUS_STEP_LIMIT
+            for i in range(NX):
+                if not math.isfinite(x[i]):
+                    return STATUS_NONFINITE
+            s = sf[S]
+            tc_free(x, s, pv, X, O)
+            h = step_size(X, NX, O, NSTOPS, 0, GUARD_SCALE, ORDER, T, factor)
+            rem = (st[KS] - st[K]) * T + (sf[SS] - s)  # (step.step_end)
+            last = False
+            if st[ISAMP] == st[N_SAMPLES] - 1 and h >= rem:
+                h = rem
+                last = True
+            u, ev_stop = first_event(O, h, st[DEFL], st[DEFL_STOP], a, work)
+            event = u >= 0.0 and h > 0.0  # (step.accept_step)
+            if event and u == 0.0:
+                st[ZERO_EVENTS] += 1
+                if st[ZERO_EVENTS] > 3:
+                    return STATUS_ZENO
+            else:
+                st[ZERO_EVENTS] = 0
+            h_acc = u * h if event else h
+            if event and last and u >= 1.0:
+                event = False
+            if (st[KS] - st[K]) * T + (sf[SS] - s) <= h_acc:
+                take_samples(st, sf, X, T, h_acc, event, last, buf, xe, wrap)
+            recording = st[RECORDING]
+            eval_rows(X, NX, ORDER, h_acc, x)  # (the lanes' advance)
+            sf[S] = s + h_acc  # (step.end_step)
+            if wrap and sf[S] >= T:
+                sf[S] -= T
+                st[K] += 1
+            st[STEPS] += 1
+            st[DEFL] = 0
+            if event:  # an impact on stop ev_stop (impacts.at_event, apply_impact)
+                s = sf[S]
+                vn = normal_rate(x, s, pv, ev_stop)
+                reset(x, s, pv, xp, ev_stop)
+                for i in range(NX):
+                    x[i] = xp[i]
+                st[DEFL] = 1
+                st[DEFL_STOP] = ev_stop
+                if STICKS[ev_stop] != 0 and chatter_remaining(x, s, pv, ev_stop, -vn, chatter_time) >= 0.0:
+                    return NEEDS_CPU  # (complete chattering, then sticking: not on the GPU yet)
+                if recording != 0 and final:
+                    counts[ev_stop] += 1
+        return STATUS_OK
+
+    @dj
+    def run_point(st, sf, x, pv, T, iset, fset, X, O, a, xe, xp, buf, counts, work):
+        """The point's protocol (``lanes.take_point``, ``end_request``); returns its status."""
+        wrap = iset[PERIODIC] != 0
+        budget = iset[TRANSIENT_PERIODS]
+        periods = iset[PERIODS]
+        adaptive = iset[ADAPTIVE] != 0
+        for j in range(NSTOPS):
+            counts[j] = 0
+        st[USED] = 0
+        if budget > 0:
+            blk = min(ADAPTIVE_BLOCK, budget)
+            st[BLOCK] = blk
+            st[STAGE] = TRANSIENT
+            begin_request(st, sf, blk, blk if adaptive else 0)
+        else:
+            st[STAGE] = FINAL
+            begin_request(st, sf, periods, periods)
+        while True:
+            status = run_request(st, sf, x, pv, T, wrap, st[STAGE] == FINAL, fset, X, O, a, xe, xp, buf,
+                                 counts, work)  # fmt: skip
+            if status != STATUS_OK:
+                return status
+            if wrap:
+                st[REQ_KS] += st[N_SAMPLES]
+            else:
+                sf[REQ_SS] += st[N_SAMPLES] * T
+            stage = st[STAGE]
+            if stage == FINAL:
+                return STATUS_OK
+            if stage == EXTRA:
+                st[STAGE] = FINAL
+                begin_request(st, sf, periods, periods)
+                continue
+            blk = st[BLOCK]
+            st[USED] += blk
+            used = st[USED]
+            nxt = -1
+            if adaptive and blk == ADAPTIVE_BLOCK:
+                per = repeats_with_period(buf, blk, fset[ADAPTIVE_TOL], ADAPTIVE_MAX_PERIOD)
+                if per > 0:
+                    extra = (budget - used) % per
+                    if extra:
+                        st[USED] += extra
+                        st[STAGE] = EXTRA
+                        begin_request(st, sf, extra, 0)
+                        continue
+                    nxt = 0
+            if nxt < 0 and used < budget:
+                blk = min(ADAPTIVE_BLOCK, budget - used)
+                st[BLOCK] = blk
+                begin_request(st, sf, blk, blk if adaptive else 0)
+                continue
+            st[STAGE] = FINAL
+            begin_request(st, sf, periods, periods)
+
+    @cuda.jit
+    def kernel(jobs, control, x0, firsts, pvs, Ts, sphase, tcarry, samples, by_stop, used, x_final, t_final,
+               status, work, iset, fset):  # fmt: skip
+        tid = cuda.grid(1)
+        if tid >= work.shape[0]:
+            return
+        st = cuda.local.array(INT_FIELDS, int64)
+        sf = cuda.local.array(FLOAT_FIELDS, float64)
+        x = cuda.local.array(NX, float64)
+        X = cuda.local.array((NX, KC), float64)
+        O = cuda.local.array((NSTOPS, KC), float64)
+        a = cuda.local.array(KC, float64)
+        xe = cuda.local.array(NX, float64)
+        xp = cuda.local.array(NX, float64)
+        buf = cuda.local.array((KEEP, NX), float64)
+        counts = cuda.local.array(NSTOPS, int64)
+        mine = work[tid]
+        periods = iset[PERIODS]
+        while True:
+            job = cuda.atomic.add(control, 0, 1)
+            if job >= jobs.shape[0]:
+                return
+            ok = False
+            for p in range(jobs[job, 0], jobs[job, 1]):
+                T = Ts[p]
+                if p == jobs[job, 0]:
+                    for i in range(NX):
+                        x[i] = firsts[job, 1 + i]
+                    t0 = firsts[job, 0]
+                elif iset[FRESH] != 0 or not ok:
+                    for i in range(NX):
+                        x[i] = x0[job, i]
+                    t0 = 0.0
+                elif iset[PERIODIC] != 0:  # (the previous point's end: its state and time)
+                    t0 = tcarry[p]
+                else:
+                    t0 = t_final[p - 1]
+                k0, s0, ks0, ss0 = start_times(t0, T, sphase[p], iset[PERIODIC] != 0)
+                st[K] = k0
+                sf[S] = s0
+                st[REQ_KS] = ks0
+                sf[REQ_SS] = ss0
+                code = run_point(st, sf, x, pvs[p], T, iset, fset, X, O, a, xe, xp, buf, counts, mine)
+                if code == STATUS_OK:  # (lanes.finish_point)
+                    for i in range(NX):
+                        if not math.isfinite(x[i]):
+                            code = STATUS_NONFINITE
+                    for r in range(periods):
+                        for c in range(NX):
+                            if not math.isfinite(buf[r, c]):
+                                code = STATUS_NONFINITE
+                if code == STATUS_OK:
+                    for r in range(periods):
+                        for c in range(NX):
+                            samples[p, r, c] = buf[r, c]
+                    for j in range(NSTOPS):
+                        by_stop[p, j] = counts[j]
+                    used[p] = st[USED]
+                    for i in range(NX):
+                        x_final[p, i] = x[i]
+                    t_final[p] = st[K] * T + sf[S]
+                status[p] = code
+                if code == NEEDS_CPU:
+                    break  # (the rest of the job goes to the CPU)
+                ok = code == STATUS_OK
+
+    return kernel

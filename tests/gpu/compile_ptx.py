@@ -1,0 +1,62 @@
+"""Compile the sweep kernel of built-in one-mode models to PTX for a GPU, without a GPU (a manual check).
+
+Needs numba-cuda and NVVM (the ``nvidia-cuda-nvcc-cu12`` and ``nvidia-cuda-nvrtc-cu12`` wheels; their
+``lib`` folders on ``LD_LIBRARY_PATH``).  numba compiles a device function for the current device's
+compute capability; with no device, that is taken to be ``--cc`` (9.0: an H100).  Typing, lowering and
+NVVM's compilation to PTX are the device's: a construct the device cannot compile fails here.
+
+    python tests/gpu/compile_ptx.py pendulum impact_oscillator bouncing_ball --cc 9.0
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+import types as pytypes
+
+import grazing
+from grazing.engine.codegen import taylor_order
+from grazing.gpu.kernel import build_kernel, keep_rows
+from grazing.gpu.model import model_functions
+
+
+def kernel_signature() -> tuple[object, ...]:
+    """The argument types of the sweep kernel (:func:`grazing.gpu.kernel.build_kernel`)."""
+    from numba import types
+
+    f8, i8 = types.float64, types.int64
+
+    def array(t: object, nd: int) -> object:
+        return types.Array(t, nd, "C")
+
+    return (array(i8, 2), array(i8, 1), array(f8, 2), array(f8, 2), array(f8, 2), array(f8, 1),
+            array(f8, 1), array(f8, 1), array(f8, 3), array(i8, 2), array(i8, 1), array(f8, 2),
+            array(f8, 1), array(i8, 1), array(f8, 3), array(i8, 1), array(f8, 1))  # fmt: skip
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("models", nargs="*", default=["pendulum", "impact_oscillator", "bouncing_ball"])
+    parser.add_argument("--cc", default="9.0", help="compute capability (default 9.0)")
+    parser.add_argument("--tol", type=float, default=1e-10, help="the tolerance, for the Taylor order")
+    args = parser.parse_args()
+    from numba import cuda
+
+    cc = tuple(int(v) for v in args.cc.split("."))
+    try:
+        cuda.get_current_device()
+    except Exception:  # (no device: its compute capability is --cc)
+        import numba.cuda.dispatcher as dispatcher
+
+        dispatcher.get_current_device = lambda: pytypes.SimpleNamespace(compute_capability=cc)
+    for name in args.models:
+        model = getattr(grazing.models, name)()
+        kernel = build_kernel(model_functions(model._def, taylor_order(args.tol)), keep_rows(100))
+        start = time.perf_counter()
+        ptx, _ = cuda.compile_ptx(kernel.py_func, kernel_signature(), cc=cc)
+        seconds = time.perf_counter() - start
+        print(f"{name}: PTX for sm_{cc[0]}{cc[1]}, {len(ptx)} characters, {seconds:.1f} s")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,174 @@
+"""Sweeps on the CPU lanes and on the GPU kernel under numba's CUDA simulator, side by side (run as a script).
+
+Run by ``tests/gpu/test_simulator.py`` in a process of its own with ``NUMBA_ENABLE_CUDASIM=1`` (set
+before numba is imported: the simulator must not leak into other tests).  Prints one JSON object: per
+case, both sides' periods, impacts by stop, statuses, transient periods used, the largest difference of
+their samples and final states, and how many points the GPU batch handed to the CPU (sticking).
+A few points and a few periods each: the simulator runs every CUDA thread as a Python thread.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import sys
+
+import numpy as np
+
+import grazing
+from grazing.gpu.batch import GpuLaneBatch
+from grazing.sweeps.run import run_parts
+from grazing.sweeps.spec import map_spec, sweep_spec
+
+SHORT = {"transient": 64, "periods": 16, "lyapunov": False}
+
+
+def cases() -> dict[str, list[tuple[object, int]]]:
+    """Each case's chunks: ``(spec, chunk index)`` pairs that share a batch."""
+    B40 = grazing.models.pendulum("B", theta_hat=math.radians(40))
+    fresh = grazing.SweepSettings(**SHORT, fresh=True)
+    chained = grazing.SweepSettings(**SHORT, fresh=False, chunk_size=3, phase=1.0)
+    equal_work = grazing.SweepSettings(**SHORT, fresh=True, adaptive=False, tol=1e-10, chunk_size=0)
+    out = {
+        # fig 7's first grazing at 40 degrees: period 1 free of the stop, period 4, chaos (case B)
+        "pendulum B fresh": [(sweep_spec(B40, "eta", np.linspace(0.44, 0.46, 4), settings=fresh), 0)],
+        # case C, each point from the previous one's end, two chains (chunks) in one batch, sampled at phase 1
+        "pendulum C chained": [
+            (spec, i)
+            for spec in [
+                sweep_spec(
+                    grazing.models.pendulum("C", theta_hat=math.radians(30)),
+                    "eta",
+                    np.linspace(0.40, 0.50, 6),
+                    settings=chained,
+                )
+            ]
+            for i in range(2)
+        ],
+        # the equal-work map's settings (no adaptive transient, tol 1e-10), eta x theta_hat, case A
+        "pendulum A map": [
+            (
+                map_spec(
+                    grazing.models.pendulum("A"),
+                    "eta",
+                    [0.44, 0.47],
+                    "theta_hat",
+                    [math.radians(30), math.radians(40)],
+                    settings=equal_work,
+                ),
+                i,
+            )
+            for i in range(2)
+        ],
+        # a point that blows up (status non-finite) between two that do not
+        "pendulum huge forcing": [
+            (sweep_spec(B40, "alpha", [0.2254, 1e300], settings=fresh), 0),
+        ],
+        "impact oscillator": [
+            (sweep_spec(grazing.models.impact_oscillator(), "omega", [2.6, 2.8, 3.0], settings=fresh), 0)
+        ],
+        # chattering continued as sticking from the third point on: the GPU hands the rest of the chain to the
+        # CPU lanes, from the state it carried
+        "bouncing ball": [
+            (
+                sweep_spec(
+                    grazing.models.bouncing_ball(),
+                    "amplitude",
+                    [1.2, 1.5, 2.0, 2.5],
+                    x0=[0.0, 3.0],
+                    settings=grazing.SweepSettings(**SHORT, chunk_size=4),
+                ),
+                0,
+            )
+        ],
+    }
+    return out
+
+
+def compare(parts: list[tuple[object, int]]) -> dict[str, object]:
+    """Both sides of one case."""
+    cpu = run_parts(parts)
+    batch = GpuLaneBatch(parts)
+    batch.run()
+    gpu = batch.results(range(len(parts)))
+    row: dict[str, object] = {"cpu_points": batch.cpu_points}
+    for name in ("period", "impacts_by_stop", "status", "transient_used", "impacts"):
+        row[f"cpu_{name}"] = np.concatenate([getattr(r, name) for r in cpu]).tolist()
+        row[f"gpu_{name}"] = np.concatenate([getattr(r, name) for r in gpu]).tolist()
+    for name in ("samples", "x_final"):
+        a = np.concatenate([getattr(r, name) for r in cpu])
+        b = np.concatenate([getattr(r, name) for r in gpu])
+        same_nans = np.array_equal(np.isnan(a), np.isnan(b))  # (a NaN on one side only: inf)
+        row[f"{name}_diff"] = float(np.nanmax(np.abs(a - b), initial=0.0)) if same_nans else math.inf
+    return row
+
+
+def foreign_names() -> list[str]:
+    """Names the device code reads that are neither device functions nor constants (nor ``math``)."""
+    import types
+
+    from grazing.gpu.model import model_functions
+    from grazing.gpu.ported import device_helpers
+
+    def python_function(obj: object) -> object:
+        return getattr(obj, "py_func", None) or getattr(obj, "fn", None)
+
+    found = set()
+    spaces = [device_helpers()["namespace"]]
+    for model in (grazing.models.pendulum("B"), grazing.models.bouncing_ball()):
+        fns = model_functions(model._def, 13).functions
+        spaces.append(python_function(next(iter(fns.values()))).__globals__)
+    for space in spaces:
+        for value in list(space.values()):
+            fn = python_function(value)
+            if not isinstance(fn, types.FunctionType) or fn.__module__ == "grazing.gpu.target":
+                continue  # (target's are the simulator's forms of libdevice calls)
+            for name in fn.__code__.co_names:
+                obj = fn.__globals__.get(name)
+                device = python_function(obj) is not None
+                constant = isinstance(obj, (int, float, np.ndarray)) or obj is math
+                if name in fn.__globals__ and not (device or constant):
+                    found.add(f"{fn.__name__}: {name}")
+    return sorted(found)
+
+
+def api_map() -> dict[str, object]:
+    """``parameter_map(device="gpu")`` against ``device="cpu"``: every variable of the two datasets."""
+    from grazing.sweeps import parameter_map
+
+    args = (grazing.models.pendulum("B"), "eta", [0.44, 0.46], "theta_hat", np.radians([30.0, 40.0]))
+    kw = {"transient": 64, "periods": 16, "lyapunov": False, "workers": 1}
+    cpu = parameter_map(*args, **kw, device="cpu")
+    gpu = parameter_map(*args, **kw, device="gpu")
+    differ = sorted(name for name in cpu.data_vars if not cpu[name].equals(gpu[name]))
+    return {"differ": differ, "variables": sorted(cpu.data_vars), "period": cpu.period.values.tolist()}
+
+
+def api_basins() -> dict[str, object]:
+    """``basins(device="gpu")`` against ``device="cpu"`` (the refined runs with Lyapunov exponents on the
+    CPU either way): every variable of the two datasets."""
+    from grazing.attractors import basins
+
+    model = grazing.models.pendulum("B", eta=0.446, theta_hat=math.radians(40))
+    args = (model, (-1.5, math.radians(40)), (-2.0, 2.0), (3, 3))
+    kw = {"transient": 64, "periods": 16, "workers": 1}
+    cpu = basins(*args, **kw, device="cpu")
+    gpu = basins(*args, **kw, device="gpu")
+    differ = sorted(name for name in cpu.data_vars if not cpu[name].equals(gpu[name]))
+    return {"differ": differ, "variables": sorted(cpu.data_vars), "kinds": cpu.kind.values.tolist()}
+
+
+def main(names: list[str]) -> None:
+    table = cases()
+    out: dict[str, object] = {name: compare(table[name]) for name in (names or list(table))}
+    out["foreign names"] = foreign_names()
+    out["api map"] = api_map()
+    out["api basins"] = api_basins()
+    print(json.dumps(out))
+
+
+if __name__ == "__main__":
+    if os.environ.get("NUMBA_ENABLE_CUDASIM") != "1":
+        sys.exit("run with NUMBA_ENABLE_CUDASIM=1 (set before numba is imported)")
+    main(sys.argv[1:])

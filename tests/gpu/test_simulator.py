@@ -1,0 +1,136 @@
+"""The GPU kernel's logic under numba's CUDA simulator: its sweeps equal the CPU lanes' at every point.
+
+The simulator runs each CUDA thread as a Python thread executing the kernel's Python text; the
+model's functions are the same generated text as the CPU's compiled code, with grazing's own sin and
+cos, and the step size and event location are the CPU driver's own functions.  So in the simulator
+the GPU does the CPU's arithmetic: periods, impacts per stop, statuses and transient periods must be
+equal and the samples and final states equal to the bit (:data:`SAMPLE_TOL`; on a device, where the
+compiler fuses multiply-adds, ``test_device.py`` allows more).  The cases run in one process of their
+own with ``NUMBA_ENABLE_CUDASIM=1`` (``simulator_cases.py``), so the simulator never reaches another
+test.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from grazing.errors import InvalidParameterError
+
+SAMPLE_TOL = 0.0
+"""Largest difference of the samples (and final states) of the GPU in the simulator and the CPU lanes."""
+
+CASES = ("pendulum B fresh", "pendulum C chained", "pendulum A map", "pendulum huge forcing",
+         "impact oscillator", "bouncing ball")  # fmt: skip
+ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture(scope="module")
+def compared() -> dict[str, dict[str, object]]:
+    """Every case's CPU and GPU results (one process under the simulator)."""
+    env = {**os.environ, "NUMBA_ENABLE_CUDASIM": "1", "PYTHONWARNINGS": "ignore"}
+    env["PYTHONPATH"] = os.pathsep.join(p for p in (str(ROOT / "src"), str(ROOT), env.get("PYTHONPATH")) if p)
+    proc = subprocess.run(
+        [sys.executable, str(Path(__file__).with_name("simulator_cases.py"))],
+        capture_output=True, text=True, env=env, timeout=300,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    return json.loads(proc.stdout.strip().splitlines()[-1])  # type: ignore[no-any-return]
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_the_gpu_equals_the_cpu_lanes_at_every_point(
+    compared: dict[str, dict[str, object]], case: str
+) -> None:
+    row = compared[case]
+    for name in ("period", "impacts_by_stop", "status", "transient_used", "impacts"):
+        assert row[f"gpu_{name}"] == row[f"cpu_{name}"], name
+    assert row["samples_diff"] <= SAMPLE_TOL
+    assert row["x_final_diff"] <= SAMPLE_TOL
+
+
+def test_the_cases_reach_what_they_are_for(compared: dict[str, dict[str, object]]) -> None:
+    """The cases are not trivially equal: impacts, chaos (period 0), a failed point, several periods."""
+    assert compared["pendulum B fresh"]["cpu_period"] == [1, 0, 3, 0]  # (fig 7 at 40 degrees, case B)
+    assert compared["pendulum huge forcing"]["cpu_status"] == [0, 2]  # (non-finite state)
+    assert all(sum(map(sum, compared[case]["cpu_impacts_by_stop"])) > 0 for case in CASES)
+    assert len(set(compared["pendulum C chained"]["cpu_period"])) >= 3
+
+
+def test_only_a_chain_that_sticks_goes_to_the_cpu(compared: dict[str, dict[str, object]]) -> None:
+    """Sticking is not on the GPU: the bouncing ball's chain is finished on the CPU lanes from its third
+    point (two points), from the state the GPU carried there; every other case is the GPU's alone."""
+    assert compared["bouncing ball"]["cpu_points"] == 2
+    assert all(compared[case]["cpu_points"] == 0 for case in CASES if case != "bouncing ball")
+
+
+def test_the_ported_code_calls_only_device_functions(compared: dict[str, dict[str, object]]) -> None:
+    """Every name the device code reads is a device function, a constant or ``math`` (a CPU function
+    there would run in the simulator but not compile for a device)."""
+    assert compared["foreign names"] == []
+
+
+def test_parameter_map_on_the_gpu_is_the_same_dataset(compared: dict[str, dict[str, object]]) -> None:
+    """``parameter_map(device="gpu")``: every variable equals ``device="cpu"``'s (shared downstream)."""
+    row = compared["api map"]
+    assert {"period", "samples", "status", "impacts"} <= set(row["variables"])
+    assert row["differ"] == []
+    assert len({p for line in row["period"] for p in line}) >= 2  # (not all alike)
+
+
+def test_basins_on_the_gpu_are_the_same_dataset(compared: dict[str, dict[str, object]]) -> None:
+    """``basins(device="gpu")``: every variable equals ``device="cpu"``'s."""
+    row = compared["api basins"]
+    assert {"label", "fraction", "kind", "period"} <= set(row["variables"])
+    assert row["differ"] == []
+
+
+def test_the_simulator_does_not_leak_into_this_process() -> None:
+    from numba import config
+
+    assert os.environ.get("NUMBA_ENABLE_CUDASIM") != "1"
+    assert not config.ENABLE_CUDASIM
+
+
+def test_what_the_gpu_does_not_do_yet_is_refused_in_one_line() -> None:
+    import grazing
+    from grazing.gpu.batch import GpuLaneBatch
+    from grazing.sweeps.spec import sweep_spec
+
+    spec = sweep_spec(grazing.models.pendulum("B"), "eta", [0.44], settings=grazing.SweepSettings())
+    with pytest.raises(InvalidParameterError, match=r"^Lyapunov exponents are not computed on the GPU yet"):
+        GpuLaneBatch([(spec, 0)])
+
+
+def test_no_device_is_one_line() -> None:
+    import grazing
+    from grazing.gpu.target import NoDeviceError, device_present
+    from grazing.sweeps import sweep
+
+    if device_present():
+        pytest.skip("a CUDA device is present")
+    with pytest.raises(NoDeviceError) as info:
+        sweep(grazing.models.pendulum("B"), "eta", [0.44], lyapunov=False, fresh=True, device="gpu")
+    assert "\n" not in str(info.value) and "(device=)" in str(info.value)
+
+
+def test_device_auto_without_a_gpu_is_the_cpu_and_a_chain_of_chunks_is_refused() -> None:
+    import grazing
+    from grazing.gpu.device import resolve_device
+    from grazing.sweeps import sweep
+    from grazing.sweeps.spec import sweep_spec
+
+    m = grazing.models.pendulum("B")
+    ds = sweep(m, "eta", [0.44, 0.45], transient=40, periods=10, lyapunov=False, workers=1, device="auto")
+    assert ds.status.values.tolist() == [0, 0]
+    chained = sweep_spec(m, "eta", [0.44, 0.45, 0.46], settings=grazing.SweepSettings(
+        lyapunov=False, chunk_size=2))  # fmt: skip
+    with pytest.raises(InvalidParameterError, match=r"^a chain of several chunks"):
+        resolve_device("gpu", chained)
+    with pytest.raises(InvalidParameterError, match=r"^device must be"):
+        sweep(m, "eta", [0.44], device="GPU")
