@@ -42,3 +42,29 @@ def test_the_map_on_the_simulated_gpu_is_the_cpus(tmp_path: Path) -> None:
     a, b = json.loads(cpu.stdout), json.loads(gpu.stdout)
     a.pop("elapsed_s"), b.pop("elapsed_s")
     assert a == b
+
+
+BALL = "--model bouncing-ball --set r=0.8 --set omega=1 --set gravity=1".split()
+GRID = "--x-range 0,6 --y-range=-4,4 --num 3,3 --transient 20 --periods 8 --no-lyapunov --refine 0".split()
+
+
+def test_basins_and_attractors_take_device_and_refuse_gpu_without_one_in_one_line(tmp_path: Path) -> None:
+    basins = ["basins", *BALL, "--set", "amplitude=0.8", *GRID, "--out", "b.nc"]
+    along = ["--param", "amplitude", "--start", "0.7", "--stop", "0.8", "--num", "2"]
+    grid = [g.replace("--num", "--num-grid") for g in GRID]
+    attractors = ["attractors", *BALL, *along, *grid, "--out", "a.nc"]
+    for args in (basins, attractors):
+        run = grazing([*args, "--device", "gpu"], tmp_path)
+        assert run.returncode != 0, run.stdout
+        assert len(run.stderr.strip().splitlines()) == 1 and "device" in run.stderr, run.stderr
+        assert list(tmp_path.iterdir()) == []
+
+
+def test_basins_on_the_simulated_gpu_are_the_cpus(tmp_path: Path) -> None:
+    args = ["basins", *BALL, "--set", "amplitude=0.8", *GRID, "--json"]
+    cpu = grazing([*args, "--device", "cpu"], tmp_path)
+    gpu = grazing([*args, "--device", "gpu"], tmp_path, simulator=True)
+    assert cpu.returncode == 0 and gpu.returncode == 0, gpu.stderr
+    a, b = json.loads(cpu.stdout), json.loads(gpu.stdout)
+    a.pop("elapsed_s"), b.pop("elapsed_s")
+    assert a == b and a["attractors"], a

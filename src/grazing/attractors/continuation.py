@@ -31,6 +31,7 @@ from grazing.attractors.kinds import AttractorKind
 from grazing.core.model import HybridModel
 from grazing.core.options import CELL_FRACTION, BasinSettings, refuse_unknown, with_shorthands
 from grazing.errors import InvalidParameterError
+from grazing.gpu.device import DEFAULT_DEVICE
 
 MATCH_DISTANCE = 8.0
 """Largest distance (in cells) between an attractor at one parameter value and at the next for them
@@ -161,6 +162,7 @@ def continue_attractors(
     workers: int | None = None,
     client: Any = None,
     progress: Callable[[int, int], None] | None = None,
+    device: str = DEFAULT_DEVICE,
     **shorthands: Any,
 ) -> Any:
     """Attractors and their basin fractions followed along ``param`` over ``values`` (an xarray Dataset).
@@ -185,6 +187,8 @@ def continue_attractors(
         Local threads, or a Dask client.
     progress
         Called as ``progress(values_done, values_total)``.
+    device
+        Where each value's runs go, as for :func:`~grazing.attractors.basins.find_attractors`.
     **shorthands
         Any field of :class:`~grazing.core.options.BasinSettings` by name.
 
@@ -226,7 +230,13 @@ def continue_attractors(
         extra, origin = _seeds(previous, seeds)
         states_here = np.concatenate([x, extra]) if extra.size else x
         found = find_attractors(
-            here, states_here, settings=s, cell_fraction=cell_fraction, workers=workers, client=client
+            here,
+            states_here,
+            settings=s,
+            cell_fraction=cell_fraction,
+            workers=workers,
+            client=client,
+            device=device,
         )
         # (the cell grid of the first value throughout: distances in the same units)
         cell = steps[0].found.cell if steps else found.cell

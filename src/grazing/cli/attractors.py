@@ -40,6 +40,7 @@ from grazing.core.options import (
     CELL_FRACTION,
     SWEEP_TOL,
 )
+from grazing.gpu.device import DEFAULT_DEVICE, DEVICES, check_device
 
 CELL = Number(0.0, 1.0, low_open=False, high_open=False)
 """A recurrence cell as a fraction of an attractor's extent (``--cell``)."""
@@ -133,6 +134,15 @@ def _grid_options(num_name: str) -> Callable[[Callable[..., Any]], Callable[...,
                 help="Integrator tolerance, in (0, 0.01).",
             ),
             click.option("--workers", type=WORKERS, help="Local threads (default: all cores)."),
+            click.option(
+                "--device",
+                type=click.Choice(DEVICES),
+                default=DEFAULT_DEVICE,
+                show_default=True,
+                help="Where the runs go: the CPU lanes, an NVIDIA GPU (one CUDA thread per initial state; "
+                "the runs with Lyapunov exponents stay on the CPU), or the GPU when one is present and the "
+                "grid is large (auto).",
+            ),
             click.option(
                 "--plot",
                 type=path_type(dir_okay=False),
@@ -310,12 +320,14 @@ def basins_cmd(
     chunk_size: int,
     out: Path | None,
     wait: bool,
+    device: str,
 ) -> None:
     """Attractors and their basins on a grid of initial states (a slice of two states at a phase)."""
     from grazing.attractors.basins import find_attractors, to_dataset
 
     grid = _grid(model, x_range, y_range, num_grid, "--num", states, fixed, phase)
     zarr_out = _check_outputs(out, plot, overwrite, wait, zarr_ok=True)
+    check_device(device)  # (before a store is made: an error writes nothing)
     n = grid.size
     need = basin_bytes(
         n,
@@ -364,6 +376,7 @@ def basins_cmd(
             workers=workers,
             store=store,
             progress=bar,
+            device=device,
         )
     finally:
         bar.close()
@@ -455,6 +468,7 @@ def attractors_cmd(
     as_json: bool,
     seeds: int,
     out: Path | None,
+    device: str,
 ) -> None:
     """Global continuation: the attractors and their basin fractions along a parameter."""
     from grazing.attractors.continuation import continue_attractors
@@ -470,6 +484,7 @@ def attractors_cmd(
         model.with_params(**{par.name: par.from_display(v)})
     grid = _grid(model, x_range, y_range, num_grid, "--num-grid", states, fixed, phase)
     _check_outputs(out, plot, overwrite, False, zarr_ok=False)
+    check_device(device)
     need = basin_bytes(
         grid.size,
         periods,
@@ -505,6 +520,7 @@ def attractors_cmd(
             cell_fraction=cell_fraction,
             workers=workers,
             progress=bar,
+            device=device,
         )
     finally:
         bar.close()
