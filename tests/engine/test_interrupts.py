@@ -200,3 +200,18 @@ def test_the_clean_up_of_a_sigterm_is_not_cut_short_by_its_delivery_again(defaul
     assert cleaned == [True]
     assert signal.getsignal(signal.SIGTERM) == signal.SIG_DFL
     assert not [t for t in threading.enumerate() if t.name == "grazing-signal-again"]
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="fork")
+def test_a_process_forked_inside_the_block_has_no_block_of_its_own(default_sigint, default_sigterm):
+    """A pool's worker forked during a command (the report's, which keeps Ctrl-C's effect) delivers
+    nothing again and reports a lost exception as Python does."""
+    import sys
+
+    before = sys.unraisablehook
+    with interrupts.terminating_as_interrupted():
+        pid = os.fork()
+        if pid == 0:  # (the child: its answer is its exit status)
+            os._exit(0 if not interrupts._BLOCK and sys.unraisablehook is before else 1)
+        _, status = os.waitpid(pid, 0)
+    assert os.waitstatus_to_exitcode(status) == 0

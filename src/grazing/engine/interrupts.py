@@ -106,8 +106,21 @@ REDELIVERY_INTERVAL = 0.2
 """Seconds between two deliveries again of a signal whose exception may be lost (:func:`_redeliver`)."""
 
 _BLOCK: dict[str, Any] = {}
-"""The :func:`terminating_as_interrupted` block running: ``"done"``, an event set as it ends, and
-``"again"``, the thread delivering a signal again (once one came)."""
+"""The :func:`terminating_as_interrupted` block running: ``"done"``, an event set as it ends,
+``"hook"``, the ``sys.unraisablehook`` before it, and ``"again"``, the thread delivering a signal again
+(once one came)."""
+
+
+def _forked() -> None:
+    """In a process forked inside the block (a pool's worker): no block of its own, so nothing delivered
+    again, and lost exceptions reported as before."""
+    if _BLOCK:
+        sys.unraisablehook = _BLOCK["hook"]
+        _BLOCK.clear()
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_forked)
 
 
 def _in_flight() -> bool:
@@ -230,7 +243,7 @@ def terminating_as_interrupted() -> Iterator[None]:
         yield
         return
     hook = sys.unraisablehook
-    _BLOCK["done"] = threading.Event()
+    _BLOCK.update(done=threading.Event(), hook=hook)
     for sig in taken:
         signal.signal(sig, ours[sig])
     sys.unraisablehook = _quiet_lost_interrupts(hook)
