@@ -31,11 +31,18 @@ class Status(IntEnum):
     """Impacts accumulate and the model has no sticking rule (or a zero-time event loop)."""
     INTERRUPTED = 4
     """Ctrl-C (SIGINT) during the run: the caller raises :class:`KeyboardInterrupt`."""
+    OUTSIDE_MODE = 5
+    """A transition entered a mode at a state outside its region (a guard of the mode's own transitions
+    already negative there): the modes' regions do not fit together."""
 
-    def message(self, t: float, max_steps: int, model: HybridModel | None = None, x: Any = None) -> str:
-        """The user-facing sentence for this status at time ``t`` (the run ended in state ``x`` of ``model``).
+    def message(
+        self, t: float, max_steps: int, model: HybridModel | None = None, x: Any = None, mode: int = -1
+    ) -> str:
+        """The user-facing sentence for this status at time ``t`` (the run ended in state ``x`` of ``model``,
+        in its mode number ``mode``).
 
-        For :attr:`ZENO` the model and the state say why: see :func:`accumulation_message`.
+        For :attr:`ZENO` the model and the state say why: see :func:`accumulation_message`; for
+        :attr:`OUTSIDE_MODE` the mode too: see :func:`outside_mode_message`.
         """
         if self is Status.STEP_LIMIT:
             return f"step limit of {max_steps} steps reached at t = {t:.6g}"
@@ -47,6 +54,10 @@ class Status(IntEnum):
             return accumulation_message(model, x, t)
         if self is Status.INTERRUPTED:
             return f"interrupted at t = {t:.6g}"
+        if self is Status.OUTSIDE_MODE:
+            if model is None or x is None or mode < 0:
+                return f"a transition entered a mode outside its region at t = {t:.6g}"
+            return outside_mode_message(model, x, t, mode)
         return "ok"
 
     @property
@@ -56,7 +67,7 @@ class Status(IntEnum):
         Examples
         --------
         >>> [s.reason for s in Status]
-        ['ok', 'step limit', 'non-finite state', 'accumulating impacts', 'interrupted']
+        ['ok', 'step limit', 'non-finite state', 'accumulating impacts', 'interrupted', 'outside its mode']
         """
         return _REASONS[self][0]
 
@@ -84,6 +95,11 @@ _REASONS = {
         "does not move away from)",
     ),
     Status.INTERRUPTED: ("interrupted", "Ctrl-C stopped the run (raised as KeyboardInterrupt)"),
+    Status.OUTSIDE_MODE: (
+        "outside its mode",
+        "a transition entered a mode at a state where a guard of that mode's own transitions is already "
+        "negative (outside the mode's region): the model's modes and guards do not fit together there",
+    ),
 }
 
 
@@ -151,6 +167,40 @@ def accumulation_message(model: HybridModel, x: Any, t: float) -> str:
             "(events repeat at zero time: the contact neither holds nor releases)"
         )
     return f"events repeat at zero time at t = {t:.6g}: the run cannot be continued"
+
+
+def outside_mode_message(model: HybridModel, x: Any, t: float, mode: int) -> str:
+    """Why a run ended in mode number ``mode`` at ``(x, t)`` (the driver's :attr:`Status.OUTSIDE_MODE`).
+
+    A transition entered the mode where a guard of the mode's own transitions is already negative
+    (beyond :data:`~grazing.core.model.ON_STOP_TOL`): the state is outside the mode's region, and
+    the run would have jumped at once onto that guard's surface.  The message names the mode and that
+    guard (the most negative, if several).
+
+    Examples
+    --------
+    >>> import grazing
+    >>> m = grazing.models.soft_impact_oscillator(gap=0.5)
+    >>> contact = m.mode_index("contact")
+    >>> print(outside_mode_message(m, [0.0, 0.0], 2.0, contact))  # doctest: +NORMALIZE_WHITESPACE
+    a transition entered mode 'contact' at t = 2 outside its region: there the guard of its transition
+    'leave' is already h = -0.5 < 0 (the guards of the model's modes do not fit together there)
+    """
+    from grazing.core.model import ON_STOP_TOL
+
+    state = np.asarray(x, dtype=float).reshape(-1)
+    name = model.mode_names[mode]
+    tol = ON_STOP_TOL * max(1.0, float(np.max(np.abs(state), initial=0.0)))
+    guards = model.guards(state, t)
+    own = [j for j in range(model.n_stops) if model.transition_source[j] == name and guards[j] < -tol]
+    if not own:
+        return f"a transition entered mode {name!r} at t = {t:.6g} outside its region"
+    j = min(own, key=lambda i: guards[i])
+    return (
+        f"a transition entered mode {name!r} at t = {t:.6g} outside its region: there the guard of its "
+        f"transition {model.stop_names[j]!r} is already h = {guards[j]:.3g} < 0 (the guards of the model's "
+        "modes do not fit together there)"
+    )
 
 
 @dataclass(frozen=True)

@@ -486,11 +486,13 @@ def driver_key() -> str:
     numba's on-disk cache does not notice changes in functions imported from
     other modules, so the sources of the helpers are part of the key, and so
     are the values of the constants the driver takes from :mod:`grazing.core`
-    (the step limit, the status codes), and the sources of the functions of :mod:`grazing.core` it
+    (the step limit, the status codes, the tolerance of a state on a guard),
+    and the sources of the functions of :mod:`grazing.core` it
     compiles in (the step limit's formula, the test of a repeating transient).
     """
     import inspect
 
+    from grazing.core.model import ON_STOP_TOL
     from grazing.core.options import STEPS_EXTRA, STEPS_PER_PERIOD, step_limit
     from grazing.core.period import repeats_with_period
     from grazing.core.solution import Status
@@ -501,7 +503,7 @@ def driver_key() -> str:
     deps = "".join(path.read_text() for path in [*files, *driver.template_files()])
     from grazing.engine.llvmgen import lane_width
 
-    constants = (STEPS_PER_PERIOD, STEPS_EXTRA, [(s.name, int(s)) for s in Status])  # (from core)
+    constants = (STEPS_PER_PERIOD, STEPS_EXTRA, [(s.name, int(s)) for s in Status], ON_STOP_TOL)  # (core's)
     constants += tuple(inspect.getsource(f) for f in (step_limit, repeats_with_period))
     versions = (_CODEGEN_VERSION, _numba_version(), sys.version)
     return _key(*versions, deps, constants, lane_width())  # (lanevec's vectors are lane_width() wide)

@@ -44,6 +44,7 @@ import _signal
 import ctypes
 import os
 import signal
+import sys
 import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -101,12 +102,88 @@ _TERMINATED: list[bool] = []
 """Set when :func:`raise_terminated` has run since the last :func:`terminating_as_interrupted` block began
 (:func:`was_terminated`)."""
 
+REDELIVERY_INTERVAL = 0.2
+"""Seconds between two deliveries again of a signal whose exception may be lost (:func:`_redeliver`)."""
+
+_BLOCK: dict[str, Any] = {}
+"""The :func:`terminating_as_interrupted` block running: ``"done"``, an event set as it ends,
+``"hook"``, the ``sys.unraisablehook`` before it, and ``"again"``, the thread delivering a signal again
+(once one came)."""
+
+
+def _forked() -> None:
+    """In a process forked inside the block (a pool's worker): no block of its own, so nothing delivered
+    again, and lost exceptions reported as before."""
+    if _BLOCK:
+        sys.unraisablehook = _BLOCK["hook"]
+        _BLOCK.clear()
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_forked)
+
+
+def _in_flight() -> bool:
+    """Whether a ``KeyboardInterrupt`` (or :class:`Terminated`) is on its way out of the main thread: the
+    exception being handled where this runs (a ``finally``, ``except`` or ``__exit__`` it passes
+    through), or the one that exception was raised while handling."""
+    exc = sys.exc_info()[1]
+    seen: set[int] = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, KeyboardInterrupt):
+            return True
+        seen.add(id(exc))
+        exc = exc.__context__
+    return False
+
+
+def _redeliver(signum: int) -> None:
+    """Deliver ``signum`` to the main thread again every :data:`REDELIVERY_INTERVAL` s until the
+    :func:`terminating_as_interrupted` block ends (a thread started once).
+
+    The exception a signal handler raises is lost where Python cannot raise it: a handler run inside a
+    weak reference's callback (importlib's module locks), a ``__del__`` or a garbage collector's
+    callback is reported as "Exception ignored" and the command went on to its end, exit 0 (the
+    signal fuzz, 1 run in 87).  Each delivery again runs the handler, which raises again unless the
+    first exception is still on its way out (:func:`_in_flight`).  ``_thread.interrupt_main`` trips
+    Python's flag for the signal without sending one: no system call of the main thread is
+    interrupted, and nothing is sent once the handler is gone.
+    """
+    import _thread
+
+    done = _BLOCK.get("done")
+    if done is None or "again" in _BLOCK:
+        return
+
+    def again() -> None:
+        while not done.wait(REDELIVERY_INTERVAL):
+            _thread.interrupt_main(signum)
+
+    thread = threading.Thread(target=again, name="grazing-signal-again", daemon=True)
+    _BLOCK["again"] = thread
+    thread.start()
+
+
+def _raise(signum: int, error: type[KeyboardInterrupt]) -> None:
+    """Raise ``error`` for ``signum`` (a handler of :func:`terminating_as_interrupted`), unless one is
+    on its way out already (a delivery again of the same signal: :func:`_redeliver`)."""
+    if _in_flight():
+        return
+    _redeliver(signum)
+    raise error
+
 
 def raise_terminated(_signum: int, _frame: object) -> None:
     """The SIGTERM handler of :func:`terminating_as_interrupted`: raise :class:`Terminated` (and remember
     it: :func:`was_terminated`)."""
     _TERMINATED.append(True)
-    raise Terminated
+    _raise(signal.SIGTERM, Terminated)
+
+
+def raise_interrupted(_signum: int, _frame: object) -> None:
+    """The SIGINT handler of :func:`terminating_as_interrupted`: Python's (``KeyboardInterrupt``), raised
+    again if it was lost (:func:`_redeliver`)."""
+    _raise(signal.SIGINT, KeyboardInterrupt)
 
 
 def was_terminated() -> bool:
@@ -119,10 +196,24 @@ def was_terminated() -> bool:
     return bool(_TERMINATED)
 
 
+def _quiet_lost_interrupts(previous: Callable[[Any], object]) -> Callable[[Any], object]:
+    """``sys.unraisablehook`` that says nothing of a lost ``KeyboardInterrupt`` (delivered again:
+    :func:`_redeliver`) and passes anything else to ``previous``."""
+
+    def hook(unraisable: Any) -> None:
+        if not isinstance(unraisable.exc_value, KeyboardInterrupt):
+            previous(unraisable)
+
+    return hook
+
+
 @contextmanager
 def terminating_as_interrupted() -> Iterator[None]:
     """Within the block, SIGTERM raises :class:`Terminated` (in the main thread, where SIGTERM's default
     action is in place: a program with a handler of its own keeps it); the default is restored after.
+
+    A SIGTERM or a Ctrl-C (where Python's own handler is in place) whose exception is lost is delivered
+    again until the block ends (:func:`_redeliver`), and the loss is not reported.
 
     Examples
     --------
@@ -137,19 +228,37 @@ def terminating_as_interrupted() -> Iterator[None]:
     True
     >>> _ = signal.signal(signal.SIGTERM, previous)
     """
-    if threading.current_thread() is not threading.main_thread():
+    if threading.current_thread() is not threading.main_thread() or _BLOCK:
         yield
         return
     _TERMINATED.clear()
-    previous = signal.getsignal(signal.SIGTERM)
-    if previous != signal.SIG_DFL:
+    previous = {
+        signal.SIGTERM: signal.getsignal(signal.SIGTERM),
+        signal.SIGINT: signal.getsignal(signal.SIGINT),
+    }
+    ours = {signal.SIGTERM: raise_terminated, signal.SIGINT: raise_interrupted}
+    default = {signal.SIGTERM: signal.SIG_DFL, signal.SIGINT: signal.default_int_handler}
+    taken = [sig for sig in ours if previous[sig] == default[sig]]
+    if signal.SIGTERM not in taken:
         yield
         return
-    signal.signal(signal.SIGTERM, raise_terminated)
+    hook = sys.unraisablehook
+    _BLOCK.update(done=threading.Event(), hook=hook)
+    for sig in taken:
+        signal.signal(sig, ours[sig])
+    sys.unraisablehook = _quiet_lost_interrupts(hook)
     try:
         yield
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        try:
+            _BLOCK["done"].set()
+            if "again" in _BLOCK:
+                _BLOCK["again"].join()  # (a delivery it made is handled here, while the handlers are ours)
+        finally:
+            _BLOCK.clear()
+            sys.unraisablehook = hook
+            for sig in reversed(taken):
+                signal.signal(sig, previous[sig])
 
 
 _SIGACTION_BYTES = 512
@@ -199,15 +308,18 @@ def _sigaction() -> Any:
     return _state["sigaction"]
 
 
-_COUNTED = {signal.SIGINT: signal.default_int_handler, signal.SIGTERM: raise_terminated}
-"""The signals the machine-code handler counts, each where this Python handler of it is in place."""
+_COUNTED = {
+    signal.SIGINT: (signal.default_int_handler, raise_interrupted),
+    signal.SIGTERM: (raise_terminated,),
+}
+"""The signals the machine-code handler counts, each where one of these Python handlers of it is in place."""
 
 
 def _counted_signals() -> list[int]:
     if threading.current_thread() is not threading.main_thread() or _sigaction() is None:
         return []
     # (signal.getsignal's value, without its 2 us of trying the handler as an enum member)
-    return [sig for sig, handler in _COUNTED.items() if _signal.getsignal(sig) is handler]
+    return [sig for sig, handlers in _COUNTED.items() if any(_signal.getsignal(sig) is h for h in handlers)]
 
 
 @contextmanager

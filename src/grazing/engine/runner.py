@@ -293,7 +293,7 @@ class Runner:
         out = integrate(self.kern, start, self.pv, cfg)
         if out.status != Status.OK:
             raise SimulationError(
-                Status(int(out.status)).message(out.k * T + out.s, max_steps, self.model, out.x)
+                Status(int(out.status)).message(out.k * T + out.s, max_steps, self.model, out.x, int(out.vf))
             )
         self.x, self.V, self.k, self.s, self.mode, self.vf = out.x, out.V, out.k, out.s, out.mode, out.vf
         self.touch_start = False  # only the first call starts at the contact

@@ -279,8 +279,8 @@ def sweep(
     (0: none <= 64; -1: the point failed), ``impacts_per_period``, ``lyapunov``
     (largest exponent per unit time), ``transient_used``, and ``status``: 0
     (ok) or why the point failed, a :class:`~grazing.core.solution.Status`
-    code (1 step limit, 2 non-finite state, 3 accumulating impacts; its
-    attributes ``flag_values`` and ``flag_meanings`` say so too).  A failed
+    code (1 step limit, 2 non-finite state, 3 accumulating impacts, 5 outside
+    its mode; its attributes ``flag_values`` and ``flag_meanings`` say so too).  A failed
     point has NaN samples and Lyapunov exponent and -1 impacts; the sweep
     goes on, its next point starting afresh from ``x0``.
 

@@ -21,7 +21,7 @@ NOT_COMPUTED = -1
 STATUS_DTYPE = np.int8
 """The dtype of the ``status`` variable."""
 
-POINT_STATUSES = (Status.OK, Status.STEP_LIMIT, Status.NONFINITE, Status.ZENO)
+POINT_STATUSES = (Status.OK, Status.STEP_LIMIT, Status.NONFINITE, Status.ZENO, Status.OUTSIDE_MODE)
 """The outcomes a computed point can have (an interrupted sweep keeps no point of its unfinished chunks)."""
 
 
@@ -32,7 +32,7 @@ def status_attrs() -> dict[str, Any]:
     --------
     >>> a = status_attrs()
     >>> a["flag_values"].tolist(), a["flag_meanings"]
-    ([-1, 0, 1, 2, 3], 'not_computed ok step_limit non_finite_state accumulating_impacts')
+    ([-1, 0, 1, 2, 3, 5], 'not_computed ok step_limit non_finite_state accumulating_impacts outside_its_mode')
     """
     codes = [NOT_COMPUTED, *(int(s) for s in POINT_STATUSES)]
     words = ["not computed", *(s.reason for s in POINT_STATUSES)]

@@ -13,6 +13,7 @@ import math
 import numpy as np
 from numba import njit
 
+from grazing.core.model import ON_STOP_TOL
 from grazing.engine.driver.calls import (
     contact_dir,
     guard,
@@ -25,6 +26,7 @@ from grazing.engine.driver.calls import (
     reset_jac,
     rhs,
 )
+from grazing.engine.driver.state import STATUS_OUTSIDE_MODE
 from grazing.engine.stepping import append_pair, append_record, append_row, pack_var, unpack_var
 
 
@@ -203,7 +205,7 @@ def at_event(m, r, x, xp, pv, j, nrows, V, chatter_time, record, tables):
     r.defl = 1
     r.defl_stop = j
     if m.targets[j] != r.vf:  # a reset that also changes the mode (the rocking block's corners)
-        change_mode(m, r, x, j, record, tables)
+        change_mode(m, r, x, pv, j, record, tables)
     if m.sticks[j]:
         dt_acc = chatter_remaining(m, x, r.s, pv, j, speed, chatter_time)
         if dt_acc >= 0.0:  # complete chattering: on to the accumulation point, then sticking
@@ -252,6 +254,31 @@ def switch_mode(m, r, x, pv, j, V, record, tables):
     r.surface = 0
     r.defl = 1 if m.back[j] >= 0 else 0
     r.defl_stop = m.back[j]
+    check_region(m, r, x, pv, m.back[j])
+
+
+@njit(cache=True)
+def check_region(m, r, x, pv, known):
+    """Run ``r``, which has just entered mode ``r.vf`` at state ``x``, ends (status ``OUTSIDE_MODE``) if
+    ``x`` is outside that mode's region.
+
+    Outside: a guard of the mode's own transitions, other than ``known`` (the way back after a switch,
+    whose guard is 0 there; -1: none), below ``-ON_STOP_TOL * max(1, |x|)`` (as
+    :meth:`HybridModel.check_state` refuses an initial state).  The run would take an event at once on
+    that guard, off its surface: the modes' regions do not fit together there.  The run keeps its
+    state and mode, and its status says why it ended.
+    """
+    scale = 1.0
+    for i in range(m.nx):
+        scale = max(scale, abs(x[i]))
+    vf = r.vf
+    for row in range(m.rows.shape[1]):
+        k = m.rows[vf, row]  # (-1: padding; from m.nstops on: a sliding pseudo-mode's exits)
+        if k < 0 or k >= m.nstops or k == known:
+            continue
+        if guard(m, x, r.s, pv, k) < -ON_STOP_TOL * scale:
+            r.status = STATUS_OUTSIDE_MODE
+            return
 
 
 @njit(cache=True)
@@ -323,14 +350,15 @@ def leave_sliding(m, r, x, j, record, tables):
 
 
 @njit(cache=True)
-def change_mode(m, r, x, j, record, tables):
+def change_mode(m, r, x, pv, j, record, tables):
     """Run ``r``, just reset by transition ``j`` (``x`` holds the state after it), enters ``j``'s target mode.
 
     The impact is recorded by :func:`apply_impact` (with the saltation matrix
     between the two modes' fields); here the switch is recorded as well, as
     ``[t, j, state after the reset]`` in ``tables[3]`` when ``record``.  The
     root at ``u = 0`` is that of the transition back (``m.back[j]``, whose
-    guard is 0 right after the reset; -1: none known).
+    guard is 0 right after the reset; -1: none known).  A state after the reset outside the target
+    mode's region ends the run (:func:`check_region`).
     """
     if record:
         append_record(tables[3], r.n_switch, r.k * r.T + r.s, j, x, m.nx)
@@ -339,6 +367,7 @@ def change_mode(m, r, x, j, record, tables):
     r.surface = 0
     r.defl = 1 if m.back[j] >= 0 else 0
     r.defl_stop = m.back[j]
+    check_region(m, r, x, pv, -1)
 
 
 @njit(cache=True)

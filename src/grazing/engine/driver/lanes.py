@@ -281,6 +281,11 @@ def sweep_lanes(m, cfg, work, points, out):
                 end_lane_step(
                     m, cfg, la, lane, XT[:, :, lane], (xl, Tp, xp, V, scratch, xe, gh, gv, fbuf), tables
                 )
+                if run.status != STATUS_OK:  # (a mode entered outside its region: impacts.check_region)
+                    store_release(out.status, run.point, run.status)
+                    run.stage = IDLE
+                    active -= 1
+                    continue
             n_samples = ls[lane].n_samples
             if ls[lane].isamp < n_samples:
                 continue

@@ -208,6 +208,8 @@ def integrate(start, pv, cfg, m, out):
                 m, r, x, X, pv, nrows, cfg, chatter_time, record_impacts, Tp, buffers, tables
             )
             r.n_imp += int(kicked) + int(impact)
+            if r.status != STATUS_OK:  # (a mode entered outside its region: impacts.check_region)
+                break
         if r.isamp >= n_samples:
             break
 
