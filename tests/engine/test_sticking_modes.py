@@ -25,6 +25,7 @@ from grazing.core.options import SweepSettings
 from grazing.engine.codegen import generate_source
 from grazing.engine.runner import Runner
 from grazing.models import bouncing_ball
+from grazing.sweeps.run import run_chunks
 from grazing.sweeps.spec import sweep_spec
 from tests.engine.test_lanes import assert_lanes_equal_the_oracle
 
@@ -273,10 +274,14 @@ def test_sticking_marks_the_jacobian_invalid_and_a_smooth_run_keeps_it() -> None
     assert not sol.jacobian_valid
 
 
-@pytest.mark.parametrize("make", [stick_spring, stick_lift])
-def test_sweep_with_sticking_on_lanes_equals_the_runner_oracle(make) -> None:
-    """(c) Sweeps through sticking and switches: lanes bit-identical to the scalar Runner oracle."""
-    values = np.linspace(1.6, 2.4, 8)
+@pytest.mark.parametrize(("make", "top"), [(stick_spring, 2.4), (stick_lift, 1.95)])
+def test_sweep_with_sticking_on_lanes_equals_the_runner_oracle(make, top) -> None:
+    """(c) Sweeps through sticking and switches: lanes bit-identical to the scalar Runner oracle.
+
+    (The lift has no floor while it pulls: above a = 2 a mass still falling when the pull begins goes
+    through the floor, and the drop back then enters ``free`` beyond its floor, which ends the run:
+    :func:`test_the_lift_above_a_2_ends_outside_its_mode`.)"""
+    values = np.linspace(1.6, top, 8)
     settings_ = SweepSettings(transient=12, periods=6, chunk_size=4, adaptive=False, lyapunov=False)
     spec = dataclasses.replace(
         sweep_spec(make(), "a", values, x0=(0.3, 0.0), settings=settings_), polish=False
@@ -285,6 +290,20 @@ def test_sweep_with_sticking_on_lanes_equals_the_runner_oracle(make) -> None:
     for value in values[::3]:  # (the points stick)
         sol = grazing.simulate(make().with_params(a=float(value)), [0.3, 0.0], transient=12, periods=6)
         assert len(sol.sticking) > 0
+
+
+def test_the_lift_above_a_2_ends_outside_its_mode() -> None:
+    """The lift at a = 2.4 is ill-posed (no floor while it pulls): the run ends where the drop enters
+    ``free`` below its floor, said in one line, on the scalar driver and on lanes alike."""
+    model = stick_lift().with_params(a=2.4)
+    with pytest.raises(grazing.SimulationError, match=r"entered mode 'free' .* outside its region"):
+        grazing.simulate(model, [0.3, 0.0], transient=12, periods=6)
+    settings_ = SweepSettings(
+        transient=12, periods=6, chunk_size=4, adaptive=False, lyapunov=False, fresh=True
+    )
+    spec = sweep_spec(stick_lift(), "a", [1.6, 2.4], x0=(0.3, 0.0), settings=settings_)
+    statuses = np.concatenate([r.status for r in run_chunks(spec, range(spec.n_chunks))])
+    assert statuses.tolist() == [0, 5]
 
 
 def test_a_sweep_through_sticking_has_no_lyapunov_exponent() -> None:
