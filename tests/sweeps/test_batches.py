@@ -59,20 +59,81 @@ def test_local_results_of_a_fresh_sweep_in_growing_batches(monkeypatch):
     assert all(_same(got[i], alone[i]) for i in alone)
 
 
-def test_a_batch_that_cannot_be_built_stops_the_threads():
-    """An error building a later batch reaches the consumer; every thread has returned."""
+def _thread_errors(monkeypatch) -> list[str]:
+    """The exceptions that end a thread from now on, as "thread: exception" (none may go unhandled)."""
+    errors: list[str] = []
+    monkeypatch.setattr(
+        threading, "excepthook", lambda a: errors.append(f"{a.thread.name}: {a.exc_type.__name__}")
+    )
+    return errors
+
+
+def _alive() -> list[str]:
+    return [t.name for t in threading.enumerate() if t.name.startswith(("grazing-sweep", "grazing-batch"))]
+
+
+def test_a_batch_that_cannot_be_built_stops_the_threads(monkeypatch):
+    """An error building a later batch reaches the consumer; no batch after it is begun (the next one was
+    begun while the error travelled, and left building); every thread has returned, none with an exception
+    (a thread stopping the stream met the next batch's cancelled future: CancelledError)."""
     spec = sweep_spec(pendulum("B"), "eta", np.linspace(0.44, 0.49, 8), settings=SweepSettings(
         fresh=True, chunk_size=2, transient=20, periods=6))  # fmt: skip
+    errors = _thread_errors(monkeypatch)
+    begun: list[int] = []
 
     def broken() -> LaneBatch:
         raise ValueError("no table")
 
-    makers = [functools.partial(LaneBatch, [(spec, 0), (spec, 1)]), broken,
-              functools.partial(LaneBatch, [(spec, 2)])]  # fmt: skip
+    def after() -> LaneBatch:
+        begun.append(2)
+        return LaneBatch([(spec, 2)])
+
+    makers = [functools.partial(LaneBatch, [(spec, 0), (spec, 1)]), broken, after]
     with pytest.raises(ValueError, match="no table"):
         list(stream_batches(makers, 2))
-    alive = [t.name for t in threading.enumerate() if t.name.startswith(("grazing-sweep", "grazing-batch"))]
-    assert alive == []
+    assert (begun, _alive(), errors) == ([], [], [])
+
+
+class _FailingBatch:
+    """A batch whose run fails once ``begin`` is set (the next batch being built)."""
+
+    def __init__(self, begin: threading.Event) -> None:
+        self.control, self.jobs, self._begin = np.zeros(3, dtype=np.int64), [0], begin
+
+    def run(self) -> None:
+        assert self._begin.wait(30)
+        raise RuntimeError("lane failed")
+
+    def stop(self) -> None:
+        pass
+
+    def finished(self) -> list[int]:
+        return []
+
+    def all_taken(self) -> bool:
+        return False
+
+    def results(self, ks):
+        return []
+
+
+def test_a_failed_batch_waits_for_the_batch_being_built(monkeypatch):
+    """A batch whose run fails while the next one is being built: the error reaches the consumer once the
+    builder's thread has finished it and returned (it was left alive); no thread ends with an exception."""
+    import time
+
+    errors = _thread_errors(monkeypatch)
+    building, built = threading.Event(), threading.Event()
+
+    def slow() -> _FailingBatch:
+        building.set()
+        time.sleep(0.3)
+        built.set()
+        return _FailingBatch(building)
+
+    with pytest.raises(RuntimeError, match="lane failed"):
+        list(stream_batches([lambda: _FailingBatch(building), slow], 2))
+    assert (built.is_set(), _alive(), errors) == (True, [], [])
 
 
 def test_a_stopped_stream_does_not_wait_for_a_batch_being_built():

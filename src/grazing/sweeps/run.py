@@ -356,12 +356,15 @@ def stream_batches(
     ``threads`` threads run the batches in order, sharing each batch's jobs
     (the compiled driver runs without the GIL); a thread with no job left in
     a batch goes on to the next one at once, so that no thread waits for the
-    others' last points at a batch's end.  When the consumer stops early
-    (Ctrl-C, an error, ``close()``) the threads are told to stop and have
-    returned, at their next step, before this returns.  A batch being built
-    then is not waited for: its builder thread (:class:`BatchBuilder`) goes on
-    in the background, a daemon, and the first compile of the driver (half a
-    minute) no longer holds up a Ctrl-C.
+    others' last points at a batch's end.  When the stream ends, or a
+    thread's error (a batch that cannot be built, or fails to run) ends it,
+    the threads are told to stop and have returned, at their next step, before
+    this returns, the builder's thread too (no batch is begun after a batch
+    that could not be built; one being built is waited for).  When the
+    consumer stops it (Ctrl-C, ``close()``), a batch being built is not waited
+    for: its builder thread (:class:`BatchBuilder`) goes on in the background,
+    a daemon, and the first compile of the driver (half a minute) no longer
+    holds up a Ctrl-C.
     """
     if not batches:
         return
@@ -412,16 +415,16 @@ def stream_batches(
         with lock:
             futures = list(built.values())
         for future in futures:
-            if future.done() and future.exception() is None:
-                future.result().stop()
+            batch = _built(future)
+            if batch is not None:
+                batch.stop()
 
     def report() -> list[tuple[int, int, ChunkResult]]:
         """The chunks finished since the last look, in the batches built so far, with their results."""
         with lock:
-            ready = sorted((k, f) for k, f in built.items() if f.done() and f.exception() is None)
+            ready = sorted((k, b) for k, b in ((k, _built(f)) for k, f in built.items()) if b is not None)
         done = []
-        for k, future in ready:
-            batch = future.result()
+        for k, batch in ready:
             chunks = batch.finished()
             done += [(k, i, res) for i, res in zip(chunks, batch.results(chunks))]
             if batch.all_taken():
@@ -434,11 +437,13 @@ def stream_batches(
     for w in workers:
         w.start()
     running, last = len(workers), time.perf_counter()
+    ended = False  # (by itself: all reported, or a thread's error; not stopped by the consumer)
     try:
         while running:
             if finished.acquire(timeout=POLL_INTERVAL):
                 running -= 1
             if errors:
+                ended = True
                 raise errors[0]
             done = report()
             now = time.perf_counter()
@@ -447,11 +452,19 @@ def stream_batches(
                 yield k, i, res
             last = now if done else last
         yield from report()
+        ended = True
     finally:
         stop()
-        builder.shutdown()  # (a batch not begun is cancelled; one being built is left to its daemon thread)
+        builder.shutdown(wait=ended)  # (a batch not begun is cancelled; one being built waited for if ended)
         for w in workers:
             w.join()
+
+
+def _built(future: Any) -> LaneBatch | None:
+    """The batch of ``future`` if it is built; None while it is being built, if it failed or was cancelled."""
+    if not future.done() or future.cancelled() or future.exception() is not None:
+        return None
+    return future.result()  # type: ignore[no-any-return]
 
 
 def _when_built(future: Any, stopping: threading.Event) -> LaneBatch | None:
@@ -475,7 +488,9 @@ class BatchBuilder:
     process's end does not wait for its thread: a batch being built when the
     sweep is stopped may be the first compile of the driver, which cannot be
     interrupted and takes half a minute (issue 43: Ctrl-C ended such a sweep
-    35-40 s late).  What it builds then is thrown away.
+    35-40 s late).  What it builds then is thrown away.  A batch that cannot
+    be built ends the stream on its error: the batches submitted after it are
+    cancelled, not built.
     """
 
     def __init__(self) -> None:
@@ -483,17 +498,24 @@ class BatchBuilder:
 
         self._jobs: Any = queue.SimpleQueue()
         self._thread: threading.Thread | None = None
-        self._busy = threading.Event()  # (set while a batch is being built)
+        self._lock = threading.Lock()  # (whether a batch is begun, and whether one is being built)
+        self._busy = False  # (a batch is being built)
+        self._closed = False  # (shut down, or a batch could not be built: nothing more is begun)
 
     def submit(self, fn: Callable[..., Any], *args: Any) -> Any:
-        """Build ``fn(*args)`` after the batches submitted before; a future of it."""
+        """Build ``fn(*args)`` after the batches submitted before; a future of it (cancelled at once once
+        a batch could not be built or the builder is shut down)."""
         from concurrent.futures import Future
 
         future: Future[Any] = Future()
-        self._jobs.put((future, fn, args))
-        if self._thread is None:
-            self._thread = threading.Thread(target=self._work, name="grazing-batch", daemon=True)
-            self._thread.start()
+        with self._lock:
+            if self._closed:
+                future.cancel()
+                return future
+            self._jobs.put((future, fn, args))
+            if self._thread is None:
+                self._thread = threading.Thread(target=self._work, name="grazing-batch", daemon=True)
+                self._thread.start()
         return future
 
     def _work(self) -> None:
@@ -502,21 +524,32 @@ class BatchBuilder:
             if job is None:
                 return
             future, fn, args = job
-            if not future.set_running_or_notify_cancel():
-                continue
-            self._busy.set()
+            with self._lock:
+                if self._closed:
+                    future.cancel()
+                    continue
+                if not future.set_running_or_notify_cancel():
+                    continue
+                self._busy = True
             try:
-                future.set_result(fn(*args))
+                batch = fn(*args)
             except BaseException as exc:  # (the consumer's thread reports it)
+                with self._lock:
+                    self._busy, self._closed = False, True  # (before anyone hears of it: nothing more begun)
                 future.set_exception(exc)
-            finally:
-                self._busy.clear()
+            else:
+                with self._lock:
+                    self._busy = False
+                future.set_result(batch)
 
-    def shutdown(self) -> None:
-        """Cancel the batches not begun; the thread ends now if idle, else after the batch it builds (not
-        waited for)."""
+    def shutdown(self, wait: bool = False) -> None:
+        """Cancel the batches not begun; the thread ends now if idle, else after the batch it builds (waited
+        for if ``wait``)."""
         import queue
 
+        with self._lock:
+            self._closed = True
+            busy = self._busy
         while True:
             try:
                 job = self._jobs.get_nowait()
@@ -525,8 +558,8 @@ class BatchBuilder:
             if job is not None:
                 job[0].cancel()
         self._jobs.put(None)
-        if self._thread is not None and not self._busy.is_set():
-            self._thread.join(timeout=1.0)  # (idle: it ends at once)
+        if self._thread is not None and (wait or not busy):
+            self._thread.join()  # (idle, or begun nothing since `busy` was read: it ends at once)
 
 
 def run_chunk(spec: SweepSpec, index: int) -> ChunkResult:
