@@ -318,3 +318,24 @@ def test_no_sliding_pseudo_mode_to_start_in():
     m = friction_oscillator()
     with pytest.raises(grazing.InvalidParameterError, match="cannot start in mode \"sliding on 'belt'\""):
         grazing.simulate(m, [0.0, 0.5], periods=1, mode="sliding on 'belt'")
+
+
+@pytest.mark.parametrize("impacts", ["all", "sampled"])
+@pytest.mark.parametrize("mode", ["slip_behind", "slip_ahead"])
+def test_a_run_starting_on_the_belt_slides_from_its_start(impacts, mode):
+    """Started on the belt (x' = v_b) where the friction holds the mass (|a cos(0) - x| < mu), the run
+    sticks at t = 0 from either side: its first sliding interval starts there and ends at the exact
+    stick's end, as its first stay in mode_spans() does (it was left out of Solution.sliding)."""
+    m = friction_oscillator(**VALUES)
+    ref = FrictionReference(dict(m.params))
+    x0 = [0.8, VALUES["v_belt"]]
+    assert abs(ref.force(x0[0], 0.0)) < VALUES["mu"]  # (stuck at once)
+    sol = grazing.simulate(m, x0, periods=2, impacts=impacts, mode=mode)
+    _, last, _, events = ref.run(np.array(x0), STICK, 0.0, sol.t_final)
+    starts = [0.0] + [tz for tz, k in events if k == "stick"]
+    ends = [tz for tz, k in events if k == "slip"] + ([sol.t_final] if last == STICK else [])
+    assert len(starts) >= 2 and len(ends) == len(starts)
+    assert sol.sliding.shape == (len(starts), 3) and np.all(sol.sliding[:, 2] == 0)
+    assert np.abs(sol.sliding[:, 0] - starts).max() < 1e-12 and np.abs(sol.sliding[:, 1] - ends).max() < 1e-12
+    stays = [(a, b) for a, b, k in sol.mode_spans() if k == STICK]
+    assert np.abs(np.array(stays) - sol.sliding[:, :2]).max() < 1e-12

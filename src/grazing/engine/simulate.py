@@ -204,7 +204,7 @@ def simulate(
             parts[key].append(arr)
         if keep and model.sliding_modes:  # the recorded span's sliding intervals in this chunk
             t_span = t_chunk if done >= transient else first_sample + (transient - 1) * T
-            slides.append(_sliding_intervals(model, seg.switches, seg.vf_span, t_span, run.vf, run.t))
+            slides.append(_sliding_intervals(model, seg.switches, t_span, run.vf, run.t))
         log_sum += seg.log_sums
         lyap_span += seg.lyap_span
         if guard_min and keep:  # the smallest over the chunks, for each stop
@@ -367,23 +367,26 @@ def _merge_intervals(iv: np.ndarray) -> np.ndarray:
 
 
 def _sliding_intervals(
-    model: HybridModel, switches: np.ndarray, vf_start: int, t_start: float, vf_end: int, t_end: float
+    model: HybridModel, switches: np.ndarray, t_start: float, vf_end: int, t_end: float
 ) -> np.ndarray:
     """Rows ``[start, end, surface]`` of the sliding of a recorded span from ``t_start`` to ``t_end``.
 
-    The span starts in mode ``vf_start`` and ends in ``vf_end``; ``switches``
-    are its rows ``[t, transition, state...]`` (:attr:`HybridModel.switch_names`).
-    Sliding is the time spent in a sliding pseudo-mode (:attr:`HybridModel.sliding_modes`).
+    The span ends in mode ``vf_end``; ``switches`` are its rows ``[t, transition, state...]``
+    (:attr:`HybridModel.switch_names`).  Sliding is the time spent in a sliding pseudo-mode
+    (:attr:`HybridModel.sliding_modes`).  The mode after ``t_start`` is the source of the first switch
+    after it (as :meth:`~grazing.core.solution.Solution.mode_spans` reads it), not the mode the run was
+    in when the span began: a run starting on a sliding surface switches into sliding at ``t_start``
+    itself, after that.
     """
     sliding = model.sliding_modes
     modes = model.mode_names
+    source = [modes.index(name) for name in model.switch_sources]
     target = [modes.index(name) for name in model.switch_targets]
+    later = [(t, int(j)) for t, j in switches[:, :2] if t > t_start]  # (impacts="all": earlier ones too)
     rows = []
-    mode, since = vf_start, t_start
-    for t, j in switches[:, :2]:
-        if t <= t_start:  # (impacts="all": the switches before the span are recorded too)
-            continue
-        new = target[int(j)]
+    mode, since = (source[later[0][1]] if later else vf_end), t_start
+    for t, j in later:
+        new = target[j]
         if new != mode:
             if mode in sliding:
                 rows.append((since, t, sliding[mode]))
