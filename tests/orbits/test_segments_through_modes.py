@@ -233,6 +233,11 @@ def test_continuation_hands_over_to_multiple_shooting_and_ends_at_the_exact_graz
     assert orbit.impacts == 1 and np.abs(orbit.state - u[:2]).max() < 1e-10
     branch = continue_orbit(m, "omega", start, 1.59, orbit=orbit)
     assert "by multiple shooting from omega = " in branch.status, branch.status
+    # (the wall is an impact: its grazing changes the impacts, not the switches of mode)
+    assert (
+        "; the orbit with the new impact sequence can be followed with switch (switch=True)" in branch.status
+    )
+    assert "switches of mode" not in branch.status
     [graze] = branch.special
     exact = exact_wall_grazing(dict(m.params), [*GUESS, start])
     assert graze.kind == "grazing" and abs(graze.param - exact[5]) < 1e-9, (graze.param, exact[5])
@@ -241,3 +246,20 @@ def test_continuation_hands_over_to_multiple_shooting_and_ends_at_the_exact_graz
         if q > exact[5] + 1e-7:  # (the exact boundary-value problem is well posed off the grazing)
             ux, _ = exact_wall_orbit(dict(o.model.params), [*o.state, *u[2:]])
             assert np.abs(o.state - ux[:2]).max() < 1e-10, (q, o.state - ux[:2])
+
+
+def test_past_the_wall_s_grazing_the_branch_switches_to_the_orbit_without_the_impact():
+    """With switch, the branch goes on past the wall's grazing along the orbit that misses the wall (no
+    impact, its switches into and out of the contact kept), and says that its impacts changed."""
+    start = 1.5926184272441661
+    m = soft_hard(omega=start)
+    u, _ = exact_wall_orbit(dict(m.params), GUESS)
+    orbit = find_orbit(m, u[:2], period=1, mode="free")
+    branch = continue_orbit(m, "omega", start, 1.59, orbit=orbit, switch=True)
+    first = branch.segment_status[0]
+    assert (
+        "(the orbit loses an impact)" in first
+        and "; switched to the orbit with the new impact sequence" in first
+    )
+    assert "switches of mode" not in first
+    assert branch.orbits[0].impacts == 1 and branch.orbits[-1].impacts == 0

@@ -994,8 +994,10 @@ class _Continuation:
                 reason = f"the orbit touches the stop between its impacts: it {what}"
             reason += " (located from this side: the branch does not continue beyond it)"
         status = f"ended at a grazing at {where}: {reason}"
-        sequence = "switches of mode" if self.model.has_modes else "impact sequence"
-        other = "other switches of mode" if self.model.has_modes else "another impact sequence"
+        model = self.model  # (an impact: a transition with a reset; without modes every stop is one)
+        impact = where_stop < model.n_stops and model.transition_resets[where_stop]
+        sequence = "impact sequence" if impact else "switches of mode"
+        other = "another impact sequence" if impact else "other switches of mode"
         if not self.switch:
             branch.special.append(graze)
             branch.end_segment(
