@@ -201,6 +201,38 @@ def test_the_page_starts_a_click_in_the_mode_chosen_and_continues_through_modes(
     page.close()
 
 
+def test_find_the_grazings_words_the_orbit_through_its_modes():
+    """On a model with modes "Find the grazings" follows the orbit itself through its modes (there is no
+    nonimpacting orbit): its lines and its copied code say so and name the transition grazed.  The soft
+    stop's orbit at omega = 0.5 clears the contact while the gap exceeds the free orbit's amplitude
+    a / sqrt((1 - w^2)^2 + (2 zeta w)^2) and grazes it where they are equal."""
+    model = grazing.models.soft_impact_oscillator(omega=0.5)
+    p = model.params
+    amplitude = p["a"] / np.hypot(1 - p["omega"] ** 2, 2 * p["zeta"] * p["omega"])
+    page = Explorer(View.of(model, {"gap": (1.6, 2.0)}, num=3), deliver=lambda fn: fn(), compute=False)
+    try:
+        page.find_grazings()
+        wait_until(lambda: page.grazings is not None)
+        text = page.grazings_text.object
+        assert text.startswith("no grazing of the period-1 orbit followed through its modes in the range (")
+        assert "nonimpacting" not in text
+    finally:
+        page.close()
+    page = Explorer(View.of(model, {"gap": (1.0, 1.6)}, num=3), deliver=lambda fn: fn(), compute=False)
+    try:
+        page.find_grazings()
+        wait_until(lambda: page.grazings is not None)
+        [mark] = page.grazings.marks
+        assert abs(mark.value - amplitude) < 1e-6, (mark.value, amplitude)
+        assert page.grazings_text.object.endswith("(transition touch)")
+        page.show_code()
+        assert "# the grazings of the period-1 orbit followed through its modes over the range (every " \
+            "transition's)" in page.code_python.value  # fmt: skip
+        assert "nonimpacting" not in page.code_python.value
+    finally:
+        page.close()
+
+
 def test_an_unknown_start_mode_is_one_line():
     view = View.of(grazing.models.soft_impact_oscillator(), {"omega": (0.8, 1.6)}, num=3)
     with pytest.raises(grazing.InvalidParameterError) as info:

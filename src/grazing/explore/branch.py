@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from grazing.core.model import HybridModel
 from grazing.engine.simulate import simulate
 from grazing.errors import GrazingError, GrazingWarning, InvalidParameterError
 from grazing.explore.diagram import IsCancelled, SupersededError, View, checkpoint
@@ -202,10 +203,20 @@ def continue_click(view: View, point: PointReport, *, cancelled: IsCancelled | N
     return Continued(axis.name, tuple(pieces), tuple(marks), tuple(lines))
 
 
+def grazed_orbit(model: HybridModel, period: int = 1) -> str:
+    """The orbit whose grazings :func:`grazings_in_view` seeks, in words: the nonimpacting one (the stops
+    ignored), or on a model with modes the orbit itself followed through its modes
+    (:func:`~grazing.orbits.find_grazings`)."""
+    if model.has_modes:
+        return f"the period-{period} orbit followed through its modes"
+    return f"the nonimpacting period-{period} orbit"
+
+
 @dataclass(frozen=True)
 class Grazings:
-    """The grazings of the nonimpacting orbit in the view's range: marks and one line each; where they
-    were sought (the parameter, its range, the other explored parameter's value held: ``fixed``).
+    """The grazings of the nonimpacting orbit (on a model with modes: the orbit through its modes) in the
+    view's range: marks and one line each; where they were sought (the parameter, its range, the other
+    explored parameter's value held: ``fixed``).
 
     Parameters
     ----------
@@ -251,7 +262,9 @@ def grazings_in_view(
 
     ``fixed``: the other explored parameter's value (a period map: the clicked row).
     The orbit is followed with the stops ignored from the range's start (its guess:
-    a simulation from rest with the stops ignored), through folds.
+    a simulation from rest with the stops ignored), through folds.  On a model with
+    modes, every transition's grazings of the period-``period`` orbit followed through
+    its modes (:func:`~grazing.orbits.find_grazings`).
 
     Parameters
     ----------
@@ -286,15 +299,16 @@ def grazings_in_view(
         _, branch = find_grazings(
             model, axis.name, axis.lo, axis.hi, period=period, progress=lambda _n, _v: checkpoint(cancelled)
         )
+    stop_word = "transition" if model.has_modes else "stop"
     marks, lines = [], []
     for sp in branch.special:
         if sp.kind != SpecialKind.GRAZING or sp.grazing is None:
             continue
         checkpoint(cancelled)
         g = sp.grazing
-        note = f"stop {g.stop_name}"
+        note = f"{stop_word} {g.stop_name}"
         if g.crossed:
-            note += f"; passes through stop(s) {', '.join(g.crossed)}: not a motion of the system"
+            note += f"; passes through {stop_word}(s) {', '.join(g.crossed)}: not a motion of the system"
         try:
             states = section_states(sp.orbit)
         except GrazingError:
@@ -304,7 +318,7 @@ def grazings_in_view(
         )
         lines.append(marks[-1].text)
     if not marks:
-        lines.append(f"no grazing of the nonimpacting period-{period} orbit in the range ({branch.status})")
+        lines.append(f"no grazing of {grazed_orbit(model, period)} in the range ({branch.status})")
     return Grazings(axis.name, tuple(marks), tuple(lines), (axis.lo, axis.hi), dict(fixed or {}))
 
 

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from grazing.explore.basins import BasinView
-from grazing.explore.branch import Curves, Grazings
+from grazing.explore.branch import Curves, Grazings, grazed_orbit
 from grazing.explore.diagram import View
 from grazing.explore.point import PointReport
 from grazing.explore.source import command_line
@@ -338,13 +338,15 @@ def _basins_code(found: BasinView, point_args: list[str] | None, py: list[str], 
 
 
 def _grazings_code(view: View, found: Grazings, with_cli: bool, py: list[str], cli: list[str]) -> None:
-    """The grazings of the nonimpacting period-1 orbit over the range they were sought in, the other
-    explored parameter held (:func:`~grazing.explore.branch.grazings_in_view`)."""
+    """The grazings of the nonimpacting period-1 orbit (through its modes on a model with modes) over the
+    range they were sought in, the other explored parameter held
+    (:func:`~grazing.explore.branch.grazings_in_view`)."""
     lo, hi = found.range
     held = ", ".join(f"{k}={v!r}" for k, v in found.fixed.items())
+    stop_word = "transition" if view.model.has_modes else "stop"
     py += [
         "",
-        "# the grazings of the nonimpacting period-1 orbit over the range (every stop's)",
+        f"# the grazings of {grazed_orbit(view.model)} over the range (every {stop_word}'s)",
         f"_, branch = find_grazings(model{f'.with_params({held})' if held else ''}, {found.param!r}, {lo!r}, "
         f"{hi!r}, period=1)",
         'print("grazings", [round(s.param, 8) for s in branch.special if s.kind == "grazing"])',
