@@ -79,8 +79,8 @@ def tangent_bytes(nx: int, order: int) -> int:
 
     Examples
     --------
-    >>> tangent_bytes(2, 20)  # (the pendulum at order 20: 816 bytes)
-    816
+    >>> tangent_bytes(2, 13)  # (the pendulum at tol 1e-10: Taylor order 13)
+    800
     """
     nn = nx * nx
     return 8 * (3 * nn + nn * (order + 1) + 3 * nn + nx + 9 * nx)
@@ -145,15 +145,9 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
     LYAP = bool(lyapunov)
     NT = NX + NX * NX if LYAP else NX  # (rows of the state with the variational matrix)
     NV = NX if LYAP else 1  # (sides of the tangent arrays: one element without Lyapunov exponents)
-    if LYAP:
-        from grazing.gpu.tangent import LYAP_STARTED_NOW_AT_END, LYAP_STARTED_NOW_AT_SPAN, tangent_functions
+    from grazing.gpu.tangent import LYAP_STARTED_NOW_AT_END, tangent_functions
 
-        tangent = tangent_functions(dm)
-        lyapunov_step, saltation = tangent.lyapunov_step, tangent.saltation
-    else:  # (never called: the kernel's branches on LYAP are pruned when it is compiled)
-        from grazing.gpu.tangent import LYAP_STARTED_NOW_AT_END, LYAP_STARTED_NOW_AT_SPAN
-
-        lyapunov_step = saltation = dm.functions["rhs"]
+    lyapunov_step, saltation = tangent_functions(dm)  # (without LYAP, in branches pruned at compilation)
     KEEP = int(keep)
     STICKS = np.array(dm.sticks, dtype=np.int64)
     from numba import types
@@ -253,8 +247,10 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
                 if not math.isfinite(x[i]):
                     return STATUS_NONFINITE
             s = sf[S]
-            var = LYAP and st[USE_VAR] != 0
-            if var:
+            var = False
+            if LYAP:
+                var = st[USE_VAR] != 0
+            if LYAP and var:
                 tc_var(x, s, pv, X, O)
                 h = step_size(X, NT, O, NSTOPS, 0, GUARD_SCALE, ORDER, T, factor)
             else:
@@ -286,7 +282,7 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
                 st[K] += 1
             st[STEPS] += 1
             st[DEFL] = 0
-            if var:  # the Lyapunov vectors (tangent.lyapunov_step)
+            if LYAP and var:  # the Lyapunov vectors (tangent.lyapunov_step)
                 started = lyapunov_step(st[LYAP_STARTED] != 0, st[RECORDING] != 0, sf[SPAN_DT], x, X, V,
                                         scratch, logs, xe, before)  # fmt: skip
                 if started != 0:
@@ -298,7 +294,7 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
                 s = sf[S]
                 vn = normal_rate(x, s, pv, ev_stop)
                 reset(x, s, pv, xp, ev_stop)
-                if var:  # (the variational matrix times the saltation matrix)
+                if LYAP and var:  # (the variational matrix times the saltation matrix)
                     unpack_var(x, NX, NX, V)
                     if not saltation(x, xp, s, pv, ev_stop, V, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn):
                         st[JAC_VALID] = 0  # (an impact at zero normal speed has no Jacobian)
@@ -337,7 +333,6 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
         """The point's protocol (``lanes.take_point``, ``end_request``); returns its status."""
         wrap = iset[PERIODIC] != 0
         budget = iset[TRANSIENT_PERIODS]
-        periods = iset[PERIODS]
         adaptive = iset[ADAPTIVE] != 0
         logs = tw[1]
         for j in range(NSTOPS):
@@ -446,8 +441,8 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
                 sf[S] = s0
                 st[REQ_KS] = ks0
                 sf[REQ_SS] = ss0
-                code = run_point(st, sf, x, pvs[p], T, sphase[p], iset, fset, X, O, a, xe, xp, buf, counts, mine,
-                                 tw)  # fmt: skip
+                code = run_point(st, sf, x, pvs[p], T, sphase[p], iset, fset, X, O, a, xe, xp, buf, counts,
+                                 mine, tw)  # fmt: skip
                 if code == STATUS_OK:  # (lanes.finish_point)
                     for i in range(NX):
                         if not math.isfinite(x[i]):
