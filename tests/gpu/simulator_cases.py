@@ -175,9 +175,22 @@ def api_basins() -> dict[str, object]:
     args = (model, (-1.5, math.radians(40)), (-2.0, 2.0), (3, 3))
     kw = {"transient": 64, "periods": 16, "workers": 1}
     cpu = basins(*args, **kw, device="cpu")
-    gpu = basins(*args, **kw, device="gpu")
+    launched: list[int] = []  # (the points of each GPU launch with Lyapunov exponents)
+    run = GpuLaneBatch.run
+
+    def counted(batch: GpuLaneBatch) -> None:
+        if batch._spec0.lyapunov:
+            launched.append(len(batch.status))
+        run(batch)
+
+    GpuLaneBatch.run = counted  # type: ignore[method-assign]
+    try:
+        gpu = basins(*args, **kw, device="gpu")
+    finally:
+        GpuLaneBatch.run = run  # type: ignore[method-assign]
     differ = sorted(name for name in cpu.data_vars if not cpu[name].equals(gpu[name]))
-    return {"differ": differ, "variables": sorted(cpu.data_vars), "kinds": cpu.kind.values.tolist()}
+    return {"differ": differ, "variables": sorted(cpu.data_vars), "kinds": cpu.kind.values.tolist(),
+            "lyapunov_on_gpu": launched, "lyapunov": cpu.lyapunov.values.tolist()}  # fmt: skip
 
 
 def main(names: list[str]) -> None:

@@ -100,10 +100,13 @@ def test_parameter_map_on_the_gpu_is_the_same_dataset(compared: dict[str, dict[s
 
 
 def test_basins_on_the_gpu_are_the_same_dataset(compared: dict[str, dict[str, object]]) -> None:
-    """``basins(device="gpu")``: every variable equals ``device="cpu"``'s."""
+    """``basins(device="gpu")``: every variable equals ``device="cpu"``'s, the Lyapunov exponents among them,
+    computed on the GPU (the refined runs' last and the periodic orbit's run)."""
     row = compared["api basins"]
-    assert {"label", "fraction", "kind", "period"} <= set(row["variables"])
+    assert {"label", "fraction", "kind", "period", "lyapunov"} <= set(row["variables"])
     assert row["differ"] == []
+    assert len(row["lyapunov_on_gpu"]) >= 2 and "periodic" in row["kinds"], row
+    assert any(math.isfinite(v) for v in row["lyapunov"]), row
 
 
 def test_the_simulator_does_not_leak_into_this_process() -> None:
