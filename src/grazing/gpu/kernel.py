@@ -18,12 +18,16 @@ CPU's own code as device functions (:mod:`grazing.gpu.ported`).
 Not on the GPU yet: sticking (a chattering sequence that the CPU would sum
 and continue as sticking ends the thread's job with :data:`NEEDS_CPU` at that
 point; :mod:`grazing.gpu.batch` computes the rest of the job on the CPU
-lanes), Lyapunov exponents, the discontinuity map and models with several
-modes (refused before a launch).
+lanes), the discontinuity map and models with several modes (refused before
+a launch).  Lyapunov exponents are a kernel of their own
+(:func:`build_kernel`'s ``lyapunov``: the variational equations, their
+Gram-Schmidt after each step and the saltation matrix at each impact,
+:mod:`grazing.gpu.tangent`).
 
 Each thread's arrays are local (sized by the model: constants of the
-compiled kernel) except the root search's work array, one slice per thread of
-a global array the caller allocates; nothing is allocated in a kernel.
+compiled kernel; with Lyapunov exponents :func:`tangent_bytes` more) except
+the root search's work array, one slice per thread of a global array the
+caller allocates; nothing is allocated in a kernel.
 """
 
 from __future__ import annotations
