@@ -6,11 +6,15 @@ compute capability; with no device, that is taken to be ``--cc`` (9.0: an H100).
 NVVM's compilation to PTX are the device's: a construct the device cannot compile fails here.
 
     python tests/gpu/compile_ptx.py pendulum impact_oscillator bouncing_ball --cc 9.0
+
+Each model's kernel is compiled twice: without and with Lyapunov exponents (``build_kernel``'s
+``lyapunov``).
 """
 
 from __future__ import annotations
 
 import argparse
+import re
 import time
 import types as pytypes
 
@@ -30,8 +34,8 @@ def kernel_signature() -> tuple[object, ...]:
         return types.Array(t, nd, "C")
 
     return (array(i8, 2), array(i8, 1), array(f8, 2), array(f8, 2), array(f8, 2), array(f8, 1),
-            array(f8, 1), array(f8, 1), array(f8, 3), array(i8, 2), array(i8, 1), array(f8, 2),
-            array(f8, 1), array(i8, 1), array(f8, 3), array(i8, 1), array(f8, 1))  # fmt: skip
+            array(f8, 1), array(f8, 1), array(f8, 3), array(i8, 2), array(f8, 1), array(i8, 1),
+            array(f8, 2), array(f8, 1), array(i8, 1), array(f8, 3), array(i8, 1), array(f8, 1))  # fmt: skip
 
 
 def main() -> None:
@@ -51,11 +55,18 @@ def main() -> None:
         dispatcher.get_current_device = lambda: pytypes.SimpleNamespace(compute_capability=cc)
     for name in args.models:
         model = getattr(grazing.models, name)()
-        kernel = build_kernel(model_functions(model._def, taylor_order(args.tol)), keep_rows(100))
-        start = time.perf_counter()
-        ptx, _ = cuda.compile_ptx(kernel.py_func, kernel_signature(), cc=cc)
-        seconds = time.perf_counter() - start
-        print(f"{name}: PTX for sm_{cc[0]}{cc[1]}, {len(ptx)} characters, {seconds:.1f} s")
+        for lyapunov in (False, True):
+            dm = model_functions(model._def, taylor_order(args.tol))
+            kernel = build_kernel(dm, keep_rows(100), lyapunov)
+            start = time.perf_counter()
+            ptx, _ = cuda.compile_ptx(kernel.py_func, kernel_signature(), cc=cc)
+            seconds = time.perf_counter() - start
+            # (the local frames of the kernel and the device functions not inlined, in bytes)
+            local = [int(v) for v in re.findall(r"__local_depot\d+\[(\d+)\]", ptx)]
+            print(
+                f"{name}{' (Lyapunov)' if lyapunov else ''}: PTX for sm_{cc[0]}{cc[1]}, {len(ptx)} "
+                f"characters, local frames {local} bytes, {seconds:.1f} s"
+            )
 
 
 if __name__ == "__main__":

@@ -22,6 +22,7 @@ from grazing.sweeps.run import run_parts
 from grazing.sweeps.spec import map_spec, sweep_spec
 
 SHORT = {"transient": 64, "periods": 16, "lyapunov": False}
+LYAP = {"transient": 64, "periods": 16, "lyapunov": True}
 
 
 def cases() -> dict[str, list[tuple[object, int]]]:
@@ -29,6 +30,7 @@ def cases() -> dict[str, list[tuple[object, int]]]:
     B40 = grazing.models.pendulum("B", theta_hat=math.radians(40))
     fresh = grazing.SweepSettings(**SHORT, fresh=True)
     chained = grazing.SweepSettings(**SHORT, fresh=False, chunk_size=3, phase=1.0)
+    lyap = grazing.SweepSettings(**LYAP, fresh=True)
     equal_work = grazing.SweepSettings(**SHORT, fresh=True, adaptive=False, tol=1e-10, chunk_size=0)
     out = {
         # fig 7's first grazing at 40 degrees: period 1 free of the stop, period 4, chaos (case B)
@@ -82,6 +84,24 @@ def cases() -> dict[str, list[tuple[object, int]]]:
                 0,
             )
         ],
+        # Lyapunov exponents (tangent vectors through impacts by the saltation matrix): case B at 40 degrees
+        # (period 1 free of the stop, period 4, chaos), case C each point from the previous one's end, the
+        # impact oscillator
+        "lyapunov pendulum B": [(sweep_spec(B40, "eta", np.linspace(0.44, 0.46, 4), settings=lyap), 0)],
+        "lyapunov pendulum C chained": [
+            (
+                sweep_spec(
+                    grazing.models.pendulum("C", theta_hat=math.radians(30)),
+                    "eta",
+                    np.linspace(0.40, 0.50, 4),
+                    settings=grazing.SweepSettings(**LYAP, fresh=False, chunk_size=0, phase=1.0),
+                ),
+                0,
+            )
+        ],
+        "lyapunov impact oscillator": [
+            (sweep_spec(grazing.models.impact_oscillator(), "omega", [2.6, 2.8, 3.0], settings=lyap), 0)
+        ],
     }
     return out
 
@@ -96,11 +116,12 @@ def compare(parts: list[tuple[object, int]]) -> dict[str, object]:
     for name in ("period", "impacts_by_stop", "status", "transient_used", "impacts"):
         row[f"cpu_{name}"] = np.concatenate([getattr(r, name) for r in cpu]).tolist()
         row[f"gpu_{name}"] = np.concatenate([getattr(r, name) for r in gpu]).tolist()
-    for name in ("samples", "x_final"):
+    for name in ("samples", "x_final", "lyapunov"):
         a = np.concatenate([getattr(r, name) for r in cpu])
         b = np.concatenate([getattr(r, name) for r in gpu])
         same_nans = np.array_equal(np.isnan(a), np.isnan(b))  # (a NaN on one side only: inf)
         row[f"{name}_diff"] = float(np.nanmax(np.abs(a - b), initial=0.0)) if same_nans else math.inf
+    row["cpu_lyapunov_values"] = np.concatenate([r.lyapunov for r in cpu]).tolist()
     return row
 
 
@@ -146,17 +167,30 @@ def api_map() -> dict[str, object]:
 
 
 def api_basins() -> dict[str, object]:
-    """``basins(device="gpu")`` against ``device="cpu"`` (the refined runs with Lyapunov exponents on the
-    CPU either way): every variable of the two datasets."""
+    """``basins(device="gpu")`` against ``device="cpu"`` (the orbits' Lyapunov runs on the GPU too): every
+    variable of the two datasets."""
     from grazing.attractors import basins
 
     model = grazing.models.pendulum("B", eta=0.446, theta_hat=math.radians(40))
     args = (model, (-1.5, math.radians(40)), (-2.0, 2.0), (3, 3))
     kw = {"transient": 64, "periods": 16, "workers": 1}
     cpu = basins(*args, **kw, device="cpu")
-    gpu = basins(*args, **kw, device="gpu")
+    launched: list[int] = []  # (the points of each GPU launch with Lyapunov exponents)
+    run = GpuLaneBatch.run
+
+    def counted(batch: GpuLaneBatch) -> None:
+        if batch._spec0.lyapunov:
+            launched.append(len(batch.status))
+        run(batch)
+
+    GpuLaneBatch.run = counted  # type: ignore[method-assign]
+    try:
+        gpu = basins(*args, **kw, device="gpu")
+    finally:
+        GpuLaneBatch.run = run  # type: ignore[method-assign]
     differ = sorted(name for name in cpu.data_vars if not cpu[name].equals(gpu[name]))
-    return {"differ": differ, "variables": sorted(cpu.data_vars), "kinds": cpu.kind.values.tolist()}
+    return {"differ": differ, "variables": sorted(cpu.data_vars), "kinds": cpu.kind.values.tolist(),
+            "lyapunov_on_gpu": launched, "lyapunov": cpu.lyapunov.values.tolist()}  # fmt: skip
 
 
 def main(names: list[str]) -> None:

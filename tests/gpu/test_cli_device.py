@@ -27,7 +27,7 @@ def grazing(args: list[str], cwd: Path, simulator: bool = False) -> subprocess.C
 
 
 def test_gpu_without_a_device_is_one_line_and_writes_nothing(tmp_path: Path) -> None:
-    for extra in (["--no-lyapunov"], []):  # (no device; Lyapunov exponents not on the GPU yet)
+    for extra in (["--no-lyapunov"], []):  # (no device, with or without Lyapunov exponents)
         run = grazing([*MAP, *extra, "--device", "gpu", "--out", "m.zarr"], tmp_path)
         assert run.returncode != 0
         assert len(run.stderr.strip().splitlines()) == 1 and "device" in run.stderr
@@ -35,13 +35,15 @@ def test_gpu_without_a_device_is_one_line_and_writes_nothing(tmp_path: Path) -> 
 
 
 def test_the_map_on_the_simulated_gpu_is_the_cpus(tmp_path: Path) -> None:
-    args = [*MAP, "--no-lyapunov", "--fresh", "--json"]
+    """With Lyapunov exponents (the default): they are the CPU's too."""
+    args = [*MAP, "--fresh", "--json"]
     cpu = grazing([*args, "--device", "cpu"], tmp_path)
     gpu = grazing([*args, "--device", "gpu"], tmp_path, simulator=True)
     assert cpu.returncode == 0 and gpu.returncode == 0, gpu.stderr
     a, b = json.loads(cpu.stdout), json.loads(gpu.stdout)
     a.pop("elapsed_s"), b.pop("elapsed_s")
     assert a == b
+    assert all(isinstance(v, float) and v == v for line in a["lyapunov"] for v in line), a["lyapunov"]
 
 
 BALL = "--model bouncing-ball --set r=0.8 --set omega=1 --set gravity=1".split()

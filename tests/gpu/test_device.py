@@ -69,3 +69,42 @@ def test_the_device_equals_the_cpu_lanes(parts) -> None:
         assert g.status.tolist() == c.status.tolist()
         periodic = c.period > 0
         assert np.nanmax(np.abs(g.samples[periodic] - c.samples[periodic]), initial=0.0) <= DEVICE_SAMPLE_TOL
+
+
+DEVICE_LYAPUNOV_TOL = 1e-6
+"""Largest difference of the Lyapunov exponent of a periodic point on a device and on the CPU lanes (the
+exponent of a stable orbit is an average over the sampled periods, insensitive to the last bits)."""
+
+
+@pytest.mark.parametrize(
+    "parts",
+    [
+        pytest.param(
+            lambda: [(sweep_spec(grazing.models.pendulum("B", theta_hat=math.radians(40)), "eta",
+                                 np.linspace(0.44, 0.46, 16), settings=grazing.SweepSettings(
+                                     transient=200, periods=40, lyapunov=True, fresh=True)), 0)],
+            id="pendulum B",
+        ),
+        pytest.param(
+            lambda: [(sweep_spec(grazing.models.pendulum("C", theta_hat=math.radians(30)), "eta",
+                                 np.linspace(0.40, 0.50, 12), settings=grazing.SweepSettings(
+                                     transient=200, periods=40, lyapunov=True, chunk_size=0)), 0)],
+            id="pendulum C chained",
+        ),
+        pytest.param(
+            lambda: [(sweep_spec(grazing.models.impact_oscillator(), "omega", np.linspace(2.6, 3.0, 16),
+                                 settings=grazing.SweepSettings(transient=200, periods=40, lyapunov=True,
+                                                                fresh=True)), 0)],
+            id="impact oscillator",
+        ),
+    ],
+)  # fmt: skip
+def test_the_devices_lyapunov_exponents_equal_the_cpu_lanes(parts) -> None:
+    cpu, gpu = _both(parts())
+    for c, g in zip(cpu, gpu):
+        assert g.period.tolist() == c.period.tolist()
+        assert g.status.tolist() == c.status.tolist()
+        periodic = c.period > 0
+        assert np.isfinite(g.lyapunov[periodic]).all()
+        diff = np.nanmax(np.abs(g.lyapunov[periodic] - c.lyapunov[periodic]), initial=0.0)
+        assert diff <= DEVICE_LYAPUNOV_TOL

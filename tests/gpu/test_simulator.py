@@ -13,6 +13,7 @@ test.
 from __future__ import annotations
 
 import json
+import math
 import os
 import subprocess
 import sys
@@ -25,8 +26,9 @@ from grazing.errors import InvalidParameterError
 SAMPLE_TOL = 0.0
 """Largest difference of the samples (and final states) of the GPU in the simulator and the CPU lanes."""
 
+LYAPUNOV_CASES = ("lyapunov pendulum B", "lyapunov pendulum C chained", "lyapunov impact oscillator")
 CASES = ("pendulum B fresh", "pendulum C chained", "pendulum A map", "pendulum huge forcing",
-         "impact oscillator", "bouncing ball")  # fmt: skip
+         "impact oscillator", "bouncing ball", *LYAPUNOV_CASES)  # fmt: skip
 ROOT = Path(__file__).resolve().parents[2]
 
 
@@ -52,6 +54,20 @@ def test_the_gpu_equals_the_cpu_lanes_at_every_point(
         assert row[f"gpu_{name}"] == row[f"cpu_{name}"], name
     assert row["samples_diff"] <= SAMPLE_TOL
     assert row["x_final_diff"] <= SAMPLE_TOL
+    assert row["lyapunov_diff"] <= SAMPLE_TOL  # (NaN on one side only: inf)
+
+
+def test_the_lyapunov_cases_have_exponents_of_both_signs(compared: dict[str, dict[str, object]]) -> None:
+    """The exponents compared are real ones: finite at every point, negative on the periodic orbits and
+    positive at the last point of case B at 40 degrees (chaos: fig 7; the second point, aperiodic over
+    these few periods, is still settling)."""
+    for case in LYAPUNOV_CASES:
+        values = compared[case]["cpu_lyapunov_values"]
+        assert all(math.isfinite(v) for v in values), (case, values)
+        assert all(v < 0 for v, p in zip(values, compared[case]["cpu_period"]) if p > 0), (case, values)
+    b = compared["lyapunov pendulum B"]
+    assert b["cpu_period"][-1] == 0 and b["cpu_lyapunov_values"][-1] > 0, b
+    assert all(sum(map(sum, compared[case]["cpu_impacts_by_stop"])) > 0 for case in LYAPUNOV_CASES)
 
 
 def test_the_cases_reach_what_they_are_for(compared: dict[str, dict[str, object]]) -> None:
@@ -84,10 +100,13 @@ def test_parameter_map_on_the_gpu_is_the_same_dataset(compared: dict[str, dict[s
 
 
 def test_basins_on_the_gpu_are_the_same_dataset(compared: dict[str, dict[str, object]]) -> None:
-    """``basins(device="gpu")``: every variable equals ``device="cpu"``'s."""
+    """``basins(device="gpu")``: every variable equals ``device="cpu"``'s, the Lyapunov exponents among them,
+    computed on the GPU (the refined runs' last and the periodic orbit's run)."""
     row = compared["api basins"]
-    assert {"label", "fraction", "kind", "period"} <= set(row["variables"])
+    assert {"label", "fraction", "kind", "period", "lyapunov"} <= set(row["variables"])
     assert row["differ"] == []
+    assert len(row["lyapunov_on_gpu"]) >= 2 and "periodic" in row["kinds"], row
+    assert any(math.isfinite(v) for v in row["lyapunov"]), row
 
 
 def test_the_simulator_does_not_leak_into_this_process() -> None:
@@ -100,11 +119,14 @@ def test_the_simulator_does_not_leak_into_this_process() -> None:
 def test_what_the_gpu_does_not_do_yet_is_refused_in_one_line() -> None:
     import grazing
     from grazing.gpu.batch import GpuLaneBatch
+    from grazing.gpu.device import gpu_refusal
     from grazing.sweeps.spec import sweep_spec
 
-    spec = sweep_spec(grazing.models.pendulum("B"), "eta", [0.44], settings=grazing.SweepSettings())
-    with pytest.raises(InvalidParameterError, match=r"^Lyapunov exponents are not computed on the GPU yet"):
+    spec = sweep_spec(grazing.models.rocking_block(), "alpha", [0.1], settings=grazing.SweepSettings())
+    with pytest.raises(InvalidParameterError, match=r"^models with several modes are not on the GPU yet"):
         GpuLaneBatch([(spec, 0)])
+    lyapunov = sweep_spec(grazing.models.pendulum("B"), "eta", [0.44], settings=grazing.SweepSettings())
+    assert lyapunov.lyapunov and gpu_refusal(lyapunov) is None  # (Lyapunov exponents are the GPU's too)
 
 
 def test_no_device_is_one_line() -> None:

@@ -210,9 +210,9 @@ def find_attractors(
     progress
         Called as ``progress(done, total)``.
     device
-        ``"cpu"`` (the default), ``"gpu"`` or ``"auto"`` (:mod:`grazing.gpu.device`): the runs without
-        Lyapunov exponents on an NVIDIA GPU, one CUDA thread per initial state; those with them (the
-        refined runs' last, each orbit's exponent) on the CPU lanes.
+        ``"cpu"`` (the default), ``"gpu"`` or ``"auto"`` (:mod:`grazing.gpu.device`): the runs on an
+        NVIDIA GPU, one CUDA thread per initial state, those with Lyapunov exponents (the refined
+        runs' last, each orbit's exponent) too.
     **shorthands
         Any field of :class:`~grazing.core.options.BasinSettings` by name
         (``transient=200``, ``lyapunov=False`` ...), replacing that field of
@@ -287,17 +287,17 @@ def find_attractors(
             deferred = _refine(model, catalogue, deferred, s, look, replace(run, store=None, progress=None))
         exact = catalogue.examine_orbits()
         if s.lyapunov:
-            _orbit_exponents(model, catalogue, s, workers, client, exact)
+            _orbit_exponents(model, catalogue, s, run, exact)
     attractors, labels = catalogue.attractors(int(invalid.sum()))
     seconds = time.perf_counter() - start
     return AttractorSet(tuple(attractors), labels, np.array(cells), s.phase, s.transient, s.periods, seconds,
                         fraction, catalogue.polished)  # fmt: skip
 
 
-def _orbit_exponents(model: HybridModel, catalogue: Catalogue, s: BasinSettings, workers: int | None,
-                     client: Any, exact: dict[int, float]) -> None:  # fmt: skip
+def _orbit_exponents(model: HybridModel, catalogue: Catalogue, s: BasinSettings, run: _Run,
+                     exact: dict[int, float]) -> None:  # fmt: skip
     """Each periodic orbit's largest Lyapunov exponent: ``exact`` (from its multipliers) where given, else
-    from a run from one of its points."""
+    from a run from one of its points (on ``run``'s device: :func:`~grazing.gpu.device.spec_device`)."""
     from grazing.sweeps.api import run_sweep
 
     for k, value in exact.items():
@@ -307,7 +307,9 @@ def _orbit_exponents(model: HybridModel, catalogue: Catalogue, s: BasinSettings,
         return
     points = np.array([catalogue.entries[k].points[0] for k in orbits])
     one = replace(s, chunk_size=max(1, len(orbits)))  # (on the orbit: the adaptive transient ends at once)
-    ds = run_sweep(basin_spec(model, points, one, True), workers=workers, client=client)
+    spec = basin_spec(model, points, one, True)
+    device = spec_device(run.device, spec, run.client)
+    ds = run_sweep(spec, workers=run.workers, client=run.client, device=device)
     for k, value in zip(orbits, ds.lyapunov.values):
         catalogue.entries[k].exponents = [float(value)]
 

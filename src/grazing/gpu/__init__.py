@@ -5,6 +5,7 @@
 * :mod:`.ported` -- the CPU driver's step size, event location and period test as device functions,
   made from their own source;
 * :mod:`.model` -- a model's generated functions as device functions;
+* :mod:`.tangent` -- the Lyapunov vectors' step and the saltation matrix at an impact;
 * :mod:`.kernel` -- the sweep kernel;
 * :mod:`.batch` -- a sweep's chunks on the GPU, as the CPU lanes' :class:`~grazing.sweeps.run.LaneBatch`.
 

@@ -9,9 +9,10 @@ that reaches what the kernel does not do (complete chattering continued as
 sticking: :data:`~grazing.gpu.kernel.NEEDS_CPU`) is finished on the CPU lanes
 from that point on, from the state the GPU had reached there.
 
-Refused in one line (:class:`~grazing.errors.InvalidParameterError`) before
-anything runs: Lyapunov exponents, the discontinuity map and models with
-several modes (not on the GPU yet).
+Lyapunov exponents are the kernel's too (its variational build).  Refused in
+one line (:class:`~grazing.errors.InvalidParameterError`) before anything
+runs: the discontinuity map and models with several modes (not on the GPU
+yet).
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from collections.abc import Iterator, Sequence
 
 import numpy as np
 
+from grazing.core.options import LYAPUNOV_ALIGN
 from grazing.core.solution import Status
 from grazing.engine.records import LaneJobs
 from grazing.errors import InvalidParameterError
@@ -67,15 +69,17 @@ class GpuLaneBatch(LaneBatch):
 
         spec = self._spec0
         cuda = cuda_module()
-        kernel = sweep_kernel(spec.model._def, self._order, keep_rows(spec.periods))
+        kernel = sweep_kernel(spec.model._def, self._order, keep_rows(spec.periods), bool(spec.lyapunov))
         njobs = len(self.jobs)
         threads = min(njobs, self.max_threads)
+        align = min(LYAPUNOV_ALIGN, spec.transient) if spec.lyapunov else 0  # (as the lanes')
         iset = np.array(
-            [self.fresh, spec.model.periodic, spec.transient, spec.periods, spec.adaptive], dtype=np.int64
+            [self.fresh, spec.model.periodic, spec.transient - align, spec.periods, spec.adaptive, align],
+            dtype=np.int64,
         )
         factor = step_factor(step_safety(spec.tol, self._order), self._order)
         fset = np.array([spec.adaptive_tol, factor, spec.chatter_tol], dtype=np.float64)
-        outputs = (self.samples, self.by_stop, self.used, self.x_final, self.t_final, self.status)
+        outputs = (self.samples, self.by_stop, self.lyap, self.used, self.x_final, self.t_final, self.status)
         counter = np.zeros(1, dtype=np.int64)  # (the next job)
         inputs = (self.jobs, counter, self.x0, self.firsts, self.pvs, self.Ts, self.sphase, self.tcarry)
         d_in = [cuda.to_device(np.ascontiguousarray(a)) for a in inputs]
@@ -129,12 +133,11 @@ def run_parts_gpu(parts: Sequence[tuple[SweepSpec, int]], threads: int | None = 
     --------
     >>> import grazing
     >>> from grazing.sweeps.spec import sweep_spec
-    >>> spec = sweep_spec(grazing.models.pendulum("B"), "eta", [0.44, 0.45],
-    ...                   settings=grazing.SweepSettings(lyapunov=True))
+    >>> spec = sweep_spec(grazing.models.rocking_block(), "alpha", [0.1, 0.2])
     >>> run_parts_gpu([(spec, 0)])  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    grazing.errors.InvalidParameterError: Lyapunov exponents are not computed on the GPU yet: ...
+    grazing.errors.InvalidParameterError: models with several modes are not on the GPU yet: ...
     """
     start = time.perf_counter()
     batch = GpuLaneBatch(parts, threads)

@@ -22,11 +22,6 @@ AUTO_MIN_POINTS = 20_000
 
 def gpu_refusal(spec: Any) -> str | None:
     """Why the sweep ``spec`` cannot run on the GPU yet (one line), or None."""
-    if spec.lyapunov:
-        return (
-            "Lyapunov exponents are not computed on the GPU yet: go without them (lyapunov=False) or run on "
-            "the CPU (device=)"
-        )
     if spec.zdm is not None:
         return "the discontinuity map is not on the GPU yet: run on the CPU (device=)"
     if spec.model.n_modes > 1:

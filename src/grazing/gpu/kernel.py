@@ -18,12 +18,16 @@ CPU's own code as device functions (:mod:`grazing.gpu.ported`).
 Not on the GPU yet: sticking (a chattering sequence that the CPU would sum
 and continue as sticking ends the thread's job with :data:`NEEDS_CPU` at that
 point; :mod:`grazing.gpu.batch` computes the rest of the job on the CPU
-lanes), Lyapunov exponents, the discontinuity map and models with several
-modes (refused before a launch).
+lanes), the discontinuity map and models with several modes (refused before
+a launch).  Lyapunov exponents are a kernel of their own
+(:func:`build_kernel`'s ``lyapunov``: the variational equations, their
+Gram-Schmidt after each step and the saltation matrix at each impact,
+:mod:`grazing.gpu.tangent`).
 
 Each thread's arrays are local (sized by the model: constants of the
-compiled kernel) except the root search's work array, one slice per thread of
-a global array the caller allocates; nothing is allocated in a kernel.
+compiled kernel; with Lyapunov exponents :func:`tangent_bytes` more) except
+the root search's work array, one slice per thread of a global array the
+caller allocates; nothing is allocated in a kernel.
 """
 
 from __future__ import annotations
@@ -44,15 +48,15 @@ NEEDS_CPU = -2
 
 # The run state of a thread: integer fields of ``st``, float fields of ``sf`` (lanes' RUN_STATE names).
 K, KS, ISAMP, N_SAMPLES, N_KEEP, RECORDING, STEPS, MAX_STEPS, ZERO_EVENTS, DEFL, DEFL_STOP = range(11)
-STAGE, BLOCK, USED, REQ_KS = 11, 12, 13, 14
-INT_FIELDS = 15
-S, SS, REQ_SS = 0, 1, 2
-FLOAT_FIELDS = 3
+STAGE, BLOCK, USED, REQ_KS, USE_VAR, LYAP_STARTED, JAC_VALID = 11, 12, 13, 14, 15, 16, 17
+INT_FIELDS = 18
+S, SS, REQ_SS, SPAN_DT, LYAP_T0 = range(5)
+FLOAT_FIELDS = 5
 TRANSIENT, EXTRA, FINAL = 1, 2, 3
 """A point's stages (as the lanes')."""
 
 # The settings arrays: integers, floats.
-FRESH, PERIODIC, TRANSIENT_PERIODS, PERIODS, ADAPTIVE = range(5)
+FRESH, PERIODIC, TRANSIENT_PERIODS, PERIODS, ADAPTIVE, ALIGN = range(6)
 ADAPTIVE_TOL, FACTOR, CHATTER_TOL = range(3)
 
 STATUS_OK = int(Status.OK)
@@ -69,20 +73,38 @@ def keep_rows(periods: int) -> int:
     return max(int(periods), ADAPTIVE_BLOCK)
 
 
-_kernels: dict[tuple[str, int, int], Any] = {}
+def tangent_bytes(nx: int, order: int) -> int:
+    """Bytes of local memory a thread's variational arrays add to the kernel with Lyapunov exponents.
+
+    The state's arrays (``x``, ``xe``, ``xp``: ``n`` to ``n + n^2`` doubles) and its Taylor coefficients
+    (``n + n^2`` rows of ``order + 1``), the matrices ``V``, ``Vn``, ``Gx`` (``n x n``) and ``Gp``
+    (``n x 1``), the vectors ``logs``, ``scratch``, ``before``, ``fm``, ``fp``, ``Gt``, ``hx``, ``w``,
+    ``hv`` (``n`` each).
+
+    Examples
+    --------
+    >>> tangent_bytes(2, 13)  # (the pendulum at tol 1e-10: Taylor order 13)
+    800
+    """
+    nn = nx * nx
+    return 8 * (3 * nn + nn * (order + 1) + 3 * nn + nx + 9 * nx)
 
 
-def sweep_kernel(definition: Any, order: int, keep: int) -> Any:
-    """The kernel of a model definition at Taylor ``order`` with ``keep`` sample rows, built once."""
+_kernels: dict[tuple[str, int, int, bool], Any] = {}
+
+
+def sweep_kernel(definition: Any, order: int, keep: int, lyapunov: bool = False) -> Any:
+    """The kernel of a model definition at Taylor ``order`` with ``keep`` sample rows, built once;
+    ``lyapunov``: with the variational equations (:func:`build_kernel`)."""
     from grazing.gpu.model import model_functions
 
-    key = (definition.identity(), int(order), int(keep))
+    key = (definition.identity(), int(order), int(keep), bool(lyapunov))
     if key not in _kernels:
-        _kernels[key] = build_kernel(model_functions(definition, order), keep)
+        _kernels[key] = build_kernel(model_functions(definition, order), keep, lyapunov)
     return _kernels[key]
 
 
-def build_kernel(dm: Any, keep: int) -> Any:
+def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
     """The sweep kernel of the device model ``dm`` (:class:`~grazing.gpu.model.DeviceModel`).
 
     ``kernel[blocks, threads](jobs, control, x0, firsts, pvs, Ts, sphase,
@@ -92,7 +114,15 @@ def build_kernel(dm: Any, keep: int) -> Any:
     :class:`~grazing.engine.records.LaneResults` (``control[0]`` the next job,
     0 at the start), ``work`` the root search's arrays (one per thread),
     ``iset`` and ``fset`` the settings (the module's ``FRESH ...`` and
-    ``ADAPTIVE_TOL ...`` positions).
+    ``ADAPTIVE_TOL ...`` positions; ``iset[TRANSIENT_PERIODS]`` the transient
+    less the Lyapunov alignment ``iset[ALIGN]``), ``lyap`` the largest
+    Lyapunov exponents.  With ``lyapunov`` (the lanes' ``final_request``) the
+    recorded stage starts a new run with the variational equations from the
+    identity (``tc_var``: the state's rows then the matrix's, row by row), its
+    first ``iset[ALIGN]`` periods aligning the tangent vectors; each step
+    ends with their Gram-Schmidt (:mod:`grazing.gpu.tangent`), each impact
+    multiplies them by the saltation matrix; ``tangent_bytes`` more local
+    memory per thread.  Without it the kernel has no variational arrays.
     """
     from grazing.gpu.ported import device_helpers
 
@@ -104,15 +134,24 @@ def build_kernel(dm: Any, keep: int) -> Any:
     isolate_first_root = helpers["isolate_first_root"]
     confirm_first_root = helpers["confirm_first_root"]
     eval_rows = helpers["eval_rows"]
+    unpack_var = helpers["unpack_var"]
+    pack_var = helpers["pack_var"]
     repeats_with_period = helpers["repeats_with_period"]
     step_limit = helpers["step_limit"]
     start_times = helpers["start_times"]
     tc_free = dm.functions["tc_free"]
+    tc_var = dm.functions["tc_var"]
     reset = dm.functions["reset"]
     normal_rate = dm.functions["normal_rate"]
     normal_accel = dm.functions["normal_accel"]
     NX, NSTOPS, ORDER = dm.nx, dm.nstops, dm.order
     KC = ORDER + 1
+    LYAP = bool(lyapunov)
+    NT = NX + NX * NX if LYAP else NX  # (rows of the state with the variational matrix)
+    NV = NX if LYAP else 1  # (sides of the tangent arrays: one element without Lyapunov exponents)
+    from grazing.gpu.tangent import LYAP_STARTED_NOW_AT_END, tangent_functions
+
+    lyapunov_step, saltation = tangent_functions(dm)  # (without LYAP, in branches pruned at compilation)
     KEEP = int(keep)
     STICKS = np.array(dm.sticks, dtype=np.int64)
     from numba import types
@@ -153,12 +192,17 @@ def build_kernel(dm: Any, keep: int) -> Any:
         return -1.0
 
     @dj
-    def begin_request(st, sf, periods, keep_n):
+    def begin_request(st, sf, periods, keep_n, use_var, T):
         """Start a request of ``periods`` samples keeping the last ``keep_n`` (``lanes.begin_request``)."""
         st[N_SAMPLES] = periods
         st[N_KEEP] = keep_n
         st[ISAMP] = 0
         st[RECORDING] = 1 if periods - keep_n == 0 else 0
+        st[LYAP_STARTED] = st[RECORDING]
+        sf[SPAN_DT] = math.nan
+        st[JAC_VALID] = 1
+        st[USE_VAR] = use_var
+        sf[LYAP_T0] = st[K] * T + sf[S]
         st[STEPS] = 0
         st[MAX_STEPS] = step_limit(periods)
         st[ZERO_EVENTS] = 0
@@ -188,10 +232,16 @@ def build_kernel(dm: Any, keep: int) -> Any:
                 sf[SS] += T
             if st[ISAMP] == keep_from and st[RECORDING] == 0 and st[N_KEEP] > 0:
                 st[RECORDING] = 1
+                sf[SPAN_DT] = dt  # (where the Lyapunov sums start)
+                sf[LYAP_T0] = st[K] * T + sf[S] + dt
 
     @dj
-    def run_request(st, sf, x, pv, T, wrap, final, fset, X, O, a, xe, xp, buf, counts, work):
-        """Steps until the request's last sample; returns the point's status (OK: go on)."""
+    def run_request(st, sf, x, pv, T, wrap, final, fset, X, O, a, xe, xp, buf, counts, work, tw):
+        """Steps until the request's last sample; returns the point's status (OK: go on).
+
+        ``tw`` = ``(V, logs, scratch, before, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn)``: the tangent arrays.
+        """
+        V, logs, scratch, before, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn = tw
         factor = fset[FACTOR]
         chatter_time = fset[CHATTER_TOL] * T
         while st[ISAMP] < st[N_SAMPLES]:
@@ -201,8 +251,15 @@ def build_kernel(dm: Any, keep: int) -> Any:
                 if not math.isfinite(x[i]):
                     return STATUS_NONFINITE
             s = sf[S]
-            tc_free(x, s, pv, X, O)
-            h = step_size(X, NX, O, NSTOPS, 0, GUARD_SCALE, ORDER, T, factor)
+            var = False
+            if LYAP:
+                var = st[USE_VAR] != 0
+            if LYAP and var:
+                tc_var(x, s, pv, X, O)
+                h = step_size(X, NT, O, NSTOPS, 0, GUARD_SCALE, ORDER, T, factor)
+            else:
+                tc_free(x, s, pv, X, O)
+                h = step_size(X, NX, O, NSTOPS, 0, GUARD_SCALE, ORDER, T, factor)
             rem = (st[KS] - st[K]) * T + (sf[SS] - s)  # (step.step_end)
             last = False
             if st[ISAMP] == st[N_SAMPLES] - 1 and h >= rem:
@@ -222,18 +279,31 @@ def build_kernel(dm: Any, keep: int) -> Any:
             if (st[KS] - st[K]) * T + (sf[SS] - s) <= h_acc:
                 take_samples(st, sf, X, T, h_acc, event, last, buf, xe, wrap)
             recording = st[RECORDING]
-            eval_rows(X, NX, ORDER, h_acc, x)  # (the lanes' advance)
+            eval_rows(X, NT if var else NX, ORDER, h_acc, x)  # (the lanes' advance)
             sf[S] = s + h_acc  # (step.end_step)
             if wrap and sf[S] >= T:
                 sf[S] -= T
                 st[K] += 1
             st[STEPS] += 1
             st[DEFL] = 0
+            if LYAP and var:  # the Lyapunov vectors (tangent.lyapunov_step)
+                started = lyapunov_step(st[LYAP_STARTED] != 0, st[RECORDING] != 0, sf[SPAN_DT], x, X, V,
+                                        scratch, logs, xe, before)  # fmt: skip
+                if started != 0:
+                    st[LYAP_STARTED] = 1
+                    if started == LYAP_STARTED_NOW_AT_END:
+                        sf[LYAP_T0] = st[K] * T + sf[S]
+            sf[SPAN_DT] = math.nan
             if event:  # an impact on stop ev_stop (impacts.at_event, apply_impact)
                 s = sf[S]
                 vn = normal_rate(x, s, pv, ev_stop)
                 reset(x, s, pv, xp, ev_stop)
-                for i in range(NX):
+                if LYAP and var:  # (the variational matrix times the saltation matrix)
+                    unpack_var(x, NX, NX, V)
+                    if not saltation(x, xp, s, pv, ev_stop, V, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn):
+                        st[JAC_VALID] = 0  # (an impact at zero normal speed has no Jacobian)
+                    pack_var(V, NX, NX, xp)
+                for i in range(NT if var else NX):
                     x[i] = xp[i]
                 st[DEFL] = 1
                 st[DEFL_STOP] = ev_stop
@@ -244,12 +314,31 @@ def build_kernel(dm: Any, keep: int) -> Any:
         return STATUS_OK
 
     @dj
-    def run_point(st, sf, x, pv, T, iset, fset, X, O, a, xe, xp, buf, counts, work):
+    def final_request(st, sf, x, T, iset, s_phase, logs):
+        """The recorded stage (``lanes.final_request``): with Lyapunov exponents a new run at the current
+        time, the variational matrix the identity, ``iset[ALIGN]`` periods before the recorded ones."""
+        periods = iset[PERIODS]
+        if LYAP:
+            k0, s0, ks0, ss0 = start_times(st[K] * T + sf[S], T, s_phase, iset[PERIODIC] != 0)
+            st[K] = k0
+            sf[S] = s0
+            st[REQ_KS] = ks0
+            sf[REQ_SS] = ss0
+            for i in range(NX):
+                logs[i] = 0.0
+                for c in range(NX):
+                    x[NX + i * NX + c] = 1.0 if i == c else 0.0
+            begin_request(st, sf, iset[ALIGN] + periods, periods, 1, T)
+        else:
+            begin_request(st, sf, periods, periods, 0, T)
+
+    @dj
+    def run_point(st, sf, x, pv, T, s_phase, iset, fset, X, O, a, xe, xp, buf, counts, work, tw):
         """The point's protocol (``lanes.take_point``, ``end_request``); returns its status."""
         wrap = iset[PERIODIC] != 0
         budget = iset[TRANSIENT_PERIODS]
-        periods = iset[PERIODS]
         adaptive = iset[ADAPTIVE] != 0
+        logs = tw[1]
         for j in range(NSTOPS):
             counts[j] = 0
         st[USED] = 0
@@ -257,13 +346,13 @@ def build_kernel(dm: Any, keep: int) -> Any:
             blk = min(ADAPTIVE_BLOCK, budget)
             st[BLOCK] = blk
             st[STAGE] = TRANSIENT
-            begin_request(st, sf, blk, blk if adaptive else 0)
+            begin_request(st, sf, blk, blk if adaptive else 0, 0, T)
         else:
             st[STAGE] = FINAL
-            begin_request(st, sf, periods, periods)
+            final_request(st, sf, x, T, iset, s_phase, logs)
         while True:
             status = run_request(st, sf, x, pv, T, wrap, st[STAGE] == FINAL, fset, X, O, a, xe, xp, buf,
-                                 counts, work)  # fmt: skip
+                                 counts, work, tw)  # fmt: skip
             if status != STATUS_OK:
                 return status
             if wrap:
@@ -275,7 +364,7 @@ def build_kernel(dm: Any, keep: int) -> Any:
                 return STATUS_OK
             if stage == EXTRA:
                 st[STAGE] = FINAL
-                begin_request(st, sf, periods, periods)
+                final_request(st, sf, x, T, iset, s_phase, logs)
                 continue
             blk = st[BLOCK]
             st[USED] += blk
@@ -288,31 +377,46 @@ def build_kernel(dm: Any, keep: int) -> Any:
                     if extra:
                         st[USED] += extra
                         st[STAGE] = EXTRA
-                        begin_request(st, sf, extra, 0)
+                        begin_request(st, sf, extra, 0, 0, T)
                         continue
                     nxt = 0
             if nxt < 0 and used < budget:
                 blk = min(ADAPTIVE_BLOCK, budget - used)
                 st[BLOCK] = blk
-                begin_request(st, sf, blk, blk if adaptive else 0)
+                begin_request(st, sf, blk, blk if adaptive else 0, 0, T)
                 continue
             st[STAGE] = FINAL
-            begin_request(st, sf, periods, periods)
+            final_request(st, sf, x, T, iset, s_phase, logs)
 
     @cuda.jit
-    def kernel(jobs, control, x0, firsts, pvs, Ts, sphase, tcarry, samples, by_stop, used, x_final, t_final,
-               status, work, iset, fset):  # fmt: skip
+    def kernel(jobs, control, x0, firsts, pvs, Ts, sphase, tcarry, samples, by_stop, lyap, used, x_final,
+               t_final, status, work, iset, fset):  # fmt: skip
         tid = cuda.grid(1)
         if tid >= work.shape[0]:
             return
         st = cuda.local.array(INT_FIELDS, int64)
         sf = cuda.local.array(FLOAT_FIELDS, float64)
-        x = cuda.local.array(NX, float64)
-        X = cuda.local.array((NX, KC), float64)
+        x = cuda.local.array(NT, float64)
+        X = cuda.local.array((NT, KC), float64)
         O = cuda.local.array((NSTOPS, KC), float64)
         a = cuda.local.array(KC, float64)
-        xe = cuda.local.array(NX, float64)
-        xp = cuda.local.array(NX, float64)
+        xe = cuda.local.array(NT, float64)
+        xp = cuda.local.array(NT, float64)
+        tw = (
+            cuda.local.array((NV, NV), float64),  # V
+            cuda.local.array(NV, float64),  # logs
+            cuda.local.array(NV, float64),  # scratch
+            cuda.local.array(NV, float64),  # before
+            cuda.local.array(NV, float64),  # fm
+            cuda.local.array(NV, float64),  # fp
+            cuda.local.array((NV, NV), float64),  # Gx
+            cuda.local.array(NV, float64),  # Gt
+            cuda.local.array((NV, 1), float64),  # Gp
+            cuda.local.array(NV, float64),  # hx
+            cuda.local.array(NV, float64),  # w
+            cuda.local.array(NV, float64),  # hv
+            cuda.local.array((NV, NV), float64),  # Vn
+        )
         buf = cuda.local.array((KEEP, NX), float64)
         counts = cuda.local.array(NSTOPS, int64)
         mine = work[tid]
@@ -341,7 +445,8 @@ def build_kernel(dm: Any, keep: int) -> Any:
                 sf[S] = s0
                 st[REQ_KS] = ks0
                 sf[REQ_SS] = ss0
-                code = run_point(st, sf, x, pvs[p], T, iset, fset, X, O, a, xe, xp, buf, counts, mine)
+                code = run_point(st, sf, x, pvs[p], T, sphase[p], iset, fset, X, O, a, xe, xp, buf, counts,
+                                 mine, tw)  # fmt: skip
                 if code == STATUS_OK:  # (lanes.finish_point)
                     for i in range(NX):
                         if not math.isfinite(x[i]):
@@ -356,7 +461,20 @@ def build_kernel(dm: Any, keep: int) -> Any:
                             samples[p, r, c] = buf[r, c]
                     for j in range(NSTOPS):
                         by_stop[p, j] = counts[j]
-                    used[p] = st[USED]
+                    used[p] = st[USED] + iset[ALIGN]
+                    if LYAP:  # (lanes.finish_point)
+                        logs = tw[1]
+                        ex = math.nan
+                        span = st[K] * T + sf[S] - sf[LYAP_T0] if st[LYAP_STARTED] != 0 else 0.0
+                        if st[JAC_VALID] != 0 and span != 0.0:
+                            ex = logs[0] / span
+                            for j in range(1, NX):
+                                v = logs[j] / span
+                                if math.isnan(ex) or math.isnan(v):
+                                    ex = math.nan
+                                elif v > ex:
+                                    ex = v
+                        lyap[p] = ex
                     for i in range(NX):
                         x_final[p, i] = x[i]
                     t_final[p] = st[K] * T + sf[S]

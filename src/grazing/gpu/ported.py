@@ -5,7 +5,8 @@ The step size (:func:`~grazing.engine.stepping.step_size`, with its
 (:mod:`grazing.engine.driver.events`), the certified first root
 (:mod:`grazing.engine.polyroots`: quadratic bound, Bernstein subdivision,
 Newton polishing, the check that the root is the first), the test of a
-repeating transient, the start times and the model code's ``sin`` and ``cos``
+repeating transient, the start times, the Lyapunov vectors' Gram-Schmidt and
+(un)packing of the variational matrix, and the model code's ``sin`` and ``cos``
 (:mod:`grazing.engine.sincos`: not the C library's) are compiled for the GPU from the
 very text the CPU driver compiles: the decorators dropped, each function
 executed in one namespace where every callee is its device copy.  A change in
@@ -31,6 +32,7 @@ PORTED: dict[str, tuple[str, ...]] = {
     ),
     "grazing.engine.stepping": (
         "fast_log", "fast_exp", "step_size", "step_from_norms", "eval_rows", "divide_double_root_at_one",
+        "orthonormalize", "unpack_var", "pack_var",
     ),
     "grazing.engine.driver.events": ("event_polynomial", "event_certificate"),
     "grazing.core.period": ("repeats_with_period",),

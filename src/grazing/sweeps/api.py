@@ -72,9 +72,9 @@ def run_sweep(
         results in memory (they are in ``store``: a huge sweep streams to it).
     device
         ``"cpu"`` (the default): the CPU lanes; ``"gpu"``: an NVIDIA GPU, one
-        CUDA thread per point (:mod:`grazing.gpu`: not yet with Lyapunov
-        exponents, the discontinuity map, models with modes or chains of
-        several chunks; sticking is finished on the CPU); ``"auto"``: the GPU
+        CUDA thread per point (:mod:`grazing.gpu`, Lyapunov exponents
+        included; not yet the discontinuity map, models with modes or chains
+        of several chunks; sticking is finished on the CPU); ``"auto"``: the GPU
         when one is present and the sweep is large (:mod:`grazing.gpu.device`).
 
     Returns

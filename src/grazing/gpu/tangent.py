@@ -1,0 +1,123 @@
+"""The tangent dynamics of the sweep kernel: the Lyapunov vectors' step and the saltation matrix at an impact.
+
+The CPU driver's :func:`~grazing.engine.driver.tangent.lyapunov_step` and
+:func:`~grazing.engine.driver.impacts.saltation` as device functions, operation
+for operation (the same sums in the same order), over arrays the kernel's
+thread owns: the CPU versions allocate their small buffers and read the run's
+record, which a device function cannot.  The Gram-Schmidt step
+(:func:`~grazing.engine.stepping.orthonormalize`) and the (un)packing of the
+variational matrix are the CPU's own code (:mod:`grazing.gpu.ported`); the
+model's field, reset Jacobian and guard gradient its generated functions
+(:mod:`grazing.gpu.model`).  One mode, no sensitivity columns: the variational
+matrix is ``n x n`` (``ncol = n``, as on the CPU lanes).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, NamedTuple
+
+LYAP_STARTED_NOW_AT_END, LYAP_STARTED_NOW_AT_SPAN = 1, 2
+"""What :func:`tangent_functions`' ``lyapunov_step`` reports: the sums started at the step's end (the
+span started in an earlier step) or at the span's start inside the step; 0: nothing changed."""
+
+
+class TangentFunctions(NamedTuple):
+    """The device functions of :func:`tangent_functions`."""
+
+    lyapunov_step: Any
+    saltation: Any
+
+
+def tangent_functions(dm: Any) -> TangentFunctions:
+    """The tangent dynamics' device functions of the device model ``dm`` (see the module)."""
+    from grazing.gpu.ported import device_helpers
+    from grazing.gpu.target import device_function
+
+    helpers = device_helpers()
+    orthonormalize = helpers["orthonormalize"]
+    unpack_var = helpers["unpack_var"]
+    pack_var = helpers["pack_var"]
+    eval_rows = helpers["eval_rows"]
+    rhs = dm.functions["rhs"]
+    reset_jac = dm.functions["reset_jac"]
+    guard_grad = dm.functions["guard_grad"]
+    NX, ORDER = dm.nx, dm.order
+    NT = NX + NX * NX
+
+    def lyapunov_step(started, recording, span_dt, x, X, V, scratch, logs, xe, before):
+        """Gram-Schmidt on the tangent vectors after a step (``tangent.lyapunov_step``, ``ncol = n``).
+
+        ``started``, ``recording``: whether the sums have started and the
+        span is recorded; ``span_dt`` where the span started in the step
+        (NaN: not in it).  Returns :data:`LYAP_STARTED_NOW_AT_END`,
+        :data:`LYAP_STARTED_NOW_AT_SPAN` or 0.
+        """
+        code = 0
+        if recording and not started:
+            if math.isnan(span_dt):  # (the span started in an earlier step, while sticking)
+                code = LYAP_STARTED_NOW_AT_END
+                unpack_var(x, NX, NX, V)
+                orthonormalize(V, NX, scratch)
+            else:
+                code = LYAP_STARTED_NOW_AT_SPAN
+                eval_rows(X, NT, ORDER, span_dt, xe)
+                unpack_var(xe, NX, NX, V)
+                for c in range(NX):
+                    before[c] = 0.0
+                orthonormalize(V, NX, before)  # the vectors' growth before the span ...
+                unpack_var(x, NX, NX, V)
+                orthonormalize(V, NX, logs)
+                for c in range(NX):
+                    logs[c] -= before[c]  # ... is not the span's
+                    if before[c] == -math.inf:  # a direction already collapsed: it stays collapsed
+                        logs[c] = -math.inf
+        elif started:
+            unpack_var(x, NX, NX, V)
+            orthonormalize(V, NX, logs)
+        else:
+            unpack_var(x, NX, NX, V)
+            orthonormalize(V, NX, scratch)  # before the span: align V, discard growth
+        pack_var(V, NX, NX, x)
+        return code
+
+    def saltation(xm, xp, s, pv, j, V, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn):
+        """The saltation matrix of stop ``j`` applied to ``V`` (``impacts.saltation``, no parameter
+        columns); False, ``V`` left alone, at zero normal speed.  The rest are the thread's buffers."""
+        rhs(xm, s, pv, fm)
+        rhs(xp, s, pv, fp)
+        for i in range(NX):
+            Gt[i] = 0.0
+            Gp[i, 0] = 0.0
+            hx[i] = 0.0
+            for c in range(NX):
+                Gx[i, c] = 0.0
+        reset_jac(xm, s, pv, Gx, Gt, Gp, j)
+        ht = guard_grad(xm, s, pv, hx, j)
+        den = ht
+        for i in range(NX):
+            den += hx[i] * fm[i]
+        if den == 0.0:
+            return False
+        for i in range(NX):
+            acc = fp[i] - Gt[i]
+            for q in range(NX):
+                acc -= Gx[i, q] * fm[q]
+            w[i] = acc / den
+        for c in range(NX):
+            acc = 0.0
+            for q in range(NX):
+                acc += hx[q] * V[q, c]
+            hv[c] = acc
+        for i in range(NX):
+            for c in range(NX):
+                acc = 0.0
+                for q in range(NX):
+                    acc += Gx[i, q] * V[q, c]
+                Vn[i, c] = acc + w[i] * hv[c]
+        for i in range(NX):
+            for c in range(NX):
+                V[i, c] = Vn[i, c]
+        return True
+
+    return TangentFunctions(device_function(lyapunov_step), device_function(saltation))
