@@ -705,9 +705,10 @@ class _Continuation:
     def _layout(self, orbit: PeriodicOrbit) -> SegmentLayout | None:
         """The segments of ``orbit`` for multiple shooting, or None where it does not apply (a virtual
         branch, an orbit without impacts, a model without a forcing period)."""
-        if self.virtual or not orbit.impacts or not self.model.periodic:
+        if self.virtual or not self.model.periodic:
             return None
-        return layout_of(orbit)
+        layout = layout_of(orbit)  # (its switches, on a model without resets: segments.cuts_at_switches)
+        return layout if layout.impacts else None
 
     @staticmethod
     def margin(pt: PalcPoint) -> float:
