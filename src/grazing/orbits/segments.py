@@ -599,13 +599,15 @@ def segmented_newton(
 ) -> PeriodicOrbit:  # fmt: skip
     """The period-``period`` orbit near the run from ``x`` at ``t0``, by Newton's method on the segmented
     equations (the run's impacts give the segments; on a model with modes, from ``x`` in ``mode``, its
-    impacts those of its transitions with a reset).
+    impacts those of its transitions with a reset; on one without resets its switches,
+    :func:`cuts_at_switches`).
 
     Raises
     ------
     ConvergenceError
-        Where the run has no impact, Newton's method does not reach ``tol``, or the orbit it finds is
-        not a motion of the system (an impact speed not positive, a segment through a stop).
+        Where the run has no impact (no switch, or one that slides, where cut at switches), Newton's
+        method does not reach ``tol``, or the orbit it finds is not a motion of the system (an impact
+        speed or a switch's crossing rate not positive, a segment through a stop).
     """
     start = run_layout(model, x, t0, period, stop, mode)
     if start is None:
@@ -655,7 +657,7 @@ def cut_speeds(model: HybridModel, run: Solution) -> np.ndarray | None:
         if sw is None or not _crossing_switches(model, sw.transition):
             return None
         return np.abs(switch_rates(model, sw.t, sw.state, sw.transition))
-    return np.abs(run.impacts.speed) if len(run.impacts) else None
+    return np.abs(run.impacts.speed) if run.n_impacts else None
 
 
 REORDER_REACH = 4.0
