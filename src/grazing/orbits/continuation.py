@@ -85,11 +85,14 @@ from grazing.orbits.palc import (
     sign_changed,
 )
 from grazing.orbits.segments import (
+    MULTIPLE_SHOOTING_NORM,
     REORDER_REACH,
     SegmentLayout,
+    cuts_at_switches,
     layout_of,
     reordered,
     segmented_equations,
+    switch_rates,
 )
 from grazing.orbits.shooting import (
     SECTION_MARGIN,
@@ -688,6 +691,15 @@ class _Continuation:
                 f"{list(b.signature)}): a grazing"
             )
         if self.segmented:  # (the segments ignore the stops: past a grazing they pass through one)
+            if (
+                b.impacts == 0
+                and b.switch_states is not None
+                and len(b.switch_times)
+                and cuts_at_switches(self.model)
+            ):  # (segments cut at switches: a crossing that slows to zero is a grazing of the surface)
+                rates = switch_rates(b.model, b.switch_times, b.switch_states, b.switch_transitions)
+                if min(rates) <= 0.0:
+                    return BOUNDARY, "a switch's crossing speed reaches zero: a grazing of its surface"
             if b.impact_speeds.size and float(np.min(b.impact_speeds)) <= 0.0:
                 return BOUNDARY, "an impact speed reaches zero (the orbit loses an impact): a grazing"
             crossed = [name for name in b.crossed_stops if name not in a.crossed_stops]
@@ -705,9 +717,21 @@ class _Continuation:
     def _layout(self, orbit: PeriodicOrbit) -> SegmentLayout | None:
         """The segments of ``orbit`` for multiple shooting, or None where it does not apply (a virtual
         branch, an orbit without impacts, a model without a forcing period)."""
-        if self.virtual or not orbit.impacts or not self.model.periodic:
+        if self.virtual or not self.model.periodic:
             return None
-        return layout_of(orbit)
+        layout = layout_of(orbit)  # (its switches, on a model without resets: segments.cuts_at_switches)
+        return layout if layout.impacts else None
+
+    def _stalled_at_switches(self, palc: Palc, last: PeriodicOrbit) -> bool:
+        """Did single shooting stall (its step fell below the minimum) on a model whose segments end on
+        its switches, with a monodromy above ``MULTIPLE_SHOOTING_NORM``, where multiple shooting applies?"""
+        return (
+            palc.end is PalcEnd.STUCK
+            and not self.segmented
+            and cuts_at_switches(self.model)
+            and float(np.linalg.norm(last.monodromy, 2)) > MULTIPLE_SHOOTING_NORM
+            and self._layout(last) is not None
+        )
 
     @staticmethod
     def margin(pt: PalcPoint) -> float:
@@ -850,6 +874,12 @@ class _Continuation:
                     status = f"{RESECTION} and the orbit could not be found on another section ({exc})"
                     branch.end_segment(BranchEnd.NO_SECTION, status)
                     return []
+                continue
+            if palc.boundary is None and self._stalled_at_switches(palc, last) and len(branch) < s.max_points:
+                # A model without resets stalled by its monodromy alone (no grazing ahead): its segments
+                # end on its switches (orbits.segments.cuts_at_switches), multiple shooting from here.
+                segmented, orbit = True, last
+                self.handover = float(prev.u[-1])
                 continue
             if palc.boundary is None:
                 branch.end_segment(BranchEnd.of(palc.end), status)

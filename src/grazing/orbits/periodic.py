@@ -175,6 +175,9 @@ class PeriodicOrbit:
         ``[t0, t0 + n T)``, their times and transitions (indices into the model's
         ``stop_names``; a reset that changes the mode is both an impact and a
         switch); see :attr:`switch_signature`.
+    switch_states
+        The state at each switch (after the reset, if any), shape ``(n_switches, n_states)``; None
+        where not recorded.
     passed_stops
         A segmented orbit on a model with modes (multiple shooting, which keeps no guard minima
         there): the transitions with a reset its segments pass through between its impacts, found
@@ -219,6 +222,7 @@ class PeriodicOrbit:
     switch_times: np.ndarray = field(default_factory=lambda: np.empty(0))
     switch_transitions: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
     passed_stops: tuple[str, ...] = ()
+    switch_states: np.ndarray | None = None
 
     @property
     def guard_mins(self) -> np.ndarray:
@@ -355,4 +359,5 @@ def _orbit_from(model: HybridModel, x: np.ndarray, t0: float, n: int, fm: FlowMa
         mode=fm.mode,
         switch_times=sw.t.copy() if sw is not None else np.empty(0),
         switch_transitions=sw.transition.copy() if sw is not None else np.zeros(0, dtype=int),
+        switch_states=sw.state.copy() if sw is not None else None,
     )

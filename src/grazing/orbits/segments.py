@@ -41,6 +41,15 @@ simulation, and the segment's ``Phi`` carries those switches' saltation matrices
 it, and the last in the section's mode.  Whether a segment passes through a
 reset's guard is told by the same run with the resets watched (the engine keeps
 no guard minima through modes).
+
+A model with modes none of whose transitions has a reset (a soft stop, a spring-damper contact) has
+no impact to cut at: its segments end on its switches instead (:func:`cuts_at_switches`,
+``SegmentLayout.switches``), each segment one mode from the previous switch's surface to the next
+switch's guard, as ``hspo``'s.  The equations are the same with the identity for the reset
+(continuity ``s_i - y_{i-1} = 0``), the guard row ``h_{j_i}(y_{i-1}, t_i) = 0`` and the monodromy
+through the switches' saltation matrices; where rounding lets a segment's run cross its switch just
+before its end, the run's own saltation stands in for the end's.  Sliding is not cut at: a run that
+slides keeps the layout of its impacts (none: one segment).
 """
 
 from __future__ import annotations
@@ -154,6 +163,12 @@ def segment_flow(
     return SegmentFlow(end, sol.jacobian[:, :n], sensitivity, sol)
 
 
+def cuts_at_switches(model: HybridModel) -> bool:
+    """Are the segments of ``model``'s orbits cut at its switches: a model with modes whose transitions
+    have no reset (else they are cut at the impacts, the transitions with one)?"""
+    return model.has_modes and model.n_stops > 0 and not any(model.transition_resets)
+
+
 @dataclass(frozen=True)
 class SegmentLayout:
     """Where each unknown lies in ``u = (s_0, t_1, s_1, ..., t_k, s_k, p)``.
@@ -167,11 +182,15 @@ class SegmentLayout:
     mode
         A model with modes: the mode on the section, which the first segment starts in (each other
         starts in its impact's target mode, :meth:`start_mode`); None without modes.
+    switches
+        The segments end on switches (transitions without a reset, :func:`cuts_at_switches`), not
+        on impacts: ``stops`` are those switches' transitions and ``s_i`` the state at switch ``i``.
     """
 
     n_states: int
     stops: tuple[int, ...]
     mode: str | None = None
+    switches: bool = False
 
     def start_mode(self, model: HybridModel, i: int) -> str | None:
         """The mode segment ``i`` starts in: the section's (``i = 0``), else impact ``i``'s target mode."""
@@ -206,6 +225,11 @@ class SegmentLayout:
         """``u`` of a periodic orbit found by single shooting (its impacts give the times and states)."""
         m = orbit.model
         parts = [orbit.state]
+        if self.switches:  # (no reset: the state at each switch)
+            assert orbit.switch_states is not None
+            for t, y in zip(orbit.switch_times, orbit.switch_states):
+                parts += [np.array([t]), np.asarray(y, dtype=float)]
+            return np.concatenate([*parts, [param_value]])
         assert orbit.impact_states is not None
         for t, y, j in zip(orbit.impact_times, orbit.impact_states, orbit.impact_stops):
             parts += [np.array([t]), m.reset(y, t, int(j))]
@@ -213,8 +237,16 @@ class SegmentLayout:
 
 
 def layout_of(orbit: PeriodicOrbit) -> SegmentLayout:
-    """The segment layout of an orbit's impacts."""
-    return SegmentLayout(orbit.model.n_states, tuple(int(j) for j in orbit.impact_stops), orbit.mode)
+    """The segment layout of an orbit's impacts (of its switches, where :func:`cuts_at_switches`)."""
+    m = orbit.model
+    if cuts_at_switches(m) and _crossing_switches(m, orbit.switch_transitions):
+        return SegmentLayout(m.n_states, tuple(int(j) for j in orbit.switch_transitions), orbit.mode, True)
+    return SegmentLayout(m.n_states, tuple(int(j) for j in orbit.impact_stops), orbit.mode)
+
+
+def _crossing_switches(model: HybridModel, transitions: np.ndarray) -> bool:
+    """Are there switches, all of them crossings of a transition (none a sliding entry or exit)?"""
+    return len(transitions) > 0 and bool(np.all(np.asarray(transitions) < model.n_stops))
 
 
 def segmented_equations(
@@ -268,15 +300,22 @@ def segmented_equations(
         pre: list[np.ndarray] = []
         speeds: list[float] = []
         row = 0
+        cut_switches = layout.switches
         for i in range(k + 1):
             s_i = layout.state(u, i)
             ta, tb = times[i], times[i + 1]
             start_mode = layout.start_mode(m, i)
+            behind = cut_switches and i > 0 and not _in_mode(m, s_i, ta, start_mode)
+            if behind:  # (a Newton iterate a hair behind the switch's surface: from the mode it leaves)
+                start_mode = m.transition_source[layout.stops[i - 1]]
             seg = segment_flow(m, s_i, ta, tb, names, start_mode)
             runs.append(seg.solution)
             y = seg.end
             end_mode = seg.solution.mode_final
-            if modes:
+            crossed = False  # (a switch layout: the run crossed its end's switch just before tb)
+            if cut_switches:
+                crossed = _check_switch_segment(m, layout, i, seg.solution, behind)
+            elif modes:
                 _check_segment_modes(m, layout, i, end_mode)
             si, col_t_end = layout.state_index(i), (layout.time_index(i + 1) if i < k else None)
             # d y = Phi d s_i - Phi f(s_i, ta) d ta + f(y, tb) d tb + S d p (the fields of the modes the
@@ -307,6 +346,17 @@ def segmented_equations(
             if names:
                 DF[row, pcols] += np.asarray(cd["h_p"])[pidx]
             row += 1
+            if cut_switches:  # (no reset: continuity, the state at the switch the next segment's start)
+                nxt = layout.state_index(i + 1)
+                F[row : row + n] = layout.state(u, i + 1) - y
+                DF[row : row + n] = -dy
+                DF[row : row + n, nxt : nxt + n] += np.eye(n)
+                row += n
+                pre.append(y)
+                speeds.append(-cd["rate"])
+                if not crossed:
+                    M = m.saltation(y, tb, j) @ M
+                continue
             g = m.reset(y, tb, j)
             _, _, gx = m.jacobians(y, tb, j)
             gt = np.asarray(m.numeric("g_t", j)(list(y), tb, list(m.param_vector)), dtype=float).reshape(n)
@@ -343,6 +393,48 @@ def _check_segment_modes(m: HybridModel, layout: SegmentLayout, i: int, end_mode
             f"segment {i} of the orbit {what} in mode {end_mode!r}, not in {want!r}: its switches of mode "
             "have changed"
         )
+
+
+def _in_mode(m: HybridModel, x: np.ndarray, t: float, mode: str | None) -> bool:
+    """Does ``x`` satisfy the guards of ``mode``'s transitions (to the engine's tolerance)?"""
+    try:
+        m.check_state(x, t, mode=mode)
+    except InvalidStateError:
+        return False
+    return True
+
+
+def _check_switch_segment(m: HybridModel, layout: SegmentLayout, i: int, run: Solution, behind: bool) -> bool:
+    """Check segment ``i`` of a switch layout: it stays in its mode, or crosses only its end's switch
+    (rounding puts the crossing a hair before the end); True where it crossed it.  ``behind``: the run
+    started behind its start's surface, in the mode before, and first crosses that switch again.  The
+    last segment returns in the section's mode.  Raise :class:`ConvergenceError` otherwise."""
+    sw = run.switches
+    passed = [] if sw is None else [int(j) for j in sw.transition]
+    if behind:
+        if not passed or passed[0] != layout.stops[i - 1]:
+            raise ConvergenceError(
+                f"segment {i} of the orbit starts behind switch {m.stop_names[layout.stops[i - 1]]!r} and "
+                "does not cross it: its switches have changed"
+            )
+        passed = passed[1:]
+    start = layout.start_mode(m, i)
+    if i == layout.impacts:
+        if passed or run.mode_final != layout.mode:
+            raise ConvergenceError(
+                f"the last segment of the orbit switches mode ({len(passed)} switches) before it returns to "
+                f"the section in mode {layout.mode!r}: its switches have changed"
+            )
+        return False
+    j = layout.stops[i]
+    if not passed and run.mode_final == start:
+        return False
+    if passed == [j] and run.mode_final == m.transition_target[j]:
+        return True
+    raise ConvergenceError(
+        f"segment {i} of the orbit does not run in mode {start!r} to switch {m.stop_names[j]!r} (it switches "
+        f"{len(passed)} times, ends in {run.mode_final!r}): its switches have changed"
+    )
 
 
 def _least(rows) -> tuple[float, float, np.ndarray] | None:
@@ -401,7 +493,18 @@ def _segmented_orbit_modes(
 ) -> PeriodicOrbit:
     """:func:`_segmented_orbit` on a model with modes: no guard minima (the engine keeps none through
     modes), the switches of the segments and of the impacts that change the mode, and the transitions
-    with a reset that the segments pass through (:func:`_passed_stops`)."""
+    with a reset that the segments pass through (:func:`_passed_stops`).  A switch layout: no impacts,
+    its switches the segments' ends (no run switches elsewhere)."""
+    if layout.switches:
+        return PeriodicOrbit(
+            model=m, state=np.array(layout.state(u, 0), dtype=float), t0=float(t0), period=period,
+            impacts=0, monodromy=M, multipliers=sorted_multipliers(M), guard_min=math.nan,
+            t_guard_min=math.nan, min_impact_speed=math.nan, virtual=False,
+            residuals=(float(np.max(np.abs(F))),), impact_states=np.zeros((0, layout.n_states)), stop=stop,
+            mode=layout.mode, switch_times=np.array(times[1:-1], dtype=float),
+            switch_transitions=np.array(layout.stops, dtype=int),
+            switch_states=np.array([layout.state(u, i) for i in range(1, layout.impacts + 1)]),
+        )  # fmt: skip
     sw_t: list[float] = []
     sw_j: list[int] = []
     for i, r in enumerate(runs):
@@ -470,7 +573,18 @@ def run_layout(
         stop_name=stop, mode=mode,
     )  # fmt: skip
     imp = sol.impacts
-    if not len(imp) or len(sol.sticking) or sol.mode_final != (mode if model.has_modes else None):
+    if len(sol.sticking) or sol.mode_final != (mode if model.has_modes else None):
+        return None
+    if cuts_at_switches(model):
+        sw = sol.switches
+        if sw is None or not _crossing_switches(model, sw.transition):
+            return None
+        layout = SegmentLayout(model.n_states, tuple(int(j) for j in sw.transition), mode, True)
+        parts = [np.asarray(x, dtype=float)]
+        for t, y in zip(sw.t, sw.state):
+            parts += [np.array([t]), np.asarray(y, dtype=float)]
+        return layout, np.concatenate([*parts, [0.0]])
+    if not len(imp):
         return None
     layout = SegmentLayout(model.n_states, tuple(int(j) for j in imp.stop), mode)
     parts = [np.asarray(x, dtype=float)]
@@ -485,17 +599,19 @@ def segmented_newton(
 ) -> PeriodicOrbit:  # fmt: skip
     """The period-``period`` orbit near the run from ``x`` at ``t0``, by Newton's method on the segmented
     equations (the run's impacts give the segments; on a model with modes, from ``x`` in ``mode``, its
-    impacts those of its transitions with a reset).
+    impacts those of its transitions with a reset; on one without resets its switches,
+    :func:`cuts_at_switches`).
 
     Raises
     ------
     ConvergenceError
-        Where the run has no impact, Newton's method does not reach ``tol``, or the orbit it finds is
-        not a motion of the system (an impact speed not positive, a segment through a stop).
+        Where the run has no impact (no switch, or one that slides, where cut at switches), Newton's
+        method does not reach ``tol``, or the orbit it finds is not a motion of the system (an impact
+        speed or a switch's crossing rate not positive, a segment through a stop).
     """
     start = run_layout(model, x, t0, period, stop, mode)
     if start is None:
-        raise ConvergenceError("the run from the guess has no impact to make segments of")
+        raise ConvergenceError("the run from the guess has no impact (or switch) to make segments of")
     layout, u = start
     evaluate = segmented_equations(model, None, period, t0, layout, stop)
     residuals: list[float] = []
@@ -505,7 +621,10 @@ def segmented_newton(
         if not np.isfinite(residuals[-1]):
             break
         if residuals[-1] <= tol:
-            if orbit.crossed_stops or float(np.min(orbit.impact_speeds)) <= 0.0:
+            speeds = orbit.impact_speeds
+            if layout.switches:  # (a switch crossed at zero rate or backwards is no crossing)
+                speeds = switch_rates(orbit.model, orbit.switch_times, orbit.switch_states, layout.stops)
+            if orbit.crossed_stops or float(np.min(speeds)) <= 0.0:
                 raise ConvergenceError(
                     "the segmented orbit is not a motion of the system (it passes through a stop, or an "
                     "impact has no speed)"
@@ -519,6 +638,26 @@ def segmented_newton(
         f"Newton's method on the segmented equations did not converge: residual {residuals[-1]:.3g} after "
         f"{len(residuals) - 1} iterations"
     )
+
+
+def switch_rates(model: HybridModel, times, states, transitions) -> list[float]:
+    """The rate at which each switch's guard falls where it is crossed (positive: a crossing), as an
+    impact's speed (transitions without a reset: the state is the same either side)."""
+    return [
+        -float(model.contact_derivatives(y, t, int(j))["rate"]) for t, y, j in zip(times, states, transitions)
+    ]
+
+
+def cut_speeds(model: HybridModel, run: Solution) -> np.ndarray | None:
+    """The speeds (absolute) at the ends of the segments of ``run``: its impacts', or its switches'
+    crossing rates where :func:`cuts_at_switches`; None where it has nothing to cut at (no impact; no
+    switch, or a sliding one)."""
+    if cuts_at_switches(model):
+        sw = run.switches
+        if sw is None or not _crossing_switches(model, sw.transition):
+            return None
+        return np.abs(switch_rates(model, sw.t, sw.state, sw.transition))
+    return np.abs(run.impacts.speed) if run.n_impacts else None
 
 
 REORDER_REACH = 4.0

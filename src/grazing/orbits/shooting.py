@@ -45,7 +45,12 @@ from grazing.orbits.periodic import (  # noqa: F401 (the record and its tests, h
     sorted_multipliers,
     unstable_count,
 )
-from grazing.orbits.segments import GRAZING_SPEED_RATIO, MULTIPLE_SHOOTING_NORM, segmented_newton
+from grazing.orbits.segments import (
+    GRAZING_SPEED_RATIO,
+    MULTIPLE_SHOOTING_NORM,
+    cut_speeds,
+    segmented_newton,
+)
 
 SECTION_MARGIN = 0.05
 """When an impact of the starting orbit lies within this fraction of a period of the
@@ -433,9 +438,11 @@ class _Newton:
         physical run with impacts of a periodic model whose monodromy exceeds
         :data:`~grazing.orbits.segments.MULTIPLE_SHOOTING_NORM`, none of them at a grazing
         (:data:`~grazing.orbits.segments.GRAZING_SPEED_RATIO`)?"""
-        if virtual or not fm.impacts or not self.model.periodic or not fm.solution.jacobian_valid:
+        if virtual or not self.model.periodic or not fm.solution.jacobian_valid:
             return False
-        speeds = np.abs(fm.solution.impacts.speed)
+        speeds = cut_speeds(self.model, fm.solution)
+        if speeds is None:
+            return False
         if float(speeds.min()) < GRAZING_SPEED_RATIO * float(speeds.max()):
             return False  # (an impact of the guess's run at a grazing: single shooting's orbit, without it)
         return float(np.linalg.norm(fm.jacobian, 2)) > MULTIPLE_SHOOTING_NORM
