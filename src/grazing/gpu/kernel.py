@@ -38,6 +38,7 @@ from typing import Any
 import numpy as np
 from numba import cuda  # (the simulator's, where NUMBA_ENABLE_CUDASIM=1: a global, which it swaps in kernels)
 
+from grazing.core.model import ON_STOP_TOL
 from grazing.core.options import ADAPTIVE_BLOCK, ADAPTIVE_MAX_PERIOD
 from grazing.core.solution import Status
 from grazing.engine.polyroots import work_shape
@@ -48,8 +49,8 @@ NEEDS_CPU = -2
 
 # The run state of a thread: integer fields of ``st``, float fields of ``sf`` (lanes' RUN_STATE names).
 K, KS, ISAMP, N_SAMPLES, N_KEEP, RECORDING, STEPS, MAX_STEPS, ZERO_EVENTS, DEFL, DEFL_STOP = range(11)
-STAGE, BLOCK, USED, REQ_KS, USE_VAR, LYAP_STARTED, JAC_VALID = 11, 12, 13, 14, 15, 16, 17
-INT_FIELDS = 18
+STAGE, BLOCK, USED, REQ_KS, USE_VAR, LYAP_STARTED, JAC_VALID, VF = 11, 12, 13, 14, 15, 16, 17, 18
+INT_FIELDS = 19
 S, SS, REQ_SS, SPAN_DT, LYAP_T0 = range(5)
 FLOAT_FIELDS = 5
 TRANSIENT, EXTRA, FINAL = 1, 2, 3
@@ -63,6 +64,7 @@ STATUS_OK = int(Status.OK)
 STATUS_STEP_LIMIT = int(Status.STEP_LIMIT)
 STATUS_NONFINITE = int(Status.NONFINITE)
 STATUS_ZENO = int(Status.ZENO)
+STATUS_OUTSIDE_MODE = int(Status.OUTSIDE_MODE)
 
 ROOT_WORK = work_shape(0)
 """The shape of one thread's work array of the root search."""
@@ -107,8 +109,8 @@ def sweep_kernel(definition: Any, order: int, keep: int, lyapunov: bool = False)
 def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
     """The sweep kernel of the device model ``dm`` (:class:`~grazing.gpu.model.DeviceModel`).
 
-    ``kernel[blocks, threads](jobs, control, x0, firsts, pvs, Ts, sphase,
-    tcarry, samples, by_stop, used, x_final, t_final, status, work, iset,
+    ``kernel[blocks, threads](jobs, control, x0, firsts, first_vf, x0_vf, pvs, Ts, sphase,
+    tcarry, samples, by_stop, lyap, used, x_final, t_final, vf_final, status, work, iset,
     fset)``: the arrays of :class:`~grazing.engine.records.LaneJobs`,
     :class:`~grazing.engine.records.LanePoints` and
     :class:`~grazing.engine.records.LaneResults` (``control[0]`` the next job,
@@ -139,12 +141,18 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
     repeats_with_period = helpers["repeats_with_period"]
     step_limit = helpers["step_limit"]
     start_times = helpers["start_times"]
-    tc_free = dm.functions["tc_free"]
-    tc_var = dm.functions["tc_var"]
+    tc_free = dm.functions["mode_tc_free"]
+    tc_var = dm.functions["mode_tc_var"]
     reset = dm.functions["reset"]
+    guard = dm.functions["guard"]
     normal_rate = dm.functions["normal_rate"]
     normal_accel = dm.functions["normal_accel"]
     NX, NSTOPS, ORDER = dm.nx, dm.nstops, dm.order
+    ROWS = np.array(dm.rows, dtype=np.int64)  # (a mode's event rows: its transitions; -1 padding)
+    NEV = ROWS.shape[1]
+    TARGETS = np.array(dm.targets, dtype=np.int64)
+    RESETS = np.array(dm.resets, dtype=np.int64)
+    BACK = np.array(dm.back, dtype=np.int64)
     KC = ORDER + 1
     LYAP = bool(lyapunov)
     NT = NX + NX * NX if LYAP else NX  # (rows of the state with the variational matrix)
@@ -159,14 +167,17 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
     float64, int64 = types.float64, types.int64
 
     @dj
-    def first_event(O, h, defl, defl_stop, a, work):
-        """The first event on the step over every stop: ``(u, stop)``, ``u < 0`` none (``events.first_event``
-        for one mode, free flight, nothing skipped)."""
+    def first_event(O, h, vf, defl, defl_stop, a, work):
+        """The first event on the step over mode ``vf``'s transitions: ``(u, stop)``, ``u < 0`` none
+        (``events.first_event`` in free flight, nothing skipped)."""
         u = -1.0
         stop = 0
-        for r in range(NSTOPS):
+        for row in range(NEV):
+            r = ROWS[vf, row]  # the row's stop (transition); -1: padding
+            if r < 0:
+                continue
             defl_r = defl if r == defl_stop else 0
-            deg, tail = event_polynomial(O, r, h, 0, defl_r, False, a, ORDER)
+            deg, tail = event_polynomial(O, row, h, 0, defl_r, False, a, ORDER)
             ur = event_certificate(a, tail)
             if ur > 0.0:
                 ur = confirm_first_root(a, deg, isolate_first_root(a, deg, work), work)
@@ -174,6 +185,21 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
                 u = ur
                 stop = r
         return u, stop
+
+    @dj
+    def outside_mode(x, s, pv, vf, known):
+        """Whether ``x``, which has just entered mode ``vf``, is outside its region (``impacts.check_region``:
+        a guard of the mode's own transitions other than ``known`` below ``-ON_STOP_TOL * max(1, |x|)``)."""
+        scale = 1.0
+        for i in range(NX):
+            scale = max(scale, abs(x[i]))
+        for row in range(NEV):
+            k = ROWS[vf, row]
+            if k < 0 or k >= NSTOPS or k == known:
+                continue
+            if guard(x, s, pv, k) < -ON_STOP_TOL * scale:
+                return True
+        return False
 
     @dj
     def chatter_remaining(x, s, pv, j, speed, chatter_time):
@@ -254,18 +280,19 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
             var = False
             if LYAP:
                 var = st[USE_VAR] != 0
+            vf = st[VF]
             if LYAP and var:
-                tc_var(x, s, pv, X, O)
-                h = step_size(X, NT, O, NSTOPS, 0, GUARD_SCALE, ORDER, T, factor)
+                tc_var(x, s, pv, X, O, vf)
+                h = step_size(X, NT, O, NEV, 0, GUARD_SCALE, ORDER, T, factor)
             else:
-                tc_free(x, s, pv, X, O)
-                h = step_size(X, NX, O, NSTOPS, 0, GUARD_SCALE, ORDER, T, factor)
+                tc_free(x, s, pv, X, O, vf)
+                h = step_size(X, NX, O, NEV, 0, GUARD_SCALE, ORDER, T, factor)
             rem = (st[KS] - st[K]) * T + (sf[SS] - s)  # (step.step_end)
             last = False
             if st[ISAMP] == st[N_SAMPLES] - 1 and h >= rem:
                 h = rem
                 last = True
-            u, ev_stop = first_event(O, h, st[DEFL], st[DEFL_STOP], a, work)
+            u, ev_stop = first_event(O, h, vf, st[DEFL], st[DEFL_STOP], a, work)
             event = u >= 0.0 and h > 0.0  # (step.accept_step)
             if event and u == 0.0:
                 st[ZERO_EVENTS] += 1
@@ -294,23 +321,44 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
                     if started == LYAP_STARTED_NOW_AT_END:
                         sf[LYAP_T0] = st[K] * T + sf[S]
             sf[SPAN_DT] = math.nan
-            if event:  # an impact on stop ev_stop (impacts.at_event, apply_impact)
+            if event and RESETS[ev_stop] == 0:  # a switch of vector field, no reset (impacts.switch_mode)
+                s = sf[S]
+                target = TARGETS[ev_stop]
+                if LYAP and var:  # (the saltation matrix of a switch: the identity reset)
+                    unpack_var(x, NX, NX, V)
+                    if not saltation(x, x, s, pv, ev_stop, V, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn, vf, target):
+                        st[JAC_VALID] = 0
+                    pack_var(V, NX, NX, x)
+                st[VF] = target
+                st[DEFL] = 1 if BACK[ev_stop] >= 0 else 0
+                st[DEFL_STOP] = BACK[ev_stop]
+                if outside_mode(x, s, pv, target, BACK[ev_stop]):
+                    return STATUS_OUTSIDE_MODE
+            elif event:  # an impact on stop ev_stop (impacts.at_event, apply_impact)
                 s = sf[S]
                 vn = normal_rate(x, s, pv, ev_stop)
                 reset(x, s, pv, xp, ev_stop)
                 if LYAP and var:  # (the variational matrix times the saltation matrix)
                     unpack_var(x, NX, NX, V)
-                    if not saltation(x, xp, s, pv, ev_stop, V, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn):
+                    if not saltation(x, xp, s, pv, ev_stop, V, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn, vf,
+                                     TARGETS[ev_stop]):
                         st[JAC_VALID] = 0  # (an impact at zero normal speed has no Jacobian)
                     pack_var(V, NX, NX, xp)
                 for i in range(NT if var else NX):
                     x[i] = xp[i]
                 st[DEFL] = 1
                 st[DEFL_STOP] = ev_stop
-                if STICKS[ev_stop] != 0 and chatter_remaining(x, s, pv, ev_stop, -vn, chatter_time) >= 0.0:
-                    return NEEDS_CPU  # (complete chattering, then sticking: not on the GPU yet)
                 if recording != 0 and final:
                     counts[ev_stop] += 1
+                if TARGETS[ev_stop] != vf:  # a reset that also changes the mode (impacts.change_mode)
+                    target = TARGETS[ev_stop]
+                    st[VF] = target
+                    st[DEFL] = 1 if BACK[ev_stop] >= 0 else 0
+                    st[DEFL_STOP] = BACK[ev_stop]
+                    if outside_mode(x, s, pv, target, -1):
+                        return STATUS_OUTSIDE_MODE
+                if STICKS[ev_stop] != 0 and chatter_remaining(x, s, pv, ev_stop, -vn, chatter_time) >= 0.0:
+                    return NEEDS_CPU  # (complete chattering, then sticking: not on the GPU yet)
         return STATUS_OK
 
     @dj
@@ -389,8 +437,8 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
             final_request(st, sf, x, T, iset, s_phase, logs)
 
     @cuda.jit
-    def kernel(jobs, control, x0, firsts, pvs, Ts, sphase, tcarry, samples, by_stop, lyap, used, x_final,
-               t_final, status, work, iset, fset):  # fmt: skip
+    def kernel(jobs, control, x0, firsts, first_vf, x0_vf, pvs, Ts, sphase, tcarry, samples, by_stop, lyap,
+               used, x_final, t_final, vf_final, status, work, iset, fset):  # fmt: skip
         tid = cuda.grid(1)
         if tid >= work.shape[0]:
             return
@@ -398,7 +446,7 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
         sf = cuda.local.array(FLOAT_FIELDS, float64)
         x = cuda.local.array(NT, float64)
         X = cuda.local.array((NT, KC), float64)
-        O = cuda.local.array((NSTOPS, KC), float64)
+        O = cuda.local.array((NEV, KC), float64)
         a = cuda.local.array(KC, float64)
         xe = cuda.local.array(NT, float64)
         xp = cuda.local.array(NT, float64)
@@ -432,10 +480,12 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
                     for i in range(NX):
                         x[i] = firsts[job, 1 + i]
                     t0 = firsts[job, 0]
+                    st[VF] = first_vf[job]
                 elif iset[FRESH] != 0 or not ok:
                     for i in range(NX):
                         x[i] = x0[job, i]
                     t0 = 0.0
+                    st[VF] = x0_vf[job]
                 elif iset[PERIODIC] != 0:  # (the previous point's end: its state and time)
                     t0 = tcarry[p]
                 else:
@@ -478,6 +528,7 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
                     for i in range(NX):
                         x_final[p, i] = x[i]
                     t_final[p] = st[K] * T + sf[S]
+                    vf_final[p] = st[VF]
                 status[p] = code
                 if code == NEEDS_CPU:
                     break  # (the rest of the job goes to the CPU)
