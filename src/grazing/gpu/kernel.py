@@ -18,10 +18,15 @@ CPU's own code as device functions (:mod:`grazing.gpu.ported`).
 Not on the GPU yet: sticking (a chattering sequence that the CPU would sum
 and continue as sticking ends the thread's job with :data:`NEEDS_CPU` at that
 point; :mod:`grazing.gpu.batch` computes the rest of the job on the CPU
-lanes), the discontinuity map and models with several modes (refused before
-a launch).  Lyapunov exponents are a kernel of their own
+lanes), the discontinuity map and sliding (refused before a launch).  A
+model with modes: each thread carries its point's mode (its kernels, its
+event rows: the transitions out of it); a switch without a reset changes the
+mode (``impacts.switch_mode``), a reset may too (``impacts.change_mode``),
+each followed by the CPU's test that the state is inside the new mode's
+region (``impacts.check_region``: else the point's status is
+``OUTSIDE_MODE``).  Lyapunov exponents are a kernel of their own
 (:func:`build_kernel`'s ``lyapunov``: the variational equations, their
-Gram-Schmidt after each step and the saltation matrix at each impact,
+Gram-Schmidt after each step and the saltation matrix at each impact and switch,
 :mod:`grazing.gpu.tangent`).
 
 Each thread's arrays are local (sized by the model: constants of the
