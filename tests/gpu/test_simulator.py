@@ -76,7 +76,8 @@ def test_the_cases_reach_what_they_are_for(compared: dict[str, dict[str, object]
     """The cases are not trivially equal: impacts, chaos (period 0), a failed point, several periods."""
     assert compared["pendulum B fresh"]["cpu_period"] == [1, 0, 3, 0]  # (fig 7 at 40 degrees, case B)
     assert compared["pendulum huge forcing"]["cpu_status"] == [0, 2]  # (non-finite state)
-    assert all(sum(map(sum, compared[case]["cpu_impacts_by_stop"])) > 0 for case in CASES if "soft" not in case)
+    impacting = [case for case in CASES if "soft" not in case]  # (the soft impact switches: no impacts)
+    assert all(sum(map(sum, compared[case]["cpu_impacts_by_stop"])) > 0 for case in impacting)
     assert len(set(compared["pendulum C chained"]["cpu_period"])) >= 3
 
 
@@ -139,7 +140,7 @@ def test_what_the_gpu_does_not_do_yet_is_refused_in_one_line() -> None:
     from grazing.sweeps.spec import sweep_spec
 
     spec = sweep_spec(grazing.models.friction_oscillator(), "v_belt", [0.1], settings=grazing.SweepSettings())
-    with pytest.raises(InvalidParameterError, match=r"^sliding \(Filippov's pseudo-modes\) is not on the GPU"):
+    with pytest.raises(InvalidParameterError, match=r"^sliding \(Filippov's pseudo-modes\) is not on"):
         GpuLaneBatch([(spec, 0)])
     modes = sweep_spec(grazing.models.rocking_block(), "a", [0.2], settings=grazing.SweepSettings())
     assert gpu_refusal(modes) is None  # (switches and mode-changing resets are the GPU's)

@@ -79,8 +79,8 @@ class GpuLaneBatch(LaneBatch):
         )
         factor = step_factor(step_safety(spec.tol, self._order), self._order)
         fset = np.array([spec.adaptive_tol, factor, spec.chatter_tol], dtype=np.float64)
-        outputs = (self.samples, self.by_stop, self.lyap, self.used, self.x_final, self.t_final, self.vf_final,
-                   self.status)  # fmt: skip
+        outputs = (self.samples, self.by_stop, self.lyap, self.used, self.x_final, self.t_final,
+                   self.vf_final, self.status)  # fmt: skip
         counter = np.zeros(1, dtype=np.int64)  # (the next job)
         inputs = (self.jobs, counter, self.x0, self.firsts, self.first_vf, self.x0_vf, self.pvs, self.Ts,
                   self.sphase, self.tcarry)  # fmt: skip

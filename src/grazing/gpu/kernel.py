@@ -345,8 +345,9 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
                 reset(x, s, pv, xp, ev_stop)
                 if LYAP and var:  # (the variational matrix times the saltation matrix)
                     unpack_var(x, NX, NX, V)
-                    if not saltation(x, xp, s, pv, ev_stop, V, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn, vf,
-                                     TARGETS[ev_stop]):
+                    if not saltation(
+                        x, xp, s, pv, ev_stop, V, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn, vf, TARGETS[ev_stop]
+                    ):
                         st[JAC_VALID] = 0  # (an impact at zero normal speed has no Jacobian)
                     pack_var(V, NX, NX, xp)
                 for i in range(NT if var else NX):

@@ -20,7 +20,6 @@ from typing import Any
 
 from grazing.engine.codegen import ModelSource, generate_source
 
-
 MODE_FUNCTIONS = ("tc_free", "tc_var", "rhs")
 """The per-mode functions, reached by the mode's index (``mode_tc_free(x0, s0, pv, X, O, vf)``)."""
 
