@@ -52,7 +52,7 @@ def test_the_gpu_equals_the_cpu_lanes_at_every_point(
     compared: dict[str, dict[str, object]], case: str
 ) -> None:
     row = compared[case]
-    for name in ("period", "impacts_by_stop", "status", "transient_used", "impacts"):
+    for name in ("period", "impacts_by_stop", "status", "transient_used", "impacts", "mode_final"):
         assert row[f"gpu_{name}"] == row[f"cpu_{name}"], name
     assert row["samples_diff"] <= SAMPLE_TOL
     assert row["x_final_diff"] <= SAMPLE_TOL
