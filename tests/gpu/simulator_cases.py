@@ -136,6 +136,22 @@ def cases() -> dict[str, list[tuple[object, int]]]:
             )
         ],
         "soft impact start modes": [(start_modes_spec(), 0)],
+        # sliding (Filippov's pseudo-mode of the friction oscillator: stick-slip), fresh and with Lyapunov
+        # exponents from the previous point's end
+        "friction sliding": [
+            (sweep_spec(grazing.models.friction_oscillator(), "a", [0.6, 1.1, 1.6], settings=modes), 0)
+        ],
+        "lyapunov friction chained": [
+            (
+                sweep_spec(
+                    grazing.models.friction_oscillator(),
+                    "mu",
+                    [0.3, 0.6, 0.9],
+                    settings=grazing.SweepSettings(**MODES, lyapunov=True, chunk_size=0),
+                ),
+                0,
+            )
+        ],
     }
     return out
 

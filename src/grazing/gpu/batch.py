@@ -11,8 +11,7 @@ from that point on, from the state the GPU had reached there.
 
 Lyapunov exponents are the kernel's too (its variational build).  Refused in
 one line (:class:`~grazing.errors.InvalidParameterError`) before anything
-runs: the discontinuity map and sliding (Filippov's pseudo-modes: not on the
-GPU yet).
+runs: the discontinuity map (not on the GPU yet).
 """
 
 from __future__ import annotations
@@ -135,11 +134,11 @@ def run_parts_gpu(parts: Sequence[tuple[SweepSpec, int]], threads: int | None = 
     --------
     >>> import grazing
     >>> from grazing.sweeps.spec import sweep_spec
-    >>> spec = sweep_spec(grazing.models.friction_oscillator(), "v_belt", [0.1, 0.2])
-    >>> run_parts_gpu([(spec, 0)])  # doctest: +ELLIPSIS
+    >>> from types import SimpleNamespace
+    >>> run_parts_gpu([(SimpleNamespace(zdm=object()), 0)])  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    grazing.errors.InvalidParameterError: sliding (Filippov's pseudo-modes) is not on the GPU yet: ...
+    grazing.errors.InvalidParameterError: the discontinuity map is not on the GPU yet: ...
     """
     start = time.perf_counter()
     batch = GpuLaneBatch(parts, threads)

@@ -18,15 +18,18 @@ CPU's own code as device functions (:mod:`grazing.gpu.ported`).
 Not on the GPU yet: sticking (a chattering sequence that the CPU would sum
 and continue as sticking ends the thread's job with :data:`NEEDS_CPU` at that
 point; :mod:`grazing.gpu.batch` computes the rest of the job on the CPU
-lanes), the discontinuity map and sliding (refused before a launch).  A
-model with modes: each thread carries its point's mode (its kernels, its
-event rows: the transitions out of it); a switch without a reset changes the
-mode (``impacts.switch_mode``), a reset may too (``impacts.change_mode``),
-each followed by the CPU's test that the state is inside the new mode's
-region (``impacts.check_region``: else the point's status is
-``OUTSIDE_MODE``).  Lyapunov exponents are a kernel of their own
-(:func:`build_kernel`'s ``lyapunov``: the variational equations, their
-Gram-Schmidt after each step and the saltation matrix at each impact and switch,
+lanes) and the discontinuity map (refused before a launch).  A model with
+modes: each thread carries its point's mode (its kernels, its event rows:
+the transitions out of it); a switch without a reset changes the mode
+(``impacts.switch_mode``), a reset may too (``impacts.change_mode``), each
+followed by the CPU's test that the state is inside the new mode's region
+(``impacts.check_region``: else the point's status is ``OUTSIDE_MODE``); a
+crossing where the far side's field pushes back enters Filippov's sliding
+pseudo-mode (``impacts.enter_sliding``), kept on its surface at each step's
+end and sample, left by its virtual exits (``impacts.leave_sliding``).
+Lyapunov exponents are a kernel of their own (:func:`build_kernel`'s
+``lyapunov``: the variational equations, their Gram-Schmidt after each step
+and the saltation matrix at each impact, switch and entry into sliding,
 :mod:`grazing.gpu.tangent`).
 
 Each thread's arrays are local (sized by the model: constants of the
@@ -54,8 +57,8 @@ NEEDS_CPU = -2
 
 # The run state of a thread: integer fields of ``st``, float fields of ``sf`` (lanes' RUN_STATE names).
 K, KS, ISAMP, N_SAMPLES, N_KEEP, RECORDING, STEPS, MAX_STEPS, ZERO_EVENTS, DEFL, DEFL_STOP = range(11)
-STAGE, BLOCK, USED, REQ_KS, USE_VAR, LYAP_STARTED, JAC_VALID, VF = 11, 12, 13, 14, 15, 16, 17, 18
-INT_FIELDS = 19
+STAGE, BLOCK, USED, REQ_KS, USE_VAR, LYAP_STARTED, JAC_VALID, VF, SURFACE = 11, 12, 13, 14, 15, 16, 17, 18, 19
+INT_FIELDS = 20
 S, SS, REQ_SS, SPAN_DT, LYAP_T0 = range(5)
 FLOAT_FIELDS = 5
 TRANSIENT, EXTRA, FINAL = 1, 2, 3
@@ -150,6 +153,7 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
     tc_var = dm.functions["mode_tc_var"]
     reset = dm.functions["reset"]
     guard = dm.functions["guard"]
+    guard_grad = dm.functions["guard_grad"]
     normal_rate = dm.functions["normal_rate"]
     normal_accel = dm.functions["normal_accel"]
     NX, NSTOPS, ORDER = dm.nx, dm.nstops, dm.order
@@ -158,6 +162,7 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
     TARGETS = np.array(dm.targets, dtype=np.int64)
     RESETS = np.array(dm.resets, dtype=np.int64)
     BACK = np.array(dm.back, dtype=np.int64)
+    SLIDE_ENTRY = np.array(dm.slide_entry, dtype=np.int64)
     KC = ORDER + 1
     LYAP = bool(lyapunov)
     NT = NX + NX * NX if LYAP else NX  # (rows of the state with the variational matrix)
@@ -190,6 +195,29 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
                 u = ur
                 stop = r
         return u, stop
+
+    @dj
+    def sliding_guard(vf):
+        """The transition whose guard is 0 on the surface of sliding pseudo-mode ``vf``, or -1
+        (``impacts.sliding_guard``)."""
+        first = ROWS[vf, 0]
+        return BACK[first] if first >= NSTOPS else -1
+
+    @dj
+    def onto_guard(x, s, pv, j, gx):
+        """``x`` onto the zero set of stop ``j``'s guard (``impacts.onto_guard``; ``gx`` a buffer)."""
+        for i in range(NX):
+            gx[i] = 0.0
+        for _ in range(3):
+            hval = guard(x, s, pv, j)
+            guard_grad(x, s, pv, gx, j)
+            nn = 0.0
+            for i in range(NX):
+                nn += gx[i] * gx[i]
+            if nn == 0.0 or hval == 0.0:
+                break
+            for i in range(NX):
+                x[i] -= hval * gx[i] / nn
 
     @dj
     def outside_mode(x, s, pv, vf, known):
@@ -238,12 +266,14 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
         st[MAX_STEPS] = step_limit(periods)
         st[ZERO_EVENTS] = 0
         st[DEFL] = 0
+        st[SURFACE] = 1 + sliding_guard(st[VF])  # (0: not sliding)
         st[KS] = st[REQ_KS]
         sf[SS] = sf[REQ_SS]
 
     @dj
-    def take_samples(st, sf, X, T, h_acc, event, is_last, buf, xe, wrap):
-        """The samples within ``(0, h_acc]`` of the step (``recording.take_samples`` in free flight)."""
+    def take_samples(st, sf, X, T, h_acc, event, is_last, buf, xe, wrap, pv, gx):
+        """The samples within ``(0, h_acc]`` of the step (``recording.take_samples`` without sticking:
+        while sliding put on the surface)."""
         n_samples = st[N_SAMPLES]
         keep_from = n_samples - st[N_KEEP]
         while st[ISAMP] < n_samples:
@@ -254,6 +284,11 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
                 dt = h_acc
             if st[ISAMP] >= keep_from:
                 eval_rows(X, NX, ORDER, dt, xe)
+                if st[SURFACE] > 0:
+                    s = sf[S] + dt
+                    if wrap and s >= T:
+                        s -= T
+                    onto_guard(xe, s, pv, st[SURFACE] - 1, gx)
                 for i in range(NX):
                     buf[st[ISAMP] - keep_from, i] = xe[i]
             st[ISAMP] += 1
@@ -270,9 +305,10 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
     def run_request(st, sf, x, pv, T, wrap, final, fset, X, O, a, xe, xp, buf, counts, work, tw):
         """Steps until the request's last sample; returns the point's status (OK: go on).
 
-        ``tw`` = ``(V, logs, scratch, before, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn)``: the tangent arrays.
+        ``tw`` = ``(V, logs, scratch, before, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn, gx)``: the tangent
+        arrays and the guard's gradient.
         """
-        V, logs, scratch, before, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn = tw
+        V, logs, scratch, before, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn, gx = tw
         factor = fset[FACTOR]
         chatter_time = fset[CHATTER_TOL] * T
         while st[ISAMP] < st[N_SAMPLES]:
@@ -309,7 +345,7 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
             if event and last and u >= 1.0:
                 event = False
             if (st[KS] - st[K]) * T + (sf[SS] - s) <= h_acc:
-                take_samples(st, sf, X, T, h_acc, event, last, buf, xe, wrap)
+                take_samples(st, sf, X, T, h_acc, event, last, buf, xe, wrap, pv, gx)
             recording = st[RECORDING]
             eval_rows(X, NT if var else NX, ORDER, h_acc, x)  # (the lanes' advance)
             sf[S] = s + h_acc  # (step.end_step)
@@ -318,6 +354,8 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
                 st[K] += 1
             st[STEPS] += 1
             st[DEFL] = 0
+            if st[SURFACE] > 0:  # sliding: back onto the surface, off which the integration drifts
+                onto_guard(x, sf[S], pv, st[SURFACE] - 1, gx)
             if LYAP and var:  # the Lyapunov vectors (tangent.lyapunov_step)
                 started = lyapunov_step(st[LYAP_STARTED] != 0, st[RECORDING] != 0, sf[SPAN_DT], x, X, V,
                                         scratch, logs, xe, before)  # fmt: skip
@@ -326,7 +364,31 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
                     if started == LYAP_STARTED_NOW_AT_END:
                         sf[LYAP_T0] = st[K] * T + sf[S]
             sf[SPAN_DT] = math.nan
-            if event and RESETS[ev_stop] == 0:  # a switch of vector field, no reset (impacts.switch_mode)
+            if (
+                event and ev_stop >= NSTOPS
+            ):  # sliding ends at a tangency, to that side (impacts.leave_sliding)
+                st[VF] = TARGETS[ev_stop]
+                st[SURFACE] = 0
+                st[DEFL] = 2
+                st[DEFL_STOP] = BACK[ev_stop]
+            elif (
+                event
+                and SLIDE_ENTRY[ev_stop] >= 0
+                and st[SURFACE] == 0
+                and normal_rate(x, sf[S], pv, BACK[ev_stop]) < 0.0
+            ):  # the far side's field pushes back: sliding (impacts.enter_sliding)
+                s = sf[S]
+                target = TARGETS[SLIDE_ENTRY[ev_stop]]
+                if LYAP and var:
+                    unpack_var(x, NX, NX, V)
+                    if not saltation(x, x, s, pv, ev_stop, V, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn, vf, target):
+                        st[JAC_VALID] = 0
+                    pack_var(V, NX, NX, x)
+                onto_guard(x, s, pv, ev_stop, gx)
+                st[VF] = target
+                st[SURFACE] = 1 + ev_stop
+                st[DEFL] = 0
+            elif event and RESETS[ev_stop] == 0:  # a switch of vector field, no reset (impacts.switch_mode)
                 s = sf[S]
                 target = TARGETS[ev_stop]
                 if LYAP and var:  # (the saltation matrix of a switch: the identity reset)
@@ -335,6 +397,7 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
                         st[JAC_VALID] = 0
                     pack_var(V, NX, NX, x)
                 st[VF] = target
+                st[SURFACE] = 0
                 st[DEFL] = 1 if BACK[ev_stop] >= 0 else 0
                 st[DEFL_STOP] = BACK[ev_stop]
                 if outside_mode(x, s, pv, target, BACK[ev_stop]):
@@ -359,6 +422,7 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
                 if TARGETS[ev_stop] != vf:  # a reset that also changes the mode (impacts.change_mode)
                     target = TARGETS[ev_stop]
                     st[VF] = target
+                    st[SURFACE] = 0
                     st[DEFL] = 1 if BACK[ev_stop] >= 0 else 0
                     st[DEFL_STOP] = BACK[ev_stop]
                     if outside_mode(x, s, pv, target, -1):
@@ -470,6 +534,7 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
             cuda.local.array(NV, float64),  # w
             cuda.local.array(NV, float64),  # hv
             cuda.local.array((NV, NV), float64),  # Vn
+            cuda.local.array(NX, float64),  # gx (the guard's gradient, sliding)
         )
         buf = cuda.local.array((KEEP, NX), float64)
         counts = cuda.local.array(NSTOPS, int64)
