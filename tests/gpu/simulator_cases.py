@@ -20,6 +20,7 @@ import grazing
 from grazing.gpu.batch import GpuLaneBatch
 from grazing.sweeps.run import run_parts
 from grazing.sweeps.spec import map_spec, sweep_spec
+from tests.engine.test_lanes_sliding import diagonal
 
 SHORT = {"transient": 64, "periods": 16, "lyapunov": False}
 LYAP = {"transient": 64, "periods": 16, "lyapunov": True}
@@ -140,6 +141,11 @@ def cases() -> dict[str, list[tuple[object, int]]]:
         # exponents from the previous point's end
         "friction sliding": [
             (sweep_spec(grazing.models.friction_oscillator(), "a", [0.6, 1.1, 1.6], settings=modes), 0)
+        ],
+        # sliding on a diagonal surface, where Filippov's field leaves it by its rounding unless each step's
+        # end and sample is put back on it (tests/engine/test_lanes_sliding.py's model)
+        "diagonal sliding": [
+            (sweep_spec(diagonal(), "c", [0.5, 1.0, 1.5], x0=(1.0, 0.0), settings=modes), 0)
         ],
         "lyapunov friction chained": [
             (

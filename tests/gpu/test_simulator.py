@@ -30,7 +30,7 @@ SAMPLE_TOL = 0.0
 LYAPUNOV_CASES = ("lyapunov pendulum B", "lyapunov pendulum C chained", "lyapunov impact oscillator")
 MODE_CASES = ("soft impact modes", "lyapunov soft impact chained", "rocking block",
               "lyapunov rocking block chained", "soft impact start modes", "friction sliding",
-              "lyapunov friction chained")  # fmt: skip
+              "lyapunov friction chained", "diagonal sliding")  # fmt: skip
 CASES = ("pendulum B fresh", "pendulum C chained", "pendulum A map", "pendulum huge forcing",
          "impact oscillator", "bouncing ball", *LYAPUNOV_CASES, *MODE_CASES)  # fmt: skip
 ROOT = Path(__file__).resolve().parents[2]
@@ -78,7 +78,8 @@ def test_the_cases_reach_what_they_are_for(compared: dict[str, dict[str, object]
     """The cases are not trivially equal: impacts, chaos (period 0), a failed point, several periods."""
     assert compared["pendulum B fresh"]["cpu_period"] == [1, 0, 3, 0]  # (fig 7 at 40 degrees, case B)
     assert compared["pendulum huge forcing"]["cpu_status"] == [0, 2]  # (non-finite state)
-    impacting = [case for case in CASES if "soft" not in case and "friction" not in case]  # (switches only)
+    switching = ("soft", "friction", "diagonal")  # (switches and sliding, no impacts)
+    impacting = [case for case in CASES if not any(word in case for word in switching)]
     assert all(sum(map(sum, compared[case]["cpu_impacts_by_stop"])) > 0 for case in impacting)
     assert len(set(compared["pendulum C chained"]["cpu_period"])) >= 3
 
@@ -88,7 +89,7 @@ def test_the_mode_cases_reach_what_they_are_for(compared: dict[str, dict[str, ob
     change the mode) and one of its points fails (accumulating impacts), the exponents are finite, and the
     start modes are used: their points end in the mode they started in after one period (a state in
     contact started in the free mode would be outside its region); the friction oscillator's points end
-    sliding (its pseudo-mode, 2) or slipping."""
+    sliding (its pseudo-mode, 2) or slipping, the diagonal model's sliding."""
     assert set(compared["soft impact modes"]["cpu_mode_final"]) == {0, 1}
     block = compared["rocking block"]
     assert block["cpu_status"] == [3, 0, 0] and block["cpu_impacts_by_stop"][1:] == [[8, 8], [8, 8]], block
@@ -100,6 +101,7 @@ def test_the_mode_cases_reach_what_they_are_for(compared: dict[str, dict[str, ob
         assert all(math.isfinite(v) and v < 0 for v in compared[case]["cpu_lyapunov_values"]), case
     assert set(compared["friction sliding"]["cpu_mode_final"]) == {1, 2}
     assert 2 in compared["lyapunov friction chained"]["cpu_mode_final"]
+    assert compared["diagonal sliding"]["cpu_mode_final"] == [2, 2, 2]
     starts = compared["soft impact start modes"]
     assert starts["cpu_status"] == [0, 0, 0] and starts["cpu_mode_final"] == [1, 1, 1], starts
 
