@@ -262,12 +262,38 @@ def api_basins() -> dict[str, object]:
             "lyapunov_on_gpu": launched, "lyapunov": cpu.lyapunov.values.tolist()}  # fmt: skip
 
 
+def api_basins_modes() -> dict[str, object]:
+    """``basins(device="gpu")`` against ``device="cpu"`` on a model with modes (a grid of initial states on
+    both sides of the soft impact's contact, each point in its own mode): every variable, and the points
+    the GPU launched."""
+    from grazing.attractors import basins
+
+    args = (grazing.models.soft_impact_oscillator(), (-1.5, 1.5), (-1.0, 1.0), (3, 3))
+    kw = {"transient": 24, "periods": 8, "workers": 1}
+    cpu = basins(*args, **kw, device="cpu")
+    launched: list[int] = []
+    run = GpuLaneBatch.run
+
+    def counted(batch: GpuLaneBatch) -> None:
+        launched.append(len(batch.status))
+        run(batch)
+
+    GpuLaneBatch.run = counted  # type: ignore[method-assign]
+    try:
+        gpu = basins(*args, **kw, device="gpu")
+    finally:
+        GpuLaneBatch.run = run  # type: ignore[method-assign]
+    differ = sorted(name for name in cpu.data_vars if not cpu[name].equals(gpu[name]))
+    return {"differ": differ, "launched": launched}
+
+
 def main(names: list[str]) -> None:
     table = cases()
     out: dict[str, object] = {name: compare(table[name]) for name in (names or list(table))}
     out["foreign names"] = foreign_names()
     out["api map"] = api_map()
     out["api basins"] = api_basins()
+    out["api basins modes"] = api_basins_modes()
     print(json.dumps(out))
 
 

@@ -137,6 +137,13 @@ def test_basins_on_the_gpu_are_the_same_dataset(compared: dict[str, dict[str, ob
     assert any(math.isfinite(v) for v in row["lyapunov"]), row
 
 
+def test_basins_of_a_model_with_modes_on_the_gpu_are_the_same_dataset(
+    compared: dict[str, dict[str, object]],
+) -> None:
+    row = compared["api basins modes"]
+    assert row["differ"] == [] and sum(row["launched"]) >= 9, row  # (the grid's 9 points on the GPU)
+
+
 def test_the_simulator_does_not_leak_into_this_process() -> None:
     from numba import config
 
