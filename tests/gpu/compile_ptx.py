@@ -1,11 +1,11 @@
-"""Compile the sweep kernel of built-in one-mode models to PTX for a GPU, without a GPU (a manual check).
+"""Compile the sweep kernel of built-in models to PTX for a GPU, without a GPU (a manual check).
 
 Needs numba-cuda and NVVM (the ``nvidia-cuda-nvcc-cu12`` and ``nvidia-cuda-nvrtc-cu12`` wheels; their
 ``lib`` folders on ``LD_LIBRARY_PATH``).  numba compiles a device function for the current device's
 compute capability; with no device, that is taken to be ``--cc`` (9.0: an H100).  Typing, lowering and
 NVVM's compilation to PTX are the device's: a construct the device cannot compile fails here.
 
-    python tests/gpu/compile_ptx.py pendulum impact_oscillator bouncing_ball --cc 9.0
+    python tests/gpu/compile_ptx.py pendulum impact_oscillator bouncing_ball rocking_block --cc 9.0
 
 Each model's kernel is compiled twice: without and with Lyapunov exponents (``build_kernel``'s
 ``lyapunov``).
@@ -33,9 +33,10 @@ def kernel_signature() -> tuple[object, ...]:
     def array(t: object, nd: int) -> object:
         return types.Array(t, nd, "C")
 
-    return (array(i8, 2), array(i8, 1), array(f8, 2), array(f8, 2), array(f8, 2), array(f8, 1),
-            array(f8, 1), array(f8, 1), array(f8, 3), array(i8, 2), array(f8, 1), array(i8, 1),
-            array(f8, 2), array(f8, 1), array(i8, 1), array(f8, 3), array(i8, 1), array(f8, 1))  # fmt: skip
+    return (array(i8, 2), array(i8, 1), array(f8, 2), array(f8, 2), array(i8, 1), array(i8, 1),
+            array(f8, 2), array(f8, 1), array(f8, 1), array(f8, 1), array(f8, 3), array(i8, 2),
+            array(f8, 1), array(i8, 1), array(f8, 2), array(f8, 1), array(i8, 1), array(i8, 1),
+            array(f8, 3), array(i8, 1), array(f8, 1))  # fmt: skip
 
 
 def main() -> None:

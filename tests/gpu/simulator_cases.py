@@ -20,9 +20,11 @@ import grazing
 from grazing.gpu.batch import GpuLaneBatch
 from grazing.sweeps.run import run_parts
 from grazing.sweeps.spec import map_spec, sweep_spec
+from tests.engine.test_lanes_sliding import diagonal
 
 SHORT = {"transient": 64, "periods": 16, "lyapunov": False}
 LYAP = {"transient": 64, "periods": 16, "lyapunov": True}
+MODES = {"transient": 24, "periods": 8, "adaptive": False}
 
 
 def cases() -> dict[str, list[tuple[object, int]]]:
@@ -31,6 +33,7 @@ def cases() -> dict[str, list[tuple[object, int]]]:
     fresh = grazing.SweepSettings(**SHORT, fresh=True)
     chained = grazing.SweepSettings(**SHORT, fresh=False, chunk_size=3, phase=1.0)
     lyap = grazing.SweepSettings(**LYAP, fresh=True)
+    modes = grazing.SweepSettings(**MODES, fresh=True, lyapunov=False, chunk_size=0)
     equal_work = grazing.SweepSettings(**SHORT, fresh=True, adaptive=False, tol=1e-10, chunk_size=0)
     out = {
         # fig 7's first grazing at 40 degrees: period 1 free of the stop, period 4, chaos (case B)
@@ -102,8 +105,74 @@ def cases() -> dict[str, list[tuple[object, int]]]:
         "lyapunov impact oscillator": [
             (sweep_spec(grazing.models.impact_oscillator(), "omega", [2.6, 2.8, 3.0], settings=lyap), 0)
         ],
+        # models with modes: switches of vector field without a reset (fresh, points ending in either
+        # mode), Lyapunov exponents through them (each point from the previous one's end), mode-changing
+        # resets (the rocking block's corners), and each point from its own start in its own mode
+        "soft impact modes": [
+            (sweep_spec(grazing.models.soft_impact_oscillator(), "omega", [0.9, 1.2, 1.5], settings=modes), 0)
+        ],
+        "lyapunov soft impact chained": [
+            (
+                sweep_spec(
+                    grazing.models.soft_impact_oscillator(),
+                    "omega",
+                    [0.9, 1.2, 1.5],
+                    settings=grazing.SweepSettings(**MODES, lyapunov=True, chunk_size=0),
+                ),
+                0,
+            )
+        ],
+        "rocking block": [  # (accumulating impacts, then impacts on both corners at periods 1 and 0)
+            (sweep_spec(grazing.models.rocking_block(), "a", [0.21, 0.22, 0.29], settings=modes), 0)
+        ],
+        "lyapunov rocking block chained": [
+            (
+                sweep_spec(
+                    grazing.models.rocking_block(),
+                    "a",
+                    [0.22, 0.25, 0.28],
+                    settings=grazing.SweepSettings(**MODES, lyapunov=True, chunk_size=0),
+                ),
+                0,
+            )
+        ],
+        "soft impact start modes": [(start_modes_spec(), 0)],
+        # sliding (Filippov's pseudo-mode of the friction oscillator: stick-slip), fresh and with Lyapunov
+        # exponents from the previous point's end
+        "friction sliding": [
+            (sweep_spec(grazing.models.friction_oscillator(), "a", [0.6, 1.1, 1.6], settings=modes), 0)
+        ],
+        # sliding on a diagonal surface, where Filippov's field leaves it by its rounding unless each step's
+        # end and sample is put back on it (tests/engine/test_lanes_sliding.py's model)
+        "diagonal sliding": [
+            (sweep_spec(diagonal(), "c", [0.5, 1.0, 1.5], x0=(1.0, 0.0), settings=modes), 0)
+        ],
+        "lyapunov friction chained": [
+            (
+                sweep_spec(
+                    grazing.models.friction_oscillator(),
+                    "mu",
+                    [0.3, 0.6, 0.9],
+                    settings=grazing.SweepSettings(**MODES, lyapunov=True, chunk_size=0),
+                ),
+                0,
+            )
+        ],
     }
     return out
+
+
+def start_modes_spec() -> object:
+    """A fresh sweep of the soft-impact oscillator, each point from its own state: two in contact (mode 1),
+    one free (mode 0)."""
+    import dataclasses
+
+    m = grazing.models.soft_impact_oscillator()
+    gap = m.params["gap"]
+    starts = np.array([[gap + 0.2, -0.5], [0.0, 0.0], [gap + 0.1, 0.3]])
+    settings = grazing.SweepSettings(transient=1, periods=4, adaptive=False, fresh=True, lyapunov=False)
+    spec = sweep_spec(m, "omega", [1.0, 1.0, 1.0], settings=settings)
+    return dataclasses.replace(spec, starts=starts, start_modes=np.array([1, 0, 1]), chunk_size=0)
 
 
 def compare(parts: list[tuple[object, int]]) -> dict[str, object]:
@@ -113,7 +182,7 @@ def compare(parts: list[tuple[object, int]]) -> dict[str, object]:
     batch.run()
     gpu = batch.results(range(len(parts)))
     row: dict[str, object] = {"cpu_points": batch.cpu_points}
-    for name in ("period", "impacts_by_stop", "status", "transient_used", "impacts"):
+    for name in ("period", "impacts_by_stop", "status", "transient_used", "impacts", "mode_final"):
         row[f"cpu_{name}"] = np.concatenate([getattr(r, name) for r in cpu]).tolist()
         row[f"gpu_{name}"] = np.concatenate([getattr(r, name) for r in gpu]).tolist()
     for name in ("samples", "x_final", "lyapunov"):
@@ -193,12 +262,38 @@ def api_basins() -> dict[str, object]:
             "lyapunov_on_gpu": launched, "lyapunov": cpu.lyapunov.values.tolist()}  # fmt: skip
 
 
+def api_basins_modes() -> dict[str, object]:
+    """``basins(device="gpu")`` against ``device="cpu"`` on a model with modes (a grid of initial states on
+    both sides of the soft impact's contact, each point in its own mode): every variable, and the points
+    the GPU launched."""
+    from grazing.attractors import basins
+
+    args = (grazing.models.soft_impact_oscillator(), (-1.5, 1.5), (-1.0, 1.0), (3, 3))
+    kw = {"transient": 24, "periods": 8, "workers": 1}
+    cpu = basins(*args, **kw, device="cpu")
+    launched: list[int] = []
+    run = GpuLaneBatch.run
+
+    def counted(batch: GpuLaneBatch) -> None:
+        launched.append(len(batch.status))
+        run(batch)
+
+    GpuLaneBatch.run = counted  # type: ignore[method-assign]
+    try:
+        gpu = basins(*args, **kw, device="gpu")
+    finally:
+        GpuLaneBatch.run = run  # type: ignore[method-assign]
+    differ = sorted(name for name in cpu.data_vars if not cpu[name].equals(gpu[name]))
+    return {"differ": differ, "launched": launched}
+
+
 def main(names: list[str]) -> None:
     table = cases()
     out: dict[str, object] = {name: compare(table[name]) for name in (names or list(table))}
     out["foreign names"] = foreign_names()
     out["api map"] = api_map()
     out["api basins"] = api_basins()
+    out["api basins modes"] = api_basins_modes()
     print(json.dumps(out))
 
 

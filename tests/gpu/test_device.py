@@ -59,6 +59,24 @@ def _both(parts: list) -> tuple[list, list]:
                                      transient=200, periods=40, lyapunov=False, chunk_size=0)), 0)],
             id="pendulum chained",
         ),
+        pytest.param(
+            lambda: [(sweep_spec(grazing.models.soft_impact_oscillator(), "omega", np.linspace(0.9, 1.5, 12),
+                                 settings=grazing.SweepSettings(transient=200, periods=40, lyapunov=False,
+                                                                fresh=True)), 0)],
+            id="soft impact (switches)",
+        ),
+        pytest.param(
+            lambda: [(sweep_spec(grazing.models.rocking_block(), "a", np.linspace(0.22, 0.32, 12),
+                                 settings=grazing.SweepSettings(transient=200, periods=40, lyapunov=False,
+                                                                fresh=True)), 0)],
+            id="rocking block (mode-changing resets)",
+        ),
+        pytest.param(
+            lambda: [(sweep_spec(grazing.models.friction_oscillator(), "a", np.linspace(0.6, 1.6, 12),
+                                 settings=grazing.SweepSettings(transient=200, periods=40, lyapunov=False,
+                                                                fresh=True)), 0)],
+            id="friction oscillator (sliding)",
+        ),
     ],
 )  # fmt: skip
 def test_the_device_equals_the_cpu_lanes(parts) -> None:
@@ -68,6 +86,7 @@ def test_the_device_equals_the_cpu_lanes(parts) -> None:
         assert g.impacts_by_stop.tolist() == c.impacts_by_stop.tolist()
         assert g.status.tolist() == c.status.tolist()
         periodic = c.period > 0
+        assert g.mode_final[periodic].tolist() == c.mode_final[periodic].tolist()  # (a chaotic one's: any)
         assert np.nanmax(np.abs(g.samples[periodic] - c.samples[periodic]), initial=0.0) <= DEVICE_SAMPLE_TOL
 
 

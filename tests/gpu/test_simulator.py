@@ -17,6 +17,7 @@ import math
 import os
 import subprocess
 import sys
+import types
 from pathlib import Path
 
 import pytest
@@ -27,8 +28,11 @@ SAMPLE_TOL = 0.0
 """Largest difference of the samples (and final states) of the GPU in the simulator and the CPU lanes."""
 
 LYAPUNOV_CASES = ("lyapunov pendulum B", "lyapunov pendulum C chained", "lyapunov impact oscillator")
+MODE_CASES = ("soft impact modes", "lyapunov soft impact chained", "rocking block",
+              "lyapunov rocking block chained", "soft impact start modes", "friction sliding",
+              "lyapunov friction chained", "diagonal sliding")  # fmt: skip
 CASES = ("pendulum B fresh", "pendulum C chained", "pendulum A map", "pendulum huge forcing",
-         "impact oscillator", "bouncing ball", *LYAPUNOV_CASES)  # fmt: skip
+         "impact oscillator", "bouncing ball", *LYAPUNOV_CASES, *MODE_CASES)  # fmt: skip
 ROOT = Path(__file__).resolve().parents[2]
 
 
@@ -50,7 +54,7 @@ def test_the_gpu_equals_the_cpu_lanes_at_every_point(
     compared: dict[str, dict[str, object]], case: str
 ) -> None:
     row = compared[case]
-    for name in ("period", "impacts_by_stop", "status", "transient_used", "impacts"):
+    for name in ("period", "impacts_by_stop", "status", "transient_used", "impacts", "mode_final"):
         assert row[f"gpu_{name}"] == row[f"cpu_{name}"], name
     assert row["samples_diff"] <= SAMPLE_TOL
     assert row["x_final_diff"] <= SAMPLE_TOL
@@ -74,8 +78,32 @@ def test_the_cases_reach_what_they_are_for(compared: dict[str, dict[str, object]
     """The cases are not trivially equal: impacts, chaos (period 0), a failed point, several periods."""
     assert compared["pendulum B fresh"]["cpu_period"] == [1, 0, 3, 0]  # (fig 7 at 40 degrees, case B)
     assert compared["pendulum huge forcing"]["cpu_status"] == [0, 2]  # (non-finite state)
-    assert all(sum(map(sum, compared[case]["cpu_impacts_by_stop"])) > 0 for case in CASES)
+    switching = ("soft", "friction", "diagonal")  # (switches and sliding, no impacts)
+    impacting = [case for case in CASES if not any(word in case for word in switching)]
+    assert all(sum(map(sum, compared[case]["cpu_impacts_by_stop"])) > 0 for case in impacting)
     assert len(set(compared["pendulum C chained"]["cpu_period"])) >= 3
+
+
+def test_the_mode_cases_reach_what_they_are_for(compared: dict[str, dict[str, object]]) -> None:
+    """Points end in either mode (switches without a reset), the block impacts both corners (resets that
+    change the mode) and one of its points fails (accumulating impacts), the exponents are finite, and the
+    start modes are used: their points end in the mode they started in after one period (a state in
+    contact started in the free mode would be outside its region); the friction oscillator's points end
+    sliding (its pseudo-mode, 2) or slipping, the diagonal model's sliding."""
+    assert set(compared["soft impact modes"]["cpu_mode_final"]) == {0, 1}
+    block = compared["rocking block"]
+    assert block["cpu_status"] == [3, 0, 0] and block["cpu_impacts_by_stop"][1:] == [[8, 8], [8, 8]], block
+    for case in (
+        "lyapunov soft impact chained",
+        "lyapunov rocking block chained",
+        "lyapunov friction chained",
+    ):
+        assert all(math.isfinite(v) and v < 0 for v in compared[case]["cpu_lyapunov_values"]), case
+    assert set(compared["friction sliding"]["cpu_mode_final"]) == {1, 2}
+    assert 2 in compared["lyapunov friction chained"]["cpu_mode_final"]
+    assert compared["diagonal sliding"]["cpu_mode_final"] == [2, 2, 2]
+    starts = compared["soft impact start modes"]
+    assert starts["cpu_status"] == [0, 0, 0] and starts["cpu_mode_final"] == [1, 1, 1], starts
 
 
 def test_only_a_chain_that_sticks_goes_to_the_cpu(compared: dict[str, dict[str, object]]) -> None:
@@ -109,6 +137,13 @@ def test_basins_on_the_gpu_are_the_same_dataset(compared: dict[str, dict[str, ob
     assert any(math.isfinite(v) for v in row["lyapunov"]), row
 
 
+def test_basins_of_a_model_with_modes_on_the_gpu_are_the_same_dataset(
+    compared: dict[str, dict[str, object]],
+) -> None:
+    row = compared["api basins modes"]
+    assert row["differ"] == [] and sum(row["launched"]) >= 9, row  # (the grid's 9 points on the GPU)
+
+
 def test_the_simulator_does_not_leak_into_this_process() -> None:
     from numba import config
 
@@ -122,9 +157,12 @@ def test_what_the_gpu_does_not_do_yet_is_refused_in_one_line() -> None:
     from grazing.gpu.device import gpu_refusal
     from grazing.sweeps.spec import sweep_spec
 
-    spec = sweep_spec(grazing.models.rocking_block(), "alpha", [0.1], settings=grazing.SweepSettings())
-    with pytest.raises(InvalidParameterError, match=r"^models with several modes are not on the GPU yet"):
-        GpuLaneBatch([(spec, 0)])
+    zdm = types.SimpleNamespace(zdm=object())  # (what gpu_refusal reads of a sweep of the discontinuity map)
+    with pytest.raises(InvalidParameterError, match=r"^the discontinuity map is not on the GPU yet"):
+        GpuLaneBatch([(zdm, 0)])
+    for model in (grazing.models.rocking_block(), grazing.models.friction_oscillator()):
+        modes = sweep_spec(model, "a", [0.2], settings=grazing.SweepSettings())
+        assert gpu_refusal(modes) is None  # (switches, mode-changing resets and sliding are the GPU's)
     lyapunov = sweep_spec(grazing.models.pendulum("B"), "eta", [0.44], settings=grazing.SweepSettings())
     assert lyapunov.lyapunov and gpu_refusal(lyapunov) is None  # (Lyapunov exponents are the GPU's too)
 

@@ -11,8 +11,7 @@ from that point on, from the state the GPU had reached there.
 
 Lyapunov exponents are the kernel's too (its variational build).  Refused in
 one line (:class:`~grazing.errors.InvalidParameterError`) before anything
-runs: the discontinuity map and models with several modes (not on the GPU
-yet).
+runs: the discontinuity map (not on the GPU yet).
 """
 
 from __future__ import annotations
@@ -79,9 +78,11 @@ class GpuLaneBatch(LaneBatch):
         )
         factor = step_factor(step_safety(spec.tol, self._order), self._order)
         fset = np.array([spec.adaptive_tol, factor, spec.chatter_tol], dtype=np.float64)
-        outputs = (self.samples, self.by_stop, self.lyap, self.used, self.x_final, self.t_final, self.status)
+        outputs = (self.samples, self.by_stop, self.lyap, self.used, self.x_final, self.t_final,
+                   self.vf_final, self.status)  # fmt: skip
         counter = np.zeros(1, dtype=np.int64)  # (the next job)
-        inputs = (self.jobs, counter, self.x0, self.firsts, self.pvs, self.Ts, self.sphase, self.tcarry)
+        inputs = (self.jobs, counter, self.x0, self.firsts, self.first_vf, self.x0_vf, self.pvs, self.Ts,
+                  self.sphase, self.tcarry)  # fmt: skip
         d_in = [cuda.to_device(np.ascontiguousarray(a)) for a in inputs]
         d_out = [cuda.to_device(a) for a in outputs]
         work = cuda.device_array((threads, *ROOT_WORK), dtype=np.float64)
@@ -133,11 +134,11 @@ def run_parts_gpu(parts: Sequence[tuple[SweepSpec, int]], threads: int | None = 
     --------
     >>> import grazing
     >>> from grazing.sweeps.spec import sweep_spec
-    >>> spec = sweep_spec(grazing.models.rocking_block(), "alpha", [0.1, 0.2])
-    >>> run_parts_gpu([(spec, 0)])  # doctest: +ELLIPSIS
+    >>> from types import SimpleNamespace
+    >>> run_parts_gpu([(SimpleNamespace(zdm=object()), 0)])  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    grazing.errors.InvalidParameterError: models with several modes are not on the GPU yet: ...
+    grazing.errors.InvalidParameterError: the discontinuity map is not on the GPU yet: ...
     """
     start = time.perf_counter()
     batch = GpuLaneBatch(parts, threads)

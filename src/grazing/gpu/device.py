@@ -24,8 +24,6 @@ def gpu_refusal(spec: Any) -> str | None:
     """Why the sweep ``spec`` cannot run on the GPU yet (one line), or None."""
     if spec.zdm is not None:
         return "the discontinuity map is not on the GPU yet: run on the CPU (device=)"
-    if spec.model.n_modes > 1:
-        return "models with several modes are not on the GPU yet: run on the CPU (device=)"
     return None
 
 

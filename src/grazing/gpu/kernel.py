@@ -18,10 +18,18 @@ CPU's own code as device functions (:mod:`grazing.gpu.ported`).
 Not on the GPU yet: sticking (a chattering sequence that the CPU would sum
 and continue as sticking ends the thread's job with :data:`NEEDS_CPU` at that
 point; :mod:`grazing.gpu.batch` computes the rest of the job on the CPU
-lanes), the discontinuity map and models with several modes (refused before
-a launch).  Lyapunov exponents are a kernel of their own
-(:func:`build_kernel`'s ``lyapunov``: the variational equations, their
-Gram-Schmidt after each step and the saltation matrix at each impact,
+lanes) and the discontinuity map (refused before a launch).  A model with
+modes: each thread carries its point's mode (its kernels, its event rows:
+the transitions out of it); a switch without a reset changes the mode
+(``impacts.switch_mode``), a reset may too (``impacts.change_mode``), each
+followed by the CPU's test that the state is inside the new mode's region
+(``impacts.check_region``: else the point's status is ``OUTSIDE_MODE``); a
+crossing where the far side's field pushes back enters Filippov's sliding
+pseudo-mode (``impacts.enter_sliding``), kept on its surface at each step's
+end and sample, left by its virtual exits (``impacts.leave_sliding``).
+Lyapunov exponents are a kernel of their own (:func:`build_kernel`'s
+``lyapunov``: the variational equations, their Gram-Schmidt after each step
+and the saltation matrix at each impact, switch and entry into sliding,
 :mod:`grazing.gpu.tangent`).
 
 Each thread's arrays are local (sized by the model: constants of the
@@ -38,6 +46,7 @@ from typing import Any
 import numpy as np
 from numba import cuda  # (the simulator's, where NUMBA_ENABLE_CUDASIM=1: a global, which it swaps in kernels)
 
+from grazing.core.model import ON_STOP_TOL
 from grazing.core.options import ADAPTIVE_BLOCK, ADAPTIVE_MAX_PERIOD
 from grazing.core.solution import Status
 from grazing.engine.polyroots import work_shape
@@ -48,8 +57,8 @@ NEEDS_CPU = -2
 
 # The run state of a thread: integer fields of ``st``, float fields of ``sf`` (lanes' RUN_STATE names).
 K, KS, ISAMP, N_SAMPLES, N_KEEP, RECORDING, STEPS, MAX_STEPS, ZERO_EVENTS, DEFL, DEFL_STOP = range(11)
-STAGE, BLOCK, USED, REQ_KS, USE_VAR, LYAP_STARTED, JAC_VALID = 11, 12, 13, 14, 15, 16, 17
-INT_FIELDS = 18
+STAGE, BLOCK, USED, REQ_KS, USE_VAR, LYAP_STARTED, JAC_VALID, VF, SURFACE = 11, 12, 13, 14, 15, 16, 17, 18, 19
+INT_FIELDS = 20
 S, SS, REQ_SS, SPAN_DT, LYAP_T0 = range(5)
 FLOAT_FIELDS = 5
 TRANSIENT, EXTRA, FINAL = 1, 2, 3
@@ -63,6 +72,7 @@ STATUS_OK = int(Status.OK)
 STATUS_STEP_LIMIT = int(Status.STEP_LIMIT)
 STATUS_NONFINITE = int(Status.NONFINITE)
 STATUS_ZENO = int(Status.ZENO)
+STATUS_OUTSIDE_MODE = int(Status.OUTSIDE_MODE)
 
 ROOT_WORK = work_shape(0)
 """The shape of one thread's work array of the root search."""
@@ -107,8 +117,8 @@ def sweep_kernel(definition: Any, order: int, keep: int, lyapunov: bool = False)
 def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
     """The sweep kernel of the device model ``dm`` (:class:`~grazing.gpu.model.DeviceModel`).
 
-    ``kernel[blocks, threads](jobs, control, x0, firsts, pvs, Ts, sphase,
-    tcarry, samples, by_stop, used, x_final, t_final, status, work, iset,
+    ``kernel[blocks, threads](jobs, control, x0, firsts, first_vf, x0_vf, pvs, Ts, sphase,
+    tcarry, samples, by_stop, lyap, used, x_final, t_final, vf_final, status, work, iset,
     fset)``: the arrays of :class:`~grazing.engine.records.LaneJobs`,
     :class:`~grazing.engine.records.LanePoints` and
     :class:`~grazing.engine.records.LaneResults` (``control[0]`` the next job,
@@ -139,12 +149,20 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
     repeats_with_period = helpers["repeats_with_period"]
     step_limit = helpers["step_limit"]
     start_times = helpers["start_times"]
-    tc_free = dm.functions["tc_free"]
-    tc_var = dm.functions["tc_var"]
+    tc_free = dm.functions["mode_tc_free"]
+    tc_var = dm.functions["mode_tc_var"]
     reset = dm.functions["reset"]
+    guard = dm.functions["guard"]
+    guard_grad = dm.functions["guard_grad"]
     normal_rate = dm.functions["normal_rate"]
     normal_accel = dm.functions["normal_accel"]
     NX, NSTOPS, ORDER = dm.nx, dm.nstops, dm.order
+    ROWS = np.array(dm.rows, dtype=np.int64)  # (a mode's event rows: its transitions; -1 padding)
+    NEV = ROWS.shape[1]
+    TARGETS = np.array(dm.targets, dtype=np.int64)
+    RESETS = np.array(dm.resets, dtype=np.int64)
+    BACK = np.array(dm.back, dtype=np.int64)
+    SLIDE_ENTRY = np.array(dm.slide_entry, dtype=np.int64)
     KC = ORDER + 1
     LYAP = bool(lyapunov)
     NT = NX + NX * NX if LYAP else NX  # (rows of the state with the variational matrix)
@@ -159,14 +177,17 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
     float64, int64 = types.float64, types.int64
 
     @dj
-    def first_event(O, h, defl, defl_stop, a, work):
-        """The first event on the step over every stop: ``(u, stop)``, ``u < 0`` none (``events.first_event``
-        for one mode, free flight, nothing skipped)."""
+    def first_event(O, h, vf, defl, defl_stop, a, work):
+        """The first event on the step over mode ``vf``'s transitions: ``(u, stop)``, ``u < 0`` none
+        (``events.first_event`` in free flight, nothing skipped)."""
         u = -1.0
         stop = 0
-        for r in range(NSTOPS):
+        for row in range(NEV):
+            r = ROWS[vf, row]  # the row's stop (transition); -1: padding
+            if r < 0:
+                continue
             defl_r = defl if r == defl_stop else 0
-            deg, tail = event_polynomial(O, r, h, 0, defl_r, False, a, ORDER)
+            deg, tail = event_polynomial(O, row, h, 0, defl_r, False, a, ORDER)
             ur = event_certificate(a, tail)
             if ur > 0.0:
                 ur = confirm_first_root(a, deg, isolate_first_root(a, deg, work), work)
@@ -174,6 +195,44 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
                 u = ur
                 stop = r
         return u, stop
+
+    @dj
+    def sliding_guard(vf):
+        """The transition whose guard is 0 on the surface of sliding pseudo-mode ``vf``, or -1
+        (``impacts.sliding_guard``)."""
+        first = ROWS[vf, 0]
+        return BACK[first] if first >= NSTOPS else -1
+
+    @dj
+    def onto_guard(x, s, pv, j, gx):
+        """``x`` onto the zero set of stop ``j``'s guard (``impacts.onto_guard``; ``gx`` a buffer)."""
+        for i in range(NX):
+            gx[i] = 0.0
+        for _ in range(3):
+            hval = guard(x, s, pv, j)
+            guard_grad(x, s, pv, gx, j)
+            nn = 0.0
+            for i in range(NX):
+                nn += gx[i] * gx[i]
+            if nn == 0.0 or hval == 0.0:
+                break
+            for i in range(NX):
+                x[i] -= hval * gx[i] / nn
+
+    @dj
+    def outside_mode(x, s, pv, vf, known):
+        """Whether ``x``, which has just entered mode ``vf``, is outside its region (``impacts.check_region``:
+        a guard of the mode's own transitions other than ``known`` below ``-ON_STOP_TOL * max(1, |x|)``)."""
+        scale = 1.0
+        for i in range(NX):
+            scale = max(scale, abs(x[i]))
+        for row in range(NEV):
+            k = ROWS[vf, row]
+            if k < 0 or k >= NSTOPS or k == known:
+                continue
+            if guard(x, s, pv, k) < -ON_STOP_TOL * scale:
+                return True
+        return False
 
     @dj
     def chatter_remaining(x, s, pv, j, speed, chatter_time):
@@ -207,12 +266,14 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
         st[MAX_STEPS] = step_limit(periods)
         st[ZERO_EVENTS] = 0
         st[DEFL] = 0
+        st[SURFACE] = 1 + sliding_guard(st[VF])  # (0: not sliding)
         st[KS] = st[REQ_KS]
         sf[SS] = sf[REQ_SS]
 
     @dj
-    def take_samples(st, sf, X, T, h_acc, event, is_last, buf, xe, wrap):
-        """The samples within ``(0, h_acc]`` of the step (``recording.take_samples`` in free flight)."""
+    def take_samples(st, sf, X, T, h_acc, event, is_last, buf, xe, wrap, pv, gx):
+        """The samples within ``(0, h_acc]`` of the step (``recording.take_samples`` without sticking:
+        while sliding put on the surface)."""
         n_samples = st[N_SAMPLES]
         keep_from = n_samples - st[N_KEEP]
         while st[ISAMP] < n_samples:
@@ -223,6 +284,11 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
                 dt = h_acc
             if st[ISAMP] >= keep_from:
                 eval_rows(X, NX, ORDER, dt, xe)
+                if st[SURFACE] > 0:
+                    s = sf[S] + dt
+                    if wrap and s >= T:
+                        s -= T
+                    onto_guard(xe, s, pv, st[SURFACE] - 1, gx)
                 for i in range(NX):
                     buf[st[ISAMP] - keep_from, i] = xe[i]
             st[ISAMP] += 1
@@ -239,9 +305,10 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
     def run_request(st, sf, x, pv, T, wrap, final, fset, X, O, a, xe, xp, buf, counts, work, tw):
         """Steps until the request's last sample; returns the point's status (OK: go on).
 
-        ``tw`` = ``(V, logs, scratch, before, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn)``: the tangent arrays.
+        ``tw`` = ``(V, logs, scratch, before, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn, gx)``: the tangent
+        arrays and the guard's gradient.
         """
-        V, logs, scratch, before, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn = tw
+        V, logs, scratch, before, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn, gx = tw
         factor = fset[FACTOR]
         chatter_time = fset[CHATTER_TOL] * T
         while st[ISAMP] < st[N_SAMPLES]:
@@ -254,18 +321,19 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
             var = False
             if LYAP:
                 var = st[USE_VAR] != 0
+            vf = st[VF]
             if LYAP and var:
-                tc_var(x, s, pv, X, O)
-                h = step_size(X, NT, O, NSTOPS, 0, GUARD_SCALE, ORDER, T, factor)
+                tc_var(x, s, pv, X, O, vf)
+                h = step_size(X, NT, O, NEV, 0, GUARD_SCALE, ORDER, T, factor)
             else:
-                tc_free(x, s, pv, X, O)
-                h = step_size(X, NX, O, NSTOPS, 0, GUARD_SCALE, ORDER, T, factor)
+                tc_free(x, s, pv, X, O, vf)
+                h = step_size(X, NX, O, NEV, 0, GUARD_SCALE, ORDER, T, factor)
             rem = (st[KS] - st[K]) * T + (sf[SS] - s)  # (step.step_end)
             last = False
             if st[ISAMP] == st[N_SAMPLES] - 1 and h >= rem:
                 h = rem
                 last = True
-            u, ev_stop = first_event(O, h, st[DEFL], st[DEFL_STOP], a, work)
+            u, ev_stop = first_event(O, h, vf, st[DEFL], st[DEFL_STOP], a, work)
             event = u >= 0.0 and h > 0.0  # (step.accept_step)
             if event and u == 0.0:
                 st[ZERO_EVENTS] += 1
@@ -277,7 +345,7 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
             if event and last and u >= 1.0:
                 event = False
             if (st[KS] - st[K]) * T + (sf[SS] - s) <= h_acc:
-                take_samples(st, sf, X, T, h_acc, event, last, buf, xe, wrap)
+                take_samples(st, sf, X, T, h_acc, event, last, buf, xe, wrap, pv, gx)
             recording = st[RECORDING]
             eval_rows(X, NT if var else NX, ORDER, h_acc, x)  # (the lanes' advance)
             sf[S] = s + h_acc  # (step.end_step)
@@ -286,6 +354,8 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
                 st[K] += 1
             st[STEPS] += 1
             st[DEFL] = 0
+            if st[SURFACE] > 0:  # sliding: back onto the surface, off which the integration drifts
+                onto_guard(x, sf[S], pv, st[SURFACE] - 1, gx)
             if LYAP and var:  # the Lyapunov vectors (tangent.lyapunov_step)
                 started = lyapunov_step(st[LYAP_STARTED] != 0, st[RECORDING] != 0, sf[SPAN_DT], x, X, V,
                                         scratch, logs, xe, before)  # fmt: skip
@@ -294,23 +364,71 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
                     if started == LYAP_STARTED_NOW_AT_END:
                         sf[LYAP_T0] = st[K] * T + sf[S]
             sf[SPAN_DT] = math.nan
-            if event:  # an impact on stop ev_stop (impacts.at_event, apply_impact)
+            if (
+                event and ev_stop >= NSTOPS
+            ):  # sliding ends at a tangency, to that side (impacts.leave_sliding)
+                st[VF] = TARGETS[ev_stop]
+                st[SURFACE] = 0
+                st[DEFL] = 2
+                st[DEFL_STOP] = BACK[ev_stop]
+            elif (
+                event
+                and SLIDE_ENTRY[ev_stop] >= 0
+                and st[SURFACE] == 0
+                and normal_rate(x, sf[S], pv, BACK[ev_stop]) < 0.0
+            ):  # the far side's field pushes back: sliding (impacts.enter_sliding)
+                s = sf[S]
+                target = TARGETS[SLIDE_ENTRY[ev_stop]]
+                if LYAP and var:
+                    unpack_var(x, NX, NX, V)
+                    if not saltation(x, x, s, pv, ev_stop, V, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn, vf, target):
+                        st[JAC_VALID] = 0
+                    pack_var(V, NX, NX, x)
+                onto_guard(x, s, pv, ev_stop, gx)
+                st[VF] = target
+                st[SURFACE] = 1 + ev_stop
+                st[DEFL] = 0
+            elif event and RESETS[ev_stop] == 0:  # a switch of vector field, no reset (impacts.switch_mode)
+                s = sf[S]
+                target = TARGETS[ev_stop]
+                if LYAP and var:  # (the saltation matrix of a switch: the identity reset)
+                    unpack_var(x, NX, NX, V)
+                    if not saltation(x, x, s, pv, ev_stop, V, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn, vf, target):
+                        st[JAC_VALID] = 0
+                    pack_var(V, NX, NX, x)
+                st[VF] = target
+                st[SURFACE] = 0
+                st[DEFL] = 1 if BACK[ev_stop] >= 0 else 0
+                st[DEFL_STOP] = BACK[ev_stop]
+                if outside_mode(x, s, pv, target, BACK[ev_stop]):
+                    return STATUS_OUTSIDE_MODE
+            elif event:  # an impact on stop ev_stop (impacts.at_event, apply_impact)
                 s = sf[S]
                 vn = normal_rate(x, s, pv, ev_stop)
                 reset(x, s, pv, xp, ev_stop)
                 if LYAP and var:  # (the variational matrix times the saltation matrix)
                     unpack_var(x, NX, NX, V)
-                    if not saltation(x, xp, s, pv, ev_stop, V, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn):
+                    if not saltation(
+                        x, xp, s, pv, ev_stop, V, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn, vf, TARGETS[ev_stop]
+                    ):
                         st[JAC_VALID] = 0  # (an impact at zero normal speed has no Jacobian)
                     pack_var(V, NX, NX, xp)
                 for i in range(NT if var else NX):
                     x[i] = xp[i]
                 st[DEFL] = 1
                 st[DEFL_STOP] = ev_stop
-                if STICKS[ev_stop] != 0 and chatter_remaining(x, s, pv, ev_stop, -vn, chatter_time) >= 0.0:
-                    return NEEDS_CPU  # (complete chattering, then sticking: not on the GPU yet)
                 if recording != 0 and final:
                     counts[ev_stop] += 1
+                if TARGETS[ev_stop] != vf:  # a reset that also changes the mode (impacts.change_mode)
+                    target = TARGETS[ev_stop]
+                    st[VF] = target
+                    st[SURFACE] = 0
+                    st[DEFL] = 1 if BACK[ev_stop] >= 0 else 0
+                    st[DEFL_STOP] = BACK[ev_stop]
+                    if outside_mode(x, s, pv, target, -1):
+                        return STATUS_OUTSIDE_MODE
+                if STICKS[ev_stop] != 0 and chatter_remaining(x, s, pv, ev_stop, -vn, chatter_time) >= 0.0:
+                    return NEEDS_CPU  # (complete chattering, then sticking: not on the GPU yet)
         return STATUS_OK
 
     @dj
@@ -389,8 +507,8 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
             final_request(st, sf, x, T, iset, s_phase, logs)
 
     @cuda.jit
-    def kernel(jobs, control, x0, firsts, pvs, Ts, sphase, tcarry, samples, by_stop, lyap, used, x_final,
-               t_final, status, work, iset, fset):  # fmt: skip
+    def kernel(jobs, control, x0, firsts, first_vf, x0_vf, pvs, Ts, sphase, tcarry, samples, by_stop, lyap,
+               used, x_final, t_final, vf_final, status, work, iset, fset):  # fmt: skip
         tid = cuda.grid(1)
         if tid >= work.shape[0]:
             return
@@ -398,7 +516,7 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
         sf = cuda.local.array(FLOAT_FIELDS, float64)
         x = cuda.local.array(NT, float64)
         X = cuda.local.array((NT, KC), float64)
-        O = cuda.local.array((NSTOPS, KC), float64)
+        O = cuda.local.array((NEV, KC), float64)
         a = cuda.local.array(KC, float64)
         xe = cuda.local.array(NT, float64)
         xp = cuda.local.array(NT, float64)
@@ -416,6 +534,7 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
             cuda.local.array(NV, float64),  # w
             cuda.local.array(NV, float64),  # hv
             cuda.local.array((NV, NV), float64),  # Vn
+            cuda.local.array(NX, float64),  # gx (the guard's gradient, sliding)
         )
         buf = cuda.local.array((KEEP, NX), float64)
         counts = cuda.local.array(NSTOPS, int64)
@@ -432,10 +551,12 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
                     for i in range(NX):
                         x[i] = firsts[job, 1 + i]
                     t0 = firsts[job, 0]
+                    st[VF] = first_vf[job]
                 elif iset[FRESH] != 0 or not ok:
                     for i in range(NX):
                         x[i] = x0[job, i]
                     t0 = 0.0
+                    st[VF] = x0_vf[job]
                 elif iset[PERIODIC] != 0:  # (the previous point's end: its state and time)
                     t0 = tcarry[p]
                 else:
@@ -478,6 +599,7 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
                     for i in range(NX):
                         x_final[p, i] = x[i]
                     t_final[p] = st[K] * T + sf[S]
+                    vf_final[p] = st[VF]
                 status[p] = code
                 if code == NEEDS_CPU:
                     break  # (the rest of the job goes to the CPU)

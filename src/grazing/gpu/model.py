@@ -20,6 +20,9 @@ from typing import Any
 
 from grazing.engine.codegen import ModelSource, generate_source
 
+MODE_FUNCTIONS = ("tc_free", "tc_var", "rhs")
+"""The per-mode functions, reached by the mode's index (``mode_tc_free(x0, s0, pv, X, O, vf)``)."""
+
 
 @dataclass(frozen=True)
 class DeviceModel:
@@ -35,6 +38,12 @@ class DeviceModel:
         The sizes.
     sticks
         Per stop: it has a sticking mode.
+    nmodes, rows, targets, resets, back, slide_entry
+        The modes (the generated ``sizes``'; for one mode every stop is a row of its kernels, each
+        transition a reset into mode 0): a mode's event rows (its transitions, -1 padding), each
+        transition's target mode, whether it resets, its way back (-1 none), its sliding entry (-1 none).
+        ``functions`` has ``mode_tc_free``, ``mode_tc_var`` and ``mode_rhs``: the mode's function by its
+        index (the last argument), for one mode as for several.
     """
 
     functions: dict[str, Any]
@@ -43,6 +52,12 @@ class DeviceModel:
     nparams: int
     order: int
     sticks: tuple[bool, ...]
+    nmodes: int = 1
+    rows: tuple[tuple[int, ...], ...] = ()
+    targets: tuple[int, ...] = ()
+    resets: tuple[bool, ...] = ()
+    back: tuple[int, ...] = ()
+    slide_entry: tuple[int, ...] = ()
 
 
 def dispatcher_text(name: str, choices: list[str], args: str) -> str:
@@ -72,13 +87,13 @@ def _arguments(text: str, name: str) -> str:
 
 
 def device_model(source: ModelSource) -> DeviceModel:
-    """The device functions of the generated ``source`` (one mode: ``ValueError`` for a model with modes)."""
+    """The device functions of the generated ``source``."""
     from grazing.gpu.ported import device_helpers
     from grazing.gpu.target import device_function
 
     sizes = source.sizes
-    if int(sizes.get("nmodes", 1)) > 1:
-        raise ValueError("models with several modes are not on the GPU yet")
+    nstops = int(sizes["nstops"])
+    nmodes = int(sizes.get("nmodes", 1))
     helpers = device_helpers()
     namespace: dict[str, Any] = {"math": math, "_sin": helpers["sin"], "_cos": helpers["cos"]}
     text = source.text.replace("math.sin(", "_sin(").replace("math.cos(", "_cos(")
@@ -92,6 +107,11 @@ def device_model(source: ModelSource) -> DeviceModel:
         text = dispatcher_text(name, choices, _arguments(source.text, choices[0]))
         exec(compile(text, f"<grazing.gpu.model.{name}>", "exec"), namespace)
         functions[name] = device_function(namespace[name])
+    for name in MODE_FUNCTIONS:  # (by the mode's index: the dispatcher, or the one mode's function)
+        choices = source.dispatch[name] if nmodes > 1 else [name]
+        text = dispatcher_text(f"mode_{name}", choices, _arguments(source.text, choices[0]))
+        exec(compile(text, f"<grazing.gpu.model.mode_{name}>", "exec"), namespace)
+        functions[f"mode_{name}"] = device_function(namespace[f"mode_{name}"])
     return DeviceModel(
         functions=functions,
         nx=int(sizes["nx"]),
@@ -99,6 +119,12 @@ def device_model(source: ModelSource) -> DeviceModel:
         nparams=int(sizes["nparams"]),
         order=int(sizes["order"]),
         sticks=tuple(bool(s) for s in sizes["sticks"]),
+        nmodes=nmodes,
+        rows=tuple(tuple(int(r) for r in row) for row in sizes.get("rows", [list(range(nstops))])),
+        targets=tuple(int(t) for t in sizes.get("targets", [0] * nstops)),
+        resets=tuple(bool(r) for r in sizes.get("resets", [True] * nstops)),
+        back=tuple(int(b) for b in sizes.get("back", [-1] * nstops)),
+        slide_entry=tuple(int(e) for e in sizes.get("slide_entry", [-1] * nstops)),
     )
 
 

@@ -8,7 +8,7 @@ record, which a device function cannot.  The Gram-Schmidt step
 (:func:`~grazing.engine.stepping.orthonormalize`) and the (un)packing of the
 variational matrix are the CPU's own code (:mod:`grazing.gpu.ported`); the
 model's field, reset Jacobian and guard gradient its generated functions
-(:mod:`grazing.gpu.model`).  One mode, no sensitivity columns: the variational
+(:mod:`grazing.gpu.model`, a mode's by its index).  No sensitivity columns: the variational
 matrix is ``n x n`` (``ncol = n``, as on the CPU lanes).
 """
 
@@ -39,7 +39,7 @@ def tangent_functions(dm: Any) -> TangentFunctions:
     unpack_var = helpers["unpack_var"]
     pack_var = helpers["pack_var"]
     eval_rows = helpers["eval_rows"]
-    rhs = dm.functions["rhs"]
+    rhs = dm.functions["mode_rhs"]
     reset_jac = dm.functions["reset_jac"]
     guard_grad = dm.functions["guard_grad"]
     NX, ORDER = dm.nx, dm.order
@@ -81,11 +81,12 @@ def tangent_functions(dm: Any) -> TangentFunctions:
         pack_var(V, NX, NX, x)
         return code
 
-    def saltation(xm, xp, s, pv, j, V, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn):
+    def saltation(xm, xp, s, pv, j, V, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn, vf_from, vf_to):
         """The saltation matrix of stop ``j`` applied to ``V`` (``impacts.saltation``, no parameter
-        columns); False, ``V`` left alone, at zero normal speed.  The rest are the thread's buffers."""
-        rhs(xm, s, pv, fm)
-        rhs(xp, s, pv, fp)
+        columns); False, ``V`` left alone, at zero normal speed.  ``f-`` is mode ``vf_from``'s field at
+        ``xm``, ``f+`` mode ``vf_to``'s at ``xp``; the rest are the thread's buffers."""
+        rhs(xm, s, pv, fm, vf_from)
+        rhs(xp, s, pv, fp, vf_to)
         for i in range(NX):
             Gt[i] = 0.0
             Gp[i, 0] = 0.0
