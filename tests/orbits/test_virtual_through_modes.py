@@ -1,0 +1,108 @@
+"""Virtual orbits of a model with modes: the impacts' guard minima, each over its source mode only.
+
+The soft-hard oscillator (tests/engine/test_events_off_modes.py: a soft contact beyond ``gap``, a rigid
+wall at ``wall`` inside it) with its wall ignored is piecewise linear: its period-1 orbit is solved
+exactly as a boundary-value problem in its switch times (matrix exponentials, ``fsolve``), and the
+wall's guard minimum is ``wall`` less the largest ``x`` of the contact segment, where ``v = 0``.  A wall
+declared in the free mode beyond the gap is never reached there: its guard minimum is its value where
+the free mode is left (``wall - gap``, at the switch into the contact), although the contact segment
+goes far past it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import sympy as sp
+from scipy.optimize import brentq, fsolve
+
+import grazing
+from grazing import HybridModel, Mode, Parameter, Stop, Transition
+from grazing.orbits import find_orbit
+from tests.engine.test_events_off_modes import (
+    CONTACT,
+    FREE,
+    VALUES,
+    gap,
+    r,
+    reference,
+    soft_hard,
+    t,
+    v,
+    w,
+    wall,
+    x,
+)
+
+
+def exact_virtual_orbit(p: dict, t0: float, guess) -> tuple[np.ndarray, float, float, float]:
+    """The wall-less period-1 orbit of soft_hard from ``t0`` in mode ``free``: ``(x0, t_touch, t_peak,
+    x_peak)``, its largest ``x`` at ``t_peak`` in the contact (``v = 0``)."""
+    ref = reference(p, walls=False)
+    T = ref.period
+
+    def equations(u):
+        x0, t1, t2 = u[:2], u[2], u[3]
+        y1 = ref.flow(0, x0, t0, t1)
+        y2 = ref.flow(1, y1, t1, t2)
+        return [y1[0] - p["gap"], y2[0] - p["gap"], *(ref.flow(0, y2, t2, t0 + T) - x0)]
+
+    u, _, _, msg = fsolve(equations, guess, xtol=1e-15, full_output=True)
+    assert np.abs(equations(u)).max() < 1e-13, msg
+    x0, t1, t2 = u[:2], u[2], u[3]
+    y1 = ref.flow(0, x0, t0, t1)
+    t_peak = brentq(lambda s: ref.flow(1, y1, t1, s)[1], t1 + 1e-9, t2 - 1e-9, xtol=1e-15)
+    return x0, t1, t_peak, ref.flow(1, y1, t1, t_peak)[0]
+
+
+def _virtual(m: HybridModel):
+    """The virtual period-1 orbit from a section in the free mode, well before the contact."""
+    sol = grazing.simulate(m, [0.0, 0.0], periods=1, transient=300, events=False, trajectory=400)
+    i = int(np.argmin(sol.trajectory[:, 0]))
+    t0 = float(sol.trajectory_t[i] % m.period)
+    return find_orbit(m, sol.trajectory[i], period=1, t0=t0, virtual=True, stop_name="wall", mode="free")
+
+
+def test_the_virtual_orbit_reports_the_walls_guard_minimum_exactly():
+    m = soft_hard()
+    orbit = _virtual(m)
+    p = dict(m.params)
+    sw = orbit.switch_times
+    t0 = orbit.t0
+    first = sw[sw >= t0]
+    x0, _, t_peak, x_peak = exact_virtual_orbit(p, t0, [*orbit.state, first[0], first[1]])
+    assert np.abs(orbit.state - x0).max() < 1e-10
+    assert orbit.virtual and orbit.impacts == 0
+    assert x_peak > p["wall"] + 1.0  # (far past the wall: the orbit is virtual)
+    assert abs(orbit.guard_min - (p["wall"] - x_peak)) < 1e-10, orbit.guard_min - (p["wall"] - x_peak)
+    assert abs(orbit.t_guard_min - t_peak) < 1e-7
+    assert abs(orbit.x_guard_min[0] - x_peak) < 1e-10
+    assert orbit.crossed_stops == ("wall",)
+    mins = orbit.guard_mins  # the switches (no reset) report no minimum
+    assert np.isinf(mins[0]) and np.isinf(mins[2])
+
+
+def free_wall(**values: float) -> HybridModel:
+    """soft_hard with its wall declared in the free mode (beyond the gap: never reached there)."""
+    params = [Parameter(name, value) for name, value in VALUES.items()]
+    model = HybridModel(
+        "free-wall", [x, v], t, params,
+        modes=[Mode("free", FREE, stops=[Stop("wall", wall - x, [x, -r * v])]), Mode("contact", CONTACT)],
+        transitions=[Transition("touch", "free", "contact", gap - x),
+                     Transition("leave", "contact", "free", x - gap)],
+        period=2 * sp.pi / w,
+    )  # fmt: skip
+    return model.with_params(**values)
+
+
+def test_a_guard_is_ignored_while_the_run_is_in_another_mode():
+    m = free_wall()
+    orbit = _virtual(m)
+    p = dict(m.params)
+    i = m.stop_names.index("wall")
+    h, t_min, x_min = orbit.guard_min_by_stop[i]
+    # In the contact the orbit reaches x ~ 2, where the wall's guard is ~ -1.3; in the free mode it is
+    # smallest where the free mode is left, at the switch into the contact (x = gap).
+    assert abs(h - (p["wall"] - p["gap"])) < 1e-10, h - (p["wall"] - p["gap"])
+    touch = orbit.switch_times[orbit.switch_transitions == m.stop_names.index("touch")]
+    assert np.abs(touch - t_min).min() < 1e-9 and abs(x_min[0] - p["gap"]) < 1e-10
+    assert orbit.crossed_stops == ()
