@@ -18,6 +18,7 @@ from scipy.optimize import brentq, fsolve
 import grazing
 from grazing import HybridModel, Mode, Parameter, Stop, Transition
 from grazing.orbits import find_orbit
+from grazing.orbits.grazing import find_grazings
 from tests.engine.test_events_off_modes import (
     CONTACT,
     FREE,
@@ -106,3 +107,31 @@ def test_a_guard_is_ignored_while_the_run_is_in_another_mode():
     at_gap = orbit.switch_times  # (into and out of the contact: x = gap at both)
     assert np.abs(at_gap - t_min).min() < 1e-9 and abs(x_min[0] - p["gap"]) < 1e-10
     assert orbit.crossed_stops == ()
+
+
+def exact_wall_grazing(p: dict, guess: tuple[float, float]) -> tuple[float, float]:
+    """``(a, t_graze)`` of soft_hard's wall-less period-1 orbit touching the wall: from ``(wall, 0)`` in
+    the contact at ``t_graze`` back to it a period later (the exact flow and its switch times)."""
+
+    def back(u):
+        q = {**p, "a": u[0]}
+        ref = reference(q, walls=False)
+        y, mode, _, _ = ref.run([q["wall"], 0.0], 1, u[1], u[1] + ref.period)
+        assert mode == 1
+        return y - [q["wall"], 0.0]
+
+    u, _, _, msg = fsolve(back, guess, xtol=1e-15, full_output=True)
+    assert np.abs(back(u)).max() < 1e-13, msg
+    return float(u[0]), float(u[1])
+
+
+def test_an_impacts_grazing_is_located_on_the_virtual_branch_through_modes():
+    m = soft_hard(wall=1.5)
+    points, branch = find_grazings(m, "a", 0.5, 1.0, stop_name="wall")
+    assert len(points) == 1 and points[0].stop == m.stop_names.index("wall")
+    g = points[0]
+    a, t_graze = exact_wall_grazing(dict(m.params), (g.model.params["a"], g.t_graze))
+    assert abs(g.model.params["a"] - a) < 1e-10, g.model.params["a"] - a
+    assert abs((g.t_graze - t_graze) % m.period) < 1e-8 or abs((t_graze - g.t_graze) % m.period) < 1e-8
+    assert np.abs(g.contact - [1.5, 0.0]).max() < 1e-10 and g.mode == "contact"
+    assert all(o.virtual for o in branch.orbits)
