@@ -18,7 +18,7 @@ from scipy.optimize import brentq, fsolve
 import grazing
 from grazing import HybridModel, Mode, Parameter, Stop, Transition
 from grazing.orbits import find_orbit
-from grazing.orbits.grazing import find_grazings
+from grazing.orbits.grazing import find_grazings, grazing_curve
 from tests.engine.test_events_off_modes import (
     CONTACT,
     FREE,
@@ -135,3 +135,16 @@ def test_an_impacts_grazing_is_located_on_the_virtual_branch_through_modes():
     assert abs((g.t_graze - t_graze) % m.period) < 1e-8 or abs((t_graze - g.t_graze) % m.period) < 1e-8
     assert np.abs(g.contact - [1.5, 0.0]).max() < 1e-10 and g.mode == "contact"
     assert all(o.virtual for o in branch.orbits)
+
+
+def test_the_walls_grazing_curve_through_modes_against_the_exact_orbit():
+    m = soft_hard(wall=1.5)
+    curve = grazing_curve(m, ("a", "zeta"), 0.05, search=(0.5, 1.0), stop_name="wall")
+    assert len(curve.points) >= 5
+    zetas = [g.model.params["zeta"] for g in curve.points]
+    assert max(zetas) > 0.12  # (the curve goes well beyond its start)
+    for g in curve.points:
+        p = dict(g.model.params)
+        a, _ = exact_wall_grazing(p, (p["a"], g.t_graze))
+        assert abs(p["a"] - a) < 1e-10, (p["zeta"], p["a"] - a)
+        assert np.abs(g.contact - [1.5, 0.0]).max() < 1e-10
