@@ -148,3 +148,30 @@ def test_the_walls_grazing_curve_through_modes_against_the_exact_orbit():
         a, _ = exact_wall_grazing(p, (p["a"], g.t_graze))
         assert abs(p["a"] - a) < 1e-10, (p["zeta"], p["a"] - a)
         assert np.abs(g.contact - [1.5, 0.0]).max() < 1e-10
+
+
+def test_a_guard_smallest_where_its_mode_is_left_counts_there():
+    """A guard ``3 - x - v`` of the free mode decreases up to the switch into the contact: its minimum over
+    the free mode is at that switch, the end of the last step in the free mode (no later step sees it)."""
+    params = [Parameter(name, value) for name, value in VALUES.items()]
+    m = HybridModel(
+        "tilted-wall", [x, v], t, params,
+        modes=[Mode("free", FREE, stops=[Stop("wall", 3 - x - v, [x, -r * v])]), Mode("contact", CONTACT)],
+        transitions=[Transition("touch", "free", "contact", gap - x),
+                     Transition("leave", "contact", "free", x - gap)],
+        period=2 * sp.pi / w,
+    )  # fmt: skip
+    orbit = _virtual(m)
+    p = dict(m.params)
+    sw, T = orbit.switch_times, m.period
+    x0, t_touch, _, _ = exact_virtual_orbit(p, orbit.t0, [*orbit.state, sw[0], sw[1]])
+    ref = reference(p, walls=False)
+    y = ref.flow(0, x0, orbit.t0, t_touch)
+    h_touch = 3 - y[0] - y[1]
+    # the exact guard over the free mode (before the touch, after the leave) is nowhere smaller
+    free = [ref.flow(0, x0, orbit.t0, s) for s in np.linspace(orbit.t0, t_touch, 2001)]
+    free += [ref.flow(0, x0, orbit.t0 + T, s) for s in np.linspace(sw[1], orbit.t0 + T, 2001)]  # (backwards)
+    assert min(3 - z[0] - z[1] for z in free) >= h_touch - 1e-15
+    h, t_min, _ = orbit.guard_min_by_stop[m.stop_names.index("wall")]
+    assert abs(h - h_touch) < 1e-10, h - h_touch
+    assert abs(t_min - t_touch) < 1e-9 and orbit.crossed_stops == ("wall",)
