@@ -161,7 +161,7 @@ def flow_map(
         phase=2 * math.pi * (t0 / model.period % 1.0),  # the section through t0
         jacobian=True,
         sensitivities=tuple(sensitivities),
-        guard_min=not model.has_modes,  # (not on models with modes yet)
+        guard_min=True,
         events=not virtual,
         touching=touching,
         stop_name=stop_name,

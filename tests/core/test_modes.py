@@ -288,11 +288,9 @@ def test_check_state_per_mode():
 
 
 def test_features_not_yet_on_modes_are_refused_in_one_line():
-    from grazing.orbits import find_orbit
 
     m = soft()
-    with pytest.raises(InvalidParameterError, match=r"^a virtual orbit \(the stops ignored\) does"):
-        find_orbit(m, [0.0, 0.0], period=1, virtual=True)
+    # (virtual orbits go through modes: tests/orbits/test_virtual_through_modes.py)
     with pytest.raises(InvalidParameterError, match=r"^the discontinuity map does not support models"):
         grazing.simulate(m, [0.0, 0.0], periods=1, zdm=object())
     # (the grazing analysis and the grazing curve go through modes: tests/orbits/test_curves_through_modes.py)

@@ -25,7 +25,7 @@ import pytest
 from scipy.optimize import brentq, fsolve
 
 import grazing
-from grazing.errors import ConvergenceError, InvalidParameterError, InvalidStateError
+from grazing.errors import ConvergenceError, InvalidStateError
 from grazing.maps import flow_map
 from grazing.orbits import continue_orbit, find_orbit
 from grazing.orbits.palc import PalcSettings
@@ -162,13 +162,11 @@ def test_a_map_that_returns_in_another_mode_and_other_refusals_in_one_line():
     assert "\n" not in str(info.value)
     with pytest.raises(InvalidStateError, match="is not in mode 'free'"):
         find_orbit(m, [1.0, 0.0], period=1, mode="free")
-    for call in (
-        lambda: find_orbit(m, virtual=True),
-        lambda: continue_orbit(m, "omega", 1.2, 1.3, virtual=True),
-    ):
-        with pytest.raises(InvalidParameterError, match="does not support models with modes yet") as info:
-            call()
-        assert "\n" not in str(info.value)
+    # a virtual orbit ignores the resets only (tests/orbits/test_virtual_through_modes.py): this model has
+    # none, so it is the orbit itself
+    virtual = find_orbit(m, orbit.state, period=1, t0=orbit.t0, mode=orbit.mode, virtual=True)
+    assert virtual.virtual and np.abs(virtual.state - orbit.state).max() < 1e-10
+    assert virtual.crossed_stops == () and np.isinf(virtual.guard_mins).all()
     # multiple shooting goes through modes (tests/orbits/test_segments_through_modes.py); this model has
     # no reset, so its segments end on its switches (tests/orbits/test_segments_at_switches.py)
     ms = segmented_newton(m, orbit.state, orbit.t0, 1, tol=1e-10, max_iter=5, mode=orbit.mode)

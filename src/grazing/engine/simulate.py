@@ -63,7 +63,10 @@ def simulate(
         ``trajectory`` points per period over the sampled span (plus both
         states at each impact), which ``impacts`` to record (``"sampled"``
         span, ``"all"``, ``"none"``), ``guard_min`` (the smallest guard value
-        and the closest approach to the stop, :attr:`Solution.approach_min`).
+        and the closest approach to the stop, :attr:`Solution.approach_min`;
+        on a model with modes, of the transitions with a reset, each over the
+        time the run spends in its source mode: elsewhere it is no stop of the
+        motion; a transition without a reset reports ``inf``).
     tangent
         Tangent dynamics (:class:`~grazing.core.options.Tangent`):
         ``jacobian`` (``d x_final / d x0``, saltation matrices at impacts),
@@ -142,7 +145,6 @@ def simulate(
             model,
             zdm=zdm,
             touching=touching,
-            guard_min=guard_min,
             stop_name=stop_name,
             mode=mode,
         )
@@ -278,7 +280,6 @@ def _refuse_on_modes(
     *,
     zdm: DiscontinuityMap | None,
     touching: bool,
-    guard_min: bool,
     stop_name: int | str | None,
     mode: str | None,
 ) -> None:
@@ -292,8 +293,6 @@ def _refuse_on_modes(
                 f"a run from a grazing contact with transition {model.stop_names[j]!r} starts in its source "
                 f"mode {model.transition_source[j]!r}, not in {start!r}"
             )
-    if guard_min:
-        model.require_one_mode("the smallest guard value (guard_min)")
 
 
 def _sample_time_terms(

@@ -1246,9 +1246,7 @@ def continue_orbit(
         )
     if switch and virtual is None:
         virtual = False  # a nonimpacting orbit too: followed up to its grazing, then switched
-    if model.has_modes:
-        if virtual or (orbit is not None and orbit.virtual):
-            model.require_one_mode("a virtual branch (the stops ignored)")
+    if model.has_modes and not (virtual or (orbit is not None and orbit.virtual)):
         virtual = False  # (its switches of mode end it where they change, as impacts do)
     watch = model.stop_index(
         stop_name if stop_name is not None else (orbit.stop if orbit is not None else None)

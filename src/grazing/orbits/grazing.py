@@ -61,11 +61,15 @@ def find_grazings(
     (:attr:`GrazingPoint.crossed`) is not a motion of the system: it is
     returned, with a :class:`~grazing.errors.GrazingWarning`.
 
-    On a model with modes the branch is the orbit itself, followed through its
-    switches of mode (no virtual orbit): each grazing of a transition's guard
-    where its switches change is located (the orbit of the transition's source
-    mode tangent to the guard) and the branch goes on along the orbit with the
-    new switches (``switch``); ``stop_name`` names the transition.
+    On a model with modes, for a transition without a reset (a switch of vector
+    field), the branch is the orbit itself, followed through its switches of
+    mode (no virtual orbit): each grazing of the transition's guard where its
+    switches change is located (the orbit of the transition's source mode
+    tangent to the guard) and the branch goes on along the orbit with the new
+    switches (``switch``); ``stop_name`` names the transition.  For an impact
+    (a transition with a reset) the branch is virtual, as for a model of one
+    mode: it switches and slides, the impacts are ignored, and the impact's
+    guard counts only while the orbit is in its source mode.
 
     Parameters
     ----------
@@ -99,6 +103,8 @@ def find_grazings(
     >>> [round(p.model.params["eta"], 4) for p in points]
     [0.4451, 0.5473]
     """
+    watch = model.stop_index(stop_name)
+    switching = model.has_modes and not model.transition_resets[watch]  # (an impact's: a virtual orbit)
     branch = continue_orbit(
         model,
         param,
@@ -106,14 +112,13 @@ def find_grazings(
         stop,
         x0=None if x0 is None else np.asarray(x0, dtype=float),
         period=period,
-        virtual=not model.has_modes,
+        virtual=not switching,
         settings=settings,
         detect=(SpecialKind.FOLD, SpecialKind.GRAZING),
         progress=progress,
-        stop_name=None if model.has_modes else stop_name,
-        switch=model.has_modes,  # (through modes: the orbit with the new switches past each grazing)
+        stop_name=None if switching else stop_name,
+        switch=switching,  # (through modes: the orbit with the new switches past each grazing)
     )
-    watch = model.stop_index(stop_name)
     par = model.parameter(param)
     points = []
     for sp_ in branch.special:

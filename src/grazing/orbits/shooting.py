@@ -299,8 +299,6 @@ def find_orbit(
     >>> orbit.period, orbit.impacts, orbit.stable
     (5, 1, True)
     """
-    if virtual:
-        model.require_one_mode("a virtual orbit (the stops ignored)")
     if period is not None and (not isinstance(period, (int, np.integer)) or period < 1):
         raise InvalidParameterError(f"period must be a positive integer, got {period!r}")
     if t0 is None:
@@ -337,7 +335,7 @@ def find_orbit(
     try:
         return newton.solve(x, virtual, advice, guess, note)
     except ConvergenceError:
-        nonimpacting = not (virtual or not through_stops or model.has_modes)  # (no guard minima with modes)
+        nonimpacting = not (virtual or not through_stops or model.has_modes)
         inside = newton.nonimpacting(x) if nonimpacting else None
         if inside is None:
             raise

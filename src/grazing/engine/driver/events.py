@@ -128,3 +128,13 @@ def contact_row(m, vf, j):
         if m.rows[vf, row] == j:
             return row
     return 0
+
+
+@njit(cache=True, inline="always")
+def tracked_in(m, vf, j):
+    """Whether transition ``j``'s guard is an event row of mode ``vf``'s kernels (``vf`` is its source mode,
+    or a sliding pseudo-mode on a surface beside it)."""
+    for row in range(m.rows.shape[1]):
+        if m.rows[vf, row] == j:
+            return True
+    return False

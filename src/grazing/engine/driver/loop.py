@@ -36,10 +36,11 @@ from numba import njit
 
 from grazing.engine.driver.atomics import load_acquire
 from grazing.engine.driver.calls import tc_free, tc_stick, tc_var
-from grazing.engine.driver.events import contact_row, first_event
+from grazing.engine.driver.events import contact_row, first_event, tracked_in
 from grazing.engine.driver.impacts import close_sticking, sliding_guard
 from grazing.engine.driver.recording import (
     finish_guard,
+    guard_at_end,
     new_guard_info,
     sample_modes,
     take_samples,
@@ -195,9 +196,17 @@ def integrate(start, pv, cfg, m, out):
             sample_modes(r, first, out.sample_modes)
         if r.recording and traj_dt > 0.0:
             trajectory_points(m, r, X, h_acc, traj, xe, is_last and not event)
-        if r.recording and track_min and r.mode == 0 and h_acc > 0.0 and m.nmodes == 1:
-            for j in range(nstops):  # every stop's closest approach
-                track_guard(m, r, O, j, X, x, h, h_acc, event, gm, guard_info[j], xe)
+        if r.recording and track_min and r.mode == 0 and h_acc > 0.0:
+            if m.nmodes == 1:
+                for j in range(nstops):  # every stop's closest approach
+                    track_guard(m, r, O, j, j, X, x, h, h_acc, event, gm, guard_info[j], xe)
+            else:  # the impacts' guards that are event rows of the current mode (it is their source)
+                for row in range(nevents):
+                    j = m.rows[r.vf, row]
+                    if 0 <= j < nstops and m.resets[j]:
+                        track_guard(m, r, O, row, j, X, x, h, h_acc, event, gm, guard_info[j], xe)
+                        if event:  # a switch may leave the mode here: its guard at the step's end
+                            guard_at_end(m, r, X, h, h_acc, gm, guard_info[j], xe)
 
         # Advance to the end of the accepted part of the step.
         eval_rows(X, nrows, order, h_acc, xe)
@@ -228,7 +237,8 @@ def finish_run(m, runs, cfg, x, pv, guard_info, tables, out):
     T = cfg.T
     if cfg.track_min and r.mode == 0 and r.recording:
         for j in range(m.nstops):
-            finish_guard(m, r, x, pv, j, guard_info[j])
+            if m.nmodes == 1 or (m.resets[j] and tracked_in(m, r.vf, j)):
+                finish_guard(m, r, x, pv, j, guard_info[j])
     close_sticking(tables[1], r.n_stick, r.k * T + r.s)
     tot = out.totals[0]
     tot.status = r.status

@@ -118,8 +118,9 @@ def trajectory_points(m, r, X, h_acc, traj, xe, run_end):
 
 
 @njit(cache=True, inline="always")
-def track_guard(m, r, O, row, X, x, h, h_acc, event, gm, info, xe):
-    """Minimum of event row ``row`` (a guard) over the step of run ``r`` up to ``h_acc``, closest approach.
+def track_guard(m, r, O, row, stop, X, x, h, h_acc, event, gm, info, xe):
+    """Minimum of event row ``row`` (stop ``stop``'s guard) over the step of run ``r`` up to ``h_acc``, and
+    the closest approach.
 
     ``info`` is the stop's row of the guard's record (:func:`new_guard_info`):
     ``info[:2 + n]`` holds the smallest value, its time and the state there;
@@ -132,7 +133,7 @@ def track_guard(m, r, O, row, X, x, h, h_acc, event, gm, info, xe):
     n = m.nx
     order = m.order
     t = r.k * r.T + r.s
-    defl = r.defl if r.defl_stop == row else 0
+    defl = r.defl if r.defl_stop == stop else 0
     slope_end = info[4 + 2 * n]
     slope_first = info[5 + 2 * n]
     hk = 1.0
@@ -174,6 +175,20 @@ def track_guard(m, r, O, row, X, x, h, h_acc, event, gm, info, xe):
         slope_end = math.nan  # an impact or a release follows: no free-flight minimum here
     info[4 + 2 * n] = slope_end
     info[5 + 2 * n] = slope_first
+
+
+@njit(cache=True, inline="always")
+def guard_at_end(m, r, X, h, h_acc, gm, info, xe):
+    """The guard's value at the end ``h_acc`` of a step that ends at an event (``gm``, its polynomial in the
+    step's fraction, from :func:`track_guard`): in a model with modes a switch may leave the guard's mode
+    there, and the next step, in another mode, does not see it."""
+    uend = h_acc / h
+    ge = horner(gm, m.order, uend)
+    if ge < info[0]:
+        eval_rows(X, m.nx, m.order, h_acc, xe)
+        info[0] = ge
+        info[1] = r.k * r.T + r.s + h_acc
+        set_slice(info, 2, xe, m.nx)
 
 
 @njit(cache=True)
