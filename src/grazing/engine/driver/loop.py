@@ -199,12 +199,12 @@ def integrate(start, pv, cfg, m, out):
         if r.recording and track_min and r.mode == 0 and h_acc > 0.0:
             if m.nmodes == 1:
                 for j in range(nstops):  # every stop's closest approach
-                    track_guard(m, r, O, j, j, X, x, h, h_acc, event, gm, guard_info[j], xe)
+                    track_guard(m, r, O[j], j, X, x, h, h_acc, event, gm, guard_info[j], xe)
             else:  # the impacts' guards that are event rows of the current mode (it is their source)
                 for row in range(nevents):
                     j = m.rows[r.vf, row]
                     if 0 <= j < nstops and m.resets[j]:
-                        track_guard(m, r, O, row, j, X, x, h, h_acc, event, gm, guard_info[j], xe)
+                        track_guard(m, r, O[row], j, X, x, h, h_acc, event, gm, guard_info[j], xe)
                         if event:  # a switch may leave the mode here: its guard at the step's end
                             guard_at_end(m, r, X, h, h_acc, gm, guard_info[j], xe)
 

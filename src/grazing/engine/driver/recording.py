@@ -118,9 +118,9 @@ def trajectory_points(m, r, X, h_acc, traj, xe, run_end):
 
 
 @njit(cache=True, inline="always")
-def track_guard(m, r, O, row, stop, X, x, h, h_acc, event, gm, info, xe):
-    """Minimum of event row ``row`` (stop ``stop``'s guard) over the step of run ``r`` up to ``h_acc``, and
-    the closest approach.
+def track_guard(m, r, o_row, stop, X, x, h, h_acc, event, gm, info, xe):
+    """Minimum of the event row ``o_row`` (the Taylor coefficients of stop ``stop``'s guard, a row of the
+    kernel's ``O``) over the step of run ``r`` up to ``h_acc``, and the closest approach.
 
     ``info`` is the stop's row of the guard's record (:func:`new_guard_info`):
     ``info[:2 + n]`` holds the smallest value, its time and the state there;
@@ -138,7 +138,7 @@ def track_guard(m, r, O, row, stop, X, x, h, h_acc, event, gm, info, xe):
     slope_first = info[5 + 2 * n]
     hk = 1.0
     for j in range(order + 1):
-        gm[j] = O[row, j] * hk
+        gm[j] = o_row[j] * hk
         hk *= h
     if gm[0] < info[0]:
         info[0] = gm[0]
