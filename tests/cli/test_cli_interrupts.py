@@ -164,16 +164,20 @@ def test_sigterm_while_the_command_line_is_imported():
     assert (done.returncode, done.stderr) == (143, "grazing: terminated\n")
 
 
-def test_a_sigterm_that_an_import_turns_into_its_own_error_ends_as_terminated():
-    """A SIGTERM while an extension module is imported is raised inside its initialisation, which turns it
-    into its own error (scipy's HiGHS: ``ImportError: initialization failed``, found by the signal fuzz
-    on ``iso-damping``): one line and 143 all the same, not the import's traceback."""
+@pytest.mark.parametrize(
+    ("signame", "code", "line"), [("SIGTERM", 143, "terminated"), ("SIGINT", 130, "interrupted")]
+)
+def test_a_signal_that_an_import_turns_into_its_own_error_ends_as_the_signal(signame, code, line):
+    """A SIGTERM or a Ctrl-C while an extension module is imported is raised inside its initialisation,
+    which turns it into its own error (scipy's HiGHS: ``ImportError: initialization failed``, found by the
+    signal fuzz on ``iso-damping``, for both): one line and 143 or 130 all the same, not the import's
+    traceback."""
     script = (
         "import signal, sys, _grazing_entry\n"
         "import grazing.experiment.damping as damping\n"
         "def importing(*args, **kwargs):\n"
         "    try:\n"
-        "        signal.raise_signal(signal.SIGTERM)\n"
+        f"        signal.raise_signal(signal.{signame})\n"
         "    except BaseException:\n"
         "        raise ImportError('initialization failed') from None\n"
         "damping.iso_damping = importing\n"
@@ -181,7 +185,7 @@ def test_a_sigterm_that_an_import_turns_into_its_own_error_ends_as_terminated():
         "sys.exit(_grazing_entry.main())\n"
     )
     done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=False)
-    assert (done.returncode, done.stderr) == (143, "grazing: terminated\n")
+    assert (done.returncode, done.stderr) == (code, f"grazing: {line}\n")
 
 
 def test_a_folder_left_by_a_killed_synthesize_is_removed_by_the_next_run(warm, tmp_path, monkeypatch):

@@ -28,7 +28,7 @@ from grazing.cli.common import (
 )
 from grazing.cli.hints import flag_hints
 from grazing.cli.limits import MEMORY_ENV
-from grazing.engine.interrupts import Terminated, terminating_as_interrupted, was_terminated
+from grazing.engine.interrupts import Terminated, terminating_as_interrupted, was_interrupted, was_terminated
 from grazing.errors import GrazingError
 
 __all__ = ["COMMANDS", "cli", "main"]
@@ -179,9 +179,14 @@ def main(argv: list[str] | None = None) -> int:
         error_line(f"out of memory (the estimate before the run was too low; {MEMORY_ENV} lowers the bound)")
         return EXIT_FAILURE
     except Exception:
-        if not was_terminated():  # (an extension imported as SIGTERM came: its own error, not ours)
-            raise
-        quiet_store_exit()
-        terminated_line()
-        return EXIT_TERMINATED
+        # (an extension module imported as the signal came: its own error, not ours)
+        if was_terminated():
+            quiet_store_exit()
+            terminated_line()
+            return EXIT_TERMINATED
+        if was_interrupted():
+            quiet_store_exit()
+            interrupted_line()
+            return EXIT_INTERRUPTED
+        raise
     return 0

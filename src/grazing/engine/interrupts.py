@@ -102,6 +102,10 @@ _TERMINATED: list[bool] = []
 """Set when :func:`raise_terminated` has run since the last :func:`terminating_as_interrupted` block began
 (:func:`was_terminated`)."""
 
+_INTERRUPTED: list[bool] = []
+"""Set when :func:`raise_interrupted` has run since the last :func:`terminating_as_interrupted` block began
+(:func:`was_interrupted`)."""
+
 REDELIVERY_INTERVAL = 0.2
 """Seconds between two deliveries again of a signal whose exception may be lost (:func:`_redeliver`)."""
 
@@ -182,7 +186,8 @@ def raise_terminated(_signum: int, _frame: object) -> None:
 
 def raise_interrupted(_signum: int, _frame: object) -> None:
     """The SIGINT handler of :func:`terminating_as_interrupted`: Python's (``KeyboardInterrupt``), raised
-    again if it was lost (:func:`_redeliver`)."""
+    again if it was lost (:func:`_redeliver`), and remembered (:func:`was_interrupted`)."""
+    _INTERRUPTED.append(True)
     _raise(signal.SIGINT, KeyboardInterrupt)
 
 
@@ -194,6 +199,14 @@ def was_terminated() -> bool:
     HiGHS: ``ImportError: initialization failed``): the command line ends as terminated all the same.
     """
     return bool(_TERMINATED)
+
+
+def was_interrupted() -> bool:
+    """Has a Ctrl-C (SIGINT) been raised by :func:`raise_interrupted` since the last
+    :func:`terminating_as_interrupted` block began?  As for :func:`was_terminated`: an extension module
+    being imported turns the ``KeyboardInterrupt`` into its own error (scipy's HiGHS, ``ImportError:
+    initialization failed``, the signal fuzz), and the command line ends as interrupted all the same."""
+    return bool(_INTERRUPTED)
 
 
 def _quiet_lost_interrupts(previous: Callable[[Any], object]) -> Callable[[Any], object]:
@@ -232,6 +245,7 @@ def terminating_as_interrupted() -> Iterator[None]:
         yield
         return
     _TERMINATED.clear()
+    _INTERRUPTED.clear()
     previous = {
         signal.SIGTERM: signal.getsignal(signal.SIGTERM),
         signal.SIGINT: signal.getsignal(signal.SIGINT),
