@@ -188,16 +188,18 @@ def test_the_segmented_equations_at_switches_against_differences():
 
 def test_continuation_hands_over_to_multiple_shooting_at_switches():
     """Down in frequency the multiplier grows past 1e6: single shooting stalls (no grazing ahead) and
-    multiple shooting on the switches takes the branch on to its bound, each point the exact orbit."""
+    multiple shooting on the switches takes the branch on to its bound, each point the exact orbit.
+    (Where single shooting stalls depends on rounding: near freq = 0.3024, or 0.2996 with OpenBLAS's
+    SkylakeX kernels; the bound 0.29 lies beyond both.)"""
     m = two_soft_stops(freq=0.33)
     x, _, _ = exact_orbit(dict(m.params), GUESS[0.33])
     orbit = find_orbit(m, x, period=1, t0=m.period / 4, mode="middle")
-    branch = continue_orbit(m, "freq", 0.33, 0.3, orbit=orbit)
+    branch = continue_orbit(m, "freq", 0.33, 0.29, orbit=orbit)
     assert "by multiple shooting from freq = " in branch.status, branch.status
-    assert branch.status.startswith("reached the bound freq = 0.3")
+    assert branch.status.startswith("reached the bound freq = 0.29")
     handover = float(branch.status.split("by multiple shooting from freq = ")[1].split()[0])
     past = [o for o in branch.orbits if o.model.params["freq"] < handover]
-    assert len(past) > 3 and past[-1].model.params["freq"] == 0.3
+    assert len(past) > 3 and past[-1].model.params["freq"] == 0.29
     for o in [*past[:: max(1, len(past) // 4)], past[-1]]:
         q = dict(o.model.params)
         guess = [*o.state, *o.switch_times]
