@@ -8,13 +8,18 @@ NVVM's compilation to PTX are the device's: a construct the device cannot compil
     python tests/gpu/compile_ptx.py pendulum impact_oscillator bouncing_ball rocking_block --cc 9.0
 
 Each model's kernel is compiled twice: without and with Lyapunov exponents (``build_kernel``'s
-``lyapunov``).
+``lyapunov``).  With ``--ptxas PATH`` (the wheel's ``nvidia/cuda_nvcc/bin/ptxas``) the PTX is also
+assembled for the device (``ptxas -v``): the registers each thread takes, its stack frame and the bytes it
+spills, what fixes how many threads an SM holds at once (an H100 or H200: 65,536 registers and at most
+2,048 threads per SM).
 """
 
 from __future__ import annotations
 
 import argparse
 import re
+import subprocess
+import tempfile
 import time
 import types as pytypes
 
@@ -39,11 +44,31 @@ def kernel_signature() -> tuple[object, ...]:
             array(f8, 3), array(i8, 1), array(f8, 1))  # fmt: skip
 
 
+def assembled(ptxas: str, ptx: str, cc: tuple[int, int]) -> str:
+    """``ptxas -v``'s report of the kernel's resources (registers, stack frame, spills) for ``sm_<cc>``."""
+    with tempfile.TemporaryDirectory() as tmp:
+        src = f"{tmp}/kernel.ptx"
+        with open(src, "w", encoding="ascii") as f:
+            f.write(ptx)
+        proc = subprocess.run(
+            [ptxas, "-v", f"-arch=sm_{cc[0]}{cc[1]}", src, "-o", f"{tmp}/kernel.cubin"],
+            capture_output=True, text=True,
+        )  # fmt: skip
+    if proc.returncode != 0:
+        raise SystemExit(f"ptxas failed: {proc.stderr.strip()[:2000]}")
+    lines = proc.stderr.splitlines()
+    entry = next(i for i, ln in enumerate(lines) if "Compiling entry function" in ln)
+    frame = next(ln.strip() for ln in lines[entry:] if "stack frame" in ln)
+    used = next(ln.split(": ", 1)[1] for ln in lines[entry:] if "Used " in ln)
+    return f"{used}; {frame}"
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("models", nargs="*", default=["pendulum", "impact_oscillator", "bouncing_ball"])
     parser.add_argument("--cc", default="9.0", help="compute capability (default 9.0)")
     parser.add_argument("--tol", type=float, default=1e-10, help="the tolerance, for the Taylor order")
+    parser.add_argument("--ptxas", help="ptxas to assemble the PTX with (its -v report: registers, spills)")
     args = parser.parse_args()
     from numba import cuda
 
@@ -68,6 +93,8 @@ def main() -> None:
                 f"{name}{' (Lyapunov)' if lyapunov else ''}: PTX for sm_{cc[0]}{cc[1]}, {len(ptx)} "
                 f"characters, local frames {local} bytes, {seconds:.1f} s"
             )
+            if args.ptxas:
+                print("   ", assembled(args.ptxas, ptx, cc))
 
 
 if __name__ == "__main__":

@@ -14,6 +14,13 @@ the CPU's event location is the GPU's at once; nothing is written twice.
 
 Only three names differ: the bits of a double and back (an LLVM intrinsic on
 the CPU) and ``np.nextafter`` are :mod:`grazing.gpu.target`'s device forms.
+And one table is computed where it is read: a module's array read by a device
+function is copied into the device's 64 kB bank of constants once for each
+type signature it is compiled for, and ``polyroots._QUOTIENTS`` (34,848 bytes,
+``i / j``) twice would not fit (``ptxas``: "too much global constant data"; the
+kernel would not load).  Its reads become the division they stand for
+(:data:`COMPUTED`): the same double, as a division is correctly rounded on
+either processor.  No other array comes with a module (:func:`_constants`).
 """
 
 from __future__ import annotations
@@ -44,6 +51,21 @@ PORTED: dict[str, tuple[str, ...]] = {
 
 REPLACED = {"np.nextafter": "nextafter"}
 """Calls rewritten in the ported text (a device cannot call numpy)."""
+COMPUTED = {"_QUOTIENTS": ast.Div()}
+"""Tables of ``i op j`` whose reads ``T[i, j]`` the ported text computes as ``(i) op (j)`` (the module)."""
+
+
+class _ComputeTables(ast.NodeTransformer):
+    """Rewrites each read ``T[i, j]`` of a table of :data:`COMPUTED` as ``(i) op (j)``."""
+
+    def visit_Subscript(self, node: ast.Subscript) -> ast.AST:
+        self.generic_visit(node)
+        if isinstance(node.value, ast.Name) and node.value.id in COMPUTED:
+            index = node.slice
+            if not (isinstance(index, ast.Tuple) and len(index.elts) == 2):  # pragma: no cover
+                raise RuntimeError(f"{node.value.id} is read other than as T[i, j]: compute it otherwise")
+            return ast.BinOp(index.elts[0], COMPUTED[node.value.id], index.elts[1])
+        return node
 
 
 def _function_text(module: ModuleType, name: str) -> str:
@@ -54,21 +76,19 @@ def _function_text(module: ModuleType, name: str) -> str:
     node = tree.body[0]
     assert isinstance(node, ast.FunctionDef)
     node.decorator_list = []
-    text = ast.unparse(node)
+    text = ast.unparse(ast.fix_missing_locations(_ComputeTables().visit(node)))
     for old, new in REPLACED.items():
         text = text.replace(old, new)
     return text
 
 
 def _constants(module: ModuleType) -> dict[str, Any]:
-    """The module-level numbers and arrays of ``module`` (what its functions read as constants)."""
-    import numpy as np
-
+    """The module-level numbers of ``module`` (what its functions read as constants; no arrays: a device
+    function's array is a copy in the device's small bank of constants per signature, see the module)."""
     return {
-        k: v
-        for k, v in vars(module).items()
-        if not k.startswith("__") and isinstance(v, (int, float, np.ndarray)) and not isinstance(v, bool)
-    }
+        k: v for k, v in vars(module).items() if not k.startswith("__") and isinstance(v, (int, float))
+        and not isinstance(v, bool)
+    }  # fmt: skip
 
 
 @functools.cache
