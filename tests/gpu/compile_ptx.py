@@ -5,13 +5,14 @@ Needs numba-cuda and NVVM (the ``nvidia-cuda-nvcc-cu12`` and ``nvidia-cuda-nvrtc
 compute capability; with no device, that is taken to be ``--cc`` (9.0: an H100).  Typing, lowering and
 NVVM's compilation to PTX are the device's: a construct the device cannot compile fails here.
 
-    python tests/gpu/compile_ptx.py pendulum impact_oscillator bouncing_ball rocking_block --cc 9.0
+    python tests/gpu/compile_ptx.py pendulum impact_oscillator bouncing_ball rocking_block --cc 9.0 --zdm
 
 Each model's kernel is compiled twice: without and with Lyapunov exponents (``build_kernel``'s
-``lyapunov``).  With ``--ptxas PATH`` (the wheel's ``nvidia/cuda_nvcc/bin/ptxas``) the PTX is also
-assembled for the device (``ptxas -v``): the registers each thread takes, its stack frame and the bytes it
-spills, what fixes how many threads an SM holds at once (an H100 or H200: 65,536 registers and at most
-2,048 threads per SM).
+``lyapunov``); with ``--zdm`` twice more, with the discontinuity map standing for the first stop's impacts
+(``build_kernel``'s ``zdm_stop``).  With ``--ptxas PATH`` (a CUDA toolkit's ``ptxas`` as new as the NVVM)
+the PTX is also assembled for the device (``ptxas -v``): the registers each thread takes, its stack frame
+and the bytes it spills, what fixes how many threads an SM holds at once (an H100 or H200: 65,536
+registers and at most 2,048 threads per SM).
 """
 
 from __future__ import annotations
@@ -41,7 +42,7 @@ def kernel_signature() -> tuple[object, ...]:
     return (array(i8, 2), array(i8, 1), array(f8, 2), array(f8, 2), array(i8, 1), array(i8, 1),
             array(f8, 2), array(f8, 1), array(f8, 1), array(f8, 1), array(f8, 3), array(i8, 2),
             array(f8, 1), array(i8, 1), array(f8, 2), array(f8, 1), array(i8, 1), array(i8, 1),
-            array(f8, 3), array(i8, 1), array(f8, 1))  # fmt: skip
+            array(f8, 3), array(i8, 1), array(f8, 1), array(f8, 1), array(f8, 1))  # fmt: skip
 
 
 def assembled(ptxas: str, ptx: str, cc: tuple[int, int]) -> str:
@@ -69,6 +70,7 @@ def main() -> None:
     parser.add_argument("--cc", default="9.0", help="compute capability (default 9.0)")
     parser.add_argument("--tol", type=float, default=1e-10, help="the tolerance, for the Taylor order")
     parser.add_argument("--ptxas", help="ptxas to assemble the PTX with (its -v report: registers, spills)")
+    parser.add_argument("--zdm", action="store_true", help="also the kernels with the discontinuity map")
     args = parser.parse_args()
     from numba import cuda
 
@@ -81,16 +83,22 @@ def main() -> None:
         dispatcher.get_current_device = lambda: pytypes.SimpleNamespace(compute_capability=cc)
     for name in args.models:
         model = getattr(grazing.models, name)()
-        for lyapunov in (False, True):
+        variants = [
+            (lyapunov, zdm_stop)
+            for zdm_stop in ((-1, 0) if args.zdm else (-1,))
+            for lyapunov in (False, True)
+        ]
+        for lyapunov, zdm_stop in variants:
             dm = model_functions(model._def, taylor_order(args.tol))
-            kernel = build_kernel(dm, keep_rows(100), lyapunov)
+            kernel = build_kernel(dm, keep_rows(100), lyapunov, zdm_stop)
             start = time.perf_counter()
             ptx, _ = cuda.compile_ptx(kernel.py_func, kernel_signature(), cc=cc)
             seconds = time.perf_counter() - start
             # (the local frames of the kernel and the device functions not inlined, in bytes)
             local = [int(v) for v in re.findall(r"__local_depot\d+\[(\d+)\]", ptx)]
             print(
-                f"{name}{' (Lyapunov)' if lyapunov else ''}: PTX for sm_{cc[0]}{cc[1]}, {len(ptx)} "
+                f"{name}{' (Lyapunov)' if lyapunov else ''}{' (map)' if zdm_stop >= 0 else ''}: PTX for "
+                f"sm_{cc[0]}{cc[1]}, {len(ptx)} "
                 f"characters, local frames {local} bytes, {seconds:.1f} s"
             )
             if args.ptxas:

@@ -17,7 +17,6 @@ import math
 import os
 import subprocess
 import sys
-import types
 from pathlib import Path
 
 import pytest
@@ -153,13 +152,9 @@ def test_the_simulator_does_not_leak_into_this_process() -> None:
 
 def test_what_the_gpu_does_not_do_yet_is_refused_in_one_line() -> None:
     import grazing
-    from grazing.gpu.batch import GpuLaneBatch
     from grazing.gpu.device import gpu_refusal
     from grazing.sweeps.spec import sweep_spec
 
-    zdm = types.SimpleNamespace(zdm=object())  # (what gpu_refusal reads of a sweep of the discontinuity map)
-    with pytest.raises(InvalidParameterError, match=r"^the discontinuity map is not on the GPU yet"):
-        GpuLaneBatch([(zdm, 0)])
     for model in (grazing.models.rocking_block(), grazing.models.friction_oscillator()):
         modes = sweep_spec(model, "a", [0.2], settings=grazing.SweepSettings())
         assert gpu_refusal(modes) is None  # (switches, mode-changing resets and sliding are the GPU's)

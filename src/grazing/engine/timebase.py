@@ -39,3 +39,15 @@ def start_times(t0: float, T: float, s_phase: float, periodic: bool) -> tuple[in
         s0 -= T
     ks = k0 if s0 < s_phase - snap else k0 + 1
     return k0, s0, ks, s_phase
+
+
+def map_period(k: int, s: float, s_map: float, T: float) -> int:
+    """The period ``k`` or ``k + 1`` whose local time ``s_map`` is the first not before time ``k T + s``
+    (to ``SNAP`` of a period): where a run applies the discontinuity map at that phase first.
+
+    Examples
+    --------
+    >>> map_period(3, 1.0, 1.5, 2.0), map_period(3, 1.5, 1.5, 2.0)  # (at the map's phase: the next period)
+    (3, 4)
+    """
+    return k if s < s_map - SNAP * T else k + 1

@@ -9,9 +9,11 @@ that reaches what the kernel does not do (complete chattering continued as
 sticking: :data:`~grazing.gpu.kernel.NEEDS_CPU`) is finished on the CPU lanes
 from that point on, from the state the GPU had reached there.
 
-Lyapunov exponents are the kernel's too (its variational build).  Refused in
-one line (:class:`~grazing.errors.InvalidParameterError`) before anything
-runs: the discontinuity map (not on the GPU yet).
+Lyapunov exponents are the kernel's too (its variational build), and so is
+the discontinuity map (its build with the map, from the settings the CPU
+lanes get: :meth:`~grazing.sweeps.run.LaneBatch.settings`).  What the GPU does
+not do (:func:`~grazing.gpu.device.gpu_refusal`) is refused in one line
+(:class:`~grazing.errors.InvalidParameterError`) before anything runs.
 """
 
 from __future__ import annotations
@@ -68,7 +70,12 @@ class GpuLaneBatch(LaneBatch):
 
         spec = self._spec0
         cuda = cuda_module()
-        kernel = sweep_kernel(spec.model._def, self._order, keep_rows(spec.periods), bool(spec.lyapunov))
+        cfg = self.settings(len(self.jobs))  # (the discontinuity map's settings, as the lanes get them)
+        zdm_stop = cfg.stop if cfg.zdm else -1
+        zset = np.array([cfg.zdm_a, cfg.zdm_window, *cfg.zdm_e], dtype=np.float64)  # (kernel.ZDM_A ...)
+        kernel = sweep_kernel(
+            spec.model._def, self._order, keep_rows(spec.periods), bool(spec.lyapunov), zdm_stop
+        )
         njobs = len(self.jobs)
         threads = min(njobs, self.max_threads)
         align = min(LYAPUNOV_ALIGN, spec.transient) if spec.lyapunov else 0  # (as the lanes')
@@ -88,7 +95,8 @@ class GpuLaneBatch(LaneBatch):
         work = cuda.device_array((threads, *ROOT_WORK), dtype=np.float64)
         per_block = min(THREADS_PER_BLOCK, threads)
         blocks = math.ceil(threads / per_block)
-        kernel[blocks, per_block](*d_in, *d_out, work, cuda.to_device(iset), cuda.to_device(fset))
+        kernel[blocks, per_block](*d_in, *d_out, work, cuda.to_device(iset), cuda.to_device(fset),
+                                  cuda.to_device(self.zdms), cuda.to_device(zset))  # fmt: skip
         cuda.synchronize()
         for host, dev in zip(outputs, d_out):
             dev.copy_to_host(host)
@@ -128,18 +136,7 @@ class GpuLaneBatch(LaneBatch):
 
 
 def run_parts_gpu(parts: Sequence[tuple[SweepSpec, int]], threads: int | None = None) -> list[ChunkResult]:
-    """:func:`grazing.sweeps.run.run_parts` on the GPU: the chunks ``parts`` computed together; in order.
-
-    Examples
-    --------
-    >>> import grazing
-    >>> from grazing.sweeps.spec import sweep_spec
-    >>> from types import SimpleNamespace
-    >>> run_parts_gpu([(SimpleNamespace(zdm=object()), 0)])  # doctest: +ELLIPSIS
-    Traceback (most recent call last):
-    ...
-    grazing.errors.InvalidParameterError: the discontinuity map is not on the GPU yet: ...
-    """
+    """:func:`grazing.sweeps.run.run_parts` on the GPU: the chunks ``parts`` computed together; in order."""
     start = time.perf_counter()
     batch = GpuLaneBatch(parts, threads)
     batch.run()

@@ -18,7 +18,12 @@ CPU's own code as device functions (:mod:`grazing.gpu.ported`).
 Not on the GPU yet: sticking (a chattering sequence that the CPU would sum
 and continue as sticking ends the thread's job with :data:`NEEDS_CPU` at that
 point; :mod:`grazing.gpu.batch` computes the rest of the job on the CPU
-lanes) and the discontinuity map (refused before a launch).  A model with
+lanes).  The discontinuity map (a kernel of its own, :func:`build_kernel`'s
+``zdm_stop``): as the lanes', the stop it stands for is not searched for
+events, each step is cut at the map's phase too (``step.cut_step``), and
+there the map kicks the state (``tangent.map_kick``) and, with Lyapunov
+exponents, the tangent vectors (``tangent.kick_tangent``), a kick counted as
+an impact on that stop while the point records.  A model with
 modes: each thread carries its point's mode (its kernels, its event rows:
 the transitions out of it); a switch without a reset changes the mode
 (``impacts.switch_mode``), a reset may too (``impacts.change_mode``), each
@@ -49,6 +54,7 @@ from numba import cuda  # (the simulator's, where NUMBA_ENABLE_CUDASIM=1: a glob
 from grazing.core.model import ON_STOP_TOL
 from grazing.core.options import ADAPTIVE_BLOCK, ADAPTIVE_MAX_PERIOD
 from grazing.core.solution import Status
+from grazing.engine.driver.step import STEP_LAST, STEP_MAP
 from grazing.engine.polyroots import work_shape
 from grazing.engine.stepping import GUARD_SCALE
 
@@ -61,12 +67,19 @@ STAGE, BLOCK, USED, REQ_KS, USE_VAR, LYAP_STARTED, JAC_VALID, VF, SURFACE = 11, 
 INT_FIELDS = 20
 S, SS, REQ_SS, SPAN_DT, LYAP_T0 = range(5)
 FLOAT_FIELDS = 5
+KZ = INT_FIELDS  # the period of the discontinuity map's next kick (the lanes' ``kz``) ...
+INT_FIELDS += 1
+ZDM_S = FLOAT_FIELDS  # ... and its local time (the point's)
+FLOAT_FIELDS += 1
 TRANSIENT, EXTRA, FINAL = 1, 2, 3
 """A point's stages (as the lanes')."""
 
 # The settings arrays: integers, floats.
 FRESH, PERIODIC, TRANSIENT_PERIODS, PERIODS, ADAPTIVE, ALIGN = range(6)
 ADAPTIVE_TOL, FACTOR, CHATTER_TOL = range(3)
+ZDM_A, ZDM_WINDOW, ZDM_E = range(3)
+"""The discontinuity map's settings array: ``L_f^2 h`` at the grazing point, the window, from ``ZDM_E`` on
+its direction ``e`` (the lanes' ``zdm_a``, ``zdm_window``, ``zdm_e``)."""
 
 STATUS_OK = int(Status.OK)
 STATUS_STEP_LIMIT = int(Status.STEP_LIMIT)
@@ -100,26 +113,27 @@ def tangent_bytes(nx: int, order: int) -> int:
     return 8 * (3 * nn + nn * (order + 1) + 3 * nn + nx + 9 * nx)
 
 
-_kernels: dict[tuple[str, int, int, bool], Any] = {}
+_kernels: dict[tuple[str, int, int, bool, int], Any] = {}
 
 
-def sweep_kernel(definition: Any, order: int, keep: int, lyapunov: bool = False) -> Any:
+def sweep_kernel(definition: Any, order: int, keep: int, lyapunov: bool = False, zdm_stop: int = -1) -> Any:
     """The kernel of a model definition at Taylor ``order`` with ``keep`` sample rows, built once;
-    ``lyapunov``: with the variational equations (:func:`build_kernel`)."""
+    ``lyapunov``: with the variational equations, ``zdm_stop``: with the discontinuity map standing for
+    that stop's impacts (:func:`build_kernel`)."""
     from grazing.gpu.model import model_functions
 
-    key = (definition.identity(), int(order), int(keep), bool(lyapunov))
+    key = (definition.identity(), int(order), int(keep), bool(lyapunov), int(zdm_stop))
     if key not in _kernels:
-        _kernels[key] = build_kernel(model_functions(definition, order), keep, lyapunov)
+        _kernels[key] = build_kernel(model_functions(definition, order), keep, lyapunov, zdm_stop)
     return _kernels[key]
 
 
-def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
+def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1) -> Any:
     """The sweep kernel of the device model ``dm`` (:class:`~grazing.gpu.model.DeviceModel`).
 
     ``kernel[blocks, threads](jobs, control, x0, firsts, first_vf, x0_vf, pvs, Ts, sphase,
     tcarry, samples, by_stop, lyap, used, x_final, t_final, vf_final, status, work, iset,
-    fset)``: the arrays of :class:`~grazing.engine.records.LaneJobs`,
+    fset, zdms, zset)``: the arrays of :class:`~grazing.engine.records.LaneJobs`,
     :class:`~grazing.engine.records.LanePoints` and
     :class:`~grazing.engine.records.LaneResults` (``control[0]`` the next job,
     0 at the start), ``work`` the root search's arrays (one per thread),
@@ -133,6 +147,11 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
     ends with their Gram-Schmidt (:mod:`grazing.gpu.tangent`), each impact
     multiplies them by the saltation matrix; ``tangent_bytes`` more local
     memory per thread.  Without it the kernel has no variational arrays.
+    With ``zdm_stop`` (-1: none) the discontinuity map stands for the
+    impacts on that stop (the lanes' ``cfg.zdm``, see the module): ``zdms``
+    its local time per point (:class:`~grazing.engine.records.LanePoints`'),
+    ``zset`` its settings (the module's ``ZDM_A ...`` positions); without it
+    the kernel has no map and reads neither.
     """
     from grazing.gpu.ported import device_helpers
 
@@ -149,6 +168,10 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
     repeats_with_period = helpers["repeats_with_period"]
     step_limit = helpers["step_limit"]
     start_times = helpers["start_times"]
+    map_period = helpers["map_period"]
+    cut_step = helpers["cut_step"]
+    map_kick = helpers["map_kick"]
+    kick_tangent = helpers["kick_tangent"]
     tc_free = dm.functions["mode_tc_free"]
     tc_var = dm.functions["mode_tc_var"]
     reset = dm.functions["reset"]
@@ -156,6 +179,7 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
     guard_grad = dm.functions["guard_grad"]
     normal_rate = dm.functions["normal_rate"]
     normal_accel = dm.functions["normal_accel"]
+    normal_rate_grad = dm.functions["normal_rate_grad"]
     NX, NSTOPS, ORDER = dm.nx, dm.nstops, dm.order
     ROWS = np.array(dm.rows, dtype=np.int64)  # (a mode's event rows: its transitions; -1 padding)
     NEV = ROWS.shape[1]
@@ -172,6 +196,8 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
     lyapunov_step, saltation = tangent_functions(dm)  # (without LYAP, in branches pruned at compilation)
     KEEP = int(keep)
     STICKS = np.array(dm.sticks, dtype=np.int64)
+    ZSTOP = int(zdm_stop)
+    ZDM = ZSTOP >= 0
     from numba import types
 
     float64, int64 = types.float64, types.int64
@@ -184,7 +210,7 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
         stop = 0
         for row in range(NEV):
             r = ROWS[vf, row]  # the row's stop (transition); -1: padding
-            if r < 0:
+            if r < 0 or r == ZSTOP:  # (the discontinuity map's stop: not searched)
                 continue
             defl_r = defl if r == defl_stop else 0
             deg, tail = event_polynomial(O, row, h, 0, defl_r, False, a, ORDER)
@@ -269,6 +295,8 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
         st[SURFACE] = 1 + sliding_guard(st[VF])  # (0: not sliding)
         st[KS] = st[REQ_KS]
         sf[SS] = sf[REQ_SS]
+        if ZDM:
+            st[KZ] = map_period(st[K], sf[S], sf[ZDM_S], T)
 
     @dj
     def take_samples(st, sf, X, T, h_acc, event, is_last, buf, xe, wrap, pv, gx):
@@ -302,11 +330,32 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
                 sf[LYAP_T0] = st[K] * T + sf[S] + dt
 
     @dj
-    def run_request(st, sf, x, pv, T, wrap, final, fset, X, O, a, xe, xp, buf, counts, work, tw):
+    def apply_map(x, s, pv, var, zset, V, gh, gv):
+        """The discontinuity map at its phase (``tangent.discontinuity_map``): the state and, with ``var``,
+        the tangent vectors kicked; returns whether it applied.  ``V``, ``gh``, ``gv``: buffers."""
+        hval = guard(x, s, pv, ZSTOP)
+        vn = normal_rate(x, s, pv, ZSTOP)
+        a = zset[ZDM_A]
+        sp_ = map_kick(hval, vn, a, zset[ZDM_WINDOW])
+        if sp_ < 0.0:
+            return False
+        e = zset[ZDM_E:]
+        if LYAP and var:
+            guard_grad(x, s, pv, gh, ZSTOP)
+            normal_rate_grad(x, s, pv, gv, ZSTOP)
+            unpack_var(x, NX, NX, V)
+            kick_tangent(V, NX, NX, vn, a, sp_, e, gh, gv)
+            pack_var(V, NX, NX, x)
+        for i in range(NX):
+            x[i] -= e[i] * sp_
+        return True
+
+    @dj
+    def run_request(st, sf, x, pv, T, wrap, final, fset, X, O, a, xe, xp, buf, counts, work, tw, zset):
         """Steps until the request's last sample; returns the point's status (OK: go on).
 
         ``tw`` = ``(V, logs, scratch, before, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn, gx)``: the tangent
-        arrays and the guard's gradient.
+        arrays and the guard's gradient; ``zset`` the discontinuity map's settings.
         """
         V, logs, scratch, before, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn, gx = tw
         factor = fset[FACTOR]
@@ -329,10 +378,9 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
                 tc_free(x, s, pv, X, O, vf)
                 h = step_size(X, NX, O, NEV, 0, GUARD_SCALE, ORDER, T, factor)
             rem = (st[KS] - st[K]) * T + (sf[SS] - s)  # (step.step_end)
-            last = False
-            if st[ISAMP] == st[N_SAMPLES] - 1 and h >= rem:
-                h = rem
-                last = True
+            rem_z = (st[KZ] - st[K]) * T + (sf[ZDM_S] - s) if ZDM else 0.0
+            h, ends = cut_step(h, rem, st[ISAMP] == st[N_SAMPLES] - 1, ZDM, rem_z)
+            last = (ends & STEP_LAST) != 0
             u, ev_stop = first_event(O, h, vf, st[DEFL], st[DEFL_STOP], a, work)
             event = u >= 0.0 and h > 0.0  # (step.accept_step)
             if event and u == 0.0:
@@ -364,6 +412,10 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
                     if started == LYAP_STARTED_NOW_AT_END:
                         sf[LYAP_T0] = st[K] * T + sf[S]
             sf[SPAN_DT] = math.nan
+            if ZDM and (ends & STEP_MAP) != 0:  # the discontinuity map's phase (step.end_step)
+                st[KZ] += 1
+                if apply_map(x, sf[S], pv, var, zset, V, gx, hx) and recording != 0 and final:
+                    counts[ZSTOP] += 1  # (a kick, counted as an impact on its stop: lanes.end_lane_step)
             if (
                 event and ev_stop >= NSTOPS
             ):  # sliding ends at a tangency, to that side (impacts.leave_sliding)
@@ -451,7 +503,7 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
             begin_request(st, sf, periods, periods, 0, T)
 
     @dj
-    def run_point(st, sf, x, pv, T, s_phase, iset, fset, X, O, a, xe, xp, buf, counts, work, tw):
+    def run_point(st, sf, x, pv, T, s_phase, iset, fset, X, O, a, xe, xp, buf, counts, work, tw, zset):
         """The point's protocol (``lanes.take_point``, ``end_request``); returns its status."""
         wrap = iset[PERIODIC] != 0
         budget = iset[TRANSIENT_PERIODS]
@@ -470,7 +522,7 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
             final_request(st, sf, x, T, iset, s_phase, logs)
         while True:
             status = run_request(st, sf, x, pv, T, wrap, st[STAGE] == FINAL, fset, X, O, a, xe, xp, buf,
-                                 counts, work, tw)  # fmt: skip
+                                 counts, work, tw, zset)  # fmt: skip
             if status != STATUS_OK:
                 return status
             if wrap:
@@ -508,7 +560,7 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
 
     @cuda.jit
     def kernel(jobs, control, x0, firsts, first_vf, x0_vf, pvs, Ts, sphase, tcarry, samples, by_stop, lyap,
-               used, x_final, t_final, vf_final, status, work, iset, fset):  # fmt: skip
+               used, x_final, t_final, vf_final, status, work, iset, fset, zdms, zset):  # fmt: skip
         tid = cuda.grid(1)
         if tid >= work.shape[0]:
             return
@@ -566,8 +618,10 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
                 sf[S] = s0
                 st[REQ_KS] = ks0
                 sf[REQ_SS] = ss0
+                if ZDM:
+                    sf[ZDM_S] = zdms[p]
                 code = run_point(st, sf, x, pvs[p], T, sphase[p], iset, fset, X, O, a, xe, xp, buf, counts,
-                                 mine, tw)  # fmt: skip
+                                 mine, tw, zset)  # fmt: skip
                 if code == STATUS_OK:  # (lanes.finish_point)
                     for i in range(NX):
                         if not math.isfinite(x[i]):

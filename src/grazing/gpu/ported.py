@@ -5,8 +5,10 @@ The step size (:func:`~grazing.engine.stepping.step_size`, with its
 (:mod:`grazing.engine.driver.events`), the certified first root
 (:mod:`grazing.engine.polyroots`: quadratic bound, Bernstein subdivision,
 Newton polishing, the check that the root is the first), the test of a
-repeating transient, the start times, the Lyapunov vectors' Gram-Schmidt and
-(un)packing of the variational matrix, and the model code's ``sin`` and ``cos``
+repeating transient, the start times, the step's cut at the last sample and at
+the discontinuity map's phase (``step.cut_step``), the map's kick and its
+tangent (``tangent.map_kick``, ``kick_tangent``), the Lyapunov vectors'
+Gram-Schmidt and (un)packing of the variational matrix, and the model code's ``sin`` and ``cos``
 (:mod:`grazing.engine.sincos`: not the C library's) are compiled for the GPU from the
 very text the CPU driver compiles: the decorators dropped, each function
 executed in one namespace where every callee is its device copy.  A change in
@@ -44,7 +46,9 @@ PORTED: dict[str, tuple[str, ...]] = {
     "grazing.engine.driver.events": ("event_polynomial", "event_certificate"),
     "grazing.core.period": ("repeats_with_period",),
     "grazing.core.options": ("step_limit",),
-    "grazing.engine.timebase": ("start_times",),
+    "grazing.engine.timebase": ("start_times", "map_period"),
+    "grazing.engine.driver.step": ("cut_step",),
+    "grazing.engine.driver.tangent": ("map_kick", "kick_tangent"),
     "grazing.engine.sincos": ("sincos_fast", "sincos", "sin", "cos"),
 }  # fmt: skip
 """The functions made device functions, by module (their module's constants come with them)."""

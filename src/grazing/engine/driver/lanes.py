@@ -47,12 +47,11 @@ from grazing.engine.driver.events import contact_row, first_event
 from grazing.engine.driver.impacts import sliding_guard
 from grazing.engine.driver.recording import take_samples
 from grazing.engine.driver.state import STATUS_NONFINITE, STATUS_OK, STATUS_STEP_LIMIT, new_state
-from grazing.engine.driver.step import STEP_LAST, accept_step, end_plain_step, end_step, step_end
+from grazing.engine.driver.step import STEP_LAST, accept_step, end_plain_step, end_step, map_period, step_end
 from grazing.engine.lanevec import LANE_WIDTH, advance_rows, certify_stop
 from grazing.engine.polyroots import quadratic_bound, work_shape
 from grazing.engine.records import Kernels, LaneJobs, LanePoints, LaneResults, LaneSettings
 from grazing.engine.stepping import GUARD_SCALE, new_table, step_factor, step_size, steps_from_norms
-from grazing.engine.timebase import SNAP
 
 LANE_ROOT_ROWS, LANE_ROOT_MIN_COLS = work_shape(0)
 VECTOR_MIN_LANES = 3
@@ -123,7 +122,7 @@ def begin_request(m, st, periods, keep, use_var, T, zdm_s):
     k = st.k
     s = st.s
     st.lyap_t0 = k * T + s
-    st.kz = k if s < zdm_s - SNAP * T else k + 1
+    st.kz = map_period(k, s, zdm_s, T)
 
 
 @njit(cache=False, nogil=True)  # (compiled once per machine into its own object file, grazing.engine.native)

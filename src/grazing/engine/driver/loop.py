@@ -54,7 +54,7 @@ from grazing.engine.driver.state import (
     STATUS_STEP_LIMIT,
     new_state,
 )
-from grazing.engine.driver.step import STEP_LAST, accept_step, end_plain_step, end_step, step_end
+from grazing.engine.driver.step import STEP_LAST, accept_step, end_plain_step, end_step, map_period, step_end
 from grazing.engine.polyroots import work_shape
 from grazing.engine.records import Config, Kernels, RunOutput, Start
 from grazing.engine.stepping import (
@@ -68,7 +68,6 @@ from grazing.engine.stepping import (
     step_size,
     unpack_var,
 )
-from grazing.engine.timebase import SNAP
 
 ROOT_WORK_ROWS, ROOT_WORK_MIN_COLS = work_shape(0)
 
@@ -308,7 +307,7 @@ def start_run(m, r, start, cfg, x, tables):
     r.n_switch = 0
     r.kt = r.k
     r.st = r.s
-    r.kz = r.k if r.s < cfg.zdm_s - SNAP * T else r.k + 1
+    r.kz = map_period(r.k, r.s, cfg.zdm_s, T)
     r.status = STATUS_OK
     r.steps = 0
     r.zero_events = 0

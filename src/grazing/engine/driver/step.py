@@ -8,6 +8,7 @@ import math
 
 from numba import njit
 
+from grazing.engine import timebase
 from grazing.engine.driver.impacts import at_event, enter_contact, onto_guard
 from grazing.engine.driver.state import STATUS_ZENO
 from grazing.engine.driver.tangent import discontinuity_map, lyapunov_step, shift_period
@@ -16,6 +17,9 @@ STEP_LAST = 2
 """The step ends at the run's last sample."""
 STEP_MAP = 4
 """The step ends at the discontinuity map's phase."""
+
+map_period = njit(inline="always")(timebase.map_period)
+"""The period in which a run starting at ``(k, s)`` first applies the discontinuity map (``timebase``')."""
 
 
 @njit(cache=True, inline="always")
@@ -27,17 +31,24 @@ def step_end(r, h, zdm_on, zdm_s):
     """
     T = r.T
     rem = (r.ks - r.k) * T + (r.ss - r.s)
+    rem_z = (r.kz - r.k) * T + (zdm_s - r.s) if zdm_on else 0.0
+    return cut_step(h, rem, r.isamp == r.n_samples - 1, zdm_on, rem_z)
+
+
+@njit(cache=True, inline="always")
+def cut_step(h, rem, last_sample, zdm_on, rem_z):
+    """:func:`step_end` on numbers: a step of at most ``h`` cut ``rem`` on at the last sample (where it is
+    the request's ``last_sample``) and ``rem_z`` on at the map's phase (``zdm_on``); returns ``(h, ends)``.
+    """
     last = False
-    if r.isamp == r.n_samples - 1 and h >= rem:
+    if last_sample and h >= rem:
         h = rem
         last = True
     zdm_hit = False
-    if zdm_on:
-        rem_z = (r.kz - r.k) * T + (zdm_s - r.s)
-        if rem_z <= h:
-            h = rem_z
-            zdm_hit = True
-            last = last and rem_z >= rem
+    if zdm_on and rem_z <= h:
+        h = rem_z
+        zdm_hit = True
+        last = last and rem_z >= rem
     return h, (STEP_LAST if last else 0) | (STEP_MAP if zdm_hit else 0)
 
 

@@ -94,22 +94,14 @@ def discontinuity_map(m, r, x, pv, cfg, V, gh, gv, record, imp):
     s = r.s
     hval = guard(m, x, s, pv, j)
     vn = normal_rate(m, x, s, pv, j)
-    dz = vn * vn / (2.0 * a) - hval
-    if not (dz > 0.0 and abs(vn) < cfg.zdm_window * a):
+    sp_ = map_kick(hval, vn, a, cfg.zdm_window)
+    if sp_ < 0.0:
         return False
-    sp_ = math.sqrt(2.0 * a * dz)
     if r.use_var:
-        # dD/dx = I - e (grad S)^T, grad S = a grad(delta) / S
         guard_grad(m, x, s, pv, gh, j)
         normal_rate_grad(m, x, s, pv, gv, j)
         unpack_var(x, n, ncol, V)
-        for c in range(ncol):
-            gs = 0.0
-            for q in range(n):  # (not j: the stop is recorded below)
-                gs += (vn * gv[q] - a * gh[q]) * V[q, c]
-            gs /= sp_
-            for i in range(n):
-                V[i, c] -= e[i] * gs
+        kick_tangent(V, n, ncol, vn, a, sp_, e, gh, gv)
         pack_var(V, n, ncol, x)
     if record:
         append_record(imp, r.n_imp_rec, r.k * r.T + s, sp_, x, n)
@@ -118,3 +110,28 @@ def discontinuity_map(m, r, x, pv, cfg, V, gh, gv, record, imp):
     for i in range(n):
         x[i] -= e[i] * sp_
     return True
+
+
+@njit(cache=True, inline="always")
+def map_kick(hval, vn, a, window):
+    """The kick ``S = sqrt(2 a delta)`` of the discontinuity map at a state where the guard is ``hval`` and
+    its rate ``vn`` (:func:`discontinuity_map`), or -1 where the map does not apply (``delta <= 0``, or
+    ``|vn| / a >= window``)."""
+    dz = vn * vn / (2.0 * a) - hval
+    if not (dz > 0.0 and abs(vn) < window * a):
+        return -1.0
+    return math.sqrt(2.0 * a * dz)
+
+
+@njit(cache=True, inline="always")
+def kick_tangent(V, n, ncol, vn, a, sp_, e, gh, gv):
+    """The tangent vectors ``V`` (``n x ncol``) through the map's kick ``sp_`` (:func:`map_kick`):
+    ``V <- (I - e (grad S)^T) V``, ``grad S = a grad(delta) / S = (vn grad(vn) - a grad(h)) / S`` from the
+    guard's gradient ``gh`` and its rate's ``gv``."""
+    for c in range(ncol):
+        gs = 0.0
+        for q in range(n):
+            gs += (vn * gv[q] - a * gh[q]) * V[q, c]
+        gs /= sp_
+        for i in range(n):
+            V[i, c] -= e[i] * gs
