@@ -13,6 +13,7 @@ import json
 import math
 import os
 import sys
+from typing import Any
 
 import numpy as np
 
@@ -194,6 +195,12 @@ def compare(parts: list[tuple[object, int]]) -> dict[str, object]:
     return row
 
 
+def differing(cpu: Any, gpu: Any) -> list[str]:
+    """The variables of two datasets that are not equal (to the bit, NaN where NaN), or in one only."""
+    names = set(cpu.data_vars) | set(gpu.data_vars)
+    return sorted(name for name in names if not (name in cpu and name in gpu and cpu[name].equals(gpu[name])))
+
+
 def foreign_names() -> list[str]:
     """Names the device code reads that are neither device functions nor constants (nor ``math``)."""
     import types
@@ -231,7 +238,7 @@ def api_map() -> dict[str, object]:
     kw = {"transient": 64, "periods": 16, "lyapunov": False, "workers": 1}
     cpu = parameter_map(*args, **kw, device="cpu")
     gpu = parameter_map(*args, **kw, device="gpu")
-    differ = sorted(name for name in cpu.data_vars if not cpu[name].equals(gpu[name]))
+    differ = differing(cpu, gpu)
     return {"differ": differ, "variables": sorted(cpu.data_vars), "period": cpu.period.values.tolist()}
 
 
@@ -257,7 +264,7 @@ def api_basins() -> dict[str, object]:
         gpu = basins(*args, **kw, device="gpu")
     finally:
         GpuLaneBatch.run = run  # type: ignore[method-assign]
-    differ = sorted(name for name in cpu.data_vars if not cpu[name].equals(gpu[name]))
+    differ = differing(cpu, gpu)
     return {"differ": differ, "variables": sorted(cpu.data_vars), "kinds": cpu.kind.values.tolist(),
             "lyapunov_on_gpu": launched, "lyapunov": cpu.lyapunov.values.tolist()}  # fmt: skip
 
@@ -283,7 +290,7 @@ def api_basins_modes() -> dict[str, object]:
         gpu = basins(*args, **kw, device="gpu")
     finally:
         GpuLaneBatch.run = run  # type: ignore[method-assign]
-    differ = sorted(name for name in cpu.data_vars if not cpu[name].equals(gpu[name]))
+    differ = differing(cpu, gpu)
     return {"differ": differ, "launched": launched}
 
 
