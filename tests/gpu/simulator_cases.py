@@ -13,6 +13,9 @@ import json
 import math
 import os
 import sys
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -27,139 +30,138 @@ LYAP = {"transient": 64, "periods": 16, "lyapunov": True}
 MODES = {"transient": 24, "periods": 8, "adaptive": False}
 
 
-def cases() -> dict[str, list[tuple[object, int]]]:
-    """Each case's chunks: ``(spec, chunk index)`` pairs that share a batch."""
-    B40 = grazing.models.pendulum("B", theta_hat=math.radians(40))
-    fresh = grazing.SweepSettings(**SHORT, fresh=True)
-    chained = grazing.SweepSettings(**SHORT, fresh=False, chunk_size=3, phase=1.0)
-    lyap = grazing.SweepSettings(**LYAP, fresh=True)
-    modes = grazing.SweepSettings(**MODES, fresh=True, lyapunov=False, chunk_size=0)
-    equal_work = grazing.SweepSettings(**SHORT, fresh=True, adaptive=False, tol=1e-10, chunk_size=0)
-    out = {
-        # fig 7's first grazing at 40 degrees: period 1 free of the stop, period 4, chaos (case B)
-        "pendulum B fresh": [(sweep_spec(B40, "eta", np.linspace(0.44, 0.46, 4), settings=fresh), 0)],
-        # case C, each point from the previous one's end, two chains (chunks) in one batch, sampled at phase 1
-        "pendulum C chained": [
-            (spec, i)
-            for spec in [
-                sweep_spec(
-                    grazing.models.pendulum("C", theta_hat=math.radians(30)),
-                    "eta",
-                    np.linspace(0.40, 0.50, 6),
-                    settings=chained,
-                )
-            ]
-            for i in range(2)
-        ],
-        # the equal-work map's settings (no adaptive transient, tol 1e-10), eta x theta_hat, case A
-        "pendulum A map": [
-            (
-                map_spec(
-                    grazing.models.pendulum("A"),
-                    "eta",
-                    [0.44, 0.47],
-                    "theta_hat",
-                    [math.radians(30), math.radians(40)],
-                    settings=equal_work,
-                ),
-                i,
-            )
-            for i in range(2)
-        ],
-        # a point that blows up (status non-finite) between two that do not
-        "pendulum huge forcing": [
-            (sweep_spec(B40, "alpha", [0.2254, 1e300], settings=fresh), 0),
-        ],
-        "impact oscillator": [
-            (sweep_spec(grazing.models.impact_oscillator(), "omega", [2.6, 2.8, 3.0], settings=fresh), 0)
-        ],
-        # chattering continued as sticking from the third point on: the GPU hands the rest of the chain to the
-        # CPU lanes, from the state it carried
-        "bouncing ball": [
-            (
-                sweep_spec(
-                    grazing.models.bouncing_ball(),
-                    "amplitude",
-                    [1.2, 1.5, 2.0, 2.5],
-                    x0=[0.0, 3.0],
-                    settings=grazing.SweepSettings(**SHORT, chunk_size=4),
-                ),
-                0,
-            )
-        ],
-        # Lyapunov exponents (tangent vectors through impacts by the saltation matrix): case B at 40 degrees
-        # (period 1 free of the stop, period 4, chaos), case C each point from the previous one's end, the
-        # impact oscillator
-        "lyapunov pendulum B": [(sweep_spec(B40, "eta", np.linspace(0.44, 0.46, 4), settings=lyap), 0)],
-        "lyapunov pendulum C chained": [
-            (
-                sweep_spec(
-                    grazing.models.pendulum("C", theta_hat=math.radians(30)),
-                    "eta",
-                    np.linspace(0.40, 0.50, 4),
-                    settings=grazing.SweepSettings(**LYAP, fresh=False, chunk_size=0, phase=1.0),
-                ),
-                0,
-            )
-        ],
-        "lyapunov impact oscillator": [
-            (sweep_spec(grazing.models.impact_oscillator(), "omega", [2.6, 2.8, 3.0], settings=lyap), 0)
-        ],
-        # models with modes: switches of vector field without a reset (fresh, points ending in either
-        # mode), Lyapunov exponents through them (each point from the previous one's end), mode-changing
-        # resets (the rocking block's corners), and each point from its own start in its own mode
-        "soft impact modes": [
-            (sweep_spec(grazing.models.soft_impact_oscillator(), "omega", [0.9, 1.2, 1.5], settings=modes), 0)
-        ],
-        "lyapunov soft impact chained": [
-            (
-                sweep_spec(
-                    grazing.models.soft_impact_oscillator(),
-                    "omega",
-                    [0.9, 1.2, 1.5],
-                    settings=grazing.SweepSettings(**MODES, lyapunov=True, chunk_size=0),
-                ),
-                0,
-            )
-        ],
-        "rocking block": [  # (accumulating impacts, then impacts on both corners at periods 1 and 0)
-            (sweep_spec(grazing.models.rocking_block(), "a", [0.21, 0.22, 0.29], settings=modes), 0)
-        ],
-        "lyapunov rocking block chained": [
-            (
-                sweep_spec(
-                    grazing.models.rocking_block(),
-                    "a",
-                    [0.22, 0.25, 0.28],
-                    settings=grazing.SweepSettings(**MODES, lyapunov=True, chunk_size=0),
-                ),
-                0,
-            )
-        ],
-        "soft impact start modes": [(start_modes_spec(), 0)],
-        # sliding (Filippov's pseudo-mode of the friction oscillator: stick-slip), fresh and with Lyapunov
-        # exponents from the previous point's end
-        "friction sliding": [
-            (sweep_spec(grazing.models.friction_oscillator(), "a", [0.6, 1.1, 1.6], settings=modes), 0)
-        ],
-        # sliding on a diagonal surface, where Filippov's field leaves it by its rounding unless each step's
-        # end and sample is put back on it (tests/engine/test_lanes_sliding.py's model)
-        "diagonal sliding": [
-            (sweep_spec(diagonal(), "c", [0.5, 1.0, 1.5], x0=(1.0, 0.0), settings=modes), 0)
-        ],
-        "lyapunov friction chained": [
-            (
-                sweep_spec(
-                    grazing.models.friction_oscillator(),
-                    "mu",
-                    [0.3, 0.6, 0.9],
-                    settings=grazing.SweepSettings(**MODES, lyapunov=True, chunk_size=0),
-                ),
-                0,
-            )
-        ],
-    }
-    return out
+@dataclass(frozen=True)
+class Scale:
+    """How big a case is: its own few points and short settings (the default: the simulator's), or
+    ``points`` spread over its range with ``transient`` and ``periods`` of their own (a real device:
+    ``test_device.py``)."""
+
+    points: int | None = None
+    transient: int | None = None
+    periods: int | None = None
+
+    def values(self, few: Any) -> Any:
+        """A case's parameter values: its own ``few``, or ``points`` from the least to the greatest."""
+        if self.points is None:
+            return few
+        return np.linspace(min(few), max(few), self.points)
+
+    def settings(self, base: dict[str, Any], **more: Any) -> grazing.SweepSettings:
+        """A case's settings: ``base`` (:data:`SHORT`, :data:`LYAP`, :data:`MODES`) and ``more``, with this
+        scale's transient and periods where given."""
+        own = {k: v for k, v in (("transient", self.transient), ("periods", self.periods)) if v is not None}
+        return grazing.SweepSettings(**{**base, **more, **own})
+
+
+SIMULATOR = Scale()
+"""The simulator's scale: each case's own few points and periods."""
+
+
+def every_chunk(spec: Any) -> list[tuple[object, int]]:
+    """The parts of every chunk of ``spec``."""
+    return [(spec, i) for i in range(spec.n_chunks)]
+
+
+def b40() -> grazing.HybridModel:
+    """Case B at 40 degrees (fig 7)."""
+    return grazing.models.pendulum("B", theta_hat=math.radians(40))
+
+
+def c30() -> grazing.HybridModel:
+    """Case C at 30 degrees."""
+    return grazing.models.pendulum("C", theta_hat=math.radians(30))
+
+
+# Each case's chunks at a scale: ``(spec, chunk index)`` pairs that share a batch.
+BUILDERS: dict[str, Callable[[Scale], list[tuple[object, int]]]] = {
+    # fig 7's first grazing at 40 degrees: period 1 free of the stop, period 4, chaos (case B)
+    "pendulum B fresh": lambda sc: every_chunk(
+        sweep_spec(b40(), "eta", sc.values(np.linspace(0.44, 0.46, 4)),
+                   settings=sc.settings(SHORT, fresh=True))
+    ),
+    # case C, each point from the previous one's end, two chains (chunks) in one batch, sampled at phase 1
+    "pendulum C chained": lambda sc: every_chunk(
+        sweep_spec(c30(), "eta", sc.values(np.linspace(0.40, 0.50, 6)),
+                   settings=sc.settings(SHORT, fresh=False, chunk_size=3, phase=1.0))
+    ),
+    # the equal-work map's settings (no adaptive transient, tol 1e-10), eta x theta_hat, case A
+    "pendulum A map": lambda sc: every_chunk(
+        map_spec(grazing.models.pendulum("A"), "eta", sc.values([0.44, 0.47]), "theta_hat",
+                 [math.radians(30), math.radians(40)],
+                 settings=sc.settings(SHORT, fresh=True, adaptive=False, tol=1e-10, chunk_size=0))
+    ),
+    # a point that blows up (status non-finite) between two that do not
+    "pendulum huge forcing": lambda sc: every_chunk(
+        sweep_spec(b40(), "alpha", [0.2254, 1e300], settings=sc.settings(SHORT, fresh=True))
+    ),
+    "impact oscillator": lambda sc: every_chunk(
+        sweep_spec(grazing.models.impact_oscillator(), "omega", sc.values([2.6, 2.8, 3.0]),
+                   settings=sc.settings(SHORT, fresh=True))
+    ),
+    # chattering continued as sticking from the third point on: the GPU hands the rest of the chain to the
+    # CPU lanes, from the state it carried
+    "bouncing ball": lambda sc: [
+        (sweep_spec(grazing.models.bouncing_ball(), "amplitude", sc.values([1.2, 1.5, 2.0, 2.5]),
+                    x0=[0.0, 3.0], settings=sc.settings(SHORT, chunk_size=sc.points or 4)), 0)
+    ],
+    # Lyapunov exponents (tangent vectors through impacts by the saltation matrix): case B at 40 degrees
+    # (period 1 free of the stop, period 4, chaos), case C each point from the previous one's end, the
+    # impact oscillator
+    "lyapunov pendulum B": lambda sc: every_chunk(
+        sweep_spec(b40(), "eta", sc.values(np.linspace(0.44, 0.46, 4)),
+                   settings=sc.settings(LYAP, fresh=True))
+    ),
+    "lyapunov pendulum C chained": lambda sc: every_chunk(
+        sweep_spec(c30(), "eta", sc.values(np.linspace(0.40, 0.50, 4)),
+                   settings=sc.settings(LYAP, fresh=False, chunk_size=0, phase=1.0))
+    ),
+    "lyapunov impact oscillator": lambda sc: every_chunk(
+        sweep_spec(grazing.models.impact_oscillator(), "omega", sc.values([2.6, 2.8, 3.0]),
+                   settings=sc.settings(LYAP, fresh=True))
+    ),
+    # models with modes: switches of vector field without a reset (fresh, points ending in either
+    # mode), Lyapunov exponents through them (each point from the previous one's end), mode-changing
+    # resets (the rocking block's corners), and each point from its own start in its own mode
+    "soft impact modes": lambda sc: every_chunk(
+        sweep_spec(grazing.models.soft_impact_oscillator(), "omega", sc.values([0.9, 1.2, 1.5]),
+                   settings=sc.settings(MODES, fresh=True, lyapunov=False, chunk_size=0))
+    ),
+    "lyapunov soft impact chained": lambda sc: every_chunk(
+        sweep_spec(grazing.models.soft_impact_oscillator(), "omega", sc.values([0.9, 1.2, 1.5]),
+                   settings=sc.settings(MODES, lyapunov=True, chunk_size=0))
+    ),
+    # accumulating impacts, then impacts on both corners at periods 1 and 0
+    "rocking block": lambda sc: every_chunk(
+        sweep_spec(grazing.models.rocking_block(), "a", sc.values([0.21, 0.22, 0.29]),
+                   settings=sc.settings(MODES, fresh=True, lyapunov=False, chunk_size=0))
+    ),
+    "lyapunov rocking block chained": lambda sc: every_chunk(
+        sweep_spec(grazing.models.rocking_block(), "a", sc.values([0.22, 0.25, 0.28]),
+                   settings=sc.settings(MODES, lyapunov=True, chunk_size=0))
+    ),
+    "soft impact start modes": lambda sc: [(start_modes_spec(), 0)],  # (its own three starts, at any scale)
+    # sliding (Filippov's pseudo-mode of the friction oscillator: stick-slip), fresh and with Lyapunov
+    # exponents from the previous point's end
+    "friction sliding": lambda sc: every_chunk(
+        sweep_spec(grazing.models.friction_oscillator(), "a", sc.values([0.6, 1.1, 1.6]),
+                   settings=sc.settings(MODES, fresh=True, lyapunov=False, chunk_size=0))
+    ),
+    # sliding on a diagonal surface, where Filippov's field leaves it by its rounding unless each step's
+    # end and sample is put back on it (tests/engine/test_lanes_sliding.py's model)
+    "diagonal sliding": lambda sc: every_chunk(
+        sweep_spec(diagonal(), "c", sc.values([0.5, 1.0, 1.5]), x0=(1.0, 0.0),
+                   settings=sc.settings(MODES, fresh=True, lyapunov=False, chunk_size=0))
+    ),
+    "lyapunov friction chained": lambda sc: every_chunk(
+        sweep_spec(grazing.models.friction_oscillator(), "mu", sc.values([0.3, 0.6, 0.9]),
+                   settings=sc.settings(MODES, lyapunov=True, chunk_size=0))
+    ),
+}  # fmt: skip
+
+
+def cases(scale: Scale = SIMULATOR) -> dict[str, list[tuple[object, int]]]:
+    """Each case's chunks (:data:`BUILDERS`) at ``scale``: ``(spec, chunk index)`` pairs sharing a batch."""
+    return {name: build(scale) for name, build in BUILDERS.items()}
 
 
 def start_modes_spec() -> object:
@@ -192,6 +194,12 @@ def compare(parts: list[tuple[object, int]]) -> dict[str, object]:
         row[f"{name}_diff"] = float(np.nanmax(np.abs(a - b), initial=0.0)) if same_nans else math.inf
     row["cpu_lyapunov_values"] = np.concatenate([r.lyapunov for r in cpu]).tolist()
     return row
+
+
+def differing(cpu: Any, gpu: Any) -> list[str]:
+    """The variables of two datasets that are not equal (to the bit, NaN where NaN), or in one only."""
+    names = set(cpu.data_vars) | set(gpu.data_vars)
+    return sorted(name for name in names if not (name in cpu and name in gpu and cpu[name].equals(gpu[name])))
 
 
 def foreign_names() -> list[str]:
@@ -231,7 +239,7 @@ def api_map() -> dict[str, object]:
     kw = {"transient": 64, "periods": 16, "lyapunov": False, "workers": 1}
     cpu = parameter_map(*args, **kw, device="cpu")
     gpu = parameter_map(*args, **kw, device="gpu")
-    differ = sorted(name for name in cpu.data_vars if not cpu[name].equals(gpu[name]))
+    differ = differing(cpu, gpu)
     return {"differ": differ, "variables": sorted(cpu.data_vars), "period": cpu.period.values.tolist()}
 
 
@@ -257,7 +265,7 @@ def api_basins() -> dict[str, object]:
         gpu = basins(*args, **kw, device="gpu")
     finally:
         GpuLaneBatch.run = run  # type: ignore[method-assign]
-    differ = sorted(name for name in cpu.data_vars if not cpu[name].equals(gpu[name]))
+    differ = differing(cpu, gpu)
     return {"differ": differ, "variables": sorted(cpu.data_vars), "kinds": cpu.kind.values.tolist(),
             "lyapunov_on_gpu": launched, "lyapunov": cpu.lyapunov.values.tolist()}  # fmt: skip
 
@@ -283,7 +291,7 @@ def api_basins_modes() -> dict[str, object]:
         gpu = basins(*args, **kw, device="gpu")
     finally:
         GpuLaneBatch.run = run  # type: ignore[method-assign]
-    differ = sorted(name for name in cpu.data_vars if not cpu[name].equals(gpu[name]))
+    differ = differing(cpu, gpu)
     return {"differ": differ, "launched": launched}
 
 

@@ -3,24 +3,29 @@ its sweeps equal the CPU lanes'.
 
 On a device the compiler fuses multiply-adds, so the GPU's arithmetic is not the CPU's to the bit: the
 periods, impacts and statuses must still be equal at every point of these short sweeps, the samples of
-the periodic points within :data:`DEVICE_SAMPLE_TOL`.
+the periodic points within :data:`DEVICE_SAMPLE_TOL`.  The cases are the simulator's
+(``simulator_cases.py``'s :data:`~tests.gpu.simulator_cases.BUILDERS`), at :data:`DEVICE` scale.
 """
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pytest
 
-import grazing
 from grazing.sweeps.run import run_parts
-from grazing.sweeps.spec import map_spec, sweep_spec
+from tests.gpu.simulator_cases import BUILDERS, Scale
 
 pytestmark = pytest.mark.gpu
 
 DEVICE_SAMPLE_TOL = 1e-8
 """Largest difference of the samples of a periodic point on a device and on the CPU lanes."""
+DEVICE = Scale(points=16, transient=200, periods=40)
+"""The cases' scale on a device: 16 points over each case's range, 200 transient and 40 sampled periods."""
+DEVICE_CASES = ("pendulum A map", "impact oscillator", "pendulum C chained", "soft impact modes",
+                "rocking block", "friction sliding")  # fmt: skip
+"""The simulator's cases run on a device (mode-changing resets, switches, sliding among them)."""
+DEVICE_LYAPUNOV_CASES = ("lyapunov pendulum B", "lyapunov pendulum C chained", "lyapunov impact oscillator")
+"""The simulator's cases with Lyapunov exponents run on a device."""
 
 
 @pytest.fixture(scope="module", autouse=True)
@@ -37,50 +42,9 @@ def _both(parts: list) -> tuple[list, list]:
     return run_parts(parts), run_parts_gpu(parts)
 
 
-@pytest.mark.parametrize(
-    "parts",
-    [
-        pytest.param(
-            lambda: [(map_spec(grazing.models.pendulum("B"), "eta", np.linspace(0.44, 0.49, 16), "theta_hat",
-                               np.radians([30.0, 40.0]), settings=grazing.SweepSettings(
-                                   transient=500, periods=100, fresh=True, adaptive=False, lyapunov=False,
-                                   tol=1e-10, chunk_size=0)), i) for i in range(2)],
-            id="pendulum equal-work map",
-        ),
-        pytest.param(
-            lambda: [(sweep_spec(grazing.models.impact_oscillator(), "omega", np.linspace(2.6, 3.0, 16),
-                                 settings=grazing.SweepSettings(transient=200, periods=40, lyapunov=False,
-                                                                fresh=True)), 0)],
-            id="impact oscillator",
-        ),
-        pytest.param(
-            lambda: [(sweep_spec(grazing.models.pendulum("C", theta_hat=math.radians(30)), "eta",
-                                 np.linspace(0.40, 0.50, 12), settings=grazing.SweepSettings(
-                                     transient=200, periods=40, lyapunov=False, chunk_size=0)), 0)],
-            id="pendulum chained",
-        ),
-        pytest.param(
-            lambda: [(sweep_spec(grazing.models.soft_impact_oscillator(), "omega", np.linspace(0.9, 1.5, 12),
-                                 settings=grazing.SweepSettings(transient=200, periods=40, lyapunov=False,
-                                                                fresh=True)), 0)],
-            id="soft impact (switches)",
-        ),
-        pytest.param(
-            lambda: [(sweep_spec(grazing.models.rocking_block(), "a", np.linspace(0.22, 0.32, 12),
-                                 settings=grazing.SweepSettings(transient=200, periods=40, lyapunov=False,
-                                                                fresh=True)), 0)],
-            id="rocking block (mode-changing resets)",
-        ),
-        pytest.param(
-            lambda: [(sweep_spec(grazing.models.friction_oscillator(), "a", np.linspace(0.6, 1.6, 12),
-                                 settings=grazing.SweepSettings(transient=200, periods=40, lyapunov=False,
-                                                                fresh=True)), 0)],
-            id="friction oscillator (sliding)",
-        ),
-    ],
-)  # fmt: skip
-def test_the_device_equals_the_cpu_lanes(parts) -> None:
-    cpu, gpu = _both(parts())
+@pytest.mark.parametrize("case", DEVICE_CASES)
+def test_the_device_equals_the_cpu_lanes(case: str) -> None:
+    cpu, gpu = _both(BUILDERS[case](DEVICE))
     for c, g in zip(cpu, gpu):
         assert g.period.tolist() == c.period.tolist()
         assert g.impacts_by_stop.tolist() == c.impacts_by_stop.tolist()
@@ -95,31 +59,9 @@ DEVICE_LYAPUNOV_TOL = 1e-6
 exponent of a stable orbit is an average over the sampled periods, insensitive to the last bits)."""
 
 
-@pytest.mark.parametrize(
-    "parts",
-    [
-        pytest.param(
-            lambda: [(sweep_spec(grazing.models.pendulum("B", theta_hat=math.radians(40)), "eta",
-                                 np.linspace(0.44, 0.46, 16), settings=grazing.SweepSettings(
-                                     transient=200, periods=40, lyapunov=True, fresh=True)), 0)],
-            id="pendulum B",
-        ),
-        pytest.param(
-            lambda: [(sweep_spec(grazing.models.pendulum("C", theta_hat=math.radians(30)), "eta",
-                                 np.linspace(0.40, 0.50, 12), settings=grazing.SweepSettings(
-                                     transient=200, periods=40, lyapunov=True, chunk_size=0)), 0)],
-            id="pendulum C chained",
-        ),
-        pytest.param(
-            lambda: [(sweep_spec(grazing.models.impact_oscillator(), "omega", np.linspace(2.6, 3.0, 16),
-                                 settings=grazing.SweepSettings(transient=200, periods=40, lyapunov=True,
-                                                                fresh=True)), 0)],
-            id="impact oscillator",
-        ),
-    ],
-)  # fmt: skip
-def test_the_devices_lyapunov_exponents_equal_the_cpu_lanes(parts) -> None:
-    cpu, gpu = _both(parts())
+@pytest.mark.parametrize("case", DEVICE_LYAPUNOV_CASES)
+def test_the_devices_lyapunov_exponents_equal_the_cpu_lanes(case: str) -> None:
+    cpu, gpu = _both(BUILDERS[case](DEVICE))
     for c, g in zip(cpu, gpu):
         assert g.period.tolist() == c.period.tolist()
         assert g.status.tolist() == c.status.tolist()
@@ -127,3 +69,18 @@ def test_the_devices_lyapunov_exponents_equal_the_cpu_lanes(parts) -> None:
         assert np.isfinite(g.lyapunov[periodic]).all()
         diff = np.nanmax(np.abs(g.lyapunov[periodic] - c.lyapunov[periodic]), initial=0.0)
         assert diff <= DEVICE_LYAPUNOV_TOL
+
+
+def test_a_chain_of_several_chunks_on_the_device_is_the_cpus() -> None:
+    """``run_sweep(device="gpu")`` on a carried sweep of two points a chunk, settled into its chain
+    (``cases_chains.py``'s case C up, through periods 1, 3, 2): the CPU's periods and statuses, its samples
+    at every point within :data:`DEVICE_SAMPLE_TOL`."""
+    from grazing.sweeps.api import run_sweep
+    from tests.gpu.cases_chains import case_c
+
+    spec = case_c()
+    cpu = run_sweep(spec, workers=1, device="cpu")
+    gpu = run_sweep(spec, device="gpu")
+    assert gpu.period.values.tolist() == cpu.period.values.tolist()
+    assert gpu.status.values.tolist() == cpu.status.values.tolist()
+    assert np.nanmax(np.abs(gpu.samples.values - cpu.samples.values), initial=0.0) <= DEVICE_SAMPLE_TOL

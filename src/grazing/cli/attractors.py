@@ -140,8 +140,8 @@ def _grid_options(num_name: str) -> Callable[[Callable[..., Any]], Callable[...,
                 default=DEFAULT_DEVICE,
                 show_default=True,
                 help="Where the runs go: the CPU lanes, an NVIDIA GPU (one CUDA thread per initial state, "
-                "the runs with Lyapunov exponents too; models with modes stay on the CPU), or the GPU when "
-                "one is present and the grid is large (auto).",
+                "the runs with Lyapunov exponents and models with modes too), or the GPU when one is present "
+                "and the grid is large (auto).",
             ),
             click.option(
                 "--plot",

@@ -66,8 +66,9 @@ def _sweep_options(func: Callable[..., Any]) -> Callable[..., Any]:
                           "(default: wait; a message after 5 s)."),
         click.option("--device", type=click.Choice(DEVICES), default=DEFAULT_DEVICE, show_default=True,
                      help="Where the points run: the CPU lanes, an NVIDIA GPU (one CUDA thread per point, "
-                     "Lyapunov exponents, models with modes and the discontinuity map included), or the "
-                     "GPU when one is present and the sweep is large (auto)."),
+                     "Lyapunov exponents, models with modes, chains of several chunks and the "
+                     "discontinuity map included), or the GPU when one is present and the sweep is large "
+                     "(auto)."),
         click.option("--no-lyapunov", is_flag=True, help="Skip the Lyapunov exponents."),
         click.option("--no-adaptive", is_flag=True, help="Always run the full transient."),
         click.option("--tol", type=TOLERANCE, default=SWEEP_DEFAULTS.tol, show_default=True,

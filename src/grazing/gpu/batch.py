@@ -9,6 +9,10 @@ that reaches what the kernel does not do (complete chattering continued as
 sticking: :data:`~grazing.gpu.kernel.NEEDS_CPU`) is finished on the CPU lanes
 from that point on, from the state the GPU had reached there.
 
+A carried sweep whose chains have several chunks is settled into its chains
+(:func:`grazing.sweeps.chain.settle`) as on the CPU, its rounds' chunks,
+checks, shifts and runs computed by :func:`gpu_parts`.
+
 Lyapunov exponents are the kernel's too (its variational build), and so is
 the discontinuity map (its build with the map, from the settings the CPU
 lanes get: :meth:`~grazing.sweeps.run.LaneBatch.settings`).  What the GPU does
@@ -21,6 +25,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Iterator, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -29,14 +34,16 @@ from grazing.core.solution import Status
 from grazing.engine.records import LaneJobs
 from grazing.errors import InvalidParameterError
 from grazing.gpu.device import gpu_refusal
-from grazing.sweeps.run import LaneBatch
+from grazing.sweeps.run import LaneBatch, batch_key
 from grazing.sweeps.spec import ChunkResult, SweepSpec
 from grazing.sweeps.status import NOT_COMPUTED
 
+Part = tuple[SweepSpec, int]
+"""A chunk of a sweep: the spec and the chunk's index."""
 THREADS_PER_BLOCK = 128
 """CUDA threads per block of the sweep kernel."""
 BATCH_POINTS = 1 << 20
-"""Most points of one launch of :func:`gpu_results` (their samples: 1.6 GB at 100 periods of 2 states)."""
+"""Most points of one launch of :func:`gpu_parts` (their samples: 1.6 GB at 100 periods of 2 states)."""
 MAX_THREADS = 1 << 17
 """Most threads of one launch: each takes jobs until none is left, with a root-search work array of its
 own (33 kB: 4.4 GB for this many)."""
@@ -152,17 +159,63 @@ def gpu_results(
 ) -> Iterator[ChunkResult]:
     """The results of the chunks ``indices`` of ``spec`` computed on the GPU, in that order, a batch of
     at most ``max_points`` points at a time (at least one chunk)."""
-    group: list[int] = []
-    size = 0
-    for i in indices:
-        chunk = spec.chunk(i)
-        group.append(i)
-        size += chunk.stop - chunk.start
-        if size >= max_points:
-            yield from run_chunks_gpu(spec, group)
-            group, size = [], 0
-    if group:
-        yield from run_chunks_gpu(spec, group)
+    for _, res in gpu_parts([(spec, i) for i in indices], max_points):
+        yield res
+
+
+def gpu_parts(parts: Sequence[Part], max_points: int = BATCH_POINTS) -> Iterator[tuple[Part, ChunkResult]]:
+    """Each of ``parts`` (the caller's own tuples) with its result computed on the GPU: the parts that share
+    a :func:`~grazing.sweeps.run.batch_key` in their order, a launch of at most ``max_points`` points at a
+    time (at least one part).  What :func:`grazing.sweeps.chain.settle` computes a carried sweep's rounds
+    with on the GPU, as :func:`grazing.sweeps.executor.local_results` does on the cores.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace
+    >>> list(gpu_parts([(SimpleNamespace(zdm=object()), 0)]))  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    grazing.errors.InvalidParameterError: the discontinuity map is not on the GPU yet: ...
+    """
+    for part in parts:  # (refused before anything runs)
+        why = gpu_refusal(part[0])
+        if why is not None:
+            raise InvalidParameterError(why)
+    groups: dict[tuple[Any, ...], list[Part]] = {}
+    for part in parts:
+        groups.setdefault(batch_key(part[0]), []).append(part)
+    for group in groups.values():
+        batch: list[Part] = []
+        size = 0
+        for part in group:
+            chunk = part[0].chunk(part[1])
+            batch.append(part)
+            size += chunk.stop - chunk.start
+            if size >= max_points:
+                yield from zip(batch, run_parts_gpu(batch))
+                batch, size = [], 0
+        if batch:
+            yield from zip(batch, run_parts_gpu(batch))
+
+
+def gpu_chain_window(spec: SweepSpec, memory: bool) -> int:
+    """Most chunks of the carried sweep ``spec`` held at a time while they are settled on the GPU
+    (:func:`grazing.sweeps.chain.settle`; its results do not depend on it): all of them when the results are
+    kept in memory anyway, else a launch's worth (:data:`BATCH_POINTS` points).
+
+    Examples
+    --------
+    >>> import grazing
+    >>> from grazing.sweeps.spec import sweep_spec
+    >>> spec = sweep_spec(grazing.models.pendulum("B"), "eta", [0.44, 0.45, 0.46])
+    >>> gpu_chain_window(spec, memory=False) == BATCH_POINTS // spec.size
+    True
+    >>> gpu_chain_window(spec, memory=True) > 10**9
+    True
+    """
+    if memory:
+        return 1 << 62
+    return max(1, BATCH_POINTS // spec.size)
 
 
 def run_chunks_gpu(spec: SweepSpec, indices: Sequence[int], threads: int | None = None) -> list[ChunkResult]:

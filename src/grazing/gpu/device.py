@@ -28,16 +28,6 @@ def gpu_refusal(spec: Any) -> str | None:
     return None
 
 
-def chain_refusal(spec: Any) -> str | None:
-    """Why ``spec``'s chunks cannot run on the GPU (chains of several chunks, one line), or None."""
-    if spec.carried and spec.n_chunks > spec.segments:
-        return (
-            "a chain of several chunks runs one chunk after the other: on the GPU start every point afresh "
-            "(fresh=True) or make each chain one chunk (chunk_size=: 0), or run on the CPU (device=)"
-        )
-    return None
-
-
 def check_device(device: str, client: Any = None) -> None:
     """One line (:class:`~grazing.errors.InvalidParameterError`, or
     :class:`~grazing.gpu.target.NoDeviceError`) unless ``device`` can be used at all."""
@@ -54,11 +44,11 @@ def check_device(device: str, client: Any = None) -> None:
 def spec_device(device: str, spec: Any, client: Any = None) -> str:
     """``"cpu"`` or ``"gpu"``: where one of several sweeps of a computation runs (``device`` checked by
     :func:`check_device`): the GPU for ``"gpu"``, or ``"auto"`` with a device present and a large sweep,
-    unless it has what the GPU does not do yet (:func:`gpu_refusal`, :func:`chain_refusal`: then the CPU).
+    unless it has what the GPU does not do yet (:func:`gpu_refusal`: then the CPU).
     """
     from grazing.gpu.target import device_present
 
-    if device == "cpu" or client is not None or (gpu_refusal(spec) or chain_refusal(spec)) is not None:
+    if device == "cpu" or client is not None or gpu_refusal(spec) is not None:
         return "cpu"
     if device == "gpu":
         return "gpu"
@@ -81,7 +71,7 @@ def resolve_device(device: str, spec: Any, client: Any = None) -> str:
     grazing.errors.InvalidParameterError: device must be 'cpu', 'gpu' or 'auto', got 'tpu'
     """
     if device == "gpu" and client is None:
-        why = gpu_refusal(spec) or chain_refusal(spec)
+        why = gpu_refusal(spec)
         if why is not None:
             raise InvalidParameterError(why)
     check_device(device, client)

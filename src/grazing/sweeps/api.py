@@ -72,9 +72,10 @@ def run_sweep(
         results in memory (they are in ``store``: a huge sweep streams to it).
     device
         ``"cpu"`` (the default): the CPU lanes; ``"gpu"``: an NVIDIA GPU, one
-        CUDA thread per point (:mod:`grazing.gpu`, Lyapunov exponents
-        included; not yet the discontinuity map, models with modes or chains
-        of several chunks; sticking is finished on the CPU); ``"auto"``: the GPU
+        CUDA thread per point (:mod:`grazing.gpu`, Lyapunov exponents, models
+        with modes and chains of several chunks included, the latter settled
+        as on the CPU: :mod:`grazing.sweeps.chain`; not yet the discontinuity
+        map; sticking is finished on the CPU); ``"auto"``: the GPU
         when one is present and the sweep is large (:mod:`grazing.gpu.device`).
 
     Returns
@@ -125,15 +126,7 @@ def run_sweep(
         progress(done_points, spec.n_points)
     # (what the dataset needs besides the results, done while the cores compute: MemoryStore.prepare)
     prepare = sink.prepare if load and isinstance(sink, MemoryStore) else None
-    if where == "gpu":  # (chunks of whole chains or single points: resolve_device refused the rest)
-        from grazing.gpu.batch import gpu_results
-
-        for res in then(gpu_results(spec, todo), prepare):
-            sink.write(res)
-            done_points += res.period.size
-            if progress is not None:
-                progress(done_points, spec.n_points)
-        return sink.dataset() if load else None
+    memory = isinstance(sink, MemoryStore) and client is None
     if is_chained(spec):  # (the chunks of a chain: settled into the one chain's results)
         counted = [done_points]
 
@@ -143,9 +136,22 @@ def run_sweep(
             if progress is not None:
                 progress(counted[0], spec.n_points)
 
-        window = chain_window(workers, memory=isinstance(sink, MemoryStore) and client is None)
-        compute = compute_parts(workers, client, timeout, notice)
+        if where == "gpu":
+            from grazing.gpu.batch import gpu_chain_window, gpu_parts
+
+            compute, window = gpu_parts, gpu_chain_window(spec, memory)
+        else:
+            compute, window = compute_parts(workers, client, timeout, notice), chain_window(workers, memory)
         settle([ChainLine(spec, sink, todo)], lambda parts: then(compute(parts), prepare), write, window)
+        return sink.dataset() if load else None
+    if where == "gpu":  # (chunks of whole chains or single points)
+        from grazing.gpu.batch import gpu_results
+
+        for res in then(gpu_results(spec, todo), prepare):
+            sink.write(res)
+            done_points += res.period.size
+            if progress is not None:
+                progress(done_points, spec.n_points)
         return sink.dataset() if load else None
     results = chunk_results(spec, todo, workers, client, timeout, notice)
     try:
