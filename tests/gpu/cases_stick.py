@@ -16,7 +16,10 @@ import json
 import os
 import sys
 
+import sympy as sp
+
 import grazing
+from grazing import HybridModel, Parameter, Stop
 from grazing.sweeps.spec import sweep_spec
 from tests.engine.test_sticking_modes import stick_lift, stick_spring, stick_spring_floor_second
 from tests.gpu.simulator_cases import compare
@@ -39,6 +42,8 @@ def cases() -> dict[str, tuple[object, dict[str, object]]]:
         # the impact oscillator's mass chatters onto its stop at rest and is pulled off by the forcing
         "impact oscillator": (oscillator, "omega", [0.5, 0.7], (-1.0, 0.0), fresh),
         "lyapunov impact oscillator": (oscillator, "omega", [0.5, 0.7], (-1.0, 0.0), lyap),
+        # the table as stop 1 (its force in row 1)
+        "ball under a ceiling": (ball_under_a_ceiling(), "amplitude", [1.05, 1.3], (0.0, 0.5), fresh),
         # models with modes: sticks, released by the forcing, enters the spring; the floor as transition 1;
         # the lift's time switch firing while the mass sticks
         "stick spring chained": (stick_spring(), "a", [1.6, 2.0, 2.4], (0.3, 0.0), chained),
@@ -50,6 +55,26 @@ def cases() -> dict[str, tuple[object, dict[str, object]]]:
         name: (sweep_spec(model, param, values, x0=x0, settings=settings), {"x0": x0, "param": param})
         for name, (model, param, values, x0, settings) in table.items()
     }
+
+
+def ball_under_a_ceiling() -> HybridModel:
+    """The bouncing ball (restitution 0.3) with a ceiling far above it as stop 0: the table is stop 1, its
+    contact force row 1 of the sticking kernel."""
+    y, v, t = sp.symbols("y v t")
+    amplitude, omega, gravity, r = sp.symbols("amplitude omega gravity r")
+    table = amplitude * sp.sin(omega * t)
+    stops = [
+        Stop("ceiling", 100 - y, [y, -v]),
+        Stop("table", y - table, [y, (1 + r) * sp.diff(table, t) - r * v], contact_direction=[0, 1]),
+    ]
+    params = [
+        Parameter("amplitude", 1.2),
+        Parameter("omega", 1.0),
+        Parameter("gravity", 1.0),
+        Parameter("r", 0.3),
+    ]
+    return HybridModel("ball-ceiling", [y, v], t, params, vector_field=[v, -gravity], stops=stops,
+                       period=2 * sp.pi / omega)  # fmt: skip
 
 
 def scalar_sticking(spec: object, x0: tuple[float, float], param: str) -> list[int]:
