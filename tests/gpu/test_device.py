@@ -77,6 +77,18 @@ def _both(parts: list) -> tuple[list, list]:
                                                                 fresh=True)), 0)],
             id="friction oscillator (sliding)",
         ),
+        pytest.param(
+            lambda: [(sweep_spec(grazing.models.bouncing_ball(), "amplitude", np.linspace(1.05, 1.3, 12),
+                                 x0=(0.0, 0.5), settings=grazing.SweepSettings(
+                                     transient=200, periods=40, lyapunov=False, fresh=True)), 0)],
+            id="bouncing ball (chattering and sticking)",
+        ),
+        pytest.param(
+            lambda: [(sweep_spec(grazing.models.impact_oscillator(sigma=0.0, r=0.5), "omega",
+                                 np.linspace(0.5, 0.7, 8), x0=(-1.0, 0.0), settings=grazing.SweepSettings(
+                                     transient=200, periods=40, lyapunov=False, fresh=True)), 0)],
+            id="impact oscillator (sticking)",
+        ),
     ],
 )  # fmt: skip
 def test_the_device_equals_the_cpu_lanes(parts) -> None:
