@@ -22,8 +22,8 @@ DEVICE_SAMPLE_TOL = 1e-8
 DEVICE = Scale(points=16, transient=200, periods=40)
 """The cases' scale on a device: 16 points over each case's range, 200 transient and 40 sampled periods."""
 DEVICE_CASES = ("pendulum A map", "impact oscillator", "pendulum C chained", "soft impact modes",
-                "rocking block", "friction sliding")  # fmt: skip
-"""The simulator's cases run on a device (mode-changing resets, switches, sliding among them)."""
+                "rocking block", "friction sliding", "bouncing ball")  # fmt: skip
+"""The simulator's cases run on a device (mode-changing resets, switches, sliding, sticking among them)."""
 DEVICE_LYAPUNOV_CASES = ("lyapunov pendulum B", "lyapunov pendulum C chained", "lyapunov impact oscillator")
 """The simulator's cases with Lyapunov exponents run on a device."""
 

@@ -4,10 +4,8 @@
 table of points, jobs and result arrays, the same :meth:`results`: period
 detection, polishing and the :class:`~grazing.sweeps.spec.ChunkResult` records
 are the CPU's, not a copy) whose :meth:`run` launches
-:func:`grazing.gpu.kernel.build_kernel`'s kernel, one thread per job.  A job
-that reaches what the kernel does not do (complete chattering continued as
-sticking: :data:`~grazing.gpu.kernel.NEEDS_CPU`) is finished on the CPU lanes
-from that point on, from the state the GPU had reached there.
+:func:`grazing.gpu.kernel.build_kernel`'s kernel, one thread per job: every
+point is the kernel's (chattering and sticking among them).
 
 A carried sweep whose chains have several chunks is settled into its chains
 (:func:`grazing.sweeps.chain.settle`) as on the CPU, its rounds' chunks,
@@ -30,13 +28,10 @@ from typing import Any
 import numpy as np
 
 from grazing.core.options import LYAPUNOV_ALIGN
-from grazing.core.solution import Status
-from grazing.engine.records import LaneJobs
 from grazing.errors import InvalidParameterError
 from grazing.gpu.device import gpu_refusal
 from grazing.sweeps.run import LaneBatch, batch_key
 from grazing.sweeps.spec import ChunkResult, SweepSpec
-from grazing.sweeps.status import NOT_COMPUTED
 
 Part = tuple[SweepSpec, int]
 """A chunk of a sweep: the spec and the chunk's index."""
@@ -65,11 +60,9 @@ class GpuLaneBatch(LaneBatch):
         require_target()
         super().__init__(parts)
         self.max_threads = MAX_THREADS if threads is None else max(1, int(threads))
-        self.cpu_points = 0
-        """Points the CPU lanes computed (from the first one that sticks to the end of its job)."""
 
     def run(self) -> None:
-        """Compute the batch's points on the GPU (the rest of a job that sticks on the CPU lanes)."""
+        """Compute the batch's points on the GPU."""
         from grazing.engine.runner import step_safety
         from grazing.engine.stepping import step_factor
         from grazing.gpu.kernel import ROOT_WORK, keep_rows, sweep_kernel
@@ -107,39 +100,6 @@ class GpuLaneBatch(LaneBatch):
         cuda.synchronize()
         for host, dev in zip(outputs, d_out):
             dev.copy_to_host(host)
-        self._finish_on_cpu()
-
-    def _finish_on_cpu(self) -> None:
-        """The jobs the kernel left at a point that sticks: from that point on, on the CPU lanes."""
-        from grazing.gpu.kernel import NEEDS_CPU
-
-        stuck = np.flatnonzero(self.status == NEEDS_CPU)
-        if stuck.size == 0:
-            return
-        n = self.x0.shape[1]
-        job_of = np.searchsorted(self.jobs[:, 0], stuck, side="right") - 1
-        jobs = np.empty((stuck.size, 2), dtype=np.int64)
-        firsts = np.empty((stuck.size, 1 + n))
-        first_vf = np.zeros(stuck.size, dtype=np.int64)
-        for row, (p, job) in enumerate(zip(stuck, job_of)):
-            jobs[row] = (p, self.jobs[job, 1])
-            if p == self.jobs[job, 0]:
-                firsts[row] = self.firsts[job]
-                first_vf[row] = self.first_vf[job]
-            elif self.fresh or self.status[p - 1] != Status.OK:
-                firsts[row] = (0.0, *self.x0[job])
-                first_vf[row] = self.x0_vf[job]
-            else:  # (carried from the previous point's end, as the lanes carry it)
-                t0 = self.tcarry[p] if self._spec0.model.periodic else self.t_final[p - 1]
-                firsts[row] = (t0, *self.x_final[p - 1])
-                first_vf[row] = self.vf_final[p - 1]
-        self.status[stuck] = NOT_COMPUTED
-        self.cpu_points = int(sum(int(b - a) for a, b in jobs))
-        work = LaneJobs(
-            jobs, np.zeros(3, dtype=np.int64), np.ascontiguousarray(self.x0[job_of]), firsts, first_vf,
-            np.ascontiguousarray(self.x0_vf[job_of]),
-        )  # fmt: skip
-        self.run_jobs(work)
 
 
 def run_parts_gpu(parts: Sequence[tuple[SweepSpec, int]], threads: int | None = None) -> list[ChunkResult]:

@@ -15,15 +15,20 @@ root is the first), samples from the step's polynomials, the state advanced
 to the accepted part, and at an event the stop's reset.  The helpers are the
 CPU's own code as device functions (:mod:`grazing.gpu.ported`).
 
-Not on the GPU yet: sticking (a chattering sequence that the CPU would sum
-and continue as sticking ends the thread's job with :data:`NEEDS_CPU` at that
-point; :mod:`grazing.gpu.batch` computes the rest of the job on the CPU
-lanes).  The discontinuity map (a kernel of its own, :func:`build_kernel`'s
-``zdm_stop``): as the lanes', the stop it stands for is not searched for
-events, each step is cut at the map's phase too (``step.cut_step``), and
-there the map kicks the state (``tangent.map_kick``) and, with Lyapunov
-exponents, the tangent vectors (``tangent.kick_tangent``), a kick counted as
-an impact on that stop while the point records.  A model with
+Complete chattering is summed to its accumulation point and continued as
+sticking, as the CPU does (:func:`~grazing.engine.driver.impacts.at_event`):
+steps of the stop's sticking kernel (its generated ``tc_stick``, the contact
+force in the stop's event row), each step's end and sample put back on the
+contact manifold (``impacts.enter_contact``), until the contact force changes
+sign (the release) or another transition fires; no variational equations
+while sticking (the Jacobian is marked invalid: a point that sticks in its
+recorded span has no Lyapunov exponent).  The discontinuity map (a kernel of
+its own, :func:`build_kernel`'s ``zdm_stop``): as the lanes', the stop it
+stands for is not searched for events, each step is cut at the map's phase
+too (``step.cut_step``), and there the map kicks the state
+(``tangent.map_kick``) and, with Lyapunov exponents, the tangent vectors
+(``tangent.kick_tangent``), a kick counted as an impact on that stop while the
+point records.  A model with
 modes: each thread carries its point's mode (its kernels, its event rows:
 the transitions out of it); a switch without a reset changes the mode
 (``impacts.switch_mode``), a reset may too (``impacts.change_mode``), each
@@ -58,13 +63,11 @@ from grazing.engine.driver.step import STEP_LAST, STEP_MAP
 from grazing.engine.polyroots import work_shape
 from grazing.engine.stepping import GUARD_SCALE
 
-NEEDS_CPU = -2
-"""A point's status when it needs what the kernel does not do (sticking): the CPU lanes compute it."""
-
 # The run state of a thread: integer fields of ``st``, float fields of ``sf`` (lanes' RUN_STATE names).
 K, KS, ISAMP, N_SAMPLES, N_KEEP, RECORDING, STEPS, MAX_STEPS, ZERO_EVENTS, DEFL, DEFL_STOP = range(11)
 STAGE, BLOCK, USED, REQ_KS, USE_VAR, LYAP_STARTED, JAC_VALID, VF, SURFACE = 11, 12, 13, 14, 15, 16, 17, 18, 19
-INT_FIELDS = 20
+STICKING, STUCK = 20, 21  # (the lanes' mode 1 and stuck: sticking to stop STUCK)
+INT_FIELDS = 22
 S, SS, REQ_SS, SPAN_DT, LYAP_T0 = range(5)
 FLOAT_FIELDS = 5
 KZ = INT_FIELDS  # the period of the discontinuity map's next kick (the lanes' ``kz``) ...
@@ -172,8 +175,13 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
     cut_step = helpers["cut_step"]
     map_kick = helpers["map_kick"]
     kick_tangent = helpers["kick_tangent"]
+    chatter_time_left = helpers["chatter_time_left"]
+    along_contact_dir = helpers["along_contact_dir"]
     tc_free = dm.functions["mode_tc_free"]
     tc_var = dm.functions["mode_tc_var"]
+    tc_stick = dm.functions["tc_stick"]  # (by the stop's index)
+    contact_dir = dm.functions["contact_dir"]
+    normal_rate_grad = dm.functions["normal_rate_grad"]
     reset = dm.functions["reset"]
     guard = dm.functions["guard"]
     guard_grad = dm.functions["guard_grad"]
@@ -203,17 +211,19 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
     float64, int64 = types.float64, types.int64
 
     @dj
-    def first_event(O, h, vf, defl, defl_stop, a, work):
+    def first_event(O, h, vf, defl, defl_stop, sticking, stuck, a, work):
         """The first event on the step over mode ``vf``'s transitions: ``(u, stop)``, ``u < 0`` none
-        (``events.first_event`` in free flight, nothing skipped)."""
+        (``events.first_event`` with every event watched, nothing skipped; ``sticking`` to stop ``stuck``:
+        its row is the contact force)."""
         u = -1.0
         stop = 0
         for row in range(NEV):
             r = ROWS[vf, row]  # the row's stop (transition); -1: padding
             if r < 0 or r == ZSTOP:  # (the discontinuity map's stop: not searched)
                 continue
+            force = sticking and r == stuck
             defl_r = defl if r == defl_stop else 0
-            deg, tail = event_polynomial(O, row, h, 0, defl_r, False, a, ORDER)
+            deg, tail = event_polynomial(O, row, h, 1 if force else 0, defl_r, False, a, ORDER)
             ur = event_certificate(a, tail)
             if ur > 0.0:
                 ur = confirm_first_root(a, deg, isolate_first_root(a, deg, work), work)
@@ -246,6 +256,30 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
                 x[i] -= hval * gx[i] / nn
 
     @dj
+    def contact_row(vf, j):
+        """The event row of stop ``j`` in mode ``vf``'s kernels (``events.contact_row``)."""
+        for row in range(NEV):
+            if ROWS[vf, row] == j:
+                return row
+        return 0
+
+    @dj
+    def enter_contact(x, s, pv, j, gx, e):
+        """``x`` onto stop ``j``'s contact manifold ``{h = 0, L_f h = 0}`` (``impacts.enter_contact``;
+        ``gx``, ``e`` buffers)."""
+        onto_guard(x, s, pv, j, gx)
+        for i in range(NX):
+            e[i] = 0.0
+        contact_dir(x, s, pv, e, j)
+        for i in range(NX):
+            gx[i] = 0.0
+        for _ in range(3):
+            vn = normal_rate(x, s, pv, j)
+            normal_rate_grad(x, s, pv, gx, j)
+            if not along_contact_dir(x, e, gx, vn, NX):
+                break
+
+    @dj
     def outside_mode(x, s, pv, vf, known):
         """Whether ``x``, which has just entered mode ``vf``, is outside its region (``impacts.check_region``:
         a guard of the mode's own transitions other than ``known`` below ``-ON_STOP_TOL * max(1, |x|)``)."""
@@ -259,22 +293,6 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
             if guard(x, s, pv, k) < -ON_STOP_TOL * scale:
                 return True
         return False
-
-    @dj
-    def chatter_remaining(x, s, pv, j, speed, chatter_time):
-        """The time to the accumulation point of chattering on stop ``j``, or -1 (``impacts``')."""
-        w = normal_rate(x, s, pv, j)
-        acc = normal_accel(x, s, pv, j)
-        if not acc < 0.0:
-            return -1.0
-        if speed <= 0.0 or w <= 0.0:
-            return 0.0
-        ratio = w / speed
-        if ratio < 1.0:
-            dt_acc = 2.0 * w / (-acc * (1.0 - ratio))
-            if dt_acc < chatter_time:
-                return dt_acc
-        return -1.0
 
     @dj
     def begin_request(st, sf, periods, keep_n, use_var, T):
@@ -299,9 +317,9 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
             st[KZ] = map_period(st[K], sf[S], sf[ZDM_S], T)
 
     @dj
-    def take_samples(st, sf, X, T, h_acc, event, is_last, buf, xe, wrap, pv, gx):
-        """The samples within ``(0, h_acc]`` of the step (``recording.take_samples`` without sticking:
-        while sliding put on the surface)."""
+    def take_samples(st, sf, X, T, h_acc, event, is_last, buf, xe, wrap, pv, gx, ge):
+        """The samples within ``(0, h_acc]`` of the step (``recording.take_samples``: while sticking put on
+        the contact manifold, while sliding on the surface; ``gx``, ``ge`` buffers)."""
         n_samples = st[N_SAMPLES]
         keep_from = n_samples - st[N_KEEP]
         while st[ISAMP] < n_samples:
@@ -312,11 +330,14 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
                 dt = h_acc
             if st[ISAMP] >= keep_from:
                 eval_rows(X, NX, ORDER, dt, xe)
-                if st[SURFACE] > 0:
+                if st[STICKING] != 0 or st[SURFACE] > 0:
                     s = sf[S] + dt
                     if wrap and s >= T:
                         s -= T
-                    onto_guard(xe, s, pv, st[SURFACE] - 1, gx)
+                    if st[STICKING] != 0:
+                        enter_contact(xe, s, pv, st[STUCK], gx, ge)
+                    else:
+                        onto_guard(xe, s, pv, st[SURFACE] - 1, gx)
                 for i in range(NX):
                     buf[st[ISAMP] - keep_from, i] = xe[i]
             st[ISAMP] += 1
@@ -354,10 +375,10 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
     def run_request(st, sf, x, pv, T, wrap, final, fset, X, O, a, xe, xp, buf, counts, work, tw, zset):
         """Steps until the request's last sample; returns the point's status (OK: go on).
 
-        ``tw`` = ``(V, logs, scratch, before, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn, gx)``: the tangent
-        arrays and the guard's gradient; ``zset`` the discontinuity map's settings.
+        ``tw`` = ``(V, logs, scratch, before, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn, gx, ge)``: the tangent
+        arrays, the guard's gradient and the contact direction; ``zset`` the discontinuity map's settings.
         """
-        V, logs, scratch, before, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn, gx = tw
+        V, logs, scratch, before, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn, gx, ge = tw
         factor = fset[FACTOR]
         chatter_time = fset[CHATTER_TOL] * T
         while st[ISAMP] < st[N_SAMPLES]:
@@ -371,7 +392,12 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
             if LYAP:
                 var = st[USE_VAR] != 0
             vf = st[VF]
-            if LYAP and var:
+            sticking = st[STICKING] != 0
+            free_var = var and not sticking  # (sticking has no variational equations: lanes' kinds)
+            if sticking:  # the sticking field, the contact force in the stop's row (lanes.plan_steps)
+                tc_stick(x, s, pv, X, O, st[STUCK])
+                h = step_size(X, NX, O, NEV, contact_row(vf, st[STUCK]), math.inf, ORDER, T, factor)
+            elif LYAP and var:
                 tc_var(x, s, pv, X, O, vf)
                 h = step_size(X, NT, O, NEV, 0, GUARD_SCALE, ORDER, T, factor)
             else:
@@ -381,7 +407,7 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
             rem_z = (st[KZ] - st[K]) * T + (sf[ZDM_S] - s) if ZDM else 0.0
             h, ends = cut_step(h, rem, st[ISAMP] == st[N_SAMPLES] - 1, ZDM, rem_z)
             last = (ends & STEP_LAST) != 0
-            u, ev_stop = first_event(O, h, vf, st[DEFL], st[DEFL_STOP], a, work)
+            u, ev_stop = first_event(O, h, vf, st[DEFL], st[DEFL_STOP], sticking, st[STUCK], a, work)
             event = u >= 0.0 and h > 0.0  # (step.accept_step)
             if event and u == 0.0:
                 st[ZERO_EVENTS] += 1
@@ -393,9 +419,9 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
             if event and last and u >= 1.0:
                 event = False
             if (st[KS] - st[K]) * T + (sf[SS] - s) <= h_acc:
-                take_samples(st, sf, X, T, h_acc, event, last, buf, xe, wrap, pv, gx)
+                take_samples(st, sf, X, T, h_acc, event, last, buf, xe, wrap, pv, gx, ge)
             recording = st[RECORDING]
-            eval_rows(X, NT if var else NX, ORDER, h_acc, x)  # (the lanes' advance)
+            eval_rows(X, NT if free_var else NX, ORDER, h_acc, x)  # (the lanes' advance)
             sf[S] = s + h_acc  # (step.end_step)
             if wrap and sf[S] >= T:
                 sf[S] -= T
@@ -404,7 +430,7 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
             st[DEFL] = 0
             if st[SURFACE] > 0:  # sliding: back onto the surface, off which the integration drifts
                 onto_guard(x, sf[S], pv, st[SURFACE] - 1, gx)
-            if LYAP and var:  # the Lyapunov vectors (tangent.lyapunov_step)
+            if LYAP and free_var:  # the Lyapunov vectors (tangent.lyapunov_step)
                 started = lyapunov_step(st[LYAP_STARTED] != 0, st[RECORDING] != 0, sf[SPAN_DT], x, X, V,
                                         scratch, logs, xe, before)  # fmt: skip
                 if started != 0:
@@ -416,7 +442,15 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
                 st[KZ] += 1
                 if apply_map(x, sf[S], pv, var, zset, V, gx, hx) and recording != 0 and final:
                     counts[ZSTOP] += 1  # (a kick, counted as an impact on its stop: lanes.end_lane_step)
-            if (
+            if event and sticking and ev_stop != st[STUCK]:  # another transition fires: the contact ends
+                st[STICKING] = 0  # (impacts.at_event; a switch from the contact, off which the step drifted)
+                if RESETS[ev_stop] == 0:
+                    enter_contact(x, sf[S], pv, st[STUCK], gx, ge)
+            if event and sticking and ev_stop == st[STUCK]:  # the contact force changes sign: the release
+                st[STICKING] = 0
+                st[DEFL] = 3
+                st[DEFL_STOP] = ev_stop
+            elif (
                 event and ev_stop >= NSTOPS
             ):  # sliding ends at a tangency, to that side (impacts.leave_sliding)
                 st[VF] = TARGETS[ev_stop]
@@ -465,7 +499,7 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
                     ):
                         st[JAC_VALID] = 0  # (an impact at zero normal speed has no Jacobian)
                     pack_var(V, NX, NX, xp)
-                for i in range(NT if var else NX):
+                for i in range(NT if free_var else NX):
                     x[i] = xp[i]
                 st[DEFL] = 1
                 st[DEFL_STOP] = ev_stop
@@ -479,8 +513,21 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
                     st[DEFL_STOP] = BACK[ev_stop]
                     if outside_mode(x, s, pv, target, -1):
                         return STATUS_OUTSIDE_MODE
-                if STICKS[ev_stop] != 0 and chatter_remaining(x, s, pv, ev_stop, -vn, chatter_time) >= 0.0:
-                    return NEEDS_CPU  # (complete chattering, then sticking: not on the GPU yet)
+                if STICKS[ev_stop] != 0:  # complete chattering: to its accumulation point, then sticking
+                    w_out = normal_rate(x, s, pv, ev_stop)
+                    dt_acc = chatter_time_left(w_out, normal_accel(x, s, pv, ev_stop), -vn, chatter_time)
+                    if dt_acc >= 0.0:  # (impacts.at_event)
+                        sf[S] += dt_acc
+                        if wrap and sf[S] >= T:
+                            sf[S] -= T
+                            st[K] += 1
+                        enter_contact(x, sf[S], pv, ev_stop, gx, ge)
+                        st[STICKING] = 1
+                        st[STUCK] = ev_stop
+                        st[DEFL] = 0
+                        st[JAC_VALID] = 0  # (the Jacobian is not valid after sticking)
+            elif sticking:  # no event: back onto the stop, off which the integration drifts (step.end_step)
+                enter_contact(x, sf[S], pv, st[STUCK], gx, ge)
         return STATUS_OK
 
     @dj
@@ -512,6 +559,8 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
         for j in range(NSTOPS):
             counts[j] = 0
         st[USED] = 0
+        st[STICKING] = 0  # (a point starts in free flight: lanes.take_point)
+        st[STUCK] = 0
         if budget > 0:
             blk = min(ADAPTIVE_BLOCK, budget)
             st[BLOCK] = blk
@@ -587,6 +636,7 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
             cuda.local.array(NV, float64),  # hv
             cuda.local.array((NV, NV), float64),  # Vn
             cuda.local.array(NX, float64),  # gx (the guard's gradient, sliding)
+            cuda.local.array(NX, float64),  # ge (the contact direction, sticking)
         )
         buf = cuda.local.array((KEEP, NX), float64)
         counts = cuda.local.array(NSTOPS, int64)
@@ -655,8 +705,6 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
                     t_final[p] = st[K] * T + sf[S]
                     vf_final[p] = st[VF]
                 status[p] = code
-                if code == NEEDS_CPU:
-                    break  # (the rest of the job goes to the CPU)
                 ok = code == STATUS_OK
 
     return kernel

@@ -8,7 +8,9 @@ Newton polishing, the check that the root is the first), the test of a
 repeating transient, the start times, the step's cut at the last sample and at
 the discontinuity map's phase (``step.cut_step``), the map's kick and its
 tangent (``tangent.map_kick``, ``kick_tangent``), the Lyapunov vectors'
-Gram-Schmidt and (un)packing of the variational matrix, and the model code's ``sin`` and ``cos``
+Gram-Schmidt and (un)packing of the variational matrix, chattering's time to
+its accumulation point and the Newton step onto a sticking contact
+(:mod:`grazing.engine.driver.impacts`), and the model code's ``sin`` and ``cos``
 (:mod:`grazing.engine.sincos`: not the C library's) are compiled for the GPU from the
 very text the CPU driver compiles: the decorators dropped, each function
 executed in one namespace where every callee is its device copy.  A change in
@@ -44,6 +46,7 @@ PORTED: dict[str, tuple[str, ...]] = {
         "orthonormalize", "unpack_var", "pack_var",
     ),
     "grazing.engine.driver.events": ("event_polynomial", "event_certificate"),
+    "grazing.engine.driver.impacts": ("chatter_time_left", "along_contact_dir"),
     "grazing.core.period": ("repeats_with_period",),
     "grazing.core.options": ("step_limit",),
     "grazing.engine.timebase": ("start_times", "map_period"),

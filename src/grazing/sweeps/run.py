@@ -194,8 +194,8 @@ class LaneBatch:
         )
 
     def run_jobs(self, work: LaneJobs) -> None:
-        """Compute the points of the jobs ``work`` (this batch's, or some of its points as jobs of their own:
-        :mod:`grazing.gpu.batch`) into the batch's results."""
+        """Compute the points of the jobs ``work`` (this batch's, or some of its points as jobs of their own)
+        into the batch's results."""
         settings = self.settings(len(work.jobs))
         points = LanePoints(self.pvs, self.Ts, self.sphase, self.tcarry, self.zdms)
         out = LaneResults(

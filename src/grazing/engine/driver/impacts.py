@@ -116,13 +116,23 @@ def enter_contact(m, x, s, pv, j):
     for _ in range(3):
         vn = normal_rate(m, x, s, pv, j)
         normal_rate_grad(m, x, s, pv, gr, j)
-        d = 0.0
-        for i in range(n):
-            d += gr[i] * e[i]
-        if d == 0.0 or vn == 0.0:
+        if not along_contact_dir(x, e, gr, vn, n):
             break
-        for i in range(n):
-            x[i] -= vn / d * e[i]
+
+
+@njit(cache=True, inline="always")
+def along_contact_dir(x, e, gr, vn, n):
+    """One Newton step of :func:`enter_contact` (record-free: the GPU's too): ``x`` moved along the contact
+    direction ``e`` to cancel the normal rate ``vn`` whose gradient is ``gr``; False, ``x`` unchanged, where
+    ``vn`` is 0 or ``e`` does not change it."""
+    d = 0.0
+    for i in range(n):
+        d += gr[i] * e[i]
+    if d == 0.0 or vn == 0.0:
+        return False
+    for i in range(n):
+        x[i] -= vn / d * e[i]
+    return True
 
 
 @njit(cache=True)
@@ -372,16 +382,31 @@ def change_mode(m, r, x, pv, j, record, tables):
 
 @njit(cache=True)
 def chatter_remaining(m, x, s, pv, j, speed, chatter_time):
-    """The time to the accumulation point of a chattering sequence on stop ``j`` starting now, or -1.
-
-    After the reset the body leaves the stop with speed ``w`` while the stop
-    pushes it back (``L_f^2 h < 0``): the next bounces form a geometric
-    sequence of ratio ``w / speed``, over in ``2 w / (|a| (1 - w / speed))``.
-    Returns that time when it is below ``chatter_time`` (or 0 when the body
-    does not leave the stop at all), else -1: no sticking.
-    """
+    """The time to the accumulation point of a chattering sequence on stop ``j`` starting now, or -1
+    (:func:`chatter_time_left` of the state ``x`` just after the reset)."""
     w = normal_rate(m, x, s, pv, j)
     acc = normal_accel(m, x, s, pv, j)
+    return chatter_time_left(w, acc, speed, chatter_time)
+
+
+@njit(cache=True, inline="always")
+def chatter_time_left(w, acc, speed, chatter_time):
+    """The time to the accumulation point of a chattering sequence, or -1 (record-free: the GPU's too).
+
+    After the reset the body leaves the stop with speed ``w`` (``L_f h``)
+    while the stop pushes it back (``acc = L_f^2 h < 0``): the next bounces
+    form a geometric sequence of ratio ``w / speed`` (``speed``: the approach
+    speed of the impact), over in ``2 w / (|acc| (1 - w / speed))``.  Returns
+    that time when it is below ``chatter_time`` (or 0 when the body does not
+    leave the stop at all), else -1: no sticking.
+
+    Examples
+    --------
+    >>> chatter_time_left(0.5, -1.0, 1.0, 10.0)  # (2 * 0.5 / (1 * (1 - 0.5)))
+    2.0
+    >>> chatter_time_left(0.5, -1.0, 1.0, 1.0), chatter_time_left(0.5, 1.0, 1.0, 10.0)
+    (-1.0, -1.0)
+    """
     if not acc < 0.0:
         return -1.0
     if speed <= 0.0 or w <= 0.0:
