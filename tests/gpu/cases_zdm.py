@@ -16,6 +16,7 @@ import sys
 import grazing
 from grazing.normalform import find_grazing_point, normal_form_at
 from grazing.sweeps.spec import sweep_spec
+from tests.engine.test_zdm_several_stops import free_motion, twin_rattle
 from tests.gpu.simulator_cases import compare
 
 SHORT = {"transient": 64, "periods": 16}
@@ -34,6 +35,23 @@ def grazing_map() -> tuple[object, object]:
     return model, normal_form_at(point, ("eta", "theta_hat")).discontinuity_map()
 
 
+def twin_rattle_map() -> list[tuple[object, int]]:
+    """Two rattlers, the map on one, the other's stop hit a moment before the map's phase
+    (``tests/engine/test_zdm_several_stops.py``): a sweep of three ledges, each point from its own start."""
+    from grazing.engine.runner import DiscontinuityMap
+
+    base = twin_rattle()
+    amplitude, lag, t_star = free_motion(base)
+    model = base.with_params(g_1=0.999 * amplitude)
+    om = model.params["Om"]
+    zdm = DiscontinuityMap(phase=t_star, accel=om**2 * amplitude, direction=(0.0, 1.8, 0.0, 0.0),
+                           window=model.period / 4, stop=0)  # fmt: skip
+    x0 = [amplitude * math.cos(lag), amplitude * math.sin(lag)] * 2
+    settings = grazing.SweepSettings(transient=8, periods=8, adaptive=False, fresh=True, chunk_size=0)
+    ledges = [0.98 * amplitude, 0.99 * amplitude, 0.999 * amplitude]
+    return [(sweep_spec(model, "g_2", ledges, x0=x0, zdm=zdm, settings=settings), 0)]
+
+
 def cases() -> dict[str, list[tuple[object, int]]]:
     """Each case's chunks: ``(spec, chunk index)`` pairs that share a batch."""
     model, zdm = grazing_map()
@@ -45,6 +63,8 @@ def cases() -> dict[str, list[tuple[object, int]]]:
         "zdm pendulum B chained": [(sweep_spec(model, "eta", ETAS, settings=chained, zdm=zdm), 0)],
         # every point from x0, no exponents, sampled at phase 1, two chunks in one batch
         "zdm pendulum B fresh": [(chunks, 0), (chunks, 1)],
+        # a model of two stops, the other one hit within the step that ends at the map's phase
+        "zdm twin rattle": twin_rattle_map(),
     }
 
 

@@ -24,6 +24,7 @@ from tests.gpu.test_cli_device import grazing as run_grazing
 from tests.gpu.test_simulator import SAMPLE_TOL
 
 CASES = ("zdm pendulum B chained", "zdm pendulum B fresh")
+ALL_CASES = (*CASES, "zdm twin rattle")
 ROOT = Path(__file__).resolve().parents[2]
 
 
@@ -40,7 +41,7 @@ def compared() -> dict[str, dict[str, object]]:
     return json.loads(proc.stdout.strip().splitlines()[-1])  # type: ignore[no-any-return]
 
 
-@pytest.mark.parametrize("case", CASES)
+@pytest.mark.parametrize("case", ALL_CASES)
 def test_the_gpu_equals_the_cpu_lanes_with_the_map_at_every_point(
     compared: dict[str, dict[str, object]], case: str
 ) -> None:
@@ -100,3 +101,9 @@ def test_the_cli_sweep_of_the_map_on_the_simulated_gpu_is_the_cpus(tmp_path: Pat
     kicks = a["impacts_per_period"]
     assert a["method"] == "map" and kicks[0] == 0 and min(kicks[1:]) > 0, a
     assert all(isinstance(v, float) and math.isfinite(v) for v in a["lyapunov"]), a["lyapunov"]
+
+
+def test_the_twin_rattle_kicks_and_hits_its_other_stop(compared: dict[str, dict[str, object]]) -> None:
+    """Both stops in every point of the two-stop case: kicks on the map's stop, impacts on the other."""
+    row = compared["zdm twin rattle"]
+    assert all(a > 0 and b > 0 for a, b in row["cpu_impacts_by_stop"]), row["cpu_impacts_by_stop"]

@@ -59,7 +59,7 @@ from numba import cuda  # (the simulator's, where NUMBA_ENABLE_CUDASIM=1: a glob
 from grazing.core.model import ON_STOP_TOL
 from grazing.core.options import ADAPTIVE_BLOCK, ADAPTIVE_MAX_PERIOD
 from grazing.core.solution import Status
-from grazing.engine.driver.step import STEP_LAST, STEP_MAP
+from grazing.engine.driver.step import STEP_LAST
 from grazing.engine.polyroots import work_shape
 from grazing.engine.stepping import GUARD_SCALE
 
@@ -173,6 +173,7 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
     start_times = helpers["start_times"]
     map_period = helpers["map_period"]
     cut_step = helpers["cut_step"]
+    map_reached = helpers["map_reached"]
     map_kick = helpers["map_kick"]
     kick_tangent = helpers["kick_tangent"]
     chatter_time_left = helpers["chatter_time_left"]
@@ -438,7 +439,7 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
                     if started == LYAP_STARTED_NOW_AT_END:
                         sf[LYAP_T0] = st[K] * T + sf[S]
             sf[SPAN_DT] = math.nan
-            if ZDM and (ends & STEP_MAP) != 0:  # the discontinuity map's phase (step.end_step)
+            if ZDM and map_reached(ends, event, u):  # the discontinuity map's phase (step.end_step)
                 st[KZ] += 1
                 if apply_map(x, sf[S], pv, var, zset, V, gx, hx) and recording != 0 and final:
                     counts[ZSTOP] += 1  # (a kick, counted as an impact on its stop: lanes.end_lane_step)

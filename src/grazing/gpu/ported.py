@@ -50,7 +50,7 @@ PORTED: dict[str, tuple[str, ...]] = {
     "grazing.core.period": ("repeats_with_period",),
     "grazing.core.options": ("step_limit",),
     "grazing.engine.timebase": ("start_times", "map_period"),
-    "grazing.engine.driver.step": ("cut_step",),
+    "grazing.engine.driver.step": ("cut_step", "map_reached"),
     "grazing.engine.driver.tangent": ("map_kick", "kick_tangent"),
     "grazing.engine.sincos": ("sincos_fast", "sincos", "sin", "cos"),
 }  # fmt: skip

@@ -53,6 +53,17 @@ def cut_step(h, rem, last_sample, zdm_on, rem_z):
 
 
 @njit(cache=True, inline="always")
+def map_reached(ends, event, u):
+    """Whether a step cut at the discontinuity map's phase (``ends & STEP_MAP``) reaches it: not where an
+    event (at ``u``, a fraction of the step) ends it first; the map is then the next step's.
+
+    >>> map_reached(STEP_MAP, False, -1.0), map_reached(STEP_MAP, True, 0.5), map_reached(STEP_MAP, True, 1.0)
+    (True, False, True)
+    """
+    return (ends & STEP_MAP) != 0 and not (event and u < 1.0)
+
+
+@njit(cache=True, inline="always")
 def accept_step(r, h, ends, u, ev_stop):
     """The accepted part of the step of run ``r`` (``h``, cut as ``ends`` says) and its event; False: none.
 
@@ -75,7 +86,7 @@ def accept_step(r, h, ends, u, ev_stop):
         event = False
     r.event = event
     r.ev_stop = ev_stop
-    r.zdm_hit = (ends & STEP_MAP) != 0
+    r.zdm_hit = map_reached(ends, event, u)
     return True
 
 
