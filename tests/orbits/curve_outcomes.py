@@ -19,6 +19,7 @@ STATUS_STARTS = (
     ),
     ("an impact approaches the section", CurveEnd.RESECTION),
     ("maximum number of points reached", CurveEnd.MAX_POINTS),
+    ("the curve came back to its start ", CurveEnd.CLOSED),
 )
 """How the status of one end of a curve starts, and the outcome that says the same (the first that
 matches: the section that could not be moved before the section that had to)."""

@@ -56,7 +56,7 @@ ATTRACTOR_KINDS = ["periodic", "sticking", "neutral", "chaotic", "quasiperiodic"
 """The ``kind`` of an attractor in ``grazing basins --json`` and the basins datasets (docs/attractors.md)."""
 
 CURVE_ENDS = ["bound", "grazing", "double grazing", "1:1 resonance", "1:2 resonance", "not persistent",
-              "stuck", "resection", "no section", "max points"]  # fmt: skip
+              "stuck", "resection", "no section", "max points", "closed"]  # fmt: skip
 """The ``outcomes`` of ``grazing curve --json`` (docs/bifurcation-curves.md)."""
 
 

@@ -98,3 +98,20 @@ def test_above_the_boundary_the_orbit_sticks_and_below_it_does_not():
 def test_the_sticking_starts_by_crossing_above_and_by_grazing_below_the_velocity_limit(omega, kind):
     # below omega ~ 0.5 the velocity touches zero inside a half-period first (min_velocity = 0 there)
     assert dh.transition_kind(omega, dh.computed_boundary(omega)) == kind
+
+
+def test_at_resonance_exactly_the_boundary_is_pi_over_4():
+    """At omega = 1 the closed form is 0 / 0 and its limit pi / 4 (the friction's work a period, 4 mu X,
+    equals the resonant forcing's, pi a X): below it the motion never stops and its amplitude grows by
+    pi a - 4 mu a period (no periodic orbit); above it the orbit sticks.  The located boundary is the
+    limit (it raised ZeroDivisionError and ConvergenceError at omega = 1 exactly)."""
+    assert dh.boundary(1.0) == math.pi / 4 and dh.nonstop_boundary(1.0) == math.pi / 4
+    assert abs(dh.computed_boundary(1.0) - math.pi / 4) <= dh.BOUNDARY_RULE
+    model = dh.friction_oscillator(a=1.0, omega=1.0, mu=0.5, v_belt=0.0)
+    sol = dh.simulate(model, [0.0, 0.0], periods=200, impacts="all")
+    late = sol.switches.t > 100 * 2 * math.pi
+    x = np.abs(sol.switches.state[late, 0])
+    growth = np.diff(x[::2])  # (a period apart: every other reversal)
+    assert np.allclose(growth, math.pi - 4 * 0.5, atol=1e-6), growth
+    above = dh.reversals(dh.orbit_at(1.0, 1.02 * math.pi / 4))
+    assert above.margin < 0 and above.sticks.any()

@@ -211,6 +211,7 @@ def _grazing_json(g: Any, param: str | None = None) -> dict[str, Any]:
 )
 @stop_name_option
 @initial_option
+@mode_option
 @json_option
 def graze(
     model: grazing.HybridModel,
@@ -221,12 +222,15 @@ def graze(
     prange: str | None,
     stop_name: str | None,
     initial: str | None,
+    mode: str | None,
     as_json: bool,
 ) -> None:
     """Every grazing of the period-1 nonimpacting orbit with a stop, for a parameter in a range."""
     from grazing.orbits import find_grazings
+    from grazing.orbits.grazing import unlocated_grazing_text
 
     stop = stop_option_index(model, stop_name)
+    check_mode(model, mode)
     par, lo, hi, _ = search_range(model, "graze", gparam, prange, eta_min, eta_max)
     x0 = range_start_state(initial, model, {par.name: lo})
     bar = Progress("continuing", enabled=not as_json)
@@ -234,11 +238,12 @@ def graze(
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", GrazingWarning)  # (said below, with each grazing)
             points, branch = find_grazings(
-                model, par.name, lo, hi, x0=x0, stop_name=stop,
+                model, par.name, lo, hi, x0=x0, stop_name=stop, mode=mode,
                 progress=lambda n, v: bar(int(1000 * (v - lo) / (hi - lo)), 1000),
             )  # fmt: skip
     finally:
         bar.close()
+    unlocated = [s for s in branch.special if s.kind == "grazing" and s.grazing is None and s.stop == stop]
     res = {
         "params": model_params_json(model, case),
         "param": par.name,
@@ -246,14 +251,17 @@ def graze(
         "stop": model.stop_names[stop],
         "grazings": [_grazing_json(g, par.name) for g in points],
         "folds": [par.to_display(s.param) for s in branch.special if s.kind == "fold"],
+        "unlocated": [par.to_display(s.param) for s in unlocated],  # (bracketed, equations not converged)
     }
     if par.name == "eta":
         res["eta_range"] = [lo, hi]
     if as_json:
         emit_json(res)
         return
-    if not points:
+    if not points and not unlocated:
         click.echo(f"no grazing with stop {model.stop_names[stop]!r} for {par.show_range(lo, hi)}")
+    for sp_ in unlocated:
+        click.echo(f"note: {unlocated_grazing_text(model, par.name, sp_)}")
     for point, g in zip(points, res["grazings"]):
         mu = multipliers_text(g["multipliers"])
         where = (

@@ -487,7 +487,7 @@ class Explorer:
         self.grazings_text.object = "finding the grazings ..."
 
         def work(cancelled: Callable[[], bool]) -> Grazings:
-            return grazings_in_view(self.view, fixed, cancelled=cancelled)
+            return grazings_in_view(self.view, fixed, mode=self.start_mode, cancelled=cancelled)
 
         def done(g: Grazings) -> None:
             self.figures.show_grazings(g, fixed.get(self.view.axes[-1].name))

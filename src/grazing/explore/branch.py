@@ -23,7 +23,7 @@ from grazing.errors import GrazingError, GrazingWarning, InvalidParameterError
 from grazing.explore.diagram import IsCancelled, SupersededError, View, checkpoint
 from grazing.explore.point import PointReport
 from grazing.orbits.continuation import Branch, continue_orbit
-from grazing.orbits.grazing import find_grazings
+from grazing.orbits.grazing import find_grazings, unlocated_grazing_text
 from grazing.orbits.kinds import SpecialKind
 from grazing.orbits.periodic import multipliers_text
 from grazing.orbits.shooting import PeriodicOrbit
@@ -230,6 +230,11 @@ class Grazings:
         Where they were sought.
     fixed
         The other explored parameter's value held (a period map), else empty.
+    mode
+        A model with modes: the mode the orbit's search started in (the page's "Start mode"; None:
+        the model's initial mode).
+    unlocated
+        The grazings bracketed whose equations did not converge: where (their marks and lines say so).
 
     Examples
     --------
@@ -246,6 +251,8 @@ class Grazings:
     lines: tuple[str, ...]
     range: tuple[float, float] = (math.nan, math.nan)
     fixed: dict[str, float] = field(default_factory=dict)
+    mode: str | None = None
+    unlocated: tuple[float, ...] = ()
 
     def summary(self) -> str:
         return "\n".join(self.lines)
@@ -256,6 +263,7 @@ def grazings_in_view(
     fixed: dict[str, float] | None = None,
     *,
     period: int = 1,
+    mode: str | None = None,
     cancelled: IsCancelled | None = None,
 ) -> Grazings:
     """Every stop's grazings of the nonimpacting period-``period`` orbit over the view's first range.
@@ -264,7 +272,8 @@ def grazings_in_view(
     The orbit is followed with the stops ignored from the range's start (its guess:
     a simulation from rest with the stops ignored), through folds.  On a model with
     modes, every transition's grazings of the period-``period`` orbit followed through
-    its modes (:func:`~grazing.orbits.find_grazings`).
+    its modes (:func:`~grazing.orbits.find_grazings`), from ``mode``.  A grazing bracketed whose
+    equations do not converge is one unlocated mark and line; the search goes on.
 
     Parameters
     ----------
@@ -274,6 +283,9 @@ def grazings_in_view(
         The other explored parameter's value, by name (a period map).
     period
         Period of the nonimpacting orbit, in forcing periods.
+    mode
+        A model with modes: the mode the search starts in (the page's "Start mode"; default: the
+        model's initial mode).
     cancelled
         Looked at between the steps: when it returns True, :class:`SupersededError` is raised.
 
@@ -297,14 +309,21 @@ def grazings_in_view(
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", GrazingWarning)  # (said in each grazing's text instead)
         _, branch = find_grazings(
-            model, axis.name, axis.lo, axis.hi, period=period, progress=lambda _n, _v: checkpoint(cancelled)
-        )
+            model, axis.name, axis.lo, axis.hi, period=period, mode=mode,
+            progress=lambda _n, _v: checkpoint(cancelled),
+        )  # fmt: skip
     stop_word = "transition" if model.has_modes else "stop"
-    marks, lines = [], []
+    marks, lines, unlocated = [], [], []
     for sp in branch.special:
-        if sp.kind != SpecialKind.GRAZING or sp.grazing is None:
+        if sp.kind != SpecialKind.GRAZING:
             continue
         checkpoint(cancelled)
+        if sp.grazing is None:  # (bracketed only: one unlocated point, said)
+            unlocated.append(sp.param)
+            text = unlocated_grazing_text(model, axis.name, sp)
+            marks.append(Mark("grazing", sp.param, np.empty((0, view.model.n_states)), text))
+            lines.append(text)
+            continue
         g = sp.grazing
         note = f"{stop_word} {g.stop_name}"
         if g.crossed:
@@ -319,7 +338,9 @@ def grazings_in_view(
         lines.append(marks[-1].text)
     if not marks:
         lines.append(f"no grazing of {grazed_orbit(model, period)} in the range ({branch.status})")
-    return Grazings(axis.name, tuple(marks), tuple(lines), (axis.lo, axis.hi), dict(fixed or {}))
+    return Grazings(
+        axis.name, tuple(marks), tuple(lines), (axis.lo, axis.hi), dict(fixed or {}), mode, tuple(unlocated)
+    )
 
 
 @dataclass(frozen=True)

@@ -348,7 +348,7 @@ def _grazings_code(view: View, found: Grazings, with_cli: bool, py: list[str], c
         "",
         f"# the grazings of {grazed_orbit(view.model)} over the range (every {stop_word}'s)",
         f"_, branch = find_grazings(model{f'.with_params({held})' if held else ''}, {found.param!r}, {lo!r}, "
-        f"{hi!r}, period=1)",
+        f"{hi!r}, period=1{_mode_kw(found.mode)})",
         'print("grazings", [round(s.param, 8) for s in branch.special if s.kind == "grazing"])',
     ]
     if not with_cli:
@@ -361,6 +361,7 @@ def _grazings_code(view: View, found: Grazings, with_cli: bool, py: list[str], c
             command_line(
                 ["graze", *args, "--param", found.param, f"--range={shown(lo)!r},{shown(hi)!r}"]
                 + (["--stop-name", stop] if len(model.stop_names) > 1 else [])
+                + _mode_arg(found.mode)
             )
         )
 

@@ -104,7 +104,7 @@ from grazing.orbits.shooting import (
     quiet_section,
 )
 from grazing.orbits.sliding_bifurcations import bisect_switches, sliding_kind
-from grazing.orbits.switch_grazing import locate_switch_grazing
+from grazing.orbits.switch_grazing import grazed_transition, locate_switch_grazing
 from grazing.orbits.switching import SegmentStart, crossing_starts, doubled_start, new_sequence_orbit
 
 SPECIAL_KINDS = tuple(k for k in SpecialKind if k is not SpecialKind.UNLOCATED)
@@ -965,7 +965,10 @@ class _Continuation:
             found = switch_change(prev.payload, beyond) if beyond is not None else None
             if found is None or found[1] >= self.model.n_stops or sliding_kind(prev.payload, beyond):
                 return None  # (a sliding bifurcation: bisected in _grazing_end)
-            return locate_switch_grazing(prev.payload, beyond, self.param, found[1], BETWEEN_SLACK)
+            grazed = grazed_transition(prev.payload, beyond)
+            if grazed is None:
+                return None
+            return locate_switch_grazing(prev.payload, beyond, self.param, grazed, BETWEEN_SLACK)
         return _locate_grazing(prev.payload, beyond, self.param, self.virtual, boundary.ahead)
 
     def _grazing_end(
@@ -989,8 +992,12 @@ class _Continuation:
         if kind is not None:
             assert after is not None and switched is not None
             return self._sliding_end(kind, last, after, switched[1], sign)
-        if switched is not None:
-            where_stop = switched[1]
+        if point is not None:
+            where_stop = point.stop
+        elif switched is not None:
+            assert after is not None
+            grazed = grazed_transition(last, after) if switched[1] < self.model.n_stops else None
+            where_stop = switched[1] if grazed is None else grazed
         else:
             where_stop = grazing_margin(last).stop if point is None else point.stop
         p0 = float(prev.u[-1])

@@ -204,6 +204,8 @@ class CurveEnd(TextEnum):
     NO_SECTION = "no section"
     """The section had to move and the orbit could not be found on another one."""
     MAX_POINTS = "max points"
+    CLOSED = "closed"
+    """The curve came back to its start: it is closed (both ends are its start)."""
 
     @property
     def message(self) -> str:
@@ -232,6 +234,7 @@ _CURVE_END_MESSAGES = {
     CurveEnd.RESECTION: "the section had to move, with no points left",
     CurveEnd.NO_SECTION: "the section could not be moved",
     CurveEnd.MAX_POINTS: "maximum number of points reached",
+    CurveEnd.CLOSED: "the curve is closed: it came back to its start",
 }
 
 
@@ -299,6 +302,11 @@ class BifurcationCurve:
 
     def __len__(self) -> int:
         return len(self.points)
+
+    @property
+    def closed(self) -> bool:
+        """The curve came back to its start (:attr:`CurveEnd.CLOSED`): its last point is its first."""
+        return self.outcomes == (CurveEnd.CLOSED, CurveEnd.CLOSED)
 
     def values(self, name: str) -> np.ndarray:
         """One parameter's values along the curve."""

@@ -82,6 +82,12 @@ DOUBLE_GRAZING_MARGIN = 1e-6
 (:func:`_other_contact_margin`), it ends at a double grazing."""
 
 
+CLOSURE_TOL = 0.25
+"""A curve is closed where one of its steps passes its start within this fraction of the step's length
+(in the orbit's state, its section time and the two parameters), once the curve has been farther from
+its start than two such steps: it has come back to where it began, and stops there."""
+
+
 CurveProgress = Callable[[str, int, float, float], None]
 """``progress(stage, points, value1, value2)``: stage ``"branch"`` (the one-parameter continuation
 to the start) or ``"curve"``."""
@@ -173,6 +179,7 @@ class _Direction:
         self.handover: tuple[float, float] | None = None  # where it went over to multiple shooting
         self.segmented_start: float | None = None  # the monodromy's norm where it started on the segments
         self.reorders: list[str] = []  # where two impacts changed order (on the segments)
+        self.farthest = 0.0  # the largest distance of a point from the first (closure: _came_back)
 
 
 class _Follower:
@@ -392,6 +399,14 @@ class _Follower:
                     break
                 self.append(d, pt)
                 system.accept(pt.payload)
+                along = _came_back(d)
+                if along is not None:  # (the loop closed: its last point is its first, not one past it)
+                    d.points[-1 if along < 1.0 else len(d.points) :] = [d.points[0]]
+                    d.outcome = CurveEnd.CLOSED
+                    return (
+                        f"the curve came back to its start ({self.show(d.points[0].values)}) after "
+                        f"{len(d.points) - 1} points: it is closed"
+                    )
             if ended:
                 return d.status
             d.status, d.outcome = palc.status, CurveEnd.of(palc.end)
@@ -716,7 +731,10 @@ def follow_curve(
     in both directions, each until ``param2`` leaves ``range2``, a parameter
     leaves its own interval, or the curve ends at a codimension-two point that
     ends it (a grazing, where the orbit's impact sequence changes; a 1:1 or 1:2
-    resonance on a Neimark-Sacker curve), or Newton's method fails.
+    resonance on a Neimark-Sacker curve), or Newton's method fails.  A closed
+    curve stops where it comes back to its start, once round (both ends
+    :attr:`~grazing.orbits.curve_data.CurveEnd.CLOSED`, its last point its
+    first, :attr:`~grazing.orbits.curve_data.BifurcationCurve.closed`).
 
     On a model with modes the orbits go through their switches of mode (single
     shooting only); a fold or period-doubling curve ends where its orbits'
@@ -819,6 +837,34 @@ def follow_curve(
     )  # fmt: skip
 
 
+def _difference(a: CurvePoint, b: CurvePoint) -> np.ndarray:
+    """``a - b`` for two points of a curve: in the orbit's state, its section time (modulo the forcing
+    period) and the two parameters."""
+    model = a.orbit.model if a.orbit is not None else a.grazing.model if a.grazing is not None else None
+    dt = a.section_time - b.section_time
+    if model is not None:
+        dt = (dt + 0.5 * model.period) % model.period - 0.5 * model.period
+    return np.concatenate([a.state - b.state, np.subtract(a.values, b.values), [dt]])
+
+
+def _came_back(d: _Direction) -> float | None:
+    """Where the curve's last step passed its start (within :data:`CLOSURE_TOL` of the step's length),
+    after it had gone farther from it than two such steps: the fraction of the step at which it came
+    nearest (1 where the start lies just beyond the step); None where it did not come back."""
+    start, last = d.points[0], d.points[-1]
+    if len(d.points) < 3 or start.state.shape != last.state.shape:
+        return None
+    away = d.farthest
+    d.farthest = max(away, float(np.linalg.norm(_difference(last, start))))
+    step = _difference(last, d.points[-2])
+    size = float(np.linalg.norm(step))
+    if not (size > 0.0 and away > 2.0 * size):
+        return None
+    to_start = _difference(start, d.points[-2])
+    along = min(max(float(to_start @ step) / (size * size), 0.0), 1.0)
+    return along if float(np.linalg.norm(to_start - along * step)) <= CLOSURE_TOL * size else None
+
+
 def _follow_from(
     model: HybridModel, kind: str, params: tuple[str, str], range2: tuple[float, float],
     first: PeriodicOrbit | GrazingPoint, virtual: bool, stop: int, settings: PalcSettings,
@@ -834,7 +880,11 @@ def _follow_from(
     t = tangent(f.first(system, u0, i1 + 1).DF)
     which = 0 if abs(t[i1]) >= abs(t[i1 + 1]) else 1  # the parameter that moves most
     back = f.run(first, -1.0, which)
-    ahead = f.run(first, 1.0, which)
+    if back.outcome is CurveEnd.CLOSED:  # (the loop is whole: the other way would go round it again)
+        ahead = _Direction()
+        ahead.points, ahead.status, ahead.outcome = back.points[:1], back.status, back.outcome
+    else:
+        ahead = f.run(first, 1.0, which)
     curve = BifurcationCurve(
         model=f.model,
         kind=f.kind,

@@ -30,7 +30,7 @@ from grazing.core.model import HybridModel, Parameter
 from grazing.core.options import GRAZING_CURVE_MAX_STEP
 from grazing.errors import ConvergenceError, GrazingWarning, InvalidParameterError
 from grazing.orbits.contact import GrazingPoint, contact_system
-from grazing.orbits.continuation import Branch, continue_orbit
+from grazing.orbits.continuation import Branch, SpecialPoint, continue_orbit
 from grazing.orbits.kinds import SpecialKind
 from grazing.orbits.palc import Palc, PalcPoint, PalcSettings, locate, sign_changed
 
@@ -46,6 +46,7 @@ def find_grazings(
     settings: PalcSettings | None = None,
     progress: Callable[[int, float], None] | None = None,
     stop_name: int | str | None = None,
+    mode: str | None = None,
 ) -> tuple[list[GrazingPoint], Branch]:
     """Every grazing of the period-n nonimpacting orbit for ``param`` in ``[start, stop]``.
 
@@ -59,7 +60,11 @@ def find_grazings(
     index; the first by default; the branch's special points hold every
     stop's).  A grazing orbit that passes through another stop
     (:attr:`GrazingPoint.crossed`) is not a motion of the system: it is
-    returned, with a :class:`~grazing.errors.GrazingWarning`.
+    returned, with a :class:`~grazing.errors.GrazingWarning`.  A grazing
+    bracketed between two points of the branch whose grazing equations do not
+    converge is not returned: a :class:`~grazing.errors.GrazingWarning` says
+    where (the branch's special points hold it, its ``grazing`` None), and the
+    search goes on.
 
     On a model with modes, for a transition without a reset (a switch of vector
     field), the branch is the orbit itself, followed through its switches of
@@ -89,6 +94,9 @@ def find_grazings(
         Called as ``progress(step, value)`` after each continuation step.
     stop_name
         The stop whose grazings are sought (name or index; the first by default).
+    mode
+        A model with modes: the mode of ``x0`` (without ``x0``: the mode its simulation from rest
+        starts in; see :func:`~grazing.orbits.find_orbit`); the model's initial mode by default.
 
     Returns
     -------
@@ -118,6 +126,7 @@ def find_grazings(
         progress=progress,
         stop_name=None if switching else stop_name,
         switch=switching,  # (through modes: the orbit with the new switches past each grazing)
+        mode=mode,
     )
     par = model.parameter(param)
     points = []
@@ -126,11 +135,9 @@ def find_grazings(
             continue
         if sp_.stop != watch:
             continue
-        if sp_.grazing is None:
-            raise ConvergenceError(
-                f"the grazing near {par.show(sp_.param, '.8g')} was bracketed but its equations did not "
-                "converge"
-            )
+        if sp_.grazing is None:  # (one unlocated point, said: the search goes on)
+            warnings.warn(unlocated_grazing_text(model, param, sp_), GrazingWarning, stacklevel=2)
+            continue
         if sp_.grazing.crossed:
             warnings.warn(
                 f"the nonimpacting orbit grazing stop {sp_.grazing.stop_name!r} at {par.show(sp_.param)} "
@@ -141,6 +148,22 @@ def find_grazings(
             )
         points.append(sp_.grazing)
     return points, branch
+
+
+def unlocated_grazing_text(model: HybridModel, param: str, special: SpecialPoint) -> str:
+    """A grazing of ``special`` (a :class:`~grazing.orbits.continuation.SpecialPoint`) bracketed on a branch
+    whose grazing equations did not converge, in one line: where, and between which values."""
+    par = model.parameter(param)
+    where = f"near {par.show(special.param, '.8g')}"
+    if special.interval is not None:
+        where += (
+            f" (between {par.show(special.interval[0], '.10g')} and {par.show(special.interval[1], '.10g')})"
+        )
+    word = "transition" if model.has_modes else "stop"
+    return (
+        f"a grazing of {word} {model.stop_names[special.stop]!r} {where} was bracketed but its equations did "
+        "not converge: unlocated, not among the grazings found"
+    )
 
 
 @dataclass

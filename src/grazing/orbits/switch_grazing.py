@@ -19,9 +19,10 @@ from grazing.orbits.contact import GrazingPoint, refine_grazing
 from grazing.orbits.periodic import PeriodicOrbit
 
 
-def brief_crossing(orbit: PeriodicOrbit, transition: int) -> tuple[np.ndarray, float] | None:
-    """``(state, time)`` where ``orbit`` crosses the guard of ``transition`` for its shortest stay on
-    the other side (until its next switch of mode, over the orbit's period); None without a crossing."""
+def brief_crossing(orbit: PeriodicOrbit, transition: int) -> tuple[np.ndarray, float, float] | None:
+    """``(state, time, stay)`` where ``orbit`` crosses the guard of ``transition`` for its shortest stay on
+    the other side (``stay``: until its next switch of mode, over the orbit's period); None without a
+    crossing."""
     sw = flow_map(
         orbit.model, orbit.state, t0=orbit.t0, periods=orbit.period, mode=orbit.mode
     ).solution.switches
@@ -35,8 +36,27 @@ def brief_crossing(orbit: PeriodicOrbit, transition: int) -> tuple[np.ndarray, f
     ]
     if not stays:
         return None
-    _, i = min(stays)
-    return sw.state[i].copy(), float(sw.t[i])
+    stay, i = min(stays)
+    return sw.state[i].copy(), float(sw.t[i]), float(stay)
+
+
+def grazed_transition(last: PeriodicOrbit, beyond: PeriodicOrbit) -> int | None:
+    """The transition whose guard is grazed between ``last`` and ``beyond`` (orbits at two values of a
+    parameter whose switches of mode differ): of the transitions whose counts of switches differ, the one
+    crossed for the briefest stay on the other side by the orbit that has more of them (that stay shrinks
+    to zero at the grazing).  A brief excursion out of a mode and back crosses two transitions' guards,
+    the grazed one first (into the excursion: a ``leave`` when an orbit in contact briefly leaves it), so
+    the first whose count differs in the model's order is not always the one grazed.  None where no
+    transition's count differs."""
+    best: tuple[float, int] | None = None
+    for j in range(last.model.n_stops):
+        counts = [int(np.count_nonzero(o.switch_transitions == j)) for o in (last, beyond)]
+        if counts[0] == counts[1]:
+            continue
+        found = brief_crossing(last if counts[0] > counts[1] else beyond, j)
+        if found is not None and (best is None or found[2] < best[0]):
+            best = (found[2], j)
+    return None if best is None else best[1]
 
 
 def locate_switch_grazing(
@@ -53,7 +73,7 @@ def locate_switch_grazing(
     found = brief_crossing(crossing_orbit, transition)
     if found is None:
         return None
-    y, tg = found
+    y, tg, _ = found
     try:
         point = refine_grazing(
             crossing_orbit.model,

@@ -90,7 +90,7 @@ def boundary(omega: float) -> float:
     Parameters
     ----------
     omega
-        Forcing frequency (not 1: there the limit is ``pi / 4``).
+        Forcing frequency (at 1 exactly: the limit ``pi / 4``).
 
     Returns
     -------
@@ -99,9 +99,11 @@ def boundary(omega: float) -> float:
 
     Examples
     --------
-    >>> round(boundary(1.0 + 1e-7), 5), round(math.pi / 4, 5)   # at resonance
-    (0.7854, 0.7854)
+    >>> round(boundary(1.0 + 1e-7), 5), round(math.pi / 4, 5), boundary(1.0) == math.pi / 4  # at resonance
+    (0.7854, 0.7854, True)
     """
+    if omega == 1.0:  # (0 / 0: the limit, where the work of the friction, 4 mu X a period, is the forcing's)
+        return math.pi / 4.0
     u = math.tan(math.pi / (2.0 * omega))
     return omega * omega / (abs(1.0 - omega * omega) * math.sqrt(1.0 + (omega * u) ** 2))
 
@@ -231,7 +233,7 @@ def nonstop_boundary(omega: float) -> float:
     (True, True)
     """
     top = boundary(omega)
-    if min_velocity(omega, top) >= 0.0:
+    if omega == 1.0 or min_velocity(omega, top) >= 0.0:  # (at resonance the motion grows: no velocity limit)
         return top
     grid = np.linspace(0.0, top, 41)[1:]
     prev = grid[0]
@@ -395,7 +397,11 @@ def computed_boundary(
 
     The stick margin of :func:`reversals` (positive without stops, negative with) is scanned on
     ``n_scan`` values of ``mu / a`` in ``bracket`` from below and its first change of sign refined by
-    Brent's method to 1e-13.  Nothing of Den Hartog's closed form is used.
+    Brent's method to 1e-13.  Nothing of Den Hartog's closed form is used.  At resonance
+    (``omega = 1`` exactly, ``v_belt = 0``) the motion below the boundary never stops and grows without
+    bound: there is no periodic orbit there, and a value of ``mu / a`` where Newton's method finds none
+    counts as non-stop (its margin positive); the boundary is where the sticking orbits begin (Den
+    Hartog's limit ``pi / 4``).
 
     Parameters
     ----------
@@ -418,17 +424,27 @@ def computed_boundary(
     >>> abs(computed_boundary(2.0) - boundary(2.0)) < 1e-9
     True
     """
+    resonant = omega == 1.0 and v_belt == 0.0
 
     def margin(mu: float) -> float:
-        return reversals(orbit_at(omega, mu, v_belt)).margin
+        try:
+            orbit = orbit_at(omega, mu, v_belt)
+        except ConvergenceError:
+            if not resonant:
+                raise
+            return math.inf  # (no periodic orbit: the resonant motion grows without bound, never stopping)
+        if resonant and not orbit.isolated:  # (Newton's "orbit" at a huge amplitude, multipliers 1, 1: none)
+            return math.inf
+        return reversals(orbit).margin
 
     grid = np.linspace(bracket[0], bracket[1], n_scan)
     prev = margin(float(grid[0]))
     for lo, hi in itertools.pairwise(grid):
         cur = margin(float(hi))
         if prev > 0.0 >= cur:
-            root = float(brentq(margin, float(lo), float(hi), xtol=1e-13, rtol=1e-13))
-            return root
+            # (a positive margin capped: Brent's method needs finite values, and only their sign matters)
+            capped = lambda mu: min(margin(mu), 1.0)  # noqa: E731
+            return float(brentq(capped, float(lo), float(hi), xtol=1e-13, rtol=1e-13))
         prev = cur
     return math.nan
 
