@@ -109,8 +109,9 @@ def quiet_store_exit() -> None:
 
     A Ctrl-C or SIGTERM during a store's write leaves zarr's event loop running a task; zarr's own exit
     hook then waits 0.2 s, logs "Thread did not finish cleanly" and raises closing the running loop (a
-    traceback after the one line).  The process is ending: its hook runs with its log silenced and its
-    error dropped.
+    traceback after the one line), and the tasks still pending when the loop is collected are logged by
+    asyncio ("Task was destroyed but it is pending!", several lines).  The process is ending: its hook
+    runs with its log silenced and its error dropped, and asyncio's log is silenced.
     """
     import atexit
     import logging
@@ -120,6 +121,7 @@ def quiet_store_exit() -> None:
     cleanup = getattr(sync, "cleanup_resources", None)
     if cleanup is None:
         return
+    logging.getLogger("asyncio").disabled = True
 
     def quietly() -> None:
         logging.getLogger(sync.__name__).disabled = True
