@@ -46,9 +46,9 @@ from typing import Any
 import numpy as np
 from numba import cuda  # (the simulator's, where NUMBA_ENABLE_CUDASIM=1: a global, which it swaps in kernels)
 
-from grazing.core.model import ON_STOP_TOL
 from grazing.core.options import ADAPTIVE_BLOCK, ADAPTIVE_MAX_PERIOD
 from grazing.core.solution import Status
+from grazing.engine.driver.transitions import ENTER_SLIDING, LEAVE_SLIDING, SWITCH
 from grazing.engine.polyroots import work_shape
 from grazing.engine.stepping import GUARD_SCALE
 
@@ -144,11 +144,12 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
     isolate_first_root = helpers["isolate_first_root"]
     confirm_first_root = helpers["confirm_first_root"]
     eval_rows = helpers["eval_rows"]
-    unpack_var = helpers["unpack_var"]
-    pack_var = helpers["pack_var"]
     repeats_with_period = helpers["repeats_with_period"]
     step_limit = helpers["step_limit"]
     start_times = helpers["start_times"]
+    mode_after = helpers["mode_after"]
+    outside_region = helpers["outside_region"]
+    onto_zero_step = helpers["onto_zero_step"]
     tc_free = dm.functions["mode_tc_free"]
     tc_var = dm.functions["mode_tc_var"]
     reset = dm.functions["reset"]
@@ -211,28 +212,28 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
         for _ in range(3):
             hval = guard(x, s, pv, j)
             guard_grad(x, s, pv, gx, j)
-            nn = 0.0
-            for i in range(NX):
-                nn += gx[i] * gx[i]
-            if nn == 0.0 or hval == 0.0:
+            if not onto_zero_step(x, NX, hval, gx):
                 break
-            for i in range(NX):
-                x[i] -= hval * gx[i] / nn
 
     @dj
     def outside_mode(x, s, pv, vf, known):
         """Whether ``x``, which has just entered mode ``vf``, is outside its region (``impacts.check_region``:
         a guard of the mode's own transitions other than ``known`` below ``-ON_STOP_TOL * max(1, |x|)``)."""
-        scale = 1.0
-        for i in range(NX):
-            scale = max(scale, abs(x[i]))
+        row_guards = cuda.local.array(NEV, float64)
         for row in range(NEV):
-            k = ROWS[vf, row]
-            if k < 0 or k >= NSTOPS or k == known:
-                continue
-            if guard(x, s, pv, k) < -ON_STOP_TOL * scale:
-                return True
-        return False
+            row_guards[row] = 0.0
+            if 0 <= ROWS[vf, row] < NSTOPS:  # (-1: padding; from NSTOPS on: a sliding pseudo-mode's exits)
+                row_guards[row] = guard(x, s, pv, ROWS[vf, row])
+        return outside_region(x, NX, row_guards, ROWS[vf], NSTOPS, known)
+
+    @dj
+    def set_mode(st, j, how):
+        """The thread's mode, surface and known roots after transition ``j`` (``impacts.set_mode``)."""
+        vf, surface, defl, defl_stop = mode_after(j, how, TARGETS, BACK, SLIDE_ENTRY)
+        st[VF] = vf
+        st[SURFACE] = surface
+        st[DEFL] = defl
+        st[DEFL_STOP] = defl_stop
 
     @dj
     def chatter_remaining(x, s, pv, j, speed, chatter_time):
@@ -367,10 +368,7 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
             if (
                 event and ev_stop >= NSTOPS
             ):  # sliding ends at a tangency, to that side (impacts.leave_sliding)
-                st[VF] = TARGETS[ev_stop]
-                st[SURFACE] = 0
-                st[DEFL] = 2
-                st[DEFL_STOP] = BACK[ev_stop]
+                set_mode(st, ev_stop, LEAVE_SLIDING)
             elif (
                 event
                 and SLIDE_ENTRY[ev_stop] >= 0
@@ -379,40 +377,29 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
             ):  # the far side's field pushes back: sliding (impacts.enter_sliding)
                 s = sf[S]
                 target = TARGETS[SLIDE_ENTRY[ev_stop]]
-                if LYAP and var:
-                    unpack_var(x, NX, NX, V)
+                if LYAP and var:  # (the saltation matrix of a switch into Filippov's field)
                     if not saltation(x, x, s, pv, ev_stop, V, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn, vf, target):
                         st[JAC_VALID] = 0
-                    pack_var(V, NX, NX, x)
                 onto_guard(x, s, pv, ev_stop, gx)
-                st[VF] = target
-                st[SURFACE] = 1 + ev_stop
-                st[DEFL] = 0
+                set_mode(st, ev_stop, ENTER_SLIDING)
             elif event and RESETS[ev_stop] == 0:  # a switch of vector field, no reset (impacts.switch_mode)
                 s = sf[S]
                 target = TARGETS[ev_stop]
                 if LYAP and var:  # (the saltation matrix of a switch: the identity reset)
-                    unpack_var(x, NX, NX, V)
                     if not saltation(x, x, s, pv, ev_stop, V, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn, vf, target):
                         st[JAC_VALID] = 0
-                    pack_var(V, NX, NX, x)
-                st[VF] = target
-                st[SURFACE] = 0
-                st[DEFL] = 1 if BACK[ev_stop] >= 0 else 0
-                st[DEFL_STOP] = BACK[ev_stop]
-                if outside_mode(x, s, pv, target, BACK[ev_stop]):
+                set_mode(st, ev_stop, SWITCH)
+                if outside_mode(x, s, pv, st[VF], BACK[ev_stop]):
                     return STATUS_OUTSIDE_MODE
             elif event:  # an impact on stop ev_stop (impacts.at_event, apply_impact)
                 s = sf[S]
                 vn = normal_rate(x, s, pv, ev_stop)
                 reset(x, s, pv, xp, ev_stop)
                 if LYAP and var:  # (the variational matrix times the saltation matrix)
-                    unpack_var(x, NX, NX, V)
                     if not saltation(
                         x, xp, s, pv, ev_stop, V, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn, vf, TARGETS[ev_stop]
                     ):
                         st[JAC_VALID] = 0  # (an impact at zero normal speed has no Jacobian)
-                    pack_var(V, NX, NX, xp)
                 for i in range(NT if var else NX):
                     x[i] = xp[i]
                 st[DEFL] = 1
@@ -420,12 +407,8 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
                 if recording != 0 and final:
                     counts[ev_stop] += 1
                 if TARGETS[ev_stop] != vf:  # a reset that also changes the mode (impacts.change_mode)
-                    target = TARGETS[ev_stop]
-                    st[VF] = target
-                    st[SURFACE] = 0
-                    st[DEFL] = 1 if BACK[ev_stop] >= 0 else 0
-                    st[DEFL_STOP] = BACK[ev_stop]
-                    if outside_mode(x, s, pv, target, -1):
+                    set_mode(st, ev_stop, SWITCH)
+                    if outside_mode(x, s, pv, st[VF], -1):
                         return STATUS_OUTSIDE_MODE
                 if STICKS[ev_stop] != 0 and chatter_remaining(x, s, pv, ev_stop, -vn, chatter_time) >= 0.0:
                     return NEEDS_CPU  # (complete chattering, then sticking: not on the GPU yet)

@@ -6,7 +6,10 @@ The step size (:func:`~grazing.engine.stepping.step_size`, with its
 (:mod:`grazing.engine.polyroots`: quadratic bound, Bernstein subdivision,
 Newton polishing, the check that the root is the first), the test of a
 repeating transient, the start times, the Lyapunov vectors' Gram-Schmidt and
-(un)packing of the variational matrix, and the model code's ``sin`` and ``cos``
+(un)packing of the variational matrix, the cores of a transition
+(:mod:`grazing.engine.driver.transitions`: the saltation matrix, the
+projection onto a guard, the mode after a switch or sliding, the region
+check), and the model code's ``sin`` and ``cos``
 (:mod:`grazing.engine.sincos`: not the C library's) are compiled for the GPU from the
 very text the CPU driver compiles: the decorators dropped, each function
 executed in one namespace where every callee is its device copy.  A change in
@@ -35,6 +38,9 @@ PORTED: dict[str, tuple[str, ...]] = {
         "orthonormalize", "unpack_var", "pack_var",
     ),
     "grazing.engine.driver.events": ("event_polynomial", "event_certificate"),
+    "grazing.engine.driver.transitions": (
+        "mode_after", "outside_region", "onto_zero_step", "saltation_vector", "apply_saltation",
+    ),
     "grazing.core.period": ("repeats_with_period",),
     "grazing.core.options": ("step_limit",),
     "grazing.engine.timebase": ("start_times",),
