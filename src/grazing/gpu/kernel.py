@@ -23,7 +23,8 @@ modes: each thread carries its point's mode (its kernels, its event rows:
 the transitions out of it); a switch without a reset changes the mode
 (``impacts.switch_mode``), a reset may too (``impacts.change_mode``), each
 followed by the CPU's test that the state is inside the new mode's region
-(``impacts.check_region``: else the point's status is ``OUTSIDE_MODE``); a
+(``impacts.check_region``: else the point's status is ``OUTSIDE_MODE``; so is
+a reset within a mode, and an exit from sliding); a
 crossing where the far side's field pushes back enters Filippov's sliding
 pseudo-mode (``impacts.enter_sliding``), kept on its surface at each step's
 end and sample, left by its virtual exits (``impacts.leave_sliding``).
@@ -157,7 +158,7 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
     guard_grad = dm.functions["guard_grad"]
     normal_rate = dm.functions["normal_rate"]
     normal_accel = dm.functions["normal_accel"]
-    NX, NSTOPS, ORDER = dm.nx, dm.nstops, dm.order
+    NX, NSTOPS, ORDER, NMODES = dm.nx, dm.nstops, dm.order, dm.nmodes
     ROWS = np.array(dm.rows, dtype=np.int64)  # (a mode's event rows: its transitions; -1 padding)
     NEV = ROWS.shape[1]
     TARGETS = np.array(dm.targets, dtype=np.int64)
@@ -369,6 +370,8 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
                 event and ev_stop >= NSTOPS
             ):  # sliding ends at a tangency, to that side (impacts.leave_sliding)
                 set_mode(st, ev_stop, LEAVE_SLIDING)
+                if outside_mode(x, sf[S], pv, st[VF], BACK[ev_stop]):
+                    return STATUS_OUTSIDE_MODE
             elif (
                 event
                 and SLIDE_ENTRY[ev_stop] >= 0
@@ -410,6 +413,8 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
                     set_mode(st, ev_stop, SWITCH)
                     if outside_mode(x, s, pv, st[VF], -1):
                         return STATUS_OUTSIDE_MODE
+                elif NMODES > 1 and outside_mode(x, s, pv, vf, -1):  # (a reset within a mode: at_event)
+                    return STATUS_OUTSIDE_MODE
                 if STICKS[ev_stop] != 0 and chatter_remaining(x, s, pv, ev_stop, -vn, chatter_time) >= 0.0:
                     return NEEDS_CPU  # (complete chattering, then sticking: not on the GPU yet)
         return STATUS_OK

@@ -181,6 +181,8 @@ def at_event(m, r, x, xp, pv, j, nrows, V, chatter_time, record, tables):
     r.defl_stop = j
     if m.targets[j] != r.vf:  # a reset that also changes the mode (the rocking block's corners)
         change_mode(m, r, x, pv, j, record, tables)
+    elif m.nmodes > 1:  # a reset within a mode: it too lands inside the mode's region, or the run ends
+        check_region(m, r, x, pv, -1)
     if m.sticks[j]:
         dt_acc = chatter_remaining(m, x, r.s, pv, j, speed, chatter_time)
         if dt_acc >= 0.0:  # complete chattering: on to the accumulation point, then sticking
@@ -310,10 +312,12 @@ def leave_sliding(m, r, x, pv, j, record, tables):
     There ``f_s`` equals the field of the side it leaves to, so the saltation
     matrix is the identity.  The guard of the surface's transition from that
     side (``m.back[j]``) starts with a double root at ``u = 0`` (``h = 0`` and
-    ``L_f h = 0``).  Recorded as ``[t, j, state]`` in ``tables[3]`` when ``record``.
+    ``L_f h = 0``).  Recorded as ``[t, j, state]`` in ``tables[3]`` when ``record``.  A state outside
+    the region of the mode it leaves to ends the run (:func:`check_region`).
     """
     record_switch(m, r, x, j, record, tables)
     set_mode(m, r, j, LEAVE_SLIDING)
+    check_region(m, r, x, pv, m.back[j])
 
 
 @njit(cache=True)
