@@ -23,11 +23,14 @@ modes: each thread carries its point's mode (its kernels, its event rows:
 the transitions out of it); a switch without a reset changes the mode
 (``impacts.switch_mode``), a reset may too (``impacts.change_mode``), each
 followed by the CPU's test that the state is inside the new mode's region
-(``impacts.check_region``: else the point's status is ``OUTSIDE_MODE``; so is
-a reset within a mode, and an exit from sliding); a
-crossing where the far side's field pushes back enters Filippov's sliding
-pseudo-mode (``impacts.enter_sliding``), kept on its surface at each step's
-end and sample, left by its virtual exits (``impacts.leave_sliding``).
+(``impacts.check_region``: else the point's status is ``OUTSIDE_MODE``; so
+after a reset within a mode and an exit from sliding); a crossing where the
+far side's field pushes back enters Filippov's sliding pseudo-mode
+(``impacts.enter_sliding``), kept on its surface at each step's end and
+sample, left by its virtual exits (``impacts.leave_sliding``).  What these
+do with the model's values (the mode after the transition, the region test,
+the projection onto a guard, the saltation matrix) is the CPU's own code too
+(:mod:`grazing.engine.driver.transitions`).
 Lyapunov exponents are a kernel of their own (:func:`build_kernel`'s
 ``lyapunov``: the variational equations, their Gram-Schmidt after each step
 and the saltation matrix at each impact, switch and entry into sliding,
