@@ -5,31 +5,18 @@ equal the CPU lanes' to the bit (``cases_mode_entries.py``, run as ``test_simula
 
 from __future__ import annotations
 
-import json
-import os
-import subprocess
-import sys
-from pathlib import Path
-
 import pytest
 
 from grazing.core.solution import Status
+from tests.gpu.test_simulator import simulator_results
 
 CASES = ("leave sliding", "reset within a mode", "lyapunov reset within a mode")
-ROOT = Path(__file__).resolve().parents[2]
 
 
 @pytest.fixture(scope="module")
 def compared() -> dict[str, dict[str, object]]:
     """Every case's CPU and GPU results (one process under the simulator)."""
-    env = {**os.environ, "NUMBA_ENABLE_CUDASIM": "1", "PYTHONWARNINGS": "ignore"}
-    env["PYTHONPATH"] = os.pathsep.join(p for p in (str(ROOT / "src"), str(ROOT), env.get("PYTHONPATH")) if p)
-    proc = subprocess.run(
-        [sys.executable, str(Path(__file__).with_name("cases_mode_entries.py"))],
-        capture_output=True, text=True, env=env, timeout=300,
-    )  # fmt: skip
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    return json.loads(proc.stdout.strip().splitlines()[-1])  # type: ignore[no-any-return]
+    return simulator_results("cases_mode_entries.py")
 
 
 @pytest.mark.parametrize("case", CASES)

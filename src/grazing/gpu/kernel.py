@@ -151,9 +151,9 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False) -> Any:
     repeats_with_period = helpers["repeats_with_period"]
     step_limit = helpers["step_limit"]
     start_times = helpers["start_times"]
-    mode_after = helpers["mode_after"]
-    outside_region = helpers["outside_region"]
-    onto_zero_step = helpers["onto_zero_step"]
+    mode_after, outside_region, onto_zero_step = (
+        helpers[k] for k in ("mode_after", "outside_region", "onto_zero_step")
+    )
     tc_free = dm.functions["mode_tc_free"]
     tc_var = dm.functions["mode_tc_var"]
     reset = dm.functions["reset"]
