@@ -35,17 +35,22 @@ CASES = ("pendulum B fresh", "pendulum C chained", "pendulum A map", "pendulum h
 ROOT = Path(__file__).resolve().parents[2]
 
 
-@pytest.fixture(scope="module")
-def compared() -> dict[str, dict[str, object]]:
-    """Every case's CPU and GPU results (one process under the simulator)."""
+def simulator_results(script: str) -> dict[str, dict[str, object]]:
+    """The JSON object a script of ``tests/gpu`` prints, run in a process of its own under the simulator."""
     env = {**os.environ, "NUMBA_ENABLE_CUDASIM": "1", "PYTHONWARNINGS": "ignore"}
     env["PYTHONPATH"] = os.pathsep.join(p for p in (str(ROOT / "src"), str(ROOT), env.get("PYTHONPATH")) if p)
     proc = subprocess.run(
-        [sys.executable, str(Path(__file__).with_name("simulator_cases.py"))],
+        [sys.executable, str(Path(__file__).with_name(script))],
         capture_output=True, text=True, env=env, timeout=300,
     )  # fmt: skip
     assert proc.returncode == 0, proc.stderr[-3000:]
     return json.loads(proc.stdout.strip().splitlines()[-1])  # type: ignore[no-any-return]
+
+
+@pytest.fixture(scope="module")
+def compared() -> dict[str, dict[str, object]]:
+    """Every case's CPU and GPU results (one process under the simulator)."""
+    return simulator_results("simulator_cases.py")
 
 
 @pytest.mark.parametrize("case", CASES)

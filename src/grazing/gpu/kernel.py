@@ -33,10 +33,14 @@ modes: each thread carries its point's mode (its kernels, its event rows:
 the transitions out of it); a switch without a reset changes the mode
 (``impacts.switch_mode``), a reset may too (``impacts.change_mode``), each
 followed by the CPU's test that the state is inside the new mode's region
-(``impacts.check_region``: else the point's status is ``OUTSIDE_MODE``); a
-crossing where the far side's field pushes back enters Filippov's sliding
-pseudo-mode (``impacts.enter_sliding``), kept on its surface at each step's
-end and sample, left by its virtual exits (``impacts.leave_sliding``).
+(``impacts.check_region``: else the point's status is ``OUTSIDE_MODE``; so
+after a reset within a mode and an exit from sliding); a crossing where the
+far side's field pushes back enters Filippov's sliding pseudo-mode
+(``impacts.enter_sliding``), kept on its surface at each step's end and
+sample, left by its virtual exits (``impacts.leave_sliding``).  What these
+do with the model's values (the mode after the transition, the region test,
+the projection onto a guard, the saltation matrix) is the CPU's own code too
+(:mod:`grazing.engine.driver.transitions`).
 Lyapunov exponents are a kernel of their own (:func:`build_kernel`'s
 ``lyapunov``: the variational equations, their Gram-Schmidt after each step
 and the saltation matrix at each impact, switch and entry into sliding,
@@ -56,10 +60,10 @@ from typing import Any
 import numpy as np
 from numba import cuda  # (the simulator's, where NUMBA_ENABLE_CUDASIM=1: a global, which it swaps in kernels)
 
-from grazing.core.model import ON_STOP_TOL
 from grazing.core.options import ADAPTIVE_BLOCK, ADAPTIVE_MAX_PERIOD
 from grazing.core.solution import Status
 from grazing.engine.driver.step import STEP_LAST
+from grazing.engine.driver.transitions import ENTER_SLIDING, LEAVE_SLIDING, SWITCH
 from grazing.engine.polyroots import work_shape
 from grazing.engine.stepping import GUARD_SCALE
 
@@ -166,8 +170,6 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
     isolate_first_root = helpers["isolate_first_root"]
     confirm_first_root = helpers["confirm_first_root"]
     eval_rows = helpers["eval_rows"]
-    unpack_var = helpers["unpack_var"]
-    pack_var = helpers["pack_var"]
     repeats_with_period = helpers["repeats_with_period"]
     step_limit = helpers["step_limit"]
     start_times = helpers["start_times"]
@@ -178,6 +180,9 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
     kick_tangent = helpers["kick_tangent"]
     chatter_time_left = helpers["chatter_time_left"]
     along_contact_dir = helpers["along_contact_dir"]
+    mode_after, outside_region, onto_zero_step = (
+        helpers[k] for k in ("mode_after", "outside_region", "onto_zero_step")
+    )
     tc_free = dm.functions["mode_tc_free"]
     tc_var = dm.functions["mode_tc_var"]
     tc_stick = dm.functions["tc_stick"]  # (by the stop's index)
@@ -188,8 +193,7 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
     guard_grad = dm.functions["guard_grad"]
     normal_rate = dm.functions["normal_rate"]
     normal_accel = dm.functions["normal_accel"]
-    normal_rate_grad = dm.functions["normal_rate_grad"]
-    NX, NSTOPS, ORDER = dm.nx, dm.nstops, dm.order
+    NX, NSTOPS, ORDER, NMODES = dm.nx, dm.nstops, dm.order, dm.nmodes
     ROWS = np.array(dm.rows, dtype=np.int64)  # (a mode's event rows: its transitions; -1 padding)
     NEV = ROWS.shape[1]
     TARGETS = np.array(dm.targets, dtype=np.int64)
@@ -248,13 +252,8 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
         for _ in range(3):
             hval = guard(x, s, pv, j)
             guard_grad(x, s, pv, gx, j)
-            nn = 0.0
-            for i in range(NX):
-                nn += gx[i] * gx[i]
-            if nn == 0.0 or hval == 0.0:
+            if not onto_zero_step(x, NX, hval, gx):
                 break
-            for i in range(NX):
-                x[i] -= hval * gx[i] / nn
 
     @dj
     def contact_row(vf, j):
@@ -284,16 +283,21 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
     def outside_mode(x, s, pv, vf, known):
         """Whether ``x``, which has just entered mode ``vf``, is outside its region (``impacts.check_region``:
         a guard of the mode's own transitions other than ``known`` below ``-ON_STOP_TOL * max(1, |x|)``)."""
-        scale = 1.0
-        for i in range(NX):
-            scale = max(scale, abs(x[i]))
+        row_guards = cuda.local.array(NEV, float64)
         for row in range(NEV):
-            k = ROWS[vf, row]
-            if k < 0 or k >= NSTOPS or k == known:
-                continue
-            if guard(x, s, pv, k) < -ON_STOP_TOL * scale:
-                return True
-        return False
+            row_guards[row] = 0.0
+            if 0 <= ROWS[vf, row] < NSTOPS:  # (-1: padding; from NSTOPS on: a sliding pseudo-mode's exits)
+                row_guards[row] = guard(x, s, pv, ROWS[vf, row])
+        return outside_region(x, NX, row_guards, ROWS[vf], NSTOPS, known)
+
+    @dj
+    def set_mode(st, j, how):
+        """The thread's mode, surface and known roots after transition ``j`` (``impacts.set_mode``)."""
+        vf, surface, defl, defl_stop = mode_after(j, how, TARGETS, BACK, SLIDE_ENTRY)
+        st[VF] = vf
+        st[SURFACE] = surface
+        st[DEFL] = defl
+        st[DEFL_STOP] = defl_stop
 
     @dj
     def begin_request(st, sf, periods, keep_n, use_var, T):
@@ -454,10 +458,9 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
             elif (
                 event and ev_stop >= NSTOPS
             ):  # sliding ends at a tangency, to that side (impacts.leave_sliding)
-                st[VF] = TARGETS[ev_stop]
-                st[SURFACE] = 0
-                st[DEFL] = 2
-                st[DEFL_STOP] = BACK[ev_stop]
+                set_mode(st, ev_stop, LEAVE_SLIDING)
+                if outside_mode(x, sf[S], pv, st[VF], BACK[ev_stop]):
+                    return STATUS_OUTSIDE_MODE
             elif (
                 event
                 and SLIDE_ENTRY[ev_stop] >= 0
@@ -466,40 +469,29 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
             ):  # the far side's field pushes back: sliding (impacts.enter_sliding)
                 s = sf[S]
                 target = TARGETS[SLIDE_ENTRY[ev_stop]]
-                if LYAP and var:
-                    unpack_var(x, NX, NX, V)
+                if LYAP and var:  # (the saltation matrix of a switch into Filippov's field)
                     if not saltation(x, x, s, pv, ev_stop, V, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn, vf, target):
                         st[JAC_VALID] = 0
-                    pack_var(V, NX, NX, x)
                 onto_guard(x, s, pv, ev_stop, gx)
-                st[VF] = target
-                st[SURFACE] = 1 + ev_stop
-                st[DEFL] = 0
+                set_mode(st, ev_stop, ENTER_SLIDING)
             elif event and RESETS[ev_stop] == 0:  # a switch of vector field, no reset (impacts.switch_mode)
                 s = sf[S]
                 target = TARGETS[ev_stop]
                 if LYAP and var:  # (the saltation matrix of a switch: the identity reset)
-                    unpack_var(x, NX, NX, V)
                     if not saltation(x, x, s, pv, ev_stop, V, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn, vf, target):
                         st[JAC_VALID] = 0
-                    pack_var(V, NX, NX, x)
-                st[VF] = target
-                st[SURFACE] = 0
-                st[DEFL] = 1 if BACK[ev_stop] >= 0 else 0
-                st[DEFL_STOP] = BACK[ev_stop]
-                if outside_mode(x, s, pv, target, BACK[ev_stop]):
+                set_mode(st, ev_stop, SWITCH)
+                if outside_mode(x, s, pv, st[VF], BACK[ev_stop]):
                     return STATUS_OUTSIDE_MODE
             elif event:  # an impact on stop ev_stop (impacts.at_event, apply_impact)
                 s = sf[S]
                 vn = normal_rate(x, s, pv, ev_stop)
                 reset(x, s, pv, xp, ev_stop)
                 if LYAP and var:  # (the variational matrix times the saltation matrix)
-                    unpack_var(x, NX, NX, V)
                     if not saltation(
                         x, xp, s, pv, ev_stop, V, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn, vf, TARGETS[ev_stop]
                     ):
                         st[JAC_VALID] = 0  # (an impact at zero normal speed has no Jacobian)
-                    pack_var(V, NX, NX, xp)
                 for i in range(NT if free_var else NX):
                     x[i] = xp[i]
                 st[DEFL] = 1
@@ -507,13 +499,11 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
                 if recording != 0 and final:
                     counts[ev_stop] += 1
                 if TARGETS[ev_stop] != vf:  # a reset that also changes the mode (impacts.change_mode)
-                    target = TARGETS[ev_stop]
-                    st[VF] = target
-                    st[SURFACE] = 0
-                    st[DEFL] = 1 if BACK[ev_stop] >= 0 else 0
-                    st[DEFL_STOP] = BACK[ev_stop]
-                    if outside_mode(x, s, pv, target, -1):
+                    set_mode(st, ev_stop, SWITCH)
+                    if outside_mode(x, s, pv, st[VF], -1):
                         return STATUS_OUTSIDE_MODE
+                elif NMODES > 1 and outside_mode(x, s, pv, vf, -1):  # (a reset within a mode: at_event)
+                    return STATUS_OUTSIDE_MODE
                 if STICKS[ev_stop] != 0:  # complete chattering: to its accumulation point, then sticking
                     w_out = normal_rate(x, s, pv, ev_stop)
                     dt_acc = chatter_time_left(w_out, normal_accel(x, s, pv, ev_stop), -vn, chatter_time)

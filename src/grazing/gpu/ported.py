@@ -6,11 +6,14 @@ The step size (:func:`~grazing.engine.stepping.step_size`, with its
 (:mod:`grazing.engine.polyroots`: quadratic bound, Bernstein subdivision,
 Newton polishing, the check that the root is the first), the test of a
 repeating transient, the start times, the step's cut at the last sample and at
-the discontinuity map's phase (``step.cut_step``), the map's kick and its
-tangent (``tangent.map_kick``, ``kick_tangent``), the Lyapunov vectors'
-Gram-Schmidt and (un)packing of the variational matrix, chattering's time to
-its accumulation point and the Newton step onto a sticking contact
-(:mod:`grazing.engine.driver.impacts`), and the model code's ``sin`` and ``cos``
+the discontinuity map's phase (``step.cut_step``, ``map_reached``), the map's
+kick and its tangent (``tangent.map_kick``, ``kick_tangent``), the Lyapunov
+vectors' Gram-Schmidt and (un)packing of the variational matrix, chattering's
+time to its accumulation point and the Newton step onto a sticking contact
+(:mod:`grazing.engine.driver.impacts`), the cores of a transition
+(:mod:`grazing.engine.driver.transitions`: the saltation matrix, the
+projection onto a guard, the mode after a switch or sliding, the region
+check), and the model code's ``sin`` and ``cos``
 (:mod:`grazing.engine.sincos`: not the C library's) are compiled for the GPU from the
 very text the CPU driver compiles: the decorators dropped, each function
 executed in one namespace where every callee is its device copy.  A change in
@@ -47,6 +50,9 @@ PORTED: dict[str, tuple[str, ...]] = {
     ),
     "grazing.engine.driver.events": ("event_polynomial", "event_certificate"),
     "grazing.engine.driver.impacts": ("chatter_time_left", "along_contact_dir"),
+    "grazing.engine.driver.transitions": (
+        "mode_after", "outside_region", "onto_zero_step", "saltation_vector", "apply_saltation",
+    ),
     "grazing.core.period": ("repeats_with_period",),
     "grazing.core.options": ("step_limit",),
     "grazing.engine.timebase": ("start_times", "map_period"),

@@ -1,12 +1,15 @@
 """The tangent dynamics of the sweep kernel: the Lyapunov vectors' step and the saltation matrix at an impact.
 
-The CPU driver's :func:`~grazing.engine.driver.tangent.lyapunov_step` and
-:func:`~grazing.engine.driver.impacts.saltation` as device functions, operation
-for operation (the same sums in the same order), over arrays the kernel's
-thread owns: the CPU versions allocate their small buffers and read the run's
-record, which a device function cannot.  The Gram-Schmidt step
-(:func:`~grazing.engine.stepping.orthonormalize`) and the (un)packing of the
-variational matrix are the CPU's own code (:mod:`grazing.gpu.ported`); the
+The CPU driver's :func:`~grazing.engine.driver.tangent.lyapunov_step` as a
+device function, operation for operation (the same sums in the same order),
+over arrays the kernel's thread owns: the CPU version allocates its small
+buffers and reads the run's record, which a device function cannot.  The
+saltation matrix (:func:`~grazing.engine.driver.impacts.saltation`) is the
+model's derivatives, evaluated into the thread's arrays, handed to the CPU's
+own cores (:func:`~grazing.engine.driver.transitions.saltation_vector`,
+:func:`~grazing.engine.driver.transitions.apply_saltation`), as are the
+Gram-Schmidt step (:func:`~grazing.engine.stepping.orthonormalize`) and the
+(un)packing of the variational matrix (:mod:`grazing.gpu.ported`); the
 model's field, reset Jacobian and guard gradient its generated functions
 (:mod:`grazing.gpu.model`, a mode's by its index).  No sensitivity columns: the variational
 matrix is ``n x n`` (``ncol = n``, as on the CPU lanes).
@@ -39,6 +42,8 @@ def tangent_functions(dm: Any) -> TangentFunctions:
     unpack_var = helpers["unpack_var"]
     pack_var = helpers["pack_var"]
     eval_rows = helpers["eval_rows"]
+    saltation_vector = helpers["saltation_vector"]
+    apply_saltation = helpers["apply_saltation"]
     rhs = dm.functions["mode_rhs"]
     reset_jac = dm.functions["reset_jac"]
     guard_grad = dm.functions["guard_grad"]
@@ -82,9 +87,11 @@ def tangent_functions(dm: Any) -> TangentFunctions:
         return code
 
     def saltation(xm, xp, s, pv, j, V, fm, fp, Gx, Gt, Gp, hx, w, hv, Vn, vf_from, vf_to):
-        """The saltation matrix of stop ``j`` applied to ``V`` (``impacts.saltation``, no parameter
-        columns); False, ``V`` left alone, at zero normal speed.  ``f-`` is mode ``vf_from``'s field at
-        ``xm``, ``f+`` mode ``vf_to``'s at ``xp``; the rest are the thread's buffers."""
+        """The variational matrix in ``xm`` times the saltation matrix of stop ``j``, into ``xp``
+        (``impacts.saltation`` between ``unpack_var`` and ``pack_var``, no parameter columns); False, the
+        matrix carried unchanged, at zero normal speed.  ``f-`` is mode ``vf_from``'s field at ``xm``,
+        ``f+`` mode ``vf_to``'s at ``xp``; ``V`` and the rest are the thread's buffers."""
+        unpack_var(xm, NX, NX, V)
         rhs(xm, s, pv, fm, vf_from)
         rhs(xp, s, pv, fp, vf_to)
         for i in range(NX):
@@ -95,30 +102,10 @@ def tangent_functions(dm: Any) -> TangentFunctions:
                 Gx[i, c] = 0.0
         reset_jac(xm, s, pv, Gx, Gt, Gp, j)
         ht = guard_grad(xm, s, pv, hx, j)
-        den = ht
-        for i in range(NX):
-            den += hx[i] * fm[i]
-        if den == 0.0:
-            return False
-        for i in range(NX):
-            acc = fp[i] - Gt[i]
-            for q in range(NX):
-                acc -= Gx[i, q] * fm[q]
-            w[i] = acc / den
-        for c in range(NX):
-            acc = 0.0
-            for q in range(NX):
-                acc += hx[q] * V[q, c]
-            hv[c] = acc
-        for i in range(NX):
-            for c in range(NX):
-                acc = 0.0
-                for q in range(NX):
-                    acc += Gx[i, q] * V[q, c]
-                Vn[i, c] = acc + w[i] * hv[c]
-        for i in range(NX):
-            for c in range(NX):
-                V[i, c] = Vn[i, c]
-        return True
+        ok = saltation_vector(fm, fp, Gx, Gt, hx, ht, NX, w)
+        if ok:
+            apply_saltation(V, Gx, Gp, hx, Gt, w, NX, NX, hv, Vn)  # (no parameter columns: Gp, Gt not read)
+        pack_var(V, NX, NX, xp)
+        return ok
 
     return TangentFunctions(device_function(lyapunov_step), device_function(saltation))

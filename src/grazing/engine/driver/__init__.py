@@ -26,8 +26,11 @@ The pieces, in the order a step uses them:
   minimum and closest approach;
 * :mod:`.tangent` -- the variational equations at period boundaries, Lyapunov
   orthonormalisation, the discontinuity map;
+* :mod:`.transitions` -- the record-free cores of a transition (saltation
+  matrix, projection onto a guard, the mode after it, the region check),
+  which the GPU kernel compiles too;
 * :mod:`.impacts` -- reset and saltation matrix, chattering summed to sticking,
-  release;
+  release, switches of mode and sliding;
 * :mod:`.step` -- the parts of a step that the loop and the lanes share:
   where it ends, and its end (time, Lyapunov vectors, the map, the event);
 * :mod:`.loop` -- ``integrate(start, config) -> result`` over the records of
@@ -41,8 +44,8 @@ from __future__ import annotations
 from pathlib import Path
 
 PIECES = (
-    "atomics.py", "state.py", "calls.py", "events.py", "recording.py", "tangent.py", "impacts.py", "step.py",
-    "loop.py", "lanes.py",
+    "atomics.py", "state.py", "calls.py", "events.py", "recording.py", "tangent.py", "transitions.py",
+    "impacts.py", "step.py", "loop.py", "lanes.py",
 )  # fmt: skip
 """The template files, in the order they are appended."""
 

@@ -13,7 +13,6 @@ import math
 import numpy as np
 from numba import njit
 
-from grazing.core.model import ON_STOP_TOL
 from grazing.engine.driver.calls import (
     contact_dir,
     guard,
@@ -27,6 +26,16 @@ from grazing.engine.driver.calls import (
     rhs,
 )
 from grazing.engine.driver.state import STATUS_OUTSIDE_MODE
+from grazing.engine.driver.transitions import (
+    ENTER_SLIDING,
+    LEAVE_SLIDING,
+    SWITCH,
+    apply_saltation,
+    mode_after,
+    onto_zero_step,
+    outside_region,
+    saltation_vector,
+)
 from grazing.engine.stepping import append_pair, append_record, append_row, pack_var, unpack_var
 
 
@@ -53,56 +62,22 @@ def saltation(m, xm, xp, s, pv, j, V, ncol, vf_from, vf_to):
     hp = np.zeros(max(nsens, 1))
     ht = guard_grad(m, xm, s, pv, hx, j)
     guard_pgrad(m, xm, s, pv, hp, j)
-    den = ht
-    for i in range(n):
-        den += hx[i] * fm[i]
-    if den == 0.0:
-        return False
     w = np.empty(n)
-    for i in range(n):
-        acc = fp[i] - Gt[i]
-        for j in range(n):
-            acc -= Gx[i, j] * fm[j]
-        w[i] = acc / den
-    # row vector hx V (+ hp on the parameter columns)
-    hv = np.zeros(ncol)
-    for c in range(ncol):
-        acc = 0.0
-        for j in range(n):
-            acc += hx[j] * V[j, c]
-        if c >= n:
-            acc += hp[c - n]
-        hv[c] = acc
-    Vn = np.empty((n, ncol))
-    for i in range(n):
-        for c in range(ncol):
-            acc = 0.0
-            for j in range(n):
-                acc += Gx[i, j] * V[j, c]
-            if c >= n:
-                acc += Gp[i, c - n]
-            Vn[i, c] = acc + w[i] * hv[c]
-    for i in range(n):
-        for c in range(ncol):
-            V[i, c] = Vn[i, c]
+    if not saltation_vector(fm, fp, Gx, Gt, hx, ht, n, w):
+        return False
+    apply_saltation(V, Gx, Gp, hx, hp, w, n, ncol, np.zeros(ncol), np.empty((n, ncol)))
     return True
 
 
 @njit(cache=True)
 def onto_guard(m, x, s, pv, j):
     """Project x onto the zero set of stop ``j``'s guard (Newton along its gradient, three steps at most)."""
-    n = m.nx
-    gx = np.zeros(n)
+    gx = np.zeros(m.nx)
     for _ in range(3):
         hval = guard(m, x, s, pv, j)
         guard_grad(m, x, s, pv, gx, j)
-        nn = 0.0
-        for i in range(n):
-            nn += gx[i] * gx[i]
-        if nn == 0.0 or hval == 0.0:
+        if not onto_zero_step(x, m.nx, hval, gx):
             break
-        for i in range(n):
-            x[i] -= hval * gx[i] / nn
 
 
 @njit(cache=True)
@@ -187,7 +162,7 @@ def at_event(m, r, x, xp, pv, j, nrows, V, chatter_time, record, tables):
     """
     t = r.k * r.T + r.s
     if j >= m.nstops:  # sliding ends at a tangency: to that side (f_s = f there, S = I)
-        leave_sliding(m, r, x, j, record, tables)
+        leave_sliding(m, r, x, pv, j, record, tables)
         return False
     if r.mode == 1 and j == r.stuck:  # release from sticking: the contact force changes sign
         r.mode = 0
@@ -216,6 +191,8 @@ def at_event(m, r, x, xp, pv, j, nrows, V, chatter_time, record, tables):
     r.defl_stop = j
     if m.targets[j] != r.vf:  # a reset that also changes the mode (the rocking block's corners)
         change_mode(m, r, x, pv, j, record, tables)
+    elif m.nmodes > 1:  # a reset within a mode: it too lands inside the mode's region, or the run ends
+        check_region(m, r, x, pv, -1)
     if m.sticks[j]:
         dt_acc = chatter_remaining(m, x, r.s, pv, j, speed, chatter_time)
         if dt_acc >= 0.0:  # complete chattering: on to the accumulation point, then sticking
@@ -238,33 +215,53 @@ def at_event(m, r, x, xp, pv, j, nrows, V, chatter_time, record, tables):
 def switch_mode(m, r, x, pv, j, V, record, tables):
     """Run ``r`` (its state ``x``, on transition ``j``'s guard) switches to ``j``'s target mode, no reset.
 
-    The variational matrix is multiplied by the saltation matrix of a switch,
-    ``S = I + (f+ - f-) (h_x V + h_p) / (h_x f- + h_t)`` (:func:`saltation` with
-    the identity reset); the switch is recorded as ``[t, j, state]`` in
+    The variational matrix is multiplied by the saltation matrix of a switch
+    (:func:`switch_saltation`); the switch is recorded as ``[t, j, state]`` in
     ``tables[3]`` when ``record``, and in the trajectory.  The root at ``u = 0``
-    of the transition back (``m.back[j]``, whose guard is 0 here) is known.
+    of the transition back (``m.back[j]``, whose guard is 0 here) is known.  A
+    state outside the target mode's region ends the run (:func:`check_region`).
     """
-    n = m.nx
-    ncol = n + m.nsens
-    s = r.s
-    t = r.k * r.T + s
-    target = m.targets[j]
+    switch_saltation(m, r, x, pv, j, m.targets[j], V)
+    record_switch(m, r, x, j, record, tables)
+    set_mode(m, r, j, SWITCH)
+    check_region(m, r, x, pv, m.back[j])
+
+
+@njit(cache=True)
+def switch_saltation(m, r, x, pv, j, target, V):
+    """The variational matrix of run ``r`` (in ``x``, on transition ``j``'s guard) times the saltation
+    matrix of a switch from mode ``r.vf`` to mode ``target``.
+
+    ``S = I + (f+ - f-) (h_x V + h_p) / (h_x f- + h_t)``: :func:`saltation`
+    with the identity reset.  A switch at zero normal speed leaves the
+    Jacobian invalid (``r.jac_valid``).
+    """
     if r.use_var:
+        n = m.nx
+        ncol = n + m.nsens
         unpack_var(x, n, ncol, V)
-        ok = saltation(m, x, x, s, pv, j, V, ncol, r.vf, target)
+        ok = saltation(m, x, x, r.s, pv, j, V, ncol, r.vf, target)
         pack_var(V, n, ncol, x)
         r.jac_valid = r.jac_valid and ok
+
+
+@njit(cache=True)
+def record_switch(m, r, x, code, record, tables):
+    """A change of mode of run ``r`` at state ``x``: ``[t, code, state]`` in ``tables[3]`` when
+    ``record``, and the state in the trajectory when it is recorded."""
+    t = r.k * r.T + r.s
     if record:
-        append_record(tables[3], r.n_switch, t, j, x, n)
+        append_record(tables[3], r.n_switch, t, code, x, m.nx)
         r.n_switch += 1
     if r.recording and r.traj_dt > 0.0:
-        append_row(tables[2], r.n_traj, t, x, n)
+        append_row(tables[2], r.n_traj, t, x, m.nx)
         r.n_traj += 1
-    r.vf = target
-    r.surface = 0
-    r.defl = 1 if m.back[j] >= 0 else 0
-    r.defl_stop = m.back[j]
-    check_region(m, r, x, pv, m.back[j])
+
+
+@njit(cache=True)
+def set_mode(m, r, j, how):
+    """Run ``r``'s mode, surface and known roots after transition ``j`` (:func:`.transitions.mode_after`)."""
+    r.vf, r.surface, r.defl, r.defl_stop = mode_after(j, how, m.targets, m.back, m.slide_entry)
 
 
 @njit(cache=True)
@@ -273,22 +270,18 @@ def check_region(m, r, x, pv, known):
     ``x`` is outside that mode's region.
 
     Outside: a guard of the mode's own transitions, other than ``known`` (the way back after a switch,
-    whose guard is 0 there; -1: none), below ``-ON_STOP_TOL * max(1, |x|)`` (as
-    :meth:`HybridModel.check_state` refuses an initial state).  The run would take an event at once on
-    that guard, off its surface: the modes' regions do not fit together there.  The run keeps its
-    state and mode, and its status says why it ended.
+    whose guard is 0 there; -1: none), below ``-ON_STOP_TOL * max(1, |x|)``
+    (:func:`.transitions.outside_region`).  The run would take an event at once on that guard, off its
+    surface: the modes' regions do not fit together there.  The run keeps its state and mode, and its
+    status says why it ended.
     """
-    scale = 1.0
-    for i in range(m.nx):
-        scale = max(scale, abs(x[i]))
-    vf = r.vf
-    for row in range(m.rows.shape[1]):
-        k = m.rows[vf, row]  # (-1: padding; from m.nstops on: a sliding pseudo-mode's exits)
-        if k < 0 or k >= m.nstops or k == known:
-            continue
-        if guard(m, x, r.s, pv, k) < -ON_STOP_TOL * scale:
-            r.status = STATUS_OUTSIDE_MODE
-            return
+    rows = m.rows[r.vf]
+    row_guards = np.zeros(rows.shape[0])
+    for row in range(rows.shape[0]):
+        if 0 <= rows[row] < m.nstops:  # (-1: padding; from m.nstops on: a sliding pseudo-mode's exits)
+            row_guards[row] = guard(m, x, r.s, pv, rows[row])
+    if outside_region(x, m.nx, row_guards, rows, m.nstops, known):
+        r.status = STATUS_OUTSIDE_MODE
 
 
 @njit(cache=True)
@@ -315,48 +308,26 @@ def enter_sliding(m, r, x, pv, j, V, record, tables):
     in ``tables[3]`` when ``record``.  No root at ``u = 0`` is known: the exit
     rows are nonzero in strict sliding.
     """
-    n = m.nx
-    ncol = n + m.nsens
-    s = r.s
     entry = m.slide_entry[j]
-    target = m.targets[entry]
-    if r.use_var:
-        unpack_var(x, n, ncol, V)
-        ok = saltation(m, x, x, s, pv, j, V, ncol, r.vf, target)
-        pack_var(V, n, ncol, x)
-        r.jac_valid = r.jac_valid and ok
-    onto_guard(m, x, s, pv, j)
-    if record:
-        append_record(tables[3], r.n_switch, r.k * r.T + s, entry, x, n)
-        r.n_switch += 1
-    if r.recording and r.traj_dt > 0.0:
-        append_row(tables[2], r.n_traj, r.k * r.T + s, x, n)
-        r.n_traj += 1
-    r.vf = target
-    r.surface = 1 + j
-    r.defl = 0
+    switch_saltation(m, r, x, pv, j, m.targets[entry], V)
+    onto_guard(m, x, r.s, pv, j)
+    record_switch(m, r, x, entry, record, tables)
+    set_mode(m, r, j, ENTER_SLIDING)
 
 
 @njit(cache=True)
-def leave_sliding(m, r, x, j, record, tables):
+def leave_sliding(m, r, x, pv, j, record, tables):
     """Run ``r`` leaves its sliding pseudo-mode by the virtual exit ``j`` (an exit row reached 0).
 
     There ``f_s`` equals the field of the side it leaves to, so the saltation
     matrix is the identity.  The guard of the surface's transition from that
     side (``m.back[j]``) starts with a double root at ``u = 0`` (``h = 0`` and
-    ``L_f h = 0``).  Recorded as ``[t, j, state]`` in ``tables[3]`` when ``record``.
+    ``L_f h = 0``).  Recorded as ``[t, j, state]`` in ``tables[3]`` when ``record``.  A state outside
+    the region of the mode it leaves to ends the run (:func:`check_region`).
     """
-    t = r.k * r.T + r.s
-    if record:
-        append_record(tables[3], r.n_switch, t, j, x, m.nx)
-        r.n_switch += 1
-    if r.recording and r.traj_dt > 0.0:
-        append_row(tables[2], r.n_traj, t, x, m.nx)
-        r.n_traj += 1
-    r.vf = m.targets[j]
-    r.surface = 0
-    r.defl = 2
-    r.defl_stop = m.back[j]
+    record_switch(m, r, x, j, record, tables)
+    set_mode(m, r, j, LEAVE_SLIDING)
+    check_region(m, r, x, pv, m.back[j])
 
 
 @njit(cache=True)
@@ -373,10 +344,7 @@ def change_mode(m, r, x, pv, j, record, tables):
     if record:
         append_record(tables[3], r.n_switch, r.k * r.T + r.s, j, x, m.nx)
         r.n_switch += 1
-    r.vf = m.targets[j]
-    r.surface = 0
-    r.defl = 1 if m.back[j] >= 0 else 0
-    r.defl_stop = m.back[j]
+    set_mode(m, r, j, SWITCH)
     check_region(m, r, x, pv, -1)
 
 
