@@ -173,6 +173,8 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
     repeats_with_period = helpers["repeats_with_period"]
     step_limit = helpers["step_limit"]
     start_times = helpers["start_times"]
+    unpack_var = helpers["unpack_var"]
+    pack_var = helpers["pack_var"]
     map_period = helpers["map_period"]
     cut_step = helpers["cut_step"]
     map_reached = helpers["map_reached"]
