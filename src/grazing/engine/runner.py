@@ -127,6 +127,25 @@ def check_map_stop(model: HybridModel, stop: int) -> None:
         )
 
 
+def map_stops(model: HybridModel) -> list[int]:
+    """The stops the discontinuity map can stand for (:func:`check_map_stop`): every stop of a model of one
+    mode; with modes, the transitions with a reset back into the mode they leave.
+
+    Examples
+    --------
+    >>> import grazing
+    >>> map_stops(grazing.models.pendulum())
+    [0, 1]
+    """
+    if not model.has_modes:
+        return list(range(model.n_stops))
+    return [
+        j
+        for j in range(model.n_stops)
+        if model.transition_resets[j] and model.transition_source[j] == model.transition_target[j]
+    ]
+
+
 @dataclass(frozen=True)
 class Segment:
     """Raw outputs of one :meth:`Runner.advance` call (see the driver for details)."""
