@@ -79,7 +79,9 @@ class DiscontinuityMap:
         map is applied.
     stop
         Index of the stop it stands for; impacts on the model's other stops
-        are applied as usual.
+        are applied as usual.  On a model with modes, a stop of one mode
+        (:func:`check_map_stop`): the map is applied only while the run is in
+        that mode.
     """
 
     phase: float

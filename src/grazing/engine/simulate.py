@@ -93,6 +93,8 @@ def simulate(
         A :class:`~grazing.engine.runner.DiscontinuityMap`: ignore the stop and
         apply Nordmark's discontinuity map once per period at the grazing
         phase instead (the map Pi of the paper's eq. 20, with the nonlinear flow).
+        On a model with modes it stands for a stop of one mode (a reset back
+        into it) and is applied only while the run is in that mode.
     touching
         The run starts and ends in tangential contact with the stop (``h = 0``
         and ``L_f h = 0``: a grazing orbit followed from its contact point);
