@@ -291,8 +291,11 @@ def test_features_not_yet_on_modes_are_refused_in_one_line():
 
     m = soft()
     # (virtual orbits go through modes: tests/orbits/test_virtual_through_modes.py)
-    with pytest.raises(InvalidParameterError, match=r"^the discontinuity map does not support models"):
-        grazing.simulate(m, [0.0, 0.0], periods=1, zdm=object())
+    # (the map stands for a stop of one mode: tests/engine/test_zdm_modes.py; not for a switch)
+    from grazing.engine.runner import DiscontinuityMap
+
+    with pytest.raises(InvalidParameterError, match=r"^the discontinuity map stands for an impact"):
+        grazing.simulate(m, [0.0, 0.0], periods=1, zdm=DiscontinuityMap(0.0, 1.0, (0.0, 1.0), stop=0))
     # (the grazing analysis and the grazing curve go through modes: tests/orbits/test_curves_through_modes.py)
     # (the attractors and basins go through modes: tests/attractors/test_basins_modes.py)
     from grazing.maps import flow_map

@@ -427,16 +427,24 @@ _GRAZE_SEARCH = {"eta": (0.2, 1.0), "theta_hat": (-3.1, 3.1)}
 
 def _map_for_sweep(model: Any, name: str, lo: float, hi: float, which: str) -> tuple[Any, dict[str, Any]]:
     """The discontinuity map at the first/second grazing for a sweep in ``name`` over ``[lo, hi]``."""
+    from grazing.engine.runner import map_stops
     from grazing.normalform import find_grazing_point, normal_form_at
 
     pendulum = model.name == "pendulum"
     a, b = _GRAZE_SEARCH.get(name, (lo, hi)) if pendulum else (lo, hi)
-    point = find_grazing_point(model, name, min(a, lo), max(b, hi), which)
+    stops = map_stops(model)  # (with modes: the first stop of a mode, not a switch)
+    if not stops:
+        raise InputError(
+            f"--method map: model {model.name!r} has no stop of a mode (a transition with a reset back into "
+            "the mode it leaves) for the discontinuity map to stand for"
+        )
+    point = find_grazing_point(model, name, min(a, lo), max(b, hi), which, stop_name=stops[0])
     nf = normal_form_at(point, PENDULUM_UNFOLDING if pendulum else (name,))
     back = math.degrees if name == "theta_hat" else float
     info = {
         "param": name,
         "value": back(point.model.params[name]),
+        "stop": point.stop_name,
         "t_graze": point.phase,
         "multipliers": complex_list(point.multipliers),
         "accel": nf.accel,

@@ -24,7 +24,7 @@ from grazing.engine.codegen import ModelKernels, direction_columns, taylor_order
 from grazing.engine.native import load_integrate
 from grazing.engine.records import CALL, STATIC, Config, Result, RunOutput
 from grazing.engine.timebase import start_times
-from grazing.errors import SimulationError
+from grazing.errors import InvalidParameterError, SimulationError
 
 RECORD_IMPACTS = {"none": 0, "sampled": 1, "all": 2}
 
@@ -79,7 +79,9 @@ class DiscontinuityMap:
         map is applied.
     stop
         Index of the stop it stands for; impacts on the model's other stops
-        are applied as usual.
+        are applied as usual.  On a model with modes, a stop of one mode
+        (:func:`check_map_stop`): the map is applied only while the run is in
+        that mode.
     """
 
     phase: float
@@ -87,6 +89,63 @@ class DiscontinuityMap:
     direction: tuple[float, ...]
     window: float = math.inf
     stop: int = 0
+
+
+def check_map_stop(model: HybridModel, stop: int) -> None:
+    """One line (:class:`~grazing.errors.InvalidParameterError`) unless the discontinuity map can stand for
+    ``model``'s stop ``stop``: a stop of the model, and on a model with modes a transition with a reset
+    back into the mode it leaves (a mode's own stop: the map kicks the state and keeps the mode; it is
+    applied only while the run is in that mode).
+
+    Examples
+    --------
+    >>> import grazing
+    >>> check_map_stop(grazing.models.pendulum(), 1)
+    >>> check_map_stop(grazing.models.pendulum(), 2)
+    Traceback (most recent call last):
+    ...
+    grazing.errors.InvalidParameterError: the discontinuity map's stop 2 is not a stop of 'pendulum' (0..1)
+    """
+    if not 0 <= stop < model.n_stops:
+        raise InvalidParameterError(
+            f"the discontinuity map's stop {stop} is not a stop of {model.name!r} (0..{model.n_stops - 1})"
+        )
+    if not model.has_modes:
+        return
+    name, source, target = (
+        model.stop_names[stop],
+        model.transition_source[stop],
+        model.transition_target[stop],
+    )
+    if not model.transition_resets[stop]:
+        raise InvalidParameterError(
+            f"the discontinuity map stands for an impact: transition {name!r} has no reset (a switch of "
+            "vector field: its map is the switching surface's, grazing normal-form)"
+        )
+    if source != target:
+        raise InvalidParameterError(
+            f"the discontinuity map keeps the mode: it cannot stand for transition {name!r}, whose reset "
+            f"goes from mode {source!r} to {target!r} (only a stop of a mode, a reset back into it)"
+        )
+
+
+def map_stops(model: HybridModel) -> list[int]:
+    """The stops the discontinuity map can stand for (:func:`check_map_stop`): every stop of a model of one
+    mode; with modes, the transitions with a reset back into the mode they leave.
+
+    Examples
+    --------
+    >>> import grazing
+    >>> map_stops(grazing.models.pendulum())
+    [0, 1]
+    """
+    if not model.has_modes:
+        return list(range(model.n_stops))
+    return [
+        j
+        for j in range(model.n_stops)
+        if model.transition_resets[j] and model.transition_source[j] == model.transition_target[j]
+    ]
 
 
 @dataclass(frozen=True)

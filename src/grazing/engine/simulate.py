@@ -18,7 +18,7 @@ from grazing.core.options import (
     with_shorthands,
 )
 from grazing.core.solution import Impacts, Solution, Switches
-from grazing.engine.runner import DiscontinuityMap, Runner
+from grazing.engine.runner import DiscontinuityMap, Runner, check_map_stop
 from grazing.errors import InvalidParameterError
 
 CHUNK_PERIODS = 4096
@@ -93,6 +93,8 @@ def simulate(
         A :class:`~grazing.engine.runner.DiscontinuityMap`: ignore the stop and
         apply Nordmark's discontinuity map once per period at the grazing
         phase instead (the map Pi of the paper's eq. 20, with the nonlinear flow).
+        On a model with modes it stands for a stop of one mode (a reset back
+        into it) and is applied only while the run is in that mode.
     touching
         The run starts and ends in tangential contact with the stop (``h = 0``
         and ``L_f h = 0``: a grazing orbit followed from its contact point);
@@ -140,10 +142,11 @@ def simulate(
     tol, max_steps, chatter_tol = solver.tol, solver.max_steps, solver.chatter_tol
     if zdm is not None and not model.periodic:
         raise InvalidParameterError("the discontinuity map needs a periodically forced model")
+    if zdm is not None:
+        check_map_stop(model, int(zdm.stop))
     if model.has_modes:
         _refuse_on_modes(
             model,
-            zdm=zdm,
             touching=touching,
             stop_name=stop_name,
             mode=mode,
@@ -278,14 +281,12 @@ def simulate(
 def _refuse_on_modes(
     model: HybridModel,
     *,
-    zdm: DiscontinuityMap | None,
     touching: bool,
     stop_name: int | str | None,
     mode: str | None,
 ) -> None:
-    """One line for what ``simulate`` cannot do yet on a model with modes (``model.has_modes``)."""
-    if zdm is not None:
-        model.require_one_mode("the discontinuity map")
+    """One line for what ``simulate`` cannot do yet on a model with modes (``model.has_modes``) (the
+    discontinuity map's stop is :func:`~grazing.engine.runner.check_map_stop`'s)."""
     if touching:  # (a contact with a transition's guard, in the transition's source mode)
         j, start = model.stop_index(stop_name), model.mode_names[model.mode_index(mode)]
         if model.transition_source[j] != start:

@@ -358,9 +358,16 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
                 sf[LYAP_T0] = st[K] * T + sf[S] + dt
 
     @dj
-    def apply_map(x, s, pv, var, zset, V, gh, gv):
+    def apply_map(x, s, pv, var, zset, V, gh, gv, vf):
         """The discontinuity map at its phase (``tangent.discontinuity_map``): the state and, with ``var``,
-        the tangent vectors kicked; returns whether it applied.  ``V``, ``gh``, ``gv``: buffers."""
+        the tangent vectors kicked; returns whether it applied, never outside the stop's source mode
+        (``events.tracked_in``: its guard not a row of mode ``vf``).  ``V``, ``gh``, ``gv``: buffers."""
+        tracked = False
+        for row in range(NEV):
+            if ROWS[vf, row] == ZSTOP:
+                tracked = True
+        if not tracked:
+            return False
         hval = guard(x, s, pv, ZSTOP)
         vn = normal_rate(x, s, pv, ZSTOP)
         a = zset[ZDM_A]
@@ -447,7 +454,7 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
             sf[SPAN_DT] = math.nan
             if ZDM and map_reached(ends, event, u):  # the discontinuity map's phase (step.end_step)
                 st[KZ] += 1
-                if apply_map(x, sf[S], pv, var, zset, V, gx, hx) and recording != 0 and final:
+                if apply_map(x, sf[S], pv, var, zset, V, gx, hx, st[VF]) and recording != 0 and final:
                     counts[ZSTOP] += 1  # (a kick, counted as an impact on its stop: lanes.end_lane_step)
             if event and sticking and ev_stop != st[STUCK]:  # another transition fires: the contact ends
                 st[STICKING] = 0  # (impacts.at_event; a switch from the contact, off which the step drifted)

@@ -41,7 +41,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from grazing.core.model import HybridModel
-from grazing.engine.runner import DiscontinuityMap
+from grazing.engine.runner import DiscontinuityMap, check_map_stop
 from grazing.errors import InvalidParameterError
 from grazing.maps import flow_map
 from grazing.orbits.contact import GrazingPoint
@@ -164,7 +164,10 @@ class GrazingNormalForm:
 
         ``window`` bounds ``|L_f h| / a`` (default: a quarter period), so that
         the correction is only applied where the local parabola is meaningful.
+        On a model with modes the stop is a mode's own (a reset back into it):
+        the engine applies the map only while the run is in that mode.
         """
+        check_map_stop(self.model, self.point.stop)
         T = self.model.period
         return DiscontinuityMap(
             phase=self.point.phase,
@@ -234,7 +237,7 @@ def normal_form_at(point: GrazingPoint, params: tuple[str, ...]) -> GrazingNorma
     M = point.monodromy
     kappa = float(-(cd["h_x"] @ M @ e) / np.linalg.norm(e))
     names = [p.name for p in m.parameters]
-    fm = flow_map(m, x, t0=t, periods=point.period, sensitivities=list(params), virtual=True)
+    fm = flow_map(m, x, t0=t, periods=point.period, sensitivities=list(params), virtual=True, mode=point.mode)
     unfolding = {}
     for j, p in enumerate(params):
         i = names.index(p)

@@ -369,6 +369,10 @@ def sweep_spec(
             "direction 'both' needs a sweep that carries its state (with fresh, every point starts from "
             "x0: both directions are the same)"
         )
+    if zdm is not None:
+        from grazing.engine.runner import check_map_stop
+
+        check_map_stop(model, int(zdm.stop))
     up = np.sort(vals)
     order = {"up": up, "down": up[::-1], "both": np.concatenate([up, up[::-1]])}[direction]
     first = model.with_params(**{param: float(order[0])}) if param in model.params else model

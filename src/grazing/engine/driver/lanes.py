@@ -474,6 +474,15 @@ def _lane_norms(m, ls, XT, OT, kinds, nvar, factor, norms, nl):
 
 
 @njit(cache=True, inline="always")
+def map_row(m, cfg):
+    """The event row left out of :func:`no_events_certain`: the discontinuity map's stop on a model of one
+    mode (its rows are its stops), else -1.  With modes each lane's rows are its own mode's, the map's stop
+    in none of them or in another row: every row is certified (the map's stop's row too, which only makes
+    a lane searched, where :func:`.events.first_event` leaves that stop out)."""
+    return cfg.stop if cfg.zdm and m.rows.shape[0] == 1 else -1
+
+
+@njit(cache=True, inline="always")
 def no_events_certain(m, cfg, OT, hs, plain, certs):
     """Clear ``plain[lane]`` where an event on the step of size ``hs[lane]`` is not excluded.
 
@@ -487,8 +496,9 @@ def no_events_certain(m, cfg, OT, hs, plain, certs):
     if L == 1:
         plain[0] = 0
     elif L == LANE_WIDTH:  # (on vectors: the loop over the coefficients keeps the lanes in registers)
+        skip = map_row(m, cfg)
         for r in range(m.rows.shape[1]):  # (a mode's event rows; a padding row is a constant 1)
-            if not (cfg.zdm and r == cfg.stop):
+            if r != skip:
                 certify_stop(OT, r, m.order + 1, hs, plain)
     else:
         _no_events_certain(m, cfg, OT, hs, plain, certs)
@@ -501,8 +511,9 @@ def _no_events_certain(m, cfg, OT, hs, plain, certs):
     K = m.order + 1
     nl = hs.shape[0]
     a1, a2, tl, hk = nl, 2 * nl, 3 * nl, 4 * nl
+    skip = map_row(m, cfg)
     for r in range(nev):
-        if cfg.zdm and r == cfg.stop:
+        if r == skip:
             continue
         for lane in range(nl):
             certs[hk + lane] = 1.0

@@ -11,6 +11,7 @@ import numpy as np
 from numba import njit
 
 from grazing.engine.driver.calls import guard, guard_grad, normal_rate, normal_rate_grad, rhs
+from grazing.engine.driver.events import tracked_in
 from grazing.engine.stepping import append_record, eval_rows, orthonormalize, pack_var, unpack_var
 
 
@@ -79,7 +80,9 @@ def discontinuity_map(m, r, x, pv, cfg, V, gh, gv, record, imp):
     ``cfg`` holds the map's settings (``stop`` the stop it stands for,
     ``zdm_a``, ``zdm_e``, ``zdm_window``: the fields of
     :class:`~grazing.engine.records.Config` and
-    :class:`~grazing.engine.records.LaneSettings`).  With ``v = L_f h`` and
+    :class:`~grazing.engine.records.LaneSettings`).  On a model with modes it
+    applies only while the run is in the stop's source mode (its guard an
+    event row of mode ``r.vf``: :func:`.events.tracked_in`).  With ``v = L_f h`` and
     ``delta = v^2 / (2 a) - h`` (how far the local parabola would reach past
     the stop, ``a = L_f^2 h`` at the grazing point): if ``delta > 0`` and
     ``|v| / a < window``, ``x <- x - e sqrt(2 a delta)``, and the variational
@@ -89,6 +92,8 @@ def discontinuity_map(m, r, x, pv, cfg, V, gh, gv, record, imp):
     n = m.nx
     ncol = n + m.nsens
     j = cfg.stop
+    if not tracked_in(m, r.vf, j):  # (another mode: the stop is not there, nothing happens)
+        return False
     a = cfg.zdm_a
     e = cfg.zdm_e
     s = r.s
