@@ -47,9 +47,13 @@ def brief_excursion(orbit: PeriodicOrbit) -> tuple[int, float] | None:
 
 def locate_segmented_grazing(orbit: PeriodicOrbit, param: str, reach: float) -> GrazingPoint | None:
     """The grazing orbit where ``orbit``'s briefest excursion (:func:`brief_excursion`) shrinks to a
-    contact, solved for ``param`` by multiple shooting on its other switches; None where the model's
-    segments are not cut at switches, the orbit has no such excursion, Newton's method fails, or the
-    grazing found is farther than ``reach`` from ``orbit``'s value of ``param``, turns into the guard
+    contact, solved for ``param`` by multiple shooting on its other switches, from ``orbit`` with the
+    excursion's two switches merged into one cut half-way between them.  That start must be near the
+    grazing already (the end of a branch, where the excursion has shrunk until the segmented equations
+    stalled): from an orbit whose excursion is long, the segment to the contact crosses the surface
+    before it (the contact's guard has moved with ``param``) and Newton's method fails.  None where the
+    model's segments are not cut at switches, the orbit has no such excursion, Newton's method fails, or
+    the grazing found is farther than ``reach`` from ``orbit``'s value of ``param``, turns into the guard
     (``L_f^2 h <= 0``) or is not a motion of the system (a switch crossed at no rate or backwards).
 
     Its :attr:`~grazing.orbits.contact.GrazingPoint.precision` is the parameter component of the Newton
