@@ -29,7 +29,7 @@ import grazing
 from grazing.cli import main
 from grazing.orbits import continue_orbit, find_orbit
 from grazing.orbits.continuation import BranchEnd
-from tests.orbits.test_segments_at_switches import GUESS, VALUES, exact_orbit
+from tests.orbits.test_segments_at_switches import GUESS, VALUES, exact_orbit, two_soft_stops
 from tests.piecewise_exact import LinearMode, PiecewiseLinearModel
 
 SOURCE = """\
@@ -191,3 +191,21 @@ def test_the_cli_continue_reports_the_grazing(tmp_path, capsys):
     assert "segment 0, period 1: ended at a grazing at lip = 0.93187948" in out
     assert "switched to the orbit with the new switches of mode" in out
     assert "last point: mode aft, switches per period: off_aft, hit_aft" in out
+
+
+def test_a_symmetric_orbit_grazing_both_soft_stops_at_once_is_reported_not_located():
+    """The symmetric model of test_segments_at_switches (one ``edge`` for both stops): as ``edge`` grows
+    both excursions shrink together, and the orbit grazes both surfaces at once (codimension two, but for
+    the symmetry).  The grazing orbit is then the free saddle's forced response alone, ``Re(X exp(i w t))``
+    with ``X = (i w I - A)^-1 b``, and ``edge = |X_1|`` there.  One contact cannot be solved for with the
+    other excursion shrunk to nothing as well: the branch ends at a grazing reported not located."""
+    m = two_soft_stops(freq=0.27)
+    x, _, _ = exact_orbit(dict(m.params), GUESS[0.27])
+    orbit = find_orbit(m, x, period=1, t0=m.period / 4, mode="middle")
+    branch = continue_orbit(m, "edge", 0.4, 3.0, orbit=orbit)
+    A = np.array([[0.0, 1.0], [1.0, -2 * m.params["damp"]]])
+    X = np.linalg.solve(1j * m.params["freq"] * np.eye(2) - A, np.array([0.0, m.params["amp"]]))
+    assert branch.outcome is BranchEnd.GRAZING and branch.status.startswith("ended at an unlocated grazing")
+    (sp_,) = branch.special
+    assert sp_.kind == "grazing" and sp_.grazing is None and "not located" in sp_.note
+    assert abs(sp_.param - abs(X[0])) < 1e-9, sp_.param - abs(X[0])

@@ -621,6 +621,12 @@ def _locate_grazing(
     return point if near_time and near_state else None
 
 
+STALLED_EXCURSION = 1e-3
+"""Multiple shooting on a branch's switches that stalls with an excursion through another mode shorter
+than this many forcing periods stalled at its grazing (the excursion's two switches meet there, and the
+equations are singular: it stalls with the excursion far shorter, 1e-8 periods and less)."""
+
+
 class SwitchChange(TextEnum):
     """What a grazing of a switching surface does to an orbit's switches of mode (a model with modes)."""
 
@@ -998,11 +1004,11 @@ class _Continuation:
         through another mode shrinks to nothing (its two switches meet: the segmented equations are
         singular there): the segment ends at the grazing of that switching surface, located
         (:meth:`_segmented_grazing`), or, where it is not, with that grazing reported unlocated.  None
-        where the last orbit has no excursion shorter than :data:`NEAR_CONTACT` forcing periods (the
+        where the last orbit has no excursion shorter than :data:`STALLED_EXCURSION` forcing periods (the
         branch ends as it stalled)."""
         last: PeriodicOrbit = prev.payload
         found = brief_excursion(last) if cuts_at_switches(self.model) else None
-        if found is None or found[1] > NEAR_CONTACT * last.model.period:
+        if found is None or found[1] > STALLED_EXCURSION * last.model.period:
             return None
         i, stay = found
         names = self.model.stop_names
