@@ -1278,10 +1278,13 @@ def continue_orbit(
         point's orbit records its mode on the section and its switches of mode;
         where their number or order changes along the branch (a grazing of a
         switching surface), the segment ends there as at a change of impacts,
-        the grazing bracketed between two points (not located by the grazing
-        equations yet), and with ``switch`` goes on along the orbit with the
-        new switches.  Branches of models with modes are physical
-        (``virtual=True`` is refused) and single-shooting only.
+        the grazing located, and with ``switch`` goes on along the orbit with
+        the new switches.  Branches of models with modes are physical
+        (``virtual=True`` is refused); on a model without resets a strongly
+        unstable branch goes on by multiple shooting cut at its switches, and
+        ends where an excursion through another mode shrinks to nothing, at
+        that grazing solved on the segments
+        (:mod:`grazing.orbits.segmented_grazing`).
 
     Returns
     -------
