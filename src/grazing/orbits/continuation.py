@@ -76,6 +76,7 @@ from grazing.orbits.palc import (
     BOUNDARY,
     REFINE,
     STOP,
+    Boundary,
     Palc,
     PalcEnd,
     PalcPoint,
@@ -84,6 +85,7 @@ from grazing.orbits.palc import (
     locate,
     sign_changed,
 )
+from grazing.orbits.segmented_grazing import brief_excursion, locate_segmented_grazing
 from grazing.orbits.segments import (
     MULTIPLE_SHOOTING_NORM,
     REORDER_REACH,
@@ -619,6 +621,12 @@ def _locate_grazing(
     return point if near_time and near_state else None
 
 
+STALLED_EXCURSION = 1e-3
+"""Multiple shooting on a branch's switches that stalls with an excursion through another mode shorter
+than this many forcing periods stalled at its grazing (the excursion's two switches meet there, and the
+equations are singular: it stalls with the excursion far shorter, 1e-8 periods and less)."""
+
+
 class SwitchChange(TextEnum):
     """What a grazing of a switching surface does to an orbit's switches of mode (a model with modes)."""
 
@@ -881,6 +889,10 @@ class _Continuation:
                 segmented, orbit = True, last
                 self.handover = float(prev.u[-1])
                 continue
+            if palc.boundary is None and self.segmented and palc.end is PalcEnd.STUCK:
+                ended = self._stalled_at_contact(palc, prev, sign)
+                if ended is not None:
+                    return ended
             if palc.boundary is None:
                 branch.end_segment(BranchEnd.of(palc.end), status)
                 return []
@@ -961,6 +973,8 @@ class _Continuation:
         boundary = palc.boundary
         assert boundary is not None
         beyond = boundary.after.payload if boundary.after is not None else None
+        if self.segmented and cuts_at_switches(self.model):  # (segments cut at switches: the same switches)
+            return self._segmented_grazing(prev.payload, beyond)
         if self.model.has_modes:  # (a grazing of a switching surface: the switches of mode differ)
             found = switch_change(prev.payload, beyond) if beyond is not None else None
             if found is None or found[1] >= self.model.n_stops or sliding_kind(prev.payload, beyond):
@@ -970,6 +984,57 @@ class _Continuation:
                 return None
             return locate_switch_grazing(prev.payload, beyond, self.param, grazed, BETWEEN_SLACK)
         return _locate_grazing(prev.payload, beyond, self.param, self.virtual, boundary.ahead)
+
+    def _segmented_grazing(self, last: PeriodicOrbit, beyond: PeriodicOrbit | None) -> GrazingPoint | None:
+        """The grazing of a switching surface where ``last``'s briefest excursion shrinks to a contact,
+        solved by multiple shooting (:func:`locate_segmented_grazing`): between ``last`` and ``beyond``
+        (up to :data:`BETWEEN_SLACK`), or without ``beyond`` within :data:`NEAR_LAST` of ``last``."""
+        p = last.model.params[self.param]
+        scale = max(1.0, abs(p))
+        q = beyond.model.params[self.param] if beyond is not None else p
+        reach = abs(q - p) + (BETWEEN_SLACK if beyond is not None else NEAR_LAST) * scale
+        point = locate_segmented_grazing(last, self.param, reach)
+        if point is None or beyond is None:
+            return point
+        pg = point.model.params[self.param]
+        return point if min(p, q) - BETWEEN_SLACK * scale <= pg <= max(p, q) + BETWEEN_SLACK * scale else None
+
+    def _stalled_at_contact(self, palc: Palc, prev: PalcPoint, sign: float) -> list[SegmentStart] | None:
+        """Multiple shooting on the switches stalled (``palc`` STUCK) where the orbit's briefest excursion
+        through another mode shrinks to nothing (its two switches meet: the segmented equations are
+        singular there): the segment ends at the grazing of that switching surface, located
+        (:meth:`_segmented_grazing`), or, where it is not, with that grazing reported unlocated.  None
+        where the last orbit has no excursion shorter than :data:`STALLED_EXCURSION` forcing periods (the
+        branch ends as it stalled)."""
+        last: PeriodicOrbit = prev.payload
+        found = brief_excursion(last) if cuts_at_switches(self.model) else None
+        if found is None or found[1] > STALLED_EXCURSION * last.model.period:
+            return None
+        i, stay = found
+        names = self.model.stop_names
+        into, back = (int(j) for j in last.switch_transitions[i : i + 2])
+        reason = (
+            f"the orbit's excursion through {names[into]!r} and back through {names[back]!r} shrinks to "
+            "nothing (its two switches meet; multiple shooting stalls there): a grazing of a switching "
+            "surface"
+        )
+        point = self._segmented_grazing(last, None)
+        if point is not None:
+            palc.boundary = Boundary(prev, None, reason)
+            return self._grazing_end(palc, prev, sign, point)
+        value = float(prev.u[-1])
+        note = (
+            f"grazing of transition {names[into]!r} not located: the grazing equations on the segments did "
+            f"not converge from the last orbit, at {self.par.show(value)} (its excursion lasts {stay:.3g})"
+        )
+        self.branch.special.append(
+            SpecialPoint(
+                kind=SpecialKind.GRAZING, index=len(self.branch) - 1, param=value, orbit=last, stop=into,
+                note=note,
+            )
+        )  # fmt: skip
+        self.branch.end_segment(BranchEnd.GRAZING, f"ended at an unlocated grazing ({note}): {reason}")
+        return []
 
     def _grazing_end(
         self, palc: Palc, prev: PalcPoint, sign: float, point: GrazingPoint | None
@@ -1213,10 +1278,13 @@ def continue_orbit(
         point's orbit records its mode on the section and its switches of mode;
         where their number or order changes along the branch (a grazing of a
         switching surface), the segment ends there as at a change of impacts,
-        the grazing bracketed between two points (not located by the grazing
-        equations yet), and with ``switch`` goes on along the orbit with the
-        new switches.  Branches of models with modes are physical
-        (``virtual=True`` is refused) and single-shooting only.
+        the grazing located, and with ``switch`` goes on along the orbit with
+        the new switches.  Branches of models with modes are physical
+        (``virtual=True`` is refused); on a model without resets a strongly
+        unstable branch goes on by multiple shooting cut at its switches, and
+        ends where an excursion through another mode shrinks to nothing, at
+        that grazing solved on the segments
+        (:mod:`grazing.orbits.segmented_grazing`).
 
     Returns
     -------

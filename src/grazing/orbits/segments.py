@@ -117,11 +117,13 @@ def _segment_span(model: HybridModel, ta: float, tb: float) -> tuple[int, float]
 
 def segment_flow(
     model: HybridModel, x: np.ndarray, ta: float, tb: float, param: str | tuple[str, ...] | None,
-    mode: str | None = None,
+    mode: str | None = None, touching: int | None = None,
 ) -> SegmentFlow:  # fmt: skip
     """Free flight (the stops ignored) from state ``x`` at time ``ta`` to time ``tb > ta``.
 
     ``param``: the parameter (or a tuple of them) whose sensitivities are computed (None: none).
+    ``touching``: a transition whose guard the segment starts or ends on tangentially (a grazing
+    contact, :attr:`SegmentLayout.contact`), which is no switch there.
     The engine samples at a forcing phase: the run's last sample is the phase of
     ``tb`` after as many periods as it takes to reach it.  On a model with modes
     the segment starts in ``mode`` (the initial mode by default) and ignores the
@@ -146,7 +148,7 @@ def segment_flow(
     sol = simulate(
         model, x, t0=ta, periods=periods, phase=phase, jacobian=True, sensitivities=names,
         guard_min=not model.has_modes, events=False, impacts="all" if model.has_modes else "none",
-        mode=mode,
+        mode=mode, **({} if touching is None else {"touching": True, "stop_name": touching}),
     )  # fmt: skip
     n = model.n_states
     end = sol.x_final
@@ -185,18 +187,33 @@ class SegmentLayout:
     switches
         The segments end on switches (transitions without a reset, :func:`cuts_at_switches`), not
         on impacts: ``stops`` are those switches' transitions and ``s_i`` the state at switch ``i``.
+    contact
+        A switch layout: the index in ``stops`` of a cut that is a grazing contact with its
+        transition's guard (tangent to it in the transition's source mode, no switch), where the
+        equations gain the contact's condition ``L_f h = 0`` and the parameter is solved for
+        (:mod:`grazing.orbits.segmented_grazing`); None: every cut is a switch.
     """
 
     n_states: int
     stops: tuple[int, ...]
     mode: str | None = None
     switches: bool = False
+    contact: int | None = None
 
     def start_mode(self, model: HybridModel, i: int) -> str | None:
-        """The mode segment ``i`` starts in: the section's (``i = 0``), else impact ``i``'s target mode."""
+        """The mode segment ``i`` starts in: the section's (``i = 0``), else impact ``i``'s target mode
+        (the mode before it, after a :attr:`contact`)."""
         if self.mode is None or i == 0:
             return self.mode
+        if i - 1 == self.contact:
+            return model.transition_source[self.stops[i - 1]]
         return model.transition_target[self.stops[i - 1]]
+
+    def touching(self, i: int) -> int | None:
+        """The transition whose guard segment ``i`` starts or ends on at the :attr:`contact` (None)."""
+        if self.contact is None or i not in (self.contact, self.contact + 1):
+            return None
+        return self.stops[self.contact]
 
     @property
     def impacts(self) -> int:
@@ -284,15 +301,18 @@ def segmented_equations(
     pidx = [order.index(name) for name in names]
     size, extra = layout.size, max(1, len(names))
     pcols = slice(size, size + len(names))
+    contact = layout.contact  # (a grazing contact: one more row, its rate; the payload a GrazingPoint)
+    rows = size + (contact is not None)
 
     def evaluate(u: np.ndarray) -> tuple[np.ndarray, np.ndarray, PeriodicOrbit]:
         values = u[size : size + len(names)]
         m = model.with_params(**{q: float(v) for q, v in zip(names, values)}) if names else model
         T = m.period
         t_end = t0 + period * T
-        F = np.zeros(size)
-        DF = np.zeros((size, size + extra))
+        F = np.zeros(rows)
+        DF = np.zeros((rows, size + extra))
         M = np.eye(n)
+        factors: list[np.ndarray] = []  # (each segment's Jacobian and saltation, in order: a contact's)
         times = [t0] + [float(u[layout.time_index(i)]) for i in range(1, k + 1)] + [t_end]
         if np.any(np.diff(times) <= 0.0):
             raise ConvergenceError("the impacts of the orbit's segments are no longer in order")
@@ -305,10 +325,10 @@ def segmented_equations(
             s_i = layout.state(u, i)
             ta, tb = times[i], times[i + 1]
             start_mode = layout.start_mode(m, i)
-            behind = cut_switches and i > 0 and not _in_mode(m, s_i, ta, start_mode)
+            behind = cut_switches and i > 0 and i - 1 != contact and not _in_mode(m, s_i, ta, start_mode)
             if behind:  # (a Newton iterate a hair behind the switch's surface: from the mode it leaves)
                 start_mode = m.transition_source[layout.stops[i - 1]]
-            seg = segment_flow(m, s_i, ta, tb, names, start_mode)
+            seg = segment_flow(m, s_i, ta, tb, names, start_mode, layout.touching(i))
             runs.append(seg.solution)
             y = seg.end
             end_mode = seg.solution.mode_final
@@ -332,6 +352,7 @@ def segmented_equations(
                 tp = seg.solution.info["period_gradient"][name]  # dT/dp: the return time t0 + n T moves
                 dy[:, size + c] = seg.sensitivity[:, c] + (f_end * period * tp if i == k else 0.0)
             M = seg.jacobian @ M
+            factors.append(seg.jacobian)
             if i == k:  # the return to the section
                 F[row : row + n] = y - layout.state(u, 0)
                 DF[row : row + n] = dy
@@ -354,8 +375,18 @@ def segmented_equations(
                 row += n
                 pre.append(y)
                 speeds.append(-cd["rate"])
-                if not crossed:
+                if i == contact:  # (tangent to the guard, no switch: the rate's row, last)
+                    F[size] = cd["rate"]
+                    DF[size] = cd["rate_x"] @ dy
+                    DF[size, col_t_end] += cd["rate_t"]
+                    if names:
+                        DF[size, pcols] += np.asarray(cd["rate_p"])[pidx]
+                    factors.append(np.eye(n))
+                elif not crossed:
                     M = m.saltation(y, tb, j) @ M
+                    factors.append(m.saltation(y, tb, j))
+                else:
+                    factors.append(np.eye(n))  # (the run's Jacobian carries the saltation)
                 continue
             g = m.reset(y, tb, j)
             _, _, gx = m.jacobians(y, tb, j)
@@ -372,10 +403,59 @@ def segmented_equations(
             pre.append(y)
             speeds.append(-cd["rate"])  # (positive: the guard decreases into the stop)
             M = m.saltation(y, tb, j) @ M
+        if contact is not None:
+            return F, DF, _contact_run(m, layout, u, times, factors)
         orbit = _segmented_orbit(m, layout, u, t0, period, times, pre, speeds, runs, M, F, stop)
         return F, DF, orbit
 
     return evaluate
+
+
+@dataclass(frozen=True)
+class ContactRun:
+    """The payload of the segmented equations with a grazing :attr:`SegmentLayout.contact`.
+
+    Attributes
+    ----------
+    model
+        The model at the parameter values of ``u``.
+    contact
+        The state at the contact (on the guard of :attr:`transition`).
+    t_contact
+        Its time.
+    transition
+        The transition whose guard is touched.
+    monodromy
+        The Jacobian of the period map on the section through the contact (the product of the
+        segments' Jacobians and the switches' saltation matrices from the contact round to it).
+    accel
+        ``L_f^2 h`` at the contact (positive: the orbit turns back from the guard).
+    switches
+        The orbit's switches of mode per period (the contact none).
+    """
+
+    model: HybridModel
+    contact: np.ndarray
+    t_contact: float
+    transition: int
+    monodromy: np.ndarray
+    accel: float
+    switches: int
+
+
+def _contact_run(
+    m: HybridModel, layout: SegmentLayout, u: np.ndarray, times: list[float], factors: list[np.ndarray]
+) -> ContactRun:
+    """:class:`ContactRun` of the segmented equations at ``u`` (``factors``: each segment's Jacobian and
+    the saltation matrix at each cut, in order from the section)."""
+    c = layout.contact
+    assert c is not None
+    j, y, t = layout.stops[c], np.array(layout.state(u, c + 1), dtype=float), times[c + 1]
+    M = np.eye(layout.n_states)
+    for f in [*factors[2 * c + 2 :], *factors[: 2 * c + 2]]:  # (from the contact round to it)
+        M = f @ M
+    accel = float(m.contact_derivatives(y, t, j)["accel"])
+    return ContactRun(m, y, t, j, M, accel, layout.impacts - 1)
 
 
 def _check_segment_modes(m: HybridModel, layout: SegmentLayout, i: int, end_mode: str | None) -> None:
@@ -419,6 +499,13 @@ def _check_switch_segment(m: HybridModel, layout: SegmentLayout, i: int, run: So
             )
         passed = passed[1:]
     start = layout.start_mode(m, i)
+    if i == layout.contact:  # (to a grazing contact: no switch on the way, nor at its end)
+        if passed or run.mode_final != start:
+            raise ConvergenceError(
+                f"segment {i} of the grazing orbit switches mode ({len(passed)} switches) before its contact "
+                f"with {m.stop_names[layout.stops[i]]!r}: it crosses the surface"
+            )
+        return False
     if i == layout.impacts:
         if passed or run.mode_final != layout.mode:
             raise ConvergenceError(
