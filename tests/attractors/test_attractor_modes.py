@@ -122,3 +122,22 @@ def test_bad_modes():
     found = find_attractors(SMALL, [[2.0, 0.0], [2.0, 0.0]], modes=["ann", "bo"], workers=1)
     assert found.labels.tolist()[0] == 0  # (q = 2 is beyond ann's switch at q = 1: invalid, not run)
     assert found.labels.tolist()[1] != 0
+
+
+def test_matching_and_seeding_go_by_mode():
+    """Two orbits with the same points in two modes are matched each to its own mode, whatever their
+    order (nearest first would pair them as listed), and seeds start in the mode of their point."""
+    from grazing.attractors.classify import Attractor
+    from grazing.attractors.continuation import _start_modes, match
+
+    def orbit(i, mode):
+        return Attractor(id=i, kind="periodic", period=1, impacts_per_period=0.0, lyapunov=-0.1,
+                         points=np.array([[0.0, 0.5]]), modes=(mode,))  # fmt: skip
+
+    assert match([orbit(1, "ann"), orbit(2, "bo")], [orbit(1, "bo"), orbit(2, "ann")], np.ones(2)) == {
+        1: 2,
+        2: 1,
+    }
+    states = np.array([[0.0, 0.5]] * 3)  # (in the band: ann's and bo's regions; the grid's start in ann)
+    assert _start_modes(SMALL, states, ["bo", ""], 0.0) == [0, 1, 0]
+    assert _start_modes(grazing.models.bouncing_ball(), states, ["free"] * 3, 0.0) is None
