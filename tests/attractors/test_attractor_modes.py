@@ -88,6 +88,20 @@ def test_a_grid_is_split_by_the_mode_each_state_ends_in():
     assert [modes[k] for k in labels] == ended
 
 
+def test_a_store_read_back_keeps_each_end_states_mode(tmp_path):
+    """Run again on its Zarr store (every chunk read back, none computed), the grid is split as before: the
+    store keeps the mode of each point's last sample, not only of each chunk's last point."""
+    args = (SMALL, (-3.0, 3.0), (-3.0, 3.0), (7, 7))
+    fresh = basins(*args, workers=1)
+    path = tmp_path / "quad.zarr"
+    first = basins(*args, workers=1, store=path, chunk_size=10)
+    again = basins(*args, workers=1, store=path, chunk_size=10)
+    assert len(set(fresh.label.values.ravel().tolist())) >= 2
+    for ds in (first, again):
+        assert ds.label.values.tolist() == fresh.label.values.tolist()
+        assert ds.modes.values.tolist() == fresh.modes.values.tolist()
+
+
 def test_an_orbit_whose_modes_repeat_every_second_period_is_one_attractor_of_period_2():
     """Two runs of the large circle a period apart (the same state, in ann and in cy) end on one
     attractor, whose period is that of its states and modes together."""

@@ -480,7 +480,7 @@ def _refine(model: HybridModel, catalogue: Catalogue, deferred: _Deferred, s: Ba
 
 def _end_modes(model: HybridModel, deferred: _Deferred, t: float) -> np.ndarray:
     """The mode each deferred end state is run on in: the mode its run ended in, where known and not a
-    sliding pseudo-mode (a chunk read back from a store keeps only its last point's), else the one it
+    sliding pseudo-mode (a store made before it kept each point's: only a chunk's last), else the one it
     lies in (:func:`start_modes`; it slides on from a surface), else the initial mode (its run then
     says what it does there)."""
     assert deferred.modes is not None
