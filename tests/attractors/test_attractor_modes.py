@@ -155,3 +155,6 @@ def test_matching_and_seeding_go_by_mode():
     states = np.array([[0.0, 0.5]] * 3)  # (in the band: ann's and bo's regions; the grid's start in ann)
     assert _start_modes(SMALL, states, ["bo", ""], 0.0) == [0, 1, 0]
     assert _start_modes(grazing.models.bouncing_ball(), states, ["free"] * 3, 0.0) is None
+    rubbing = grazing.models.friction_oscillator()  # (no run starts sliding: the seed starts where it lies)
+    there = _start_modes(rubbing, np.zeros((2, 2)), [], 0.0)
+    assert _start_modes(rubbing, np.zeros((2, 2)), ["sliding on 'belt'", "slip_ahead"], 0.0) == [there[0], 1]

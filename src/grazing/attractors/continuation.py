@@ -163,15 +163,17 @@ def _seeds(attractors: Sequence[Attractor], most: int) -> tuple[np.ndarray, np.n
 
 def _start_modes(model: HybridModel, states: np.ndarray, seeded: list[str], t: float) -> list[int] | None:
     """A model with modes: the mode each of ``states`` starts in: its seed's (the last ``len(seeded)``
-    states), where known, else the one it lies in (:func:`~grazing.attractors.basins.start_modes`)."""
+    states), where known and not a sliding pseudo-mode, else the one it lies in
+    (:func:`~grazing.attractors.basins.start_modes`)."""
     if not model.has_modes:
         return None
     there = mode_of_states(model, states, t)
     out = [model.mode_index(None) if k < 0 else int(k) for k in there]  # (-1: invalid, whichever)
     first = len(out) - len(seeded)
+    real = model.mode_names[: len(model.mode_names) - len(model.sliding_modes)]
     for i, name in enumerate(seeded):
-        if name:
-            out[first + i] = model.mode_names.index(name)
+        if name in real:  # (not known, or sliding on a surface, where no run starts: the one it lies in)
+            out[first + i] = real.index(name)
     return out
 
 
