@@ -131,7 +131,7 @@ def test_bad_modes():
         find_attractors(SMALL, [[0.0, 0.5]], modes=["eve"], workers=1)
     with pytest.raises(grazing.errors.InvalidParameterError, match="one mode per initial state"):
         find_attractors(SMALL, [[0.0, 0.5]], modes=["ann", "bo"], workers=1)
-    with pytest.raises(grazing.errors.InvalidParameterError, match="needs a model with modes"):
+    with pytest.raises(grazing.errors.InvalidParameterError, match="start modes need a model with modes"):
         find_attractors(grazing.models.bouncing_ball(), [[1.0, 0.0]], modes=["free"], workers=1)
     found = find_attractors(SMALL, [[2.0, 0.0], [2.0, 0.0]], modes=["ann", "bo"], workers=1)
     assert found.labels.tolist()[0] == 0  # (q = 2 is beyond ann's switch at q = 1: invalid, not run)

@@ -165,7 +165,7 @@ def given_modes(model: HybridModel, modes: Any, n: int) -> np.ndarray | None:
     if modes is None:
         return None
     if not model.has_modes:
-        raise InvalidParameterError(f"modes= needs a model with modes: {model.name!r} has one")
+        raise InvalidParameterError(f"start modes need a model with modes: {model.name!r} has one")
     names = [modes] if isinstance(modes, (str, int)) else list(modes)
     if len(names) != n:
         raise InvalidParameterError(f"modes must give one mode per initial state ({n}), got {len(names)}")
