@@ -27,7 +27,7 @@ import numpy as np
 
 from grazing.attractors.classify import Attractor, Catalogue
 from grazing.attractors.grid import StateGrid, as_states, beyond_stops, default_cell, start_time, state_grid
-from grazing.core.model import HybridModel, mode_of_states
+from grazing.core.model import HybridModel, in_modes, mode_of_states
 from grazing.core.options import (
     BASIN_ADAPTIVE_TOL,
     BASIN_CLOSING_ROUNDS,
@@ -141,12 +141,42 @@ def start_modes(model: HybridModel, states: np.ndarray, t: float) -> np.ndarray 
     return mode_of_states(model, states, t) if model.has_modes else None
 
 
-def outside(model: HybridModel, states: np.ndarray, t: float) -> np.ndarray:
+def outside(model: HybridModel, states: np.ndarray, t: float, modes: np.ndarray | None = None) -> np.ndarray:
     """Which initial states are ``invalid``: beyond a stop (:func:`~grazing.attractors.grid.beyond_stops`),
-    or, in a model with modes, in no mode's region (:meth:`HybridModel.mode_at`)."""
+    or, in a model with modes, in no mode's region (:meth:`HybridModel.mode_at`), or not in their given
+    mode's (``modes``: :func:`~grazing.core.model.in_modes`)."""
+    if model.has_modes and modes is not None:
+        return ~in_modes(model, states, modes, t)
     if model.has_modes:
         return mode_of_states(model, states, t) < 0
     return beyond_stops(model, states, t)
+
+
+def given_modes(model: HybridModel, modes: Any, n: int) -> np.ndarray | None:
+    """The index of the mode each of ``n`` initial states starts in, from their names or indices (None:
+    the one each lies in); a one-line error for a wrong count, an unknown mode or a model without modes.
+
+    Examples
+    --------
+    >>> import grazing
+    >>> given_modes(grazing.models.soft_impact_oscillator(), ["contact", 0], 2).tolist()
+    [1, 0]
+    """
+    if modes is None:
+        return None
+    if not model.has_modes:
+        raise InvalidParameterError(f"start modes need a model with modes: {model.name!r} has one")
+    names = [modes] if isinstance(modes, (str, int)) else list(modes)
+    if len(names) != n:
+        raise InvalidParameterError(f"modes must give one mode per initial state ({n}), got {len(names)}")
+    real = model.mode_names[: len(model.mode_names) - len(model.sliding_modes)]
+    out = []
+    for m in names:
+        if isinstance(m, (int, np.integer)) and not isinstance(m, bool) and 0 <= int(m) < len(real):
+            out.append(int(m))
+        else:
+            out.append(model.mode_index(str(m)))
+    return np.asarray(out, dtype=np.int64)
 
 
 @dataclass(frozen=True)
@@ -173,6 +203,7 @@ def find_attractors(
     store: Any = None,
     progress: BasinsProgress | None = None,
     device: str = DEFAULT_DEVICE,
+    modes: Sequence[str | int] | None = None,
     **shorthands: Any,
 ) -> AttractorSet:
     """The attractors reached from the initial states ``states`` (rows), and which one each reaches.
@@ -213,6 +244,9 @@ def find_attractors(
         ``"cpu"`` (the default), ``"gpu"`` or ``"auto"`` (:mod:`grazing.gpu.device`): the runs on an
         NVIDIA GPU, one CUDA thread per initial state, those with Lyapunov exponents (the refined
         runs' last, each orbit's exponent) too.
+    modes
+        A model with modes: the mode each initial state starts in (names or indices; default the one it
+        lies in, :func:`start_modes`).  A state outside its mode's region is ``invalid``.
     **shorthands
         Any field of :class:`~grazing.core.options.BasinSettings` by name
         (``transient=200``, ``lyapunov=False`` ...), replacing that field of
@@ -250,7 +284,8 @@ def find_attractors(
     check_device(device, client)
     x = as_states(model, states)
     t0 = start_time(model, s.phase)
-    invalid = outside(model, x, t0)
+    given = given_modes(model, modes, x.shape[0])
+    invalid = outside(model, x, t0, given)
     valid = np.flatnonzero(~invalid)
     box = x[valid] if valid.size else x
     cells = default_cell(box) if cell is None else np.broadcast_to(np.asarray(cell, dtype=float), x.shape[1:])
@@ -278,7 +313,9 @@ def find_attractors(
     catalogue = Catalogue(model, x.shape[0], cells, box.min(axis=0), reach + side, s.periods, t0, fraction)
     if valid.size:
         run = _Run(workers, client, store, progress, device)
-        spec = basin_spec(model, x[valid], s, s.lyapunov and s.refine == 0)
+        spec = basin_spec(
+            model, x[valid], s, s.lyapunov and s.refine == 0, None if given is None else given[valid]
+        )
         looks = _looks(s.refine)
         deferred = _run(spec, valid, catalogue, next(looks), run, x.shape[0] - valid.size, x.shape[0])
         for look in looks:
@@ -307,7 +344,11 @@ def _orbit_exponents(model: HybridModel, catalogue: Catalogue, s: BasinSettings,
         return
     points = np.array([catalogue.entries[k].points[0] for k in orbits])
     one = replace(s, chunk_size=max(1, len(orbits)))  # (on the orbit: the adaptive transient ends at once)
-    spec = basin_spec(model, points, one, True)
+    modes = None
+    if model.has_modes:  # (each from its mode there, where known: else the one it lies in)
+        ended = np.array([e.modes[0] if e.modes.size else -1 for e in (catalogue.entries[k] for k in orbits)])
+        modes = _end_modes(model, _Deferred(np.zeros(0), points, ended), start_time(model, s.phase))
+    spec = basin_spec(model, points, one, True, modes)
     device = spec_device(run.device, spec, run.client)
     ds = run_sweep(spec, workers=run.workers, client=run.client, device=device)
     for k, value in zip(orbits, ds.lyapunov.values):
@@ -439,7 +480,7 @@ def _refine(model: HybridModel, catalogue: Catalogue, deferred: _Deferred, s: Ba
 
 def _end_modes(model: HybridModel, deferred: _Deferred, t: float) -> np.ndarray:
     """The mode each deferred end state is run on in: the mode its run ended in, where known and not a
-    sliding pseudo-mode (a chunk read back from a store keeps only its last point's), else the one it
+    sliding pseudo-mode (a store made before it kept each point's: only a chunk's last), else the one it
     lies in (:func:`start_modes`; it slides on from a surface), else the initial mode (its run then
     says what it does there)."""
     assert deferred.modes is not None
@@ -494,7 +535,8 @@ def basins(
         beyond a stop), and along ``attractor`` (the ids): ``kind``,
         ``period``, ``impacts_per_period``, ``lyapunov``, ``fraction``,
         ``count``, ``reason``, ``points`` (``attractor``, ``point``,
-        ``component``; NaN-padded) and ``n_points``.
+        ``component``; NaN-padded) and ``n_points``; a model with modes,
+        ``modes`` (``attractor``, ``point``: the mode at each point).
 
     Examples
     --------
@@ -507,6 +549,22 @@ def basins(
     grid = state_grid(model, x_range, y_range, num, states=states, fixed=fixed, phase=phase)
     found = find_attractors(model, grid.states_array(), phase=grid.phase, **options)
     return to_dataset(model, grid, found)
+
+
+def point_modes(attractors: Sequence[Attractor], longest: int) -> np.ndarray:
+    """The mode at each point of each attractor, ``''``-padded to ``longest`` points (``''``: not known).
+
+    Examples
+    --------
+    >>> a = Attractor(id=1, kind="periodic", period=2, impacts_per_period=0.0, lyapunov=-1.0,
+    ...               points=np.zeros((2, 2)), modes=("ann", "cy"))
+    >>> point_modes([a], 3).tolist()
+    [['ann', 'cy', '']]
+    """
+    out = np.full((len(attractors), longest), "", dtype=object)
+    for k, a in enumerate(attractors):
+        out[k, : min(len(a.modes), longest)] = a.modes[:longest]
+    return out.astype(str)
 
 
 def to_dataset(model: HybridModel, grid: StateGrid, found: AttractorSet) -> Any:
@@ -573,6 +631,9 @@ def to_dataset(model: HybridModel, grid: StateGrid, found: AttractorSet) -> Any:
         "periodic, sticking, neutral, chaotic, quasiperiodic, aperiodic, escaping, failed, invalid"
     )
     ds["points"].attrs["description"] = "states on the attractor at the sampling phase (NaN-padded)"
+    if model.has_modes:
+        ds["modes"] = (("attractor", "point"), point_modes(atts, longest))
+        ds["modes"].attrs["description"] = "the mode at each of the points ('': not known, or padding)"
     ds.attrs.update(
         {
             "model": model.name,

@@ -11,7 +11,13 @@ Each initial state is run for a transient, then sampled at the forcing phase
   on the orbit made of its last ``p`` samples (or Newton's orbit).  Two end states are on one orbit when each
   point of one is within :data:`~grazing.core.options.MATCH_TOL` cells of a
   point of the other (whatever point of the cycle each ended at: a distance
-  between point sets, as Attractors.jl matches attractors).  An orbit whose
+  between point sets, as Attractors.jl matches attractors) and, on a model
+  with modes, in the same mode there: an orbit is its points and the mode at
+  each (a hysteretic switch puts one state in two modes' regions; each mode
+  has its own future).  The modes of a new orbit come from one run of it
+  from its end state (:meth:`Catalogue.cycle_modes`); its period is that of
+  its states and modes together (samples that repeat every period, their
+  modes every second one: period 2);  An orbit whose
   points all lie on a stop, without impacts, is **sticking** (riding on it);
   one whose multiplier 1 is double (a Jordan block: the impact damper's
   free particle at rest, periodic only because its velocity is exactly
@@ -57,7 +63,7 @@ from grazing.core.options import (
 from grazing.core.period import orbit_impacts, sample_scale
 from grazing.core.solution import Status
 from grazing.errors import GrazingError
-from grazing.sweeps.polish import Polished, contracting_periods, is_neutral, mode_there, polish
+from grazing.sweeps.polish import Polished, contracting_periods, is_neutral, polish, run_mode
 from grazing.sweeps.spec import ChunkResult
 from grazing.sweeps.status import reason
 
@@ -108,6 +114,9 @@ class Attractor:
         ``count`` over all initial states.
     first
         The index of its first initial state.
+    modes
+        A model with modes: the mode of each of ``points`` (a periodic orbit's; empty where not known: an
+        aperiodic attractor, an outcome, a model without modes).
 
     Examples
     --------
@@ -136,12 +145,14 @@ class Attractor:
     count: int = 0
     fraction: float = 0.0
     first: int = 0
+    modes: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         self.kind = AttractorKind(self.kind)  # (given as its word: the member)
 
     def to_json(self) -> dict[str, Any]:
-        """The attractor as plain JSON data (``id``, ``kind``, ``period``, ``points``, ``lyapunov`` ...)."""
+        """The attractor as plain JSON data (``id``, ``kind``, ``period``, ``points``, ``lyapunov`` ...;
+        ``modes``: the mode at each point, null where not known)."""
         return {
             "id": self.id,
             "kind": str(self.kind),
@@ -152,6 +163,7 @@ class Attractor:
             "reason": self.reason or None,
             "count": self.count,
             "fraction": self.fraction,
+            "modes": list(self.modes) or None,
         }
 
 
@@ -174,6 +186,8 @@ class _Entry:
     cells: set[bytes] = field(default_factory=set)
     failures: int = 0  # (failed Newton polishes of its end states)
     neutral: bool = False  # (a periodic orbit whose multiplier 1 is double)
+    modes: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))  # (at each point; empty:
+    # not known)
 
     def __post_init__(self) -> None:
         self.family = AttractorKind(self.family)
@@ -303,6 +317,9 @@ class Catalogue:
         """
         index = first + np.arange(res.status.size) if which is None else np.asarray(which)
         status = np.asarray(res.status, dtype=int)
+        ended = np.full(status.size, -1, dtype=np.int64)  # (the mode of each last sample; -1: not known)
+        if self.model.has_modes and res.mode_final is not None:
+            ended = np.asarray(res.mode_final, dtype=np.int64)
         samples = np.asarray(res.samples, dtype=float)
         period = np.array(res.period, dtype=int)
         ok = status == Status.OK
@@ -326,11 +343,11 @@ class Catalogue:
                     period[k] = d
                 elif hold:  # (beyond a match of it: run on)
                     slow[k] = True
-        self._add_periodic(index, res, period, np.flatnonzero(settled & (period > 0) & ~slow))
+        self._add_periodic(index, res, period, np.flatnonzero(settled & (period > 0) & ~slow), ended)
         aperiodic = np.flatnonzero(settled & (period <= 0))
         if defer:
             return np.union1d(aperiodic, np.flatnonzero(slow))
-        self._add_aperiodic(index, res, aperiodic)
+        self._add_aperiodic(index, res, aperiodic, ended)
         return np.flatnonzero(slow)
 
     def _outcome_label(self, i: int, family: AttractorKind, why: str) -> None:
@@ -342,8 +359,9 @@ class Catalogue:
         self.labels[i] = k
 
     def _add_periodic(
-        self, index: np.ndarray, res: ChunkResult, period: np.ndarray, rows: np.ndarray
+        self, index: np.ndarray, res: ChunkResult, period: np.ndarray, rows: np.ndarray, ended: np.ndarray
     ) -> None:
+        """Label the periodic end states ``rows`` of ``res`` (their last samples in modes ``ended``)."""
         if rows.size == 0:
             return
         tol = MATCH_TOL * self.cell
@@ -354,6 +372,9 @@ class Catalogue:
             turn = (start[:, None] + np.arange(p)[None, :]) % p
             cyc = cyc[np.arange(sel.size)[:, None], turn]
             keys = np.floor((cyc[:, 0, :] - self.origin) / tol).astype(np.int64)
+            last = (p - 1 - start) % p  # (where the last sample, whose mode is known, is in each cycle)
+            if self.model.has_modes:  # (one state in two modes: two orbits)
+                keys = np.column_stack([keys, last, ended[sel]])
             uniq, inverse = np.unique(keys, axis=0, return_inverse=True)
             inverse = inverse.ravel()
             for g in range(uniq.shape[0]):
@@ -361,32 +382,94 @@ class Catalogue:
                 rep = members[0]
                 row = int(sel[rep])
                 impacts = float(orbit_impacts(np.array([res.impacts[row]]), np.array([p]), self.periods)[0])
-                k = self._periodic_entry(int(p), cyc[rep], int(index[row]), impacts)
+                at = (int(last[rep]), int(ended[row]))
+                k = self._periodic_entry(int(p), cyc[rep], int(index[row]), impacts, at)
                 e = self.entries[k]
                 e.count += members.size
                 self.labels[index[sel[members]]] = k
 
-    def _add_polished(self, i: int, found: Polished) -> None:
-        """Label initial state ``i`` with the periodic orbit its end state was polished to."""
-        cyc = np.roll(found.cycle, -int(np.argmin(found.cycle[:, 0])), axis=0)
-        k = self._periodic_entry(found.period, cyc, i, float(found.impacts))
+    def _add_polished(self, i: int, found: Polished, mode: int = -1) -> None:
+        """Label initial state ``i`` with the periodic orbit its end state (its last sample in mode
+        ``mode``) was polished to."""
+        start = int(np.argmin(found.cycle[:, 0]))
+        cyc = np.roll(found.cycle, -start, axis=0)
+        at = ((found.period - 1 - start) % found.period, int(mode))  # (the cycle's last: that sample's)
+        k = self._periodic_entry(found.period, cyc, i, float(found.impacts), at)
         self.entries[k].count += 1
         self.labels[i] = k
         self.polished += 1
 
-    def _periodic_entry(self, p: int, points: np.ndarray, first: int, impacts: float) -> int:
-        """The entry of the period-``p`` orbit through ``points`` (a new one if none found so far is it)."""
+    def _periodic_entry(
+        self, p: int, points: np.ndarray, first: int, impacts: float, at: tuple[int, int] = (0, -1)
+    ) -> int:
+        """The entry of the orbit whose samples repeat with period ``p`` through ``points``, in mode
+        ``at[1]`` at ``points[at[0]]`` (a model with modes; -1: not known, any mode matches); a new one
+        if none found so far is it."""
         for k in self._by_period.get(p, []):
             k = self.root(k)
-            if set_distance(self.entries[k].points, points, self.cell) <= MATCH_TOL or same_points(
-                self.entries[k].points, points
-            ):
+            e = self.entries[k]
+            near = set_distance(e.points, points, self.cell) <= MATCH_TOL or same_points(e.points, points)
+            if near and self._in_mode(e, points[at[0]], at[1]):
                 return k
-        k = self._new(_Entry(AttractorKind.PERIODIC, first, period=p, points=points.copy(), impacts=impacts))
+        modes = self.cycle_modes(points, *at)
+        times = max(1, modes.size // p)  # (its modes repeat every ``times`` periods of its states)
+        entry = _Entry(AttractorKind.PERIODIC, first, period=p * times, points=np.tile(points, (times, 1)),
+                       impacts=impacts * times, modes=modes)  # fmt: skip
+        k = self._new(entry)
         self._by_period.setdefault(p, []).append(k)
         return k
 
-    def _add_aperiodic(self, index: np.ndarray, res: ChunkResult, rows: np.ndarray) -> None:
+    def _in_mode(self, e: _Entry, point: np.ndarray, mode: int) -> bool:
+        """Is ``point`` in mode ``mode`` a point of the orbit ``e`` (its nearest points' modes; true where
+        either mode is not known)?"""
+        if mode < 0 or e.modes.size != len(e.points):
+            return True
+        d = np.max(np.abs(e.points - point) / self.cell, axis=1)
+        return bool(np.any(e.modes[d <= d.min() + MATCH_TOL] == mode))
+
+    def cycle_modes(self, points: np.ndarray, at: int, mode: int) -> np.ndarray:
+        """The mode at each point of the orbit whose samples repeat with ``points`` (the cycle of a period
+        ``p``), one run from ``points[at]`` in mode ``mode`` telling them; empty where not known (a model
+        without modes, ``mode`` -1, or the run fails).
+
+        The run goes on for up to as many cycles as the model has modes, until the mode at ``points[at]``
+        comes back: its modes may repeat every ``q`` cycles only (the result then has ``q p`` entries, for
+        the points repeated ``q`` times).
+
+        Examples
+        --------
+        >>> import grazing
+        >>> m = grazing.models.soft_impact_oscillator(gap=0.5, a=0.1, omega=1.2)
+        >>> cat = Catalogue(m, 1, np.full(2, 0.01), np.zeros(2), 1e3, 50, 0.0)
+        >>> run = grazing.simulate(m, [0.0, 0.0], transient=300, periods=1)
+        >>> cat.cycle_modes(run.samples, 0, 0).tolist(), cat.cycle_modes(run.samples, 0, -1).tolist()
+        ([0], [])
+        """
+        from grazing.engine.simulate import simulate
+
+        none = np.zeros(0, dtype=np.int64)
+        if not self.model.has_modes or mode < 0:
+            return none
+        p = len(points)
+        n_modes = len(self.model.mode_names)
+        phase = 2 * math.pi * (self.t_sample / float(self.model.period) % 1.0)
+        start = run_mode(self.model, mode, points[at], self.t_sample)
+        try:
+            sol = simulate(self.model, points[at], t0=self.t_sample, transient=0, periods=p * n_modes,
+                           phase=phase, mode=start)  # fmt: skip
+        except (GrazingError, ArithmeticError):
+            return none
+        seen = np.concatenate([[mode], np.asarray(sol.modes, dtype=np.int64)])  # (at points[at + j])
+        if seen.size < p * n_modes + 1:
+            return none
+        q = next((c for c in range(1, n_modes + 1) if seen[c * p] == mode), 1)
+        out = np.empty(q * p, dtype=np.int64)
+        out[(at + np.arange(q * p)) % (q * p)] = seen[: q * p]
+        return out
+
+    def _add_aperiodic(
+        self, index: np.ndarray, res: ChunkResult, rows: np.ndarray, ended: np.ndarray
+    ) -> None:
         """Aperiodic end states: those whose samples contract towards a stable orbit polished onto it; the
         others grouped when their samples share a cell, then merged with the attractors found before
         that share one or come within a recurrence cell of them."""
@@ -403,7 +486,7 @@ class Catalogue:
             fails = 0
             if self.polish:
                 targets = self._targets(groups.cells_of(owner, members), samples[members].reshape(-1, n))
-                left, fails = self._polish_members(index[rows], samples, members, targets)
+                left, fails = self._polish_members(index[rows], samples, members, targets, ended[rows])
                 if left.size == 0:
                     continue
                 members = left
@@ -434,7 +517,12 @@ class Catalogue:
         return owners | self._recurrent(points)
 
     def _polish_members(
-        self, index: np.ndarray, samples: np.ndarray, members: np.ndarray, targets: set[int]
+        self,
+        index: np.ndarray,
+        samples: np.ndarray,
+        members: np.ndarray,
+        targets: set[int],
+        ended: np.ndarray,
     ) -> tuple[np.ndarray, int]:
         """Polish the end states ``members`` (rows of ``samples``, initial states ``index``) that contract
         towards a cycle; label those on a stable orbit.  The others, and the failed attempts (at most
@@ -450,14 +538,15 @@ class Catalogue:
             if not candidates:
                 left.append(j)
                 continue
-            found = polish(self.model, samples[j], self.t_sample, candidates=candidates)
+            mode = run_mode(self.model, int(ended[j]), samples[j, -1], self.t_sample)
+            found = polish(self.model, samples[j], self.t_sample, candidates=candidates, mode=mode)
             if found is None:
                 left.append(j)
                 fails += 1
                 budget -= 1
                 continue
             budget += 1
-            self._add_polished(int(index[j]), found)
+            self._add_polished(int(index[j]), found, int(ended[j]))
         return np.asarray(left, dtype=np.int64), fails
 
     def _recurrent(self, points: np.ndarray) -> set[int]:
@@ -553,6 +642,8 @@ class Catalogue:
             e = self.entries[k]
             kind, exponent = self._kind(e)
             pts = e.points if e.points.size else np.zeros((0, self.model.n_states))
+            names = self.model.mode_names
+            modes = tuple(names[m] for m in e.modes) if e.modes.size == len(pts) and len(pts) else ()
             out.append(
                 Attractor(
                     id=ids[k],
@@ -565,6 +656,7 @@ class Catalogue:
                     count=e.count,
                     fraction=e.count / total,
                     first=e.first,
+                    modes=modes,
                 )
             )
         table = np.array(
@@ -607,7 +699,9 @@ class Catalogue:
             if self._sticks(e):
                 continue
             try:
-                mode = mode_there(self.model, e.points[0], self.t_sample)
+                mode = run_mode(
+                    self.model, int(e.modes[0]) if e.modes.size else -1, e.points[0], self.t_sample
+                )
                 fm = flow_map(self.model, e.points[0], t0=self.t_sample, periods=e.period, mode=mode)
             except (GrazingError, ArithmeticError):
                 continue
@@ -699,18 +793,27 @@ def same_points(a: np.ndarray, b: np.ndarray) -> bool:
     return set_distance(a, b, np.ones(np.shape(a)[-1])) <= PERIOD_TOL * scale
 
 
-def set_distance(a: np.ndarray, b: np.ndarray, cell: np.ndarray) -> float:
-    """The Hausdorff distance between two point sets, in cells (each component over its cell size).
+def set_distance(
+    a: np.ndarray, b: np.ndarray, cell: np.ndarray, modes_a: Any = None, modes_b: Any = None
+) -> float:
+    """The Hausdorff distance between two point sets, in cells (each component over its cell size); given
+    the mode at each point of both (``modes_a``, ``modes_b``), points in different modes are infinitely
+    far apart.
 
     Examples
     --------
     >>> a = np.array([[0.0, 0.0], [1.0, 0.0]])
     >>> set_distance(a, a[::-1], np.ones(2)), set_distance(a, a + [0.0, 0.5], np.array([1.0, 0.25]))
     (0.0, 2.0)
+    >>> one = np.ones(2)
+    >>> set_distance(a, a, one, [0, 1], [0, 1]), set_distance(a, a, one, [0, 1], [1, 0])
+    (0.0, 1.0)
     """
     a = np.asarray(a, dtype=float) / cell
     b = np.asarray(b, dtype=float) / cell
     if a.size == 0 or b.size == 0:
         return math.inf
     d = np.max(np.abs(a[:, None, :] - b[None, :, :]), axis=2)
+    if modes_a is not None and modes_b is not None:
+        d = np.where(np.asarray(modes_a)[:, None] == np.asarray(modes_b)[None, :], d, math.inf)
     return float(max(d.min(axis=1).max(), d.min(axis=0).max()))

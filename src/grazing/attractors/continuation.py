@@ -26,9 +26,9 @@ import numpy as np
 
 from grazing.attractors.basins import AttractorSet, find_attractors
 from grazing.attractors.classify import Attractor, set_distance
-from grazing.attractors.grid import state_grid
+from grazing.attractors.grid import start_time, state_grid
 from grazing.attractors.kinds import AttractorKind
-from grazing.core.model import HybridModel
+from grazing.core.model import HybridModel, mode_of_states
 from grazing.core.options import CELL_FRACTION, BasinSettings, refuse_unknown, with_shorthands
 from grazing.errors import InvalidParameterError
 from grazing.gpu.device import DEFAULT_DEVICE
@@ -75,8 +75,9 @@ def match(
     ``seeded`` maps a previous id to the current id most of its seeds ended on:
     those pairs first (of several previous ones ending on one, the nearest).
     Then the other pairs are taken nearest first (Hausdorff distance between
-    their points, in cells), each attractor at most once, up to ``threshold``;
-    outcomes match the outcome of the same kind and reason.
+    their points, in cells; on a model with modes, points in different modes
+    are not near: :func:`_distance`), each attractor at most once, up to
+    ``threshold``; outcomes match the outcome of the same kind and reason.
 
     Examples
     --------
@@ -94,9 +95,7 @@ def match(
     now = {a.id: a for a in current}
     for p_id, c_id in sorted((seeded or {}).items()):
         rivals = [q for q, c in (seeded or {}).items() if c == c_id]
-        best = min(
-            rivals, key=lambda q: (set_distance(_few(by_id[q].points), _few(now[c_id].points), cell), q)
-        )
+        best = min(rivals, key=lambda q: (_distance(by_id[q], now[c_id], cell), q))
         if best == p_id and c_id in now and not now[c_id].kind.outcome:
             out[c_id] = p_id
             taken.add(p_id)
@@ -109,7 +108,7 @@ def match(
                 if (c.kind, c.reason) == (p.kind, p.reason):
                     pairs.append((0.0, c.id, p.id))
                 continue
-            d = set_distance(_few(p.points), _few(c.points), cell)
+            d = _distance(p, c, cell)
             if d <= threshold:
                 pairs.append((d, c.id, p.id))
     for _, c_id, p_id in sorted(pairs):
@@ -126,13 +125,56 @@ def _few(points: np.ndarray, most: int = 400) -> np.ndarray:
     return points[np.linspace(0, len(points) - 1, most).astype(int)]
 
 
-def _seeds(attractors: Sequence[Attractor], most: int) -> tuple[np.ndarray, np.ndarray]:
-    """Points of each attractor (not the outcomes), at most ``most`` each, as initial states; and the id of
-    the attractor of each."""
-    chosen = [(a.id, _few(a.points, most)) for a in attractors if not a.kind.outcome and len(a.points)]
+def _distance(a: Attractor, b: Attractor, cell: np.ndarray) -> float:
+    """The distance between two attractors' points (at most 400 of each), in cells; where both know the
+    mode at each point, two points in different modes are not near (one state in two modes: two orbits).
+
+    Examples
+    --------
+    >>> def orbit(mode):
+    ...     return Attractor(id=1, kind="periodic", period=1, impacts_per_period=0.0, lyapunov=-1.0,
+    ...                      points=np.zeros((1, 2)), modes=(mode,) if mode else ())
+    >>> _distance(orbit("ann"), orbit("ann"), np.ones(2)), _distance(orbit("ann"), orbit("bo"), np.ones(2))
+    (0.0, inf)
+    >>> _distance(orbit("ann"), orbit(""), np.ones(2))
+    0.0
+    """
+    modes = len(a.modes) == len(a.points) and len(b.modes) == len(b.points)
+    return set_distance(
+        _few(a.points), _few(b.points), cell,
+        _few(np.asarray(a.modes)) if modes else None, _few(np.asarray(b.modes)) if modes else None,
+    )  # fmt: skip
+
+
+def _seeds(attractors: Sequence[Attractor], most: int) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """Points of each attractor (not the outcomes), at most ``most`` each, as initial states; the id of
+    the attractor of each; and the mode at each (``""``: not known)."""
+    chosen = [
+        (a.id, _few(a.points, most), _few(np.asarray(a.modes if len(a.modes) == len(a.points) else
+                                                     [""] * len(a.points)), most))
+        for a in attractors if not a.kind.outcome and len(a.points)
+    ]  # fmt: skip
     if not chosen:
-        return np.zeros((0, 0)), np.zeros(0, dtype=np.int64)
-    return np.concatenate([p for _, p in chosen]), np.concatenate([[i] * len(p) for i, p in chosen])
+        return np.zeros((0, 0)), np.zeros(0, dtype=np.int64), []
+    points = np.concatenate([p for _, p, _ in chosen])
+    ids = np.concatenate([[i] * len(p) for i, p, _ in chosen])
+    return points, ids, [str(m) for _, _, ms in chosen for m in ms]
+
+
+def _start_modes(model: HybridModel, states: np.ndarray, seeded: list[str], t: float) -> list[int] | None:
+    """A model with modes: the mode each of ``states`` starts in: its seed's (the last ``len(seeded)``
+    states), where known and not a sliding pseudo-mode, else the one it lies in
+    (:func:`~grazing.attractors.basins.start_modes`)."""
+    if not model.has_modes:
+        return None
+    there = mode_of_states(model, states, t)
+    out = [model.mode_index(None) if k < 0 else int(k) for k in there]  # (-1: invalid, whichever)
+    first = len(out) - len(seeded)
+    real = model.mode_names[: len(model.mode_names) - len(model.sliding_modes)]
+    for i, name in enumerate(seeded):
+        if name in real:  # (not known, or sliding on a surface, where no run starts: the one it lies in)
+            out[first + i] = real.index(name)
+    return out
 
 
 def _votes(origin: np.ndarray, labels: np.ndarray) -> dict[int, int]:
@@ -227,8 +269,9 @@ def continue_attractors(
     previous: list[Attractor] = []
     for k, v in enumerate(vals):
         here = model.with_params(**{par.name: float(v)})
-        extra, origin = _seeds(previous, seeds)
+        extra, origin, seeded = _seeds(previous, seeds)
         states_here = np.concatenate([x, extra]) if extra.size else x
+        modes = _start_modes(here, states_here, seeded, start_time(here, s.phase))
         found = find_attractors(
             here,
             states_here,
@@ -237,6 +280,7 @@ def continue_attractors(
             workers=workers,
             client=client,
             device=device,
+            modes=modes,
         )
         # (the cell grid of the first value throughout: distances in the same units)
         cell = steps[0].found.cell if steps else found.cell
@@ -280,6 +324,7 @@ def to_dataset(
     lyap = np.full((nv, na), np.nan)
     longest = max([min(len(a.points), KEPT_POINTS) for atts in shown for a in atts] + [1])
     points = np.full((nv, na, longest, n), np.nan)
+    modes = np.full((nv, na, longest), "", dtype=object)
     labels = np.zeros((nv, *grid.shape), dtype=np.int32)
     for i, st in enumerate(steps):
         fr = st.fractions()
@@ -293,6 +338,9 @@ def to_dataset(
             lyap[i, j] = a.lyapunov
             pts = _few(a.points, KEPT_POINTS)
             points[i, j, : len(pts)] = pts
+            if len(a.modes) == len(a.points):
+                kept = _few(np.asarray(a.modes), KEPT_POINTS)
+                modes[i, j, : len(kept)] = kept
         table = np.zeros(max(st.ids) + 1, dtype=np.int32)
         for local, g in st.ids.items():
             table[local] = g
@@ -318,6 +366,9 @@ def to_dataset(
             "component": ("component", list(names)),
         },
     )
+    if model.has_modes:
+        ds["modes"] = (("value", "attractor", "point"), modes.astype(str))
+        ds["modes"].attrs["description"] = "the mode at each of the points ('': not known, or padding)"
     p = model.parameter(param)
     ds["value"].attrs.update({"long_name": p.description or param, "symbol": p.label, "units": p.unit,
                               "angle": int(p.angle)})  # fmt: skip

@@ -53,6 +53,8 @@ def _sweep_options(func: Callable[..., Any]) -> Callable[..., Any]:
         ,
         click.option("--periods", type=count(1), default=SWEEP_DEFAULTS.periods, show_default=True,
                      help="Forcing periods sampled at each point."),
+        click.option("--phase", type=FINITE, default=SWEEP_DEFAULTS.phase, show_default=True, metavar="PHI",
+                     help="Stroboscopic phase in radians: each point sampled at tau = PHI mod 2 pi."),
         click.option("--initial", default=None, metavar="X1,X2,...",
                      help="Initial state (of every chunk; of every point with --fresh), one number per "
                      "state; default zero."),
@@ -309,8 +311,9 @@ def _outcomes(period: np.ndarray, status: np.ndarray) -> tuple[int, int, str]:
 def sweep_cmd(
     model: grazing.HybridModel, case: str,
     sparam: str, start: float, stop: float, num: int, direction: str, method: str, which: str,
-    transient: int, periods: int, initial: str, fresh: bool, chunk_size: int | None, workers: int | None,
-    scheduler: str | None, timeout: float | None, device: str, no_lyapunov: bool, no_adaptive: bool,
+    transient: int, periods: int, phase: float, initial: str, fresh: bool, chunk_size: int | None,
+    workers: int | None, scheduler: str | None, timeout: float | None, device: str, no_lyapunov: bool,
+    no_adaptive: bool,
     tol: float, out: Path | None, wait: bool, overwrite: bool, as_json: bool,
 ) -> None:  # fmt: skip
     """Brute-force bifurcation diagram: stroboscopic samples, periods, impacts and
@@ -340,8 +343,8 @@ def sweep_cmd(
     if method == "map":
         zdm, graze_info = _map_for_sweep(model, name, float(vals.min()), float(vals.max()), which)
     settings = SweepSettings(
-        transient=transient, periods=periods, fresh=fresh, chunk_size=chunk_size, adaptive=not no_adaptive,
-        lyapunov=not no_lyapunov, tol=tol,
+        transient=transient, periods=periods, phase=phase, fresh=fresh, chunk_size=chunk_size,
+        adaptive=not no_adaptive, lyapunov=not no_lyapunov, tol=tol,
     )  # fmt: skip
     spec = sweep_spec(model, name, vals, x0=x0, direction=direction, settings=settings, zdm=zdm)
     t0 = time.perf_counter()
@@ -352,8 +355,8 @@ def sweep_cmd(
     if as_json:
         res = {"params": model_params_json(model, case), **_sweep_json(spec, run, sparam, shown)}
         res.update({"direction": direction, "fresh": fresh, "transient": transient, "periods": periods,
-                    "chunk_size": spec.size, "elapsed_s": elapsed, "out": str(out) if out else None,
-                    "method": method, "grazing": graze_info})  # fmt: skip
+                    "phase": phase, "chunk_size": spec.size, "elapsed_s": elapsed,
+                    "out": str(out) if out else None, "method": method, "grazing": graze_info})  # fmt: skip
         if direction == "both":
             res["hysteresis"] = [_hysteresis_json(h, par) for h in _hysteresis(spec, run)]
         emit_json(res)
@@ -467,8 +470,9 @@ def _map_for_sweep(model: Any, name: str, lo: float, hi: float, which: str) -> t
 def map_cmd(
     model: grazing.HybridModel, case: str,
     param1: str, start1: float, stop1: float, num1: int, param2: str, start2: float, stop2: float, num2: int,
-    transient: int, periods: int, initial: str, fresh: bool, chunk_size: int | None, workers: int | None,
-    scheduler: str | None, timeout: float | None, device: str, no_lyapunov: bool, no_adaptive: bool,
+    transient: int, periods: int, phase: float, initial: str, fresh: bool, chunk_size: int | None,
+    workers: int | None, scheduler: str | None, timeout: float | None, device: str, no_lyapunov: bool,
+    no_adaptive: bool,
     tol: float, out: Path | None, wait: bool, overwrite: bool, as_json: bool,
 ) -> None:  # fmt: skip
     """Two-parameter map of periods, impacts and Lyapunov exponents."""
@@ -494,8 +498,8 @@ def map_cmd(
         model.with_params(**{n1: a, n2: b})
     x0 = parse_state(initial, model)
     settings = SweepSettings(
-        transient=transient, periods=periods, fresh=fresh, chunk_size=chunk_size, adaptive=not no_adaptive,
-        lyapunov=not no_lyapunov, tol=tol,
+        transient=transient, periods=periods, phase=phase, fresh=fresh, chunk_size=chunk_size,
+        adaptive=not no_adaptive, lyapunov=not no_lyapunov, tol=tol,
     )  # fmt: skip
     spec = map_spec(model, n1, v1, n2, v2, x0=x0, settings=settings)
     t0 = time.perf_counter()
@@ -510,7 +514,7 @@ def map_cmd(
             "param1": param1, "values1": np.sort(s1), "param2": param2, "values2": np.sort(s2),
             "period": ds.period.values, "impacts_per_period": ds.impacts_per_period.values,
             "lyapunov": ds.lyapunov.values, "elapsed_s": elapsed, "out": str(out) if out else None,
-            "status": reasons(ds.status.values),
+            "status": reasons(ds.status.values), "phase": phase,
         }  # fmt: skip
         emit_json(res)
         return

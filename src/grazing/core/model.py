@@ -1482,3 +1482,38 @@ def mode_of_states(model: HybridModel, states: np.ndarray, t: float) -> np.ndarr
             inside &= h >= -ON_STOP_TOL * scale
         out[(out < 0) & inside] = k
     return out
+
+
+def in_modes(model: HybridModel, states: np.ndarray, modes: np.ndarray, t: float) -> np.ndarray:
+    """Whether each row of ``states`` lies in the region of its mode ``modes`` (indices) at time ``t``: the
+    guards of the mode's outgoing transitions all above ``-ON_STOP_TOL * max(1, |x|)``, as
+    :func:`mode_of_states` decides.  A model without modes: not beyond a stop.
+
+    Examples
+    --------
+    >>> import grazing
+    >>> m = grazing.models.soft_impact_oscillator(gap=0.5)
+    >>> in_modes(m, np.array([[0.0, 1.0], [0.0, 1.0], [0.7, 0.0]]), np.array([0, 1, 0]), 0.0).tolist()
+    [True, False, False]
+    """
+    x = np.asarray(states, dtype=float)
+    which = np.asarray(modes, dtype=np.int64)
+    out = np.ones(x.shape[0], dtype=bool)
+    if x.shape[0] == 0:
+        return out
+    params = list(model.param_vector)
+    scale = np.maximum(1.0, np.max(np.abs(x), axis=1))
+    columns = [x[:, c] for c in range(x.shape[1])]
+    for j in range(model.n_stops):
+        mine = (
+            which == model.mode_names.index(model.transition_source[j])
+            if model.has_modes
+            else np.ones(out.shape, dtype=bool)
+        )
+        if not mine.any():
+            continue
+        h = np.broadcast_to(
+            np.asarray(model.numeric("h", j)(columns, float(t), params), dtype=float), out.shape
+        )
+        out &= ~mine | (h >= -ON_STOP_TOL * scale)
+    return out

@@ -165,21 +165,28 @@ def run_sweep(
     return sink.dataset() if load else None
 
 
-def run_sweeps(specs: Sequence[SweepSpec], *, workers: int | None = None) -> list[Any]:
-    """Run several sweeps together on the local cores; their datasets (as :func:`run_sweep`), in order.
+def run_sweeps(
+    specs: Sequence[SweepSpec], *, workers: int | None = None, device: str = DEFAULT_DEVICE
+) -> list[Any]:
+    """Run several sweeps together on the local cores or a GPU; their datasets (as :func:`run_sweep`), in
+    order.
 
     The chunks of sweeps that share the model and the sweep settings (they
     may differ in their points, start state, phase and ``fresh``) fill the
-    same SIMD lanes: a dozen one-chunk experimenter sweeps run as fast as
-    one sweep of a dozen chunks.  Each result is the one :func:`run_sweep`
-    gives for that spec.
+    same SIMD lanes (on the GPU: the same launches, :func:`grazing.gpu.batch.gpu_parts`):
+    a dozen one-chunk experimenter sweeps run as fast as one sweep of a dozen
+    chunks.  Each result is the one :func:`run_sweep` gives for that spec.
 
     Parameters
     ----------
     specs
         The sweeps (:func:`~grazing.sweeps.spec.sweep_spec`, :func:`~grazing.sweeps.spec.map_spec`).
     workers
-        Local threads computing the chunks (default: all cores).
+        Local threads computing the chunks on the CPU (default: all cores).
+    device
+        ``"cpu"`` (the default), ``"gpu"`` or ``"auto"``, decided for each sweep as :func:`run_sweep`
+        decides (:func:`~grazing.gpu.device.resolve_device`: ``"gpu"`` refuses, in one line and before
+        anything runs, a sweep the GPU does not do; ``"auto"`` puts a large sweep on a GPU present).
 
     Returns
     -------
@@ -199,16 +206,38 @@ def run_sweeps(specs: Sequence[SweepSpec], *, workers: int | None = None) -> lis
     from grazing.sweeps.store import MemoryStore
 
     unique = {id(spec): spec for spec in specs}  # (a spec given twice is computed once)
+    where = {key: resolve_device(device, spec) for key, spec in unique.items()}  # (refused before any run)
     sinks = {key: MemoryStore(spec) for key, spec in unique.items()}
-    parts = [(spec, i) for spec in unique.values() if not is_chained(spec) for i in range(spec.n_chunks)]
-    for (spec, _), res in local_results(parts, workers):
-        sinks[id(spec)].write(res)
-    chained = [spec for spec in unique.values() if is_chained(spec)]
-    lines = [ChainLine(spec, sinks[id(spec)], list(range(spec.n_chunks))) for spec in chained]
-    if lines:
-        write = lambda k, res: lines[k].sink.write(res)  # noqa: E731
-        settle(lines, compute_parts(workers, None), write, chain_window(0, True))
+    for on in ("cpu", "gpu"):
+        mine = [spec for key, spec in unique.items() if where[key] == on]
+        parts = [(spec, i) for spec in mine if not is_chained(spec) for i in range(spec.n_chunks)]
+        if parts:
+            if on == "gpu":
+                from grazing.gpu.batch import gpu_parts
+
+                computed = gpu_parts(parts)
+            else:
+                computed = local_results(parts, workers)
+            for (spec, _), res in computed:
+                sinks[id(spec)].write(res)
+        lines = [
+            ChainLine(spec, sinks[id(spec)], list(range(spec.n_chunks))) for spec in mine if is_chained(spec)
+        ]
+        if lines:
+            write = lambda k, res, lines=lines: lines[k].sink.write(res)  # noqa: E731
+            compute = parts_on(on, workers)
+            settle(lines, compute, write, chain_window(0, True))  # (in memory: every chunk at a time)
     return [sinks[id(spec)].dataset() for spec in specs]
+
+
+def parts_on(device: str, workers: int | None) -> Any:
+    """What computes a round of chained parts on ``device`` (``"cpu"``: the local cores; ``"gpu"``:
+    :func:`grazing.gpu.batch.gpu_parts`) for :func:`grazing.sweeps.chain.settle`."""
+    if device == "gpu":
+        from grazing.gpu.batch import gpu_parts
+
+        return gpu_parts
+    return compute_parts(workers, None)
 
 
 def then(items: Iterable[T], action: Callable[[], None] | None) -> Iterator[T]:

@@ -166,14 +166,35 @@ def mode_there(model: HybridModel, state: np.ndarray, t: float) -> str | None:
     return model.mode_at(state, t) if model.has_modes else None
 
 
-def cycle_points(model: HybridModel, state: np.ndarray, t0: float, period: int) -> np.ndarray:
-    """The points of the period-``period`` orbit through ``state`` at times ``t0 + j T``, ``j = 1 ..
-    period`` (the last is ``state`` again, to the orbit's accuracy)."""
+def run_mode(model: HybridModel, index: int, state: np.ndarray, t: float) -> str | None:
+    """The mode a run from ``state`` at time ``t`` that a run left in mode ``index`` starts in: that mode
+    where it is a real one (a state of a hysteretic switch lies in two modes' regions: the one it was
+    in is the right one), else (-1: unknown; a sliding pseudo-mode, where no run starts) the one it lies
+    in (:func:`mode_there`; it slides on from the surface).  None without modes.
+
+    Examples
+    --------
+    >>> import grazing
+    >>> m = grazing.models.soft_impact_oscillator(gap=0.5)
+    >>> run_mode(m, 1, np.array([0.5, 0.0]), 0.0), run_mode(m, -1, np.array([0.5, 0.0]), 0.0)
+    ('contact', 'free')
+    """
+    if not model.has_modes:
+        return None
+    real = len(model.mode_names) - len(model.sliding_modes)
+    return model.mode_names[int(index)] if 0 <= int(index) < real else mode_there(model, state, t)
+
+
+def cycle_points(model: HybridModel, state: np.ndarray, t0: float, period: int,
+                 mode: str | None = None) -> np.ndarray:  # fmt: skip
+    """The points of the period-``period`` orbit through ``state`` (in ``mode``, by default the one it lies
+    in) at times ``t0 + j T``, ``j = 1 .. period`` (the last is ``state`` again, to the orbit's
+    accuracy)."""
     from grazing.engine.simulate import simulate
 
     phase = 2 * math.pi * (t0 / float(model.period) % 1.0)
-    sol = simulate(model, state, t0=t0, transient=0, periods=period, phase=phase,
-                   mode=mode_there(model, state, t0))  # fmt: skip
+    mode = mode_there(model, state, t0) if mode is None else mode
+    sol = simulate(model, state, t0=t0, transient=0, periods=period, phase=phase, mode=mode)
     return np.asarray(sol.samples, dtype=float)[-period:]
 
 
@@ -185,6 +206,7 @@ def polish(
     max_period: int = MAX_PERIOD,
     candidates: list[int] | None = None,
     max_iter: int = POLISH_MAX_ITER,
+    mode: str | None = None,
 ) -> Polished | None:
     """The stable periodic orbit that ``samples`` (a run's, at times ``t0 + k T``) approach, or None.
 
@@ -193,7 +215,8 @@ def polish(
     sample; the first orbit it converges to that is stable, not neutral (:func:`is_neutral`) and
     that the samples :func:`approaches` is the answer.  None where there is no candidate, Newton
     fails, or the orbits it finds are unstable (a torus around an unstable orbit, chaos): then the
-    run is what its samples say.
+    run is what its samples say.  ``mode``: the mode of the last sample (a model with modes; by default
+    the one it lies in, :func:`mode_there`).
 
     Examples
     --------
@@ -210,18 +233,19 @@ def polish(
 
     s = np.asarray(samples, dtype=float)
     tries = contracting_periods(s, max_period) if candidates is None else list(candidates)
+    mode = mode_there(model, s[-1], float(t0)) if mode is None else mode
     for p in tries:
         try:
             orbit = find_orbit(
                 model, s[-1], period=int(p), t0=float(t0), max_iter=max_iter, through_stops=False,
-                mode=mode_there(model, s[-1], float(t0)),
+                mode=mode,
             )  # fmt: skip
         except (GrazingError, ArithmeticError, np.linalg.LinAlgError):
             continue
         if not orbit.stable or is_neutral(orbit.monodromy, orbit.multipliers):
             continue
         try:
-            cycle = cycle_points(model, orbit.state, float(t0), int(p))
+            cycle = cycle_points(model, orbit.state, float(t0), int(p), mode)
         except (GrazingError, ArithmeticError):
             continue
         if not approaches(s, cycle, orbit.abs_lambda):

@@ -51,7 +51,7 @@ from grazing.engine.codegen import taylor_order
 from grazing.engine.native import load_sweep_lanes
 from grazing.engine.records import LaneJobs, LanePoints, LaneResults, LaneSettings
 from grazing.engine.runner import step_safety
-from grazing.sweeps.polish import polish
+from grazing.sweeps.polish import polish, run_mode
 from grazing.sweeps.spec import ChunkResult, SweepSpec
 from grazing.sweeps.status import NOT_COMPUTED, STATUS_DTYPE
 
@@ -257,7 +257,8 @@ class LaneBatch:
         for j in np.flatnonzero((period == 0) & (self.status[a:b] == Status.OK)):
             model = spec.model_at(spec.points[first + j])
             t0 = float(self.sphase[a + j])
-            found = polish(model, self.samples[a + j], t0, max_period=DEFAULT_MAX_PERIOD)
+            mode = run_mode(model, int(self.vf_final[a + j]), self.samples[a + j, -1], t0)
+            found = polish(model, self.samples[a + j], t0, max_period=DEFAULT_MAX_PERIOD, mode=mode)
             if found is not None:
                 period[j] = found.period
 

@@ -80,6 +80,10 @@ END_TIME = "chunk_end_time"
 END_MODE = "chunk_end_mode"
 """Per chunk of a model with modes: the mode its last point ends in (-1: failed), where a chain goes on."""
 """Per chunk: the time its last point ended at, where a chain goes on from (a model that is not periodic)."""
+POINT_MODE = "point_end_mode"
+"""Per point of a model with modes: the mode its last sample is in (-1: failed), what tells two attractors
+with the same samples in two modes apart (:mod:`grazing.attractors.classify`; a store made before it
+existed gives each chunk's last point's only)."""
 
 
 def _shapes(spec: SweepSpec) -> dict[str, tuple[int, ...]]:
@@ -364,6 +368,7 @@ class ZarrStore:
                 raise StoreDamagedError(self._damaged("chunk_done has the wrong shape"))
             self._has_end_time = (self.path / END_TIME).is_dir()  # (not in earlier fresh sweeps' stores)
             self._has_end_mode = (self.path / END_MODE).is_dir()  # (models with modes only)
+            self._has_point_mode = (self.path / POINT_MODE).is_dir()  # (and not in earlier stores)
         except BaseException:
             self.close()
             raise
@@ -452,6 +457,9 @@ class ZarrStore:
         if self.spec.model.has_modes:
             data[END_MODE] = ("chunk", da.full(nc, -1, dtype=np.int64, chunks=min(nc, 1 << 20)))
             encoding[END_MODE] = {"chunks": (1,), "fill_value": -1}
+            n = self.spec.n_points
+            data[POINT_MODE] = ("point", da.full(n, -1, dtype=np.int64, chunks=c))
+            encoding[POINT_MODE] = {"chunks": (c,), "fill_value": -1}
         ds = xr.Dataset(data)
         ds["status"].attrs.update(status_attrs())
         summary = spec_summary(self.spec)
@@ -474,6 +482,11 @@ class ZarrStore:
 
         sl = self.spec.chunk(res.index)
         part = _flat({name: getattr(res, name) for name in _VARIABLES})
+        if self._has_point_mode:
+            ended = (
+                np.full(sl.stop - sl.start, -1, dtype=np.int64) if res.mode_final is None else res.mode_final
+            )
+            part[POINT_MODE] = ("point", np.asarray(ended, dtype=np.int64))
         flag = xr.Dataset({"chunk_done": ("chunk", np.ones(1, dtype=np.int8))})
         if self._has_end_time:
             flag[END_TIME] = ("chunk", np.array([_end_time(res)]))
@@ -499,7 +512,9 @@ class ZarrStore:
         t_final = np.full(sl.stop - sl.start, np.nan)
         t_final[-1] = t
         mode_final = None
-        if self._has_end_mode:  # (the mode of the last point only: where the chain goes on)
+        if self._has_point_mode:
+            mode_final = self._read(POINT_MODE, lambda z: np.asarray(z[sl], dtype=np.int64))
+        elif self._has_end_mode:  # (a store made before POINT_MODE: the mode of the last point only)
             mode_final = np.full(sl.stop - sl.start, -1, dtype=np.int64)
             mode_final[-1] = int(self._read(END_MODE, lambda z: z[i]))
         return ChunkResult(index=i, t_final=t_final, mode_final=mode_final, **got)
