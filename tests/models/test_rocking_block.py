@@ -276,3 +276,9 @@ def test_basins_name_the_overturned_block_once_a_side():
     assert (ds.period.values[side] == 1).all() and ds["count"].values[side].sum() >= 32  # (half the grid)
     assert not np.any(np.abs(ds.points.values[..., 0]) > math.pi / 2 + 1e-12)  # (nothing spins on)
     assert ds.sizes["attractor"] <= 4, ds.kind.values
+    assert set(ds["mode"].values[side].tolist()) == {"overturned"}  # (named by the mode they end in)
+    rocking = ~side & (ds.period.values == 1)  # (the rocking orbit: on the side of its corner)
+    assert rocking.sum() == 1
+    assert ds["mode"].values[rocking].tolist() == [
+        "right_corner" if points[rocking, 0][0] > 0 else "left_corner"
+    ]

@@ -555,6 +555,7 @@ def to_dataset(model: HybridModel, grid: StateGrid, found: AttractorSet) -> Any:
             "fraction": ("attractor", np.array([a.fraction for a in atts], dtype=float)),
             "count": ("attractor", np.array([a.count for a in atts], dtype=np.int64)),
             "reason": ("attractor", np.array([a.reason for a in atts], dtype=str)),
+            "mode": ("attractor", np.array([a.mode for a in atts], dtype=str)),
             "points": (("attractor", "point", "component"), points),
             "n_points": ("attractor", np.array([len(a.points) for a in atts], dtype=np.int32)),
         },
@@ -573,6 +574,7 @@ def to_dataset(model: HybridModel, grid: StateGrid, found: AttractorSet) -> Any:
         "periodic, sticking, neutral, chaotic, quasiperiodic, aperiodic, escaping, failed, invalid"
     )
     ds["points"].attrs["description"] = "states on the attractor at the sampling phase (NaN-padded)"
+    ds["mode"].attrs["description"] = "the mode its end states ended in ('': in different ones, or not known)"
     ds.attrs.update(
         {
             "model": model.name,

@@ -108,6 +108,11 @@ class Attractor:
         ``count`` over all initial states.
     first
         The index of its first initial state.
+    mode
+        The mode every end state on it ended in, at the sampling phase (a model with modes: an
+        absorbing mode such as the rocking block's ``overturned`` names the outcome); ``""`` where
+        they ended in different modes (an orbit through several, sampled at different points), where
+        it is not known (an orbit found by a Newton polish, an outcome) or the model has one mode.
 
     Examples
     --------
@@ -136,6 +141,7 @@ class Attractor:
     count: int = 0
     fraction: float = 0.0
     first: int = 0
+    mode: str = ""
 
     def __post_init__(self) -> None:
         self.kind = AttractorKind(self.kind)  # (given as its word: the member)
@@ -152,11 +158,18 @@ class Attractor:
             "reason": self.reason or None,
             "count": self.count,
             "fraction": self.fraction,
+            "mode": self.mode or None,
         }
 
 
 def _finite(v: float) -> float | None:
     return float(v) if math.isfinite(v) else None
+
+
+NO_MODE = -2
+"""An entry's ``mode`` before any end state on it is counted."""
+MIXED_MODES = -1
+"""An entry's ``mode`` where its end states ended in different modes (or one not known)."""
 
 
 @dataclass
@@ -174,9 +187,17 @@ class _Entry:
     cells: set[bytes] = field(default_factory=set)
     failures: int = 0  # (failed Newton polishes of its end states)
     neutral: bool = False  # (a periodic orbit whose multiplier 1 is double)
+    mode: int = NO_MODE  # (the mode its end states ended in; MIXED_MODES where they differ)
 
     def __post_init__(self) -> None:
         self.family = AttractorKind(self.family)
+
+    def ended_in(self, modes: np.ndarray | None) -> None:
+        """Note the modes (indices; -1 or None: not known) that end states on it ended in."""
+        seen = {-1} if modes is None else {int(k) for k in np.asarray(modes).ravel()}
+        if self.mode != NO_MODE:
+            seen.add(self.mode)
+        self.mode = seen.pop() if len(seen) == 1 else MIXED_MODES
 
 
 class Catalogue:
@@ -268,6 +289,8 @@ class Catalogue:
         e.count += g.count
         e.exponents = (e.exponents + g.exponents)[:MAX_EXPONENTS]
         e.failures += g.failures
+        if g.mode != NO_MODE:
+            e.ended_in(np.array([g.mode]))
         if len(e.points) < MAX_POINTS and len(g.points):
             e.points = np.concatenate([e.points, g.points[: MAX_POINTS - len(e.points)]])
         e.cells |= g.cells
@@ -364,13 +387,16 @@ class Catalogue:
                 k = self._periodic_entry(int(p), cyc[rep], int(index[row]), impacts)
                 e = self.entries[k]
                 e.count += members.size
+                e.ended_in(None if res.mode_final is None else np.asarray(res.mode_final)[sel[members]])
                 self.labels[index[sel[members]]] = k
 
-    def _add_polished(self, i: int, found: Polished) -> None:
-        """Label initial state ``i`` with the periodic orbit its end state was polished to."""
+    def _add_polished(self, i: int, found: Polished, mode: int = -1) -> None:
+        """Label initial state ``i`` with the periodic orbit its end state (ended in mode ``mode``; -1:
+        not known) was polished to."""
         cyc = np.roll(found.cycle, -int(np.argmin(found.cycle[:, 0])), axis=0)
         k = self._periodic_entry(found.period, cyc, i, float(found.impacts))
         self.entries[k].count += 1
+        self.entries[k].ended_in(np.array([mode]))
         self.labels[i] = k
         self.polished += 1
 
@@ -403,7 +429,8 @@ class Catalogue:
             fails = 0
             if self.polish:
                 targets = self._targets(groups.cells_of(owner, members), samples[members].reshape(-1, n))
-                left, fails = self._polish_members(index[rows], samples, members, targets)
+                ended = None if res.mode_final is None else np.asarray(res.mode_final)[rows]
+                left, fails = self._polish_members(index[rows], samples, members, targets, ended)
                 if left.size == 0:
                     continue
                 members = left
@@ -420,6 +447,7 @@ class Catalogue:
             e.exponents = [float(v) for v in lyap[members][:MAX_EXPONENTS]]
             e.cells = cells
             e.failures = fails
+            e.ended_in(None if res.mode_final is None else np.asarray(res.mode_final)[rows[members]])
             self._aperiodic.append(k)
             for key in cells:
                 self._owner[key] = k
@@ -434,9 +462,15 @@ class Catalogue:
         return owners | self._recurrent(points)
 
     def _polish_members(
-        self, index: np.ndarray, samples: np.ndarray, members: np.ndarray, targets: set[int]
+        self,
+        index: np.ndarray,
+        samples: np.ndarray,
+        members: np.ndarray,
+        targets: set[int],
+        modes: np.ndarray | None = None,
     ) -> tuple[np.ndarray, int]:
-        """Polish the end states ``members`` (rows of ``samples``, initial states ``index``) that contract
+        """Polish the end states ``members`` (rows of ``samples``, initial states ``index``, ended in
+        ``modes``: None, not known) that contract
         towards a cycle; label those on a stable orbit.  The others, and the failed attempts (at most
         :data:`~grazing.core.options.POLISH_TRIES` on the attractors ``targets`` they are on, more as
         long as attempts succeed), are returned."""
@@ -457,7 +491,7 @@ class Catalogue:
                 budget -= 1
                 continue
             budget += 1
-            self._add_polished(int(index[j]), found)
+            self._add_polished(int(index[j]), found, -1 if modes is None else int(modes[j]))
         return np.asarray(left, dtype=np.int64), fails
 
     def _recurrent(self, points: np.ndarray) -> set[int]:
@@ -565,6 +599,7 @@ class Catalogue:
                     count=e.count,
                     fraction=e.count / total,
                     first=e.first,
+                    mode=self.model.mode_names[e.mode] if self.model.has_modes and e.mode >= 0 else "",
                 )
             )
         table = np.array(
