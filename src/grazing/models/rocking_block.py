@@ -21,7 +21,10 @@ about the new corner, ``1 - 3/2 sin^2(alpha)``, or a given ``r``::
 (``housner = 1``, the default, is Housner's; ``housner = 0`` uses ``r``).
 Between impacts ``theta'^2 / 2 + p^2 cos(alpha - |theta|)`` is conserved when
 ``a = 0``.  The model is of a block already rocking: it has no mode at rest
-on its base (a block at rest starts to rock once ``|u_g''| > g tan(alpha)``).
+on its base (a block at rest starts to rock once ``|u_g''| > g tan(alpha)``);
+a decaying motion whose landings accumulate (the block coming to rest) ends
+the run with the status ``accumulating impacts``, which the engine does not
+continue across modes yet.
 Past ``|theta| = alpha`` gravity tips it further over; when ``|theta|`` reaches
 ``pi/2`` its side face meets the base: it has overturned.  The transitions
 ``overturn_right`` / ``overturn_left`` then enter the absorbing mode
