@@ -97,3 +97,38 @@ def test_the_lanes_run_each_initial_state_in_its_mode():
         mode = SOFT.mode_at(x0, t0)
         sol = grazing.simulate(SOFT, x0, t0=t0, transient=2, periods=3, phase=phase, mode=mode, tol=spec.tol)
         assert np.max(np.abs(ds.samples.values[k] - sol.samples)) < 1e-8, k
+
+
+def test_each_attractor_names_the_mode_its_points_are_in(grid):
+    """A periodic attractor of a model with modes names the mode of its point at the sampling phase: the
+    region it lies in (``mode_at``); none on a model of one mode."""
+    expected = [SOFT.mode_at(grid.points.values[k, 0]) for k in range(2)]
+    assert grid["modes"].values[:, 0].tolist() == expected
+    found = find_attractors(SOFT, grid.points.values[:, 0], workers=1)
+    assert [a.mode for a in found.attractors] == expected
+    assert [a.to_json()["modes"] for a in found.attractors] == [[m] for m in expected]
+    ball = find_attractors(grazing.models.bouncing_ball(amplitude=0.8, r=0.8), [[0.0, 0.8]], workers=1)
+    assert [a.mode for a in ball.attractors] == [""] and ball.attractors[0].to_json()["modes"] is None
+
+
+def test_the_mode_of_an_attractor_is_that_of_its_own_end_states():
+    """End states of a chunk, a failed one among them: each orbit takes the final mode of its own rows."""
+    from grazing.attractors.classify import Catalogue
+    from grazing.models import rocking_block
+    from grazing.sweeps.spec import ChunkResult
+
+    block = rocking_block()
+    ends = np.array([[np.nan, np.nan], [np.pi / 2, 0.0], [0.05, -0.01]])
+    res = ChunkResult(
+        index=0, samples=np.repeat(ends[:, None, :], 4, axis=1), period=np.array([-1, 1, 1]),
+        impacts=np.array([0, 0, 8]), lyapunov=np.full(3, np.nan), transient_used=np.full(3, 10),
+        x_final=ends, status=np.array([3, 0, 0]), mode_final=np.array([-1, 2, 0]),
+    )  # fmt: skip
+    cat = Catalogue(block, 3, np.full(2, 0.01), np.zeros(2), 1e3, 4, 0.0)
+    cat.add(0, res)
+    atts, _ = cat.attractors()
+    assert [(a.kind, a.mode) for a in atts] == [
+        ("failed", ""),
+        ("periodic", "overturned"),
+        ("periodic", "right_corner"),
+    ]

@@ -96,7 +96,21 @@ def test_the_mode_cases_reach_what_they_are_for(compared: dict[str, dict[str, ob
     sliding (its pseudo-mode, 2) or slipping, the diagonal model's sliding."""
     assert set(compared["soft impact modes"]["cpu_mode_final"]) == {0, 1}
     block = compared["rocking block"]
-    assert block["cpu_status"] == [3, 0, 0] and block["cpu_impacts_by_stop"][1:] == [[8, 8], [8, 8]], block
+    from grazing.models import rocking_block
+
+    names = rocking_block().stop_names  # (landings on both corners, no overturn)
+    landings = [
+        [row[names.index(n)] for n in ("onto_left", "onto_right")] for row in block["cpu_impacts_by_stop"]
+    ]
+    overturns = [
+        [row[names.index(n)] for n in ("overturn_right", "overturn_left")]
+        for row in block["cpu_impacts_by_stop"]
+    ]
+    assert (
+        block["cpu_status"] == [3, 0, 0]
+        and landings[1:] == [[8, 8], [8, 8]]
+        and overturns[1:] == [[0, 0]] * 2
+    ), block
     for case in (
         "lyapunov soft impact chained",
         "lyapunov rocking block chained",

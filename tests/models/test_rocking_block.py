@@ -175,3 +175,110 @@ def test_free_rocking_comes_to_rest_in_one_line():
     assert "\n" not in str(info.value) and "'onto_left', 'onto_right'" in str(info.value)
     t = float(re.search(r"at t = (\S+) ", str(info.value)).group(1))
     assert abs(t - t_rest) < 1e-4 * t_rest, (t, t_rest)
+
+
+def overturn_time(theta0, p, alpha):
+    """Time from rest at ``theta0`` (alpha < theta0 < pi/2) to ``theta = pi/2``, free: the quadrature of
+    ``theta'^2 / 2 = p^2 (cos(alpha - theta0) - cos(alpha - theta))``, with ``theta = theta0 + u^2``."""
+
+    def integrand(u):  # cos(alpha - theta0) - cos(alpha - theta) = 2 sin(theta0 + u^2/2 - alpha) sin(u^2/2)
+        if u == 0.0:
+            return 2.0 / math.sqrt(2 * p**2 * math.sin(theta0 - alpha))
+        return 2 * u / math.sqrt(4 * p**2 * math.sin(theta0 + u * u / 2 - alpha) * math.sin(u * u / 2))
+
+    return quad(integrand, 0.0, math.sqrt(math.pi / 2 - theta0), epsabs=0.0, epsrel=1e-13, limit=200)[0]
+
+
+@pytest.mark.parametrize("side", [1.0, -1.0])
+def test_free_overturning_against_its_quadrature(side):
+    """Released past its slenderness, the unforced block falls onto its side at ``|theta| = pi/2`` at the
+    time of the energy quadrature, with the energy's speed there, and lies there: ``(+-pi/2, 0)`` in the
+    mode ``overturned`` at every later sample."""
+    p, alpha, theta0 = 1.3, 0.25, 0.3
+    m = rocking_block(a=0.0, p=p, alpha=alpha)
+    t_side = overturn_time(theta0, p, alpha)
+    speed = math.sqrt(2 * p**2 * (math.cos(alpha - theta0) - math.sin(alpha)))
+    start = "right_corner" if side > 0 else "left_corner"
+    sol = grazing.simulate(m, [side * theta0, 0.0], periods=10, impacts="all", mode=start)
+    assert t_side < sol.t[3]  # (several samples lie after it)
+    name = "overturn_right" if side > 0 else "overturn_left"
+    assert [sol.switches.name(i) for i in range(len(sol.switches))] == [name]
+    assert [m.stop_names[j] for j in sol.impacts.stop] == [name]
+    assert abs(sol.impacts.t[0] - t_side) < 1e-11 and abs(sol.switches.t[0] - t_side) < 1e-11
+    assert np.abs(sol.impacts.state[0] - [side * math.pi / 2, side * speed]).max() < 1e-11
+    assert sol.switches.state[0].tolist() == [side * math.pi / 2, 0.0]
+    after = sol.t > t_side
+    assert np.all(sol.samples[after] == [side * math.pi / 2, 0.0])
+    assert {sol.mode_names[k] for k in sol.modes[after]} == {"overturned"} and sol.mode_final == "overturned"
+    assert np.all(np.abs(sol.samples[~after, 0]) < math.pi / 2)
+
+
+def test_forced_overturning_against_scipy():
+    """Forced hard (a = 0.5, beyond tan(alpha) = 0.31), the block rocks on both corners, then overturns: the
+    landings and the overturning (``|theta| = pi/2``, a terminal event of the scipy reference of
+    :func:`test_forced_rocking_against_scipy`'s equations) to 1e-9, the samples before it to 1e-9 and
+    ``(+-pi/2, 0)`` after it."""
+    from scipy.integrate import solve_ivp
+
+    m = rocking_block(a=0.5, omega=3.0, alpha=0.3, p=1.5)
+    q = dict(m.params)
+    rho = housner_restitution(q["alpha"])
+
+    def field(t, y):
+        sgn = 1.0 if y[0] > 0 or (y[0] == 0 and y[1] > 0) else -1.0
+        phi = q["alpha"] * sgn - y[0]
+        return [y[1], -(q["p"] ** 2) * (math.sin(phi) + q["a"] * math.cos(q["omega"] * t) * math.cos(phi))]
+
+    def landing(t, y):
+        return y[0]
+
+    def side(t, y):
+        return math.pi / 2 - abs(y[0])
+
+    landing.terminal = side.terminal = True
+    sol = grazing.simulate(m, [0.1, 0.0], periods=8, impacts="all")
+    y, t, times, over = [0.1, 0.0], 0.0, [], None
+    for ts, xs in zip(sol.t, sol.samples):
+        while over is None:
+            run = solve_ivp(
+                field, (t, ts), y, method="DOP853", rtol=1e-13, atol=1e-15, events=(landing, side)
+            )
+            if run.status == 1 and len(run.t_events[1]):
+                over = float(run.t_events[1][0])
+                y = [math.copysign(math.pi / 2, run.y_events[1][0][0]), 0.0]
+                break
+            if run.status == 1:
+                t = float(run.t_events[0][0])
+                speed = rho * run.y_events[0][0][1]
+                y = [math.copysign(1e-300, speed), speed]
+                times.append(t)
+                continue
+            y, t = list(run.y[:, -1]), ts
+            break
+        assert np.abs(np.array(y) - xs).max() < 1e-9, (ts, y, xs)
+    assert over is not None and len(times) >= 4  # (it rocked on both corners first)
+    assert np.abs(np.array([*times, over]) - sol.impacts.t).max() < 1e-9
+    assert sol.switches.name(len(sol.switches) - 1).startswith("overturn_") and sol.mode_final == "overturned"
+    assert sol.t[-1] > over + 2 * m.period  # (samples after it, all on the side)
+
+
+def test_basins_name_the_overturned_block_once_a_side():
+    """On a grid of initial states the overturned blocks end on two attractors, the block on either side
+    (``(+-pi/2, 0)``, period 1), not on as many one-cell "chaotic" sets as there are spinning blocks
+    (before the mode ``overturned``: 20 attractors on this grid, their samples at ``|theta|`` in the
+    thousands)."""
+    from grazing.attractors import basins
+
+    ds = basins(rocking_block(a=0.15), (-0.3, 0.3), (-0.6, 0.6), (8, 8), workers=1)
+    points = ds.points.values[:, 0, :]
+    side = np.isclose(np.abs(points[:, 0]), math.pi / 2, rtol=0, atol=1e-12) & (points[:, 1] == 0)
+    assert sorted(np.sign(points[side, 0]).tolist()) == [-1.0, 1.0]
+    assert (ds.period.values[side] == 1).all() and ds["count"].values[side].sum() >= 32  # (half the grid)
+    assert not np.any(np.abs(ds.points.values[..., 0]) > math.pi / 2 + 1e-12)  # (nothing spins on)
+    assert ds.sizes["attractor"] <= 4, ds.kind.values
+    assert set(ds["modes"].values[side, 0].tolist()) == {"overturned"}  # (named by the mode they are in)
+    rocking = ~side & (ds.period.values == 1)  # (the rocking orbit: on the side of its corner)
+    assert rocking.sum() == 1
+    assert ds["modes"].values[rocking, 0].tolist() == [
+        "right_corner" if points[rocking, 0][0] > 0 else "left_corner"
+    ]

@@ -150,6 +150,12 @@ class Attractor:
     def __post_init__(self) -> None:
         self.kind = AttractorKind(self.kind)  # (given as its word: the member)
 
+    @property
+    def mode(self) -> str:
+        """The one mode of all its points (an absorbing mode such as the rocking block's ``overturned``
+        names the outcome); ``""`` where they are in several modes or not known."""
+        return self.modes[0] if self.modes and len(set(self.modes)) == 1 else ""
+
     def to_json(self) -> dict[str, Any]:
         """The attractor as plain JSON data (``id``, ``kind``, ``period``, ``points``, ``lyapunov`` ...;
         ``modes``: the mode at each point, null where not known)."""
@@ -524,7 +530,8 @@ class Catalogue:
         targets: set[int],
         ended: np.ndarray,
     ) -> tuple[np.ndarray, int]:
-        """Polish the end states ``members`` (rows of ``samples``, initial states ``index``) that contract
+        """Polish the end states ``members`` (rows of ``samples``, initial states ``index``, ended in
+        ``modes``: None, not known) that contract
         towards a cycle; label those on a stable orbit.  The others, and the failed attempts (at most
         :data:`~grazing.core.options.POLISH_TRIES` on the attractors ``targets`` they are on, more as
         long as attempts succeed), are returned."""

@@ -272,6 +272,8 @@ def _attractor_lines(atts: list[Any], model: grazing.HybridModel) -> list[str]:
             words += f", lyapunov {a.lyapunov:+.4g}"
         if a.kind is AttractorKind.NEUTRAL:
             words += " (a double multiplier 1: a family of motions, not an isolated attractor)"
+        if a.mode:
+            words += f", in mode {a.mode}"
         if len(a.points) and not a.kind.aperiodic:
             pt = ", ".join(f"{n} = {v:.6g}" for n, v in zip(model.state_names, a.points[0]))
             words += f"; at {pt}"

@@ -21,9 +21,17 @@ about the new corner, ``1 - 3/2 sin^2(alpha)``, or a given ``r``::
 (``housner = 1``, the default, is Housner's; ``housner = 0`` uses ``r``).
 Between impacts ``theta'^2 / 2 + p^2 cos(alpha - |theta|)`` is conserved when
 ``a = 0``.  The model is of a block already rocking: it has no mode at rest
-on its base (a block at rest starts to rock once ``|u_g''| > g tan(alpha)``),
-and nothing stops it past ``|theta| = alpha``, where it overturns.  For small
-angles it is the piecewise-linear ``theta'' = p^2 (theta -+ alpha) - p^2 a cos(omega t)``.
+on its base (a block at rest starts to rock once ``|u_g''| > g tan(alpha)``);
+a decaying motion whose landings accumulate (the block coming to rest) ends
+the run with the status ``accumulating impacts``, which the engine does not
+continue across modes yet.
+Past ``|theta| = alpha`` gravity tips it further over; when ``|theta|`` reaches
+``pi/2`` its side face meets the base: it has overturned.  The transitions
+``overturn_right`` / ``overturn_left`` then enter the absorbing mode
+``overturned`` (field 0) with the state reset to ``(+-pi/2, 0)``, so every
+overturned block ends on one of two fixed states (the equations would
+otherwise carry it on through the base).  For small angles it is the
+piecewise-linear ``theta'' = p^2 (theta -+ alpha) - p^2 a cos(omega t)``.
 
 References: G. W. Housner, "The behavior of inverted pendulum structures
 during earthquakes", Bull. Seismol. Soc. Am. 53 (1963) 403-417; P. D. Spanos
@@ -70,6 +78,10 @@ def housner_restitution(alpha: float) -> float:
     return 1.0 - 1.5 * math.sin(alpha) ** 2
 
 
+OVERTURN_ANGLE = math.pi / 2
+"""``|theta|`` at which the block lies on its side: overturned."""
+
+
 @lru_cache(maxsize=1)
 def _base() -> HybridModel:
     import sympy as sp
@@ -81,15 +93,18 @@ def _base() -> HybridModel:
     left = [om, p**2 * (sp.sin(alpha + th) - base * sp.cos(alpha + th))]
     rho = housner * (1 - sp.Rational(3, 2) * sp.sin(alpha) ** 2) + (1 - housner) * r
     land = [th, rho * om]
+    side = sp.pi / 2  # OVERTURN_ANGLE
     return HybridModel(
         "rocking-block",
         [th, om],
         t,
         PARAMETERS,
-        modes=[Mode("right_corner", right), Mode("left_corner", left)],
+        modes=[Mode("right_corner", right), Mode("left_corner", left), Mode("overturned", [0, 0])],
         transitions=[
             Transition("onto_left", "right_corner", "left_corner", th, reset=land),
             Transition("onto_right", "left_corner", "right_corner", -th, reset=land),
+            Transition("overturn_right", "right_corner", "overturned", side - th, reset=[side, 0]),
+            Transition("overturn_left", "left_corner", "overturned", side + th, reset=[-side, 0]),
         ],
         period=2 * sp.pi / omega,
         state_labels=["θ", "θ′"],
@@ -100,7 +115,7 @@ def _base() -> HybridModel:
 
 
 def rocking_block(**values: float) -> HybridModel:
-    """Housner's rocking block (modes ``right_corner`` and ``left_corner``) with parameter overrides.
+    """Housner's rocking block (modes ``right_corner``, ``left_corner`` and ``overturned``) with overrides.
 
     Parameters
     ----------
@@ -120,7 +135,9 @@ def rocking_block(**values: float) -> HybridModel:
     Examples
     --------
     >>> m = rocking_block(housner=0.0, r=0.8)
-    >>> m.mode_names, m.stop_names
-    (('right_corner', 'left_corner'), ('onto_left', 'onto_right'))
+    >>> m.mode_names
+    ('right_corner', 'left_corner', 'overturned')
+    >>> m.stop_names  # (the transitions, by their source mode)
+    ('onto_left', 'overturn_right', 'onto_right', 'overturn_left')
     """
     return _base().with_params(**values)
