@@ -168,16 +168,16 @@ def test_the_simulator_does_not_leak_into_this_process() -> None:
     assert not config.ENABLE_CUDASIM
 
 
-def test_what_the_gpu_does_not_do_yet_is_refused_in_one_line() -> None:
+def test_device_gpu_takes_models_with_modes_and_lyapunov_exponents() -> None:
     import grazing
-    from grazing.gpu.device import gpu_refusal
+    from grazing.gpu.device import spec_device
     from grazing.sweeps.spec import sweep_spec
 
     for model in (grazing.models.rocking_block(), grazing.models.friction_oscillator()):
         modes = sweep_spec(model, "a", [0.2], settings=grazing.SweepSettings())
-        assert gpu_refusal(modes) is None  # (switches, mode-changing resets and sliding are the GPU's)
+        assert spec_device("gpu", modes) == "gpu"  # (switches, resets, sliding: the GPU's)
     lyapunov = sweep_spec(grazing.models.pendulum("B"), "eta", [0.44], settings=grazing.SweepSettings())
-    assert lyapunov.lyapunov and gpu_refusal(lyapunov) is None  # (Lyapunov exponents are the GPU's too)
+    assert lyapunov.lyapunov and spec_device("gpu", lyapunov) == "gpu"  # (exponents too)
 
 
 def test_no_device_is_one_line() -> None:

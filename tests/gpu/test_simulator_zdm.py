@@ -72,14 +72,14 @@ def test_the_map_kicks_past_the_grazing_and_not_before(compared: dict[str, dict[
 def test_a_sweep_of_the_map_is_the_gpus() -> None:
     """Nothing in a sweep of the map is refused on the GPU; without a device ``auto`` is the CPU."""
     import grazing
-    from grazing.gpu.device import gpu_refusal, resolve_device
+    from grazing.gpu.device import resolve_device, spec_device
     from grazing.normalform import find_grazing_point, normal_form_at
     from grazing.sweeps.spec import sweep_spec
 
     model = grazing.models.pendulum("B", theta_hat=math.radians(40))
     zdm = normal_form_at(find_grazing_point(model, "eta", 0.2, 1.0, "first"), ("eta", "theta_hat"))
     spec = sweep_spec(model, "eta", [0.4452], settings=grazing.SweepSettings(), zdm=zdm.discontinuity_map())
-    assert spec.zdm is not None and gpu_refusal(spec) is None
+    assert spec.zdm is not None and spec_device("gpu", spec) == "gpu"
     assert resolve_device("auto", spec) == "cpu"
 
 

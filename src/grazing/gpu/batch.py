@@ -13,9 +13,7 @@ checks, shifts and runs computed by :func:`gpu_parts`.
 
 Lyapunov exponents are the kernel's too (its variational build), and so is
 the discontinuity map (its build with the map, from the settings the CPU
-lanes get: :meth:`~grazing.sweeps.run.LaneBatch.settings`).  What the GPU does
-not do (:func:`~grazing.gpu.device.gpu_refusal`) is refused in one line
-(:class:`~grazing.errors.InvalidParameterError`) before anything runs.
+lanes get: :meth:`~grazing.sweeps.run.LaneBatch.settings`).
 """
 
 from __future__ import annotations
@@ -28,8 +26,6 @@ from typing import Any
 import numpy as np
 
 from grazing.core.options import LYAPUNOV_ALIGN
-from grazing.errors import InvalidParameterError
-from grazing.gpu.device import gpu_refusal
 from grazing.sweeps.run import LaneBatch, batch_key
 from grazing.sweeps.spec import ChunkResult, SweepSpec
 
@@ -51,10 +47,6 @@ class GpuLaneBatch(LaneBatch):
     """
 
     def __init__(self, parts: Sequence[tuple[SweepSpec, int]], threads: int | None = None) -> None:
-        for spec, _ in parts:
-            why = gpu_refusal(spec)
-            if why is not None:
-                raise InvalidParameterError(why)
         from grazing.gpu.target import require_target
 
         require_target()
@@ -136,10 +128,6 @@ def gpu_parts(parts: Sequence[Part], max_points: int = BATCH_POINTS) -> Iterator
     >>> list(gpu_parts([]))
     []
     """
-    for part in parts:  # (refused before anything runs)
-        why = gpu_refusal(part[0])
-        if why is not None:
-            raise InvalidParameterError(why)
     groups: dict[tuple[Any, ...], list[Part]] = {}
     for part in parts:
         groups.setdefault(batch_key(part[0]), []).append(part)

@@ -1,9 +1,10 @@
-"""Where a sweep runs: ``device="cpu"`` (the default), ``"gpu"`` or ``"auto"``, and what the GPU refuses.
+"""Where a sweep runs: ``device="cpu"`` (the default), ``"gpu"`` or ``"auto"``.
 
-``"auto"`` is the CPU unless a CUDA device is present, the sweep has at least
-:data:`AUTO_MIN_POINTS` points and nothing in it is refused on the GPU
-(:func:`gpu_refusal`).  ``"gpu"`` where no device (and no simulator) is
-available, or on a sweep the GPU does not do yet, is an error of one line.
+``"auto"`` is the CPU unless a CUDA device is present and the sweep has at
+least :data:`AUTO_MIN_POINTS` points.  ``"gpu"`` where no device (and no
+simulator) is available is an error of one line.  Every sweep runs on the GPU:
+Lyapunov exponents, sticking, models with modes, the discontinuity map and
+chains of several chunks included.
 """
 
 from __future__ import annotations
@@ -18,14 +19,6 @@ DEFAULT_DEVICE = "cpu"
 """Where a sweep runs unless told otherwise."""
 AUTO_MIN_POINTS = 20_000
 """Fewest points for which ``device="auto"`` takes a present GPU (fewer finish in seconds on the cores)."""
-
-
-def gpu_refusal(spec: Any) -> str | None:
-    """Why the sweep ``spec`` cannot run on the GPU yet (one line), or None: nothing a single sweep asks for
-    is refused now (the discontinuity map, Lyapunov exponents and models with modes are the GPU's; a chain
-    of several chunks is :func:`chain_refusal`'s)."""
-    del spec
-    return None
 
 
 def check_device(device: str, client: Any = None) -> None:
@@ -44,11 +37,10 @@ def check_device(device: str, client: Any = None) -> None:
 def spec_device(device: str, spec: Any, client: Any = None) -> str:
     """``"cpu"`` or ``"gpu"``: where one of several sweeps of a computation runs (``device`` checked by
     :func:`check_device`): the GPU for ``"gpu"``, or ``"auto"`` with a device present and a large sweep,
-    unless it has what the GPU does not do yet (:func:`gpu_refusal`: then the CPU).
     """
     from grazing.gpu.target import device_present
 
-    if device == "cpu" or client is not None or gpu_refusal(spec) is not None:
+    if device == "cpu" or client is not None:
         return "cpu"
     if device == "gpu":
         return "gpu"
@@ -70,9 +62,5 @@ def resolve_device(device: str, spec: Any, client: Any = None) -> str:
     ...
     grazing.errors.InvalidParameterError: device must be 'cpu', 'gpu' or 'auto', got 'tpu'
     """
-    if device == "gpu" and client is None:
-        why = gpu_refusal(spec)
-        if why is not None:
-            raise InvalidParameterError(why)
     check_device(device, client)
     return spec_device(device, spec, client)
