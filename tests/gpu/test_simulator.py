@@ -47,6 +47,17 @@ def simulator_results(script: str) -> dict[str, dict[str, object]]:
     return json.loads(proc.stdout.strip().splitlines()[-1])  # type: ignore[no-any-return]
 
 
+def assert_gpu_equals_cpu(row: dict[str, object]) -> None:
+    """One case's GPU results equal its CPU lanes' (``simulator_cases.compare``'s row): periods, impacts,
+    statuses, transients and final modes equal, samples, final states and exponents within
+    :data:`SAMPLE_TOL` (the bit)."""
+    for name in ("period", "impacts_by_stop", "status", "transient_used", "impacts", "mode_final"):
+        assert row[f"gpu_{name}"] == row[f"cpu_{name}"], name
+    assert row["samples_diff"] <= SAMPLE_TOL  # type: ignore[operator]
+    assert row["x_final_diff"] <= SAMPLE_TOL  # type: ignore[operator]
+    assert row["lyapunov_diff"] <= SAMPLE_TOL  # type: ignore[operator]  # (NaN on one side only: inf)
+
+
 @pytest.fixture(scope="module")
 def compared() -> dict[str, dict[str, object]]:
     """Every case's CPU and GPU results (one process under the simulator)."""
@@ -58,11 +69,7 @@ def test_the_gpu_equals_the_cpu_lanes_at_every_point(
     compared: dict[str, dict[str, object]], case: str
 ) -> None:
     row = compared[case]
-    for name in ("period", "impacts_by_stop", "status", "transient_used", "impacts", "mode_final"):
-        assert row[f"gpu_{name}"] == row[f"cpu_{name}"], name
-    assert row["samples_diff"] <= SAMPLE_TOL
-    assert row["x_final_diff"] <= SAMPLE_TOL
-    assert row["lyapunov_diff"] <= SAMPLE_TOL  # (NaN on one side only: inf)
+    assert_gpu_equals_cpu(row)
 
 
 def test_the_lyapunov_cases_have_exponents_of_both_signs(compared: dict[str, dict[str, object]]) -> None:

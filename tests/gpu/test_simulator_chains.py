@@ -10,13 +10,11 @@ in a process of their own with ``NUMBA_ENABLE_CUDASIM=1`` (``cases_chains.py``).
 
 from __future__ import annotations
 
-import json
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
+
+from tests.gpu.test_simulator import simulator_results
 
 ROOT = Path(__file__).resolve().parents[2]
 CASES = ("pendulum C both directions",)
@@ -25,14 +23,7 @@ CASES = ("pendulum C both directions",)
 @pytest.fixture(scope="module")
 def compared() -> dict[str, dict[str, object]]:
     """Every case's CPU and GPU datasets compared (one process under the simulator)."""
-    env = {**os.environ, "NUMBA_ENABLE_CUDASIM": "1", "PYTHONWARNINGS": "ignore"}
-    env["PYTHONPATH"] = os.pathsep.join(p for p in (str(ROOT / "src"), str(ROOT), env.get("PYTHONPATH")) if p)
-    proc = subprocess.run(
-        [sys.executable, str(Path(__file__).with_name("cases_chains.py"))],
-        capture_output=True, text=True, env=env, timeout=300,
-    )  # fmt: skip
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    return json.loads(proc.stdout.strip().splitlines()[-1])  # type: ignore[no-any-return]
+    return simulator_results("cases_chains.py")
 
 
 @pytest.mark.parametrize("case", CASES)

@@ -7,17 +7,12 @@ so everything is equal to the bit (``test_simulator.py``), and no point is hande
 
 from __future__ import annotations
 
-import json
 import math
-import os
-import subprocess
-import sys
-from pathlib import Path
 
 import pytest
 
 from grazing.models import rocking_block
-from tests.gpu.test_simulator import ROOT, SAMPLE_TOL
+from tests.gpu.test_simulator import assert_gpu_equals_cpu, simulator_results
 
 CASES = ("overturn", "lyapunov overturn chained")
 
@@ -25,24 +20,13 @@ CASES = ("overturn", "lyapunov overturn chained")
 @pytest.fixture(scope="module")
 def compared() -> dict[str, object]:
     """Every case's CPU and GPU results (one process under the simulator)."""
-    env = {**os.environ, "NUMBA_ENABLE_CUDASIM": "1", "PYTHONWARNINGS": "ignore"}
-    env["PYTHONPATH"] = os.pathsep.join(p for p in (str(ROOT / "src"), str(ROOT), env.get("PYTHONPATH")) if p)
-    proc = subprocess.run(
-        [sys.executable, str(Path(__file__).with_name("cases_rocking_overturn.py"))],
-        capture_output=True, text=True, env=env, timeout=300,
-    )  # fmt: skip
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    return json.loads(proc.stdout.strip().splitlines()[-1])  # type: ignore[no-any-return]
+    return simulator_results("cases_rocking_overturn.py")
 
 
 @pytest.mark.parametrize("case", CASES)
 def test_overturning_on_the_gpu_equals_the_cpu_lanes_at_every_point(compared: dict, case: str) -> None:
     row = compared[case]
-    for name in ("period", "impacts_by_stop", "status", "transient_used", "impacts", "mode_final"):
-        assert row[f"gpu_{name}"] == row[f"cpu_{name}"], name
-    assert row["samples_diff"] <= SAMPLE_TOL
-    assert row["x_final_diff"] <= SAMPLE_TOL
-    assert row["lyapunov_diff"] <= SAMPLE_TOL
+    assert_gpu_equals_cpu(row)
     assert row["cpu_points"] == 0  # (no point handed to the CPU lanes)
 
 

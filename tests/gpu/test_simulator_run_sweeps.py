@@ -9,13 +9,11 @@ must be equal to the bit.  The cases run in a process of their own with ``NUMBA_
 
 from __future__ import annotations
 
-import json
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
+
+from tests.gpu.test_simulator import simulator_results
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -23,14 +21,7 @@ ROOT = Path(__file__).resolve().parents[2]
 @pytest.fixture(scope="module")
 def compared() -> dict[str, object]:
     """The CPU's and the GPU's datasets of the sweeps compared (one process under the simulator)."""
-    env = {**os.environ, "NUMBA_ENABLE_CUDASIM": "1", "PYTHONWARNINGS": "ignore"}
-    env["PYTHONPATH"] = os.pathsep.join(p for p in (str(ROOT / "src"), str(ROOT), env.get("PYTHONPATH")) if p)
-    proc = subprocess.run(
-        [sys.executable, str(Path(__file__).with_name("cases_run_sweeps.py"))],
-        capture_output=True, text=True, env=env, timeout=300,
-    )  # fmt: skip
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    return json.loads(proc.stdout.strip().splitlines()[-1])  # type: ignore[no-any-return]
+    return simulator_results("cases_run_sweeps.py")
 
 
 def test_run_sweeps_on_the_gpu_is_the_cpus(compared: dict[str, object]) -> None:

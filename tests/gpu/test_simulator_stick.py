@@ -9,16 +9,11 @@ no point is handed to the CPU lanes.
 
 from __future__ import annotations
 
-import json
 import math
-import os
-import subprocess
-import sys
-from pathlib import Path
 
 import pytest
 
-from tests.gpu.test_simulator import ROOT, SAMPLE_TOL
+from tests.gpu.test_simulator import assert_gpu_equals_cpu, simulator_results
 
 LYAPUNOV_CASES = ("lyapunov ball chained", "lyapunov impact oscillator", "lyapunov stick spring")
 FRESH_CASES = ("ball", "ball under a ceiling", "impact oscillator", "stick spring floor second", "stick lift")
@@ -29,14 +24,7 @@ CASES = (*FRESH_CASES, "stick spring chained", *LYAPUNOV_CASES)
 @pytest.fixture(scope="module")
 def compared() -> dict[str, dict[str, object]]:
     """Every case's CPU and GPU results (one process under the simulator)."""
-    env = {**os.environ, "NUMBA_ENABLE_CUDASIM": "1", "PYTHONWARNINGS": "ignore"}
-    env["PYTHONPATH"] = os.pathsep.join(p for p in (str(ROOT / "src"), str(ROOT), env.get("PYTHONPATH")) if p)
-    proc = subprocess.run(
-        [sys.executable, str(Path(__file__).with_name("cases_stick.py"))],
-        capture_output=True, text=True, env=env, timeout=300,
-    )  # fmt: skip
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    return json.loads(proc.stdout.strip().splitlines()[-1])  # type: ignore[no-any-return]
+    return simulator_results("cases_stick.py")
 
 
 @pytest.mark.parametrize("case", CASES)
@@ -44,11 +32,7 @@ def test_sticking_on_the_gpu_equals_the_cpu_lanes_at_every_point(
     compared: dict[str, dict[str, object]], case: str
 ) -> None:
     row = compared[case]
-    for name in ("period", "impacts_by_stop", "status", "transient_used", "impacts", "mode_final"):
-        assert row[f"gpu_{name}"] == row[f"cpu_{name}"], name
-    assert row["samples_diff"] <= SAMPLE_TOL
-    assert row["x_final_diff"] <= SAMPLE_TOL
-    assert row["lyapunov_diff"] <= SAMPLE_TOL  # (NaN on one side only: inf)
+    assert_gpu_equals_cpu(row)
 
 
 def test_no_point_that_sticks_goes_to_the_cpu(compared: dict[str, dict[str, object]]) -> None:

@@ -13,15 +13,12 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
 from tests.gpu.test_cli_device import grazing as run_grazing
-from tests.gpu.test_simulator import SAMPLE_TOL
+from tests.gpu.test_simulator import assert_gpu_equals_cpu, simulator_results
 
 CASES = ("zdm pendulum B chained", "zdm pendulum B fresh")
 ALL_CASES = (*CASES, "zdm twin rattle")
@@ -31,14 +28,7 @@ ROOT = Path(__file__).resolve().parents[2]
 @pytest.fixture(scope="module")
 def compared() -> dict[str, dict[str, object]]:
     """Every case's CPU and GPU results (one process under the simulator)."""
-    env = {**os.environ, "NUMBA_ENABLE_CUDASIM": "1", "PYTHONWARNINGS": "ignore"}
-    env["PYTHONPATH"] = os.pathsep.join(p for p in (str(ROOT / "src"), str(ROOT), env.get("PYTHONPATH")) if p)
-    proc = subprocess.run(
-        [sys.executable, str(Path(__file__).with_name("cases_zdm.py"))],
-        capture_output=True, text=True, env=env, timeout=300,
-    )  # fmt: skip
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    return json.loads(proc.stdout.strip().splitlines()[-1])  # type: ignore[no-any-return]
+    return simulator_results("cases_zdm.py")
 
 
 @pytest.mark.parametrize("case", ALL_CASES)
@@ -47,11 +37,7 @@ def test_the_gpu_equals_the_cpu_lanes_with_the_map_at_every_point(
 ) -> None:
     row = compared[case]
     assert row["cpu_points"] == 0  # (every point the GPU's: no sticking here)
-    for name in ("period", "impacts_by_stop", "status", "transient_used", "impacts", "mode_final"):
-        assert row[f"gpu_{name}"] == row[f"cpu_{name}"], name
-    assert row["samples_diff"] <= SAMPLE_TOL
-    assert row["x_final_diff"] <= SAMPLE_TOL
-    assert row["lyapunov_diff"] <= SAMPLE_TOL  # (NaN on one side only: inf)
+    assert_gpu_equals_cpu(row)
 
 
 def test_the_map_kicks_past_the_grazing_and_not_before(compared: dict[str, dict[str, object]]) -> None:

@@ -10,15 +10,11 @@ states and exponents equal to the bit.  The cases run in a process of their own 
 
 from __future__ import annotations
 
-import json
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
-from tests.gpu.test_simulator import SAMPLE_TOL
+from tests.gpu.test_simulator import assert_gpu_equals_cpu, simulator_results
 
 CASES = tuple(
     f"zdm modes bumper in {where}{lyap}" for where in ("Taut_2", "Slack_1") for lyap in ("", " lyapunov")
@@ -29,14 +25,7 @@ ROOT = Path(__file__).resolve().parents[2]
 @pytest.fixture(scope="module")
 def compared() -> dict[str, dict[str, object]]:
     """Every case's CPU and GPU results (one process under the simulator)."""
-    env = {**os.environ, "NUMBA_ENABLE_CUDASIM": "1", "PYTHONWARNINGS": "ignore"}
-    env["PYTHONPATH"] = os.pathsep.join(p for p in (str(ROOT / "src"), str(ROOT), env.get("PYTHONPATH")) if p)
-    proc = subprocess.run(
-        [sys.executable, str(Path(__file__).with_name("cases_zdm_modes.py"))],
-        capture_output=True, text=True, env=env, timeout=300,
-    )  # fmt: skip
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    return json.loads(proc.stdout.strip().splitlines()[-1])  # type: ignore[no-any-return]
+    return simulator_results("cases_zdm_modes.py")
 
 
 @pytest.mark.parametrize("case", CASES)
@@ -45,11 +34,7 @@ def test_the_gpu_equals_the_cpu_lanes_with_the_map_on_a_model_with_modes(
 ) -> None:
     row = compared[case]
     assert row["cpu_points"] == 0  # (every point the GPU's)
-    for name in ("period", "impacts_by_stop", "status", "transient_used", "impacts", "mode_final"):
-        assert row[f"gpu_{name}"] == row[f"cpu_{name}"], name
-    assert row["samples_diff"] <= SAMPLE_TOL
-    assert row["x_final_diff"] <= SAMPLE_TOL
-    assert row["lyapunov_diff"] <= SAMPLE_TOL
+    assert_gpu_equals_cpu(row)
 
 
 def test_the_map_kicks_in_its_stops_mode_only(compared: dict[str, dict[str, object]]) -> None:
