@@ -29,6 +29,8 @@ import grazing
 from grazing.cli import main
 from grazing.orbits import continue_orbit, find_orbit
 from grazing.orbits.continuation import BranchEnd
+from grazing.orbits.kinds import SpecialKind
+from grazing.orbits.segmented_grazing import excursions, extrapolated_grazing
 from tests.orbits.test_segments_at_switches import GUESS, VALUES, exact_orbit, two_soft_stops
 from tests.piecewise_exact import LinearMode, PiecewiseLinearModel
 
@@ -193,19 +195,30 @@ def test_the_cli_continue_reports_the_grazing(tmp_path, capsys):
     assert "last point: mode aft, switches per period: off_aft, hit_aft" in out
 
 
-def test_a_symmetric_orbit_grazing_both_soft_stops_at_once_is_reported_not_located():
+def test_a_symmetric_orbit_grazing_both_soft_stops_at_once_is_a_located_double_grazing():
     """The symmetric model of test_segments_at_switches (one ``edge`` for both stops): as ``edge`` grows
     both excursions shrink together, and the orbit grazes both surfaces at once (codimension two, but for
     the symmetry).  The grazing orbit is then the free saddle's forced response alone, ``Re(X exp(i w t))``
     with ``X = (i w I - A)^-1 b``, and ``edge = |X_1|`` there.  One contact cannot be solved for with the
-    other excursion shrunk to nothing as well: the branch ends at a grazing reported not located."""
+    other excursion shrunk to nothing as well; each excursion's time ``s`` is extrapolated to zero
+    (``edge = edge* + k s^2 + ...``) and the two agree: a double grazing, located."""
     m = two_soft_stops(freq=0.27)
     x, _, _ = exact_orbit(dict(m.params), GUESS[0.27])
     orbit = find_orbit(m, x, period=1, t0=m.period / 4, mode="middle")
     branch = continue_orbit(m, "edge", 0.4, 3.0, orbit=orbit)
     A = np.array([[0.0, 1.0], [1.0, -2 * m.params["damp"]]])
     X = np.linalg.solve(1j * m.params["freq"] * np.eye(2) - A, np.array([0.0, m.params["amp"]]))
-    assert branch.outcome is BranchEnd.GRAZING and branch.status.startswith("ended at an unlocated grazing")
+    edge = abs(X[0])
+    assert branch.outcome is BranchEnd.DOUBLE_GRAZING, branch.status
+    assert branch.status.startswith("ended at a double grazing at edge = 0.93200609"), branch.status
     (sp_,) = branch.special
-    assert sp_.kind == "grazing" and sp_.grazing is None and "not located" in sp_.note
-    assert abs(sp_.param - abs(X[0])) < 1e-9, sp_.param - abs(X[0])
+    assert sp_.kind == "double grazing" and sp_.kind is SpecialKind.DOUBLE_GRAZING
+    assert sp_.precision < 1e-10 and "'into_port'" in sp_.note and "'into_stbd'" in sp_.note
+    assert abs(sp_.param - edge) < 1e-10, sp_.param - edge
+    # the extrapolation itself, from points short of the stall: the last of them is off by more than
+    # 1e-10, the extrapolated value is not
+    early, values = branch.orbits[:-6], branch.values[:-6]
+    assert abs(values[-1] - edge) > 1e-10
+    i = min(excursions(early[-1]), key=lambda e: e[1])[0]
+    found = extrapolated_grazing(early, values, i)
+    assert found is not None and abs(found[0] - edge) < 1e-10 and found[1] < 1e-9, (found, edge)

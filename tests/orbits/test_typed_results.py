@@ -45,7 +45,8 @@ from tests.orbits.test_closed_forms import (
 )
 
 JSON_KINDS = ["fold", "branch point", "period-doubling", "neimark-sacker", "grazing", "grazing-sliding",
-              "crossing-sliding", "switching-sliding", "adding-sliding", "unlocated"]  # fmt: skip
+              "crossing-sliding", "switching-sliding", "adding-sliding", "double grazing",
+              "unlocated"]  # fmt: skip
 """The ``kind`` of a special point in ``grazing continue --json`` (docs/continuation.md)."""
 
 CLI_CURVE_KINDS = ["fold", "period-doubling", "neimark-sacker", "branch-point", "grazing"]

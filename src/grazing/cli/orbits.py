@@ -487,7 +487,7 @@ def continue_(
             {
                 "kind": sp_.kind,
                 "value": back(sp_.param),
-                **({"stop": model.stop_names[sp_.stop]} if sp_.kind == "grazing" else {}),
+                **({"stop": model.stop_names[sp_.stop]} if sp_.kind in ("grazing", "double grazing") else {}),
                 **({"between": [back(v) for v in sp_.between]} if sp_.between is not None else {}),
                 **({"note": sp_.note} if sp_.note else {}),
                 **({"angle": sp_.angle} if sp_.kind == "neimark-sacker" else {}),

@@ -85,7 +85,12 @@ from grazing.orbits.palc import (
     locate,
     sign_changed,
 )
-from grazing.orbits.segmented_grazing import brief_excursion, locate_segmented_grazing
+from grazing.orbits.segmented_grazing import (
+    brief_excursion,
+    excursions,
+    extrapolated_grazing,
+    locate_segmented_grazing,
+)
 from grazing.orbits.segments import (
     MULTIPLE_SHOOTING_NORM,
     REORDER_REACH,
@@ -144,6 +149,7 @@ class BranchEnd(enum.Enum):
     NO_SECTION = "the orbit could not be found on another section"
     CANNOT_CONTINUE = "the orbit could not be computed where the segment starts"
     GRAZING = "ended at a grazing"
+    DOUBLE_GRAZING = "ended at a double grazing"
     SWITCHED = "switched to another branch"
 
     @property
@@ -621,6 +627,10 @@ def _locate_grazing(
     return point if near_time and near_state else None
 
 
+DOUBLE_GRAZING_AGREE = 1e-9
+"""Two excursions of a stalled branch that shrink to nothing at values of its parameter this close
+(relative to ``max(1, |p|)``, their extrapolations' precisions included) end it at a double grazing."""
+
 STALLED_EXCURSION = 1e-3
 """Multiple shooting on a branch's switches that stalls with an excursion through another mode shorter
 than this many forcing periods stalled at its grazing (the excursion's two switches meet there, and the
@@ -1022,6 +1032,8 @@ class _Continuation:
         if point is not None:
             palc.boundary = Boundary(prev, None, reason)
             return self._grazing_end(palc, prev, sign, point)
+        if self._double_grazing(last, i, reason):
+            return []
         value = float(prev.u[-1])
         note = (
             f"grazing of transition {names[into]!r} not located: the grazing equations on the segments did "
@@ -1035,6 +1047,47 @@ class _Continuation:
         )  # fmt: skip
         self.branch.end_segment(BranchEnd.GRAZING, f"ended at an unlocated grazing ({note}): {reason}")
         return []
+
+    def _double_grazing(self, last: PeriodicOrbit, i: int, reason: str) -> bool:
+        """Where ``last`` has a second excursion as brief as its briefest (switches ``i``, ``i + 1``),
+        both shrinking to nothing at the same value of the parameter (:func:`extrapolated_grazing`, each
+        to within :data:`DOUBLE_GRAZING_AGREE`): end the segment at that double grazing, located, and say
+        True.  (One contact's equations on the segments cannot be solved with the other excursion
+        shrinking to nothing as well: its segments are singular there too.)"""
+        T = last.model.period
+        others = [k for k, stay in excursions(last) if abs(k - i) >= 2 and stay <= STALLED_EXCURSION * T]
+        if not others:
+            return False
+        branch, j = self.branch, others[0]
+        values = [v for v, sg in zip(branch.values, branch.segments) if sg == branch.segments[-1]]
+        orbits = branch.orbits[-len(values) :]
+        a, b = extrapolated_grazing(orbits, values, i), extrapolated_grazing(orbits, values, j)
+        if a is None or b is None:
+            return False
+        scale = max(1.0, abs(a[0]))
+        precision = max(a[1], b[1], abs(a[0] - b[0]))
+        if precision > DOUBLE_GRAZING_AGREE * scale:
+            return False
+        names = self.model.stop_names
+        first, second = int(last.switch_transitions[i]), int(last.switch_transitions[j])
+        value = 0.5 * (a[0] + b[0])
+        note = (
+            f"double grazing of transitions {names[first]!r} and {names[second]!r}, located by extrapolating "
+            f"each excursion's time to zero over the branch's last points ({self.par.show(a[0])} and "
+            f"{self.par.show(b[0])}, to +-{precision:.1g})"
+        )
+        branch.special.append(
+            SpecialPoint(
+                kind=SpecialKind.DOUBLE_GRAZING, index=len(branch) - 1, param=value, orbit=last, stop=first,
+                precision=precision, note=note,
+            )
+        )  # fmt: skip
+        branch.end_segment(
+            BranchEnd.DOUBLE_GRAZING,
+            f"ended at a double grazing at {self.par.show(value)} of transitions {names[first]!r} and "
+            f"{names[second]!r}: {reason}; both excursions shrink to nothing together",
+        )
+        return True
 
     def _grazing_end(
         self, palc: Palc, prev: PalcPoint, sign: float, point: GrazingPoint | None

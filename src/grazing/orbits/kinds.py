@@ -61,6 +61,9 @@ class SpecialKind(TextEnum):
     """An entry into sliding turns into a crossing and a short excursion before the entry."""
     ADDING_SLIDING = "adding-sliding"
     """A short excursion off the surface splits a sliding segment in two."""
+    DOUBLE_GRAZING = "double grazing"
+    """The orbit grazes two surfaces at once (codimension two, but for a symmetry that maps one contact
+    onto the other): a branch ends there."""
     UNLOCATED = "unlocated"
     """A stability change that no located point explains (never silent)."""
 

@@ -24,13 +24,17 @@ from grazing.orbits.palc import PalcSettings, newton
 from grazing.orbits.periodic import PeriodicOrbit, sorted_multipliers
 from grazing.orbits.segments import ContactRun, cuts_at_switches, layout_of, segmented_equations, switch_rates
 
+EXTRAPOLATION_POINTS = 4
+"""The last points of a stalled branch whose excursion times :func:`extrapolated_grazing` fits (the
+briefest excursions, where the series in the excursion time converges fastest)."""
 
-def brief_excursion(orbit: PeriodicOrbit) -> tuple[int, float] | None:
-    """``(i, stay)``: the orbit's briefest excursion out of a mode and straight back, between its
-    switches ``i`` and ``i + 1`` (over one period from its section; ``stay`` the time between them);
-    None without one (an excursion across the section is not looked at)."""
+
+def excursions(orbit: PeriodicOrbit) -> list[tuple[int, float]]:
+    """``(i, stay)`` for each of the orbit's excursions out of a mode and straight back, between its
+    switches ``i`` and ``i + 1`` (over one period from its section; ``stay`` the time between them), in
+    order (an excursion across the section is not looked at)."""
     m, times, js = orbit.model, orbit.switch_times, orbit.switch_transitions
-    best: tuple[int, float] | None = None
+    found: list[tuple[int, float]] = []
     for i in range(len(js) - 1):
         a, b = int(js[i]), int(js[i + 1])
         if b >= m.n_stops or a >= m.n_stops:
@@ -39,10 +43,47 @@ def brief_excursion(orbit: PeriodicOrbit) -> tuple[int, float] | None:
             m.transition_source[b] == m.transition_target[a]
             and m.transition_target[b] == m.transition_source[a]
         )
-        stay = float(times[i + 1] - times[i])
-        if back and (best is None or stay < best[1]):
-            best = (i, stay)
-    return best
+        if back:
+            found.append((i, float(times[i + 1] - times[i])))
+    return found
+
+
+def brief_excursion(orbit: PeriodicOrbit) -> tuple[int, float] | None:
+    """``(i, stay)``: the orbit's briefest excursion (:func:`excursions`); None without one."""
+    found = excursions(orbit)
+    return min(found, key=lambda e: e[1]) if found else None
+
+
+def extrapolated_grazing(
+    orbits: list[PeriodicOrbit], values: list[float], i: int
+) -> tuple[float, float] | None:
+    """``(p, precision)``: the parameter where the excursion between switches ``i`` and ``i + 1`` of the last
+    of ``orbits`` (a branch's points, at ``values`` of its parameter) shrinks to nothing, extrapolated from
+    the last :data:`EXTRAPOLATION_POINTS` points' excursion times through the same two transitions.
+
+    An excursion of depth ``d`` past a surface that the field turns back from lasts ``s = 2 sqrt(2 d / a)``
+    (``a = L_f^2 h``) and ``d`` is linear in the parameter near the grazing ``p*``, so
+    ``p = p* + k s^2 + O(s^4)``: fitted in ``(1, s^2, s^4)`` by least squares.  ``precision``: the
+    largest of the fit's residuals and its difference from the fit in ``(1, s^2)`` of the last three
+    points.  None with fewer points through that excursion."""
+    last = orbits[-1]
+    pair = tuple(int(j) for j in last.switch_transitions[i : i + 2])
+    rows: list[tuple[float, float]] = []
+    for o, v in zip(orbits[-EXTRAPOLATION_POINTS:], values[-EXTRAPOLATION_POINTS:]):
+        stays = [
+            st for k, st in excursions(o) if tuple(int(j) for j in o.switch_transitions[k : k + 2]) == pair
+        ]
+        if len(stays) == 1:
+            rows.append((stays[0] ** 2, v))
+    if len(rows) < 4:
+        return None
+    s2, p = np.array(rows).T
+    scale = float(np.max(s2))
+    A = np.stack([np.ones_like(s2), s2 / scale, (s2 / scale) ** 2], axis=1)
+    coef, *_ = np.linalg.lstsq(A, p, rcond=None)
+    lin, *_ = np.linalg.lstsq(A[-3:, :2], p[-3:], rcond=None)
+    precision = max(float(np.max(np.abs(A @ coef - p))), abs(float(coef[0] - lin[0])))
+    return float(coef[0]), precision
 
 
 def locate_segmented_grazing(orbit: PeriodicOrbit, param: str, reach: float) -> GrazingPoint | None:

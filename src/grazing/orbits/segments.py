@@ -700,6 +700,16 @@ def segmented_newton(
     if start is None:
         raise ConvergenceError("the run from the guess has no impact (or switch) to make segments of")
     layout, u = start
+    return solve_segments(model, layout, u, t0, period, tol=tol, max_iter=max_iter, stop=stop)
+
+
+def solve_segments(
+    model: HybridModel, layout: SegmentLayout, u: np.ndarray, t0: float, period: int, *, tol: float,
+    max_iter: int, stop: int = 0,
+) -> PeriodicOrbit:  # fmt: skip
+    """The period-``period`` orbit on the section ``t0`` by Newton's method on the segmented equations of
+    ``layout`` from the unknowns ``u`` (the parameters fixed), as :func:`segmented_newton` (its errors)."""
+    u = np.array(u, dtype=float)
     evaluate = segmented_equations(model, None, period, t0, layout, stop)
     residuals: list[float] = []
     for _ in range(max_iter + 1):
@@ -725,6 +735,41 @@ def segmented_newton(
         f"Newton's method on the segmented equations did not converge: residual {residuals[-1]:.3g} after "
         f"{len(residuals) - 1} iterations"
     )
+
+
+def resectioned(orbit: PeriodicOrbit, t_new: float) -> tuple[SegmentLayout, np.ndarray, float] | None:
+    """``(layout, u, t0)``: the segments of ``orbit`` on the section through the next time ``t_new (mod T)``
+    after its own, from its own cuts: the state there is one segment's flow from the cut before it
+    (never a run over a whole period, which a strongly unstable orbit's rounding would leave), its mode
+    that segment's, and the cuts after it come first (the others a period later).  ``t0`` lies in
+    ``[0, T)``.  None where the orbit has no cut, or the flow leaves that segment's mode."""
+    m = orbit.model
+    layout = layout_of(orbit)
+    if not layout.impacts or (layout.switches and orbit.switch_states is None):
+        return None
+    T, span = m.period, orbit.period * m.period
+    u = layout.pack(orbit, 0.0)
+    t_abs = orbit.t0 + (t_new - orbit.t0) % T
+    times = np.array([u[layout.time_index(i)] for i in range(1, layout.impacts + 1)])
+    i = int(np.count_nonzero(times <= t_abs))  # (the segment t_abs lies on)
+    ta = orbit.t0 if i == 0 else float(times[i - 1])
+    x, mode = np.array(layout.state(u, i), dtype=float), layout.start_mode(m, i)
+    if t_abs > ta:
+        try:
+            run = segment_flow(m, x, ta, t_abs, None, mode=mode).solution
+        except (ConvergenceError, SimulationError, InvalidStateError):
+            return None
+        if run.mode_final != mode or (run.switches is not None and len(run.switches.t)):
+            return None
+        x = run.x_final
+    shift = round((t_abs - t_new) / T) * T
+    order = [*range(i + 1, layout.impacts + 1), *range(1, i + 1)]
+    parts = [x]
+    for j in order:
+        t = float(times[j - 1]) + (span if j <= i else 0.0) - shift
+        parts += [np.array([t]), np.array(layout.state(u, j), dtype=float)]
+    moved = dataclasses.replace(layout, stops=tuple(layout.stops[j - 1] for j in order), mode=mode)
+    return moved, np.concatenate([*parts, [0.0]]), t_abs - shift
 
 
 def switch_rates(model: HybridModel, times, states, transitions) -> list[float]:

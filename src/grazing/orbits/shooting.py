@@ -49,7 +49,9 @@ from grazing.orbits.segments import (
     GRAZING_SPEED_RATIO,
     MULTIPLE_SHOOTING_NORM,
     cut_speeds,
+    resectioned,
     segmented_newton,
+    solve_segments,
 )
 
 SECTION_MARGIN = 0.05
@@ -79,6 +81,25 @@ def move_section(orbit: PeriodicOrbit, t_new: float, *, tol: float = NEWTON_TOL)
     in the mode the orbit is in at ``t_new``.
     """
     T = orbit.model.period
+    if not orbit.virtual and float(np.linalg.norm(orbit.monodromy)) > MULTIPLE_SHOOTING_NORM:
+        # A strongly unstable orbit: a run over the lag (and single shooting) would leave it by its
+        # rounding times |M|, even land in another mode; its own segments are moved to the new section.
+        moved = resectioned(orbit, t_new)
+        if moved is not None:
+            layout, u, t0 = moved
+            try:
+                return solve_segments(
+                    orbit.model,
+                    layout,
+                    u,
+                    t0,
+                    orbit.period,
+                    tol=tol,
+                    max_iter=NEWTON_MAX_ITER,
+                    stop=orbit.stop,
+                )
+            except (GrazingError, np.linalg.LinAlgError):
+                pass  # (then as any orbit's)
     lag = (t_new - orbit.t0) % T
     x, mode = orbit.state, orbit.mode
     if lag > 0:
