@@ -103,8 +103,9 @@ def test_start_in_another_mode_and_one_line_refusals():
     m = soft_impact()
     sol = grazing.simulate(m, [1.0, 0.0], periods=1, mode="contact", impacts="all")
     assert sol.switches.name(0) == "leave"
-    with pytest.raises(grazing.InvalidStateError, match="is not in mode 'free'"):
-        grazing.simulate(m, [1.0, 0.0], periods=1)
+    # given no mode, it starts in the one it lies in (HybridModel.start_mode): the same run
+    auto = grazing.simulate(m, [1.0, 0.0], periods=1, impacts="all")
+    assert np.array_equal(auto.switches.t, sol.switches.t) and np.array_equal(auto.x_final, sol.x_final)
     with pytest.raises(InvalidParameterError, match=r"^unknown mode 'stuck' for model 'soft-impact'"):
         grazing.simulate(m, [0.0, 0.0], periods=1, mode="stuck")
     # the guard minima are the resets' only (tests/orbits/test_virtual_through_modes.py): this model has none

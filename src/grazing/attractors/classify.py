@@ -679,7 +679,7 @@ class Catalogue:
         return out, labels
 
     def _kind(self, e: _Entry) -> tuple[AttractorKind, float]:
-        exps = np.array([v for v in e.exponents if math.isfinite(v)])
+        exps = np.array([v for v in e.exponents if not math.isnan(v)])  # (-inf: reached in finite time)
         exponent = float(np.median(exps)) if exps.size else math.nan
         if e.family.outcome:
             return e.family, math.nan
@@ -716,6 +716,12 @@ class Catalogue:
                 continue
             mu = np.linalg.eigvals(fm.jacobian)
             e.neutral = is_neutral(fm.jacobian, mu)
+            if e.neutral and mode is not None and landing_point(self.model, e.points[0], self.t_sample, mode):
+                e.neutral = (
+                    False  # (a rest every entering motion lands on: superstable, reached in finite time)
+                )
+                out[k] = -math.inf
+                continue
             largest = float(np.max(np.abs(mu)))
             if largest > 0:
                 out[k] = math.log(largest) / (e.period * float(self.model.period))
@@ -730,6 +736,40 @@ class Catalogue:
             if not any(abs(self.model.guard(x, self.t_sample, j)) <= tol for j in range(self.model.n_stops)):
                 return False
         return True
+
+
+def landing_point(model: HybridModel, point: np.ndarray, t: float, mode: str) -> bool:
+    """Is ``point`` in ``mode`` a state of rest that every motion entering that mode lands on exactly: the
+    mode absorbing (no transition leaves it), its field zero at ``point``, and a transition into it whose
+    reset puts every state on ``point`` (``g_x = 0``, ``g = point``: the rocking block's ``overturned``,
+    entered at ``(+-pi/2, 0)``)?
+
+    Its monodromy in the mode is the identity (multipliers 1: within the mode every state is at rest), but
+    no motion reaches the states around it: each perturbation of a motion that enters is erased by the
+    reset (its saltation matrix is 0), so the point is an isolated attractor reached in finite time
+    (multipliers 0, Lyapunov exponent ``-inf``), not a family of motions (``neutral``).  A state put in the
+    mode elsewhere stays where it is: that one is neutral.
+
+    Examples
+    --------
+    >>> import grazing
+    >>> m = grazing.models.rocking_block()
+    >>> side = np.array([np.pi / 2, 0.0])
+    >>> landing_point(m, side, 0.0, "overturned"), landing_point(m, side + 0.1, 0.0, "overturned")
+    (True, False)
+    """
+    from grazing.core.model import absorbing_modes
+
+    if mode not in absorbing_modes(model) or np.any(model.vector_field(point, t, mode) != 0):
+        return False
+    scale = max(1.0, float(np.max(np.abs(point))))
+    for j in range(model.n_stops):
+        if model.transition_target[j] != mode or not model.transition_resets[j]:
+            continue
+        gx = model.jacobians(point, t, j)[2]
+        if not np.any(gx) and np.max(np.abs(model.reset(point, t, j) - point)) <= ON_STOP_TOL * scale:
+            return True
+    return False
 
 
 def unsettled(samples: np.ndarray, period: np.ndarray, tol: float = BASIN_ADAPTIVE_TOL) -> np.ndarray:

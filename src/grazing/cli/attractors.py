@@ -270,6 +270,8 @@ def _attractor_lines(atts: list[Any], model: grazing.HybridModel) -> list[str]:
             words += f" ({a.reason})"
         if np.isfinite(a.lyapunov):
             words += f", lyapunov {a.lyapunov:+.4g}"
+        elif a.lyapunov == -np.inf:
+            words += ", lyapunov -inf (every motion near it lands on it exactly: reached in finite time)"
         if a.kind is AttractorKind.NEUTRAL:
             words += " (a double multiplier 1: a family of motions, not an isolated attractor)"
         if a.mode:

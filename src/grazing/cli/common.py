@@ -315,7 +315,8 @@ mode_option = click.option(
     "--mode",
     default=None,
     metavar="NAME",
-    help="A model with modes: the mode to start in (default: its initial mode).",
+    help="A model with modes: the mode to start in (default: the one the initial state lies in, its "
+    "initial mode where that is in its region).",
 )
 
 
@@ -343,8 +344,8 @@ def model_params_json(model: grazing.HybridModel, case: str) -> dict[str, Any]:
 
 
 def parse_state(text: str | None, model: grazing.HybridModel, mode: str | None = None) -> np.ndarray:
-    """``--initial``: one number per state, comma-separated (default: zero), inside every stop (of ``mode``,
-    the initial mode by default, for a model with modes)."""
+    """``--initial``: one number per state, comma-separated (default: zero), inside every stop (of ``mode``
+    for a model with modes; by default of the mode it lies in, :meth:`~grazing.HybridModel.start_mode`)."""
     n = model.n_states
     if text is None:
         return np.zeros(n)
@@ -366,7 +367,7 @@ def parse_state(text: str | None, model: grazing.HybridModel, mode: str | None =
             f"({th:.6g} rad)"
         )
     try:
-        model.check_state(values, mode=mode)
+        model.check_state(values, mode=model.start_mode(values, 0.0, mode))
     except grazing.InvalidStateError as exc:
         raise InputError(f"--initial: {exc}") from None
     return values

@@ -1241,6 +1241,48 @@ class HybridModel:
                                     "has a transition whose guard is negative there)")  # fmt: skip
         return self.mode_names[int(k)]
 
+    def start_mode(self, x: Any, t: float = 0.0, mode: str | None = None, *, resets: bool = True) -> str:
+        """The mode a run from ``x`` at time ``t`` starts in: ``mode`` where given; else the initial mode
+        where ``x`` lies in its region (on its edge too: :meth:`check_state`, with ``resets`` as there), else
+        the one other mode whose region it lies in (an absorbing mode, which no transition leaves and whose
+        region is everywhere, only where no other's is): :meth:`mode_at`'s answer, which the basins use.
+
+        Raises a one-line :class:`~grazing.errors.InvalidStateError` where that is ambiguous (``x``
+        outside the initial mode's region on a switching surface between two others: give ``mode``) or
+        where ``x`` is in no mode's region.  A model without modes: its one mode.
+
+        Examples
+        --------
+        >>> import grazing
+        >>> m = grazing.models.rocking_block()
+        >>> m.start_mode([0.1, 0.0]), m.start_mode([-0.1, 0.0]), m.start_mode([0.0, -1.0])
+        ('right_corner', 'left_corner', 'right_corner')
+        >>> m.start_mode([2.0, 0.0]), m.start_mode([0.1, 0.0], mode="overturned")
+        ('overturned', 'overturned')
+        """
+        if mode is not None or not self.has_modes:
+            return self.mode_names[self.mode_index(mode)]
+        try:
+            arr = self.check_state(x, t, resets=resets)
+        except InvalidStateError:
+            arr = self.check_state(x, t, allowed=False)
+        else:
+            return self.initial_mode
+        inside = mode_regions(self, arr[None], float(t))[0]
+        absorbing = absorbing_modes(self)
+        order = _mode_order(self)[1:]
+        for group in ([k for k in order if self.mode_names[k] not in absorbing], order):
+            found = [self.mode_names[k] for k in group if inside[k]]
+            if len(found) > 1:
+                names = ", ".join(map(repr, found))
+                raise InvalidStateError(
+                    f"state {arr.tolist()} lies in the regions of modes {names} of model {self.name!r} (not "
+                    f"in the initial mode {self.initial_mode!r}'s): say which mode it starts in"
+                )
+            if found:
+                return found[0]
+        return self.mode_at(arr, t)  # (in none: its one-line error)
+
     def require_one_mode(self, what: str) -> None:
         """Raise a one-line error if this model has several modes: ``what`` does not support them yet."""
         if self.has_modes:
@@ -1452,8 +1494,9 @@ class HybridModel:
 
 def mode_of_states(model: HybridModel, states: np.ndarray, t: float) -> np.ndarray:
     """The index of the mode each row of ``states`` lies in at time ``t`` (:meth:`HybridModel.mode_at`),
-    -1 where none: the first mode (the initial one first) whose outgoing transitions' guards are all
-    above ``-ON_STOP_TOL * max(1, |x|)``.
+    -1 where none: the first mode (the initial one first, the absorbing ones, without a transition out,
+    last: their region is everywhere) whose outgoing transitions' guards are all above
+    ``-ON_STOP_TOL * max(1, |x|)``.
 
     Examples
     --------
@@ -1462,26 +1505,65 @@ def mode_of_states(model: HybridModel, states: np.ndarray, t: float) -> np.ndarr
     >>> mode_of_states(m, np.array([[0.0, 1.0], [0.7, 0.0], [0.5, 0.0]]), 0.0).tolist()
     [0, 1, 0]
     """
+    inside = mode_regions(model, states, t)
+    out = np.full(inside.shape[0], -1, dtype=np.int64)
+    for k in _mode_order(model):
+        out[(out < 0) & inside[:, k]] = k
+    return out
+
+
+def mode_regions(model: HybridModel, states: np.ndarray, t: float) -> np.ndarray:
+    """Whether each row of ``states`` lies in the region of each mode (a run can start in; not the sliding
+    pseudo-modes) at time ``t``: ``(rows, modes)``, the guards of the mode's outgoing transitions all above
+    ``-ON_STOP_TOL * max(1, |x|)`` (an absorbing mode, without one: everywhere).  A model without modes:
+    its one mode, inside every stop.
+
+    Examples
+    --------
+    >>> import grazing
+    >>> m = grazing.models.rocking_block()
+    >>> mode_regions(m, np.array([[0.1, 0.0], [0.0, 0.0], [2.0, 0.0]]), 0.0).tolist()
+    [[True, False, True], [True, True, True], [False, False, True]]
+    """
     x = np.asarray(states, dtype=float)
-    out = np.full(x.shape[0], -1, dtype=np.int64)
+    real = model.mode_names[: len(model.mode_names) - len(model.sliding_modes)]
+    inside = np.ones((x.shape[0], len(real)), dtype=bool)
     if x.shape[0] == 0:
-        return out
+        return inside
     params = list(model.param_vector)
     scale = np.maximum(1.0, np.max(np.abs(x), axis=1))
     columns = [x[:, c] for c in range(x.shape[1])]
+    for j in range(model.n_stops):
+        k = real.index(model.transition_source[j]) if model.has_modes else 0
+        h = np.broadcast_to(
+            np.asarray(model.numeric("h", j)(columns, float(t), params), dtype=float), scale.shape
+        )
+        inside[:, k] &= h >= -ON_STOP_TOL * scale
+    return inside
+
+
+def absorbing_modes(model: HybridModel) -> tuple[str, ...]:
+    """The modes (not the sliding pseudo-modes) that no transition leaves: a motion that enters one ends
+    there (the rocking block's ``overturned``).  Their region is everywhere.
+
+    Examples
+    --------
+    >>> import grazing
+    >>> absorbing_modes(grazing.models.rocking_block()), absorbing_modes(grazing.models.pendulum())
+    (('overturned',), ())
+    """
+    if not model.has_modes:
+        return ()
     real = model.mode_names[: len(model.mode_names) - len(model.sliding_modes)]
-    first = model.mode_index(None)
-    for k in [first] + [i for i in range(len(real)) if i != first]:
-        inside = np.ones(x.shape[0], dtype=bool)
-        for j in range(model.n_stops):
-            if model.has_modes and model.transition_source[j] != real[k]:
-                continue
-            h = np.broadcast_to(
-                np.asarray(model.numeric("h", j)(columns, float(t), params), dtype=float), inside.shape
-            )
-            inside &= h >= -ON_STOP_TOL * scale
-        out[(out < 0) & inside] = k
-    return out
+    return tuple(m for m in real if m not in model.transition_source)
+
+
+def _mode_order(model: HybridModel) -> list[int]:
+    """The order in which a state's mode is looked for: the initial mode, the others, the absorbing ones."""
+    real = model.mode_names[: len(model.mode_names) - len(model.sliding_modes)]
+    first, absorbing = model.mode_index(None), absorbing_modes(model)
+    rest = [i for i in range(len(real)) if i != first]
+    return [first] + [i for i in rest if real[i] not in absorbing] + [i for i in rest if real[i] in absorbing]
 
 
 def in_modes(model: HybridModel, states: np.ndarray, modes: np.ndarray, t: float) -> np.ndarray:

@@ -109,8 +109,12 @@ def simulate(
         of :data:`CHUNK_PERIODS` periods (the run is always chunked the same
         way, so results do not depend on whether progress is shown).
     mode
-        The mode a model with modes starts in (its initial mode by default);
-        ``x0`` must lie in it.  Switches between modes are located as impacts
+        The mode a model with modes starts in; ``x0`` must lie in it.  By
+        default the one ``x0`` lies in (:meth:`~grazing.HybridModel.start_mode`):
+        the initial mode where ``x0`` is in its region (on its edge too), else
+        the one other mode whose region it is in; a one-line error where that
+        is ambiguous (outside the initial mode, on a surface between two
+        others) or where it is in none.  Switches between modes are located as impacts
         are, and the Jacobian is carried across them by their saltation
         matrices (:attr:`Solution.switches`).
 
@@ -144,7 +148,11 @@ def simulate(
         raise InvalidParameterError("the discontinuity map needs a periodically forced model")
     if zdm is not None:
         check_map_stop(model, int(zdm.stop))
+    allowed = (events or model.has_modes) and zdm is None  # (with the map, it may be past the grazing stop)
+    x0 = np.zeros(model.n_states) if x0 is None else x0
     if model.has_modes:
+        if mode is None and allowed:  # (the mode x0 lies in: the initial one where it lies in its region)
+            mode = model.start_mode(x0, t0, resets=events)
         _refuse_on_modes(
             model,
             touching=touching,
@@ -153,8 +161,6 @@ def simulate(
         )
     elif mode is not None:
         model.mode_index(mode)  # (only the one mode's name)
-    allowed = (events or model.has_modes) and zdm is None  # (with the map, it may be past the grazing stop)
-    x0 = np.zeros(model.n_states) if x0 is None else x0
     x = model.check_state(x0, t0, allowed=allowed, mode=mode, resets=events)
     start_mode = model.mode_index(mode)
     stop_index = model.stop_index(stop_name)

@@ -288,8 +288,10 @@ def find_orbit(
     transient
         Forcing periods simulated from rest for the default guess.
     mode
-        A model with modes: the mode of ``x0`` on the section (its initial
-        mode by default), which the orbit must be in again one period later.
+        A model with modes: the mode of ``x0`` on the section (by default the
+        one it lies in, :meth:`~grazing.HybridModel.start_mode`: the initial
+        mode where it is in its region), which the orbit must be in again one
+        period later.
         Without ``x0``, the guess is simulated from rest in ``mode`` and the
         orbit is sought in the mode that run ends in.  The monodromy carries
         the saltation matrices of the switches (a switch of mode without a
@@ -349,6 +351,8 @@ def find_orbit(
             )
     else:
         advice = "try another initial guess or another period"
+        if model.has_modes and not virtual:  # (by default the mode x0 lies in: HybridModel.start_mode)
+            mode = model.start_mode(x0, t0, mode)
         x = model.check_state(x0, t0, allowed=not virtual, mode=mode)
         n = int(period or 1)
     mode = model.mode_names[model.mode_index(mode)] if model.has_modes else None

@@ -108,10 +108,10 @@ class LaneBatch:
         pvs, Ts = _point_table(parts, slices, npts)
         two_pi = 2 * math.pi
         sphase, tcarry, zdms = np.empty(npts), np.empty(npts), np.zeros(npts)
-        jobs, x0s, firsts, first_vfs = [], [], [], []
-        vf0 = model.mode_index(None)  # (x0's mode: the model's initial one)
+        jobs, x0s, firsts, first_vfs, x0_vfs = [], [], [], [], []
         for (spec, i), sl, (a, b) in zip(parts, slices, bounds):
             size, T = b - a, Ts[a:b]
+            vf0 = model.mode_index(None) if spec.x0_mode is None else spec.x0_mode  # (x0's mode)
             sphase[a:b] = (spec.phase % two_pi) / two_pi * T
             carry = (spec.phase / two_pi) % 1.0 * T
             tcarry[a:b] = carry
@@ -121,6 +121,7 @@ class LaneBatch:
             # Jobs: runs of points, each continuing from the previous (a chunk; every point when fresh).
             if spec.fresh:
                 jobs.append(np.column_stack([np.arange(a, b), np.arange(a + 1, b + 1)]))
+                x0_vfs.append([vf0] * size)
                 first_vfs.append([vf0] * size if spec.start_modes is None else spec.start_modes[sl])
                 x0s.append(np.broadcast_to(x0, (size, n)))
                 if spec.starts is not None:  # (each from its own state, at its sampling phase)
@@ -129,6 +130,7 @@ class LaneBatch:
                     firsts.append(np.broadcast_to(np.concatenate([[0.0], x0]), (size, n + 1)))
             else:
                 jobs.append(np.array([[a, b]]))
+                x0_vfs.append([vf0])
                 x0s.append(x0[None])
                 if i == 0 and spec.resume is not None:  # (continuing a chain: grazing.sweeps.chain)
                     t, x = spec.resume[:2]
@@ -147,7 +149,7 @@ class LaneBatch:
         self.x0 = np.ascontiguousarray(np.concatenate(x0s), dtype=float).reshape(-1, n)
         self.firsts = np.ascontiguousarray(np.concatenate(firsts), dtype=float).reshape(-1, n + 1)
         self.first_vf = np.ascontiguousarray(np.concatenate(first_vfs), dtype=np.int64)  # (their modes)
-        self.x0_vf = np.full(len(self.jobs), vf0, dtype=np.int64)
+        self.x0_vf = np.ascontiguousarray(np.concatenate(x0_vfs), dtype=np.int64)
         self.pvs = pvs
         self.Ts = Ts
         self.sphase = sphase

@@ -86,7 +86,7 @@ class SweepSpec:
         the final state of the chunk before it, :mod:`grazing.sweeps.chain`);
         after a failed point the chain still starts again from ``x0``.  A
         model with modes: ``(t, x, mode)``, the index of the mode ``x`` is in
-        (``x0`` is in the model's initial mode).
+        (``x0`` is in :attr:`x0_mode`).
     chatter_tol
         Chattering shorter than this fraction of the forcing period is summed
         to its accumulation point and continued as sticking (as
@@ -96,6 +96,10 @@ class SweepSpec:
         polished by Newton's method (:mod:`grazing.sweeps.polish`): where it
         converges to a stable orbit the samples approach, the point has that
         orbit's period.  (The basins polish their end states themselves.)
+    x0_mode
+        A model with modes: the index of the mode ``x0`` starts in, the one it
+        lies in at the first point (:meth:`~grazing.HybridModel.start_mode`);
+        None: the model's initial mode (where ``x0`` lies in its region).
 
     Examples
     --------
@@ -132,6 +136,7 @@ class SweepSpec:
     resume: tuple[float, tuple[float, ...]] | tuple[float, tuple[float, ...], int] | None = None
     chatter_tol: float = CHATTER_TOL
     polish: bool = True
+    x0_mode: int | None = None
 
     def __post_init__(self) -> None:
         if not self.points:
@@ -157,6 +162,12 @@ class SweepSpec:
                     "start_modes needs starts and one mode index of the model per point"
                 )
             object.__setattr__(self, "start_modes", modes)
+        if self.x0_mode is not None and not 0 <= self.x0_mode < len(self.model.mode_names) - len(
+            self.model.sliding_modes
+        ):
+            raise InvalidParameterError(
+                f"x0_mode must be the index of a mode of the model, got {self.x0_mode!r}"
+            )
         for p in self.params:
             if p not in self.model.params:
                 raise InvalidParameterError(
@@ -256,6 +267,8 @@ class SweepSpec:
             d["chatter_tol"] = self.chatter_tol
         if not self.polish:
             d["polish"] = False
+        if self.x0_mode is not None:
+            d["x0_mode"] = self.model.mode_names[self.x0_mode]
         return d
 
     def fingerprint(self) -> str:
@@ -295,8 +308,12 @@ def spec_summary(spec: SweepSpec) -> dict[str, Any]:
     return d
 
 
-def _checked_start(first: HybridModel, x0: Sequence[float] | None, tol: float) -> tuple[float, ...]:
-    """The sweep's start (zeros by default), checked against ``first``'s stops.
+def _checked_start(
+    first: HybridModel, x0: Sequence[float] | None, tol: float
+) -> tuple[tuple[float, ...], int | None]:
+    """The sweep's start (zeros by default), checked against ``first``'s stops, and on a model with modes
+    the index of the mode it starts in where that is not the initial one (the one it lies in:
+    :meth:`~grazing.HybridModel.start_mode`; else None).
 
     The kernels the sweep runs are loaded first: the check evaluates the guards with them
     (``scalar_kernels``) instead of loading a module of the default order as well (about 15 ms of
@@ -306,7 +323,9 @@ def _checked_start(first: HybridModel, x0: Sequence[float] | None, tol: float) -
 
     first.kernels(0, taylor_order(tol))
     x = np.zeros(first.n_states) if x0 is None else np.asarray(x0, dtype=float)
-    return tuple(float(v) for v in first.check_state(x))
+    mode = first.start_mode(x) if first.has_modes else None
+    checked = tuple(float(v) for v in first.check_state(x, mode=mode))
+    return checked, (None if mode is None or mode == first.initial_mode else first.mode_index(mode))
 
 
 def sweep_spec(
@@ -331,7 +350,8 @@ def sweep_spec(
         Its values (any order: they are visited in ``direction``), finite.
     x0
         Initial state (default: zeros), checked against the guard at the
-        first value.
+        first value; on a model with modes it starts in the mode it lies in
+        there (:meth:`~grazing.HybridModel.start_mode`).
     direction
         ``"up"``, ``"down"`` or ``"both"``: up, then down from ``x0`` again,
         as two chains (``segments = 2``) of one sweep.
@@ -376,12 +396,14 @@ def sweep_spec(
     up = np.sort(vals)
     order = {"up": up, "down": up[::-1], "both": np.concatenate([up, up[::-1]])}[direction]
     first = model.with_params(**{param: float(order[0])}) if param in model.params else model
+    start, start_mode = _checked_start(first, x0, s.tol)
     return SweepSpec(
         model=model,
         params=(param,),
         points=tuple((float(v),) for v in order),
         segments=2 if direction == "both" else 1,
-        x0=_checked_start(first, x0, s.tol),
+        x0=start,
+        x0_mode=start_mode,
         transient=s.transient,
         periods=s.periods,
         phase=s.phase,
@@ -445,11 +467,13 @@ def map_spec(
         raise InvalidParameterError("parameter values must be finite numbers")
     known = param1 in model.params and param2 in model.params
     first = model.with_params(**{param1: float(v1[0]), param2: float(v2[0])}) if known else model
+    start, start_mode = _checked_start(first, x0, s.tol)
     return SweepSpec(
         model=model,
         params=(param1, param2),
         points=tuple((float(a), float(b)) for b in v2 for a in v1),
-        x0=_checked_start(first, x0, s.tol),
+        x0=start,
+        x0_mode=start_mode,
         transient=s.transient,
         periods=s.periods,
         phase=s.phase,
