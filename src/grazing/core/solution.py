@@ -33,7 +33,8 @@ class Status(IntEnum):
     """Ctrl-C (SIGINT) during the run: the caller raises :class:`KeyboardInterrupt`."""
     OUTSIDE_MODE = 5
     """A transition entered a mode at a state outside its region (a guard of the mode's own transitions
-    already negative there): the modes' regions do not fit together."""
+    already negative there): the modes' regions do not fit together; on a model of one mode, an impact's
+    reset put the state beyond a stop."""
 
     def message(
         self, t: float, max_steps: int, model: HybridModel | None = None, x: Any = None, mode: int = -1
@@ -98,7 +99,8 @@ _REASONS = {
     Status.OUTSIDE_MODE: (
         "outside its mode",
         "a transition entered a mode at a state where a guard of that mode's own transitions is already "
-        "negative (outside the mode's region): the model's modes and guards do not fit together there",
+        "negative (outside the mode's region): the model's modes and guards do not fit together there; "
+        "on a model of one mode, an impact's reset put the state beyond a stop",
     ),
 }
 
@@ -175,7 +177,8 @@ def outside_mode_message(model: HybridModel, x: Any, t: float, mode: int) -> str
     A transition entered the mode where a guard of the mode's own transitions is already negative
     (beyond :data:`~grazing.core.model.ON_STOP_TOL`): the state is outside the mode's region, and
     the run would have jumped at once onto that guard's surface.  The message names the mode and that
-    guard (the most negative, if several).
+    guard (the most negative, if several); on a model of one mode, where only an impact's reset can
+    put the state there, the stop it is beyond.
 
     Examples
     --------
@@ -196,6 +199,11 @@ def outside_mode_message(model: HybridModel, x: Any, t: float, mode: int) -> str
     if not own:
         return f"a transition entered mode {name!r} at t = {t:.6g} outside its region"
     j = min(own, key=lambda i: guards[i])
+    if not model.has_modes:  # (one mode: an impact's reset beyond a stop)
+        return (
+            f"an impact's reset at t = {t:.6g} put the state beyond stop {model.stop_names[j]!r}: its guard "
+            f"is h = {guards[j]:.3g} < 0 there (a reset must leave the state where every guard is >= 0)"
+        )
     return (
         f"a transition entered mode {name!r} at t = {t:.6g} outside its region: there the guard of its "
         f"transition {model.stop_names[j]!r} is already h = {guards[j]:.3g} < 0 (the guards of the model's "

@@ -28,7 +28,11 @@ stands for is not searched for events, each step is cut at the map's phase
 too (``step.cut_step``), and there the map kicks the state
 (``tangent.map_kick``) and, with Lyapunov exponents, the tangent vectors
 (``tangent.kick_tangent``), a kick counted as an impact on that stop while the
-point records.  A model with
+point records.  After an impact within a mode (on any model) the state must
+be inside the mode's region too (else ``OUTSIDE_MODE``: a reset beyond a
+stop), and the root of the stop's guard at the next step's start is divided
+out only where the reset leaves the state on that guard
+(``transitions.roots_after_reset``, as the CPU).  A model with
 modes: each thread carries its point's mode (its kernels, its event rows:
 the transitions out of it); a switch without a reset changes the mode
 (``impacts.switch_mode``), a reset may too (``impacts.change_mode``), each
@@ -182,8 +186,8 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
     kick_tangent = helpers["kick_tangent"]
     chatter_time_left = helpers["chatter_time_left"]
     along_contact_dir = helpers["along_contact_dir"]
-    mode_after, outside_region, onto_zero_step = (
-        helpers[k] for k in ("mode_after", "outside_region", "onto_zero_step")
+    mode_after, outside_region, onto_zero_step, roots_after_reset = (
+        helpers[k] for k in ("mode_after", "outside_region", "onto_zero_step", "roots_after_reset")
     )
     tc_free = dm.functions["mode_tc_free"]
     tc_var = dm.functions["mode_tc_var"]
@@ -195,7 +199,7 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
     guard_grad = dm.functions["guard_grad"]
     normal_rate = dm.functions["normal_rate"]
     normal_accel = dm.functions["normal_accel"]
-    NX, NSTOPS, ORDER, NMODES = dm.nx, dm.nstops, dm.order, dm.nmodes
+    NX, NSTOPS, ORDER = dm.nx, dm.nstops, dm.order
     ROWS = np.array(dm.rows, dtype=np.int64)  # (a mode's event rows: its transitions; -1 padding)
     NEV = ROWS.shape[1]
     TARGETS = np.array(dm.targets, dtype=np.int64)
@@ -503,16 +507,17 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
                         st[JAC_VALID] = 0  # (an impact at zero normal speed has no Jacobian)
                 for i in range(NT if free_var else NX):
                     x[i] = xp[i]
-                st[DEFL] = 1
-                st[DEFL_STOP] = ev_stop
                 if recording != 0 and final:
                     counts[ev_stop] += 1
                 if TARGETS[ev_stop] != vf:  # a reset that also changes the mode (impacts.change_mode)
                     set_mode(st, ev_stop, SWITCH)
                     if outside_mode(x, s, pv, st[VF], -1):
                         return STATUS_OUTSIDE_MODE
-                elif NMODES > 1 and outside_mode(x, s, pv, vf, -1):  # (a reset within a mode: at_event)
-                    return STATUS_OUTSIDE_MODE
+                else:  # a reset within a mode: inside its region, on its guard or off it (at_event)
+                    if outside_mode(x, s, pv, vf, -1):
+                        return STATUS_OUTSIDE_MODE
+                    st[DEFL] = roots_after_reset(guard(x, s, pv, ev_stop), x, NX)
+                    st[DEFL_STOP] = ev_stop
                 if STICKS[ev_stop] != 0:  # complete chattering: to its accumulation point, then sticking
                     w_out = normal_rate(x, s, pv, ev_stop)
                     dt_acc = chatter_time_left(w_out, normal_accel(x, s, pv, ev_stop), -vn, chatter_time)

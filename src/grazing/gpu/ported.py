@@ -13,7 +13,7 @@ time to its accumulation point and the Newton step onto a sticking contact
 (:mod:`grazing.engine.driver.impacts`), the cores of a transition
 (:mod:`grazing.engine.driver.transitions`: the saltation matrix, the
 projection onto a guard, the mode after a switch or sliding, the region
-check), and the model code's ``sin`` and ``cos``
+check, the roots an impact's reset leaves known), and the model code's ``sin`` and ``cos``
 (:mod:`grazing.engine.sincos`: not the C library's) are compiled for the GPU from the
 very text the CPU driver compiles: the decorators dropped, each function
 executed in one namespace where every callee is its device copy.  A change in
@@ -51,7 +51,8 @@ PORTED: dict[str, tuple[str, ...]] = {
     "grazing.engine.driver.events": ("event_polynomial", "event_certificate"),
     "grazing.engine.driver.impacts": ("chatter_time_left", "along_contact_dir"),
     "grazing.engine.driver.transitions": (
-        "mode_after", "outside_region", "onto_zero_step", "saltation_vector", "apply_saltation",
+        "state_scale", "mode_after", "outside_region", "roots_after_reset", "onto_zero_step",
+        "saltation_vector", "apply_saltation",
     ),
     "grazing.core.period": ("repeats_with_period",),
     "grazing.core.options": ("step_limit",),

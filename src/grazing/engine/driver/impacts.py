@@ -25,7 +25,7 @@ from grazing.engine.driver.calls import (
     reset_jac,
     rhs,
 )
-from grazing.engine.driver.state import STATUS_OUTSIDE_MODE
+from grazing.engine.driver.state import STATUS_OK, STATUS_OUTSIDE_MODE
 from grazing.engine.driver.transitions import (
     ENTER_SLIDING,
     LEAVE_SLIDING,
@@ -34,6 +34,7 @@ from grazing.engine.driver.transitions import (
     mode_after,
     onto_zero_step,
     outside_region,
+    roots_after_reset,
     saltation_vector,
 )
 from grazing.engine.stepping import append_pair, append_record, append_row, pack_var, unpack_var
@@ -157,7 +158,11 @@ def at_event(m, r, x, xp, pv, j, nrows, V, chatter_time, record, tables):
     (sliding's entry and exit among them), or an impact (:func:`apply_impact`),
     and on a stop with a sticking mode a chattering sequence shorter than
     ``chatter_time`` is summed to its accumulation point and continued as
-    sticking.  The sticking intervals of the recorded span go into
+    sticking.  After a reset within a mode the root of the stop's guard at
+    the next step's start (``r.defl``) is known only where the reset leaves
+    the state on the guard (:func:`.transitions.roots_after_reset`), and a
+    state after it outside the mode's region (beyond a stop) ends the run
+    (:func:`check_region`, status ``OUTSIDE_MODE``).  The sticking intervals of the recorded span go into
     ``tables[1]`` (``r.n_stick``).
     """
     t = r.k * r.T + r.s
@@ -187,12 +192,14 @@ def at_event(m, r, x, xp, pv, j, nrows, V, chatter_time, record, tables):
     # Impact: x holds the state on stop j, just before its reset.
     speed, jac_ok = apply_impact(m, r, x, xp, pv, j, nrows, V, record, tables)
     r.jac_valid = r.jac_valid and jac_ok  # (an impact at zero normal speed has no Jacobian)
-    r.defl = 1
-    r.defl_stop = j
     if m.targets[j] != r.vf:  # a reset that also changes the mode (the rocking block's corners)
-        change_mode(m, r, x, pv, j, record, tables)
-    elif m.nmodes > 1:  # a reset within a mode: it too lands inside the mode's region, or the run ends
+        change_mode(m, r, x, pv, j, record, tables)  # (its way back's guard is 0 after it: codegen checks)
+    else:  # a reset within a mode: it too lands inside the mode's region, or the run ends ...
         check_region(m, r, x, pv, -1)
+        r.defl = roots_after_reset(guard(m, x, r.s, pv, j), x, m.nx)  # (... and on its guard, or off it)
+        r.defl_stop = j
+    if r.status != STATUS_OK:
+        return True
     if m.sticks[j]:
         dt_acc = chatter_remaining(m, x, r.s, pv, j, speed, chatter_time)
         if dt_acc >= 0.0:  # complete chattering: on to the accumulation point, then sticking

@@ -68,9 +68,7 @@ def outside_region(x, n, row_guards, mode_rows, nstops, known):
     ...     x, 2, np.array([0.0, -1e-8, 0.0]), rows, 3, 1)
     (True, False)
     """
-    scale = 1.0
-    for i in range(n):
-        scale = max(scale, abs(x[i]))
+    scale = state_scale(x, n)
     for row in range(mode_rows.shape[0]):
         k = mode_rows[row]
         if k < 0 or k >= nstops or k == known:
@@ -78,6 +76,37 @@ def outside_region(x, n, row_guards, mode_rows, nstops, known):
         if row_guards[row] < -ON_STOP_TOL * scale:
             return True
     return False
+
+
+@njit(cache=True)
+def state_scale(x, n):
+    """``max(1, |x_i|)`` over the first ``n`` components: the scale of the tolerance ``ON_STOP_TOL`` of a
+    guard's value at ``x`` (what counts as on a stop)."""
+    scale = 1.0
+    for i in range(n):
+        scale = max(scale, abs(x[i]))
+    return scale
+
+
+@njit(cache=True)
+def roots_after_reset(hval, x, n):
+    """The roots at ``u = 0`` known of an impact's guard after its reset: 1 where the state ``x`` after
+    the reset is on the guard (its value ``hval`` there within ``ON_STOP_TOL * max(1, |x|)`` of 0), else 0.
+
+    A reset that keeps the state on its guard (``v <- -r v``) leaves the root of the next step's guard
+    polynomial at ``u = 0`` known, and the event search divides it out
+    (:func:`~grazing.engine.driver.events.event_polynomial`); a reset that moves the state off the guard
+    (``h(g(x)) != 0``: a shift of the position, a landing on another stop) leaves no root there, and
+    dividing one out would put a spurious event where the guard comes back to its value after the reset.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> x = np.array([0.25, -3.0])
+    >>> roots_after_reset(2e-9, x, 2), roots_after_reset(-4e-9, x, 2), roots_after_reset(0.05, x, 2)
+    (1, 0, 0)
+    """
+    return 1 if abs(hval) <= ON_STOP_TOL * state_scale(x, n) else 0
 
 
 @njit(cache=True)
