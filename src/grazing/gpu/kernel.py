@@ -514,7 +514,7 @@ def build_kernel(dm: Any, keep: int, lyapunov: bool = False, zdm_stop: int = -1)
                     if outside_mode(x, s, pv, st[VF], -1):
                         return STATUS_OUTSIDE_MODE
                 else:  # a reset within a mode: inside its region, on its guard or off it (at_event)
-                    if outside_mode(x, s, pv, vf, -1):
+                    if outside_mode(x, s, pv, vf, ZSTOP):
                         return STATUS_OUTSIDE_MODE
                     st[DEFL] = roots_after_reset(guard(x, s, pv, ev_stop), x, NX)
                     st[DEFL_STOP] = ev_stop

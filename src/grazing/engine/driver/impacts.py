@@ -150,7 +150,7 @@ def apply_impact(m, r, x, xp, pv, j, nrows, V, record, tables):
 
 
 @njit(cache=True, inline="always")
-def at_event(m, r, x, xp, pv, j, nrows, V, chatter_time, record, tables):
+def at_event(m, r, x, xp, pv, j, nrows, V, chatter_time, record, tables, virtual):
     """The event that ends the step of run ``r``, on stop ``j``; returns True for an impact.
 
     Sticking to stop ``j``, its contact force changes sign: the release;
@@ -162,7 +162,9 @@ def at_event(m, r, x, xp, pv, j, nrows, V, chatter_time, record, tables):
     the next step's start (``r.defl``) is known only where the reset leaves
     the state on the guard (:func:`.transitions.roots_after_reset`), and a
     state after it outside the mode's region (beyond a stop) ends the run
-    (:func:`check_region`, status ``OUTSIDE_MODE``).  The sticking intervals of the recorded span go into
+    (:func:`check_region`, status ``OUTSIDE_MODE``), the guard of stop
+    ``virtual`` aside (the discontinuity map's, which the flow crosses; -1: none).  The sticking
+    intervals of the recorded span go into
     ``tables[1]`` (``r.n_stick``).
     """
     t = r.k * r.T + r.s
@@ -195,7 +197,7 @@ def at_event(m, r, x, xp, pv, j, nrows, V, chatter_time, record, tables):
     if m.targets[j] != r.vf:  # a reset that also changes the mode (the rocking block's corners)
         change_mode(m, r, x, pv, j, record, tables)  # (its way back's guard is 0 after it: codegen checks)
     else:  # a reset within a mode: it too lands inside the mode's region, or the run ends ...
-        check_region(m, r, x, pv, -1)
+        check_region(m, r, x, pv, virtual)  # (... the discontinuity map's stop aside: the flow crosses it)
         r.defl = roots_after_reset(guard(m, x, r.s, pv, j), x, m.nx)  # (... and on its guard, or off it)
         r.defl_stop = j
     if r.status != STATUS_OK:

@@ -158,7 +158,8 @@ def end_step(m, r, x, X, pv, nrows, cfg, chatter_time, record_impacts, Tp, work,
         kicked = discontinuity_map(m, r, x, pv, cfg, V, gh, gv, record, tables[0])
     impact = False
     if r.event:
-        impact = at_event(m, r, x, xp, pv, r.ev_stop, nrows, V, chatter_time, record, tables)
+        virtual = cfg.stop if cfg.zdm else -1  # (the map's stop, which the flow crosses: no region)
+        impact = at_event(m, r, x, xp, pv, r.ev_stop, nrows, V, chatter_time, record, tables, virtual)
     elif mode == 1:  # sticking: back onto the stop, off which the integration drifts
         enter_contact(m, x, r.s, pv, r.stuck)
     return kicked, impact
