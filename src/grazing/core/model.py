@@ -1578,24 +1578,10 @@ def in_modes(model: HybridModel, states: np.ndarray, modes: np.ndarray, t: float
     >>> in_modes(m, np.array([[0.0, 1.0], [0.0, 1.0], [0.7, 0.0]]), np.array([0, 1, 0]), 0.0).tolist()
     [True, False, False]
     """
-    x = np.asarray(states, dtype=float)
-    which = np.asarray(modes, dtype=np.int64)
-    out = np.ones(x.shape[0], dtype=bool)
-    if x.shape[0] == 0:
-        return out
-    params = list(model.param_vector)
-    scale = np.maximum(1.0, np.max(np.abs(x), axis=1))
-    columns = [x[:, c] for c in range(x.shape[1])]
-    for j in range(model.n_stops):
-        mine = (
-            which == model.mode_names.index(model.transition_source[j])
-            if model.has_modes
-            else np.ones(out.shape, dtype=bool)
-        )
-        if not mine.any():
-            continue
-        h = np.broadcast_to(
-            np.asarray(model.numeric("h", j)(columns, float(t), params), dtype=float), out.shape
-        )
-        out &= ~mine | (h >= -ON_STOP_TOL * scale)
+    inside = mode_regions(model, states, t)
+    n = inside.shape[0]
+    which = np.asarray(modes, dtype=np.int64) if model.has_modes else np.zeros(n, dtype=np.int64)
+    out = np.ones(n, dtype=bool)  # (a mode not known, -1, or a sliding pseudo-mode: no guard of its own)
+    known = np.flatnonzero((which >= 0) & (which < inside.shape[1]))
+    out[known] = inside[known, which[known]]
     return out
